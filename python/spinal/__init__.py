@@ -1,0 +1,11 @@
+"""spinal: moving frames, sweeps and volume-preserving deformations along 3D curves.
+
+Frames are ``(n, 3, 3)`` rotation matrices whose columns are ``(r, s, t)``: the reference
+vector, ``s = t × r`` and the unit tangent. See :func:`frames`.
+"""
+
+from . import curves
+from ._core import __version__
+from ._frames import closing_angle, estimate_tangents, frames
+
+__all__ = ["frames", "closing_angle", "estimate_tangents", "curves", "__version__"]

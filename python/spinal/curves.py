@@ -1,0 +1,251 @@
+"""Analytic space curves with exact derivatives.
+
+Each curve maps a parameter ``u`` (a float or an array) to points ``(k, 3)``; ``d1``, ``d2``
+and ``d3`` are the exact first, second and third derivatives with respect to ``u``. They feed
+``spinal.frames(curve, u=..., method="rk4")`` (which needs ``x′`` and ``x″``), give exact
+tangents to the other methods, and serve as references in tests:
+
+* :class:`Helix` – ``(a cos u, a sin u, b u)``; constant curvature ``a/(a²+b²)`` and torsion
+  ``b/(a²+b²)``; its rotation-minimising frame is known in closed form (:meth:`Helix.rmf`).
+* :class:`TorusKnot` – ``((R + r cos qu) cos pu, (R + r cos qu) sin pu, r sin qu)``; the
+  default ``p = 2, q = 7, R = 0.6, r = 0.3`` is Example 1 of Wang et al. (ACM TOG 2008).
+* :class:`Viviani` – ``a (1 + cos u, sin u, 2 sin(u/2))`` on the sphere of radius ``2a``
+  about the origin (a spherical curve: double reflection is exact on it).
+* :class:`Polynomial` – ``Σ c_j u^j``; :class:`Bezier` – Bernstein form on ``[0, 1]``.
+
+Lengths are in the units of the coordinates, angles in radians.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._validate import as_float_array
+
+__all__ = ["Curve", "Helix", "TorusKnot", "Viviani", "Polynomial", "Bezier"]
+
+
+def _u(u) -> np.ndarray:
+    arr = as_float_array(u, "u")
+    if arr.ndim > 1:
+        raise ValueError(f"u: expected a scalar or a 1-D array, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("u: contains non-finite values")
+    return np.atleast_1d(arr)
+
+
+class Curve:
+    """Base class: subclasses implement ``_eval(u, k)`` (the k-th derivative, k = 0..3)."""
+
+    #: Natural parameter interval.
+    domain: tuple[float, float] = (0.0, 1.0)
+    #: True when ``point(domain[0]) == point(domain[1])`` with matching derivatives.
+    closed: bool = False
+
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def point(self, u) -> np.ndarray:
+        """Points ``x(u)``, shape ``(k, 3)``."""
+        return self._eval(_u(u), 0)
+
+    def d1(self, u) -> np.ndarray:
+        """First derivative ``x′(u)``, shape ``(k, 3)``."""
+        return self._eval(_u(u), 1)
+
+    def d2(self, u) -> np.ndarray:
+        """Second derivative ``x″(u)``, shape ``(k, 3)``."""
+        return self._eval(_u(u), 2)
+
+    def d3(self, u) -> np.ndarray:
+        """Third derivative ``x‴(u)``, shape ``(k, 3)``."""
+        return self._eval(_u(u), 3)
+
+    def parameters(self, n: int) -> np.ndarray:
+        """``n`` uniformly spaced parameters over :attr:`domain` (both ends included)."""
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+            raise ValueError(f"u: a sample count must be an integer >= 2, got {n!r}")
+        return np.linspace(self.domain[0], self.domain[1], int(n))
+
+    def sample(self, n: int) -> np.ndarray:
+        """``n`` points at uniformly spaced parameters over :attr:`domain`."""
+        return self.point(self.parameters(n))
+
+    def tangent(self, u) -> np.ndarray:
+        """Unit tangents ``x′/|x′|``."""
+        d = self.d1(u)
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+    def curvature(self, u) -> np.ndarray:
+        """Curvature ``κ = |x′ × x″| / |x′|³`` (1/length)."""
+        d1, d2 = self.d1(u), self.d2(u)
+        return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+
+    def torsion(self, u) -> np.ndarray:
+        """Torsion ``τ = det(x′, x″, x‴) / |x′ × x″|²`` (1/length; undefined where κ = 0)."""
+        d1, d2, d3 = self.d1(u), self.d2(u), self.d3(u)
+        c = np.cross(d1, d2)
+        return np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
+
+    def speed(self, u) -> np.ndarray:
+        """``|x′(u)|`` (length per unit parameter)."""
+        return np.linalg.norm(self.d1(u), axis=1)
+
+    def frenet(self, u) -> np.ndarray:
+        """Exact Frenet frames ``(k, 3, 3)``, columns ``(N, B, T)`` (undefined where κ = 0)."""
+        d1, d2 = self.d1(u), self.d2(u)
+        t = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
+        b = np.cross(d1, d2)
+        b /= np.linalg.norm(b, axis=1, keepdims=True)
+        n = np.cross(b, t)
+        return np.stack([n, b, t], axis=2)
+
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{k}={v!r}" for k, v in vars(self).items() if not k.startswith("_"))
+        return f"{type(self).__name__}({fields})"
+
+
+class Helix(Curve):
+    """Circular helix ``(a cos u, a sin u, b u)``, ``u ∈ [0, 2π·turns]``.
+
+    Arc length ``s = c u`` with ``c = √(a² + b²)``; ``κ = a/c²``, ``τ = b/c²``.
+    """
+
+    def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0):
+        if not (a > 0 and math.isfinite(a) and math.isfinite(b)):
+            raise ValueError(f"a: the helix radius must be positive and finite, got {a!r}")
+        self.a, self.b = float(a), float(b)
+        self.domain = (0.0, 2 * math.pi * float(turns))
+
+    def _eval(self, u, k):
+        a, b = self.a, self.b
+        c, s = np.cos(u), np.sin(u)
+        z = np.zeros_like(u)
+        if k == 0:
+            return np.stack([a * c, a * s, b * u], axis=1)
+        if k == 1:
+            return np.stack([-a * s, a * c, np.full_like(u, b)], axis=1)
+        if k == 2:
+            return np.stack([-a * c, -a * s, z], axis=1)
+        return np.stack([a * s, -a * c, z], axis=1)
+
+    def rmf(self, u, angle: float = 0.0) -> np.ndarray:
+        """Exact rotation-minimising frames ``(k, 3, 3)`` (columns ``r, s, t``).
+
+        ``r(u) = cos θ N + sin θ B`` with ``θ = angle − τ c (u − u_0)``: the Frenet frame
+        turned back by the integrated torsion (Wang et al. 2008, Eq. 3). ``angle`` is the
+        angle of ``r`` from the principal normal ``N`` at ``u[0]``.
+        """
+        uu = _u(u)
+        f = self.frenet(uu)
+        c = math.hypot(self.a, self.b)
+        theta = angle - (self.b / c**2) * c * (uu - uu[0])
+        r = np.cos(theta)[:, None] * f[:, :, 0] + np.sin(theta)[:, None] * f[:, :, 1]
+        t = f[:, :, 2]
+        return np.stack([r, np.cross(t, r), t], axis=2)
+
+
+class TorusKnot(Curve):
+    """``((R + r cos qu) cos pu, (R + r cos qu) sin pu, r sin qu)``, ``u ∈ [0, 2π]``.
+
+    The defaults (p, q, R, r) = (2, 7, 0.6, 0.3) are the torus knot of Wang et al. (2008).
+    """
+
+    closed = True
+
+    def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3):
+        if not (R > 0 and r > 0):
+            raise ValueError("R, r: radii must be positive")
+        self.p, self.q, self.R, self.r = p, q, float(R), float(r)
+        self.domain = (0.0, 2 * math.pi)
+
+    def _eval(self, u, k):
+        p, q, R, r = self.p, self.q, self.R, self.r
+        cq, sq = np.cos(q * u), np.sin(q * u)
+        cp, sp = np.cos(p * u), np.sin(p * u)
+        rho = [R + r * cq, -r * q * sq, -r * q**2 * cq, r * q**3 * sq]
+        z = [r * sq, r * q * cq, -r * q**2 * sq, -r * q**3 * cq][k]
+        # Leibniz rule for rho(u) * (cos pu, sin pu)
+        x = np.zeros_like(u)
+        y = np.zeros_like(u)
+        for j in range(k + 1):
+            m = k - j
+            w = math.comb(k, j) * p**m
+            # m-th derivative of (cos pu, sin pu) = p^m (cos(pu + mπ/2), sin(pu + mπ/2))
+            cm = [cp, -sp, -cp, sp][m % 4]
+            sm = [sp, cp, -sp, -cp][m % 4]
+            x = x + w * rho[j] * cm
+            y = y + w * rho[j] * sm
+        return np.stack([x, y, z], axis=1)
+
+
+class Viviani(Curve):
+    """Viviani's curve ``a (1 + cos u, sin u, 2 sin(u/2))``, ``u ∈ [0, 4π]``.
+
+    It lies on the sphere of radius ``2a`` about the origin, so its rotation-minimising frame
+    is ``r = x/|x|`` (the sphere normal) up to a constant rotation about the tangent.
+    """
+
+    closed = True
+
+    def __init__(self, a: float = 1.0):
+        if not a > 0:
+            raise ValueError(f"a: must be positive, got {a!r}")
+        self.a = float(a)
+        self.domain = (0.0, 4 * math.pi)
+
+    def _eval(self, u, k):
+        a = self.a
+        c, s = np.cos(u), np.sin(u)
+        c2, s2 = np.cos(u / 2), np.sin(u / 2)
+        cols = [
+            (1 + c, s, 2 * s2),
+            (-s, c, c2),
+            (-c, -s, -0.5 * s2),
+            (s, -c, -0.25 * c2),
+        ][k]
+        return a * np.stack(np.broadcast_arrays(*cols), axis=1)
+
+
+class Polynomial(Curve):
+    """Polynomial curve ``x(u) = Σ_j c_j u^j`` with coefficient rows ``c_j`` (shape (d+1, 3))."""
+
+    def __init__(self, coefficients, domain: tuple[float, float] = (0.0, 1.0)):
+        c = as_float_array(coefficients, "coefficients")
+        if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] < 2:
+            raise ValueError(f"coefficients: expected shape (d+1, 3) with d >= 1, got {c.shape}")
+        if not np.all(np.isfinite(c)):
+            raise ValueError("coefficients: contains non-finite values")
+        self.coefficients = c.copy()
+        self.domain = (float(domain[0]), float(domain[1]))
+
+    def _eval(self, u, k):
+        c = self.coefficients
+        d = c.shape[0] - 1
+        out = np.zeros((u.shape[0], 3))
+        for j in range(k, d + 1):
+            f = math.perm(j, k)
+            out += f * np.power.outer(u, j - k)[:, None] * c[j]
+        return out
+
+
+class Bezier(Polynomial):
+    """Bézier curve on ``u ∈ [0, 1]`` with control points of shape ``(d+1, 3)``."""
+
+    def __init__(self, control_points):
+        p = as_float_array(control_points, "control_points")
+        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2:
+            raise ValueError(f"control_points: expected shape (d+1, 3), d >= 1, got {p.shape}")
+        d = p.shape[0] - 1
+        # power-basis coefficients: c_j = C(d, j) Σ_i (-1)^(j-i) C(j, i) P_i
+        coeffs = np.array(
+            [
+                math.comb(d, j)
+                * sum((-1) ** (j - i) * math.comb(j, i) * p[i] for i in range(j + 1))
+                for j in range(d + 1)
+            ]
+        )
+        super().__init__(coeffs, (0.0, 1.0))
+        self.control_points = p.copy()

@@ -1,0 +1,105 @@
+//! Input checks shared by the frame methods. Every check runs in parallel and reports the
+//! first offending row, naming the argument.
+//!
+//! * Non-finite values (NaN, ±inf) are refused.
+//! * Consecutive samples that coincide to round-off (`|x_{i+1} − x_i|_∞ ≤ 8ε·max|x|_∞`)
+//!   make a zero-length segment: refused (the reflection `R₁` is undefined and no tangent
+//!   can be estimated there).
+//! * A segment whose chord runs against its tangents, `v̂₁·(t_i + t_{i+1}) ≤ 10⁻⁶`, is a
+//!   reversal (cusp) or far too coarse a sampling: refused. This is exactly the condition
+//!   under which double reflection degenerates (`v₂ → 0`, TOG §4.4) and the rotation method
+//!   meets opposite tangents.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::error::{InputError, Result};
+
+/// Relative round-off tolerance for coinciding points.
+pub const COINCIDE_EPS: f64 = 8.0 * f64::EPSILON;
+/// Smallest accepted `v̂₁·(t_i + t_{i+1})`.
+pub const MIN_ALIGNMENT: f64 = 1e-6;
+
+pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
+    match v.par_iter().position_first(|p| !p.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            arg,
+            format!("non-finite value ({}) at row {i}", describe(v[i])),
+        )),
+    }
+}
+
+pub fn finite_scalars(arg: &'static str, v: &[f64]) -> Result<()> {
+    match v.par_iter().position_first(|p| !p.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            arg,
+            format!("non-finite value ({}) at index {i}", v[i]),
+        )),
+    }
+}
+
+fn describe(p: DVec3) -> String {
+    format!("[{}, {}, {}]", p.x, p.y, p.z)
+}
+
+#[inline]
+pub fn coincide(a: DVec3, b: DVec3) -> bool {
+    let d = (b - a).abs().max_element();
+    d <= COINCIDE_EPS * a.abs().max_element().max(b.abs().max_element())
+}
+
+/// Refuse repeated consecutive points (and the closing pair when `closed`).
+pub fn distinct(x: &[DVec3], closed: bool) -> Result<()> {
+    let n = x.len();
+    let m = if closed { n } else { n.saturating_sub(1) };
+    match (0..m)
+        .into_par_iter()
+        .position_first(|i| coincide(x[i], x[(i + 1) % n]))
+    {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            "points",
+            format!(
+                "rows {i} and {} coincide (a zero-length segment); remove repeated \
+                 consecutive points",
+                (i + 1) % n
+            ),
+        )),
+    }
+}
+
+/// Refuse segments whose chord `v1(i)` runs against the tangents.
+pub fn aligned(
+    t: &[DVec3],
+    closed: bool,
+    chord: impl Fn(usize) -> DVec3 + Sync,
+    what: &'static str,
+) -> Result<()> {
+    let n = t.len();
+    let m = if closed { n } else { n - 1 };
+    let bad = (0..m).into_par_iter().position_first(|i| {
+        let v = chord(i);
+        let j = (i + 1) % n;
+        let a = v.dot(t[i] + t[j]) / v.length();
+        !(a > MIN_ALIGNMENT)
+    });
+    match bad {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            what,
+            format!(
+                "the segment from row {i} to row {} runs against its tangents (the curve \
+                 reverses there, a cusp, or it is sampled far too coarsely; the tangents \
+                 turn by {:.1}° across it); sample more densely or check the tangent \
+                 orientation",
+                (i + 1) % n,
+                t[i].dot(t[(i + 1) % n])
+                    .clamp(-1.0, 1.0)
+                    .acos()
+                    .to_degrees()
+            ),
+        )),
+    }
+}

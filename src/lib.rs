@@ -1,0 +1,23 @@
+//! spinal — moving frames, sweeps and volume-preserving deformations along 3D curves.
+//!
+//! The crate is split in two layers:
+//!
+//! * plain Rust modules that know nothing of Python ([`frames`], [`error`]); they work on
+//!   `glam::DVec3` slices and flat `f64` output buffers and return [`error::InputError`]
+//!   for bad input, never panicking on user data;
+//! * one thin binding module (`python`, compiled into the `spinal._core` extension) that
+//!   converts NumPy arrays, releases the GIL around the heavy calls and maps errors to
+//!   Python exceptions.
+//!
+//! Frame layout everywhere: frame `i` occupies `out[9 i .. 9 i + 9]` in row-major order of
+//! the 3×3 matrix whose **columns** are `(r, s, t)`, i.e. `[r.x, s.x, t.x, r.y, s.y, t.y,
+//! r.z, s.z, t.z]`, which is what NumPy sees as an `(n, 3, 3)` C-ordered array.
+
+// `!(a > b)` is used on purpose: it is also true when a value is NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod error;
+pub mod frames;
+mod python;
+
+pub use error::InputError;

@@ -1,0 +1,239 @@
+//! The Python binding layer (`spinal._core`): converts NumPy arrays to slices, releases the
+//! GIL around the computation and maps [`InputError`] to `ValueError`. It holds no
+//! algorithms; the Python package (`python/spinal`) normalises arguments (dtype, layout,
+//! shapes) before calling in here, so these functions expect C-contiguous float64 arrays.
+
+use glam::{DMat3, DVec3};
+use numpy::{
+    PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::InputError;
+use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+
+type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
+
+fn to_py(e: InputError) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+fn vec3s<'a>(arg: &'static str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [DVec3]> {
+    if a.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{arg}: expected shape (n, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    let s = a
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{arg}: array must be C-contiguous")))?;
+    Ok(bytemuck::cast_slice(s))
+}
+
+fn parse_method(s: &str) -> PyResult<Method> {
+    Ok(match s {
+        "double_reflection" => Method::DoubleReflection,
+        "projection" => Method::Projection,
+        "rotation" => Method::Rotation,
+        "frenet" => Method::Frenet,
+        "rk4" => Method::Rk4,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "method: unknown method {s:?}; expected 'double_reflection', 'projection', \
+                 'rotation', 'frenet' or 'rk4'"
+            )));
+        }
+    })
+}
+
+fn parse_rule(s: &str) -> PyResult<TangentRule> {
+    match s {
+        "five_point" => Ok(TangentRule::FivePoint),
+        "circle" => Ok(TangentRule::Circle),
+        _ => Err(PyValueError::new_err(format!(
+            "method: unknown tangent estimate {s:?}; expected 'five_point' or 'circle'"
+        ))),
+    }
+}
+
+fn orientations(
+    vectors: Option<PyReadonlyArray2<'_, f64>>,
+    frames: Option<PyReadonlyArray3<'_, f64>>,
+) -> PyResult<Vec<Orientation>> {
+    let mut out = Vec::new();
+    if let Some(v) = vectors {
+        for p in vec3s("initial", &v)? {
+            out.push(Orientation::Vector(*p));
+        }
+    }
+    if let Some(f) = frames {
+        let s = f
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("frame array must be C-contiguous"))?;
+        for a in s.chunks_exact(9) {
+            let mut cols = [0.0; 9];
+            cols.copy_from_slice(a);
+            // row-major (rows of the matrix) -> glam's column-major: transpose
+            out.push(Orientation::Frame(
+                DMat3::from_cols_array(&cols).transpose(),
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Frames of one or many sampled curves; see `spinal.frames` for the meaning.
+#[pyfunction]
+#[pyo3(signature = (points, tangents, offsets, method, tangent_rule, tangent_chords, closed,
+                    initial_vectors, initial_frames, end_vectors, end_frames, turns))]
+#[allow(clippy::too_many_arguments)]
+fn frames_sampled<'py>(
+    py: Python<'py>,
+    points: Option<PyReadonlyArray2<'py, f64>>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    method: &str,
+    tangent_rule: &str,
+    tangent_chords: bool,
+    closed: bool,
+    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
+    end_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    end_frames: Option<PyReadonlyArray3<'py, f64>>,
+    turns: i64,
+) -> PyResult<FramesAndAngles<'py>> {
+    let method = parse_method(method)?;
+    let tangent_rule = parse_rule(tangent_rule)?;
+    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
+    let tgs = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let rows = pts.or(tgs).map(<[DVec3]>::len).unwrap_or(0);
+    let offsets: Vec<usize> = offsets
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("offsets must be contiguous"))?
+        .iter()
+        .map(|&o| usize::try_from(o))
+        .collect::<Result<_, _>>()
+        .map_err(|_| PyValueError::new_err("lengths: must be non-negative"))?;
+    let initial = orientations(initial_vectors, initial_frames)?;
+    let end = orientations(end_vectors, end_frames)?;
+    let template = Request {
+        points: pts,
+        tangents: tgs,
+        analytic: None,
+        closed,
+        method,
+        tangent_chords,
+        tangent_rule,
+        initial: None,
+        end: None,
+        turns,
+    };
+    let out = PyArray3::<f64>::zeros(py, [rows, 3, 3], false);
+    let angles = {
+        let mut rw = out.readwrite();
+        let buf = rw
+            .as_slice_mut()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        py.detach(|| frames::compute_many(&template, &offsets, &initial, &end, buf))
+            .map_err(to_py)?
+    };
+    Ok((out, PyArray1::from_vec(py, angles)))
+}
+
+/// Frames of one analytic curve from exact derivatives at the samples and midpoints.
+#[pyfunction]
+#[pyo3(signature = (points, u, d1, d2, method, closed, initial_vectors, initial_frames,
+                    end_vectors, end_frames, turns))]
+#[allow(clippy::too_many_arguments)]
+fn frames_analytic<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    d1: PyReadonlyArray2<'py, f64>,
+    d2: PyReadonlyArray2<'py, f64>,
+    method: &str,
+    closed: bool,
+    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
+    end_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    end_frames: Option<PyReadonlyArray3<'py, f64>>,
+    turns: i64,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, f64)> {
+    let method = parse_method(method)?;
+    let pts = vec3s("points", &points)?;
+    let us = u
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("u: must be contiguous"))?;
+    let d1s = vec3s("points", &d1)?;
+    let d2s = vec3s("points", &d2)?;
+    let initial = orientations(initial_vectors, initial_frames)?;
+    let end = orientations(end_vectors, end_frames)?;
+    let req = Request {
+        points: Some(pts),
+        analytic: Some(Analytic {
+            u: us,
+            d1: d1s,
+            d2: d2s,
+        }),
+        closed,
+        method,
+        initial: frames::pick(&initial, 0),
+        end: frames::pick(&end, 0),
+        turns,
+        ..Request::default()
+    };
+    let out = PyArray3::<f64>::zeros(py, [pts.len(), 3, 3], false);
+    let angle = {
+        let mut rw = out.readwrite();
+        let buf = rw
+            .as_slice_mut()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        py.detach(|| frames::compute_into(&req, buf))
+            .map_err(to_py)?
+    };
+    Ok((out, angle))
+}
+
+/// Unit tangents estimated from points (one curve).
+#[pyfunction]
+fn estimate_tangents<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    closed: bool,
+    rule: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let rule = parse_rule(rule)?;
+    let x = vec3s("points", &points)?;
+    let t = py
+        .detach(|| -> Result<Vec<DVec3>, InputError> {
+            frames::validate::finite("points", x)?;
+            let mut n = x.len();
+            if closed && n >= 2 && frames::validate::coincide(x[n - 1], x[0]) {
+                n -= 1;
+            }
+            frames::validate::distinct(&x[..n], closed)?;
+            let mut t = frames::tangents::estimate(&x[..n], closed, rule)?;
+            if n < x.len() {
+                t.push(t[0]);
+            }
+            Ok(t)
+        })
+        .map_err(to_py)?;
+    let flat: Vec<f64> = bytemuck::cast_slice(&t).to_vec();
+    PyArray1::from_vec(py, flat).reshape([t.len(), 3])
+}
+
+#[pymodule(name = "_core")]
+fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
+    m.add_function(wrap_pyfunction!(frames_analytic, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_tangents, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
