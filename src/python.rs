@@ -53,8 +53,9 @@ fn parse_rule(s: &str) -> PyResult<TangentRule> {
     match s {
         "five_point" => Ok(TangentRule::FivePoint),
         "circle" => Ok(TangentRule::Circle),
+        "five_point_uniform" => Ok(TangentRule::FivePointUniform),
         _ => Err(PyValueError::new_err(format!(
-            "method: unknown tangent estimate {s:?}; expected 'five_point' or 'circle'"
+            "method: unknown tangent estimate {s:?}; expected 'five_point', 'five_point_uniform' or 'circle'"
         ))),
     }
 }

@@ -37,5 +37,5 @@ def closing_angle(
     offsets: Sequence[int] | npt.NDArray[np.integer] | None = None,
 ) -> float | npt.NDArray[np.float64]: ...
 def estimate_tangents(
-    points: _Array, *, closed: bool = False, method: Literal["five_point", "circle"] = "five_point"
+    points: _Array, *, closed: bool = False, method: Literal["five_point", "five_point_uniform", "circle"] = "five_point"
 ) -> npt.NDArray[np.float64]: ...

@@ -14,7 +14,7 @@ __all__ = ["frames", "closing_angle", "estimate_tangents"]
 
 METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")
-TANGENT_RULES = ("five_point", "circle")
+TANGENT_RULES = ("five_point", "five_point_uniform", "circle")
 
 
 def _offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]:
@@ -153,10 +153,10 @@ def frames(
         or an analytic curve together with ``u``.
     tangents : array_like (n, 3), optional
         Tangent directions at the samples (normalised here). Without them the unit tangents
-        are estimated from the points with the 5-point differences of Wang et al. (2008,
-        §6.1), one-sided at the ends, which keeps double reflection 4th order when the samples
-        come from a uniform step of a smooth parameterisation; 3–4 points use the circle
-        through neighbours (2nd order), 2 points the chord (see :func:`estimate_tangents`).
+        are estimated from the points by :func:`estimate_tangents` (5-point differences in
+        chord length, one-sided at open ends, periodic when ``closed``), which keeps double
+        reflection 4th order for any smooth spacing; 3–4 points use the circle through
+        neighbours (2nd order), 2 points the chord.
     method : str
         * ``"double_reflection"`` (default): the rotation-minimising frame (RMF) by two
           reflections per segment (Wang, Jüttler, Zheng & Liu, ACM TOG 27(1), 2008). 4th
@@ -270,17 +270,25 @@ def closing_angle(
 def estimate_tangents(points, *, closed: bool = False, method: str = "five_point") -> np.ndarray:
     r"""Unit tangents estimated from sampled points, ``(n, 3)``.
 
-    ``method="five_point"`` (default): the 5-point central difference
-    ``x_{i−2} − 8x_{i−1} + 8x_{i+1} − x_{i+2}`` (one-sided 5-point formulas at open ends;
-    periodic when ``closed``), normalised; O(h⁴) direction error for samples at a uniform
-    step of a smooth parameterisation (Wang et al. 2008, §6.1). With 3–4 points the circle
-    rule, with 2 points the chord.
-    ``method="circle"``: the tangent of the circle through each point and its two neighbours,
-    ``|b|² a + |a|² b`` with ``a = x_i − x_{i−1}``, ``b = x_{i+1} − x_i`` (Zheng 2008 §7.1;
-    exact on circles for any spacing, O(h²) in general).
+    * ``"five_point"`` (default): the derivative at ``x_i`` of the quartic through the five
+      samples around it (one-sided at open ends, periodic when ``closed``), parameterised by
+      cumulative chord length (Lagrange weights by Fornberg's algorithm). For equal chords
+      these are the 5-point formulas of Wang et al. (2008, §6.1),
+      ``x_{i−2} − 8x_{i−1} + 8x_{i+1} − x_{i+2}``; for unequal spacing the direction stays
+      O(h⁴) accurate and straight runs give the exact direction. Double reflection with these
+      tangents is 4th order.
+    * ``"five_point_uniform"``: the paper's stencils with the sample index as parameter:
+      O(h⁴) only if the samples come from a uniform step of a smooth parameterisation
+      (kept to reproduce the paper; it can point backwards on very uneven spacing).
+    * ``"circle"``: the tangent of the circle through each point and its two neighbours,
+      ``|b|² a + |a|² b`` with ``a = x_i − x_{i−1}``, ``b = x_{i+1} − x_i`` (Zheng 2008 §7.1,
+      whose printed weights ``|b| a + |a| b`` are exact only for equal chords); exact on
+      circles for any spacing, O(h²) in general.
 
-    Raises ValueError for NaN/inf, repeated consecutive points and cusps (the estimate
-    vanishes), naming the row.
+    With 3–4 points the circle rule is used, with 2 points the chord. A closed curve may
+    repeat its first point at the end (that row gets the first tangent). Raises ValueError
+    for NaN/inf, repeated consecutive points and cusps (the estimate vanishes), naming the
+    row.
     """
     method = as_choice(method, "method", TANGENT_RULES)
     pts = as_points(points, "points")

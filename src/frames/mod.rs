@@ -167,12 +167,10 @@ impl Curvature<'_> {
                 let (v, a) = (d1[2 * i], d2[2 * i]);
                 (v, a, 64.0 * f64::EPSILON * a.length(), None)
             }
-            Curvature::Points(x, noise, diag) => (
-                tangents::first_derivative(x, i, closed),
-                tangents::second_derivative(x, i, closed),
-                noise,
-                Some(diag),
-            ),
+            Curvature::Points(x, scale, diag) => {
+                let (v, a, amp) = tangents::chord_derivatives(x, i, closed);
+                (v, a, 64.0 * f64::EPSILON * scale * amp, Some(diag))
+            }
             Curvature::Tangents => {
                 let n = t.len();
                 let (p, q) = if closed {
@@ -408,8 +406,7 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
     let curvature = if let Some(a) = req.analytic {
         Curvature::Analytic(a.d1, a.d2)
     } else if !x.is_empty() {
-        let noise = 64.0 * f64::EPSILON * max_abs(x);
-        Curvature::Points(x, noise, bbox_diagonal(x))
+        Curvature::Points(x, max_abs(x), bbox_diagonal(x))
     } else {
         Curvature::Tangents
     };

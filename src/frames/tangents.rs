@@ -1,13 +1,15 @@
 //! Tangent and curvature-vector estimation from sampled points, and the tangents-only
 //! reflection vectors of double reflection.
 //!
-//! All stencils treat the sample index as the curve parameter (uniform spacing `h = 1`), as
-//! in Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1); the direction of the estimate does
-//! not depend on the spacing as long as the samples come from a uniform step of *some*
-//! smooth parameterisation.
-//!
-//! * Five-point first derivative (4th order; `12 x'(u_i) + O(h⁵)`, unit-tangent error
-//!   O(h⁴), which keeps double reflection 4th order):
+//! * Five-point chord-length rule (the default): the derivative at `x_i` of the quartic that
+//!   interpolates five consecutive samples at their cumulative chord lengths (Lagrange
+//!   weights by Fornberg's algorithm, centred where possible, one-sided at open ends,
+//!   periodic for loops). For equal chords it is the formula below; for unequal spacing it
+//!   stays 4th order in the direction and is exact on straight lines whatever the spacing,
+//!   where index-based stencils can even point backwards.
+//! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
+//!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
+//!   samples come from a uniform step of a smooth parameterisation):
 //!   interior `x_{i−2} − 8x_{i−1} + 8x_{i+1} − x_{i+2}`, one-sided
 //!   `t_0 = −25x_0 + 48x_1 − 36x_2 + 16x_3 − 3x_4`, `t_1 = −3x_0 − 10x_1 + 18x_2 − 6x_3 + x_4`,
 //!   mirrored (with a sign change) at the far end. Periodic for closed curves. Needs 5 points.
@@ -18,9 +20,9 @@
 //!   as the unit test `circle_rule_exact_on_circle` checks.) At an open end the tangent
 //!   of the same circle, `t_0 = 2(ĉ·t_1)ĉ − t_1` with `ĉ` the unit first chord. Used for 3 or 4
 //!   points and on request. Two points: the chord direction (1st order).
-//! * Five-point second derivative (for the principal normal of the Frenet frame):
-//!   `(−x_{i−2} + 16x_{i−1} − 30x_i + 16x_{i+1} − x_{i+2})/12`, one-sided
-//!   `(35x_0 − 104x_1 + 114x_2 − 56x_3 + 11x_4)/12`, `(11x_0 − 20x_1 + 6x_2 + 4x_3 − x_4)/12`.
+//! * Curvature vector (for the principal normal of the Frenet frame and the default initial
+//!   frame): first and second derivatives of the same chord-length quartic (a parabola for
+//!   3–4 points), so `κ N = x″ − (x″·t) t` per unit chord length squared.
 //! * Tangents-only reflection vector (TOG Eq. 17): `v_1 = 13(t_i + t_{i+1}) − (t_{i−1} + t_{i+2})`,
 //!   and at the open ends the 4-point Adams–Moulton weights `9t_0 + 19t_1 − 5t_2 + t_3` and
 //!   its mirror (resolution A16 of the spec). Needs 4 tangents.
@@ -33,9 +35,11 @@ use crate::error::{InputError, Result};
 /// How tangents are estimated from points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TangentRule {
-    /// Five-point differences (4th order) where there are at least 5 points, else the
-    /// circle rule (3–4 points) or the chord (2 points).
+    /// Five-point chord-length Lagrange derivative (4th order, any spacing) where there are
+    /// at least 5 points, else the circle rule (3–4 points) or the chord (2 points).
     FivePoint,
+    /// The uniform five-point stencils of the TOG paper (index as parameter).
+    FivePointUniform,
     /// Circle through three consecutive points (2nd order), chord for 2 points.
     Circle,
 }
@@ -65,6 +69,89 @@ fn five_point_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     } else {
         3.0 * x[n - 1] + 10.0 * x[n - 2] - 18.0 * x[n - 3] + 6.0 * x[n - 4] - x[n - 5]
     }
+}
+
+/// Finite-difference weights (Fornberg 1988): `w[j][k]` is the weight of node `j` for the
+/// `k`-th derivative at `z` of the polynomial interpolating the values at `x` (k ≤ 2).
+pub fn fornberg<const N: usize>(z: f64, x: &[f64; N]) -> [[f64; 3]; N] {
+    let mut c = [[0.0; 3]; N];
+    let mut c1 = 1.0;
+    let mut c4 = x[0] - z;
+    c[0][0] = 1.0;
+    for i in 1..N {
+        let mn = i.min(2);
+        let mut c2 = 1.0;
+        let c5 = c4;
+        c4 = x[i] - z;
+        for j in 0..i {
+            let c3 = x[i] - x[j];
+            c2 *= c3;
+            if j == i - 1 {
+                for k in (1..=mn).rev() {
+                    c[i][k] = c1 * (k as f64 * c[i - 1][k - 1] - c5 * c[i - 1][k]) / c2;
+                }
+                c[i][0] = -c1 * c5 * c[i - 1][0] / c2;
+            }
+            for k in (1..=mn).rev() {
+                c[j][k] = (c4 * c[j][k] - k as f64 * c[j][k - 1]) / c3;
+            }
+            c[j][0] = c4 * c[j][0] / c3;
+        }
+        c1 = c2;
+    }
+    c
+}
+
+/// Stencil (first sample index, evaluation offset) of `width` consecutive samples around `i`.
+#[inline]
+fn window(i: usize, n: usize, width: usize, closed: bool) -> (isize, usize) {
+    let half = width / 2;
+    if closed {
+        (i as isize - half as isize, half)
+    } else {
+        let first = i.saturating_sub(half).min(n - width);
+        (first as isize, i - first)
+    }
+}
+
+/// First and second derivatives with respect to chord length at sample `i`, from the
+/// polynomial through the five (three for 3–4 samples) neighbouring samples, and the sum of
+/// the absolute second-derivative weights (its round-off amplification).
+pub fn chord_derivatives(x: &[DVec3], i: usize, closed: bool) -> (DVec3, DVec3, f64) {
+    let n = x.len();
+    if n < 3 {
+        return ((x[1] - x[0]).normalize_or_zero(), DVec3::ZERO, 0.0);
+    }
+    if n >= 5 {
+        stencil::<5>(x, i, closed)
+    } else {
+        stencil::<3>(x, i, closed)
+    }
+}
+
+fn stencil<const W: usize>(x: &[DVec3], i: usize, closed: bool) -> (DVec3, DVec3, f64) {
+    let n = x.len();
+    let (first, at) = window(i, n, W, closed);
+    let p: [DVec3; W] = std::array::from_fn(|k| x[idx(first + k as isize, n, closed)]);
+    let mut tau = [0.0; W];
+    for k in 1..W {
+        tau[k] = tau[k - 1] + (p[k] - p[k - 1]).length();
+    }
+    let z = tau[at];
+    for v in tau.iter_mut() {
+        *v -= z;
+    }
+    let w = fornberg(0.0, &tau);
+    let mut d1 = DVec3::ZERO;
+    let mut d2 = DVec3::ZERO;
+    let mut amp = 0.0;
+    for k in 0..W {
+        let rel = p[k] - p[at];
+        d1 += w[k][1] * rel;
+        d2 += w[k][2] * rel;
+        amp += w[k][2].abs();
+    }
+    (d1, d2, amp)
 }
 
 /// Unnormalised circle tangent at an interior (or periodic) index.
@@ -102,11 +189,13 @@ pub fn estimate(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec
             ),
         ));
     }
-    let five = rule == TangentRule::FivePoint && n >= 5;
+    let five = rule != TangentRule::Circle && n >= 5;
     let mut t = vec![DVec3::ZERO; n];
     t.par_iter_mut().enumerate().for_each(|(i, ti)| {
         *ti = if n == 2 {
             x[1] - x[0]
+        } else if five && rule == TangentRule::FivePoint {
+            stencil::<5>(x, i, closed).0
         } else if five {
             five_point_raw(x, i, closed)
         } else if closed || (i > 0 && i + 1 < n) {
@@ -144,54 +233,6 @@ pub fn normalize_all(t: &mut [DVec3]) -> std::result::Result<(), usize> {
     match bad {
         Some(i) => Err(i),
         None => Ok(()),
-    }
-}
-
-/// Estimated second derivative of the curve with respect to the sample index.
-pub fn second_derivative(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
-    let n = x.len();
-    let ii = i as isize;
-    let p = |k: isize| x[idx(ii + k, n, closed)];
-    if n < 3 {
-        DVec3::ZERO
-    } else if n < 5 {
-        if closed || (i > 0 && i + 1 < n) {
-            p(-1) - 2.0 * x[i] + p(1)
-        } else if i == 0 {
-            x[0] - 2.0 * x[1] + x[2]
-        } else {
-            x[n - 3] - 2.0 * x[n - 2] + x[n - 1]
-        }
-    } else if closed || (i >= 2 && i + 2 < n) {
-        (-p(-2) + 16.0 * p(-1) - 30.0 * x[i] + 16.0 * p(1) - p(2)) / 12.0
-    } else if i == 0 {
-        (35.0 * x[0] - 104.0 * x[1] + 114.0 * x[2] - 56.0 * x[3] + 11.0 * x[4]) / 12.0
-    } else if i == 1 {
-        (11.0 * x[0] - 20.0 * x[1] + 6.0 * x[2] + 4.0 * x[3] - x[4]) / 12.0
-    } else if i == n - 1 {
-        (35.0 * x[n - 1] - 104.0 * x[n - 2] + 114.0 * x[n - 3] - 56.0 * x[n - 4] + 11.0 * x[n - 5])
-            / 12.0
-    } else {
-        (11.0 * x[n - 1] - 20.0 * x[n - 2] + 6.0 * x[n - 3] + 4.0 * x[n - 4] - x[n - 5]) / 12.0
-    }
-}
-
-/// Estimated first derivative with respect to the sample index (speed scale for curvature).
-pub fn first_derivative(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
-    let n = x.len();
-    if n >= 5 {
-        five_point_raw(x, i, closed) / 12.0
-    } else if n == 2 {
-        x[1] - x[0]
-    } else {
-        let ii = i as isize;
-        if closed || (i > 0 && i + 1 < n) {
-            0.5 * (x[idx(ii + 1, n, closed)] - x[idx(ii - 1, n, closed)])
-        } else if i == 0 {
-            x[1] - x[0]
-        } else {
-            x[n - 1] - x[n - 2]
-        }
     }
 }
 
@@ -246,6 +287,48 @@ mod tests {
         for (i, &u) in [0.0_f64, 0.3, 1.1, 1.2].iter().enumerate() {
             let e = DVec3::new(-u.sin(), u.cos(), 0.0);
             assert!((t[i] - e).length() < 1e-14, "{i}");
+        }
+    }
+
+    #[test]
+    fn chord_rule_exact_on_lines_and_uniform_rule_on_equal_chords() {
+        let d = DVec3::new(1.0, -2.0, 0.5).normalize();
+        let s = [0.0, 1e-3, 1.3e-3, 0.2, 0.21, 0.5, 0.5001];
+        let x: Vec<DVec3> = s
+            .iter()
+            .map(|&v| DVec3::new(1.0, 2.0, 3.0) + v * d)
+            .collect();
+        let t = estimate(&x, false, TangentRule::FivePoint).unwrap();
+        for ti in &t {
+            assert!((*ti - d).length() < 1e-9, "{ti}");
+        }
+        // equal chords (a regular polygon): chord rule = uniform stencil
+        let x: Vec<DVec3> = (0..9)
+            .map(|i| {
+                let a = 0.4 * i as f64;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let a = estimate(&x, false, TangentRule::FivePoint).unwrap();
+        let b = estimate(&x, false, TangentRule::FivePointUniform).unwrap();
+        for i in 0..9 {
+            assert!((a[i] - b[i]).length() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn fornberg_matches_central_differences() {
+        let w = fornberg(0.0, &[-2.0, -1.0, 0.0, 1.0, 2.0]);
+        let d1 = [1.0 / 12.0, -8.0 / 12.0, 0.0, 8.0 / 12.0, -1.0 / 12.0];
+        let d2 = [
+            -1.0 / 12.0,
+            16.0 / 12.0,
+            -30.0 / 12.0,
+            16.0 / 12.0,
+            -1.0 / 12.0,
+        ];
+        for k in 0..5 {
+            assert!((w[k][1] - d1[k]).abs() < 1e-15 && (w[k][2] - d2[k]).abs() < 1e-14);
         }
     }
 
