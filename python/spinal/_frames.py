@@ -167,7 +167,9 @@ def frames(
         * ``"projection"``: the RMF by projecting along each chord (Klok 1986). 2nd order,
           depends on ``initial``.
         * ``"frenet"``: the Frenet frame ``r = N`` (towards the centre of curvature),
-          ``s = B``. Where the curvature vanishes (inflection samples, straight runs) it is
+          ``s = B``; exact on analytic curves, from sampled points ``N`` points to the centre
+          of the circle through each sample and its neighbours (2nd order; 1st order at the
+          two end samples; exact on circles, exactly straight on collinear samples). Where the curvature vanishes (inflection samples, straight runs) it is
           undefined; there the frame is carried by double reflection from the last defined
           frame and the mismatch with the next one is spread linearly in arc length, so the
           filled frames are continuous; runs at open ends are carried from the nearest

@@ -153,24 +153,30 @@ fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) -> Result<D
 
 /// Where the principal normal comes from.
 enum Curvature<'a> {
-    Analytic(&'a [DVec3], &'a [DVec3]),
+    /// Exact derivatives at the samples (every other row of the analytic arrays).
+    Analytic(&'a [DVec3], &'a [DVec3], f64),
+    /// The circle through neighbouring samples; (points, round-off level, bbox diagonal).
     Points(&'a [DVec3], f64, f64),
+    /// Differences of consecutive unit tangents (tangents-only input).
     Tangents,
 }
 
 impl Curvature<'_> {
-    /// Unit principal normal at sample `i`, or None where the curve is straight there.
+    /// Unit principal normal at sample `i`, or None where the curve is straight there
+    /// (`κ·diag ≤ STRAIGHT_TOL`, or the curvature is below round-off).
     fn normal(&self, t: &[DVec3], i: usize, closed: bool) -> Option<DVec3> {
         let ti = t[i];
-        let (v, a, noise, diag) = match *self {
-            Curvature::Analytic(d1, d2) => {
+        match *self {
+            Curvature::Analytic(d1, d2, diag) => {
                 let (v, a) = (d1[2 * i], d2[2 * i]);
-                (v, a, 64.0 * f64::EPSILON * a.length(), None)
+                let perp = a - a.dot(ti) * ti;
+                let l = perp.length();
+                let kappa = l / v.length_squared();
+                (l > 64.0 * f64::EPSILON * a.length() && kappa * diag > STRAIGHT_TOL)
+                    .then(|| perp / l)
             }
-            Curvature::Points(x, scale, diag) => {
-                let (v, a, amp) = tangents::chord_derivatives(x, i, closed);
-                (v, a, 64.0 * f64::EPSILON * scale * amp, Some(diag))
-            }
+            Curvature::Points(x, noise, diag) => tangents::circle_normal(x, ti, i, closed, noise)
+                .and_then(|(nrm, kappa)| (kappa * diag > STRAIGHT_TOL).then_some(nrm)),
             Curvature::Tangents => {
                 let n = t.len();
                 let (p, q) = if closed {
@@ -179,21 +185,11 @@ impl Curvature<'_> {
                     (t[i.saturating_sub(1)], t[(i + 1).min(n - 1)])
                 };
                 let a = q - p;
-                (DVec3::ONE, a, 1e-10, None)
-            }
-        };
-        let perp = a - a.dot(ti) * ti;
-        let l = perp.length();
-        if !(l > noise) {
-            return None;
-        }
-        if let Some(diag) = diag {
-            let kappa = l / v.length_squared();
-            if !(kappa * diag > STRAIGHT_TOL) {
-                return None;
+                let perp = a - a.dot(ti) * ti;
+                let l = perp.length();
+                (l > 1e-10).then(|| perp / l)
             }
         }
-        Some(perp / l)
     }
 }
 
@@ -404,9 +400,9 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
     };
 
     let curvature = if let Some(a) = req.analytic {
-        Curvature::Analytic(a.d1, a.d2)
+        Curvature::Analytic(a.d1, a.d2, bbox_diagonal(&req.points.unwrap_or(&[])[..n]))
     } else if !x.is_empty() {
-        Curvature::Points(x, max_abs(x), bbox_diagonal(x))
+        Curvature::Points(x, 64.0 * f64::EPSILON * max_abs(x), bbox_diagonal(x))
     } else {
         Curvature::Tangents
     };
@@ -589,8 +585,13 @@ pub fn compute_many(
                 end: pick(end, c),
                 ..*template
             };
-            compute_into(&req, buf)
-                .map_err(|e| e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1)))
+            compute_into(&req, buf).map_err(|e| {
+                if curves > 1 {
+                    e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
+                } else {
+                    e
+                }
+            })
         })
         .collect();
     results.into_iter().collect()

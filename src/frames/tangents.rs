@@ -20,9 +20,8 @@
 //!   as the unit test `circle_rule_exact_on_circle` checks.) At an open end the tangent
 //!   of the same circle, `t_0 = 2(ĉ·t_1)ĉ − t_1` with `ĉ` the unit first chord. Used for 3 or 4
 //!   points and on request. Two points: the chord direction (1st order).
-//! * Curvature vector (for the principal normal of the Frenet frame and the default initial
-//!   frame): first and second derivatives of the same chord-length quartic (a parabola for
-//!   3–4 points), so `κ N = x″ − (x″·t) t` per unit chord length squared.
+//! * Principal normal (for the Frenet frame and the default initial frame): towards the
+//!   centre of the circle through the sample and its two neighbours (see [`circle_normal`]).
 //! * Tangents-only reflection vector (TOG Eq. 17): `v_1 = 13(t_i + t_{i+1}) − (t_{i−1} + t_{i+2})`,
 //!   and at the open ends the 4-point Adams–Moulton weights `9t_0 + 19t_1 − 5t_2 + t_3` and
 //!   its mirror (resolution A16 of the spec). Needs 4 tangents.
@@ -114,19 +113,38 @@ fn window(i: usize, n: usize, width: usize, closed: bool) -> (isize, usize) {
     }
 }
 
-/// First and second derivatives with respect to chord length at sample `i`, from the
-/// polynomial through the five (three for 3–4 samples) neighbouring samples, and the sum of
-/// the absolute second-derivative weights (its round-off amplification).
-pub fn chord_derivatives(x: &[DVec3], i: usize, closed: bool) -> (DVec3, DVec3, f64) {
+/// Principal normal and curvature at sample `i` from the circle through three consecutive
+/// samples (`i−1, i, i+1`; the first or last three at open ends): the unit vector from `x_i`
+/// towards the circle's centre, projected onto the normal plane of `t_i`, and `κ = 1/ρ`.
+/// Exact on circles, exactly straight (None) on collinear samples, and free of the overshoot
+/// that higher-order stencils show next to a jump in curvature; 2nd order otherwise.
+/// `noise` is the round-off level of the coordinates (64ε·max|x|).
+pub fn circle_normal(
+    x: &[DVec3],
+    t: DVec3,
+    i: usize,
+    closed: bool,
+    noise: f64,
+) -> Option<(DVec3, f64)> {
     let n = x.len();
     if n < 3 {
-        return ((x[1] - x[0]).normalize_or_zero(), DVec3::ZERO, 0.0);
+        return None;
     }
-    if n >= 5 {
-        stencil::<5>(x, i, closed)
-    } else {
-        stencil::<3>(x, i, closed)
+    let (first, _) = window(i, n, 3, closed);
+    let p0 = x[idx(first, n, closed)];
+    let a = x[idx(first + 1, n, closed)] - p0;
+    let b = x[idx(first + 2, n, closed)] - p0;
+    let axb = a.cross(b);
+    let l2 = axb.length_squared();
+    if !(axb.length() > noise * (a.length() + b.length())) {
+        return None;
     }
+    let centre =
+        p0 + (a.length_squared() * b.cross(axb) + b.length_squared() * axb.cross(a)) / (2.0 * l2);
+    let d = centre - x[i];
+    let perp = d - d.dot(t) * t;
+    let kappa = 1.0 / d.length();
+    perp.try_normalize().map(|v| (v, kappa))
 }
 
 fn stencil<const W: usize>(x: &[DVec3], i: usize, closed: bool) -> (DVec3, DVec3, f64) {
@@ -314,6 +332,23 @@ mod tests {
         for i in 0..9 {
             assert!((a[i] - b[i]).length() < 1e-14);
         }
+    }
+
+    #[test]
+    fn circle_normal_of_a_circle_and_a_line() {
+        let c = DVec3::new(1.0, -2.0, 0.5);
+        let x: Vec<DVec3> = [0.1_f64, 0.5, 1.7, 2.0]
+            .iter()
+            .map(|&u| c + 3.0 * DVec3::new(u.cos(), u.sin(), 0.0))
+            .collect();
+        for (i, &u) in [0.1_f64, 0.5, 1.7, 2.0].iter().enumerate() {
+            let t = DVec3::new(-u.sin(), u.cos(), 0.0);
+            let (nrm, k) = circle_normal(&x, t, i, false, 1e-14).unwrap();
+            assert!((nrm + DVec3::new(u.cos(), u.sin(), 0.0)).length() < 1e-13);
+            assert!((k - 1.0 / 3.0).abs() < 1e-13);
+        }
+        let line: Vec<DVec3> = (0..5).map(|i| DVec3::splat(i as f64 * 0.3)).collect();
+        assert!(circle_normal(&line, DVec3::ONE.normalize(), 2, false, 1e-14).is_none());
     }
 
     #[test]
