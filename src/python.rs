@@ -218,8 +218,8 @@ fn estimate_tangents<'py>(
             if closed && n >= 2 && frames::validate::coincide(x[n - 1], x[0]) {
                 n -= 1;
             }
-            frames::validate::distinct(&x[..n], closed)?;
-            let mut t = frames::tangents::estimate(&x[..n], closed, rule)?;
+            let chords = frames::validate::chords(&x[..n], closed)?;
+            let mut t = frames::tangents::estimate(&x[..n], &chords, closed, rule)?;
             if n < x.len() {
                 t.push(t[0]);
             }

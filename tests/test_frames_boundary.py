@@ -2,11 +2,9 @@
 
 import numpy as np
 import pytest
-
 import spinal
-from spinal.curves import Curve, TorusKnot
-
 from conftest import orthonormality_error
+from spinal.curves import Curve, TorusKnot
 
 
 def signed(a, b, t):
@@ -36,11 +34,8 @@ class Trefoil(Curve):
 
     closed = True
     domain = (0.0, 2 * np.pi)
-    C = {  # coefficients of cos t, sin t, cos 2t, sin 2t, cos 3t, sin 3t
-        0: [41, -18, -83, -83, -11, 27],
-        1: [36, 27, -113, 30, 11, -27],
-        2: [0, 45, -30, 113, -11, 27],
-    }
+    # coefficients of cos t, sin t, cos 2t, sin 2t, cos 3t, sin 3t per axis
+    C = ((41, -18, -83, -83, -11, 27), (36, 27, -113, 30, 11, -27), (0, 45, -30, 113, -11, 27))
 
     def _eval(self, u, k):
         cols = []

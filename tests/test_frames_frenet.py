@@ -1,11 +1,9 @@
 """Frenet frames: exact where the curvature is non-zero, continuous fill where it vanishes."""
 
 import numpy as np
-
 import spinal
-from spinal.curves import Bezier, Helix
-
 from conftest import orthonormality_error
+from spinal.curves import Bezier, Helix
 
 
 def test_frenet_matches_analytic_frenet():

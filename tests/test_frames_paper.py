@@ -3,11 +3,9 @@ the closed-form helix benchmark (see ../shared/spec/wang-double-reflection.md §
 
 import numpy as np
 import pytest
-
 import spinal
-from spinal.curves import Helix
-
 from conftest import angle_between
+from spinal.curves import Helix
 
 # Table III (double reflection) of the paper, n = 2^6 … 2^11 segments.
 TABLE_III_DR = [5.10e-3, 3.24e-4, 2.03e-5, 1.27e-6, 7.95e-8, 4.97e-9]

@@ -8,4 +8,4 @@ from . import curves
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 
-__all__ = ["frames", "closing_angle", "estimate_tangents", "curves", "__version__"]
+__all__ = ["__version__", "closing_angle", "curves", "estimate_tangents", "frames"]

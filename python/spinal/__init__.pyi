@@ -1,5 +1,5 @@
 from collections.abc import Sequence
-from typing import Literal
+from typing import Literal, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -9,7 +9,7 @@ from .curves import Curve
 
 __version__: str
 
-Method = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
+Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Array = npt.ArrayLike
 
 def frames(

@@ -10,7 +10,7 @@ from . import _core
 from ._validate import as_bool, as_choice, as_float_array, as_int, as_points
 from .curves import Curve
 
-__all__ = ["frames", "closing_angle", "estimate_tangents"]
+__all__ = ["closing_angle", "estimate_tangents", "frames"]
 
 METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")

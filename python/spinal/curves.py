@@ -24,7 +24,7 @@ import numpy as np
 
 from ._validate import as_float_array
 
-__all__ = ["Curve", "Helix", "TorusKnot", "Viviani", "Polynomial", "Bezier"]
+__all__ = ["Bezier", "Curve", "Helix", "Polynomial", "TorusKnot", "Viviani"]
 
 
 def _u(u) -> np.ndarray:

@@ -303,9 +303,11 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
     }
     let closed = req.closed;
     let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);
-    if !x.is_empty() {
-        validate::distinct(x, closed)?;
-    }
+    let chords = if x.is_empty() {
+        Vec::new()
+    } else {
+        validate::chords(x, closed)?
+    };
 
     // Unit tangents.
     let t: Vec<DVec3> = if let Some(a) = req.analytic {
@@ -338,7 +340,7 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
         })?;
         t
     } else {
-        tangents::estimate(x, closed, req.tangent_rule)?
+        tangents::estimate(x, &chords, closed, req.tangent_rule)?
     };
     if req.tangent_chords && n < 4 {
         return Err(InputError::new(
@@ -391,10 +393,7 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
             })
             .collect()
     } else if !x.is_empty() {
-        (0..m)
-            .into_par_iter()
-            .map(|i| (x[(i + 1) % n] - x[i]).length())
-            .collect()
+        chords
     } else {
         vec![1.0; m]
     };
@@ -438,85 +437,84 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
         return Ok(0.0);
     }
 
-    let rk4_omega: Vec<DVec3>;
-    let step: Box<dyn DynStep + '_> = match req.method {
-        Method::DoubleReflection => Box::new(dr),
-        Method::Rotation => Box::new(rotation::Rotation { t: &t }),
-        Method::Projection => Box::new(projection::Projection { x, t: &t }),
+    let ctx = Ctx {
+        req,
+        t: &t,
+        seg: &seg,
+        curvature: &curvature,
+        closed,
+    };
+    match req.method {
+        Method::DoubleReflection => ctx.run(&dr, out),
+        Method::Rotation => ctx.run(&rotation::Rotation { t: &t }, out),
+        Method::Projection => ctx.run(&projection::Projection { x, t: &t }, out),
         Method::Rk4 => {
             let a = req
                 .analytic
                 .ok_or_else(|| InputError::new("method", "rk4"))?;
-            rk4_omega =
+            let omega: Vec<DVec3> =
                 a.d1.par_iter()
                     .zip(a.d2.par_iter())
                     .map(|(d1, d2)| rk4::omega(*d1, *d2))
                     .collect();
-            Box::new(rk4::Rk4 {
-                u: a.u,
-                omega: &rk4_omega,
-                t: &t,
-            })
+            ctx.run(
+                &rk4::Rk4 {
+                    u: a.u,
+                    omega: &omega,
+                    t: &t,
+                },
+                out,
+            )
         }
         Method::Frenet => unreachable!("handled above"),
-    };
-    let step = DynWrap(&*step);
+    }
+}
 
-    let r0 = match &req.initial {
-        Some(o) => resolve(o, t[0], 0, "initial")?,
-        None => {
-            let found = (0..n)
-                .into_par_iter()
-                .find_map_first(|i| curvature.normal(&t, i, closed).map(|v| (i, v)));
-            let p = any_perpendicular(t[0]);
-            match found {
-                None => p,
-                Some((k, nk)) => {
-                    let mut r = p;
-                    for i in 0..k {
-                        r = step.step(i, r);
+/// What the transport of one curve needs besides the step (static dispatch on the step type
+/// keeps the per-sample loop inlined).
+struct Ctx<'a> {
+    req: &'a Request<'a>,
+    t: &'a [DVec3],
+    seg: &'a [f64],
+    curvature: &'a Curvature<'a>,
+    closed: bool,
+}
+
+impl Ctx<'_> {
+    fn run<S: Step>(&self, step: &S, out: &mut [f64]) -> Result<f64> {
+        let (req, t, closed) = (self.req, self.t, self.closed);
+        let n = t.len();
+        let curvature = self.curvature;
+        let r0 = match &req.initial {
+            Some(o) => resolve(o, t[0], 0, "initial")?,
+            None => {
+                let found = (0..n)
+                    .into_par_iter()
+                    .find_map_first(|i| curvature.normal(t, i, closed).map(|v| (i, v)));
+                let p = any_perpendicular(t[0]);
+                match found {
+                    None => p,
+                    Some((k, nk)) => {
+                        let mut r = p;
+                        for i in 0..k {
+                            r = step.step(i, r);
+                        }
+                        rotate_about(p, t[0], signed_angle(r, nk, t[k]))
                     }
-                    rotate_about(p, t[0], signed_angle(r, nk, t[k]))
                 }
             }
-        }
-    };
-    let twist = if closed {
-        Twist::Closed { turns: req.turns }
-    } else if let Some(o) = &req.end {
-        Twist::End {
-            target: resolve(o, t[n - 1], n - 1, "end")?,
-            turns: req.turns,
-        }
-    } else {
-        Twist::None
-    };
-    Ok(transport_into(&step, &t, &seg, closed, r0, twist, out))
-}
-
-/// Object-safe view of [`Step`], so the method can be chosen at run time while the
-/// transport loop stays generic.
-trait DynStep: Sync {
-    fn step_dyn(&self, i: usize, r: DVec3) -> DVec3;
-    fn is_rotation_dyn(&self) -> bool;
-}
-impl<S: Step> DynStep for S {
-    #[inline(always)]
-    fn step_dyn(&self, i: usize, r: DVec3) -> DVec3 {
-        self.step(i, r)
-    }
-    fn is_rotation_dyn(&self) -> bool {
-        self.is_rotation()
-    }
-}
-struct DynWrap<'a>(&'a dyn DynStep);
-impl Step for DynWrap<'_> {
-    #[inline(always)]
-    fn step(&self, i: usize, r: DVec3) -> DVec3 {
-        self.0.step_dyn(i, r)
-    }
-    fn is_rotation(&self) -> bool {
-        self.0.is_rotation_dyn()
+        };
+        let twist = if closed {
+            Twist::Closed { turns: req.turns }
+        } else if let Some(o) = &req.end {
+            Twist::End {
+                target: resolve(o, t[n - 1], n - 1, "end")?,
+                turns: req.turns,
+            }
+        } else {
+            Twist::None
+        };
+        Ok(transport_into(step, t, self.seg, closed, r0, twist, out))
     }
 }
 

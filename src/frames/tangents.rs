@@ -147,29 +147,39 @@ pub fn circle_normal(
     perp.try_normalize().map(|v| (v, kappa))
 }
 
-fn stencil<const W: usize>(x: &[DVec3], i: usize, closed: bool) -> (DVec3, DVec3, f64) {
+/// Derivative direction at sample `i` of the quartic through five consecutive samples
+/// parameterised by cumulative chord length (weights `w_j = L_j′(τ_i)` of the Lagrange basis).
+fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec3 {
     let n = x.len();
-    let (first, at) = window(i, n, W, closed);
-    let p: [DVec3; W] = std::array::from_fn(|k| x[idx(first + k as isize, n, closed)]);
-    let mut tau = [0.0; W];
-    for k in 1..W {
-        tau[k] = tau[k - 1] + (p[k] - p[k - 1]).length();
+    let (first, at) = window(i, n, 5, closed);
+    let mut tau = [0.0; 5];
+    for k in 1..5 {
+        tau[k] = tau[k - 1] + chords[idx(first + k as isize - 1, n, closed)];
     }
     let z = tau[at];
     for v in tau.iter_mut() {
         *v -= z;
     }
-    let w = fornberg(0.0, &tau);
-    let mut d1 = DVec3::ZERO;
-    let mut d2 = DVec3::ZERO;
-    let mut amp = 0.0;
-    for k in 0..W {
-        let rel = p[k] - p[at];
-        d1 += w[k][1] * rel;
-        d2 += w[k][2] * rel;
-        amp += w[k][2].abs();
+    // For j ≠ at: L_j′(0) = Π_{m≠j,at}(−τ_m) / Π_{m≠j}(τ_j − τ_m); Σ_j w_j = 0, so the
+    // derivative is Σ_{j≠at} w_j (x_j − x_at).
+    let p0 = x[idx(first + at as isize, n, closed)];
+    let mut d = DVec3::ZERO;
+    for j in 0..5 {
+        if j == at {
+            continue;
+        }
+        let (mut num, mut den) = (1.0, 1.0);
+        for m in 0..5 {
+            if m != j {
+                den *= tau[j] - tau[m];
+                if m != at {
+                    num *= -tau[m];
+                }
+            }
+        }
+        d += (num / den) * (x[idx(first + j as isize, n, closed)] - p0);
     }
-    (d1, d2, amp)
+    d
 }
 
 /// Unnormalised circle tangent at an interior (or periodic) index.
@@ -195,7 +205,14 @@ fn cusp_error(i: usize) -> InputError {
 ///
 /// Errors if fewer than 2 points (3 for a loop) or if an estimate vanishes (a cusp).
 /// Points are assumed finite and free of repeated consecutive points (checked by the caller).
-pub fn estimate(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec3>> {
+///
+/// `chords[i] = |x_{i+1} − x_i|` (mod n when closed), as returned by `validate::chords`.
+pub fn estimate(
+    x: &[DVec3],
+    chords: &[f64],
+    closed: bool,
+    rule: TangentRule,
+) -> Result<Vec<DVec3>> {
     let n = x.len();
     let min = if closed { 3 } else { 2 };
     if n < min {
@@ -213,7 +230,7 @@ pub fn estimate(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec
         *ti = if n == 2 {
             x[1] - x[0]
         } else if five && rule == TangentRule::FivePoint {
-            stencil::<5>(x, i, closed).0
+            chord_five_point(x, chords, i, closed)
         } else if five {
             five_point_raw(x, i, closed)
         } else if closed || (i > 0 && i + 1 < n) {
@@ -274,6 +291,10 @@ pub fn tangent_chord(t: &[DVec3], i: usize, closed: bool) -> DVec3 {
 mod tests {
     use super::*;
 
+    fn ch(x: &[DVec3]) -> Vec<f64> {
+        crate::frames::validate::chords(x, false).unwrap()
+    }
+
     fn helix(u: f64) -> DVec3 {
         DVec3::new(u.cos(), u.sin(), 0.5 * u)
     }
@@ -286,7 +307,7 @@ mod tests {
         let err = |n: usize| {
             let h = 3.0 / n as f64;
             let x: Vec<DVec3> = (0..=n).map(|i| helix(i as f64 * h)).collect();
-            let t = estimate(&x, false, TangentRule::FivePoint).unwrap();
+            let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
             (0..=n)
                 .map(|i| (t[i] - helix_t(i as f64 * h)).length())
                 .fold(0.0, f64::max)
@@ -301,7 +322,7 @@ mod tests {
             .iter()
             .map(|&u: &f64| DVec3::new(u.cos(), u.sin(), 0.0))
             .collect();
-        let t = estimate(&x, false, TangentRule::Circle).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::Circle).unwrap();
         for (i, &u) in [0.0_f64, 0.3, 1.1, 1.2].iter().enumerate() {
             let e = DVec3::new(-u.sin(), u.cos(), 0.0);
             assert!((t[i] - e).length() < 1e-14, "{i}");
@@ -316,7 +337,7 @@ mod tests {
             .iter()
             .map(|&v| DVec3::new(1.0, 2.0, 3.0) + v * d)
             .collect();
-        let t = estimate(&x, false, TangentRule::FivePoint).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
         for ti in &t {
             assert!((*ti - d).length() < 1e-9, "{ti}");
         }
@@ -327,8 +348,8 @@ mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        let a = estimate(&x, false, TangentRule::FivePoint).unwrap();
-        let b = estimate(&x, false, TangentRule::FivePointUniform).unwrap();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointUniform).unwrap();
         for i in 0..9 {
             assert!((a[i] - b[i]).length() < 1e-14);
         }
@@ -370,6 +391,6 @@ mod tests {
     #[test]
     fn cusp_is_an_error() {
         let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO];
-        assert!(estimate(&x, false, TangentRule::FivePoint).is_err());
+        assert!(estimate(&x, &ch(&x), false, TangentRule::FivePoint).is_err());
     }
 }

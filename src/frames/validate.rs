@@ -50,15 +50,23 @@ pub fn coincide(a: DVec3, b: DVec3) -> bool {
     d <= COINCIDE_EPS * a.abs().max_element().max(b.abs().max_element())
 }
 
-/// Refuse repeated consecutive points (and the closing pair when `closed`).
-pub fn distinct(x: &[DVec3], closed: bool) -> Result<()> {
+/// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
+/// consecutive points.
+pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
     let n = x.len();
     let m = if closed { n } else { n.saturating_sub(1) };
-    match (0..m)
-        .into_par_iter()
-        .position_first(|i| coincide(x[i], x[(i + 1) % n]))
-    {
-        None => Ok(()),
+    let mut seg = vec![0.0; m];
+    let bad = seg
+        .par_iter_mut()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
+            *l = (b - a).length();
+            coincide(a, b).then_some(i)
+        })
+        .min();
+    match bad {
+        None => Ok(seg),
         Some(i) => Err(InputError::new(
             "points",
             format!(

@@ -1,0 +1,114 @@
+"""Frame throughput: spinal's methods vs the NumPy write floor (and a plain NumPy loop).
+
+For n = 10^3 … 10^7 points on a helix it times ``spinal.frames(points)`` (tangents estimated,
+the usual call) and ``spinal.frames(points, tangents)`` per method, on all cores and on one
+thread (a subprocess with RAYON_NUM_THREADS=1), and divides by the time NumPy needs to
+allocate and write the (n, 3, 3) float64 output once (``np.full``). A pure NumPy/Python
+double-reflection loop is timed at small n as the peer a user would otherwise write.
+
+    python benchmarks/bench_frames.py            # up to 10^7 points
+    python benchmarks/bench_frames.py --max 1e6  # quicker
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import spinal
+
+METHODS = ["double_reflection", "rotation", "projection", "frenet"]
+
+
+def best(f, repeat, *args, **kwargs):
+    ts = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        f(*args, **kwargs)
+        ts.append(time.perf_counter() - t0)
+    return min(ts)
+
+
+def helix(n):
+    u = np.linspace(0, 200 * np.pi, n)
+    x = np.c_[np.cos(u), np.sin(u), 0.05 * u]
+    t = np.c_[-np.sin(u), np.cos(u), np.full_like(u, 0.05)]
+    return x, t
+
+
+def numpy_double_reflection(x, t):
+    """The loop a NumPy user writes (Table I of Wang et al.), for comparison."""
+    t = t / np.linalg.norm(t, axis=1, keepdims=True)
+    r = np.empty_like(x)
+    r[0] = np.cross(t[0], [0.0, 0.0, 1.0])
+    r[0] /= np.linalg.norm(r[0])
+    for i in range(len(x) - 1):
+        v1 = x[i + 1] - x[i]
+        c1 = v1 @ v1
+        rl = r[i] - (2 / c1) * (v1 @ r[i]) * v1
+        tl = t[i] - (2 / c1) * (v1 @ t[i]) * v1
+        v2 = t[i + 1] - tl
+        r[i + 1] = rl - (2 / (v2 @ v2)) * (v2 @ rl) * v2
+    return np.stack([r, np.cross(t, r), t], axis=2)
+
+
+def measure(sizes, repeat):
+    rows = []
+    for n in sizes:
+        x, t = helix(n)
+        rep = repeat if n < 5_000_000 else max(2, repeat // 2)
+        floor = best(np.full, rep, (n, 3, 3), 1.0)
+        rows.append({"n": n, "method": "numpy write floor", "tangents": "-", "s": floor})
+        for method in METHODS:
+            for given in (False, True):
+                args = (x, t) if given else (x,)
+                s = best(spinal.frames, rep, *args, method=method)
+                rows.append({"n": n, "method": method, "tangents": "given" if given else
+                             "estimated", "s": s})
+        if n <= 10_000:
+            s = best(numpy_double_reflection, 1, x, t)
+            rows.append({"n": n, "method": "numpy loop (DR)", "tangents": "given", "s": s})
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--max", type=float, default=1e7)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--json", action="store_true", help="print raw rows as JSON (internal)")
+    a = ap.parse_args()
+    sizes = [n for n in (10**3, 10**4, 10**5, 10**6, 10**7) if n <= a.max]
+    rows = measure(sizes, a.repeat)
+    if a.json:
+        print(json.dumps(rows))
+        return
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    single = json.loads(subprocess.run(
+        [sys.executable, __file__, "--max", str(a.max), "--repeat", str(a.repeat), "--json"],
+        env=env, check=True, capture_output=True, text=True).stdout)
+    one = {(r["n"], r["method"], r["tangents"]): r["s"] for r in single}
+    floors = {r["n"]: r["s"] for r in rows if r["method"] == "numpy write floor"}
+    cores = os.cpu_count()
+    print(f"spinal {spinal.__version__}, {cores} cores; best of {a.repeat}; helix samples\n")
+    print("| n | method | tangents | ms, 1 thread | ms, all cores | Mframes/s (all) "
+          "| × write floor (all) | speed-up |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        n, s = r["n"], r["s"]
+        s1 = one.get((n, r["method"], r["tangents"]), float("nan"))
+        print(f"| {n:,} | {r['method']} | {r['tangents']} | {1e3 * s1:.3f} | {1e3 * s:.3f} | "
+              f"{n / s / 1e6:.1f} | {s / floors[n]:.2f} | {s1 / s:.2f} |")
+    if 10**6 in floors:
+        dr = next(r["s"] for r in rows if r["n"] == 10**6 and r["method"] == "double_reflection"
+                  and r["tangents"] == "estimated")
+        print(f"\ndouble reflection, 1M points, tangents estimated: {dr / floors[10**6]:.2f}× "
+              "the NumPy write floor (target ≤ 4×)")
+
+
+if __name__ == "__main__":
+    main()
