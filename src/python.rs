@@ -212,19 +212,7 @@ fn estimate_tangents<'py>(
     let rule = parse_rule(rule)?;
     let x = vec3s("points", &points)?;
     let t = py
-        .detach(|| -> Result<Vec<DVec3>, InputError> {
-            frames::validate::finite("points", x)?;
-            let mut n = x.len();
-            if closed && n >= 2 && frames::validate::coincide(x[n - 1], x[0]) {
-                n -= 1;
-            }
-            let chords = frames::validate::chords(&x[..n], closed)?;
-            let mut t = frames::tangents::estimate(&x[..n], &chords, closed, rule)?;
-            if n < x.len() {
-                t.push(t[0]);
-            }
-            Ok(t)
-        })
+        .detach(|| frames::tangents::estimate_rows(x, closed, rule))
         .map_err(to_py)?;
     let flat: Vec<f64> = bytemuck::cast_slice(&t).to_vec();
     PyArray1::from_vec(py, flat).reshape([t.len(), 3])

@@ -83,7 +83,7 @@ def _analytic(curve: Curve, u: Any):
 
 
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-             lengths, offsets, tangent_estimate="five_point"):
+             lengths, offsets):
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -119,7 +119,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     iv, if_ = _orientation(initial, "initial", curves, bundle)
     ev, ef = _orientation(end, "end", curves, bundle)
     out, angles = _core.frames_sampled(
-        pts, tgs, offs, method, tangent_estimate, reflection == "tangents", closed,
+        pts, tgs, offs, method, "five_point", reflection == "tangents", closed,
         iv, if_, ev, ef, turns,
     )
     return out, angles, bundle

@@ -70,37 +70,6 @@ fn five_point_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     }
 }
 
-/// Finite-difference weights (Fornberg 1988): `w[j][k]` is the weight of node `j` for the
-/// `k`-th derivative at `z` of the polynomial interpolating the values at `x` (k ≤ 2).
-pub fn fornberg<const N: usize>(z: f64, x: &[f64; N]) -> [[f64; 3]; N] {
-    let mut c = [[0.0; 3]; N];
-    let mut c1 = 1.0;
-    let mut c4 = x[0] - z;
-    c[0][0] = 1.0;
-    for i in 1..N {
-        let mn = i.min(2);
-        let mut c2 = 1.0;
-        let c5 = c4;
-        c4 = x[i] - z;
-        for j in 0..i {
-            let c3 = x[i] - x[j];
-            c2 *= c3;
-            if j == i - 1 {
-                for k in (1..=mn).rev() {
-                    c[i][k] = c1 * (k as f64 * c[i - 1][k - 1] - c5 * c[i - 1][k]) / c2;
-                }
-                c[i][0] = -c1 * c5 * c[i - 1][0] / c2;
-            }
-            for k in (1..=mn).rev() {
-                c[j][k] = (c4 * c[j][k] - k as f64 * c[j][k - 1]) / c3;
-            }
-            c[j][0] = c4 * c[j][0] / c3;
-        }
-        c1 = c2;
-    }
-    c
-}
-
 /// Stencil (first sample index, evaluation offset) of `width` consecutive samples around `i`.
 #[inline]
 fn window(i: usize, n: usize, width: usize, closed: bool) -> (isize, usize) {
@@ -250,6 +219,22 @@ pub fn estimate(
     Ok(t)
 }
 
+/// Unit tangents for one curve as the user gave it: validates the points, accepts a closed
+/// curve that repeats its first point at the end (that row gets the first tangent).
+pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec3>> {
+    crate::frames::validate::finite("points", x)?;
+    let mut n = x.len();
+    if closed && n >= 2 && crate::frames::validate::coincide(x[n - 1], x[0]) {
+        n -= 1;
+    }
+    let chords = crate::frames::validate::chords(&x[..n], closed)?;
+    let mut t = estimate(&x[..n], &chords, closed, rule)?;
+    if n < x.len() {
+        t.push(t[0]);
+    }
+    Ok(t)
+}
+
 /// Normalise in place; on a zero or non-finite result returns the first bad index.
 pub fn normalize_all(t: &mut [DVec3]) -> std::result::Result<(), usize> {
     let bad = t
@@ -370,6 +355,58 @@ mod tests {
         }
         let line: Vec<DVec3> = (0..5).map(|i| DVec3::splat(i as f64 * 0.3)).collect();
         assert!(circle_normal(&line, DVec3::ONE.normalize(), 2, false, 1e-14).is_none());
+    }
+
+    /// Independent reference: finite-difference weights by Fornberg's algorithm (1988);
+    /// `w[j][k]` weights node `j` for the `k`-th derivative at `z` (k ≤ 2).
+    fn fornberg<const N: usize>(z: f64, x: &[f64; N]) -> [[f64; 3]; N] {
+        let mut c = [[0.0; 3]; N];
+        let mut c1 = 1.0;
+        let mut c4 = x[0] - z;
+        c[0][0] = 1.0;
+        for i in 1..N {
+            let mn = i.min(2);
+            let mut c2 = 1.0;
+            let c5 = c4;
+            c4 = x[i] - z;
+            for j in 0..i {
+                let c3 = x[i] - x[j];
+                c2 *= c3;
+                if j == i - 1 {
+                    for k in (1..=mn).rev() {
+                        c[i][k] = c1 * (k as f64 * c[i - 1][k - 1] - c5 * c[i - 1][k]) / c2;
+                    }
+                    c[i][0] = -c1 * c5 * c[i - 1][0] / c2;
+                }
+                for k in (1..=mn).rev() {
+                    c[j][k] = (c4 * c[j][k] - k as f64 * c[j][k - 1]) / c3;
+                }
+                c[j][0] = c4 * c[j][0] / c3;
+            }
+            c1 = c2;
+        }
+        c
+    }
+
+    #[test]
+    fn chord_rule_uses_lagrange_weights_on_uneven_chords() {
+        // unevenly sampled space curve: the chord rule equals Fornberg's first-derivative
+        // weights at the cumulative chord lengths, one-sided and centred
+        let x: Vec<DVec3> = [0.0, 0.1, 0.35, 0.5, 0.9, 1.0]
+            .iter()
+            .map(|&u: &f64| DVec3::new(u, u * u, 0.3 * u * u * u))
+            .collect();
+        let chords = ch(&x);
+        for (i, first) in [(0, 0), (1, 0), (2, 0), (3, 1), (5, 1)] {
+            let mut tau = [0.0; 5];
+            for k in 1..5 {
+                tau[k] = tau[k - 1] + chords[first + k - 1];
+            }
+            let w = fornberg(tau[i - first], &tau);
+            let d: DVec3 = (0..5).map(|k| w[k][1] * x[first + k]).sum();
+            let e = chord_five_point(&x, &chords, i, false);
+            assert!((d - e).length() < 1e-12 * d.length(), "{i}: {d} vs {e}");
+        }
     }
 
     #[test]
