@@ -128,12 +128,8 @@ pub fn transport_into<S: Step>(
                 end_r = rotate_about(prov[c].1, tt(b - 1), theta);
             }
         }
-    } else {
-        for c in 1..=chunks {
-            let (a, b) = bounds(c - 1);
-            len_prefix[c] = len_prefix[c - 1] + seg[a..(b.min(m))].iter().sum::<f64>();
-        }
     }
+    // Without a scan there is one chunk and no twist: the arc-length prefix is not needed.
 
     let (raw, total) = match twist {
         Twist::None => (0.0, 0.0),
