@@ -20,6 +20,7 @@ import sys
 import time
 
 import numpy as np
+
 import spinal
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]

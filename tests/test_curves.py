@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 import spinal
 from spinal.curves import Bezier, Helix, Polynomial, TorusKnot, Viviani
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import trimesh
+
 from spinal.__main__ import main
 
 

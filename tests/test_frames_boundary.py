@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
-import spinal
 from conftest import orthonormality_error
+
+import spinal
 from spinal.curves import Curve, TorusKnot
 
 

@@ -7,6 +7,7 @@ import threading
 
 import numpy as np
 import pytest
+
 import spinal
 from spinal.curves import Helix, TorusKnot
 

@@ -3,9 +3,10 @@ invariance) and the structural guarantees of every method."""
 
 import numpy as np
 import pytest
-import spinal
 from conftest import angle_between, orthonormality_error
 from scipy.spatial.transform import Rotation
+
+import spinal
 from spinal.curves import Bezier, Helix, TorusKnot, Viviani
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]

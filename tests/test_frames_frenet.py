@@ -1,8 +1,9 @@
 """Frenet frames: exact where the curvature is non-zero, continuous fill where it vanishes."""
 
 import numpy as np
-import spinal
 from conftest import orthonormality_error
+
+import spinal
 from spinal.curves import Bezier, Helix
 
 

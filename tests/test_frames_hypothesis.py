@@ -1,11 +1,12 @@
 """Property tests over random curves and random bad input."""
 
 import numpy as np
-import spinal
 from conftest import orthonormality_error
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+
+import spinal
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]
 

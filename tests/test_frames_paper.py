@@ -3,8 +3,9 @@ the closed-form helix benchmark (see ../shared/spec/wang-double-reflection.md §
 
 import numpy as np
 import pytest
-import spinal
 from conftest import angle_between
+
+import spinal
 from spinal.curves import Helix
 
 # Table III (double reflection) of the paper, n = 2^6 … 2^11 segments.
