@@ -77,6 +77,11 @@ def test_long_curve_parallel_scan_matches_closed_form_and_serial():
     exact = h.rmf(u)
     F = spinal.frames(x, t, initial=exact[0][:, 0])
     assert np.linalg.norm(F[:, :, 0] - exact[:, :, 0], axis=1).max() < 1e-10
+    E = spinal.frames(x, t, initial=exact[0][:, 0], end=exact[-1][:, 1])  # twisted, split
+    np.testing.assert_allclose(E[-1][:, 0], exact[-1][:, 1], atol=1e-12)
+    twist = np.arctan2(np.einsum("ij,ij->i", E[:, :, 0], exact[:, :, 1]),
+                       np.einsum("ij,ij->i", E[:, :, 0], exact[:, :, 0]))
+    np.testing.assert_allclose(twist, np.pi / 2 * u / u[-1], atol=1e-9)  # linear in arc length
     k = TorusKnot()
     C = spinal.frames(k.sample(300_001), closed=True, initial=[-1.0, 0, 0])
     np.testing.assert_array_equal(C[-1], C[0])

@@ -9,6 +9,7 @@
 //!   with `t` (first such axis on ties), projected onto the normal plane and normalised.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 #[inline]
 pub fn rotate_about(v: DVec3, t: DVec3, angle: f64) -> DVec3 {
@@ -36,22 +37,25 @@ pub fn any_perpendicular(t: DVec3) -> DVec3 {
     (axis - axis.dot(t) * t).normalize()
 }
 
-/// Largest absolute coordinate, used as the scale for round-off thresholds.
-pub fn max_abs(points: &[DVec3]) -> f64 {
+/// Axis-aligned bounding box `(lo, hi)` (both zero for no points), in parallel.
+pub fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
+    let Some(&p0) = points.first() else {
+        return (DVec3::ZERO, DVec3::ZERO);
+    };
     points
-        .iter()
-        .fold(0.0_f64, |m, p| m.max(p.abs().max_element()))
+        .par_chunks(1 << 12)
+        .map(|c| {
+            c.iter()
+                .fold((p0, p0), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        })
+        .reduce(|| (p0, p0), |a, b| (a.0.min(b.0), a.1.max(b.1)))
 }
 
-/// Diagonal of the axis-aligned bounding box.
-pub fn bbox_diagonal(points: &[DVec3]) -> f64 {
-    if points.is_empty() {
-        return 0.0;
-    }
-    let (lo, hi) = points.iter().fold((points[0], points[0]), |(lo, hi), p| {
-        (lo.min(*p), hi.max(*p))
-    });
-    (hi - lo).length()
+/// Largest absolute coordinate (the scale for round-off thresholds) and the diagonal of the
+/// bounding box.
+pub fn scale_and_diagonal(points: &[DVec3]) -> (f64, f64) {
+    let (lo, hi) = bounds(points);
+    (lo.abs().max(hi.abs()).max_element(), (hi - lo).length())
 }
 
 #[cfg(test)]

@@ -32,7 +32,7 @@ use rayon::prelude::*;
 
 use crate::error::{InputError, Result};
 use double_reflection::DoubleReflection;
-use geometry::{any_perpendicular, bbox_diagonal, max_abs, rotate_about, signed_angle};
+use geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 pub use tangents::TangentRule;
 use transport::{Step, Twist, transport_into};
 
@@ -399,9 +399,14 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
     };
 
     let curvature = if let Some(a) = req.analytic {
-        Curvature::Analytic(a.d1, a.d2, bbox_diagonal(&req.points.unwrap_or(&[])[..n]))
+        Curvature::Analytic(
+            a.d1,
+            a.d2,
+            scale_and_diagonal(&req.points.unwrap_or(&[])[..n]).1,
+        )
     } else if !x.is_empty() {
-        Curvature::Points(x, 64.0 * f64::EPSILON * max_abs(x), bbox_diagonal(x))
+        let (scale, diag) = scale_and_diagonal(x);
+        Curvature::Points(x, 64.0 * f64::EPSILON * scale, diag)
     } else {
         Curvature::Tangents
     };

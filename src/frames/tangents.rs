@@ -151,6 +151,19 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
     d
 }
 
+/// `chord_five_point` at a centred stencil: chords `h = (|x₁−x₀|, …, |x₄−x₃|)` of the
+/// samples `x₀ … x₄`, derivative at `x₂` (the same Lagrange weights, unrolled).
+#[inline(always)]
+fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
+    let (t0, t1, t3, t4) = (-(h[0] + h[1]), -h[1], h[2], h[2] + h[3]);
+    let w0 = -(t1 * t3 * t4) / ((t0 - t1) * t0 * (t0 - t3) * (t0 - t4));
+    let w1 = -(t0 * t3 * t4) / ((t1 - t0) * t1 * (t1 - t3) * (t1 - t4));
+    let w3 = -(t0 * t1 * t4) / ((t3 - t0) * (t3 - t1) * t3 * (t3 - t4));
+    let w4 = -(t0 * t1 * t3) / ((t4 - t0) * (t4 - t1) * t4 * (t4 - t3));
+    let p = x[2];
+    w0 * (x[0] - p) + w1 * (x[1] - p) + w3 * (x[3] - p) + w4 * (x[4] - p)
+}
+
 /// Unnormalised circle tangent at an interior (or periodic) index.
 fn circle_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     let n = x.len();
@@ -194,29 +207,76 @@ pub fn estimate(
         ));
     }
     let five = rule != TangentRule::Circle && n >= 5;
-    let mut t = vec![DVec3::ZERO; n];
-    t.par_iter_mut().enumerate().for_each(|(i, ti)| {
-        *ti = if n == 2 {
-            x[1] - x[0]
-        } else if five && rule == TangentRule::FivePoint {
-            chord_five_point(x, chords, i, closed)
-        } else if five {
-            five_point_raw(x, i, closed)
-        } else if closed || (i > 0 && i + 1 < n) {
-            circle_raw(x, i, closed)
-        } else {
-            DVec3::ZERO // open ends of the circle rule: filled below
-        };
-    });
+    // Estimate and normalise in one pass; a zero (or non-finite) estimate is a cusp. The open
+    // ends of the circle rule are zero here and filled below.
+    let mut t = Vec::with_capacity(n);
+    (0..n)
+        .into_par_iter()
+        .with_min_len(1 << 12)
+        .map(|i| {
+            let v = raw_tangent(x, chords, i, closed, rule, five);
+            let l = v.length();
+            let u = v * (1.0 / l);
+            if l > 0.0 && u.is_finite() {
+                u
+            } else {
+                DVec3::ZERO
+            }
+        })
+        .collect_into_vec(&mut t);
     if !five && !closed && n >= 3 {
         for (end, inner, chord) in [(0, 1, x[1] - x[0]), (n - 1, n - 2, x[n - 1] - x[n - 2])] {
-            let ti = t[inner].normalize_or_zero();
+            let ti = t[inner];
             let c = chord.normalize_or_zero();
-            t[end] = 2.0 * c.dot(ti) * c - ti;
+            t[end] = (2.0 * c.dot(ti) * c - ti).normalize_or_zero();
         }
     }
-    normalize_all(&mut t).map_err(cusp_error)?;
-    Ok(t)
+    match first_zero(&t) {
+        Some(i) => Err(cusp_error(i)),
+        None => Ok(t),
+    }
+}
+
+/// Index of the first zero vector (an estimate that could not be normalised).
+fn first_zero(t: &[DVec3]) -> Option<usize> {
+    t.par_chunks(1 << 12)
+        .position_first(|c| c.contains(&DVec3::ZERO))
+        .and_then(|b| {
+            let a = b << 12;
+            t[a..].iter().position(|v| *v == DVec3::ZERO).map(|k| a + k)
+        })
+}
+
+/// The unnormalised tangent estimate at `i` (zero at the open ends of the circle rule, which
+/// `estimate` fills afterwards).
+#[inline(always)]
+fn raw_tangent(
+    x: &[DVec3],
+    chords: &[f64],
+    i: usize,
+    closed: bool,
+    rule: TangentRule,
+    five: bool,
+) -> DVec3 {
+    let n = x.len();
+    if n == 2 {
+        x[1] - x[0]
+    } else if five && rule == TangentRule::FivePoint {
+        if i >= 2 && i + 2 < n {
+            centred_five_point(
+                [x[i - 2], x[i - 1], x[i], x[i + 1], x[i + 2]],
+                [chords[i - 2], chords[i - 1], chords[i], chords[i + 1]],
+            )
+        } else {
+            chord_five_point(x, chords, i, closed)
+        }
+    } else if five {
+        five_point_raw(x, i, closed)
+    } else if closed || (i > 0 && i + 1 < n) {
+        circle_raw(x, i, closed)
+    } else {
+        DVec3::ZERO
+    }
 }
 
 /// Unit tangents for one curve as the user gave it: validates the points, accepts a closed
@@ -238,16 +298,19 @@ pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec
 /// Normalise in place; on a zero or non-finite result returns the first bad index.
 pub fn normalize_all(t: &mut [DVec3]) -> std::result::Result<(), usize> {
     let bad = t
-        .par_iter_mut()
+        .par_chunks_mut(1 << 12)
         .enumerate()
-        .filter_map(|(i, v)| {
-            let l = v.length();
-            if l > 0.0 && l.is_finite() && (*v / l).is_finite() {
-                *v /= l;
-                None
-            } else {
-                Some(i)
+        .filter_map(|(c, block)| {
+            let mut bad = None;
+            for (k, v) in block.iter_mut().enumerate() {
+                let l = v.length();
+                if l > 0.0 && l.is_finite() && (*v / l).is_finite() {
+                    *v /= l;
+                } else if bad.is_none() {
+                    bad = Some((c << 12) + k);
+                }
             }
+            bad
         })
         .min();
     match bad {

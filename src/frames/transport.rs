@@ -54,6 +54,16 @@ pub fn write_frame(buf: &mut [f64], r: DVec3, t: DVec3) {
     buf[8] = t.z;
 }
 
+/// Turn the `(r, s)` columns of a written frame about its `t` column.
+#[inline(always)]
+fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
+    for row in 0..3 {
+        let (r, s) = (f[3 * row], f[3 * row + 1]);
+        f[3 * row] = cos * r + sin * s;
+        f[3 * row + 1] = cos * s - sin * r;
+    }
+}
+
 /// Transport `r0` (unit, ⟂ `t[0]`) along the curve and write the frames.
 ///
 /// * `t`: unit tangents of the `n` distinct samples; `closed` adds the segment `n−1 → 0`.
@@ -88,48 +98,50 @@ pub fn transport_into<S: Step>(
     let cs = ext.div_ceil(chunks);
     let chunks = ext.div_ceil(cs);
     let bounds = |c: usize| (c * cs, ((c + 1) * cs).min(ext));
+    let write_rows = rows.min(ext);
 
-    // Phase 1: provisional transport of every chunk (skipped when nothing needs it).
-    let need_scan = chunks > 1 || !matches!(twist, Twist::None);
-    let mut start = vec![r0; chunks];
-    let mut len_prefix = vec![0.0; chunks + 1];
-    let mut end_r = r0;
-    if need_scan {
-        let prov: Vec<(DVec3, DVec3, f64)> = (0..chunks)
-            .into_par_iter()
-            .map(|c| {
-                let (a, b) = bounds(c);
-                let s0 = if c == 0 { r0 } else { any_perpendicular(tt(a)) };
-                let mut r = s0;
-                let mut len = 0.0;
-                for (i, l) in seg.iter().enumerate().take(b - 1).skip(a) {
-                    r = step.step(i, r);
-                    len += l;
-                }
-                if b < ext {
-                    len += seg[b - 1];
-                }
-                (s0, r, len)
-            })
-            .collect();
-        // Phase 2: serial fix-up of the chunk start vectors.
-        let mut theta = 0.0;
-        for c in 0..chunks {
-            let (a, b) = bounds(c);
-            len_prefix[c + 1] = len_prefix[c] + prov[c].2;
-            if c > 0 {
-                let (_, pb) = bounds(c - 1);
-                let last = rotate_about(prov[c - 1].1, tt(pb - 1), theta);
-                let true_start = step.step(a - 1, last);
-                theta = signed_angle(prov[c].0, true_start, tt(a));
-                start[c] = true_start;
+    // Phase 1 (parallel): every chunk transports a provisional start vector (the true one
+    // for chunk 0), writes its rows into `buf`, and reports its start, its last vector and
+    // its length.
+    let provisional = |c: usize, buf: &mut [f64]| {
+        let (a, b) = bounds(c);
+        let s0 = if c == 0 { r0 } else { any_perpendicular(tt(a)) };
+        let mut rows = buf.chunks_exact_mut(9);
+        let mut r = s0;
+        for i in a..b {
+            if let Some(f) = rows.next() {
+                write_frame(f, r, tt(i));
             }
-            if c + 1 == chunks {
-                end_r = rotate_about(prov[c].1, tt(b - 1), theta);
+            if i + 1 < b {
+                r = step.step(i, r);
             }
         }
+        (s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>())
+    };
+    let mut prov: Vec<(DVec3, DVec3, f64)> = out[..9 * write_rows]
+        .par_chunks_mut(9 * cs)
+        .enumerate()
+        .map(|(c, buf)| provisional(c, buf))
+        .collect();
+    // A closed curve's extended frame may form a last chunk with no row to write.
+    for c in prov.len()..chunks {
+        prov.push(provisional(c, &mut []));
     }
-    // Without a scan there is one chunk and no twist: the arc-length prefix is not needed.
+
+    // Phase 2 (serial): the angle that turns each chunk's provisional vectors into the true
+    // ones, the arc length at each chunk start, and the true vector at the far end.
+    let mut theta = vec![0.0; chunks];
+    let mut len_prefix = vec![0.0; chunks + 1];
+    for c in 0..chunks {
+        len_prefix[c + 1] = len_prefix[c] + prov[c].2;
+        if c > 0 {
+            let (a, _) = bounds(c);
+            let last = rotate_about(prov[c - 1].1, tt(a - 1), theta[c - 1]);
+            let true_start = step.step(a - 1, last);
+            theta[c] = signed_angle(prov[c].0, true_start, tt(a));
+        }
+    }
+    let end_r = rotate_about(prov[chunks - 1].1, tt(ext - 1), theta[chunks - 1]);
 
     let (raw, total) = match twist {
         Twist::None => (0.0, 0.0),
@@ -149,26 +161,25 @@ pub fn transport_into<S: Step>(
         0.0
     };
 
-    // Phase 3: write the frames from the true chunk starts.
-    let write_rows = rows.min(ext);
-    out[..9 * write_rows]
-        .par_chunks_mut(9 * cs)
-        .enumerate()
-        .for_each(|(c, buf)| {
-            let (a, _) = bounds(c);
-            let k = buf.len() / 9;
-            let mut r = start[c];
-            let mut s = len_prefix[c];
-            for (off, f) in buf.chunks_exact_mut(9).enumerate() {
-                let i = a + off;
-                let ti = tt(i);
-                write_frame(f, rotate_about(r, ti, rate * s), ti);
-                if off + 1 < k {
-                    r = step.step(i, r);
-                    s += seg[i];
+    // Phase 3 (parallel): turn every row about its tangent by the chunk's correction plus the
+    // twist `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r).
+    if rate != 0.0 || theta.iter().any(|&a| a != 0.0) {
+        out[..9 * write_rows]
+            .par_chunks_mut(9 * cs)
+            .enumerate()
+            .for_each(|(c, buf)| {
+                let (a, _) = bounds(c);
+                let mut arc = len_prefix[c];
+                let (mut sin, mut cos) = theta[c].sin_cos();
+                for (off, f) in buf.chunks_exact_mut(9).enumerate() {
+                    if rate != 0.0 {
+                        (sin, cos) = (theta[c] + rate * arc).sin_cos();
+                        arc += seg[(a + off).min(seg.len() - 1)];
+                    }
+                    turn_frame(f, cos, sin);
                 }
-            }
-        });
+            });
+    }
     if closed && rows == n + 1 {
         let (head, tail) = out.split_at_mut(9 * n);
         tail[..9].copy_from_slice(&head[..9]);

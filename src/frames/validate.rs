@@ -20,8 +20,21 @@ pub const COINCIDE_EPS: f64 = 8.0 * f64::EPSILON;
 /// Smallest accepted `v̂₁·(t_i + t_{i+1})`.
 pub const MIN_ALIGNMENT: f64 = 1e-6;
 
+/// Rows per parallel task in the cheap whole-array checks.
+const CHECK_CHUNK: usize = 1 << 12;
+
+/// Index of the first element failing `ok`, scanning blocks in parallel.
+fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+    v.par_chunks(CHECK_CHUNK)
+        .position_first(|c| !c.iter().all(&ok))
+        .and_then(|b| {
+            let a = b * CHECK_CHUNK;
+            v[a..].iter().position(|p| !ok(p)).map(|k| a + k)
+        })
+}
+
 pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
-    match v.par_iter().position_first(|p| !p.is_finite()) {
+    match first_bad(v, |p| p.is_finite()) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             arg,
@@ -31,7 +44,7 @@ pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
 }
 
 pub fn finite_scalars(arg: &'static str, v: &[f64]) -> Result<()> {
-    match v.par_iter().position_first(|p| !p.is_finite()) {
+    match first_bad(v, |p| p.is_finite()) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             arg,
@@ -57,12 +70,20 @@ pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
     let m = if closed { n } else { n.saturating_sub(1) };
     let mut seg = vec![0.0; m];
     let bad = seg
-        .par_iter_mut()
+        .par_chunks_mut(CHECK_CHUNK)
         .enumerate()
-        .filter_map(|(i, l)| {
-            let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
-            *l = (b - a).length();
-            coincide(a, b).then_some(i)
+        .filter_map(|(c, ls)| {
+            let a0 = c * CHECK_CHUNK;
+            let mut bad = None;
+            for (k, l) in ls.iter_mut().enumerate() {
+                let i = a0 + k;
+                let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
+                *l = (b - a).length();
+                if bad.is_none() && coincide(a, b) {
+                    bad = Some(i);
+                }
+            }
+            bad
         })
         .min();
     match bad {
@@ -87,12 +108,17 @@ pub fn aligned(
 ) -> Result<()> {
     let n = t.len();
     let m = if closed { n } else { n - 1 };
-    let bad = (0..m).into_par_iter().position_first(|i| {
+    // v̂·(t_i + t_j) > MIN  ⇔  d > 0 and d² > MIN²·|v|²  with d = v·(t_i + t_j).
+    let ok = |i: usize| {
         let v = chord(i);
-        let j = (i + 1) % n;
-        let a = v.dot(t[i] + t[j]) / v.length();
-        !(a > MIN_ALIGNMENT)
-    });
+        let j = if i + 1 == n { 0 } else { i + 1 };
+        let d = v.dot(t[i] + t[j]);
+        d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * v.length_squared()
+    };
+    let bad = (0..m.div_ceil(CHECK_CHUNK))
+        .into_par_iter()
+        .position_first(|c| !(c * CHECK_CHUNK..((c + 1) * CHECK_CHUNK).min(m)).all(&ok))
+        .and_then(|c| (c * CHECK_CHUNK..m).find(|&i| !ok(i)));
     match bad {
         None => Ok(()),
         Some(i) => Err(InputError::new(
