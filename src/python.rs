@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 
 use crate::error::InputError;
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+use crate::sweep::{self, Options, Profile, Spine};
 
 type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
@@ -218,11 +219,103 @@ fn estimate_tangents<'py>(
     PyArray1::from_vec(py, flat).reshape([t.len(), 3])
 }
 
+fn offsets_of(offsets: &PyReadonlyArray1<'_, i64>) -> PyResult<Vec<usize>> {
+    offsets
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("offsets must be contiguous"))?
+        .iter()
+        .map(|&o| usize::try_from(o))
+        .collect::<Result<_, _>>()
+        .map_err(|_| PyValueError::new_err("lengths: must be non-negative"))
+}
+
+fn slice_of<'a, T: numpy::Element>(
+    arg: &str,
+    a: &'a numpy::PyReadonlyArray<'_, T, impl numpy::ndarray::Dimension>,
+) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{arg}: array must be C-contiguous")))
+}
+
+type MeshArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// Sweep a profile along one or many spines; see `spinal.sweep`.
+#[pyfunction]
+#[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
+                    miter_limit, split_seams))]
+#[allow(clippy::too_many_arguments)]
+fn sweep_mesh<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    frames: PyReadonlyArray3<'py, f64>,
+    scale: PyReadonlyArray2<'py, f64>,
+    twist: Option<PyReadonlyArray1<'py, f64>>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    profile: PyReadonlyArray2<'py, f64>,
+    profile_closed: bool,
+    closed: bool,
+    caps: bool,
+    miter_limit: f64,
+    split_seams: bool,
+) -> PyResult<MeshArrays<'py>> {
+    let pts = vec3s("points", &points)?;
+    let fr: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
+    let sc: &[glam::DVec2] = bytemuck::cast_slice(slice_of("scale", &scale)?);
+    let tw: &[f64] = match &twist {
+        Some(t) => slice_of("twist", t)?,
+        None => &[],
+    };
+    let prof: &[glam::DVec2] = bytemuck::cast_slice(slice_of("profile", &profile)?);
+    let offsets = offsets_of(&offsets)?;
+    let opts = Options {
+        closed,
+        caps,
+        miter_limit,
+        split_seams,
+    };
+    let mesh = py
+        .detach(|| {
+            let p = Profile::new(prof, profile_closed)?;
+            let spine = Spine {
+                points: pts,
+                frames: fr,
+                scale: sc,
+                twist: tw,
+            };
+            sweep::sweep_many(&spine, &offsets, &p, &opts)
+        })
+        .map_err(to_py)?;
+    let nv = mesh.vertices.len();
+    let nf = mesh.faces.len();
+    let flat3 = |v: Vec<glam::DVec3>| -> Vec<f64> { bytemuck::allocation::cast_vec(v) };
+    let v = PyArray1::from_vec(py, flat3(mesh.vertices)).reshape([nv, 3])?;
+    let n = PyArray1::from_vec(py, flat3(mesh.normals)).reshape([nv, 3])?;
+    let uv = PyArray1::from_vec(
+        py,
+        bytemuck::allocation::cast_vec::<glam::DVec2, f64>(mesh.uv),
+    )
+    .reshape([nv, 2])?;
+    let f = PyArray1::from_vec(
+        py,
+        bytemuck::allocation::cast_vec::<[i64; 3], i64>(mesh.faces),
+    )
+    .reshape([nf, 3])?;
+    let folds: Vec<i64> = mesh.folds.iter().map(|&i| i as i64).collect();
+    Ok((v, f, n, uv, PyArray1::from_vec(py, folds)))
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
     m.add_function(wrap_pyfunction!(frames_analytic, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_tangents, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_mesh, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,11 +1,24 @@
 """spinal: moving frames, sweeps and volume-preserving deformations along 3D curves.
 
 Frames are ``(n, 3, 3)`` rotation matrices whose columns are ``(r, s, t)``: the reference
-vector, ``s = t × r`` and the unit tangent. See :func:`frames`.
+vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tubes turn
+curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
 """
 
 from . import curves
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
+from ._mesh import FoldOverWarning, Mesh
+from ._sweep import sweep, tube
 
-__all__ = ["__version__", "closing_angle", "curves", "estimate_tangents", "frames"]
+__all__ = [
+    "FoldOverWarning",
+    "Mesh",
+    "__version__",
+    "closing_angle",
+    "curves",
+    "estimate_tangents",
+    "frames",
+    "sweep",
+    "tube",
+]

@@ -1,0 +1,139 @@
+"""The triangle mesh returned by the sweeps, with conversions to trimesh and pyvista."""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FoldOverWarning", "Mesh"]
+
+
+class FoldOverWarning(UserWarning):
+    """The swept profile reaches past the spine's centre of curvature, so the surface folds
+    over itself there. ``indices`` holds the spine rows that start the folded segments."""
+
+    def __init__(self, message: str, indices: np.ndarray):
+        super().__init__(message)
+        self.indices = indices
+
+
+class Mesh:
+    """A triangle mesh: what :func:`spinal.sweep` and :func:`spinal.tube` return.
+
+    Attributes
+    ----------
+    vertices : ndarray (V, 3) float64
+    faces : ndarray (F, 3) int64
+        Vertex indices, counter-clockwise seen from outside (the right-hand normal points
+        outwards on closed and capped sweeps).
+    normals : ndarray (V, 3) float64
+        Unit normals of the smooth swept surface at the vertices (not averaged face normals).
+    uv : ndarray (V, 2) float64
+        Texture coordinates: ``u`` = arc length of the spine at the vertex's ring (in the
+        units of the points), ``v`` = arc length around the profile / its perimeter.
+    fold_over : ndarray (k,) int64
+        Spine rows starting a segment where the surface folds over itself (empty when
+        none); see :class:`FoldOverWarning`.
+    """
+
+    def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None):
+        self.vertices = np.asarray(vertices, dtype=np.float64)
+        self.faces = np.asarray(faces, dtype=np.int64)
+        self.normals = None if normals is None else np.asarray(normals, dtype=np.float64)
+        self.uv = None if uv is None else np.asarray(uv, dtype=np.float64)
+        self.fold_over = (
+            np.zeros(0, dtype=np.int64) if fold_over is None else np.asarray(fold_over, np.int64)
+        )
+
+    def __repr__(self) -> str:
+        return f"spinal.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
+
+    @property
+    def volume(self) -> float:
+        """Signed enclosed volume, ``Σ (a · (b × c)) / 6`` over the faces (divergence
+        theorem); positive for a closed, outward-facing mesh."""
+        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
+        return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+    @property
+    def area(self) -> float:
+        """Total surface area."""
+        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
+        return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+
+    @property
+    def is_watertight(self) -> bool:
+        """Every edge is shared by exactly two faces that traverse it in opposite directions
+        (closed, consistently oriented, by vertex index)."""
+        f = self.faces
+        e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        key = e[:, 0] * (len(self.vertices) + 1) + e[:, 1]
+        rev = e[:, 1] * (len(self.vertices) + 1) + e[:, 0]
+        if np.unique(key).size != key.size:  # a directed edge used twice
+            return False
+        return bool(np.isin(rev, key).all())
+
+    def to_trimesh(self):
+        """A ``trimesh.Trimesh`` with the same vertices, faces and normals (no merging or
+        reordering; ``uv`` goes to a ``TextureVisuals`` when present)."""
+        import trimesh
+
+        visual = None
+        if self.uv is not None:
+            visual = trimesh.visual.TextureVisuals(uv=self.uv)
+        return trimesh.Trimesh(
+            vertices=self.vertices,
+            faces=self.faces,
+            vertex_normals=self.normals,
+            visual=visual,
+            process=False,
+        )
+
+    def to_pyvista(self):
+        """A ``pyvista.PolyData`` with point data ``Normals`` (active normals) and the
+        texture coordinates ``uv``."""
+        import pyvista as pv
+
+        cells = np.hstack([np.full((len(self.faces), 1), 3, dtype=np.int64), self.faces])
+        poly = pv.PolyData(self.vertices, cells.ravel())
+        if self.normals is not None:
+            poly.point_data["Normals"] = self.normals
+            poly.point_data.active_normals_name = "Normals"
+        if self.uv is not None:
+            poly.point_data["uv"] = self.uv
+            poly.point_data.active_texture_coordinates_name = "uv"
+        return poly
+
+    def plot(self, screenshot: str | os.PathLike | None = None, *, window_size=(800, 600),
+             **kwargs: Any):
+        """Render with pyvista.
+
+        Off-screen (when there is no display, or when ``screenshot`` is given) the image is
+        returned as an ``(h, w, 3)`` uint8 array and written to ``screenshot`` if given;
+        otherwise an interactive window opens. Extra keyword arguments go to
+        ``Plotter.add_mesh`` (default: smooth shading with sharp edges split, so caps and
+        profile corners stay crisp).
+        """
+        import pyvista as pv
+
+        off = screenshot is not None or pv.OFF_SCREEN or not _has_display()
+        pl = pv.Plotter(off_screen=off, window_size=list(window_size))
+        kwargs.setdefault("smooth_shading", True)
+        kwargs.setdefault("split_sharp_edges", True)
+        kwargs.setdefault("color", "#c9a227")
+        pl.add_mesh(self.to_pyvista(), **kwargs)
+        pl.camera_position = "iso"
+        pl.reset_camera()
+        if off:
+            img = pl.screenshot(None if screenshot is None else os.fspath(screenshot),
+                                return_img=True)
+            pl.close()
+            return img
+        pl.show()
+        return None
+
+
+def _has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
