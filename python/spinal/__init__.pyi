@@ -1,5 +1,6 @@
+import os
 from collections.abc import Sequence
-from typing import Literal, TypeAlias
+from typing import Any, Literal, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -39,3 +40,66 @@ def closing_angle(
 def estimate_tangents(
     points: _Array, *, closed: bool = False, method: Literal["five_point", "five_point_uniform", "circle"] = "five_point"
 ) -> npt.NDArray[np.float64]: ...
+
+_Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
+
+class FoldOverWarning(UserWarning):
+    indices: npt.NDArray[np.int64]
+    def __init__(self, message: str, indices: npt.NDArray[np.int64]) -> None: ...
+
+class Mesh:
+    vertices: npt.NDArray[np.float64]
+    faces: npt.NDArray[np.int64]
+    normals: npt.NDArray[np.float64] | None
+    uv: npt.NDArray[np.float64] | None
+    fold_over: npt.NDArray[np.int64]
+    def __init__(
+        self,
+        vertices: _Array,
+        faces: _Array,
+        normals: _Array | None = None,
+        uv: _Array | None = None,
+        fold_over: _Array | None = None,
+    ) -> None: ...
+    @property
+    def volume(self) -> float: ...
+    @property
+    def area(self) -> float: ...
+    @property
+    def is_watertight(self) -> bool: ...
+    def to_trimesh(self) -> Any: ...
+    def to_pyvista(self) -> Any: ...
+    def plot(
+        self, screenshot: str | os.PathLike[str] | None = None, *, window_size: tuple[int, int] = ..., **kwargs: Any
+    ) -> npt.NDArray[np.uint8] | None: ...
+
+def sweep(
+    points: _Array,
+    profile: _Array,
+    *,
+    frames: _Array | None = None,
+    scale: float | _Array | None = None,
+    twist: float | _Array | None = None,
+    closed: bool = False,
+    caps: bool = True,
+    profile_closed: bool = True,
+    miter_limit: float = 4.0,
+    split_seams: bool = False,
+    strict: bool = False,
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
+) -> Mesh: ...
+def tube(
+    points: _Array,
+    radius: float | _Array = 1.0,
+    sides: int = 16,
+    *,
+    frames: _Array | None = None,
+    closed: bool = False,
+    caps: bool = True,
+    miter_limit: float = 4.0,
+    split_seams: bool = False,
+    strict: bool = False,
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
+) -> Mesh: ...

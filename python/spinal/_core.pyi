@@ -35,3 +35,22 @@ def frames_analytic(
 def estimate_tangents(
     points: npt.NDArray[np.float64], closed: bool, rule: str
 ) -> npt.NDArray[np.float64]: ...
+def sweep_mesh(
+    points: npt.NDArray[np.float64],
+    frames: npt.NDArray[np.float64],
+    scale: npt.NDArray[np.float64],
+    twist: npt.NDArray[np.float64] | None,
+    offsets: npt.NDArray[np.int64],
+    profile: npt.NDArray[np.float64],
+    profile_closed: bool,
+    closed: bool,
+    caps: bool,
+    miter_limit: float,
+    split_seams: bool,
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+]: ...

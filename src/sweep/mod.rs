@@ -229,6 +229,45 @@ fn central_weights(h1: f64, h2: f64) -> [f64; 3] {
     ]
 }
 
+/// Derivative along the spine at ring `i`: three rings and their weights (three-point rule
+/// in arc length; one-sided at open ends; two points for a two-sample spine).
+fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3], [f64; 3]) {
+    if closed {
+        let (a, b) = ((i + r_n - 1) % r_n, (i + 1) % r_n);
+        let h1 = if i == 0 {
+            arc[r_n] - arc[r_n - 1]
+        } else {
+            arc[i] - arc[i - 1]
+        };
+        let h2 = arc[i + 1] - arc[i];
+        ([a, i, b], central_weights(h1, h2))
+    } else if r_n == 2 {
+        let h = arc[1] - arc[0];
+        ([0, 1, 1], [-1.0 / h, 1.0 / h, 0.0])
+    } else if i == 0 || i + 1 == r_n {
+        let (i0, i1, i2) = if i == 0 {
+            (0, 1, 2)
+        } else {
+            (r_n - 1, r_n - 2, r_n - 3)
+        };
+        let h1 = (arc[i1] - arc[i0]).abs();
+        let h2 = (arc[i2] - arc[i1]).abs();
+        let sg = if i == 0 { 1.0 } else { -1.0 };
+        (
+            [i0, i1, i2],
+            [
+                -sg * (2.0 * h1 + h2) / (h1 * (h1 + h2)),
+                sg * (h1 + h2) / (h1 * h2),
+                -sg * h1 / (h2 * (h1 + h2)),
+            ],
+        )
+    } else {
+        let h1 = arc[i] - arc[i - 1];
+        let h2 = arc[i + 1] - arc[i];
+        ([i - 1, i, i + 1], central_weights(h1, h2))
+    }
+}
+
 /// Sweep one spine into its share of the output buffers.
 #[allow(clippy::too_many_arguments)]
 fn sweep_one(
@@ -248,6 +287,8 @@ fn sweep_one(
     let cols = plan.cols;
     let x = &s.points[..r_n];
     let closed = opts.closed;
+    // Rings per parallel task: enough work (~4k vertices) to pay for the task.
+    let grain = (4096 / cols).max(1);
     // Arc length at every ring (and the closing chord).
     let mut arc = Vec::with_capacity(r_n + 1);
     let mut acc = 0.0;
@@ -261,105 +302,81 @@ fn sweep_one(
     }
     let tangent = |i: usize| columns(&s.frames[i % r_n]).2;
 
-    // Vertices and uv, ring by ring (stored ring `i` is spine sample `i mod rings`, stored
-    // column `j` is profile vertex `j mod m`; the duplicates carry u = L and v = 1).
+    // Pass 1: ring positions of the smooth swept surface (before the mitre) and uv; stored
+    // ring `i` is spine sample `i mod rings`, stored column `j` is profile vertex `j mod m`
+    // (the duplicates of split seams carry u = L and v = 1).
     verts
         .par_chunks_mut(cols)
         .zip(uv.par_chunks_mut(cols))
+        .with_min_len(grain)
         .enumerate()
         .for_each(|(i, (ring, ruv))| {
             let k = i % r_n;
-            let (r, q, t) = columns(&s.frames[k]);
-            let (mf, mk) = mitre(x, t, k, closed, opts.miter_limit);
+            let (r, q, _) = columns(&s.frames[k]);
             let sc = s.scale[k];
             let (sn, cs) = if s.twist.is_empty() {
                 (0.0, 1.0)
             } else {
                 s.twist[k].sin_cos()
             };
+            let (ra, rb) = (sc.x * (cs * r + sn * q), sc.y * (cs * q - sn * r));
             for (j, (v, w)) in ring.iter_mut().zip(ruv.iter_mut()).enumerate() {
                 let pj = p.points[j % m];
-                let (a, b) = (sc.x * pj.x, sc.y * pj.y);
-                let off = (cs * a - sn * b) * r + (sn * a + cs * b) * q;
-                *v = x[k] + off + (mf * off.dot(mk)) * mk;
+                *v = x[k] + pj.x * ra + pj.y * rb;
                 *w = DVec2::new(arc[i], if j == m { 1.0 } else { p.v[j] });
             }
         });
 
-    // Normals of the smooth swept surface, from differences of the ring positions before
-    // the mitre stretch (a discretisation correction that would otherwise tilt them).
-    let verts: &[DVec3] = verts;
-    let at = |ii: usize, jj: usize| verts[ii * cols + jj];
-    let smooth = |ii: usize, jj: usize| {
-        let (r, q, _) = columns(&s.frames[ii]);
-        let sc = s.scale[ii];
-        let (sn, cs) = if s.twist.is_empty() {
-            (0.0, 1.0)
-        } else {
-            s.twist[ii].sin_cos()
-        };
-        let (a, b) = (sc.x * p.points[jj].x, sc.y * p.points[jj].y);
-        x[ii] + (cs * a - sn * b) * r + (sn * a + cs * b) * q
-    };
-    let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
-    normals
+    // Pass 2: normals of the smooth swept surface from differences of those positions (the
+    // mitre, a discretisation correction, would otherwise tilt them).
+    {
+        let verts: &[DVec3] = verts;
+        let at = |ii: usize, jj: usize| verts[ii * cols + jj];
+        let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
+        normals
+            .par_chunks_mut(cols)
+            .with_min_len(grain)
+            .enumerate()
+            .for_each(|(i, ring)| {
+                let i = i % r_n;
+                let (idx, w) = spine_weights(&arc, i, r_n, closed);
+                let t = tangent(i);
+                for (j, nv) in ring.iter_mut().enumerate() {
+                    let j = j % m;
+                    let (jp, jn) = if p.closed {
+                        ((j + m - 1) % m, (j + 1) % m)
+                    } else {
+                        (j.saturating_sub(1), (j + 1).min(m - 1))
+                    };
+                    let e = at(i, jn) - at(i, jp);
+                    let su = w[0] * at(idx[0], j) + w[1] * at(idx[1], j) + w[2] * at(idx[2], j);
+                    let nn = sign * e.cross(su);
+                    *nv = nn
+                        .try_normalize()
+                        .or_else(|| (sign * e.cross(t)).try_normalize())
+                        .unwrap_or(t);
+                }
+            });
+    }
+
+    // Pass 3: the mitre stretch, ring by ring.
+    verts
         .par_chunks_mut(cols)
+        .with_min_len(grain)
         .enumerate()
         .for_each(|(i, ring)| {
-            let i = i % r_n;
-            // Along the spine: weights on rings (i0, i1, i2).
-            let (idx, w) = if closed {
-                let (a, b) = ((i + r_n - 1) % r_n, (i + 1) % r_n);
-                let h1 = if i == 0 {
-                    arc[r_n] - arc[r_n - 1]
-                } else {
-                    arc[i] - arc[i - 1]
-                };
-                let h2 = arc[i + 1] - arc[i];
-                ([a, i, b], central_weights(h1, h2))
-            } else if r_n == 2 {
-                let h = arc[1] - arc[0];
-                ([0, 1, 1], [-1.0 / h, 1.0 / h, 0.0])
-            } else if i == 0 || i + 1 == r_n {
-                let (i0, i1, i2) = if i == 0 {
-                    (0, 1, 2)
-                } else {
-                    (r_n - 1, r_n - 2, r_n - 3)
-                };
-                let h1 = (arc[i1] - arc[i0]).abs();
-                let h2 = (arc[i2] - arc[i1]).abs();
-                let sg = if i == 0 { 1.0 } else { -1.0 };
-                (
-                    [i0, i1, i2],
-                    [
-                        -sg * (2.0 * h1 + h2) / (h1 * (h1 + h2)),
-                        sg * (h1 + h2) / (h1 * h2),
-                        -sg * h1 / (h2 * (h1 + h2)),
-                    ],
-                )
-            } else {
-                let h1 = arc[i] - arc[i - 1];
-                let h2 = arc[i + 1] - arc[i];
-                ([i - 1, i, i + 1], central_weights(h1, h2))
-            };
-            let t = tangent(i);
-            for (j, nv) in ring.iter_mut().enumerate() {
-                let j = j % m;
-                let (jp, jn) = if p.closed {
-                    ((j + m - 1) % m, (j + 1) % m)
-                } else {
-                    (j.saturating_sub(1), (j + 1).min(m - 1))
-                };
-                let e = smooth(i, jn) - smooth(i, jp);
-                let su =
-                    w[0] * smooth(idx[0], j) + w[1] * smooth(idx[1], j) + w[2] * smooth(idx[2], j);
-                let nn = sign * e.cross(su);
-                *nv = nn
-                    .try_normalize()
-                    .or_else(|| (sign * e.cross(t)).try_normalize())
-                    .unwrap_or(t);
+            let k = i % r_n;
+            let (mf, mk) = mitre(x, tangent(k), k, closed, opts.miter_limit);
+            if mf != 0.0 {
+                for v in ring.iter_mut() {
+                    let off = *v - x[k];
+                    *v += (mf * off.dot(mk)) * mk;
+                }
             }
         });
+    let verts: &[DVec3] = verts;
+    let at = |ii: usize, jj: usize| verts[ii * cols + jj];
+    let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
 
     // Side faces. Without split seams the last column/ring wraps to the first.
     let edges = if p.closed { m } else { m - 1 };
@@ -367,6 +384,7 @@ fn sweep_one(
     let col = |j: usize| if j == cols { 0 } else { j };
     let row = |i: usize| if i == plan.stored_rings { 0 } else { i };
     side.par_chunks_mut(2 * edges)
+        .with_min_len(grain)
         .enumerate()
         .for_each(|(i, quads)| {
             let id = |ii: usize, jj: usize| (vbase + row(ii) * cols + col(jj)) as i64;
@@ -396,6 +414,7 @@ fn sweep_one(
     // Fold-over: rail edges must advance along both tangents.
     (0..plan.segments)
         .into_par_iter()
+        .with_min_len(grain)
         .filter(|&i| {
             let i2 = (i + 1) % r_n;
             let (ta, tb) = (tangent(i), tangent(i2));
