@@ -115,13 +115,7 @@ fn frames_sampled<'py>(
         .map(|t| vec3s("tangents", t))
         .transpose()?;
     let rows = pts.or(tgs).map(<[DVec3]>::len).unwrap_or(0);
-    let offsets: Vec<usize> = offsets
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("offsets must be contiguous"))?
-        .iter()
-        .map(|&o| usize::try_from(o))
-        .collect::<Result<_, _>>()
-        .map_err(|_| PyValueError::new_err("lengths: must be non-negative"))?;
+    let offsets = offsets_of(&offsets)?;
     let initial = orientations(initial_vectors, initial_frames)?;
     let end = orientations(end_vectors, end_frames)?;
     let template = Request {
