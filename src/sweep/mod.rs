@@ -104,7 +104,7 @@ struct Plan {
 }
 
 impl Plan {
-    fn vertices(&self, _m: usize) -> usize {
+    fn vertices(&self) -> usize {
         self.stored_rings * self.cols
     }
     fn faces(&self, p: &Profile) -> usize {
@@ -289,6 +289,8 @@ fn sweep_one(
     let closed = opts.closed;
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
     let grain = (4096 / cols).max(1);
+    // Winding: normals to the right of the profile's direction, outward for closed profiles.
+    let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
     // Arc length at every ring (and the closing chord).
     let mut arc = Vec::with_capacity(r_n + 1);
     let mut acc = 0.0;
@@ -332,7 +334,6 @@ fn sweep_one(
     {
         let verts: &[DVec3] = verts;
         let at = |ii: usize, jj: usize| verts[ii * cols + jj];
-        let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
         normals
             .par_chunks_mut(cols)
             .with_min_len(grain)
@@ -376,7 +377,6 @@ fn sweep_one(
         });
     let verts: &[DVec3] = verts;
     let at = |ii: usize, jj: usize| verts[ii * cols + jj];
-    let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
 
     // Side faces. Without split seams the last column/ring wraps to the first.
     let edges = if p.closed { m } else { m - 1 };
@@ -494,7 +494,7 @@ pub fn sweep_many(
             ..p
         })
         .collect();
-    let nv: usize = plans.iter().map(|p| p.vertices(m)).sum();
+    let nv: usize = plans.iter().map(|p| p.vertices()).sum();
     let nf: usize = plans.iter().map(|p| p.faces(profile)).sum();
     let mut mesh = Mesh {
         vertices: vec![DVec3::ZERO; nv],
@@ -514,7 +514,7 @@ pub fn sweep_many(
         );
         let mut vbase = 0;
         for (c, plan) in plans.iter().enumerate() {
-            let (k, kf) = (plan.vertices(m), plan.faces(profile));
+            let (k, kf) = (plan.vertices(), plan.faces(profile));
             let (v1, v2) = v.split_at_mut(k);
             let (n1, n2) = nr.split_at_mut(k);
             let (u1, u2) = u.split_at_mut(k);
