@@ -273,35 +273,60 @@ fn sweep_mesh<'py>(
         miter_limit,
         split_seams,
     };
-    let mesh = py
+    let spine = Spine {
+        points: pts,
+        frames: fr,
+        scale: sc,
+        twist: tw,
+    };
+    let (p, lay) = py
         .detach(|| {
             let p = Profile::new(prof, profile_closed)?;
-            let spine = Spine {
-                points: pts,
-                frames: fr,
-                scale: sc,
-                twist: tw,
-            };
-            sweep::sweep_many(&spine, &offsets, &p, &opts)
+            let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
+            Ok((p, lay))
         })
         .map_err(to_py)?;
-    let nv = mesh.vertices.len();
-    let nf = mesh.faces.len();
-    let flat3 = |v: Vec<glam::DVec3>| -> Vec<f64> { bytemuck::allocation::cast_vec(v) };
-    let v = PyArray1::from_vec(py, flat3(mesh.vertices)).reshape([nv, 3])?;
-    let n = PyArray1::from_vec(py, flat3(mesh.normals)).reshape([nv, 3])?;
-    let uv = PyArray1::from_vec(
-        py,
-        bytemuck::allocation::cast_vec::<glam::DVec2, f64>(mesh.uv),
-    )
-    .reshape([nv, 2])?;
-    let f = PyArray1::from_vec(
-        py,
-        bytemuck::allocation::cast_vec::<[i64; 3], i64>(mesh.faces),
-    )
-    .reshape([nf, 3])?;
-    let folds: Vec<i64> = mesh.folds.iter().map(|&i| i as i64).collect();
+    let (nv, nf) = (lay.vertices, lay.faces);
+    let v = empty::<f64>(py, nv, 3)?;
+    let n = empty::<f64>(py, nv, 3)?;
+    let uv = empty::<f64>(py, nv, 2)?;
+    let f = empty::<i64>(py, nf, 3)?;
+    let folds = {
+        let (mut wv, mut wn, mut wu, mut wf) =
+            (v.readwrite(), n.readwrite(), uv.readwrite(), f.readwrite());
+        let out = sweep::MeshMut {
+            vertices: bytemuck::cast_slice_mut(slice_mut(&mut wv)?),
+            faces: bytemuck::cast_slice_mut(slice_mut(&mut wf)?),
+            normals: bytemuck::cast_slice_mut(slice_mut(&mut wn)?),
+            uv: bytemuck::cast_slice_mut(slice_mut(&mut wu)?),
+        };
+        py.detach(|| sweep::sweep_into(&spine, &offsets, &p, &opts, &lay, out))
+    };
+    let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
     Ok((v, f, n, uv, PyArray1::from_vec(py, folds)))
+}
+
+/// `numpy.empty((rows, cols), dtype)`: NumPy's allocator reuses freed heap memory for small
+/// arrays and asks for transparent huge pages for large ones, and nothing is zeroed, so an
+/// output that is written once costs about what NumPy's own write floor costs. Every
+/// caller writes every element.
+fn empty<'py, T: numpy::Element>(
+    py: Python<'py>,
+    rows: usize,
+    cols: usize,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let np = py.import("numpy")?;
+    let a = np
+        .getattr("empty")?
+        .call1(((rows, cols), numpy::dtype::<T>(py)))?;
+    Ok(a.cast_into::<PyArray2<T>>()?)
+}
+
+fn slice_mut<'a, T: numpy::Element>(
+    a: &'a mut numpy::PyReadwriteArray<'_, T, numpy::Ix2>,
+) -> PyResult<&'a mut [T]> {
+    a.as_slice_mut()
+        .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 #[pymodule(name = "_core")]

@@ -24,7 +24,7 @@ pub const MIN_ALIGNMENT: f64 = 1e-6;
 const CHECK_CHUNK: usize = 1 << 12;
 
 /// Index of the first element failing `ok`, scanning blocks in parallel.
-fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+pub(crate) fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Option<usize> {
     v.par_chunks(CHECK_CHUNK)
         .position_first(|c| !c.iter().all(&ok))
         .and_then(|b| {

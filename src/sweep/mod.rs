@@ -90,7 +90,7 @@ fn columns(f: &[f64; 9]) -> (DVec3, DVec3, DVec3) {
 }
 
 /// Layout of one spine's part of the mesh.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Plan {
     /// Distinct spine samples.
     rings: usize,
@@ -101,6 +101,8 @@ struct Plan {
     /// Vertices per stored ring (one more than the profile for a closed profile with split
     /// seams).
     cols: usize,
+    /// Arc length of the spine polyline at every ring (and after the closing chord).
+    arc: Vec<f64>,
 }
 
 impl Plan {
@@ -113,7 +115,22 @@ impl Plan {
     }
 }
 
-fn check_spine(s: &Spine, opts: &Options) -> Result<Plan> {
+/// Is `f` (row-major, columns `r, s, t`) a rotation matrix to 10⁻⁶?
+fn is_rotation(f: &[f64; 9]) -> bool {
+    let (r, q, t) = columns(f);
+    r.is_finite()
+        && q.is_finite()
+        && t.is_finite()
+        && (r.length_squared() - 1.0).abs() < 1e-6
+        && (q.length_squared() - 1.0).abs() < 1e-6
+        && (t.length_squared() - 1.0).abs() < 1e-6
+        && r.dot(q).abs() < 1e-6
+        && r.dot(t).abs() < 1e-6
+        && q.dot(t).abs() < 1e-6
+        && r.cross(q).dot(t) > 0.0
+}
+
+fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
     let n = s.points.len();
     if s.frames.len() != n {
         return Err(InputError::new(
@@ -148,18 +165,8 @@ fn check_spine(s: &Spine, opts: &Options) -> Result<Plan> {
             ),
         ));
     }
-    validate::chords(&s.points[..rings], opts.closed)?;
-    if let Some(i) = s.frames.iter().position(|f| {
-        let (r, q, t) = columns(f);
-        !(r.is_finite() && q.is_finite() && t.is_finite())
-            || !((r.length_squared() - 1.0).abs() < 1e-6
-                && (q.length_squared() - 1.0).abs() < 1e-6
-                && (t.length_squared() - 1.0).abs() < 1e-6
-                && r.dot(q).abs() < 1e-6
-                && r.dot(t).abs() < 1e-6
-                && q.dot(t).abs() < 1e-6
-                && r.cross(q).dot(t) > 0.0)
-    }) {
+    let chords = validate::chords(&s.points[..rings], opts.closed)?;
+    if let Some(i) = validate::first_bad(s.frames, is_rotation) {
         return Err(InputError::new(
             "frames",
             format!(
@@ -168,11 +175,7 @@ fn check_spine(s: &Spine, opts: &Options) -> Result<Plan> {
             ),
         ));
     }
-    if let Some(i) = s
-        .scale
-        .iter()
-        .position(|v| !(v.x > 0.0 && v.y > 0.0 && v.is_finite()))
-    {
+    if let Some(i) = validate::first_bad(s.scale, |v| v.x > 0.0 && v.y > 0.0 && v.is_finite()) {
         return Err(InputError::new(
             "scale",
             format!(
@@ -182,18 +185,26 @@ fn check_spine(s: &Spine, opts: &Options) -> Result<Plan> {
             ),
         ));
     }
-    if let Some(i) = s.twist.iter().position(|v| !v.is_finite()) {
+    if let Some(i) = validate::first_bad(s.twist, |v| v.is_finite()) {
         return Err(InputError::new(
             "twist",
             format!("non-finite value at row {i}"),
         ));
     }
+    let mut arc = Vec::with_capacity(chords.len() + 1);
+    let mut acc = 0.0;
+    arc.push(acc);
+    for c in chords {
+        acc += c;
+        arc.push(acc);
+    }
     Ok(Plan {
         rings,
         segments: if opts.closed { rings } else { rings - 1 },
-        caps: opts.caps && !opts.closed,
+        caps: opts.caps && !opts.closed && p.closed,
         stored_rings: rings + usize::from(opts.closed && opts.split_seams),
-        cols: 0, // set by the caller, which knows the profile
+        cols: p.len() + usize::from(p.closed && opts.split_seams),
+        arc,
     })
 }
 
@@ -268,8 +279,25 @@ fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3]
     }
 }
 
-/// Sweep one spine into its share of the output buffers.
-#[allow(clippy::too_many_arguments)]
+/// Output buffers of a sweep, sized by [`Layout`]; every element is written.
+#[derive(Debug)]
+pub struct MeshMut<'a> {
+    pub vertices: &'a mut [DVec3],
+    pub faces: &'a mut [[i64; 3]],
+    pub normals: &'a mut [DVec3],
+    pub uv: &'a mut [DVec2],
+}
+
+/// The checked input of a sweep and the size of its mesh, from [`layout`].
+#[derive(Debug, Clone)]
+pub struct Layout {
+    plans: Vec<Plan>,
+    pub vertices: usize,
+    pub faces: usize,
+}
+
+/// Sweep one spine into its share of the output buffers; returns the rows (global) that
+/// start a folded-over segment.
 fn sweep_one(
     s: &Spine,
     plan: &Plan,
@@ -277,110 +305,155 @@ fn sweep_one(
     opts: &Options,
     vbase: usize,
     rowbase: usize,
-    verts: &mut [DVec3],
-    normals: &mut [DVec3],
-    uv: &mut [DVec2],
-    faces: &mut [[i64; 3]],
+    out: MeshMut,
 ) -> Vec<usize> {
     let m = p.len();
     let r_n = plan.rings;
     let cols = plan.cols;
     let x = &s.points[..r_n];
+    let arc = &plan.arc;
     let closed = opts.closed;
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
     let grain = (4096 / cols).max(1);
     // Winding: normals to the right of the profile's direction, outward for closed profiles.
     let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
-    // Arc length at every ring (and the closing chord).
-    let mut arc = Vec::with_capacity(r_n + 1);
-    let mut acc = 0.0;
-    arc.push(0.0);
-    for i in 1..=r_n {
-        if i == r_n && !closed {
-            break;
+    let tangent = |k: usize| columns(&s.frames[k]).2;
+    // Ring k of the smooth swept surface: centre and the images of the profile axes.
+    let base = |k: usize| -> (DVec3, DVec3, DVec3) {
+        let (r, q, _) = columns(&s.frames[k]);
+        let sc = s.scale[k];
+        let (sn, cs) = if s.twist.is_empty() {
+            (0.0, 1.0)
+        } else {
+            s.twist[k].sin_cos()
+        };
+        (x[k], sc.x * (cs * r + sn * q), sc.y * (cs * q - sn * r))
+    };
+    let mitre_at = |k: usize| mitre(x, tangent(k), k, closed, opts.miter_limit);
+
+    // One pass over the stored rings: positions (mitred), normals of the smooth surface
+    // (un-mitred: the mitre is a discretisation correction and would tilt them), uv, and the
+    // fold-over test of the segment starting there. Stored ring `i` is spine sample
+    // `i mod rings`, stored column `j` is profile vertex `j mod m` (the duplicates of split
+    // seams carry u = L and v = 1). Nothing is read back from the outputs but the ring just
+    // written; rings go in blocks so that each ring's geometry is computed once.
+    #[derive(Clone, Copy)]
+    struct Geo {
+        k: usize,
+        /// Centre and profile axes of the smooth surface.
+        b: (DVec3, DVec3, DVec3),
+        /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
+        /// `x + a_j·ma + b_j·mb`.
+        ma: DVec3,
+        mb: DVec3,
+        t: DVec3,
+    }
+    let geo = |k: usize| {
+        let b = base(k);
+        let (mf, mk) = mitre_at(k);
+        Geo {
+            k,
+            b,
+            ma: b.1 + (mf * b.1.dot(mk)) * mk,
+            mb: b.2 + (mf * b.2.dot(mk)) * mk,
+            t: tangent(k),
         }
-        acc += (x[i % r_n] - x[i - 1]).length();
-        arc.push(acc);
+    };
+    // Per stored column: the profile vertex, the difference of its neighbours (the derivative
+    // around the profile, central; one-sided at the ends of an open profile) and v.
+    struct Column {
+        p: DVec2,
+        dp: DVec2,
+        v: f64,
     }
-    let tangent = |i: usize| columns(&s.frames[i % r_n]).2;
-
-    // Pass 1: ring positions of the smooth swept surface (before the mitre) and uv; stored
-    // ring `i` is spine sample `i mod rings`, stored column `j` is profile vertex `j mod m`
-    // (the duplicates of split seams carry u = L and v = 1).
-    verts
-        .par_chunks_mut(cols)
-        .zip(uv.par_chunks_mut(cols))
-        .with_min_len(grain)
-        .enumerate()
-        .for_each(|(i, (ring, ruv))| {
-            let k = i % r_n;
-            let (r, q, _) = columns(&s.frames[k]);
-            let sc = s.scale[k];
-            let (sn, cs) = if s.twist.is_empty() {
-                (0.0, 1.0)
+    let column: Vec<Column> = (0..cols)
+        .map(|j| {
+            let jj = if j == m { 0 } else { j };
+            let (jp, jn) = if p.closed {
+                ((jj + m - 1) % m, (jj + 1) % m)
             } else {
-                s.twist[k].sin_cos()
+                (jj.saturating_sub(1), (jj + 1).min(m - 1))
             };
-            let (ra, rb) = (sc.x * (cs * r + sn * q), sc.y * (cs * q - sn * r));
-            for (j, (v, w)) in ring.iter_mut().zip(ruv.iter_mut()).enumerate() {
-                let pj = p.points[j % m];
-                *v = x[k] + pj.x * ra + pj.y * rb;
-                *w = DVec2::new(arc[i], if j == m { 1.0 } else { p.v[j] });
+            Column {
+                p: p.points[jj],
+                dp: p.points[jn] - p.points[jp],
+                v: if j == m { 1.0 } else { p.v[j] },
             }
-        });
-
-    // Pass 2: normals of the smooth swept surface from differences of those positions (the
-    // mitre, a discretisation correction, would otherwise tilt them).
-    {
-        let verts: &[DVec3] = verts;
-        let at = |ii: usize, jj: usize| verts[ii * cols + jj];
-        normals
-            .par_chunks_mut(cols)
-            .with_min_len(grain)
-            .enumerate()
-            .for_each(|(i, ring)| {
-                let i = i % r_n;
-                let (idx, w) = spine_weights(&arc, i, r_n, closed);
-                let t = tangent(i);
-                for (j, nv) in ring.iter_mut().enumerate() {
-                    let j = j % m;
-                    let (jp, jn) = if p.closed {
-                        ((j + m - 1) % m, (j + 1) % m)
-                    } else {
-                        (j.saturating_sub(1), (j + 1).min(m - 1))
-                    };
-                    let e = at(i, jn) - at(i, jp);
-                    let su = w[0] * at(idx[0], j) + w[1] * at(idx[1], j) + w[2] * at(idx[2], j);
-                    let nn = sign * e.cross(su);
-                    *nv = nn
-                        .try_normalize()
-                        .or_else(|| (sign * e.cross(t)).try_normalize())
-                        .unwrap_or(t);
-                }
-            });
-    }
-
-    // Pass 3: the mitre stretch, ring by ring.
-    verts
-        .par_chunks_mut(cols)
-        .with_min_len(grain)
+        })
+        .collect();
+    let block = grain * cols;
+    let folds: Vec<usize> = out
+        .vertices
+        .par_chunks_mut(block)
+        .zip(out.normals.par_chunks_mut(block))
+        .zip(out.uv.par_chunks_mut(block))
         .enumerate()
-        .for_each(|(i, ring)| {
-            let k = i % r_n;
-            let (mf, mk) = mitre(x, tangent(k), k, closed, opts.miter_limit);
-            if mf != 0.0 {
-                for v in ring.iter_mut() {
-                    let off = *v - x[k];
-                    *v += (mf * off.dot(mk)) * mk;
+        .flat_map_iter(|(bi, ((bv, bn), bu))| {
+            let i0 = bi * grain;
+            let mut folds = Vec::new();
+            let mut prev = geo((i0 + r_n - 1) % r_n);
+            let mut cur = geo(i0 % r_n);
+            let rings = bv
+                .chunks_mut(cols)
+                .zip(bn.chunks_mut(cols))
+                .zip(bu.chunks_mut(cols));
+            for (di, ((rv, rn), ruv)) in rings.enumerate() {
+                let i = i0 + di;
+                let k = cur.k;
+                let next = geo((i + 1) % r_n);
+                let b = cur.b;
+                // d/ds of the ring: the same weights on centres and axes.
+                let (idx, w) = spine_weights(arc, k, r_n, closed);
+                let (mut dx, mut da, mut db) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+                for (&ii, &wi) in idx.iter().zip(&w) {
+                    let bi = match ii {
+                        _ if ii == k => b,
+                        _ if ii == next.k => next.b,
+                        _ if ii == prev.k => prev.b,
+                        _ => base(ii),
+                    };
+                    dx += wi * bi.0;
+                    da += wi * bi.1;
+                    db += wi * bi.2;
                 }
+                for (c, ((v, nv), w)) in
+                    column.iter().zip(rv.iter_mut().zip(rn.iter_mut()).zip(ruv))
+                {
+                    let (pj, dp) = (c.p, c.dp);
+                    let e = dp.x * b.1 + dp.y * b.2;
+                    let su = dx + pj.x * da + pj.y * db;
+                    *nv = (sign * e.cross(su))
+                        .try_normalize()
+                        .or_else(|| (sign * e.cross(cur.t)).try_normalize())
+                        .unwrap_or(cur.t);
+                    *v = b.0 + pj.x * cur.ma + pj.y * cur.mb;
+                    *w = DVec2::new(arc[i], c.v);
+                }
+                // Fold-over: rail edges must advance along both tangents. The rail edge of
+                // profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb), so its
+                // components along t and t′ are affine in p.
+                if i < plan.segments {
+                    let (dx0, dma, dmb) = (next.b.0 - b.0, next.ma - cur.ma, next.mb - cur.mb);
+                    let along = |t: DVec3| (dx0.dot(t), DVec2::new(dma.dot(t), dmb.dot(t)));
+                    let ((c1, g1), (c2, g2)) = (along(cur.t), along(next.t));
+                    let folded = p
+                        .points
+                        .iter()
+                        .any(|&pj| !(c1 + pj.dot(g1) > 0.0 && c2 + pj.dot(g2) > 0.0));
+                    if folded {
+                        folds.push(rowbase + i);
+                    }
+                }
+                prev = cur;
+                cur = next;
             }
-        });
-    let verts: &[DVec3] = verts;
-    let at = |ii: usize, jj: usize| verts[ii * cols + jj];
+            folds
+        })
+        .collect();
 
     // Side faces. Without split seams the last column/ring wraps to the first.
     let edges = if p.closed { m } else { m - 1 };
-    let (side, caps) = faces.split_at_mut(2 * plan.segments * edges);
+    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
     let col = |j: usize| if j == cols { 0 } else { j };
     let row = |i: usize| if i == plan.stored_rings { 0 } else { i };
     side.par_chunks_mut(2 * edges)
@@ -410,31 +483,26 @@ fn sweep_one(
             caps[k + c] = [last + a, last + b, last + d]; // faces +t
         }
     }
-
-    // Fold-over: rail edges must advance along both tangents.
-    (0..plan.segments)
-        .into_par_iter()
-        .with_min_len(grain)
-        .filter(|&i| {
-            let i2 = (i + 1) % r_n;
-            let (ta, tb) = (tangent(i), tangent(i2));
-            (0..m).any(|j| {
-                let e = at(i2, j) - at(i, j);
-                !(e.dot(ta) > 0.0 && e.dot(tb) > 0.0)
-            })
-        })
-        .map(|i| rowbase + i)
-        .collect()
+    folds
 }
 
-/// Sweep `profile` along every spine of a bundle (`offsets[c]..offsets[c+1]` are the rows
-/// of spine `c` in the flat arrays) into one mesh, spines in parallel.
-pub fn sweep_many(
-    all: &Spine,
-    offsets: &[usize],
-    profile: &Profile,
-    opts: &Options,
-) -> Result<Mesh> {
+fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
+    let (a, b) = (offsets[c], offsets[c + 1]);
+    Spine {
+        points: &all.points[a..b],
+        frames: &all.frames[a..b],
+        scale: &all.scale[a..b],
+        twist: if all.twist.is_empty() {
+            &[]
+        } else {
+            &all.twist[a..b]
+        },
+    }
+}
+
+/// Check a bundle of spines (`offsets[c]..offsets[c+1]` are the rows of spine `c` in the
+/// flat arrays) and size its mesh.
+pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options) -> Result<Layout> {
     let curves = offsets.len().saturating_sub(1);
     let n = all.points.len();
     if offsets.first() != Some(&0)
@@ -455,23 +523,10 @@ pub fn sweep_many(
             ),
         ));
     }
-    let part = |c: usize| {
-        let (a, b) = (offsets[c], offsets[c + 1]);
-        Spine {
-            points: &all.points[a..b],
-            frames: &all.frames[a..b],
-            scale: &all.scale[a..b],
-            twist: if all.twist.is_empty() {
-                &[]
-            } else {
-                &all.twist[a..b]
-            },
-        }
-    };
     let plans: Vec<Plan> = (0..curves)
         .into_par_iter()
         .map(|c| {
-            check_spine(&part(c), opts).map_err(|e| {
+            check_spine(&part(all, offsets, c), opts, profile).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!(
                         "curve {c} (rows {} to {})",
@@ -484,63 +539,95 @@ pub fn sweep_many(
             })
         })
         .collect::<Result<_>>()?;
-    let m = profile.len();
-    let cols = m + usize::from(profile.closed && opts.split_seams);
-    let plans: Vec<Plan> = plans
-        .into_iter()
-        .map(|p| Plan {
-            cols,
-            caps: p.caps && profile.closed,
-            ..p
-        })
-        .collect();
-    let nv: usize = plans.iter().map(|p| p.vertices()).sum();
-    let nf: usize = plans.iter().map(|p| p.faces(profile)).sum();
-    let mut mesh = Mesh {
-        vertices: vec![DVec3::ZERO; nv],
-        faces: vec![[0; 3]; nf],
-        normals: vec![DVec3::ZERO; nv],
-        uv: vec![DVec2::ZERO; nv],
-        folds: Vec::new(),
-    };
+    Ok(Layout {
+        vertices: plans.iter().map(Plan::vertices).sum(),
+        faces: plans.iter().map(|p| p.faces(profile)).sum(),
+        plans,
+    })
+}
+
+/// Sweep `profile` along every spine of a checked bundle into buffers of the sizes in
+/// `layout` (spines in parallel). Returns the rows starting a folded-over segment.
+pub fn sweep_into(
+    all: &Spine,
+    offsets: &[usize],
+    profile: &Profile,
+    opts: &Options,
+    layout: &Layout,
+    out: MeshMut,
+) -> Vec<usize> {
+    let (nv, nf) = (layout.vertices, layout.faces);
+    assert!(
+        out.vertices.len() == nv
+            && out.normals.len() == nv
+            && out.uv.len() == nv
+            && out.faces.len() == nf,
+        "sweep_into: buffers must have the sizes of the layout"
+    );
     // Split the buffers per spine.
-    let mut jobs = Vec::with_capacity(curves);
-    {
-        let (mut v, mut nr, mut u, mut f) = (
-            &mut mesh.vertices[..],
-            &mut mesh.normals[..],
-            &mut mesh.uv[..],
-            &mut mesh.faces[..],
-        );
-        let mut vbase = 0;
-        for (c, plan) in plans.iter().enumerate() {
-            let (k, kf) = (plan.vertices(), plan.faces(profile));
-            let (v1, v2) = v.split_at_mut(k);
-            let (n1, n2) = nr.split_at_mut(k);
-            let (u1, u2) = u.split_at_mut(k);
-            let (f1, f2) = f.split_at_mut(kf);
-            jobs.push((c, vbase, v1, n1, u1, f1));
-            (v, nr, u, f) = (v2, n2, u2, f2);
-            vbase += k;
-        }
+    let mut jobs = Vec::with_capacity(layout.plans.len());
+    let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, out.faces);
+    let mut vbase = 0;
+    for (c, plan) in layout.plans.iter().enumerate() {
+        let (k, kf) = (plan.vertices(), plan.faces(profile));
+        let (v1, v2) = v.split_at_mut(k);
+        let (n1, n2) = nr.split_at_mut(k);
+        let (u1, u2) = u.split_at_mut(k);
+        let (f1, f2) = f.split_at_mut(kf);
+        let mine = MeshMut {
+            vertices: v1,
+            faces: f1,
+            normals: n1,
+            uv: u1,
+        };
+        jobs.push((c, vbase, mine));
+        (v, nr, u, f) = (v2, n2, u2, f2);
+        vbase += k;
     }
     let folds: Vec<Vec<usize>> = jobs
         .into_par_iter()
-        .map(|(c, vbase, v, nr, u, f)| {
+        .map(|(c, vbase, mine)| {
             sweep_one(
-                &part(c),
-                &plans[c],
+                &part(all, offsets, c),
+                &layout.plans[c],
                 profile,
                 opts,
                 vbase,
                 offsets[c],
-                v,
-                nr,
-                u,
-                f,
+                mine,
             )
         })
         .collect();
-    mesh.folds = folds.concat();
+    folds.concat()
+}
+
+/// [`layout`] and [`sweep_into`] with freshly allocated buffers.
+pub fn sweep_many(
+    all: &Spine,
+    offsets: &[usize],
+    profile: &Profile,
+    opts: &Options,
+) -> Result<Mesh> {
+    let lay = layout(all, offsets, profile, opts)?;
+    let mut mesh = Mesh {
+        vertices: vec![DVec3::ZERO; lay.vertices],
+        faces: vec![[0; 3]; lay.faces],
+        normals: vec![DVec3::ZERO; lay.vertices],
+        uv: vec![DVec2::ZERO; lay.vertices],
+        folds: Vec::new(),
+    };
+    mesh.folds = sweep_into(
+        all,
+        offsets,
+        profile,
+        opts,
+        &lay,
+        MeshMut {
+            vertices: &mut mesh.vertices,
+            faces: &mut mesh.faces,
+            normals: &mut mesh.normals,
+            uv: &mut mesh.uv,
+        },
+    );
     Ok(mesh)
 }
