@@ -256,8 +256,9 @@ def closing_angle(
     Carry a reference vector ``r_0`` once round the loop with the RMF; the result ``r_n``
     differs from ``r_0`` by a rotation about ``t_0``. The closing angle is the signed angle
     from ``r_n`` to ``r_0`` about ``t_0``, in (−π, π] radians (right-handed about the
-    tangent); it does not depend on ``r_0``, and equals ``−∮τ ds`` mod 2π where the Frenet
-    frame exists. ``frames(..., closed=True)`` spreads exactly this angle (plus ``2π·turns``)
+    tangent); it does not depend on ``r_0``, and equals the total torsion ``∮τ ds`` mod 2π
+    where the Frenet frame exists (the RMF turns against the Frenet frame at the rate
+    ``−τ``). ``frames(..., closed=True)`` spreads exactly this angle (plus ``2π·turns``)
     along the curve. Example: the torus knot of Wang et al. (2008) gives −2.8757 rad.
 
     Takes the arguments of :func:`frames` (the points are treated as a loop). Returns a float,
