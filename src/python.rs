@@ -130,7 +130,7 @@ fn frames_sampled<'py>(
         end: None,
         turns,
     };
-    let out = PyArray3::<f64>::zeros(py, [rows, 3, 3], false);
+    let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
     let angles = {
         let mut rw = out.readwrite();
         let buf = rw
@@ -184,7 +184,7 @@ fn frames_analytic<'py>(
         turns,
         ..Request::default()
     };
-    let out = PyArray3::<f64>::zeros(py, [pts.len(), 3, 3], false);
+    let out = empty::<f64, numpy::Ix3>(py, &[pts.len(), 3, 3])?;
     let angle = {
         let mut rw = out.readwrite();
         let buf = rw
@@ -287,10 +287,10 @@ fn sweep_mesh<'py>(
         })
         .map_err(to_py)?;
     let (nv, nf) = (lay.vertices, lay.faces);
-    let v = empty::<f64>(py, nv, 3)?;
-    let n = empty::<f64>(py, nv, 3)?;
-    let uv = empty::<f64>(py, nv, 2)?;
-    let f = empty::<i64>(py, nf, 3)?;
+    let v = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
+    let n = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
+    let uv = empty::<f64, numpy::Ix2>(py, &[nv, 2])?;
+    let f = empty::<i64, numpy::Ix2>(py, &[nf, 3])?;
     let folds = {
         let (mut wv, mut wn, mut wu, mut wf) =
             (v.readwrite(), n.readwrite(), uv.readwrite(), f.readwrite());
@@ -306,20 +306,18 @@ fn sweep_mesh<'py>(
     Ok((v, f, n, uv, PyArray1::from_vec(py, folds)))
 }
 
-/// `numpy.empty((rows, cols), dtype)`: NumPy's allocator reuses freed heap memory for small
-/// arrays and asks for transparent huge pages for large ones, and nothing is zeroed, so an
-/// output that is written once costs about what NumPy's own write floor costs. Every
-/// caller writes every element.
-fn empty<'py, T: numpy::Element>(
+/// `numpy.empty(shape, dtype)`: NumPy's allocator reuses freed heap memory for small arrays
+/// and asks for transparent huge pages for large ones, and nothing is zeroed, so an output
+/// that is written once costs about what NumPy's own write floor costs. Every caller writes
+/// every element before the array reaches Python.
+fn empty<'py, T: numpy::Element, D: numpy::ndarray::Dimension>(
     py: Python<'py>,
-    rows: usize,
-    cols: usize,
-) -> PyResult<Bound<'py, PyArray2<T>>> {
+    shape: &[usize],
+) -> PyResult<Bound<'py, numpy::PyArray<T, D>>> {
     let np = py.import("numpy")?;
-    let a = np
-        .getattr("empty")?
-        .call1(((rows, cols), numpy::dtype::<T>(py)))?;
-    Ok(a.cast_into::<PyArray2<T>>()?)
+    let shape = pyo3::types::PyTuple::new(py, shape)?;
+    let a = np.getattr("empty")?.call1((shape, numpy::dtype::<T>(py)))?;
+    Ok(a.cast_into::<numpy::PyArray<T, D>>()?)
 }
 
 fn slice_mut<'a, T: numpy::Element>(
