@@ -2,9 +2,9 @@
 //!
 //! The crate is split in two layers:
 //!
-//! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`error`]); they work on
-//!   `glam::DVec3` slices and flat `f64` output buffers and return [`error::InputError`]
-//!   for bad input, never panicking on user data;
+//! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`quaternion`],
+//!   [`error`]); they work on `glam::DVec3` slices and flat `f64` output buffers and return
+//!   [`error::InputError`] for bad input, never panicking on user data;
 //! * one thin binding module (`python`, compiled into the `spinal._core` extension) that
 //!   converts NumPy arrays, releases the GIL around the heavy calls and maps errors to
 //!   Python exceptions.
@@ -19,6 +19,7 @@
 pub mod error;
 pub mod frames;
 mod python;
+pub mod quaternion;
 pub mod sweep;
 
 pub use error::InputError;

@@ -13,6 +13,7 @@ use pyo3::prelude::*;
 
 use crate::error::InputError;
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+use crate::quaternion;
 use crate::sweep::{self, Options, Profile, Spine};
 
 type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
@@ -327,12 +328,222 @@ fn slice_mut<'a, T: numpy::Element>(
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
+fn quats<'a>(arg: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [glam::DQuat]> {
+    if a.shape()[1] != 4 {
+        return Err(PyValueError::new_err(format!(
+            "{arg}: expected shape (n, 4), got {:?}",
+            a.shape()
+        )));
+    }
+    Ok(bytemuck::cast_slice(slice_of(arg, a)?))
+}
+
+fn quat_array<'py>(py: Python<'py>, q: Vec<glam::DQuat>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = q.len();
+    PyArray1::from_vec(py, bytemuck::allocation::cast_vec::<glam::DQuat, f64>(q)).reshape([n, 4])
+}
+
+/// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
+#[pyfunction]
+fn quat_from_frames<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArray3<'py, f64>,
+    continuous: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let fr: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
+    let q = py
+        .detach(|| quaternion::from_frames(fr, continuous))
+        .map_err(to_py)?;
+    quat_array(py, q)
+}
+
+/// Frames of quaternions `(x, y, z, w)`.
+#[pyfunction]
+fn quat_to_frames<'py>(
+    py: Python<'py>,
+    q: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let qs = quats("quaternions", &q)?;
+    let out = empty::<f64, numpy::Ix3>(py, &[qs.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(
+            rw.as_slice_mut()
+                .map_err(|e| PyValueError::new_err(e.to_string()))?,
+        );
+        py.detach(|| quaternion::to_frames(qs, buf))
+            .map_err(to_py)?;
+    }
+    Ok(out)
+}
+
+/// Sign-continuous copy of quaternions `(x, y, z, w)`.
+#[pyfunction]
+fn quat_continuous<'py>(
+    py: Python<'py>,
+    q: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let mut v = quats("q", &q)?.to_vec();
+    quaternion::make_continuous(&mut v);
+    quat_array(py, v)
+}
+
+/// Row-wise slerp of quaternions `(x, y, z, w)`.
+#[pyfunction]
+fn quat_slerp<'py>(
+    py: Python<'py>,
+    q0: PyReadonlyArray2<'py, f64>,
+    q1: PyReadonlyArray2<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b, us) = (quats("q0", &q0)?, quats("q1", &q1)?, slice_of("u", &u)?);
+    if a.len() != b.len() || a.len() != us.len() {
+        return Err(PyValueError::new_err(
+            "q0, q1 and u must have the same number of rows",
+        ));
+    }
+    let mut out = vec![glam::DQuat::IDENTITY; a.len()];
+    py.detach(|| quaternion::slerp_many(a, b, us, &mut out))
+        .map_err(to_py)?;
+    quat_array(py, out)
+}
+
+/// Length of a quaternion curve on S³.
+#[pyfunction]
+fn quat_path_length(py: Python<'_>, q: PyReadonlyArray2<'_, f64>, closed: bool) -> PyResult<f64> {
+    let qs = quats("quaternions", &q)?;
+    py.detach(|| quaternion::path_length(qs, closed))
+        .map_err(to_py)
+}
+
+/// Parallel transport as a quaternion recurrence; returns (quaternions, closing angle).
+#[pyfunction]
+fn quat_transport<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tangents: PyReadonlyArray2<'py, f64>,
+    r0: PyReadonlyArray1<'py, f64>,
+    closed: bool,
+    turns: i64,
+    closing_row: bool,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+    let x = vec3s("points", &points)?;
+    let t = vec3s("tangents", &tangents)?;
+    let r = slice_of("initial", &r0)?;
+    if r.len() != 3 || t.len() != x.len() || t.len() < 2 {
+        return Err(PyValueError::new_err(
+            "points and tangents must have the same n >= 2 rows and initial 3 values",
+        ));
+    }
+    let r = DVec3::new(r[0], r[1], r[2]);
+    let rows = t.len() + usize::from(closed && closing_row);
+    let mut out = vec![glam::DQuat::IDENTITY; rows];
+    let angle = py
+        .detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))
+        .map_err(to_py)?;
+    Ok((quat_array(py, out)?, angle))
+}
+
+type WalkArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// Walk on a triangle mesh; see `spinal.quaternions.walk_mesh`.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, face, point, direction, moves))]
+fn walk_mesh<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    face: i64,
+    point: PyReadonlyArray1<'py, f64>,
+    direction: Option<PyReadonlyArray1<'py, f64>>,
+    moves: PyReadonlyArray2<'py, f64>,
+) -> PyResult<WalkArrays<'py>> {
+    let v = vec3s("vertices", &vertices)?;
+    if faces.shape()[1] != 3 {
+        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
+    }
+    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let p = slice_of("point", &point)?;
+    if p.len() != 3 {
+        return Err(PyValueError::new_err("point: expected 3 values"));
+    }
+    let d = direction
+        .as_ref()
+        .map(|d| slice_of("direction", d))
+        .transpose()?;
+    if moves.shape()[1] != 2 {
+        return Err(PyValueError::new_err("moves: expected shape (k, 2)"));
+    }
+    let mv: &[glam::DVec2] = bytemuck::cast_slice(slice_of("moves", &moves)?);
+    let p = DVec3::new(p[0], p[1], p[2]);
+    if d.is_some_and(|d| d.len() != 3) {
+        return Err(PyValueError::new_err("direction: expected 3 values"));
+    }
+    let d = d.map(|d| DVec3::new(d[0], d[1], d[2]));
+    let (states, path) = py
+        .detach(|| {
+            let w = quaternion::walk::Walker::new(v, f)?;
+            let mut s = w.start(face, p, d)?;
+            let mut states = vec![s];
+            let mut path = vec![(s.point, s.face, 0usize)];
+            let mut crossings = Vec::new();
+            for (k, m) in mv.iter().enumerate() {
+                crossings.clear();
+                s = w.step(s, *m, &mut crossings)?;
+                path.extend(crossings.iter().map(|&(q, g)| (q, g, k + 1)));
+                path.push((s.point, s.face, k + 1));
+                states.push(s);
+            }
+            Ok::<_, crate::error::InputError>((states, path))
+        })
+        .map_err(to_py)?;
+    let k = states.len();
+    let pts: Vec<f64> = states.iter().flat_map(|s| s.point.to_array()).collect();
+    let fcs: Vec<i64> = states.iter().map(|s| s.face as i64).collect();
+    let frs: Vec<f64> = states
+        .iter()
+        .flat_map(|s| {
+            let (a, b, c) = (s.frame.x_axis, s.frame.y_axis, s.frame.z_axis);
+            [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
+        })
+        .collect();
+    let stopped: Vec<bool> = states[1..].iter().map(|s| s.stopped).collect();
+    let m = path.len();
+    let pp: Vec<f64> = path.iter().flat_map(|p| p.0.to_array()).collect();
+    let pf: Vec<i64> = path.iter().map(|p| p.1 as i64).collect();
+    let pm: Vec<i64> = path.iter().map(|p| p.2 as i64).collect();
+    Ok((
+        PyArray1::from_vec(py, pts).reshape([k, 3])?,
+        PyArray1::from_vec(py, fcs),
+        PyArray1::from_vec(py, frs).reshape([k, 3, 3])?,
+        PyArray1::from_vec(py, stopped),
+        PyArray1::from_vec(py, pp).reshape([m, 3])?,
+        PyArray1::from_vec(py, pf),
+        PyArray1::from_vec(py, pm),
+    ))
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
     m.add_function(wrap_pyfunction!(frames_analytic, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_tangents, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_from_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_to_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_continuous, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_slerp, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_path_length, m)?)?;
+    m.add_function(wrap_pyfunction!(quat_transport, m)?)?;
+    m.add_function(wrap_pyfunction!(walk_mesh, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

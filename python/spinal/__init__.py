@@ -3,9 +3,10 @@
 Frames are ``(n, 3, 3)`` rotation matrices whose columns are ``(r, s, t)``: the reference
 vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tubes turn
 curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
+:mod:`spinal.quaternions` holds frames as quaternion curves, cameras and a mesh walker.
 """
 
-from . import curves
+from . import curves, quaternions
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -19,6 +20,7 @@ __all__ = [
     "curves",
     "estimate_tangents",
     "frames",
+    "quaternions",
     "sweep",
     "tube",
 ]

@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import curves as curves
+from . import quaternions as quaternions
 from .curves import Curve
 
 __version__: str

@@ -54,3 +54,34 @@ def sweep_mesh(
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
 ]: ...
+def quat_from_frames(frames: npt.NDArray[np.float64], continuous: bool) -> npt.NDArray[np.float64]: ...
+def quat_to_frames(q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def quat_continuous(q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def quat_slerp(
+    q0: npt.NDArray[np.float64], q1: npt.NDArray[np.float64], u: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def quat_path_length(q: npt.NDArray[np.float64], closed: bool) -> float: ...
+def quat_transport(
+    points: npt.NDArray[np.float64],
+    tangents: npt.NDArray[np.float64],
+    r0: npt.NDArray[np.float64],
+    closed: bool,
+    turns: int,
+    closing_row: bool,
+) -> tuple[npt.NDArray[np.float64], float]: ...
+def walk_mesh(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    face: int,
+    point: npt.NDArray[np.float64],
+    direction: npt.NDArray[np.float64] | None,
+    moves: npt.NDArray[np.float64],
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.bool_],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.int64],
+]: ...

@@ -115,21 +115,6 @@ impl Plan {
     }
 }
 
-/// Is `f` (row-major, columns `r, s, t`) a rotation matrix to 10⁻⁶?
-fn is_rotation(f: &[f64; 9]) -> bool {
-    let (r, q, t) = columns(f);
-    r.is_finite()
-        && q.is_finite()
-        && t.is_finite()
-        && (r.length_squared() - 1.0).abs() < 1e-6
-        && (q.length_squared() - 1.0).abs() < 1e-6
-        && (t.length_squared() - 1.0).abs() < 1e-6
-        && r.dot(q).abs() < 1e-6
-        && r.dot(t).abs() < 1e-6
-        && q.dot(t).abs() < 1e-6
-        && r.cross(q).dot(t) > 0.0
-}
-
 fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
     let n = s.points.len();
     if s.frames.len() != n {
@@ -166,7 +151,7 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
         ));
     }
     let chords = validate::chords(&s.points[..rings], opts.closed)?;
-    if let Some(i) = validate::first_bad(s.frames, is_rotation) {
+    if let Some(i) = validate::first_bad(s.frames, validate::is_rotation) {
         return Err(InputError::new(
             "frames",
             format!(

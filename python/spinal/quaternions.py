@@ -1,0 +1,462 @@
+r"""Quaternion frames (Hanson & Ma 1995; Ma 1996).
+
+A frame ``F = (r, s, t)`` (columns, as everywhere in spinal) is the rotation ``R(q)`` of a
+unit quaternion ``q``; ``q`` and ``−q`` give the same frame. Quaternion arrays are
+``(n, 4)`` in scipy's order: ``(x, y, z, w)`` by default, ``(w, x, y, z)`` with
+``scalar_first=True`` — exactly ``scipy.spatial.transform.Rotation.from_matrix(F)
+.as_quat(scalar_first=...)`` up to sign, and ``Rotation.from_quat(q, scalar_first=...)
+.as_matrix()`` returns the frames.
+
+* :func:`to_quaternions` / :func:`from_quaternions` — conversions (Shepperd's method, robust
+  at half turns), with sign continuity along a curve (:func:`make_continuous`).
+* :func:`slerp`, :func:`slerp_frames` — interpolation of frames on the short great arc.
+* :func:`quaternion_frames` — parallel transport as a quaternion recurrence
+  ``Q_{i+1} = Δq_i Q_i``, ``Δq_i = normalise(1 + T_i·T_{i+1}, T_i × T_{i+1})``, with the
+  closure correction of closed curves; or the Frenet frame as a quaternion curve.
+* :func:`quaternion_length` — the length of the quaternion curve on S³, a measure of the
+  frames' total turning (``½∫|ω| ds``: ``½∫κ ds`` for parallel transport,
+  ``½∫√(κ²+τ²) ds`` for Frenet).
+* :func:`spin` — the angle about the common tangent between two frames.
+* :func:`camera_frames` — the frame a viewer flies with along a path, or a level-horizon
+  camera with a fixed world up.
+* :func:`walk_mesh` — a walker with a frame on a triangle mesh, rotated across every edge.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from . import _core
+from ._frames import estimate_tangents, frames
+from ._validate import as_bool, as_choice, as_float_array, as_int, as_points
+
+__all__ = [
+    "WalkResult",
+    "camera_frames",
+    "from_quaternions",
+    "make_continuous",
+    "quaternion_frames",
+    "quaternion_length",
+    "slerp",
+    "slerp_frames",
+    "spin",
+    "to_quaternions",
+    "walk_mesh",
+]
+
+
+def _to_xyzw(q: np.ndarray, scalar_first: bool) -> np.ndarray:
+    return np.ascontiguousarray(q[..., [1, 2, 3, 0]] if scalar_first else q)
+
+
+def _from_xyzw(q: np.ndarray, scalar_first: bool) -> np.ndarray:
+    return np.ascontiguousarray(q[..., [3, 0, 1, 2]]) if scalar_first else q
+
+
+def _quats(x, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
+    """(n, 4) xyzw array and whether the input was a single quaternion."""
+    q = as_float_array(x, name)
+    single = q.ndim == 1
+    if single:
+        q = q[None]
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise ValueError(f"{name}: expected shape (4,) or (n, 4), got {np.shape(x)}")
+    return _to_xyzw(q, scalar_first), single
+
+
+def _frames_arg(x, name: str = "frames") -> tuple[np.ndarray, bool]:
+    f = as_float_array(x, name)
+    single = f.ndim == 2
+    if single:
+        f = f[None]
+    if f.ndim != 3 or f.shape[1:] != (3, 3):
+        raise ValueError(f"{name}: expected shape (3, 3) or (n, 3, 3), got {np.shape(x)}")
+    return np.ascontiguousarray(f), single
+
+
+def to_quaternions(frames, *, scalar_first: bool = False, continuous: bool = True) -> np.ndarray:
+    """Unit quaternions of frames: ``(n, 3, 3)`` → ``(n, 4)`` (a single ``(3, 3)`` → ``(4,)``).
+
+    Shepperd's method: the largest of ``1 + tr R`` and ``1 + 2R_kk − tr R`` gives the
+    square-rooted component, so no small divisor occurs (exact to round-off at half turns).
+    ``continuous=True`` (default) makes the signs continuous along the rows: the first
+    quaternion is canonical (``w ≥ 0``, like scipy's ``canonical=True``), every next one is
+    negated if its dot product with the previous is negative. With ``continuous=False`` every
+    row is canonical.
+
+    Raises ValueError for a row that is not a rotation matrix (orthonormal to 1e-6,
+    ``det = +1``; a reflection has no quaternion).
+    """
+    f, single = _frames_arg(frames)
+    q = _core.quat_from_frames(f, as_bool(continuous, "continuous"))
+    q = _from_xyzw(q, as_bool(scalar_first, "scalar_first"))
+    return q[0] if single else q
+
+
+def from_quaternions(quaternions, *, scalar_first: bool = False) -> np.ndarray:
+    """Frames (rotation matrices, columns ``r, s, t``) of quaternions: ``(n, 4)`` →
+    ``(n, 3, 3)``. Quaternions are normalised first; a zero or non-finite row is refused."""
+    q, single = _quats(quaternions, "quaternions", as_bool(scalar_first, "scalar_first"))
+    f = _core.quat_to_frames(q)
+    return f[0] if single else f
+
+
+def make_continuous(quaternions, *, scalar_first: bool = False) -> np.ndarray:
+    """A copy with signs flipped so that consecutive quaternions have a non-negative dot
+    product (the first made canonical, ``w ≥ 0``). The frames are unchanged."""
+    sf = as_bool(scalar_first, "scalar_first")
+    q, _ = _quats(quaternions, "quaternions", sf)
+    if not np.isfinite(q).all():
+        raise ValueError("quaternions: contains non-finite values")
+    return _from_xyzw(_core.quat_continuous(q), sf)
+
+
+def slerp(q0, q1, u, *, scalar_first: bool = False) -> np.ndarray:
+    """Spherical linear interpolation ``q(u)`` from ``q0`` (``u = 0``) to ``q1`` (``u = 1``)
+    on the short arc (``q1`` is negated when ``q0·q1 < 0``): constant angular speed, the
+    rotation of the frames turning about a fixed axis. ``q0``, ``q1``: ``(4,)`` or ``(k, 4)``;
+    ``u``: scalar or ``(k,)`` (broadcast). Returns unit quaternions ``(k, 4)`` (or ``(4,)``)."""
+    sf = as_bool(scalar_first, "scalar_first")
+    a, s0 = _quats(q0, "q0", sf)
+    b, s1 = _quats(q1, "q1", sf)
+    uu = as_float_array(u, "u")
+    if uu.ndim > 1:
+        raise ValueError(f"u: expected a scalar or a 1-D array, got shape {uu.shape}")
+    single = s0 and s1 and uu.ndim == 0
+    try:
+        k = np.broadcast_shapes((a.shape[0],), (b.shape[0],), uu.reshape(-1).shape)
+    except ValueError:
+        raise ValueError(
+            f"q0, q1, u: cannot broadcast {a.shape[0]}, {b.shape[0]} and {uu.size} rows"
+        ) from None
+    a = np.ascontiguousarray(np.broadcast_to(a, (k[0], 4)))
+    b = np.ascontiguousarray(np.broadcast_to(b, (k[0], 4)))
+    uu = np.ascontiguousarray(np.broadcast_to(uu.reshape(-1), k))
+    out = _from_xyzw(_core.quat_slerp(a, b, uu), sf)
+    return out[0] if single else out
+
+
+def slerp_frames(frames, new_u, key_u=None) -> np.ndarray:
+    """Frames interpolated between key frames by slerp.
+
+    ``frames`` ``(n, 3, 3)`` at the strictly increasing parameters ``key_u`` (default
+    ``0, 1, …, n−1``; e.g. cumulative arc length of the key points), evaluated at
+    ``new_u`` ``(k,)`` inside ``[key_u[0], key_u[-1]]``. Between two keys the frame turns
+    at constant speed about a fixed axis (Ma's key frames for camera paths). Returns
+    ``(k, 3, 3)``.
+    """
+    f, _ = _frames_arg(frames)
+    n = len(f)
+    if n < 2:
+        raise ValueError(f"frames: need at least 2 key frames, got {n}")
+    ku = np.arange(n, dtype=float) if key_u is None else as_float_array(key_u, "key_u")
+    if ku.shape != (n,):
+        raise ValueError(f"key_u: expected shape ({n},) to match frames, got {ku.shape}")
+    if not (np.isfinite(ku).all() and np.all(np.diff(ku) > 0)):
+        raise ValueError("key_u: must be finite and strictly increasing")
+    nu = as_float_array(new_u, "new_u").reshape(-1)
+    if not np.isfinite(nu).all():
+        raise ValueError("new_u: contains non-finite values")
+    if nu.size and (nu.min() < ku[0] or nu.max() > ku[-1]):
+        raise ValueError(f"new_u: values must lie in [{ku[0]}, {ku[-1]}] (the key range)")
+    q = _core.quat_from_frames(f, True)
+    i = np.clip(np.searchsorted(ku, nu, side="right") - 1, 0, n - 2)
+    w = (nu - ku[i]) / (ku[i + 1] - ku[i])
+    return _core.quat_to_frames(_core.quat_slerp(q[i], q[i + 1], np.ascontiguousarray(w)))
+
+
+def _initial_r0(pts, t, initial, closed):
+    """Unit reference vector at row 0: the user's (vector or frame), else spinal's default."""
+    t0 = t[0]
+    if initial is None:
+        return np.ascontiguousarray(frames(pts, tangents=t, method="rotation", closed=closed)[0][:, 0])
+    v = as_float_array(initial, "initial")
+    if v.shape == (3, 3):
+        v = v[:, 0]
+    if v.shape != (3,) or not np.isfinite(v).all():
+        raise ValueError("initial: expected a finite (3,) vector or a (3, 3) frame")
+    p = v - (v @ t0) * t0
+    nrm = np.linalg.norm(p)
+    if not nrm > 1e-8 * np.linalg.norm(v):
+        raise ValueError("initial: the vector is zero or parallel to the first tangent")
+    return np.ascontiguousarray(p / nrm)
+
+
+def quaternion_frames(
+    points,
+    tangents=None,
+    *,
+    method: str = "transport",
+    initial=None,
+    closed: bool = False,
+    turns: int = 0,
+    scalar_first: bool = False,
+) -> np.ndarray:
+    r"""Frames along a sampled curve as a sign-continuous quaternion curve ``(n, 4)``.
+
+    * ``method="transport"`` (default): discrete parallel transport written with
+      quaternions (Ma §2.4). ``Δq_i = normalise(1 + T_i·T_{i+1}, T_i × T_{i+1})`` rotates
+      ``T_i`` onto ``T_{i+1}`` about their common normal and ``Q_{i+1} = Δq_i Q_i``. These
+      are the frames of ``spinal.frames(points, tangents, method="rotation")`` (2nd order
+      accurate RMF), computed by an independent recurrence. ``closed=True``: the closing
+      angle ``α`` (= :func:`spinal.closing_angle` with ``method="rotation"``, ``∮τ ds`` mod
+      2π in the limit) plus ``2π·turns`` is spread linearly in arc length by body
+      rotations about the tangent, ``Q_i ← Q_i (cos(a_i/2), 0, 0, sin(a_i/2))`` with
+      ``a_i = α L_i/L``, so the frames close. (Ma's text applies the mismatch angle with the
+      opposite sign, which doubles it.)
+    * ``method="frenet"``: the Frenet frame ``(N, B, T)`` of ``spinal.frames(points,
+      method="frenet")`` (with its continuous fill at inflections and straight runs) as
+      quaternions.
+
+    ``tangents``: optional ``(n, 3)`` (normalised); default :func:`spinal.estimate_tangents`.
+    ``initial``: reference vector (or frame) at row 0, default the one of
+    :func:`spinal.frames`. A closed curve may repeat its first point at the end; that row
+    then gets the frame carried once round the loop (after the correction), ``±q₀``: the
+    sign tells whether the quaternion curve closes on S³ or ends at the antipode.
+    """
+    method = as_choice(method, "method", ("transport", "frenet"))
+    closed = as_bool(closed, "closed")
+    sf = as_bool(scalar_first, "scalar_first")
+    turns = as_int(turns, "turns")
+    pts = as_points(points, "points")
+    if method == "frenet":
+        if initial is not None or turns:
+            raise ValueError("initial, turns: not used by method='frenet'")
+        f = frames(pts, tangents, method="frenet", closed=closed)
+        return _from_xyzw(_core.quat_from_frames(f, True), sf)
+    n = len(pts)
+    if n < 2:
+        raise ValueError(f"points: need at least 2 samples, got {n}")
+    repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
+    core_pts = pts[:-1] if repeat else pts
+    if tangents is None:
+        t = estimate_tangents(core_pts, closed=closed)
+    else:
+        t = as_float_array(tangents, "tangents")
+        if t.shape != pts.shape:
+            raise ValueError(f"tangents: expected shape {pts.shape} to match points, got {t.shape}")
+        if not np.isfinite(t).all():
+            raise ValueError("tangents: contains non-finite values")
+        ln = np.linalg.norm(t, axis=1)
+        if not np.all(ln > 0):
+            raise ValueError(f"tangents: zero-length tangent at row {int(np.argmin(ln))}")
+        t = (t / ln[:, None])[: len(core_pts)]
+    t = np.ascontiguousarray(t)
+    r0 = _initial_r0(core_pts, t, initial, closed)
+    q, _ = _core.quat_transport(np.ascontiguousarray(core_pts), t, r0, closed, turns, repeat)
+    return _from_xyzw(q, sf)
+
+
+def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) -> float:
+    r"""Length of the quaternion curve on the unit sphere S³: ``Σ 2·atan2(|q_{i+1} − q_i|,
+    |q_{i+1} + q_i|)`` with each pair sign-aligned (= ``Σ arccos|q_i·q_{i+1}|``), plus the
+    closing arc when ``closed``. Half the total rotation angle of the frames; in the limit
+    ``½∫|ω| ds``: ``½∫κ ds`` for parallel transport, ``½∫√(κ² + τ²) ds`` for Frenet (``π``
+    per turn of any helix). Accepts ``(n, 4)`` quaternions or ``(n, 3, 3)`` frames."""
+    a = as_float_array(q, "q")
+    if a.ndim == 3:
+        a = _core.quat_from_frames(_frames_arg(a, "q")[0], True)
+    else:
+        a, _ = _quats(a, "q", as_bool(scalar_first, "scalar_first"))
+    return float(_core.quat_path_length(a, as_bool(closed, "closed")))
+
+
+def spin(a, b) -> np.ndarray | float:
+    """Signed angle (radians, in (−π, π]) that turns frame ``a``'s reference vector ``r``
+    into frame ``b``'s about ``a``'s tangent — the twist between two frames with the same
+    tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``.
+    """
+    fa, sa = _frames_arg(a, "a")
+    fb, sb = _frames_arg(b, "b")
+    ra, sa_, ta = fa[:, :, 0], fa[:, :, 1], fa[:, :, 2]
+    rb = fb[:, :, 0]
+    ang = np.arctan2(np.einsum("ij,ij->i", rb, sa_), np.einsum("ij,ij->i", rb, ra))
+    del ta
+    return float(ang[0]) if (sa and sb) else ang
+
+
+def camera_frames(
+    points,
+    *,
+    up=None,
+    mode: str = "transport",
+    closed: bool = False,
+    turns: int = 0,
+    bank=None,
+    tangents=None,
+    singular_angle: float = 1e-3,
+) -> np.ndarray:
+    r"""Camera orientations for flying along a path: ``(n, 3, 3)`` camera-to-world rotations
+    with columns ``(right, up, back)``, ``back = −gaze`` (the OpenGL/VTK convention: the
+    camera looks along its −z). With pyvista: ``position = points[i]``, ``focal_point =
+    points[i] − cam[i][:, 2]``, ``view_up = cam[i][:, 1]``.
+
+    The gaze is the path's unit tangent. The up vector:
+
+    * ``mode="transport"`` (default): the rotation-minimising frame of
+      :func:`spinal.frames` started from ``up`` (projected onto the first normal plane;
+      default world +z, or spinal's default where the path starts vertical) — the frame a
+      viewer flies with, no roll from one sample to the next; on ``closed`` paths the closing
+      angle is spread so that the camera returns to its start orientation.
+    * ``mode="up"``: a level horizon: up is the world ``up`` (default +z) projected onto the
+      normal plane, ``right = gaze × up`` stays horizontal. Where the path runs within
+      ``singular_angle`` radians of vertical the projection is undefined; those runs are
+      carried by the rotation-minimising frame from the last regular sample and the
+      mismatch to the next regular sample is spread linearly in arc length. (Passing through
+      the vertical, a level-horizon camera must turn by about π about its gaze.)
+
+    ``bank``: optional roll angles (scalar or ``(n,)``, radians) about the gaze, positive
+    turning up towards right.
+    """
+    mode = as_choice(mode, "mode", ("transport", "up"))
+    closed = as_bool(closed, "closed")
+    pts = as_points(points, "points")
+    n = len(pts)
+    if n < 2:
+        raise ValueError(f"points: need at least 2 samples, got {n}")
+    if tangents is None:
+        if closed and np.array_equal(pts[0], pts[-1]):
+            tc = estimate_tangents(pts[:-1], closed=True)
+            t = np.vstack([tc, tc[:1]])
+        else:
+            t = estimate_tangents(pts, closed=closed)
+    else:
+        t = as_float_array(tangents, "tangents")
+        if t.shape != pts.shape or not np.isfinite(t).all():
+            raise ValueError(f"tangents: expected finite values of shape {pts.shape}")
+        ln = np.linalg.norm(t, axis=1)
+        if not np.all(ln > 0):
+            raise ValueError(f"tangents: zero-length tangent at row {int(np.argmin(ln))}")
+        t = t / ln[:, None]
+    u = np.array([0.0, 0.0, 1.0]) if up is None else as_float_array(up, "up")
+    if u.shape != (3,) or not np.isfinite(u).all() or not np.linalg.norm(u) > 0:
+        raise ValueError("up: expected a finite non-zero (3,) vector")
+    u = u / np.linalg.norm(u)
+    if mode == "transport":
+        vertical = np.linalg.norm(np.cross(t[0], u)) <= 1e-3
+        if vertical and up is not None:
+            raise ValueError("up: parallel to the path's first tangent; the start up vector "
+                             "is undefined")
+        init = None if vertical else u
+        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
+    else:
+        f = _level_frames(pts, t, u, float(singular_angle), closed)
+    if bank is not None:
+        b = as_float_array(bank, "bank")
+        b = np.broadcast_to(b, (n,)) if b.ndim == 0 else b
+        if b.shape != (n,) or not np.isfinite(b).all():
+            raise ValueError(f"bank: expected a finite scalar or shape ({n},)")
+        c, s = np.cos(b)[:, None], np.sin(b)[:, None]
+        r, q = f[:, :, 0].copy(), f[:, :, 1].copy()
+        f = f.copy()
+        f[:, :, 0] = c * r - s * q
+        f[:, :, 1] = s * r + c * q
+    # spinal frame (r, s, t) = (up, right, gaze)  →  camera (right, up, −gaze)
+    return np.stack([f[:, :, 1], f[:, :, 0], -f[:, :, 2]], axis=2)
+
+
+def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
+    c, s = np.cos(ang), np.sin(ang)
+    g = f.copy()
+    g[:, :, 0] = c * f[:, :, 0] + s * f[:, :, 1]
+    g[:, :, 1] = c * f[:, :, 1] - s * f[:, :, 0]
+    return g
+
+
+def _angle_about(a, b, t) -> float:
+    return float(np.arctan2(np.cross(a, b) @ t, a @ b))
+
+
+def _level_frames(pts, t, u, eps, closed):
+    n = len(pts)
+    w = u - (t @ u)[:, None] * t
+    wn = np.linalg.norm(w, axis=1)
+    regular = wn > np.sin(eps)
+    if not regular.any():
+        raise ValueError("points: the path is parallel to up everywhere; a level horizon is "
+                         "undefined (use mode='transport' or another up)")
+    f = np.empty((n, 3, 3))
+    r = w[regular] / wn[regular][:, None]
+    f[regular] = np.stack([r, np.cross(t[regular], r), t[regular]], axis=2)
+    if regular.all():
+        return f
+    shift = 0
+    if closed:  # start the bookkeeping at a regular row
+        shift = int(np.argmax(regular))
+        pts, t, f, regular = (np.roll(a, -shift, axis=0) for a in (pts, t, f, regular))
+    bad = np.flatnonzero(~regular)
+    runs = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
+    for run in runs:
+        a, b = run[0], run[-1]  # singular rows a..b
+        if a > 0 and b + 1 < n:  # between regular rows: carry and meet the end frame
+            sub = frames(pts[a - 1 : b + 2], t[a - 1 : b + 2], initial=f[a - 1],
+                         end=f[b + 1])
+            f[a : b + 1] = sub[1:-1]
+        elif a > 0:  # trailing run: carry from the last regular row
+            f[a:] = frames(pts[a - 1 :], t[a - 1 :], initial=f[a - 1])[1:]
+        else:  # leading run: carry backwards from the first regular row
+            sub = frames(pts[: b + 2], t[: b + 2])
+            sub = _rotate_about_t(sub, _angle_about(sub[-1][:, 0], f[b + 1][:, 0], t[b + 1]))
+            f[: b + 1] = sub[:-1]
+    if shift:
+        f = np.roll(f, shift, axis=0)
+    return f
+
+
+class WalkResult(NamedTuple):
+    """Result of :func:`walk_mesh`: the state after every move (row 0 is the start) and the
+    polyline of the walk with every edge crossing."""
+
+    points: np.ndarray  # (k+1, 3)
+    faces: np.ndarray  # (k+1,)
+    frames: np.ndarray  # (k+1, 3, 3) columns e1 (right), e2 (up), e3 (face normal)
+    stopped: np.ndarray  # (k,) bool: the move ended early at a boundary edge
+    path: np.ndarray  # (m, 3) start, crossings and move ends
+    path_faces: np.ndarray  # (m,) face entered at each path point
+    path_moves: np.ndarray  # (m,) index of the move (0 = start)
+
+
+def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkResult:
+    r"""Walk on a triangle mesh with a frame (Ma 1996 §4.2.1).
+
+    The walker starts at ``point`` (projected onto face ``face``; must lie inside it) with
+    the frame ``e₃`` = the face normal (from the winding), ``e₁`` = ``direction`` projected
+    onto the face (default: the face's first edge), ``e₂ = e₃ × e₁``. Each move ``(dx, dy)``
+    of ``moves`` ``(k, 2)`` goes the distance ``|(dx, dy)|`` in the direction ``dx e₁ +
+    dy e₂`` along the surface. At every edge the frame and the direction are rotated about
+    the edge by the dihedral angle (the next face unfolded onto the current one), so the
+    path is straight in the unfolded strip and the frame turns without twist; around a
+    vertex it turns by the angle deficit ``2π − Σ angles``. A move stops early at a
+    boundary edge (``stopped``). ``e₁, e₂, e₃`` are the camera-to-world axes of a camera
+    looking straight down at the surface.
+
+    Raises ValueError for out-of-range or degenerate faces, non-manifold edges (more than two
+    faces), a start point off the face, non-finite values.
+    """
+    v = as_points(vertices, "vertices")
+    fa = np.asarray(faces)
+    if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
+        raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "
+                         f"{fa.dtype}")
+    if len(fa) == 0:
+        raise ValueError("faces: the mesh has no faces")
+    p = as_float_array(point, "point")
+    if p.shape != (3,):
+        raise ValueError(f"point: expected shape (3,), got {p.shape}")
+    d = None
+    if direction is not None:
+        d = as_float_array(direction, "direction")
+        if d.shape != (3,):
+            raise ValueError(f"direction: expected shape (3,), got {d.shape}")
+        d = np.ascontiguousarray(d)
+    mv = as_float_array(moves, "moves")
+    if mv.ndim == 1 and mv.shape == (2,):
+        mv = mv[None]
+    if mv.ndim != 2 or mv.shape[1] != 2:
+        raise ValueError(f"moves: expected shape (k, 2), got {mv.shape}")
+    out = _core.walk_mesh(np.ascontiguousarray(v), np.ascontiguousarray(fa, dtype=np.int64),
+                          as_int(face, "face"), np.ascontiguousarray(p), d,
+                          np.ascontiguousarray(mv))
+    return WalkResult(*out)

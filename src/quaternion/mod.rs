@@ -1,0 +1,316 @@
+//! Quaternion frames (Hanson & Ma 1995; Ma's thesis 1996, seed 004).
+//!
+//! A frame `F = (r, s, t)` (columns) is the rotation `R(q)` of a unit quaternion
+//! `q = (w, x, y, z)`; `q` and `−q` give the same frame. Arrays here store `(x, y, z, w)`
+//! (glam's and scipy's default order); the Python layer offers `scalar_first`.
+//!
+//! * **Matrix → quaternion** by Shepperd's method: take the square root of the largest of
+//!   `1 + tr R`, `1 + 2R₀₀ − tr R`, `1 + 2R₁₁ − tr R`, `1 + 2R₂₂ − tr R` and the other
+//!   components from sums/differences of off-diagonal pairs, so no division by a small
+//!   number happens (Ma's Fig. 3.1 tests `> 0` exactly and fails at half turns).
+//! * **Sign continuity**: `q₀` canonical (`w ≥ 0`), then `q_i ← −q_i` whenever
+//!   `q_i·q_{i−1} < 0`, so that neighbours are close on S³ and slerp takes the short arc.
+//! * **Parallel transport** as a quaternion recurrence (Ma §2.4): the rotation taking
+//!   `T_i` to `T_{i+1}` about `T_i × T_{i+1}` is `Δq_i = normalise(1 + T_i·T_{i+1},
+//!   T_i × T_{i+1})`, and `Q_{i+1} = Δq_i Q_i` (a rotation of the world multiplies on the
+//!   left). This is Bloomenthal's rotation method written with quaternions.
+//! * **Closure** of a closed curve: after one circuit the transported `r` differs from
+//!   `r₀` by the closing angle `α` (signed, about `t₀`, from the end vector to the start
+//!   vector, = ∮τ ds mod 2π); the body rotation `Q_i ← Q_i (cos(a_i/2), 0, 0, sin(a_i/2))`
+//!   about the tangent with `a_i = (α + 2π·turns) L_i / L` closes the frames (Ma's text
+//!   applies the angle with the opposite sign, which doubles the mismatch).
+//! * **Path length** `Σ 2 atan2(|q_{i+1} − q_i|, |q_{i+1} + q_i|)`: the length of the
+//!   quaternion curve on S³, half the total rotation angle of the frames — a measure of
+//!   their total twist and turn (`½∫|ω| ds` in the limit).
+
+pub mod walk;
+
+use glam::{DMat3, DQuat, DVec3};
+use rayon::prelude::*;
+
+use crate::error::{InputError, Result};
+use crate::frames::validate;
+
+const GRAIN: usize = 1 << 12;
+
+/// The unit quaternion of a row-major rotation matrix (columns `r, s, t`), Shepperd's
+/// method. The result is normalised; its sign is not canonical.
+pub fn from_matrix(f: &[f64; 9]) -> DQuat {
+    // R[row][col] = f[3 row + col]
+    let (r00, r01, r02) = (f[0], f[1], f[2]);
+    let (r10, r11, r12) = (f[3], f[4], f[5]);
+    let (r20, r21, r22) = (f[6], f[7], f[8]);
+    let tr = r00 + r11 + r22;
+    let q = if tr >= r00 && tr >= r11 && tr >= r22 {
+        let w = 0.5 * (1.0 + tr).max(0.0).sqrt();
+        let k = 0.25 / w;
+        DQuat::from_xyzw((r21 - r12) * k, (r02 - r20) * k, (r10 - r01) * k, w)
+    } else if r00 >= r11 && r00 >= r22 {
+        let x = 0.5 * (1.0 + r00 - r11 - r22).max(0.0).sqrt();
+        let k = 0.25 / x;
+        DQuat::from_xyzw(x, (r01 + r10) * k, (r02 + r20) * k, (r21 - r12) * k)
+    } else if r11 >= r22 {
+        let y = 0.5 * (1.0 - r00 + r11 - r22).max(0.0).sqrt();
+        let k = 0.25 / y;
+        DQuat::from_xyzw((r01 + r10) * k, y, (r12 + r21) * k, (r02 - r20) * k)
+    } else {
+        let z = 0.5 * (1.0 - r00 - r11 + r22).max(0.0).sqrt();
+        let k = 0.25 / z;
+        DQuat::from_xyzw((r02 + r20) * k, (r12 + r21) * k, z, (r10 - r01) * k)
+    };
+    q.normalize()
+}
+
+/// The row-major rotation matrix of a unit quaternion.
+pub fn to_matrix(q: DQuat) -> [f64; 9] {
+    let m = DMat3::from_quat(q);
+    let (a, b, c) = (m.x_axis, m.y_axis, m.z_axis);
+    [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
+}
+
+/// `q` or `−q`, whichever has `w > 0` (or, for `w = 0`, the first non-zero of `x, y, z`
+/// positive), as scipy's canonical form.
+pub fn canonical(q: DQuat) -> DQuat {
+    let lead = [q.w, q.x, q.y, q.z]
+        .into_iter()
+        .find(|v| *v != 0.0)
+        .unwrap_or(1.0);
+    if lead < 0.0 { -q } else { q }
+}
+
+/// Flip signs so that consecutive quaternions have a non-negative dot product, starting
+/// from the canonical sign of the first.
+pub fn make_continuous(q: &mut [DQuat]) {
+    if let Some(first) = q.first_mut() {
+        *first = canonical(*first);
+    }
+    for i in 1..q.len() {
+        if q[i].dot(q[i - 1]) < 0.0 {
+            q[i] = -q[i];
+        }
+    }
+}
+
+/// Quaternions of frames (row-major `(n, 3, 3)`), sign-continuous if asked.
+pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> {
+    if let Some(i) = validate::first_bad(frames, validate::is_rotation) {
+        return Err(InputError::new(
+            "frames",
+            format!(
+                "row {i} is not a rotation matrix (columns must be orthonormal to 1e-6 and \
+                 right-handed; a reflection has no quaternion)"
+            ),
+        ));
+    }
+    let mut q: Vec<DQuat> = Vec::with_capacity(frames.len());
+    frames
+        .par_iter()
+        .with_min_len(GRAIN)
+        .map(|f| canonical(from_matrix(f)))
+        .collect_into_vec(&mut q);
+    if continuous {
+        make_continuous(&mut q);
+    }
+    Ok(q)
+}
+
+/// Frames of quaternions (normalised first; a zero or non-finite quaternion is refused).
+pub fn to_frames(q: &[DQuat], out: &mut [[f64; 9]]) -> Result<()> {
+    if let Some(i) = validate::first_bad(q, |v| v.is_finite() && v.length_squared() > 1e-200) {
+        return Err(InputError::new(
+            "quaternions",
+            format!("row {i} is zero or not finite and cannot be normalised"),
+        ));
+    }
+    out.par_iter_mut()
+        .zip(q.par_iter())
+        .with_min_len(GRAIN)
+        .for_each(|(o, v)| *o = to_matrix(v.normalize()));
+    Ok(())
+}
+
+/// Spherical linear interpolation from `a` to `b` (the short arc: `b` is negated when
+/// `a·b < 0`) at `u` (0 gives `a`, 1 gives ±`b`). The angle comes from
+/// `2 atan2(|b − a|, |b + a|)`, accurate for small and large angles alike.
+pub fn slerp(a: DQuat, b: DQuat, u: f64) -> DQuat {
+    let b = if a.dot(b) < 0.0 { -b } else { b };
+    let half = ((b - a).length()).atan2((b + a).length()); // θ/2 ∈ [0, π/4]
+    let theta = 2.0 * half;
+    if theta < 1e-8 {
+        return (a * (1.0 - u) + b * u).normalize();
+    }
+    let s = theta.sin();
+    (a * (((1.0 - u) * theta).sin() / s) + b * ((u * theta).sin() / s)).normalize()
+}
+
+/// Slerp row by row (all three slices have the same length).
+pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Result<()> {
+    for (arg, v) in [("q0", a), ("q1", b)] {
+        if let Some(i) = validate::first_bad(v, |v| v.is_finite() && v.length_squared() > 1e-200) {
+            return Err(InputError::new(
+                arg,
+                format!("row {i} is zero or not finite"),
+            ));
+        }
+    }
+    validate::finite_scalars("u", u)?;
+    out.par_iter_mut()
+        .enumerate()
+        .with_min_len(GRAIN)
+        .for_each(|(i, o)| *o = slerp(a[i].normalize(), b[i].normalize(), u[i]));
+    Ok(())
+}
+
+/// Angle between two frames' quaternions: the length of the short arc on S³,
+/// `2 atan2(|b − a|, |b + a|)` after sign alignment (half the relative rotation angle).
+#[inline]
+fn arc(a: DQuat, b: DQuat) -> f64 {
+    let b = if a.dot(b) < 0.0 { -b } else { b };
+    2.0 * (b - a).length().atan2((b + a).length())
+}
+
+/// Length of the quaternion curve (unit quaternions, any signs), `closed` adding the arc
+/// from the last to the first.
+pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
+    if let Some(i) = validate::first_bad(q, |v| v.is_finite() && v.length_squared() > 1e-200) {
+        return Err(InputError::new(
+            "quaternions",
+            format!("row {i} is zero or not finite"),
+        ));
+    }
+    let n = q.len();
+    let m = if closed { n } else { n.saturating_sub(1) };
+    Ok((0..m)
+        .into_par_iter()
+        .with_min_len(GRAIN)
+        .map(|i| arc(q[i].normalize(), q[(i + 1) % n].normalize()))
+        .sum())
+}
+
+/// The quaternion rotating unit `a` onto unit `b` about `a × b`, `normalise(1 + a·b, a × b)`;
+/// None when `b ≈ −a` (a reversal, the axis is undefined).
+#[inline]
+fn rotation_between(a: DVec3, b: DVec3) -> Option<DQuat> {
+    let c = a.dot(b);
+    if !(1.0 + c > 1e-12) {
+        return None;
+    }
+    let v = a.cross(b);
+    Some(DQuat::from_xyzw(v.x, v.y, v.z, 1.0 + c).normalize())
+}
+
+/// Signed angle from `a` to `b` about the unit axis `t`, in (−π, π].
+fn signed_angle(a: DVec3, b: DVec3, t: DVec3) -> f64 {
+    a.cross(b).dot(t).atan2(a.dot(b))
+}
+
+/// Parallel transport as a quaternion curve.
+///
+/// * `x`: the points (for arc lengths; `n` rows), `t`: unit tangents (`n` rows);
+/// * `r0`: unit reference vector ⟂ `t[0]`;
+/// * `closed`: the samples form a loop (no repeated end point); the closing angle is then
+///   spread linearly in arc length (plus `2π·turns`) so the frames close.
+///
+/// Writes `n` quaternions (sign-continuous, `out[0]` canonical), and for a closed curve with
+/// `out.len() == n + 1` also the frame carried once round the loop, corrected (`±q₀`: the
+/// sign tells whether the frames' circuit is an even or odd number of turns on S³). Returns
+/// the closing angle (0 for an open curve).
+pub fn transport(
+    x: &[DVec3],
+    t: &[DVec3],
+    r0: DVec3,
+    closed: bool,
+    turns: i64,
+    out: &mut [DQuat],
+) -> Result<f64> {
+    let n = t.len();
+    debug_assert!(out.len() == n || (closed && out.len() == n + 1));
+    let q0 = canonical(from_matrix(&{
+        let s0 = t[0].cross(r0);
+        [r0.x, s0.x, t[0].x, r0.y, s0.y, t[0].y, r0.z, s0.z, t[0].z]
+    }));
+    out[0] = q0;
+    let step = |i: usize| {
+        let j = if i + 1 == n { 0 } else { i + 1 };
+        rotation_between(t[i], t[j]).ok_or_else(|| {
+            InputError::new(
+                "tangents",
+                format!(
+                    "the tangents at rows {i} and {j} are opposite (the curve reverses, a \
+                     cusp); parallel transport is undefined there"
+                ),
+            )
+        })
+    };
+    for i in 0..n - 1 {
+        let q = (step(i)? * out[i]).normalize();
+        out[i + 1] = q;
+    }
+    if !closed {
+        return Ok(0.0);
+    }
+    // One more step closes the loop; compare the carried r with r0.
+    let q_end = (step(n - 1)? * out[n - 1]).normalize();
+    let r_end = q_end * DVec3::X;
+    let alpha = signed_angle(r_end, r0, t[0]);
+    let total = alpha + std::f64::consts::TAU * turns as f64;
+    let mut arc = Vec::with_capacity(n + 1);
+    let mut acc = 0.0;
+    arc.push(0.0);
+    for i in 0..n {
+        acc += (x[(i + 1) % n] - x[i]).length();
+        arc.push(acc);
+    }
+    let len = arc[n];
+    if out.len() == n + 1 {
+        out[n] = q_end;
+    }
+    out.par_iter_mut()
+        .enumerate()
+        .with_min_len(GRAIN)
+        .for_each(|(i, q)| {
+            let a = 0.5 * total * arc[i] / len;
+            *q = (*q * DQuat::from_xyzw(0.0, 0.0, a.sin(), a.cos())).normalize();
+        });
+    make_continuous(out);
+    Ok(alpha)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rot(axis: DVec3, angle: f64) -> [f64; 9] {
+        to_matrix(DQuat::from_axis_angle(axis.normalize(), angle))
+    }
+
+    #[test]
+    fn shepperd_round_trip_including_half_turns() {
+        let axes = [
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(-1.0, 2.0, 3.0),
+        ];
+        for a in axes {
+            for ang in [0.0, 0.3, 1.5, 3.0, std::f64::consts::PI] {
+                let m = rot(a, ang);
+                let back = to_matrix(from_matrix(&m));
+                for k in 0..9 {
+                    assert!((back[k] - m[k]).abs() < 1e-15 * 4.0, "{a:?} {ang}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn slerp_ends_and_short_arc() {
+        let a = DQuat::from_axis_angle(DVec3::Z, 0.2);
+        let b = -DQuat::from_axis_angle(DVec3::Z, 1.0);
+        assert!((slerp(a, b, 0.0) - a).length() < 1e-15);
+        assert!((slerp(a, b, 1.0) + b).length() < 1e-15);
+        let mid = slerp(a, b, 0.5);
+        assert!((mid - DQuat::from_axis_angle(DVec3::Z, 0.6)).length() < 1e-15);
+    }
+}

@@ -1,0 +1,277 @@
+//! Walking on a triangle mesh with a moving frame (Ma 1996, §4.2.1, Eq. 4.1).
+//!
+//! A walker stands at a point `p` of a face with a frame `E = (e₁, e₂, e₃)`: `e₁, e₂` in
+//! the face plane (screen right and up), `e₃ = e₁ × e₂` the face normal. A move
+//! `(dx, dy)` goes the distance `|d|` in the direction `d = dx e₁ + dy e₂`. Where the
+//! straight path leaves the face through an edge with unit direction `ê`, the frame and the
+//! direction are rotated about `ê` by the angle `θ` taking `Â` (in the old face, ⟂ `ê`,
+//! pointing out of it) to `B̂` (in the next face, ⟂ `ê`, pointing into it): the next face
+//! is unfolded onto the plane of the old one, so the path is straight in the unfolded strip
+//! (a "straightest" polyhedral geodesic) and the frame is transported without twist. On
+//! consistently oriented meshes the rotation maps one face normal onto the next exactly.
+//!
+//! A walk stops at a boundary edge. A path that hits a vertex exactly is nudged along the
+//! edge by a round-off amount (Ma assumes it never happens).
+
+use std::collections::HashMap;
+
+use glam::{DMat3, DQuat, DVec2, DVec3};
+
+use crate::error::{InputError, Result};
+
+/// A triangle mesh prepared for walking: faces and edge adjacency.
+pub struct Walker<'a> {
+    v: &'a [DVec3],
+    f: Vec<[usize; 3]>,
+    /// For face `f` and local edge `k` (from corner `k` to corner `k+1`): the neighbouring
+    /// face and its local index of the shared edge.
+    adj: Vec<[Option<(usize, usize)>; 3]>,
+    scale: f64,
+}
+
+/// The state of a walker after a move.
+#[derive(Debug, Clone, Copy)]
+pub struct State {
+    pub point: DVec3,
+    pub face: usize,
+    /// Columns `e₁, e₂, e₃`.
+    pub frame: DMat3,
+    /// The move ended at a boundary edge before its full length.
+    pub stopped: bool,
+}
+
+impl<'a> Walker<'a> {
+    /// Check the mesh (indices in range, no degenerate faces, manifold edges) and build
+    /// the edge adjacency.
+    pub fn new(vertices: &'a [DVec3], faces: &[[i64; 3]]) -> Result<Self> {
+        if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+            return Err(InputError::new(
+                "vertices",
+                format!("non-finite value at row {i}"),
+            ));
+        }
+        let nv = vertices.len();
+        let mut f = Vec::with_capacity(faces.len());
+        for (i, tri) in faces.iter().enumerate() {
+            let mut c = [0usize; 3];
+            for k in 0..3 {
+                c[k] = usize::try_from(tri[k])
+                    .ok()
+                    .filter(|&x| x < nv)
+                    .ok_or_else(|| {
+                        InputError::new(
+                            "faces",
+                            format!(
+                                "face {i} refers to vertex {} but there are {nv} vertices",
+                                tri[k]
+                            ),
+                        )
+                    })?;
+            }
+            f.push(c);
+        }
+        let (lo, hi) = vertices.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(a, b), v| (a.min(*v), b.max(*v)),
+        );
+        let diag = (hi - lo).length();
+        let scale = if diag > 0.0 { diag } else { 1.0 };
+        for (i, c) in f.iter().enumerate() {
+            let area2 = (vertices[c[1]] - vertices[c[0]])
+                .cross(vertices[c[2]] - vertices[c[0]])
+                .length();
+            if !(area2 > 1e-12 * scale * scale) {
+                return Err(InputError::new(
+                    "faces",
+                    format!("face {i} is degenerate (zero area or repeated vertices)"),
+                ));
+            }
+        }
+        let mut edges: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
+        for (i, c) in f.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (c[k], c[(k + 1) % 3]);
+                edges.entry((a.min(b), a.max(b))).or_default().push((i, k));
+            }
+        }
+        let mut adj = vec![[None; 3]; f.len()];
+        for ((a, b), list) in &edges {
+            if list.len() > 2 {
+                return Err(InputError::new(
+                    "faces",
+                    format!(
+                        "the edge between vertices {a} and {b} is shared by {} faces (the \
+                         mesh must be manifold)",
+                        list.len()
+                    ),
+                ));
+            }
+            if let [(f1, k1), (f2, k2)] = list[..] {
+                adj[f1][k1] = Some((f2, k2));
+                adj[f2][k2] = Some((f1, k1));
+            }
+        }
+        Ok(Walker {
+            v: vertices,
+            f,
+            adj,
+            scale,
+        })
+    }
+
+    fn corners(&self, face: usize) -> [DVec3; 3] {
+        self.f[face].map(|i| self.v[i])
+    }
+
+    fn normal(&self, face: usize) -> DVec3 {
+        let [a, b, c] = self.corners(face);
+        (b - a).cross(c - a).normalize()
+    }
+
+    /// The start state: `point` (must lie in `face`, it is projected onto its plane) and a
+    /// frame with `e₃` the face normal and `e₁` along `direction` projected onto the face
+    /// (default: the face's first edge).
+    pub fn start(&self, face: i64, point: DVec3, direction: Option<DVec3>) -> Result<State> {
+        let face = usize::try_from(face)
+            .ok()
+            .filter(|&f| f < self.f.len())
+            .ok_or_else(|| {
+                InputError::new(
+                    "face",
+                    format!("{face} is not a face index (there are {})", self.f.len()),
+                )
+            })?;
+        if !point.is_finite() {
+            return Err(InputError::new("point", "contains a non-finite value"));
+        }
+        let [a, b, c] = self.corners(face);
+        let n = self.normal(face);
+        let p = point - (point - a).dot(n) * n;
+        // barycentric coordinates of the projection
+        let area = (b - a).cross(c - a).dot(n);
+        let w = [
+            (c - b).cross(p - b).dot(n) / area,
+            (a - c).cross(p - c).dot(n) / area,
+            (b - a).cross(p - a).dot(n) / area,
+        ];
+        let off = (point - p).length();
+        if w.iter().any(|&x| x < -1e-9) || off > 1e-6 * self.scale {
+            return Err(InputError::new(
+                "point",
+                format!(
+                    "is not on face {face} (barycentric coordinates {w:?}, distance {off:.3e} \
+                     from its plane)"
+                ),
+            ));
+        }
+        let d = direction.unwrap_or(b - a);
+        if !d.is_finite() {
+            return Err(InputError::new("direction", "contains a non-finite value"));
+        }
+        let e1 = d - d.dot(n) * n;
+        let l = e1.length();
+        if !(l > 1e-12 * d.length()) || l == 0.0 {
+            return Err(InputError::new(
+                "direction",
+                format!("is zero or perpendicular to face {face}; it must lie along the face"),
+            ));
+        }
+        let e1 = e1 / l;
+        Ok(State {
+            point: p,
+            face,
+            frame: DMat3::from_cols(e1, n.cross(e1), n),
+            stopped: false,
+        })
+    }
+
+    /// One move of `(dx, dy)` in the walker's `(e₁, e₂)` axes. `path` receives every edge
+    /// crossing (point and the face entered).
+    pub fn step(&self, s: State, mv: DVec2, path: &mut Vec<(DVec3, usize)>) -> Result<State> {
+        if !mv.is_finite() {
+            return Err(InputError::new("moves", "contains a non-finite value"));
+        }
+        let mut st = State {
+            stopped: false,
+            ..s
+        };
+        let d = mv.x * st.frame.x_axis + mv.y * st.frame.y_axis;
+        let mut left = d.length();
+        if left == 0.0 {
+            return Ok(st);
+        }
+        let mut u = d / left;
+        let mut entered: Option<usize> = None;
+        // Each crossing consumes path length or enters a new face; the cap only guards
+        // against a malformed mesh looping forever.
+        for _ in 0..(16 * self.f.len() + 64) {
+            let corners = self.corners(st.face);
+            let mut best: Option<(f64, usize)> = None;
+            for k in 0..3 {
+                if entered == Some(k) {
+                    continue;
+                }
+                let (a, b, c) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
+                let e = (b - a).normalize();
+                let m = (c - a) - (c - a).dot(e) * e;
+                let mh = m.normalize();
+                let du = u.dot(mh);
+                if du < -1e-15 {
+                    let delta = (st.point - a).dot(mh).max(0.0);
+                    let dist = delta / -du;
+                    if best.is_none_or(|(bd, _)| dist < bd) {
+                        best = Some((dist, k));
+                    }
+                }
+            }
+            let Some((dist, k)) = best else {
+                // the direction does not leave the face (round-off): finish in place
+                st.point += left * u;
+                return Ok(st);
+            };
+            if dist >= left {
+                st.point += left * u;
+                return Ok(st);
+            }
+            let (a, b) = (corners[k], corners[(k + 1) % 3]);
+            let e = (b - a).normalize();
+            let mut pe = st.point + dist * u;
+            left -= dist;
+            // keep off the vertices
+            let along = (pe - a).dot(e);
+            let len = (b - a).length();
+            let nudge = 1e-9 * len;
+            if along < nudge {
+                pe = a + nudge * e;
+            } else if along > len - nudge {
+                pe = b - nudge * e;
+            }
+            let Some((g, kg)) = self.adj[st.face][k] else {
+                st.point = pe;
+                st.stopped = true;
+                return Ok(st);
+            };
+            let c = corners[(k + 2) % 3];
+            let m = (c - a) - (c - a).dot(e) * e;
+            let a_hat = -m.normalize();
+            let vg = self.v[self.f[g][(kg + 2) % 3]];
+            let bm = (vg - a) - (vg - a).dot(e) * e;
+            let b_hat = bm.normalize();
+            let theta = a_hat.cross(b_hat).dot(e).atan2(a_hat.dot(b_hat));
+            let rot = DQuat::from_axis_angle(e, theta);
+            let fr = st.frame;
+            let (e1, e3) = ((rot * fr.x_axis).normalize(), (rot * fr.z_axis).normalize());
+            let e1 = (e1 - e1.dot(e3) * e3).normalize();
+            st.frame = DMat3::from_cols(e1, e3.cross(e1), e3);
+            u = (rot * u).normalize();
+            st.face = g;
+            st.point = pe;
+            entered = Some(kg);
+            path.push((pe, g));
+        }
+        Err(InputError::new(
+            "moves",
+            "the walk crossed more edges than the mesh allows (is the mesh malformed?)",
+        ))
+    }
+}
