@@ -270,10 +270,8 @@ def spin(a, b) -> np.ndarray | float:
     """
     fa, sa = _frames_arg(a, "a")
     fb, sb = _frames_arg(b, "b")
-    ra, sa_, ta = fa[:, :, 0], fa[:, :, 1], fa[:, :, 2]
-    rb = fb[:, :, 0]
+    ra, sa_, rb = fa[:, :, 0], fa[:, :, 1], fb[:, :, 0]
     ang = np.arctan2(np.einsum("ij,ij->i", rb, sa_), np.einsum("ij,ij->i", rb, ra))
-    del ta
     return float(ang[0]) if (sa and sb) else ang
 
 
