@@ -148,3 +148,20 @@ def test_tangent_estimation_errors():
     t = spinal.estimate_tangents(GOOD, closed=True)
     assert t.shape == GOOD.shape and np.all(np.isfinite(t))
     np.testing.assert_array_equal(t[-1], t[0])
+
+
+def test_five_point_tangents_do_not_swing_round_at_a_kink():
+    """A straight run, a 35° kink and very uneven chords (found by the sweep property test):
+    the interpolating quartic's end tangent points backwards (t·chord = −0.23); the guard
+    falls back to the circle estimate, which follows the chords."""
+    x = np.array([[4.93422374, 18.71165806, -8.53999907],
+                  [3.7953209, 19.4846463, -9.04887575],
+                  [3.68386077, 19.56029574, -9.09867759],
+                  [3.65097633, 19.62439471, -9.09746686],
+                  [3.34808006, 20.21480587, -9.08631497]])
+    t = spinal.estimate_tangents(x)
+    c = np.diff(x, axis=0)
+    c /= np.linalg.norm(c, axis=1)[:, None]
+    assert np.einsum("ij,ij->i", t[:-1], c).min() > 0.5
+    assert np.einsum("ij,ij->i", t[1:], c).min() > 0.5
+    np.testing.assert_allclose(t[0], spinal.estimate_tangents(x, method="circle")[0], atol=1e-15)

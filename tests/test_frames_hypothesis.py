@@ -13,7 +13,8 @@ METHODS = ["double_reflection", "rotation", "projection", "frenet"]
 
 @st.composite
 def smooth_curves(draw):
-    """Random walks whose direction turns by at most ~60° per step, random step lengths."""
+    """Random walks: straight runs or turns (usually small, occasionally over 90°) with
+    random step lengths (ratios up to 200)."""
     n = draw(st.integers(2, 80))
     seed = draw(st.integers(0, 2**32 - 1))
     rng = np.random.default_rng(seed)
@@ -31,7 +32,16 @@ def smooth_curves(draw):
 @settings(max_examples=150, deadline=None)
 @given(smooth_curves(), st.sampled_from(METHODS))
 def test_random_curves_give_rotations(x, method):
-    F = spinal.frames(x, method=method)
+    try:
+        F = spinal.frames(x, method=method)
+    except ValueError as e:
+        # the documented refusal of the projection method: a chord lying in (or behind) the
+        # next normal plane, which a sharp kink next to a short chord produces
+        assert method == "projection" and "needs each chord to cross" in str(e)
+        c = np.diff(x, axis=0)
+        t = spinal.estimate_tangents(x)
+        assert (np.einsum("ij,ij->i", c, t[1:]) <= 1e-9 * np.linalg.norm(c, axis=1)).any()
+        return
     assert F.shape == (len(x), 3, 3)
     assert np.all(np.isfinite(F))
     assert orthonormality_error(F) < 1e-12
@@ -75,3 +85,63 @@ def test_garbage_never_panics_or_returns_nan(a, method, closed):
         assert np.all(np.isfinite(F))
         assert orthonormality_error(F) < 1e-9
     np.testing.assert_array_equal(a, before)
+
+
+@st.composite
+def profiles(draw):
+    """Polygons star-shaped about the origin (3–12 vertices, counter-clockwise or clockwise):
+    jittered even angles, so every angular gap is below π and the origin is inside."""
+    m = draw(st.integers(3, 12))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    a = 2 * np.pi * (np.arange(m) + rng.uniform(-0.2, 0.2, m)) / m
+    rad = rng.uniform(0.4, 1.0, m)
+    p = np.c_[rad * np.cos(a), rad * np.sin(a)]
+    return p[::-1] if draw(st.booleans()) else p
+
+
+@st.composite
+def gentle_curves(draw):
+    """Random walks turning by less than ~25° per step, chords within a factor 5."""
+    n = draw(st.integers(2, 60))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    d = rng.normal(size=3)
+    d /= np.linalg.norm(d)
+    pts = [rng.normal(size=3) * 10]
+    kick = draw(st.sampled_from([0.0, 0.05, 0.15]))
+    for _ in range(n - 1):
+        d = d + np.clip(rng.normal(size=3) * kick, -0.25, 0.25)
+        d /= np.linalg.norm(d)
+        pts.append(pts[-1] + d * rng.uniform(0.2, 1.0))
+    return np.array(pts)
+
+
+@settings(max_examples=120, deadline=None)
+@given(gentle_curves(), profiles(), st.booleans())
+def test_random_sweeps_are_clean_watertight_meshes(x, prof, caps):
+    """Any smooth spine and star profile, thin enough not to fold: a watertight (when
+    capped), consistently wound, outward mesh with unit normals; trimesh and libigl agree."""
+    import warnings
+
+    import igl
+    import trimesh
+
+    chord = np.linalg.norm(np.diff(x, axis=0), axis=1).min()
+    size = 0.2 * chord
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no fold-over may be reported here
+        mesh = spinal.sweep(x, prof, scale=size, caps=caps)
+    m = len(prof)
+    assert mesh.vertices.shape == (len(x) * m, 3)
+    assert np.isfinite(mesh.vertices).all() and np.isfinite(mesh.normals).all()
+    np.testing.assert_allclose(np.linalg.norm(mesh.normals, axis=1), 1, atol=1e-12)
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+    assert tm.is_winding_consistent
+    assert tm.is_watertight == caps
+    # normals point away from the spine (the profiles are star-shaped about the origin)
+    off = mesh.vertices.reshape(len(x), m, 3) - x[:, None]
+    assert (np.einsum("ijk,ijk->ij", off, mesh.normals.reshape(len(x), m, 3)) > 0).all()
+    if caps:
+        _, vol = igl.centroid(mesh.vertices, mesh.faces)
+        assert tm.volume > 0
+        assert abs(tm.volume - vol) <= 1e-9 * abs(vol)

@@ -6,7 +6,9 @@
 //!   weights by Fornberg's algorithm, centred where possible, one-sided at open ends,
 //!   periodic for loops). For equal chords it is the formula below; for unequal spacing it
 //!   stays 4th order in the direction and is exact on straight lines whatever the spacing,
-//!   where index-based stencils can even point backwards.
+//!   where index-based stencils can even point backwards. Guard: where it turns more than
+//!   60° away from the circle estimate below (the quartic overshooting at a kink next to
+//!   very uneven chords), the circle estimate is used instead.
 //! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
 //!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
 //!   samples come from a uniform step of a smooth parameterisation):
@@ -217,10 +219,12 @@ pub fn estimate(
             let v = raw_tangent(x, chords, i, closed, rule, five);
             let l = v.length();
             let u = v * (1.0 / l);
-            if l > 0.0 && u.is_finite() {
-                u
-            } else {
+            if !(l > 0.0 && u.is_finite()) {
                 DVec3::ZERO
+            } else if five && rule == TangentRule::FivePoint {
+                guard_overshoot(x, i, closed, u)
+            } else {
+                u
             }
         })
         .collect_into_vec(&mut t);
@@ -234,6 +238,43 @@ pub fn estimate(
     match first_zero(&t) {
         Some(i) => Err(cusp_error(i)),
         None => Ok(t),
+    }
+}
+
+/// Smallest accepted cosine between the five-point estimate and the circle (3-point)
+/// estimate; below it the quartic overshoots (a kink, or wildly uneven spacing) and the
+/// circle estimate is used.
+pub const OVERSHOOT_COS: f64 = 0.5;
+
+/// The five-point unit tangent `u` at `i`, or the circle estimate where they disagree by
+/// more than 60°. On smoothly sampled curves the two agree to O(h²), so this never changes
+/// the 4th-order estimate there; on a polyline with a kink next to very uneven chords the
+/// interpolating quartic can swing round and point backwards, which the frames would accept
+/// but a sweep would fold over.
+#[inline]
+fn guard_overshoot(x: &[DVec3], i: usize, closed: bool, u: DVec3) -> DVec3 {
+    let n = x.len();
+    let w = if closed || (i > 0 && i + 1 < n) {
+        circle_raw(x, i, closed)
+    } else {
+        // open end: the tangent there of the circle through the first (last) three points
+        let (inner, chord) = if i == 0 {
+            (1, x[1] - x[0])
+        } else {
+            (n - 2, x[n - 1] - x[n - 2])
+        };
+        let ti = circle_raw(x, inner, false).normalize_or_zero();
+        let c = chord.normalize_or_zero();
+        2.0 * c.dot(ti) * c - ti
+    };
+    // u·ŵ ≥ cos 60° without a square root in the common case
+    let d = u.dot(w);
+    if d >= 0.0 && d * d >= OVERSHOOT_COS * OVERSHOOT_COS * w.length_squared() {
+        return u;
+    }
+    match w.try_normalize() {
+        Some(c) => c,
+        None => u,
     }
 }
 
