@@ -58,8 +58,8 @@ def args_for(script: Path, quick: bool) -> list[str]:
     if script.name in QUICK:
         return QUICK[script.name]
     try:
-        h = subprocess.run([sys.executable, str(script), "--help"], capture_output=True,
-                           text=True, timeout=60)
+        h = subprocess.run([sys.executable, str(script), "--help"], check=False,
+                           capture_output=True, text=True, timeout=60)
     except subprocess.TimeoutExpired:
         return []
     return ["--quick"] if "--quick" in h.stdout else []
@@ -83,16 +83,16 @@ def main() -> int:
         f"- versions: {versions()}",
         f"- command: `python benchmarks/run_all.py{' --quick' if a.quick else ''}`",
         "",
-        "Every table below comes from one run of the script named above it; ratios compare "
-        "timings from that same run. Timings on shared or virtual machines vary between runs.",
+        ("Every table below comes from one run of the script named above it; ratios compare "
+         "timings from that same run. Timings on shared or virtual machines vary between runs."),
     ]
     failed = []
     for s in scripts:
         extra = args_for(s, a.quick)
         cmd = ["python", f"benchmarks/{s.name}", *extra]
         print(f"\n=== {' '.join(cmd)}", flush=True)
-        r = subprocess.run([sys.executable, str(s), *extra], capture_output=True, text=True,
-                           cwd=HERE.parent)
+        r = subprocess.run([sys.executable, str(s), *extra], check=False, capture_output=True,
+                           text=True, cwd=HERE.parent)
         print(r.stdout, end="")
         if r.returncode != 0:
             print(r.stderr, file=sys.stderr)
