@@ -365,3 +365,15 @@ def test_tube_bad_input_and_inputs_untouched():
     spinal.tube(x, r)
     np.testing.assert_array_equal(x, keep)
     assert np.all(r == 0.1)
+
+
+@pytest.mark.parametrize("ext", ["ply", "obj"])
+def test_save_round_trips_through_trimesh(tmp_path, ext):
+    mesh = spinal.tube(TorusKnot().sample(201), 0.1, 8, closed=True)
+    path = mesh.save(tmp_path / f"knot.{ext}")
+    back = trimesh.load(path, process=False)
+    np.testing.assert_array_equal(back.vertices, mesh.vertices)
+    np.testing.assert_array_equal(back.faces, mesh.faces)
+    assert back.volume == pytest.approx(mesh.volume, rel=1e-12)
+    with pytest.raises(ValueError, match="path: unknown format"):
+        mesh.save(tmp_path / "knot.stl")
