@@ -5,7 +5,7 @@ vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tube
 curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
 """
 
-from . import curves
+from . import curves, ph
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -19,6 +19,7 @@ __all__ = [
     "curves",
     "estimate_tangents",
     "frames",
+    "ph",
     "sweep",
     "tube",
 ]

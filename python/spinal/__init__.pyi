@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import curves as curves
+from . import ph as ph
 from .curves import Curve
 
 __version__: str
