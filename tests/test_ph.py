@@ -450,3 +450,201 @@ def test_spline_sweep_mesh():
     ring = mesh.vertices[:12] - sp.evaluate(0.0)
     np.testing.assert_allclose(np.linalg.norm(ring, axis=1), 0.1, rtol=1e-12)
     np.testing.assert_allclose(ring @ sp.rmf(0.0)[0][:, 2], 0, atol=1e-14)
+
+
+# ---------------------------------------------------------------------------------------
+# 7. curves -> G¹ PH splines: the brief's tables and the measured orders
+
+HELIX = spinal.curves.Helix(1.0, 0.5)
+TWISTED = spinal.curves.Polynomial([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+INFLECTION = spinal.curves.Polynomial([[0, 0, 0], [1, 0, 0], [0, 0, 0], [0, 1, 0],
+                                       [0, 0, 0.2]], domain=(-1, 1))
+
+
+def frame_measures(sp, r=0.1, nv=2001):
+    """max |Ω̃ − Ω|, max Î, max |O| for a circular section of radius r (Ω_start = π/2).
+
+    O = δ r/√(μ̃²σ² + δ²r²) at the worst point of the circle, μ̃ = 1 − κr, with
+    δ = Ω̃′ − Ω′ from the fitted W (Bernstein form) and the closed-form Ω′."""
+    f = sp.angle_fit(omega_start=PI / 2)
+    inv = ph.invariants(sp.control_points)
+    v = np.linspace(0, 1, nv)
+    amax = omax = 0.0
+    for i in range(sp.segments):
+        s = i + v
+        amax = max(amax, np.abs(sp.angle(s, exact=False, omega_start=PI / 2)
+                                - sp.angle(s, omega_start=PI / 2)).max())
+        b, g = f["beta"][i], f["gamma"][i]
+        N, D = bern(g, v), bern(b, v)
+        dN = 2 * ((g[1] - g[0]) * (1 - v) + (g[2] - g[1]) * v)
+        dD = 2 * ((b[1] - b[0]) * (1 - v) + (b[2] - b[1]) * v)
+        W, dW = N / D, (dN * D - N * dD) / D**2
+        k, a, bb, c = inv["k"][i], inv["a"][i], inv["b"][i], inv["c"][i]
+        delta = f["sg"][i] * 2 * dW / (1 + W * W) - 2 * k * c * a / (a * a + (c * v - bb) ** 2)
+        d1, d2 = sp.evaluate(s, 1), sp.evaluate(s, 2)
+        sig = np.linalg.norm(d1, axis=1)
+        kap = np.linalg.norm(np.cross(d1, d2), axis=1) / sig**3
+        O = np.abs(delta) * r / np.sqrt((1 - kap * r) ** 2 * sig**2 + delta**2 * r**2)
+        omax = max(omax, O.max())
+    return amax, f["I_min"].max(), omax
+
+
+def end_vs_true_rmf(sp, curve):
+    """Angle between the spline's rational RMF and the curve's true RMF at the end, both
+    started from the spline's start frame (r0 = b of the first cubic)."""
+    r0 = sp.rmf(0.0, omega_start=PI / 2)[0][:, 0]
+    lo, hi = curve.domain
+    if isinstance(curve, spinal.curves.Helix):
+        fr = curve.frenet(np.array([lo]))[0]
+        R = curve.rmf(np.array([lo, hi]), angle=np.arctan2(r0 @ fr[:, 1], r0 @ fr[:, 0]))[-1]
+    else:
+        R = spinal.frames(curve, u=20001, method="rk4", initial=r0)[-1]
+    E = sp.rmf(float(sp.segments), omega_start=PI / 2)[0]
+    np.testing.assert_allclose(R[:, 2], E[:, 2], atol=1e-14)  # same end tangent
+    return np.arctan2(np.linalg.norm(np.cross(R[:, 0], E[:, 0])), R[:, 0] @ E[:, 0])
+
+
+def test_helix_spline_table_and_orders():
+    with pytest.raises(ValueError, match=r"^segments: interval 0 \[0, 6.28319\]: no PH cubic: "
+                                         "the end tangents are parallel"):
+        ph.fit(HELIX, segments=1)
+    dev = {N: ph.fit(HELIX, segments=N).deviation.max() for N in (2, 3, 4, 8, 16, 32, 64)}
+    ref = {2: 5.333e-1, 3: 6.275e-2, 4: 1.778e-2, 8: 1.017e-3, 16: 6.233e-5, 32: 3.877e-6,
+           64: 2.420e-7}
+    for N, val in ref.items():
+        assert dev[N] == pytest.approx(val, rel=1e-3), N
+    table = {4: (1.826e-4, 6.687e-7, 8.721e-5, 2.233e-2), 8: (5.199e-6, 5.387e-10, 4.609e-6,
+                                                             1.234e-3),
+             16: (1.589e-7, 5.026e-13, 2.766e-7, 7.496e-5),
+             32: (4.938e-9, 4.853e-16, 1.711e-8, 4.651e-6)}
+    ends = {}
+    for N, (ang, imax, o, end) in table.items():
+        sp = ph.fit(HELIX, segments=N)
+        got = frame_measures(sp)
+        np.testing.assert_allclose(got, (ang, imax, o), rtol=1e-3)
+        ends[N] = end_vs_true_rmf(sp, HELIX)
+        assert ends[N] == pytest.approx(end, rel=1e-3)
+    for a, b in ((4, 8), (8, 16), (16, 32), (32, 64)):
+        assert 12 < dev[a] / dev[b] < 20                     # spine h⁴
+    for a, b in ((8, 16), (16, 32)):
+        assert 12 < ends[a] / ends[b] < 20                   # frame vs true RMF h⁴
+
+
+def test_twisted_cubic_spline_table_and_orders():
+    ref = {1: 1.2666e-2, 2: 1.2754e-3, 4: 1.4994e-4, 8: 1.1741e-5, 16: 7.7890e-7,
+           32: 4.9421e-8, 64: 3.1005e-9}
+    dev = {N: ph.fit(TWISTED, segments=N).deviation.max() for N in ref}
+    for N, val in ref.items():
+        assert dev[N] == pytest.approx(val, rel=1e-3), N
+    for a, b in ((8, 16), (16, 32), (32, 64)):
+        assert 12 < dev[a] / dev[b] < 20
+    table = {2: (9.189e-5, 1.512e-7, 1.385e-4, 5.175e-4), 4: (5.089e-6, 5.044e-10, 1.726e-5,
+                                                             3.471e-5),
+             8: (1.857e-7, 6.832e-13, 1.290e-6, 2.202e-6),
+             16: (6.033e-9, 7.238e-16, 8.422e-8, 1.371e-7)}
+    ends = {}
+    for N, (ang, imax, o, end) in table.items():
+        sp = ph.fit(TWISTED, segments=N)
+        np.testing.assert_allclose(frame_measures(sp), (ang, imax, o), rtol=1e-3)
+        ends[N] = end_vs_true_rmf(sp, TWISTED)
+        # the true RMF is RK4 on 20001 samples: ~1e-9 of its own error
+        assert ends[N] == pytest.approx(end, rel=1e-3 if N < 16 else 1e-2)
+    assert 12 < ends[4] / ends[8] < 20 and 12 < ends[8] / ends[16] < 20
+
+
+def test_inflection_curve_order_three_and_errors():
+    dev = [ph.fit(INFLECTION, segments=N).deviation.max() for N in (2, 4, 8, 16, 32, 64)]
+    np.testing.assert_allclose(dev, [5.781e-2, 7.158e-3, 8.497e-4, 1.056e-4, 1.320e-5,
+                                     1.649e-6], rtol=1e-3)
+    ratios = np.array(dev[:-1]) / dev[1:]
+    assert np.all((ratios > 6) & (ratios < 10))              # h³ next to the inflection knot
+    for N in (3, 5, 9, 17, 33):                              # inflection inside the middle
+        with pytest.raises(ValueError, match=rf"^segments: interval {N // 2} .*inflection"):
+            ph.fit(INFLECTION, segments=N)
+    lopsided = spinal.curves.Polynomial(INFLECTION.coefficients, domain=(-1, 1.1))
+    for N in (3, 5, 16, 64):
+        with pytest.raises(ValueError, match="no PH cubic"):
+            ph.fit(lopsided, segments=N)
+    for N in (2, 4, 6, 7, 8, 32):
+        ph.fit(lopsided, segments=N)
+    with pytest.raises(ValueError, match=r"^knots: interval 1 \[-0.5, 0.5\]"):
+        ph.fit(INFLECTION, knots=[-1, -0.5, 0.5, 1])
+
+
+def test_adaptive_fit():
+    for tol in (1e-3, 1e-6):
+        sp = ph.fit(INFLECTION, tol=tol)
+        assert sp.deviation.max() <= tol and 0.0 in sp.knots
+        assert sp.knots[0] == -1 and sp.knots[-1] == 1
+        # G¹: shared points and unit tangents at the joints
+        P = sp.control_points
+        np.testing.assert_array_equal(P[1:, 0], P[:-1, 3])
+        d_in = P[:-1, 3] - P[:-1, 2]
+        d_out = P[1:, 1] - P[1:, 0]
+        np.testing.assert_allclose(d_in / np.linalg.norm(d_in, axis=1)[:, None],
+                                   d_out / np.linalg.norm(d_out, axis=1)[:, None], atol=1e-14)
+    coarse = ph.fit(INFLECTION, tol=1e-3)
+    # the independent deviation: closest points of the curve to dense spline points
+    x = coarse.points(64)
+    u = np.linspace(-1, 1, 200001)
+    c = INFLECTION.point(u)
+    from scipy.spatial import cKDTree
+    d, _ = cKDTree(c).query(x)
+    assert d.max() <= 1e-3 * 1.001
+    # sampled input: knots are rows, the inflection row 200 is one of them
+    u = np.linspace(-1, 1, 401)
+    sp = ph.fit(INFLECTION.point(u), tol=1e-5)
+    assert sp.deviation.max() <= 1e-5 and 200 in sp.knots
+    assert np.all(sp.knots == np.round(sp.knots))
+    with pytest.raises(ValueError, match="^tol: interval .* cannot be split further"):
+        ph.fit(INFLECTION.point(np.linspace(-1, 1, 9)), tol=1e-9)
+
+
+def test_fit_bad_input():
+    with pytest.raises(TypeError, match="^tol, segments, knots"):
+        ph.fit(HELIX, tol=1e-3, segments=3)
+    with pytest.raises(ValueError, match="^segments: must be >= 1"):
+        ph.fit(HELIX, segments=0)
+    with pytest.raises(ValueError, match="^knots: expected a strictly increasing"):
+        ph.fit(HELIX, knots=[0, 2, 1])
+    with pytest.raises(ValueError, match="^tol: must be positive"):
+        ph.fit(HELIX, tol=-1)
+    with pytest.raises(ValueError, match="^curve: contains non-finite"):
+        ph.fit(np.array([[0, 0, 0], [1, np.nan, 0], [2, 0, 1]]))
+    with pytest.raises(ValueError, match="^curve: expected an array of shape"):
+        ph.fit(np.zeros((5, 2)))
+    with pytest.raises(ValueError, match="^s: values must be finite"):
+        ph.fit(HELIX, segments=4).evaluate(4.5)
+    with pytest.raises(ValueError, match="^initial: is zero"):
+        ph.fit(HELIX, segments=4).rmf(initial=HELIX.tangent(0.0)[0])
+    with pytest.raises(ValueError, match="^control_points: cubic 1 is not a PH cubic"):
+        P = ph.fit(HELIX, segments=4).control_points.copy()
+        P[1, 1] += 0.01
+        ph.PHSpline(P)
+
+
+def test_orthogonality_measure_on_the_swept_surface():
+    """|O| = |<s_u, s_v>|/(|s_u||s_v|) from finite differences of the surface swept with the
+    rational frame (helix, N = 4, circle of radius 0.1): the table's 8.721e-5, computed
+    here without the closed form used in frame_measures."""
+    sp = ph.fit(HELIX, segments=4)
+    r, h = 0.1, 1e-3
+    al = np.linspace(0, 2 * PI, 361)[:-1]
+    ca, sa = np.cos(al)[None, :, None], np.sin(al)[None, :, None]
+    worst = 0.0
+    for i in range(4):
+        v = np.linspace(2 * h, 1 - 2 * h, 801)
+
+        def surf(vv, i=i):
+            F = sp.rmf(i + vv, omega_start=PI / 2)
+            x = sp.evaluate(i + vv)[:, None, :]
+            return x + r * (ca * F[:, None, :, 0] + sa * F[:, None, :, 1]), F
+
+        sv = (-surf(v + 2 * h)[0] + 8 * surf(v + h)[0] - 8 * surf(v - h)[0]
+              + surf(v - 2 * h)[0]) / (12 * h)
+        F = surf(v)[1]
+        su = r * (-sa * F[:, None, :, 0] + ca * F[:, None, :, 1])
+        O = np.abs((su * sv).sum(-1)) / (np.linalg.norm(su, axis=-1)
+                                         * np.linalg.norm(sv, axis=-1))
+        worst = max(worst, O.max())
+    assert worst == pytest.approx(8.721e-5, rel=1e-3)

@@ -50,6 +50,7 @@ __all__ = [
     "PHSpline",
     "angle_fit",
     "evaluate",
+    "fit",
 
     "from_quaternions",
     "hermite",
@@ -601,3 +602,308 @@ class PHSpline:
         s = self.samples(n_per_segment)
         F = self.rmf(s, initial=initial, exact=exact, omega_start=omega_start)
         return _sweep(self.evaluate(s), profile, frames=F, **kwargs)
+
+
+# ---------------------------------------------------------------------------------------
+# Curve -> G¹ PH spline (Pseudocode C of the brief)
+
+_REASONS = {
+    1: "no PH cubic: the end tangents are parallel but the chord is not along them",
+    2: "no PH cubic: the end tangents are antiparallel and the chord is along them",
+    3: "no PH cubic interpolates the data (an inflection or S-shape inside the interval)",
+    4: "no PH cubic interpolates the data (only reversed polygons: an inflection or "
+       "S-shape inside the interval)",
+}
+
+
+def _bez(cp: np.ndarray, v: np.ndarray, k: int = 0) -> np.ndarray:
+    """Points (k = 0) or derivatives of cubics ``cp (q, 4, 3)`` at ``v (q, r)`` -> (q, r, 3)."""
+    v = v[..., None]
+    u = 1 - v
+    b0, b1, b2, b3 = (cp[:, None, i] for i in range(4))
+    if k == 0:
+        return u**3 * b0 + 3 * u**2 * v * b1 + 3 * u * v**2 * b2 + v**3 * b3
+    if k == 1:
+        return 3 * (u**2 * (b1 - b0) + 2 * u * v * (b2 - b1) + v**2 * (b3 - b2))
+    return 6 * (u * (b2 - 2 * b1 + b0) + v * (b3 - 2 * b2 + b1))
+
+
+def _hermite_batch(p0, t0, p1, t1):
+    """Best candidate per row (q, 4, 3) and reason codes (0 = solved)."""
+    cand, counts, codes = _core.ph_hermite(
+        np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
+        np.ascontiguousarray(t1), True, True)
+    return cand.reshape(-1, 2, 4, 3)[:, 0], counts, codes
+
+
+def _dev_curve(curve, cp, ta, tb, lo, hi) -> np.ndarray:
+    """Max distance from 41 points of each cubic to the curve arc over [ta, tb] (per row)."""
+    q = cp.shape[0]
+    v = np.broadcast_to(np.linspace(0, 1, 41), (q, 41))
+    X = _bez(cp, v)
+    h = tb - ta
+    a = np.maximum(ta - 0.1 * h, lo)
+    b = np.minimum(tb + 0.1 * h, hi)
+    # coarse scan of the enlarged interval, then Newton on (p(u) − X)·p′(u) = 0
+    scan = a[:, None] + (b - a)[:, None] * np.linspace(0, 1, 65)
+    P = curve.point(scan.ravel()).reshape(q, 65, 3)
+    d2 = ((X[:, :, None, :] - P[:, None, :, :]) ** 2).sum(-1)
+    u = np.take_along_axis(scan, d2.argmin(axis=2), axis=1)
+    for _ in range(12):
+        flat = u.ravel()
+        p, d1, dd = (f(flat).reshape(q, 41, 3) for f in (curve.point, curve.d1, curve.d2))
+        e = p - X
+        g = (e * d1).sum(-1)
+        gp = (d1 * d1).sum(-1) + (e * dd).sum(-1)
+        step = np.where(gp > 0, g / np.where(gp > 0, gp, 1.0), 0.0)
+        u = np.clip(u - step, a[:, None], b[:, None])
+    dist = np.linalg.norm(curve.point(u.ravel()).reshape(q, 41, 3) - X, axis=-1)
+    return dist.max(axis=1)
+
+
+def _dev_rows(cp: np.ndarray, pts: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+    """Max distance from the rows ia..ib of ``pts`` to each cubic (Newton on v)."""
+    out = np.zeros(cp.shape[0])
+    vs = np.linspace(0, 1, 33)
+    for j in range(cp.shape[0]):
+        X = pts[ia[j]: ib[j] + 1][None]
+        c = cp[j: j + 1]
+        S = _bez(c, vs[None])[0]
+        v = vs[((X[0, :, None, :] - S[None]) ** 2).sum(-1).argmin(axis=1)][None]
+        for _ in range(12):
+            e = _bez(c, v) - X
+            d1, dd = _bez(c, v, 1), _bez(c, v, 2)
+            g = (e * d1).sum(-1)
+            gp = (d1 * d1).sum(-1) + (e * dd).sum(-1)
+            v = np.clip(v - np.where(gp > 0, g / np.where(gp > 0, gp, 1.0), 0.0), 0, 1)
+        out[j] = np.linalg.norm(_bez(c, v) - X, axis=-1).max()
+    return out
+
+
+def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float]:
+    """Parameters where κ has a local minimum with κ·diag < 1e-6 (golden-section refined)."""
+    u = np.linspace(lo, hi, n)
+    k = curve.curvature(u)
+    out = []
+    g = (np.sqrt(5) - 1) / 2
+    for i in np.flatnonzero((k[1:-1] <= k[:-2]) & (k[1:-1] <= k[2:])) + 1:
+        a, b = u[i - 1], u[i + 1]
+        while b - a > 1e-12 * (hi - lo):
+            x1, x2 = b - g * (b - a), a + g * (b - a)
+            k1, k2 = curve.curvature(np.array([x1, x2]))
+            if k1 <= k2:
+                b = x2
+            else:
+                a = x1
+        m = (a + b) / 2
+        if curve.curvature(np.array([m]))[0] * diag < 1e-6:
+            out.append(float(m))
+    return out
+
+
+def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=None,
+        max_segments: int = 4096) -> PHSpline:
+    """Convert a curve into a G¹ spline of PH cubics (Maurer & Jüttler §3.3).
+
+    Each interval ``[kᵢ, kᵢ₊₁]`` of the knots gets the PH cubic of :func:`hermite` through
+    the curve's points and unit tangents at its ends; neighbouring cubics share the point
+    and the tangent direction (G¹, each with its own ``v ∈ [0, 1]``). Where the curvature
+    does not vanish the distance to the curve falls like ``h⁴`` with the interval length
+    ``h`` (``h³`` next to an inflection at a knot); an inflection *inside* an interval can
+    leave no solution.
+
+    Parameters
+    ----------
+    curve : spinal.curves.Curve or array_like (n, 3)
+        An analytic curve (points and exact unit tangents; knots are curve parameters) or
+        samples (knots are row indices).
+    tol : float, optional
+        Adaptive segmentation: the largest distance allowed between each cubic and the
+        input — for a curve the closest-point distance from 41 points of the cubic to the
+        arc (Newton projection), for samples from the input rows inside the interval to
+        the cubic. Starts from 4 uniform intervals for a curve (every ⌈n/8⌉-th row for
+        samples) plus knots at the inflections (local minima of κ with κ·diag < 1e-6, or
+        rows where the discrete binormal flips) and splits so that the tangent turns by
+        less than π/2 on every interval; then halves intervals (middle row for samples)
+        until they are within ``tol``. Default when neither ``segments`` nor ``knots`` is
+        given: ``1e-5`` times the bounding-box diagonal.
+    segments : int, optional
+        ``segments`` uniform intervals (of the parameter, or of the row index), no
+        adaptivity.
+    knots : array_like, optional
+        Explicit increasing knots (curve parameters, or integer rows including 0 and n − 1).
+    tangents : array_like (n, 3), optional
+        Tangents of the samples (default :func:`spinal.estimate_tangents`).
+    domain : (float, float), optional
+        Parameter interval of an analytic curve (default ``curve.domain``).
+    max_segments : int
+        Adaptive segmentation stops with a ValueError beyond this many cubics.
+
+    Returns
+    -------
+    PHSpline
+        With ``knots`` (curve parameters or rows) and ``deviation`` per cubic.
+
+    Raises
+    ------
+    ValueError
+        Bad input; an interval without a PH cubic (with ``segments``/``knots``: naming the
+        interval and the reason — parallel end tangents, an inflection inside; with ``tol``
+        only when the interval cannot be split further); ``tol`` not reachable.
+    """
+    from .curves import Curve
+
+    given = [x is not None for x in (tol, segments, knots)]
+    if sum(given) > 1:
+        raise TypeError("tol, segments, knots: pass at most one of them")
+    max_segments = as_int(max_segments, "max_segments")
+    analytic = isinstance(curve, Curve)
+    if analytic:
+        if tangents is not None:
+            raise TypeError("tangents: not accepted with an analytic curve (exact tangents)")
+        lo, hi = curve.domain if domain is None else domain
+        lo, hi = float(lo), float(hi)
+        if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
+            raise ValueError(f"domain: expected a finite interval (lo, hi), got {domain!r}")
+        probe = curve.point(np.linspace(lo, hi, 257))
+        diag = float(np.linalg.norm(probe.max(0) - probe.min(0)))
+
+        def data(k):
+            return curve.point(k), curve.tangent(k)
+    else:
+        if domain is not None:
+            raise TypeError("domain: only for analytic curves")
+        from ._frames import estimate_tangents
+        from ._validate import as_points
+
+        pts = as_points(curve, "curve")
+        _finite(pts, "curve")
+        n = pts.shape[0]
+        if n < 2:
+            raise ValueError(f"curve: need at least 2 samples, got {n}")
+        if tangents is None:
+            T = estimate_tangents(pts)
+        else:
+            T = as_points(tangents, "tangents")
+            _finite(T, "tangents")
+            if T.shape[0] != n:
+                raise ValueError(f"tangents: expected {n} rows like curve, got {T.shape[0]}")
+            nt = np.linalg.norm(T, axis=1)
+            if not np.all(nt > 0):
+                raise ValueError(f"tangents: zero tangent at row {int(np.argmin(nt))}")
+            T = T / nt[:, None]
+        lo, hi = 0.0, float(n - 1)
+        diag = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+
+        def data(k):
+            i = k.astype(np.intp)
+            return pts[i], T[i]
+
+    def solve(k, what):
+        p, t = data(k)
+        cp, counts, codes = _hermite_batch(p[:-1], t[:-1], p[1:], t[1:])
+        bad = np.flatnonzero(counts == 0)
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"{what}: interval {i} [{k[i]:g}, {k[i + 1]:g}]: "
+                             f"{_REASONS[int(codes[i])]}; split it or move the knots")
+        return cp
+
+    def deviation(cp, k):
+        if analytic:
+            return _dev_curve(curve, cp, k[:-1], k[1:], lo, hi)
+        return _dev_rows(cp, pts, k[:-1].astype(np.intp), k[1:].astype(np.intp))
+
+    if segments is not None or knots is not None:
+        if segments is not None:
+            N = as_int(segments, "segments")
+            if N < 1:
+                raise ValueError(f"segments: must be >= 1, got {N}")
+            k = np.linspace(lo, hi, N + 1)
+            if not analytic:
+                k = np.unique(np.round(k))
+                if k.size != N + 1:
+                    raise ValueError(f"segments: {N} intervals need at least {N + 1} samples")
+            what = "segments"
+        else:
+            k = _finite(as_float_array(knots, "knots"), "knots")
+            if k.ndim != 1 or k.size < 2 or not np.all(np.diff(k) > 0):
+                raise ValueError("knots: expected a strictly increasing 1-D array of >= 2 values")
+            if k[0] < lo or k[-1] > hi:
+                raise ValueError(f"knots: must lie within [{lo:g}, {hi:g}]")
+            if not analytic and not np.all(k == np.round(k)):
+                raise ValueError("knots: sample knots must be integer rows")
+            what = "knots"
+        cp = solve(k, what)
+        sp = PHSpline(cp, k, check=False)
+        sp.deviation = deviation(cp, k)
+        return sp
+
+    tol = 1e-5 * diag if tol is None else float(as_float_array(tol, "tol"))
+    if not (tol > 0 and np.isfinite(tol)):
+        raise ValueError(f"tol: must be positive and finite, got {tol}")
+    # initial knots: uniform, inflections, tangent turn < π/2 (8-point scan)
+    if analytic:
+        k = set(np.linspace(lo, hi, 5).tolist())
+        k.update(_inflections(curve, lo, hi, 256, diag))
+        h_min = 1e-6 * (hi - lo)
+    else:
+        k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
+        d = np.diff(pts, axis=0)
+        bn = np.cross(d[:-1], d[1:])
+        bl = np.linalg.norm(bn, axis=1)
+        ok = bl > 1e-12 * np.linalg.norm(d[:-1], axis=1) * np.linalg.norm(d[1:], axis=1)
+        bn = bn / np.where(ok, bl, 1.0)[:, None]
+        for j in range(len(bn) - 1):
+            if ok[j] and ok[j + 1] and bn[j] @ bn[j + 1] < 0:  # rows j+1 and j+2
+                k.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
+        h_min = 1.0
+    k = np.array(sorted(k))
+    for _ in range(64):
+        sub = k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.linspace(0, 1, 9)
+        if not analytic:
+            sub = np.round(sub)
+        t0 = data(k[:-1])[1]
+        ts = data(sub.ravel())[1].reshape(sub.shape[0], 9, 3)
+        turn = (ts * t0[:, None]).sum(-1).min(axis=1) <= 0
+        split = turn & (np.diff(k) > h_min)
+        if not split.any():
+            break
+        mid = (k[:-1] + k[1:])[split] / 2
+        k = np.union1d(k, np.floor(mid) if not analytic else mid)
+    # work queue, processed in batches
+    pending = [(k[i], k[i + 1]) for i in range(len(k) - 1)]
+    done: list[tuple[float, float, np.ndarray, float]] = []
+    while pending:
+        a = np.array([x[0] for x in pending])
+        b = np.array([x[1] for x in pending])
+        pa, ta_ = data(a)
+        pb, tb_ = data(b)
+        cp, counts, codes = _hermite_batch(pa, ta_, pb, tb_)
+        dev = np.full(a.size, np.inf)
+        okr = counts > 0
+        if okr.any():
+            dev_ok = (_dev_curve(curve, cp[okr], a[okr], b[okr], lo, hi) if analytic else
+                      _dev_rows(cp[okr], pts, a[okr].astype(np.intp), b[okr].astype(np.intp)))
+            dev[okr] = dev_ok
+        pending = []
+        for j in range(a.size):
+            short = (b[j] - a[j]) <= (1.0 if not analytic else h_min)
+            if okr[j] and (dev[j] <= tol or (short and not analytic)):
+                done.append((a[j], b[j], cp[j], dev[j]))
+                continue
+            if short:
+                why = (_REASONS[int(codes[j])] if not okr[j] else
+                       f"tolerance {tol:g} not reachable (deviation {dev[j]:.3g})")
+                raise ValueError(f"tol: interval [{a[j]:g}, {b[j]:g}] cannot be split "
+                                 f"further: {why}")
+            m = (a[j] + b[j]) / 2 if analytic else np.floor((a[j] + b[j]) / 2)
+            pending += [(a[j], m), (m, b[j])]
+        if len(done) + len(pending) > max_segments:
+            raise ValueError(f"max_segments: more than {max_segments} cubics needed for "
+                             f"tol = {tol:g}")
+    done.sort(key=lambda x: x[0])
+    kn = np.array([x[0] for x in done] + [done[-1][1]])
+    sp = PHSpline(np.stack([x[2] for x in done]), kn, check=False)
+    sp.deviation = np.array([x[3] for x in done])
+    return sp
