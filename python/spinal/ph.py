@@ -489,10 +489,11 @@ class PHSpline:
         mode = "exact" if as_bool(exact, "exact") else "rational"
         return self._frames(s, mode, initial, omega_start)[0]
 
-    def angle(self, s, *, initial=None, exact: bool = True, omega_start: float = 0.0
+    def angle(self, s, *, initial=None, exact: bool = False, omega_start: float = 0.0
               ) -> np.ndarray:
-        """The RMF angle ``Ω`` (exact) or ``Ω̃`` (rational) at ``s``, radians from ``n``
-        towards ``b`` of the local cubic (per cubic, not unwrapped across joints)."""
+        """The angle of :meth:`rmf`'s ``r`` at ``s``, radians from ``n`` towards ``b`` of
+        the local cubic: ``Ω̃`` (rational, default) or ``Ω`` (``exact=True``). Per cubic, not
+        unwrapped across joints; 0 on straight cubics."""
         mode = "exact" if as_bool(exact, "exact") else "rational"
         return self._frames(s, mode, initial, omega_start)[1]
 

@@ -63,7 +63,7 @@ class PHSpline:
         s: float | _Array,
         *,
         initial: _Array | None = None,
-        exact: bool = True,
+        exact: bool = False,
         omega_start: float = 0.0,
     ) -> _F: ...
     def angle_fit(

@@ -61,7 +61,7 @@ impl AngleFit {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Segment {
     pub straight: bool,
-    /// Reference vector carried along a straight segment.
+    /// Reference vector at the start (carried unchanged along a straight segment).
     pub r: DVec3,
     pub omega0: f64,
     pub omega1: f64,
@@ -329,7 +329,8 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
             }
             Some(((n0, b0, _), (n1, b1, _))) => {
                 let om0 = r.dot(b0).atan2(r.dot(n0));
-                let seg = segment(c, om0, phi);
+                let mut seg = segment(c, om0, phi);
+                seg.r = r; // fallback where the Frenet frame is numerically undefined
                 r = seg.omega1.sin() * b1 + seg.omega1.cos() * n1;
                 out.push(seg);
             }
@@ -348,12 +349,16 @@ pub enum Mode {
 
 /// The frame (columns `r, s, t`) and its angle from `n` at `v` of a segment. On straight
 /// segments (no Frenet frame) every mode carries the reference vector; the angle is 0.
+/// (A bent PH cubic has κ > 0 on [0, 1]; should `ẋ × ẍ` still underflow, the start vector
+/// projected onto the normal plane stands in, never a NaN.)
 pub fn frame_at(c: &Cubic, seg: &Segment, v: f64, mode: Mode) -> (DMat3, f64) {
     let fr = if seg.straight { None } else { frenet(c, v) };
     match fr {
         None => {
-            let t = c.d1(v).normalize();
-            let r = (seg.r - seg.r.dot(t) * t).normalize();
+            let t = c.d1(v).normalize_or(DVec3::Z);
+            let r = (seg.r - seg.r.dot(t) * t)
+                .try_normalize()
+                .unwrap_or_else(|| any_perpendicular(t));
             (DMat3::from_cols(r, t.cross(r), t), 0.0)
         }
         Some((n, b, t)) => {
