@@ -99,12 +99,16 @@ def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
 
         (λ₁ − X)(−λ₂ − X) − 2(1 + C)X² = 2|n₁ − n₂|²/(1 − C)
 
-    and gives a forward polygon, ``L₁ = λ₁ − X > 0`` and ``L₃ = −λ₂ − X > 0``. There are 0, 1
+    and gives a forward polygon, ``L₁ = λ₁ − X > 0`` and ``L₃ = −λ₂ − X > 0``. (It is solved
+    in an equivalent form for the mean leg ``(L₁ + L₃)/2`` that stays accurate for nearly
+    parallel or antiparallel tangents, where ``λ₁, λ₂ ~ 1/(1 − C²)`` would cancel.) There are 0, 1
     or 2 solutions; the one with the shortest control polygon is the shape-matching one for
     data sampled from a smooth curve (``X ≈ h/6``). Special cases: ``C = −1/2`` (the
-    equation is linear: at most one solution); ``C ≈ 1`` (only a straight line interpolates,
-    when the chord is along the tangents: the uniform line); ``C ≈ −1`` (the planar closed
-    form ``L₁ = (d + √(d² + 4e²))/2``, ``L₃ = L₁ − d``, ``d = D·t0``, ``e = |D − d t0|``).
+    equation is linear: at most one solution); parallel tangents, ``|t0 − t1| < 1e-8``
+    (only a straight line interpolates, when the chord is along the tangents: the uniform
+    line); ``C = −1`` (the equation becomes the planar closed form
+    ``L₁ = (d + √(d² + 4e²))/2``, ``L₃ = L₁ − d``, ``d = D·t0``, ``e = |D − d t0|``; no
+    solution when ``p1`` is on the tangent line, ``e = 0``).
 
     Parameters
     ----------
@@ -698,7 +702,10 @@ def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float
                 a = x1
         m = (a + b) / 2
         if curve.curvature(np.array([m]))[0] * diag < 1e-6:
-            out.append(float(m))
+            if out and m - out[-1] <= 1e-6 * (hi - lo):  # two scan minima, one inflection
+                out[-1] = (out[-1] + m) / 2
+            else:
+                out.append(float(m))
     return out
 
 
@@ -845,9 +852,13 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         raise ValueError(f"tol: must be positive and finite, got {tol}")
     # initial knots: uniform, inflections, tangent turn < π/2 (8-point scan)
     if analytic:
-        k = set(np.linspace(lo, hi, 5).tolist())
-        k.update(_inflections(curve, lo, hi, 256, diag))
         h_min = 1e-6 * (hi - lo)
+        infl = [x for x in _inflections(curve, lo, hi, 256, diag)
+                if lo + h_min < x < hi - h_min]
+        # uniform knots give way to nearby inflections (no sliver intervals)
+        k = {x for x in np.linspace(lo, hi, 5).tolist()
+             if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
+        k.update(infl)
     else:
         k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
         d = np.diff(pts, axis=0)

@@ -9,21 +9,35 @@
 //!
 //! ```text
 //! (λ₁ − X)(−λ₂ − X) − 2(1 + C)X² = R,   R = 2|n₁ − n₂|²/(1 − C)
-//! ⇔ (1 + 2C)X² + (λ₁ − λ₂)X + λ₁λ₂ + R = 0
 //! ```
 //!
 //! and only roots with `L₁ = λ₁ − X > 0` and `L₃ = −λ₂ − X > 0` give a forward polygon.
-//! Special cases: `C = −1/2` (linear equation), `C ≈ 1` (only a straight line, when the
-//! chord is along the tangents), `C ≈ −1` (planar closed form
-//! `L₁ = (d + √(d² + 4e²))/2`, `L₃ = L₁ − d` with `d = D·t₀`, `e = |D − d t₀|`).
+//!
+//! Evaluated as printed, `λ₁, λ₂ ~ h/s²` cancel catastrophically for nearly parallel
+//! tangents (fine segments of gently curved data) and for nearly antiparallel ones. We solve
+//! the same equation for the mean leg `M = (L₁ + L₃)/2` instead, with the orthogonal pair
+//! `t_m = t₀ + t₁ = a m̂`, `t_d = t₀ − t₁ = b û` (`a² + b² = 4`):
+//!
+//! ```text
+//! L₁ − L₃ = λ₁ + λ₂ = 2(û·D)/b,   X = (λ₁ − λ₂)/2 − M = (m̂·D)/a − M,
+//! (1 − a²)M² + 2a(m̂·D)M − (m̂·D)² − [(û·D)² + 4(D·(û × m̂))²]/b² = 0
+//! ```
+//!
+//! (`1 − a² = −(1 + 2C)`: linear at `C = −1/2`), `b₁ = p₀ + L₁t₀`, `b₂ = p₁ − L₃t₁`. Every
+//! term stays bounded as `b → 0` for data from a smooth curve, and as `a → 0` the equation
+//! becomes the planar closed form `M = √(d² + 4e²)/2` of antiparallel tangents
+//! (`d = D·t₀`, `e = |D − d t₀|`), so no separate branch is needed there (the end tangents
+//! stay exact). Exactly parallel tangents (`|t₀ − t₁| < 1e-8`) are interpolated only by the
+//! straight line, when the chord is along them.
 
 use glam::DVec3;
 
 use super::Cubic;
+use crate::frames::geometry::any_perpendicular;
 
-/// `1 − C²` below which tangents with `C > 0` count as parallel.
-pub const EPS_PARALLEL: f64 = 1e-10;
-/// `1 + C` below which the antiparallel closed form is used.
+/// `|t₀ − t₁|` below which tangents count as parallel (angle < 1e-8 rad).
+pub const EPS_PARALLEL: f64 = 1e-8;
+/// `1 + C` below which data with `p₁` on the tangent line of `p₀` are refused.
 pub const EPS_ANTI: f64 = 1e-11;
 /// `|1 + 2C|` below which the equation is treated as linear.
 pub const EPS_LINEAR: f64 = 1e-12;
@@ -99,33 +113,40 @@ pub fn hermite(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Solutions {
     };
     let c = t0.dot(t1);
     let d = p1 - p0;
-    let s2 = t0.cross(t1).length_squared();
     let dl = d.length();
-    if c > 0.0 && s2 < EPS_PARALLEL {
+    // symmetric and antisymmetric tangents: tm ⟂ td, |tm|² + |td|² = 4
+    let (tm, td) = (t0 + t1, t0 - t1);
+    let (a, b) = (tm.length(), td.length());
+    if c > 0.0 && b < EPS_PARALLEL {
         let along = d.dot(t0);
         if d.cross(t0).length() <= 1e-8 * dl && along > 0.0 {
             return one(Cubic::new([p0, p0 + d / 3.0, p0 + 2.0 * d / 3.0, p1]));
         }
         return none(NoSolution::Parallel);
     }
+    let u = td / b;
     if c < 0.0 && 1.0 + c < EPS_ANTI {
-        let dd = d.dot(t0);
-        let e = (d - dd * t0).length();
+        let e = (d - d.dot(t0) * t0).length();
         if !(e > 1e-14 * dl) {
             return none(NoSolution::AntiparallelOnLine);
         }
-        let l1 = (dd + (dd * dd + 4.0 * e * e).sqrt()) / 2.0;
-        let l3 = l1 - dd;
-        return one(Cubic::new([p0, p0 + l1 * t0, p1 + l3 * t0, p1]));
     }
-    let lam1 = (t0.dot(d) - c * t1.dot(d)) / s2;
-    let lam2 = -(t1.dot(d) - c * t0.dot(d)) / s2;
-    let n1 = p0 + lam1 * t0;
-    let n2 = p1 + lam2 * t1;
-    let r = 2.0 * (n1 - n2).length_squared() / (1.0 - c);
-    let qa = 1.0 + 2.0 * c;
-    let qb = lam1 - lam2;
-    let qc = lam1 * lam2 + r;
+    // m̂: unit along tm, made exactly ⟂ û (any perpendicular when tm vanishes)
+    let m = {
+        let p = tm - tm.dot(u) * u;
+        if a > 1e-12 {
+            p.normalize()
+        } else {
+            any_perpendicular(u)
+        }
+    };
+    let md = m.dot(d);
+    let ud = u.dot(d);
+    let wd = d.dot(u.cross(m));
+    let delta = 2.0 * ud / b; // L₁ − L₃ = λ₁ + λ₂
+    let qa = 1.0 - a * a; // = −(1 + 2C)
+    let qb = 2.0 * a * md;
+    let qc = -(md * md) - (ud * ud + 4.0 * wd * wd) / (b * b);
     let mut roots: Vec<f64> = Vec::with_capacity(2);
     if qa.abs() < EPS_LINEAR {
         if qb != 0.0 {
@@ -149,8 +170,11 @@ pub fn hermite(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Solutions {
     }
     let mut cubics: Vec<Cubic> = roots
         .into_iter()
-        .filter(|&x| x.is_finite() && lam1 - x > 0.0 && -lam2 - x > 0.0)
-        .map(|x| Cubic::new([p0, n1 - x * t0, n2 + x * t1, p1]))
+        .filter(|&mm| mm.is_finite() && mm + delta / 2.0 > 0.0 && mm - delta / 2.0 > 0.0)
+        .map(|mm| {
+            let (l1, l3) = (mm + delta / 2.0, mm - delta / 2.0);
+            Cubic::new([p0, p0 + l1 * t0, p1 - l3 * t1, p1])
+        })
         .collect();
     if cubics.is_empty() {
         return none(if qa.abs() < EPS_LINEAR && qb == 0.0 {
@@ -183,6 +207,65 @@ mod tests {
         let b1 = sol.cubics[0].b[1];
         assert!((b1 - DVec3::new(1.0, 0.5858183513, 0.2929091757)).length() < 1e-9);
         assert!(sol.cubics[0].is_ph(1e-9) && sol.cubics[1].is_ph(1e-9));
+    }
+
+    /// The printed λ form (signed, PH-1), as a reference for the M form.
+    fn lambda_form(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Vec<[DVec3; 2]> {
+        let (c, d) = (t0.dot(t1), p1 - p0);
+        let s2 = t0.cross(t1).length_squared();
+        let lam1 = (t0.dot(d) - c * t1.dot(d)) / s2;
+        let lam2 = -(t1.dot(d) - c * t0.dot(d)) / s2;
+        let (n1, n2) = (p0 + lam1 * t0, p1 + lam2 * t1);
+        let r = 2.0 * (n1 - n2).length_squared() / (1.0 - c);
+        let (qa, qb, qc) = (1.0 + 2.0 * c, lam1 - lam2, lam1 * lam2 + r);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc < 0.0 {
+            return Vec::new();
+        }
+        [
+            (-qb + disc.sqrt()) / (2.0 * qa),
+            (-qb - disc.sqrt()) / (2.0 * qa),
+        ]
+        .into_iter()
+        .filter(|&x| lam1 - x > 0.0 && -lam2 - x > 0.0)
+        .map(|x| [n1 - x * t0, n2 + x * t1])
+        .collect()
+    }
+
+    #[test]
+    fn mean_leg_form_equals_the_printed_lambda_form() {
+        // a small deterministic generator (no rand dependency)
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut compared = 0;
+        for _ in 0..5000 {
+            let mut v = || DVec3::new(next(), next(), next());
+            let (p0, t0, p1, t1) = (v(), v().normalize(), v(), v().normalize());
+            let c = t0.dot(t1);
+            if (1.0 + 2.0 * c).abs() < 1e-3 || 1.0 - c.abs() < 1e-3 {
+                continue;
+            }
+            let mut want = lambda_form(p0, t0, p1, t1);
+            let got = hermite(p0, t0, p1, t1).cubics;
+            assert_eq!(got.len(), want.len());
+            want.sort_by(|a, b| {
+                let la = (a[0] - p0).length() + (a[1] - a[0]).length() + (p1 - a[1]).length();
+                let lb = (b[0] - p0).length() + (b[1] - b[0]).length() + (p1 - b[1]).length();
+                la.total_cmp(&lb)
+            });
+            for (g, w) in got.iter().zip(&want) {
+                let scale = 1.0 + g.b[1].length() + g.b[2].length();
+                assert!((g.b[1] - w[0]).length() < 1e-8 * scale, "{:?} {:?}", g.b, w);
+                assert!((g.b[2] - w[1]).length() < 1e-8 * scale);
+                compared += 1;
+            }
+        }
+        assert!(compared > 1500, "{compared}");
     }
 
     #[test]
