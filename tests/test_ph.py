@@ -86,6 +86,27 @@ def test_from_quaternions_invariants_and_round_trip():
         ph.preimage(bad)
 
 
+def test_quaternion_convention_evaluation_and_frenet_frame():
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(10)
+    A0, A1 = random_quats(rng, 3)
+    cp = ph.from_quaternions(A0, A1, scalar_first=True)
+    np.testing.assert_array_equal(ph.from_quaternions(np.roll(A0, -1, 1), np.roll(A1, -1, 1)),
+                                  cp)
+    # x'(0) = A0 i A0* = |A0|² R(A0) x̂ (scipy's rotation of the unit quaternion)
+    R = Rotation.from_quat(A0, scalar_first=True)
+    np.testing.assert_allclose(3 * (cp[:, 1] - cp[:, 0]),
+                               (A0**2).sum(1)[:, None] * R.apply([1.0, 0, 0]), atol=1e-13)
+    # points, derivatives and Frenet frames against spinal.curves.Bezier (power basis)
+    v = np.linspace(0, 1, 17)
+    for c in cp:
+        bz = spinal.curves.Bezier(c)
+        for k, f in enumerate((bz.point, bz.d1, bz.d2, bz.d3)):
+            np.testing.assert_allclose(ph.evaluate(c, v, k), f(v), atol=1e-13)
+        np.testing.assert_allclose(ph.PHSpline(c).frenet(v), bz.frenet(v), atol=1e-12)
+
+
 def test_hermite_recovers_random_ph_cubics_with_the_signed_equation():
     rng = np.random.default_rng(7)
     A0, A1 = random_quats(rng, 2000)
@@ -235,6 +256,15 @@ def test_antiparallel_closed_form_and_continuity():
     assert inv2["L3"] == pytest.approx(0.7825188, abs=1e-7)
     assert abs(inv2["L1"] - inv["L1"]) < 2e-4 and abs(inv2["L3"] - inv["L3"]) < 2e-4
     assert ph.is_ph(c, 1e-7)
+    # approaching t1 = −t0 the solution stays PH to round-off with exact end tangents (the
+    # brief measured PH defects up to 2e-4 at 1 + C = 5e-13 with the printed λ form)
+    for a in (1e-2, 1e-5, 1e-6, 1e-7, 1e-9, 0.0):
+        t1 = -t0 * np.cos(a) + np.cross(ax, -t0) * np.sin(a)
+        c = ph.hermite([0, 0, 0], t0, p1, t1)
+        ph.preimage(c, tol=1e-15)                       # raises unless PH to round-off
+        d3 = c[3] - c[2]
+        np.testing.assert_allclose(d3 / np.linalg.norm(d3), t1, atol=1e-15)
+        assert abs(ph.invariants(c)["L1"] - inv["L1"]) < 2 * a + 1e-15
     with pytest.raises(ValueError, match="antiparallel"):
         ph.hermite([0, 0, 0], t0, [2, 0, 0], -t0)
 
