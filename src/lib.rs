@@ -18,6 +18,7 @@
 
 pub mod error;
 pub mod frames;
+pub mod ph;
 mod python;
 pub mod quaternion;
 pub mod sweep;

@@ -13,8 +13,10 @@ use pyo3::prelude::*;
 
 use crate::error::InputError;
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+use crate::ph;
 use crate::quaternion;
 use crate::sweep::{self, Options, Profile, Spine};
+use rayon::prelude::*;
 
 type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
@@ -544,6 +546,339 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quat_path_length, m)?)?;
     m.add_function(wrap_pyfunction!(quat_transport, m)?)?;
     m.add_function(wrap_pyfunction!(walk_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_hermite, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_invariants, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_is_ph, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_from_quaternions, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_preimage, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_frame_setup, m)?)?;
+    m.add_function(wrap_pyfunction!(ph_frames, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// PH cubics (spinal.ph). Control points arrive as C-contiguous (m, 4, 3) float64 arrays,
+// outputs leave as flat rows that the Python layer reshapes.
+
+fn cubics_of(a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
+    let sh = a.shape();
+    if sh[1] != 4 || sh[2] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "control_points: expected shape (m, 4, 3), got {sh:?}"
+        )));
+    }
+    let flat: &[DVec3] = bytemuck::cast_slice(slice_of("control_points", a)?);
+    Ok(flat
+        .chunks_exact(4)
+        .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]]))
+        .collect())
+}
+
+fn rows_of<'py>(py: Python<'py>, data: Vec<f64>, m: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let width = data.len().checked_div(m).unwrap_or(0);
+    PyArray1::from_vec(py, data).reshape([m, width])
+}
+
+/// G¹ Hermite interpolation, one row per data set: `(candidates (m, 24), counts (m,),
+/// reasons (m,))`; with `all = False` the first row without a solution raises.
+#[pyfunction]
+#[pyo3(signature = (p0, t0, p1, t1, all, batch))]
+#[allow(clippy::type_complexity)]
+fn ph_hermite<'py>(
+    py: Python<'py>,
+    p0: PyReadonlyArray2<'py, f64>,
+    t0: PyReadonlyArray2<'py, f64>,
+    p1: PyReadonlyArray2<'py, f64>,
+    t1: PyReadonlyArray2<'py, f64>,
+    all: bool,
+    batch: bool,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+)> {
+    let (p0, t0) = (vec3s("p0", &p0)?, vec3s("t0", &t0)?);
+    let (p1, t1) = (vec3s("p1", &p1)?, vec3s("t1", &t1)?);
+    let m = p0.len();
+    if t0.len() != m || p1.len() != m || t1.len() != m {
+        return Err(PyValueError::new_err(
+            "p0, t0, p1, t1: must have the same number of rows",
+        ));
+    }
+    let (cands, counts, codes) = py
+        .detach(|| -> Result<_, InputError> {
+            let mut cands = vec![0.0; m * 24];
+            let mut counts = vec![0i64; m];
+            let mut codes = vec![0i64; m];
+            for i in 0..m {
+                let at = |arg: &'static str, msg: &str| {
+                    let msg = if batch {
+                        format!("row {i}: {msg}")
+                    } else {
+                        msg.to_string()
+                    };
+                    InputError::new(arg, msg)
+                };
+                for (arg, v) in [("p0", p0[i]), ("t0", t0[i]), ("p1", p1[i]), ("t1", t1[i])] {
+                    if !v.is_finite() {
+                        return Err(at(arg, "contains non-finite values"));
+                    }
+                }
+                for (arg, v) in [("t0", t0[i]), ("t1", t1[i])] {
+                    if !(v.length() > 0.0) {
+                        return Err(at(arg, "zero tangent vector"));
+                    }
+                }
+                if p0[i] == p1[i] {
+                    return Err(at("p1", "equals p0 (no segment to interpolate)"));
+                }
+                let sol = ph::hermite::hermite(p0[i], t0[i].normalize(), p1[i], t1[i].normalize());
+                if let Some(r) = sol.reason {
+                    if !all {
+                        return Err(at("p0, t0, p1, t1", r.message()));
+                    }
+                    codes[i] = r.code();
+                }
+                counts[i] = sol.cubics.len() as i64;
+                for (j, c) in sol.cubics.iter().enumerate() {
+                    let o = i * 24 + j * 12;
+                    let f: &[f64] = bytemuck::cast_slice(&c.b);
+                    cands[o..o + 12].copy_from_slice(f);
+                }
+            }
+            Ok((cands, counts, codes))
+        })
+        .map_err(to_py)?;
+    Ok((
+        rows_of(py, cands, m)?,
+        PyArray1::from_vec(py, counts),
+        PyArray1::from_vec(py, codes),
+    ))
+}
+
+fn locate(m: usize, s: f64) -> (usize, f64) {
+    let seg = (s.floor().max(0.0) as usize).min(m - 1);
+    (seg, s - seg as f64)
+}
+
+fn params_of<'a>(m: usize, s: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    let s = slice_of("s", s)?;
+    if m == 0 {
+        return Err(PyValueError::new_err("control_points: no segments"));
+    }
+    if s.iter()
+        .any(|x| !(x.is_finite() && *x >= 0.0 && *x <= m as f64))
+    {
+        return Err(PyValueError::new_err(format!(
+            "s: values must be finite and within [0, {m}]"
+        )));
+    }
+    Ok(s)
+}
+
+/// Points or derivatives (order 0..3, with respect to the local v) at global parameters
+/// `s = segment + v`.
+#[pyfunction]
+fn ph_eval<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    s: PyReadonlyArray1<'py, f64>,
+    derivative: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let s = params_of(cubics.len(), &s)?;
+    if derivative > 3 {
+        return Err(PyValueError::new_err("derivative: must be 0, 1, 2 or 3"));
+    }
+    let out: Vec<f64> = py.detach(|| {
+        s.par_iter()
+            .flat_map_iter(|&x| {
+                let (i, v) = locate(cubics.len(), x);
+                cubics[i].derivative(derivative, v).to_array()
+            })
+            .collect()
+    });
+    rows_of(py, out, s.len())
+}
+
+/// `[L1, L2, L3, cθ, sθ, Δ, a, b, c, k, κ/τ, σ_min, κ_max]` per cubic.
+#[pyfunction]
+fn ph_invariants<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let mut out = Vec::with_capacity(cubics.len() * 13);
+    for c in &cubics {
+        let v = c.invariants();
+        out.extend_from_slice(&[
+            v.l[0],
+            v.l[1],
+            v.l[2],
+            v.ctheta,
+            v.stheta,
+            v.delta,
+            v.a,
+            v.b,
+            v.c,
+            v.k,
+            v.kappa_over_tau,
+            v.sigma_min,
+            v.kappa_max,
+        ]);
+    }
+    let m = cubics.len();
+    PyArray1::from_vec(py, out).reshape([m, 13])
+}
+
+/// Control-polygon PH test per cubic.
+#[pyfunction]
+fn ph_is_ph<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    tol: f64,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let cubics = cubics_of(&control_points)?;
+    let out: Vec<bool> = cubics.iter().map(|c| c.is_ph(tol)).collect();
+    Ok(PyArray1::from_vec(py, out))
+}
+
+/// Control points `(m, 12)` from quaternion preimages `(m, 4)` (scalar first) and starts.
+#[pyfunction]
+fn ph_from_quaternions<'py>(
+    py: Python<'py>,
+    a0: PyReadonlyArray2<'py, f64>,
+    a1: PyReadonlyArray2<'py, f64>,
+    start: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q0: &[[f64; 4]] = bytemuck::cast_slice(slice_of("A0", &a0)?);
+    let q1: &[[f64; 4]] = bytemuck::cast_slice(slice_of("A1", &a1)?);
+    let st = vec3s("start", &start)?;
+    let m = q0.len();
+    if q1.len() != m || st.len() != m {
+        return Err(PyValueError::new_err(
+            "A0, A1, start: must have the same number of rows",
+        ));
+    }
+    let mut out = Vec::with_capacity(m * 12);
+    for i in 0..m {
+        let c = ph::Cubic::from_quaternions(q0[i], q1[i], st[i]);
+        out.extend_from_slice(bytemuck::cast_slice(&c.b));
+    }
+    rows_of(py, out, m)
+}
+
+/// Quaternion preimages `(m, 9)`: `A0` (4, scalar first), `A1` (4), residual.
+#[pyfunction]
+fn ph_preimage<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let mut out = Vec::with_capacity(cubics.len() * 9);
+    for (i, c) in cubics.iter().enumerate() {
+        let (q0, q1, res) = c.preimage().ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "control_points: cubic {i} has a control-polygon leg of zero length (not a PH cubic)"
+            ))
+        })?;
+        out.extend_from_slice(&q0);
+        out.extend_from_slice(&q1);
+        out.push(res);
+    }
+    rows_of(py, out, cubics.len())
+}
+
+fn ph_start(
+    initial: Option<PyReadonlyArray1<'_, f64>>,
+    omega_start: f64,
+) -> PyResult<ph::frame::Start> {
+    Ok(match initial {
+        Some(v) => {
+            let v = slice_of("initial", &v)?;
+            if v.len() != 3 {
+                return Err(PyValueError::new_err("initial: expected 3 components"));
+            }
+            ph::frame::Start::Vector(DVec3::new(v[0], v[1], v[2]))
+        }
+        None => ph::frame::Start::Angle(omega_start),
+    })
+}
+
+/// Per-segment frame data `(m, 25)` (see `ph::frame::Segment::to_row`).
+#[pyfunction]
+#[pyo3(signature = (control_points, initial, omega_start, phi))]
+fn ph_frame_setup<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+    omega_start: f64,
+    phi: Option<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let start = ph_start(initial, omega_start)?;
+    let segs = py
+        .detach(|| ph::frame::setup(&cubics, start, phi))
+        .map_err(to_py)?;
+    let out: Vec<f64> = segs.iter().flat_map(|s| s.to_row()).collect();
+    rows_of(py, out, segs.len())
+}
+
+/// Frames `(n, 3, 3)` (columns r, s, t) and their angles from the principal normal at
+/// global parameters `s`; `mode` is "frenet", "exact" or "rational".
+#[pyfunction]
+#[pyo3(signature = (control_points, s, mode, initial, omega_start, phi))]
+fn ph_frames<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    s: PyReadonlyArray1<'py, f64>,
+    mode: &str,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+    omega_start: f64,
+    phi: Option<f64>,
+) -> PyResult<FramesAndAngles<'py>> {
+    let mode = match mode {
+        "frenet" => ph::frame::Mode::Frenet,
+        "exact" => ph::frame::Mode::Exact,
+        "rational" => ph::frame::Mode::Rational,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "mode: unknown frame {mode:?}; expected 'frenet', 'exact' or 'rational'"
+            )));
+        }
+    };
+    let cubics = cubics_of(&control_points)?;
+    let s = params_of(cubics.len(), &s)?;
+    let start = ph_start(initial, omega_start)?;
+    let n = s.len();
+    let out = empty::<f64, numpy::Ix3>(py, &[n, 3, 3])?;
+    let angles = empty::<f64, numpy::Ix1>(py, &[n])?;
+    {
+        let mut rw = out.readwrite();
+        let buf = rw
+            .as_slice_mut()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let mut ra = angles.readwrite();
+        let abuf = ra
+            .as_slice_mut()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        py.detach(|| -> Result<(), InputError> {
+            let segs = ph::frame::setup(&cubics, start, phi)?;
+            buf.par_chunks_mut(9)
+                .zip(abuf.par_iter_mut())
+                .zip(s.par_iter())
+                .for_each(|((f, a), &x)| {
+                    let (i, v) = locate(cubics.len(), x);
+                    let (m, om) = ph::frame::frame_at(&cubics[i], &segs[i], v, mode);
+                    // glam is column-major; the NumPy frame is row-major with columns r, s, t
+                    f.copy_from_slice(&m.transpose().to_cols_array());
+                    *a = om;
+                });
+            Ok(())
+        })
+        .map_err(to_py)?;
+    }
+    Ok((out, angles))
 }

@@ -6,7 +6,7 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 :mod:`spinal.quaternions` holds frames as quaternion curves, cameras and a mesh walker.
 """
 
-from . import curves, quaternions
+from . import curves, ph, quaternions
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -20,6 +20,7 @@ __all__ = [
     "curves",
     "estimate_tangents",
     "frames",
+    "ph",
     "quaternions",
     "sweep",
     "tube",

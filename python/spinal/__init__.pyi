@@ -7,6 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import curves as curves
+from . import ph as ph
 from . import quaternions as quaternions
 from .curves import Curve
 

@@ -85,3 +85,36 @@ def walk_mesh(
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
 ]: ...
+
+# PH cubics (spinal.ph)
+def ph_hermite(
+    p0: npt.NDArray[np.float64],
+    t0: npt.NDArray[np.float64],
+    p1: npt.NDArray[np.float64],
+    t1: npt.NDArray[np.float64],
+    all: bool,
+    batch: bool,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
+def ph_eval(
+    control_points: npt.NDArray[np.float64], s: npt.NDArray[np.float64], derivative: int
+) -> npt.NDArray[np.float64]: ...
+def ph_invariants(control_points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def ph_is_ph(control_points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]: ...
+def ph_from_quaternions(
+    a0: npt.NDArray[np.float64], a1: npt.NDArray[np.float64], start: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def ph_preimage(control_points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def ph_frame_setup(
+    control_points: npt.NDArray[np.float64],
+    initial: npt.NDArray[np.float64] | None,
+    omega_start: float,
+    phi: float | None,
+) -> npt.NDArray[np.float64]: ...
+def ph_frames(
+    control_points: npt.NDArray[np.float64],
+    s: npt.NDArray[np.float64],
+    mode: str,
+    initial: npt.NDArray[np.float64] | None,
+    omega_start: float,
+    phi: float | None,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...

@@ -1,0 +1,327 @@
+//! Spatial Pythagorean-hodograph (PH) cubics (Maurer & Jüttler, "Rational approximation of
+//! rotation minimizing frames using Pythagorean-hodograph cubics", J. Geom. Graphics 1999;
+//! notes with the errata in the issue 6 brief).
+//!
+//! A cubic Bézier curve `x(v) = Σ bᵢ Bᵢ³(v)`, `v ∈ [0, 1]`, is PH when its speed
+//! `σ = |ẋ|` is a polynomial. Every spatial PH cubic comes from a linear quaternion
+//! polynomial `A(v) = A₀(1 − v) + A₁ v` as `ẋ = A i A*`, so `σ = |A|²` (quadratic). With
+//! `dᵢ = bᵢ − bᵢ₋₁`, `Lᵢ = |dᵢ|`, `cθ = d₁·d₂/(L₁L₂)`, `Δ = det[d₁, d₂, d₃]`:
+//!
+//! * `σ(v) = 3(c v² − 2b v + L₁)` with `a = √(L₁L₃ − L₂²cθ²)`, `b = L₁ − L₂cθ`,
+//!   `c = L₁ − 2L₂cθ + L₃`;
+//! * `κ = 6L₂sθ/σ²`, `τ = sgn(Δ)·6√(L₁L₃ − L₂²)/σ²` (signed, erratum PH-3), κ/τ constant;
+//! * `k = −sgn(Δ)√(L₁L₃ − L₂²)/a` (|k| ≤ 1; 0 for planar cubics), the factor of the exact
+//!   rotation-minimising angle ([`frame`]).
+//!
+//! Submodules: [`hermite`] (G¹ Hermite interpolation with the corrected, signed equation) and
+//! [`frame`] (Frenet frame, exact RMF angle, its rational approximation).
+
+pub mod frame;
+pub mod hermite;
+
+use glam::DVec3;
+
+/// A quaternion `(w, x, y, z)` (Hamilton product).
+pub type Quat = [f64; 4];
+
+/// Hamilton product `a b`.
+pub fn qmul(a: Quat, b: Quat) -> Quat {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+fn qconj(a: Quat) -> Quat {
+    [a[0], -a[1], -a[2], -a[3]]
+}
+
+const QI: Quat = [0.0, 1.0, 0.0, 0.0];
+
+/// Vector part of `a i b*`.
+fn aib(a: Quat, b: Quat) -> DVec3 {
+    let q = qmul(qmul(a, QI), qconj(b));
+    DVec3::new(q[1], q[2], q[3])
+}
+
+fn qscale(a: Quat, s: f64) -> Quat {
+    [a[0] * s, a[1] * s, a[2] * s, a[3] * s]
+}
+
+/// Bernstein basis of degree 2 at `v`.
+#[inline]
+pub fn bern2(v: f64) -> [f64; 3] {
+    let u = 1.0 - v;
+    [u * u, 2.0 * u * v, v * v]
+}
+
+/// A cubic Bézier curve by its four control points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cubic {
+    pub b: [DVec3; 4],
+}
+
+/// The scalar invariants of a PH cubic (meaningful only for PH control polygons).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Invariants {
+    pub l: [f64; 3],
+    pub ctheta: f64,
+    pub stheta: f64,
+    pub delta: f64,
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub k: f64,
+    /// `κ/τ` (constant along a PH cubic; ±∞ for planar ones).
+    pub kappa_over_tau: f64,
+    pub sigma_min: f64,
+    pub kappa_max: f64,
+}
+
+/// Relative size of `sθ` below which a cubic counts as a straight segment.
+pub const STRAIGHT_EPS: f64 = 1e-12;
+
+impl Cubic {
+    pub fn new(b: [DVec3; 4]) -> Self {
+        Cubic { b }
+    }
+
+    pub fn legs(&self) -> [DVec3; 3] {
+        [
+            self.b[1] - self.b[0],
+            self.b[2] - self.b[1],
+            self.b[3] - self.b[2],
+        ]
+    }
+
+    /// Point `x(v)` (de Casteljau).
+    pub fn point(&self, v: f64) -> DVec3 {
+        let [p0, p1, p2, p3] = self.b;
+        let a = p0.lerp(p1, v);
+        let b = p1.lerp(p2, v);
+        let c = p2.lerp(p3, v);
+        let d = a.lerp(b, v);
+        let e = b.lerp(c, v);
+        d.lerp(e, v)
+    }
+
+    /// `ẋ(v) = 3 Σ dᵢ Bᵢ²(v)`.
+    pub fn d1(&self, v: f64) -> DVec3 {
+        let [d1, d2, d3] = self.legs();
+        let w = bern2(v);
+        3.0 * (d1 * w[0] + d2 * w[1] + d3 * w[2])
+    }
+
+    /// `ẍ(v) = 6((d₂ − d₁)(1 − v) + (d₃ − d₂)v)`.
+    pub fn d2(&self, v: f64) -> DVec3 {
+        let [d1, d2, d3] = self.legs();
+        6.0 * ((d2 - d1) * (1.0 - v) + (d3 - d2) * v)
+    }
+
+    /// `x⃛ = 6(d₃ − 2d₂ + d₁)`.
+    pub fn d3(&self) -> DVec3 {
+        let [d1, d2, d3] = self.legs();
+        6.0 * (d3 - 2.0 * d2 + d1)
+    }
+
+    /// Derivative of order `k` (0..=3) at `v`.
+    pub fn derivative(&self, k: usize, v: f64) -> DVec3 {
+        match k {
+            0 => self.point(v),
+            1 => self.d1(v),
+            2 => self.d2(v),
+            3 => self.d3(),
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// True when the control polygon is (numerically) a straight line run forwards.
+    pub fn is_straight(&self) -> bool {
+        let [d1, d2, d3] = self.legs();
+        let (l1, l2, l3) = (d1.length(), d2.length(), d3.length());
+        l1 > 0.0
+            && l2 > 0.0
+            && l3 > 0.0
+            && d1.cross(d2).length() <= STRAIGHT_EPS * l1 * l2
+            && d2.cross(d3).length() <= STRAIGHT_EPS * l2 * l3
+            && d1.dot(d2) > 0.0
+            && d2.dot(d3) > 0.0
+    }
+
+    /// Invariants of §1.1 (the cubic is assumed PH).
+    pub fn invariants(&self) -> Invariants {
+        let [d1, d2, d3] = self.legs();
+        let l = [d1.length(), d2.length(), d3.length()];
+        let ctheta = d1.dot(d2) / (l[0] * l[1]);
+        let stheta = d1.cross(d2).length() / (l[0] * l[1]);
+        let delta = d1.cross(d2).dot(d3);
+        let l2c = l[1] * ctheta;
+        let a = (l[0] * l[2] - l2c * l2c).max(0.0).sqrt();
+        let b = l[0] - l2c;
+        let c = l[0] - 2.0 * l2c + l[2];
+        // √(L₁L₃ − L₂²), 0 for planar cubics (below round-off of the difference)
+        let gap = l[0] * l[2] - l[1] * l[1];
+        let root = if gap > 1e-14 * l[0] * l[2] {
+            gap.sqrt()
+        } else {
+            0.0
+        };
+        let sgn = if delta > 0.0 {
+            1.0
+        } else if delta < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let k = if a > 0.0 && root > 0.0 {
+            -sgn * root / a
+        } else {
+            0.0
+        };
+        let kappa_over_tau = if root > 0.0 {
+            l[1] * stheta / root * if sgn != 0.0 { sgn } else { 1.0 }
+        } else {
+            f64::INFINITY
+        };
+        let vm = if c > 0.0 { b / c } else { -1.0 };
+        let sigma_min = if (0.0..=1.0).contains(&vm) {
+            3.0 * a * a / c
+        } else {
+            3.0 * l[0].min(l[2])
+        };
+        let kappa_max = 6.0 * l[1] * stheta / (sigma_min * sigma_min);
+        Invariants {
+            l,
+            ctheta,
+            stheta,
+            delta,
+            a,
+            b,
+            c,
+            k,
+            kappa_over_tau,
+            sigma_min,
+            kappa_max,
+        }
+    }
+
+    /// Control-polygon PH test (MJ (17)): `θ₁₂ = θ₂₃` and `cos ψ = 2L₂²/(L₁L₃) − 1`, each
+    /// within `tol` (dimensionless). Polygons with a zero leg are not PH cubics here; a
+    /// straight polygon run forwards is PH iff `L₂² ≤ L₁L₃` (then it has a quaternion
+    /// preimage); a planar bent polygon iff the angles agree and `L₂² = L₁L₃` (convex).
+    pub fn is_ph(&self, tol: f64) -> bool {
+        let [d1, d2, d3] = self.legs();
+        let (l1, l2, l3) = (d1.length(), d2.length(), d3.length());
+        if !(l1 > 0.0 && l2 > 0.0 && l3 > 0.0 && (l1 + l2 + l3).is_finite()) {
+            return false;
+        }
+        let c12 = d1.dot(d2) / (l1 * l2);
+        let c23 = d2.dot(d3) / (l2 * l3);
+        if !((c12 - c23).abs() <= tol) {
+            return false;
+        }
+        let target = 2.0 * l2 * l2 / (l1 * l3) - 1.0;
+        let n12 = d1.cross(d2);
+        let n23 = d2.cross(d3);
+        let (m12, m23) = (n12.length(), n23.length());
+        let planar_eps = 1e-12;
+        if m12 <= planar_eps * l1 * l2 && m23 <= planar_eps * l2 * l3 {
+            // straight: forward legs; the preimage exists iff L₂² ≤ L₁L₃
+            return c12 > 0.0 && target <= 1.0 + tol;
+        }
+        if m12 <= planar_eps * l1 * l2 || m23 <= planar_eps * l2 * l3 {
+            return false; // one bend only: the angle test cannot really pass
+        }
+        let cpsi = n12.dot(n23) / (m12 * m23);
+        (cpsi - target).abs() <= tol
+    }
+
+    /// Control points from a quaternion preimage `A₀, A₁` and the start point (MJ §2.1).
+    pub fn from_quaternions(a0: Quat, a1: Quat, start: DVec3) -> Self {
+        let b0 = start;
+        let b1 = b0 + aib(a0, a0) / 3.0;
+        let b2 = b1 + (aib(a0, a1) + aib(a1, a0)) / 6.0;
+        let b3 = b2 + aib(a1, a1) / 3.0;
+        Cubic::new([b0, b1, b2, b3])
+    }
+
+    /// Quaternion preimage `(A₀, A₁)` and the residual `max |regenerated bᵢ − bᵢ|` (the PH
+    /// defect; 0 up to round-off for PH cubics). `None` when a leg has zero length.
+    pub fn preimage(&self) -> Option<(Quat, Quat, f64)> {
+        let [d1, d2, d3] = self.legs();
+        let a0 = root(3.0 * d1)?;
+        let a10 = root(3.0 * d3)?;
+        let x = (aib(a0, a10) + aib(a10, a0)) / 6.0;
+        let a1i = qmul(a10, QI);
+        let y = (aib(a0, a1i) + aib(a1i, a0)) / 6.0;
+        // least squares [x y] (cφ, sφ)ᵀ = d₂
+        let (xx, xy, yy) = (x.dot(x), x.dot(y), y.dot(y));
+        let (xd, yd) = (x.dot(d2), y.dot(d2));
+        let det = xx * yy - xy * xy;
+        let (mut cp, mut sp) = if det.abs() > 1e-300 {
+            ((yy * xd - xy * yd) / det, (xx * yd - xy * xd) / det)
+        } else {
+            (1.0, 0.0)
+        };
+        let n = cp.hypot(sp);
+        if n > 0.0 {
+            cp /= n;
+            sp /= n;
+        } else {
+            (cp, sp) = (1.0, 0.0);
+        }
+        let a1 = qmul(a10, [cp, sp, 0.0, 0.0]);
+        let back = Cubic::from_quaternions(a0, a1, self.b[0]);
+        let res = (0..4)
+            .map(|i| (back.b[i] - self.b[i]).length())
+            .fold(0.0, f64::max);
+        Some((a0, a1, res))
+    }
+}
+
+/// The quaternion `A` with `A i A* = d` (one of the circle of solutions), or None for d = 0.
+fn root(d: DVec3) -> Option<Quat> {
+    let len = d.length();
+    if !(len > 0.0) || !len.is_finite() {
+        return None;
+    }
+    let e = d / len;
+    let u = if e.x > -0.5 {
+        [1.0 + e.x, 0.0, -e.z, e.y]
+    } else {
+        // j maps x̂ to −x̂ first: u = normalize(1 − δx, −x̂×δ)·j
+        qmul([1.0 - e.x, 0.0, e.z, -e.y], [0.0, 0.0, 1.0, 0.0])
+    };
+    let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]).sqrt();
+    Some(qscale(u, len.sqrt() / n))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternion_round_trip() {
+        let a0 = [0.3, -1.2, 0.7, 0.4];
+        let a1 = [-0.5, 0.2, 1.1, -0.9];
+        let c = Cubic::from_quaternions(a0, a1, DVec3::new(1.0, 2.0, 3.0));
+        assert!(c.is_ph(1e-9));
+        let (_, _, res) = c.preimage().unwrap();
+        assert!(res < 1e-12, "{res}");
+        // σ = |A|² at v = 0.3
+        let v = 0.3;
+        let a: Vec<f64> = (0..4).map(|i| a0[i] * (1.0 - v) + a1[i] * v).collect();
+        let s2: f64 = a.iter().map(|x| x * x).sum();
+        assert!((c.d1(v).length() - s2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn root_covers_both_branches() {
+        for d in [DVec3::X, -DVec3::X, DVec3::new(-0.9, 0.1, 0.2), DVec3::Y] {
+            let a = root(d).unwrap();
+            assert!((aib(a, a) - d).length() < 1e-15);
+        }
+    }
+}
