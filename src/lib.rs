@@ -2,7 +2,7 @@
 //!
 //! The crate is split in two layers:
 //!
-//! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`quaternion`],
+//! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`quaternion`], [`ph`],
 //!   [`error`]); they work on `glam::DVec3` slices and flat `f64` output buffers and return
 //!   [`error::InputError`] for bad input, never panicking on user data;
 //! * one thin binding module (`python`, compiled into the `spinal._core` extension) that
