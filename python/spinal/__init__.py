@@ -5,7 +5,8 @@ vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tube
 curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
 """
 
-from . import curves
+from . import curves, fields
+from ._advect import advect
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -15,9 +16,11 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "__version__",
+    "advect",
     "closing_angle",
     "curves",
     "estimate_tangents",
+    "fields",
     "frames",
     "sweep",
     "tube",
