@@ -533,6 +533,82 @@ fn walk_mesh<'py>(
     ))
 }
 
+// ---- deformation (issue 4) -------------------------------------------------------------
+
+fn field_of(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<crate::deform::Field> {
+    if rows.shape()[1] != crate::deform::ROW {
+        return Err(PyValueError::new_err(format!(
+            "field: expected element rows of shape (k, {}), got {:?}",
+            crate::deform::ROW,
+            rows.shape()
+        )));
+    }
+    crate::deform::Field::parse(slice_of("field", rows)?).map_err(to_py)
+}
+
+/// Velocities of a field at points; see `spinal.fields`.
+#[pyfunction]
+fn field_eval<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    rows: PyReadonlyArray2<'py, f64>,
+    t: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let field = field_of(&rows)?;
+    let x = vec3s("points", &points)?;
+    let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+    {
+        let mut w = out.readwrite();
+        let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        py.detach(|| crate::deform::advect::eval_into(&field, x, t, o));
+    }
+    Ok(out)
+}
+
+/// `(max_speed, length_scale, default steps for duration)` of a field.
+#[pyfunction]
+fn field_info(rows: PyReadonlyArray2<'_, f64>, duration: f64) -> PyResult<(f64, f64, usize)> {
+    let field = field_of(&rows)?;
+    Ok((
+        field.max_speed(),
+        field.length_scale(),
+        field.default_steps(duration),
+    ))
+}
+
+/// Advect points: `steps` steps of size `h` from `t0`; a new array.
+#[pyfunction]
+fn advect<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    rows: PyReadonlyArray2<'py, f64>,
+    t0: f64,
+    h: f64,
+    steps: usize,
+    method: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use crate::deform::advect::{Method as M, advect_in_place};
+    let m = match method {
+        "rk4" => M::Rk4,
+        "euler" => M::Euler,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "method: unknown method {method:?}; expected 'rk4' or 'euler'"
+            )));
+        }
+    };
+    let field = field_of(&rows)?;
+    let x = vec3s("vertices", &points)?;
+    let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+    {
+        let mut w = out.readwrite();
+        let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        o.copy_from_slice(x);
+        py.detach(|| advect_in_place(&field, o, t0, h, steps, m));
+    }
+    Ok(out)
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
@@ -554,6 +630,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ph_preimage, m)?)?;
     m.add_function(wrap_pyfunction!(ph_frame_setup, m)?)?;
     m.add_function(wrap_pyfunction!(ph_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(field_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(field_info, m)?)?;
+    m.add_function(wrap_pyfunction!(advect, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

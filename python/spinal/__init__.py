@@ -6,7 +6,8 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 :mod:`spinal.quaternions` holds frames as quaternion curves, cameras and a mesh walker.
 """
 
-from . import curves, ph, quaternions
+from . import curves, fields, ph, quaternions
+from ._advect import advect
 from ._core import __version__
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -16,9 +17,11 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "__version__",
+    "advect",
     "closing_angle",
     "curves",
     "estimate_tangents",
+    "fields",
     "frames",
     "ph",
     "quaternions",

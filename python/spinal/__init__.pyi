@@ -107,3 +107,20 @@ def tube(
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
 ) -> Mesh: ...
+
+# ---- deformation (issue 4) ----
+from collections.abc import Callable
+
+from . import fields as fields
+from .fields import Field
+
+def advect(
+    vertices: _Array,
+    field: Field,
+    duration: float,
+    steps: int | None = None,
+    *,
+    method: Literal["rk4", "euler"] = "rk4",
+    t0: float = 0.0,
+    progress: bool | Callable[[int, int], object] = False,
+) -> npt.NDArray[np.float64]: ...

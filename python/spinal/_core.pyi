@@ -118,3 +118,15 @@ def ph_frames(
     omega_start: float,
     phi: float | None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def field_eval(
+    points: npt.NDArray[np.float64], rows: npt.NDArray[np.float64], t: float
+) -> npt.NDArray[np.float64]: ...
+def field_info(rows: npt.NDArray[np.float64], duration: float) -> tuple[float, float, int]: ...
+def advect(
+    points: npt.NDArray[np.float64],
+    rows: npt.NDArray[np.float64],
+    t0: float,
+    h: float,
+    steps: int,
+    method: str,
+) -> npt.NDArray[np.float64]: ...

@@ -1,0 +1,103 @@
+"""``spinal.advect``: move points along a divergence-free field (Rust core, in parallel)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._validate import as_choice, as_int, as_points
+from .fields import Field, _check_finite, _real
+
+__all__ = ["advect"]
+
+
+def _progress_bar(total: int, progress):
+    """A callable ``update(done)`` and ``close()`` for ``progress`` (True: tqdm if installed,
+    else a line on stderr; a callable: called as ``progress(done, total)``)."""
+    if callable(progress):
+        return (lambda done: progress(done, total)), (lambda: None)
+    try:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=total, unit="step", desc="advect")
+        state = {"n": 0}
+
+        def update(done):
+            bar.update(done - state["n"])
+            state["n"] = done
+
+        return update, bar.close
+    except ImportError:
+        import sys
+
+        def update(done):
+            sys.stderr.write(f"\radvect: {done}/{total} steps")
+            sys.stderr.flush()
+
+        return update, (lambda: sys.stderr.write("\n"))
+
+
+def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
+           t0=0.0, progress=False) -> np.ndarray:
+    """Move points along a velocity field for ``duration``: integrate ``dX/dt = v(X, t)``
+    from ``t0`` to ``t0 + duration`` for every point, independently and in parallel.
+
+    ``method="rk4"`` (classical Runge–Kutta, 4th order, error ≈ 16× smaller per halving of
+    the step on smooth path lines) or ``"euler"`` (explicit, 1st order; for comparison).
+    The fields of :mod:`spinal.fields` are exactly divergence-free, so the continuous flow
+    preserves every volume; RK4 adds an O(h⁴) volume error per unit time, the mesh adds its
+    own O(edge²) error (a triangle mesh follows the flow only at its vertices).
+
+    Parameters
+    ----------
+    vertices : array_like (n, 3)
+        Points (never modified; a new array is returned).
+    field : spinal.fields.Field
+    duration : float
+        Time to integrate (negative: backwards; 0: an unchanged copy).
+    steps : int ≥ 1, optional
+        Number of equal steps. Default ``field.steps(duration)``: each step moves a point by
+        at most 1/8 of the field's length scale (``h = ℓ/(8 max|v|)``, at least 4 steps),
+        which keeps the integration error 2–3 orders below the mesh error of a 40k-vertex
+        sphere.
+    method : "rk4" or "euler"
+    t0 : float
+        Start time (tools that move are at ``center + velocity·t``).
+    progress : bool or callable
+        Report progress for long animations: True shows a tqdm bar (notebook-aware) or a
+        line on stderr; a callable is called as ``progress(done_steps, total_steps)``.
+
+    Returns
+    -------
+    (n, 3) float64 array of the moved points.
+    """
+    x = as_points(vertices, "vertices")
+    _check_finite(x, "vertices")
+    if not isinstance(field, Field):
+        raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
+    duration = _real(duration, "duration")
+    t0 = _real(t0, "t0")
+    method = as_choice(method, "method", ("rk4", "euler"))
+    if steps is None:
+        steps = field.steps(duration)
+    else:
+        steps = as_int(steps, "steps")
+        if steps < 1:
+            raise ValueError(f"steps: must be at least 1, got {steps}")
+    if duration == 0.0:
+        return x.copy()
+    h = duration / steps
+    if not progress:
+        return _core.advect(x, field.rows, t0, h, steps, method)
+    update, close = _progress_bar(steps, progress)
+    block = max(1, steps // 100)
+    done = 0
+    try:
+        while done < steps:
+            n = min(block, steps - done)
+            x = _core.advect(x, field.rows, t0 + done * h, h, n, method)
+            done += n
+            update(done)
+    finally:
+        close()
+    return x

@@ -1,0 +1,367 @@
+//! Cross-product fields `v = ∇p × ∇q` (von Funck, Theisel & Seidel 2006; Zheng's thesis
+//! Ch. 11), divergence-free by the identity `div(∇p × ∇q) = 0` for any C² scalars p, q.
+//!
+//! Region function (brief §2, erratum A-12): `D = b(σ)`, `σ = clamp(d/R_f, 0, 1)`, with `d` the
+//! signed distance to the tool and `R_f` the reach; von Funck's C¹ blend `b = 4σ³ − 3σ⁴`
+//! (`b′ = 12σ²(1 − σ)`), or Zheng's linear `b = σ` (C⁰). `D = 0` inside the tool, `v = 0`
+//! where `d ≥ R_f`.
+//!
+//! * **Translation of a region** (§11.1, §11.2.1, and the exact distance-field extension
+//!   §2.2 of the brief): `p = (1 − D) N·Y`, `q = (1 − D) B·Y`, `N × B = u/|u|`, `Y = X − c`.
+//!   Because `N(B·Y) − B(N·Y) = Y × (N × B)`, the field does not depend on the choice of
+//!   `N, B` and is linear in the velocity `u`:
+//!
+//!   `v = (1 − D)² u + (1 − D) D′ [ (n·u) Y − (n·Y) u ]`,  `n = ∇d`,
+//!
+//!   rigid (`v = u`) inside the tool, normal velocity `(1 − D)²(u·n)`. This holds for **any**
+//!   C¹ distance `d` with its exact gradient: a sphere ([`Sphere`], von Funck with
+//!   `r_i = ρ`, `r_o = ρ + R_f`) or a capsule ([`Capsule`], the free-form extension; also
+//!   Zheng's strip of type I on a straight axis when `u` is along the axis, where
+//!   `∇(N·(X − γ)) = N` exactly).
+//! * **Strip of type II**, flow across a straight strip (§11.2.3, S increasing along the
+//!   axis t, A-14): `p = s σ(X)` (arc-length parameter of the closest axis point, clamped),
+//!   `q = (1 − D) U·(X − a)`, `U = m̂ × t`; `v = s [(1 − D) m̂ − D′ (U·(X − a)) t × n]`
+//!   between the end planes, 0 beyond them (a tangential jump: the flux is continuous).
+//! * **Torus** moving along its axis k (§11.2.4): the two half-torus fields of the thesis sum
+//!   to the field of the multivalued `p = s R_t θ`, whose gradient `s R_t e_θ/ρ_ax` is single
+//!   valued; `q = −(1 − D)(ρ_ax − R_t)`:
+//!
+//!   `v = s (R_t/ρ_ax) [ (1 − D) k + D′ (ρ_ax − R_t) e_θ × n ]`.
+
+use glam::DVec3;
+
+use crate::error::{InputError, Result};
+
+/// `(D, D′)` of the region function at signed distance `d`, reach `rf`.
+#[inline(always)]
+fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
+    let s = d / rf;
+    if !(s > 0.0) {
+        (0.0, 0.0)
+    } else if !(s < 1.0) {
+        (1.0, 0.0)
+    } else if linear {
+        (s, 1.0 / rf)
+    } else {
+        (s * s * s * (4.0 - 3.0 * s), 12.0 * s * s * (1.0 - s) / rf)
+    }
+}
+
+/// The translation field from `d`, `n`, `Y = X − c`, `u` (`None` outside the support).
+#[inline(always)]
+fn translate(d: f64, n: DVec3, y: DVec3, u: DVec3, rf: f64, linear: bool) -> DVec3 {
+    if !(d < rf) {
+        return DVec3::ZERO;
+    }
+    if !(d > 0.0) {
+        return u;
+    }
+    let (b, db) = blend(d, rf, linear);
+    let g = 1.0 - b;
+    (g * g) * u + (g * db) * (y * n.dot(u) - u * n.dot(y))
+}
+
+/// `max_σ [(1 − D)² + (1 − D) D′ L(σ)]` sampled on 2049 distances, `L(σ)` a bound of `|Y|`
+/// (a sampled maximum is low by O(spacing²), immaterial for a step-size rule).
+fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64 {
+    let n = 2048;
+    let mut m: f64 = 1.0;
+    for i in 0..=n {
+        let d = rf * i as f64 / n as f64;
+        let (b, db) = blend(d, rf, linear);
+        let g = 1.0 - b;
+        m = m.max(g * g + g * db * l(d));
+    }
+    m
+}
+
+/// Sphere tool of radius ρ translating with velocity u (von Funck's region translation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sphere {
+    pub center: DVec3,
+    pub velocity: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+    pub linear: bool,
+    pub moving: bool,
+}
+
+impl Sphere {
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let c = if self.moving {
+            self.center + self.velocity * t
+        } else {
+            self.center
+        };
+        let y = x - c;
+        let r = y.length();
+        let d = r - self.radius;
+        if !(r > 0.0) {
+            return self.velocity;
+        }
+        translate(d, y / r, y, self.velocity, self.reach, self.linear)
+    }
+
+    /// Exact maximum for a sphere: `|v| = |u| max((1 − D)², |(1 − D)² − (1 − D)D′ r|)`
+    /// (the extremes over the angle between Y and u), sampled over r.
+    pub fn max_speed(&self) -> f64 {
+        let n = 2048;
+        let mut m: f64 = 1.0;
+        for i in 0..=n {
+            let d = self.reach * i as f64 / n as f64;
+            let (b, db) = blend(d, self.reach, self.linear);
+            let g = 1.0 - b;
+            m = m.max((g * g - g * db * (self.radius + d)).abs());
+        }
+        m * self.velocity.length()
+    }
+}
+
+/// Capsule tool (segment a–b, radius ρ) translating with velocity u: the exact
+/// distance-field extension of the region translation, `Y = X − (a + b)/2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Capsule {
+    pub a: DVec3,
+    pub b: DVec3,
+    pub velocity: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+    pub linear: bool,
+    pub moving: bool,
+    ab: DVec3,
+    inv_len2: f64,
+}
+
+/// Closest point on the segment `a + λ ab`, λ ∈ [0, 1].
+#[inline(always)]
+fn closest(x: DVec3, a: DVec3, ab: DVec3, inv_len2: f64) -> (DVec3, f64) {
+    let lam = ((x - a).dot(ab) * inv_len2).clamp(0.0, 1.0);
+    (a + ab * lam, lam)
+}
+
+impl Capsule {
+    pub fn new(
+        a: DVec3,
+        b: DVec3,
+        velocity: DVec3,
+        radius: f64,
+        reach: f64,
+        linear: bool,
+        moving: bool,
+    ) -> Result<Capsule> {
+        let ab = b - a;
+        let l2 = ab.length_squared();
+        Ok(Capsule {
+            a,
+            b,
+            velocity,
+            radius,
+            reach,
+            linear,
+            moving,
+            ab,
+            inv_len2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let a = if self.moving {
+            self.a + self.velocity * t
+        } else {
+            self.a
+        };
+        let (p, _) = closest(x, a, self.ab, self.inv_len2);
+        let w = x - p;
+        let r = w.length();
+        if !(r > 0.0) {
+            return self.velocity;
+        }
+        let y = x - (a + 0.5 * self.ab);
+        translate(
+            r - self.radius,
+            w / r,
+            y,
+            self.velocity,
+            self.reach,
+            self.linear,
+        )
+    }
+
+    pub fn max_speed(&self) -> f64 {
+        let half = 0.5 * self.ab.length();
+        let (rho, rf) = (self.radius, self.reach);
+        self.velocity.length() * speed_factor(rf, self.linear, |d| half + rho + d)
+    }
+}
+
+/// Torus (centre c, unit axis k, major R_t, minor r_t) moving along k with speed s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Torus {
+    pub center: DVec3,
+    pub axis: DVec3,
+    pub speed: f64,
+    pub major: f64,
+    pub minor: f64,
+    pub reach: f64,
+    pub linear: bool,
+    pub moving: bool,
+}
+
+impl Torus {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        center: DVec3,
+        axis: DVec3,
+        speed: f64,
+        major: f64,
+        minor: f64,
+        reach: f64,
+        linear: bool,
+        moving: bool,
+    ) -> Result<Torus> {
+        if !(minor + reach < major) {
+            return Err(InputError::new(
+                "field",
+                format!(
+                    "torus: minor + reach ({}) must be below the major radius ({major}) so the \
+                     field stays away from the axis",
+                    minor + reach
+                ),
+            ));
+        }
+        Ok(Torus {
+            center,
+            axis,
+            speed,
+            major,
+            minor,
+            reach,
+            linear,
+            moving,
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let k = self.axis;
+        let c = if self.moving {
+            self.center + k * (self.speed * t)
+        } else {
+            self.center
+        };
+        let y = x - c;
+        let z = k.dot(y);
+        let yp = y - k * z;
+        let rho = yp.length();
+        let dr = rho - self.major;
+        let dist = (dr * dr + z * z).sqrt();
+        let d = dist - self.minor;
+        if !(d < self.reach) || !(rho > 0.0) {
+            return DVec3::ZERO;
+        }
+        let (b, db) = blend(d, self.reach, self.linear);
+        let scale = self.speed * self.major / rho;
+        let mut v = k * (1.0 - b);
+        if db > 0.0 {
+            let e_rho = yp / rho;
+            let n = (e_rho * dr + k * z) / dist;
+            v += k.cross(e_rho).cross(n) * (db * dr);
+        }
+        v * scale
+    }
+
+    pub fn max_speed(&self) -> f64 {
+        let inner = self.major - self.minor - self.reach;
+        let f = speed_factor(self.reach, self.linear, |d| self.minor + d);
+        self.speed.abs() * self.major / inner * f
+    }
+}
+
+/// Straight strip (segment a–b, radius ρ) pushing sideways with velocity m ⟂ (b − a).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StripAcross {
+    pub a: DVec3,
+    pub b: DVec3,
+    pub velocity: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+    pub linear: bool,
+    ab: DVec3,
+    inv_len2: f64,
+    tangent: DVec3,
+    side: DVec3,
+}
+
+impl StripAcross {
+    pub fn new(
+        a: DVec3,
+        b: DVec3,
+        velocity: DVec3,
+        radius: f64,
+        reach: f64,
+        linear: bool,
+    ) -> Result<StripAcross> {
+        let ab = b - a;
+        let l = ab.length();
+        if !(l > 0.0) {
+            return Err(InputError::new(
+                "field",
+                "strip: the two end points coincide",
+            ));
+        }
+        let t = ab / l;
+        let s = velocity.length();
+        if (velocity.dot(t)).abs() > 1e-9 * s {
+            return Err(InputError::new(
+                "field",
+                "strip: the velocity of a sideways strip must be perpendicular to its axis",
+            ));
+        }
+        let side = if s > 0.0 {
+            (velocity / s).cross(t)
+        } else {
+            DVec3::ZERO
+        };
+        Ok(StripAcross {
+            a,
+            b,
+            velocity,
+            radius,
+            reach,
+            linear,
+            ab,
+            inv_len2: 1.0 / (l * l),
+            tangent: t,
+            side,
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3) -> DVec3 {
+        let (p, lam) = closest(x, self.a, self.ab, self.inv_len2);
+        if !(lam > 0.0 && lam < 1.0) {
+            return DVec3::ZERO;
+        }
+        let w = x - p;
+        let r = w.length();
+        let d = r - self.radius;
+        if !(d < self.reach) {
+            return DVec3::ZERO;
+        }
+        let (b, db) = blend(d, self.reach, self.linear);
+        let mut v = self.velocity * (1.0 - b);
+        if db > 0.0 {
+            let n = w / r;
+            let s = self.velocity.length();
+            v -= self.tangent.cross(n) * (s * db * self.side.dot(x - self.a));
+        }
+        v
+    }
+
+    pub fn max_speed(&self) -> f64 {
+        let rho = self.radius;
+        self.velocity.length() * speed_factor(self.reach, self.linear, |d| rho + d)
+    }
+}

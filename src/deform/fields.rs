@@ -1,0 +1,270 @@
+//! Curl fields `V = c · curl(φ(d) B(Y))` (Zheng, thesis Ch. 12, eq. 12.1–12.6), with the
+//! corrections of the issue-4 brief (errata ).
+//!
+//! Notation: `Y = X − pivot`, `d` the signed distance to the tool (negative inside), `n = ∇d`,
+//! `R` the reach (the field vanishes where `|d| ≥ R`), falloff `φ = (R − |d|)^p`, `p ∈ {2,3,4}`
+//! (`p = 2` is the thesis; the field is only C⁰ at `|d| = R`, `p = 4` makes it C²). Using
+//! `curl(φB) = φ′ n × B + φ curl B` and `φ′ = −p sgn(d) (R − |d|)^{p−1}`:
+//!
+//! * **translation** (eq. 12.1–12.2): `B = Y × i`, `curl B = −2i`. The printed field flows
+//!   *into* the front of the tool with a speed-independent magnitude; the corrected
+//!   field is `V = −(1/(2R^p)) curl(φ (Y × u))`, linear in the tool velocity `u`:
+//!
+//!   `V = (e^{p−1}/R^p) [ e u + (p/2) sgn(d) ((n·u) Y − (n·Y) u) ]`,  `e = R − |d|`,
+//!
+//!   whose normal component on the tool surface is exactly `u·n` (no penetration);
+//! * **rotation** (eq. 12.3): `B = (Y × Ω) × Y = |Y|²Ω − (Ω·Y)Y`, `curl B = 3 Y × Ω`;
+//!   corrected `V = −(1/(3R^p)) curl(φ B)`:
+//!
+//!   `V = (e^{p−1}/(3R^p)) [ p sgn(d) n × B + 3 e Ω × Y ]`,
+//!
+//!   whose normal component on the tool surface is `(Ω × Y)·n` (a rigidly turning tool);
+//! * **twist, bend** (eq. 12.4–12.6, printed without falloff and turning clockwise, A-17):
+//!   swirls `v = h(z, r) a × Y` (`z = a·Y`, `r = |Y|`), divergence-free because
+//!   `∇h ∈ span(a, Y) ⟂ a × Y`. With `q = r/R` and support `r < R`:
+//!   - rate form (default): twist `h = κ z (1 − q)²`, bend `h = β r² (1 − q)²`;
+//!   - curl form (the thesis's potential with the falloff inside): twist
+//!     `−(κ/(4R²)) curl((R − r)² z B)` `= κ z (1 − q)(1 − 3q/2) a × Y`, bend
+//!     `−(β/(5R²)) curl((R − r)² r² B)` `= β r² (1 − q)(1 − 7q/5) a × Y` (counter-rotates
+//!     near the edge of the support).
+//!
+//! The tools here are spheres (`d = |X − c| − ρ`); a translation tool moves with its velocity
+//! (`c(t) = c₀ + u t`) unless it is static, a rotation tool orbits the pivot when its centre
+//! is off the pivot. Swirls are exact rotations on every sphere `r = const` (`z, r` are
+//! invariants), which gives the closed-form flows used by the tests.
+
+use glam::DVec3;
+
+/// `(R − |d|)^(p−1)` and `(R − |d|)` for `|d| < R`, `None` outside the support.
+#[inline(always)]
+fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
+    let e = reach - d.abs();
+    if !(e > 0.0) {
+        return None;
+    }
+    let ep = match p {
+        2 => e,
+        3 => e * e,
+        _ => e * e * e,
+    };
+    Some((ep, e))
+}
+
+/// Rodrigues rotation of `y` about the unit axis `a` by `theta`.
+#[inline]
+pub fn rotate(a: DVec3, theta: f64, y: DVec3) -> DVec3 {
+    let (s, c) = theta.sin_cos();
+    y * c + a.cross(y) * s + a * (a.dot(y) * (1.0 - c))
+}
+
+/// Sphere tool translating with velocity `u` (curl field, eq. 12.1–12.2 corrected).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Translation {
+    pub center: DVec3,
+    pub velocity: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+    pub power: u8,
+    /// The tool centre moves, `c(t) = center + velocity · t`; else the field is steady.
+    pub moving: bool,
+}
+
+impl Translation {
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let c = if self.moving {
+            self.center + self.velocity * t
+        } else {
+            self.center
+        };
+        let y = x - c;
+        let r = y.length();
+        let d = r - self.radius;
+        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+            return DVec3::ZERO;
+        };
+        let u = self.velocity;
+        let k = ep / self.reach.powi(self.power as i32);
+        if !(r > 0.0) {
+            return u * (k * e);
+        }
+        let n = y / r;
+        let sg = if d < 0.0 { -1.0 } else { 1.0 };
+        let half_p = 0.5 * self.power as f64;
+        k * (e * u + (half_p * sg) * (y * n.dot(u) - u * r))
+    }
+
+    /// Upper bound of |V| outside the tool: `|u| (1 + (p/2) ρ/R)` (reached on the surface).
+    pub fn max_speed(&self) -> f64 {
+        self.velocity.length() * (1.0 + 0.5 * self.power as f64 * self.radius / self.reach)
+    }
+}
+
+/// Sphere tool turning with angular velocity `Ω` about `pivot` (eq. 12.3 corrected).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rotation {
+    pub center: DVec3,
+    pub pivot: DVec3,
+    /// `ω a`, right-handed.
+    pub omega: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+    pub power: u8,
+}
+
+impl Rotation {
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let w = self.omega.length();
+        let arm = self.center - self.pivot;
+        let c = if w > 0.0 && arm != DVec3::ZERO && t != 0.0 {
+            self.pivot + rotate(self.omega / w, w * t, arm)
+        } else {
+            self.center
+        };
+        let yc = x - c;
+        let rc = yc.length();
+        let d = rc - self.radius;
+        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+            return DVec3::ZERO;
+        };
+        let y = x - self.pivot;
+        let k = ep / (3.0 * self.reach.powi(self.power as i32));
+        let swirl = self.omega.cross(y) * (3.0 * e);
+        if !(rc > 0.0) {
+            return k * swirl;
+        }
+        let n = yc / rc;
+        let b = self.omega * y.length_squared() - y * self.omega.dot(y);
+        let sg = if d < 0.0 { -1.0 } else { 1.0 };
+        k * ((self.power as f64 * sg) * n.cross(b) + swirl)
+    }
+
+    /// `ω L (1 + p L/(3R))` with `L = |c − o| + ρ + R` the reach of the support about the pivot.
+    pub fn max_speed(&self) -> f64 {
+        let l = (self.center - self.pivot).length() + self.radius + self.reach;
+        self.omega.length() * l * (1.0 + self.power as f64 * l / (3.0 * self.reach))
+    }
+}
+
+/// Which swirl.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SwirlKind {
+    Twist,
+    Bend,
+}
+
+/// Twist or bend about `axis` through `pivot`, support the ball `r < reach` (eq. 12.5, 12.6).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Swirl {
+    pub pivot: DVec3,
+    /// Unit axis.
+    pub axis: DVec3,
+    /// κ (rad per length per time) for a twist, β (rad per length² per time) for a bend.
+    pub rate: f64,
+    pub reach: f64,
+    pub kind: SwirlKind,
+    /// The thesis's curl form (falloff inside the potential) instead of the rate form.
+    pub curl_form: bool,
+}
+
+impl Swirl {
+    /// Angular speed `h` (rad per time, right-handed about the axis) at `z = a·Y`, `r = |Y|`.
+    #[inline]
+    pub fn angular(&self, z: f64, r: f64) -> f64 {
+        let q = r / self.reach;
+        if !(q < 1.0) {
+            return 0.0;
+        }
+        let w = if self.curl_form {
+            (1.0 - q)
+                * match self.kind {
+                    SwirlKind::Twist => 1.0 - 1.5 * q,
+                    SwirlKind::Bend => 1.0 - 1.4 * q,
+                }
+        } else {
+            (1.0 - q) * (1.0 - q)
+        };
+        let g = match self.kind {
+            SwirlKind::Twist => z,
+            SwirlKind::Bend => r * r,
+        };
+        self.rate * g * w
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3) -> DVec3 {
+        let y = x - self.pivot;
+        let r = y.length();
+        let h = self.angular(self.axis.dot(y), r);
+        if h == 0.0 {
+            return DVec3::ZERO;
+        }
+        h * self.axis.cross(y)
+    }
+
+    /// max over the ball of `|h| r` (sampled on 4097 radii; `|z| ≤ r`).
+    pub fn max_speed(&self) -> f64 {
+        let n = 4096;
+        let mut m: f64 = 0.0;
+        for i in 0..=n {
+            let r = self.reach * i as f64 / n as f64;
+            m = m.max((self.angular(r, r) * r).abs());
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn div(f: impl Fn(DVec3) -> DVec3, x: DVec3) -> f64 {
+        let h = 1e-6;
+        let mut s = 0.0;
+        for k in 0..3 {
+            let mut e = DVec3::ZERO;
+            e[k] = h;
+            s += (f(x + e)[k] - f(x - e)[k]) / (2.0 * h);
+        }
+        s
+    }
+
+    #[test]
+    fn translation_normal_velocity_and_divergence() {
+        for p in [2u8, 3, 4] {
+            let tr = Translation {
+                center: DVec3::ZERO,
+                velocity: DVec3::new(0.3, -1.0, 0.5),
+                radius: 0.4,
+                reach: 0.3,
+                power: p,
+                moving: false,
+            };
+            let n = DVec3::new(1.0, 2.0, -0.5).normalize();
+            let v = tr.eval(n * (0.4 + 1e-12), 0.0);
+            assert!((v.dot(n) - tr.velocity.dot(n)).abs() < 1e-9);
+            let x = DVec3::new(0.3, 0.35, -0.1);
+            assert!(div(|x| tr.eval(x, 0.0), x).abs() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn swirl_speed_bounds() {
+        let s = Swirl {
+            pivot: DVec3::ZERO,
+            axis: DVec3::Z,
+            rate: 4.0,
+            reach: 2.0,
+            kind: SwirlKind::Twist,
+            curl_form: false,
+        };
+        // κ R² / 16
+        assert!((s.max_speed() - 4.0 * 4.0 / 16.0).abs() < 1e-6);
+        let b = Swirl {
+            kind: SwirlKind::Bend,
+            ..s
+        };
+        assert!((b.max_speed() - 0.03456 * 4.0 * 8.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,275 @@
+//! Volume-preserving deformation by divergence-free vector fields (issue 4).
+//!
+//! A [`Field`] is a sum of elements, each a closed-form divergence-free velocity field
+//! `v(X, t)`: the curl fields of Zheng's thesis Ch. 12 ([`fields`]: translation, rotation,
+//! twist, bend) and the cross-product fields `∇p × ∇q` of Ch. 11 / von Funck et al. 2006
+//! ([`cross`]). Sums keep `div v = 0`. Vertices are carried along the flow `dX/dt = v(X, t)`
+//! by [`advect`] (RK4, explicit Euler for comparison), path lines in parallel.
+//!
+//! Elements cross the binding as rows of [`ROW`] floats (`row[0]` the kind, the rest the
+//! parameters, see [`Element::parse`]) so that a Python field object is just an array; the
+//! rows are validated here again (finite, positive radii, unit axes), so a malformed row is an
+//! [`InputError`] naming `field`, never a panic.
+
+pub mod advect;
+pub mod cross;
+pub mod fields;
+
+use glam::DVec3;
+
+use crate::error::{InputError, Result};
+pub use cross::{Capsule, Sphere, StripAcross, Torus};
+pub use fields::{Rotation, Swirl, SwirlKind, Translation};
+
+/// Floats per element row.
+pub const ROW: usize = 16;
+
+/// One element of a field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Element {
+    Translation(Translation),
+    Rotation(Rotation),
+    Swirl(Swirl),
+    Sphere(Sphere),
+    Capsule(Capsule),
+    Torus(Torus),
+    StripAcross(StripAcross),
+}
+
+fn v3(r: &[f64], i: usize) -> DVec3 {
+    DVec3::new(r[i], r[i + 1], r[i + 2])
+}
+
+fn positive(x: f64, what: &str) -> Result<f64> {
+    if x > 0.0 && x.is_finite() {
+        Ok(x)
+    } else {
+        Err(InputError::new(
+            "field",
+            format!("{what} must be positive and finite, got {x}"),
+        ))
+    }
+}
+
+fn power(x: f64) -> Result<u8> {
+    match x {
+        2.0 => Ok(2),
+        3.0 => Ok(3),
+        4.0 => Ok(4),
+        _ => Err(InputError::new(
+            "field",
+            format!("falloff power must be 2, 3 or 4, got {x}"),
+        )),
+    }
+}
+
+fn unit(a: DVec3, what: &str) -> Result<DVec3> {
+    let l = a.length();
+    if l > 0.0 && l.is_finite() {
+        Ok(a / l)
+    } else {
+        Err(InputError::new(
+            "field",
+            format!("{what} must be a non-zero finite vector"),
+        ))
+    }
+}
+
+impl Element {
+    /// Parse one row. Layouts (`c` centre, `u` velocity, `ρ` tool radius, `R` reach,
+    /// `p` falloff power, flags 0/1):
+    ///
+    /// | kind | element | row\[1..\] |
+    /// |---|---|---|
+    /// | 0 | curl translation | `c, u, ρ, R, p, moving` |
+    /// | 1 | curl rotation | `c, pivot, Ω = ω a, ρ, R, p` |
+    /// | 2 | twist/bend | `pivot, axis, rate, R, bend?, curl_form?` |
+    /// | 3 | sphere `∇p×∇q` | `c, u, ρ, R_f, linear?, moving` |
+    /// | 4 | capsule `∇p×∇q` (distance-field extension) | `a, b, u, ρ, R_f, linear?, moving` |
+    /// | 5 | torus `∇p×∇q` | `c, k, speed, R_t, r_t, R_f, linear?, moving` |
+    /// | 6 | strip across `∇p×∇q` | `a, b, m (velocity ⟂ b − a), ρ, R_f, linear?` |
+    pub fn parse(r: &[f64]) -> Result<Element> {
+        if r.len() != ROW {
+            return Err(InputError::new(
+                "field",
+                format!("element rows have {ROW} numbers"),
+            ));
+        }
+        if let Some(i) = r.iter().position(|x| !x.is_finite()) {
+            return Err(InputError::new(
+                "field",
+                format!("element parameter {i} is not finite"),
+            ));
+        }
+        let flag = |x: f64| x != 0.0;
+        Ok(match r[0] {
+            0.0 => Element::Translation(Translation {
+                center: v3(r, 1),
+                velocity: v3(r, 4),
+                radius: positive(r[7], "radius")?,
+                reach: positive(r[8], "reach")?,
+                power: power(r[9])?,
+                moving: flag(r[10]),
+            }),
+            1.0 => Element::Rotation(Rotation {
+                center: v3(r, 1),
+                pivot: v3(r, 4),
+                omega: v3(r, 7),
+                radius: positive(r[10], "radius")?,
+                reach: positive(r[11], "reach")?,
+                power: power(r[12])?,
+            }),
+            2.0 => Element::Swirl(Swirl {
+                pivot: v3(r, 1),
+                axis: unit(v3(r, 4), "axis")?,
+                rate: r[7],
+                reach: positive(r[8], "radius")?,
+                kind: if flag(r[9]) {
+                    SwirlKind::Bend
+                } else {
+                    SwirlKind::Twist
+                },
+                curl_form: flag(r[10]),
+            }),
+            3.0 => Element::Sphere(Sphere {
+                center: v3(r, 1),
+                velocity: v3(r, 4),
+                radius: positive(r[7], "radius")?,
+                reach: positive(r[8], "reach")?,
+                linear: flag(r[9]),
+                moving: flag(r[10]),
+            }),
+            4.0 => Element::Capsule(Capsule::new(
+                v3(r, 1),
+                v3(r, 4),
+                v3(r, 7),
+                positive(r[10], "radius")?,
+                positive(r[11], "reach")?,
+                flag(r[12]),
+                flag(r[13]),
+            )?),
+            5.0 => Element::Torus(Torus::new(
+                v3(r, 1),
+                unit(v3(r, 4), "axis")?,
+                r[7],
+                positive(r[8], "major")?,
+                positive(r[9], "minor")?,
+                positive(r[10], "reach")?,
+                flag(r[11]),
+                flag(r[12]),
+            )?),
+            6.0 => Element::StripAcross(StripAcross::new(
+                v3(r, 1),
+                v3(r, 4),
+                v3(r, 7),
+                positive(r[10], "radius")?,
+                positive(r[11], "reach")?,
+                flag(r[12]),
+            )?),
+            k => {
+                return Err(InputError::new(
+                    "field",
+                    format!("unknown element kind {k}"),
+                ));
+            }
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        match self {
+            Element::Translation(e) => e.eval(x, t),
+            Element::Rotation(e) => e.eval(x, t),
+            Element::Swirl(e) => e.eval(x),
+            Element::Sphere(e) => e.eval(x, t),
+            Element::Capsule(e) => e.eval(x, t),
+            Element::Torus(e) => e.eval(x, t),
+            Element::StripAcross(e) => e.eval(x),
+        }
+    }
+
+    /// An upper bound (or a sampled estimate with margin) of |v| and of the tool speed.
+    pub fn max_speed(&self) -> f64 {
+        match self {
+            Element::Translation(e) => e.max_speed(),
+            Element::Rotation(e) => e.max_speed(),
+            Element::Swirl(e) => e.max_speed(),
+            Element::Sphere(e) => e.max_speed(),
+            Element::Capsule(e) => e.max_speed(),
+            Element::Torus(e) => e.max_speed(),
+            Element::StripAcross(e) => e.max_speed(),
+        }
+    }
+
+    /// The length over which the field changes: the reach (curl fields, swirls) or the
+    /// width of the blend region (cross-product fields).
+    pub fn length_scale(&self) -> f64 {
+        match self {
+            Element::Translation(e) => e.reach,
+            Element::Rotation(e) => e.reach,
+            Element::Swirl(e) => e.reach,
+            Element::Sphere(e) => e.reach,
+            Element::Capsule(e) => e.reach,
+            Element::Torus(e) => e.reach,
+            Element::StripAcross(e) => e.reach,
+        }
+    }
+}
+
+/// A sum of elements (an empty sum is the zero field).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Field {
+    pub elements: Vec<Element>,
+}
+
+impl Field {
+    /// Parse `k` rows of [`ROW`] floats.
+    pub fn parse(rows: &[f64]) -> Result<Field> {
+        if rows.len() % ROW != 0 {
+            return Err(InputError::new(
+                "field",
+                format!("expected rows of {ROW} numbers"),
+            ));
+        }
+        let elements = rows
+            .chunks_exact(ROW)
+            .enumerate()
+            .map(|(i, r)| Element::parse(r).map_err(|e| e.context(&format!("element {i}"))))
+            .collect::<Result<_>>()?;
+        Ok(Field { elements })
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        match self.elements.as_slice() {
+            [e] => e.eval(x, t),
+            es => es.iter().fold(DVec3::ZERO, |s, e| s + e.eval(x, t)),
+        }
+    }
+
+    /// Sum of the elements' speed bounds.
+    pub fn max_speed(&self) -> f64 {
+        self.elements.iter().map(Element::max_speed).sum()
+    }
+
+    /// Smallest length scale of the elements (∞ for the zero field).
+    pub fn length_scale(&self) -> f64 {
+        self.elements
+            .iter()
+            .map(Element::length_scale)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The step rule for `steps=None` (brief §3.4): a step moves a point by at most 1/8 of
+    /// the field's length scale, `h = ℓ / (8 v_max)`, and never fewer than 4 steps.
+    pub fn default_steps(&self, duration: f64) -> usize {
+        let v = self.max_speed();
+        let l = self.length_scale();
+        let n = (duration.abs() * 8.0 * v / l).ceil();
+        if n.is_finite() && n > 4.0 {
+            n.min(1e9) as usize
+        } else {
+            4
+        }
+    }
+}
