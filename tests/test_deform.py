@@ -490,6 +490,10 @@ def test_zero_duration_backwards_and_progress():
     (lambda V, f: fields.sum([f, 1]), TypeError, "fields"),
     (lambda V, f: f(np.zeros((2, 4))), ValueError, "points"),
     (lambda V, f: f(V, t=np.nan), ValueError, "t"),
+    (lambda V, f: spinal.deform("mesh", f, 1.0), TypeError, "mesh"),
+    (lambda V, f: spinal.deform((V, [[0, 1, 5]]), f, 1.0), ValueError, "mesh"),
+    (lambda V, f: spinal.deform((V, [[0, 1, 1]]), f, 1.0, refine=-1), ValueError, "refine"),
+    (lambda V, f: spinal.deform((V, [[0, 1, 1]]), f, 1.0, steps=0), ValueError, "steps"),
 ])
 def test_bad_input(call, exc, start):
     V = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
@@ -513,3 +517,33 @@ def test_core_rejects_malformed_rows_without_panicking():
             _core.field_eval(x, bad, 0.0)
     with pytest.raises(ValueError, match="^field"):
         _core.advect(x, np.zeros((1, 5)), 0.0, 0.1, 1, "rk4")
+
+
+def test_refinement_from_the_rest_mesh_keeps_a_long_stroke_below_1e_4():
+    """Brief §5: a 1.0-long press on a 10k icosphere stretches edges 20×; the unrefined mesh
+    loses 1.7e-2 of its volume, refinement at τ = 1.5 (new vertices integrated from the
+    rest mesh) brings it below 1e-4."""
+    import igl.predicates
+    import trimesh
+
+    V, F = icosphere(5)
+    _, r0 = spinal.deform((V, F), PRESS, 1.0, refine=None)
+    assert abs(r0.relative_change) > 1e-2 and r0.vertices_added == 0
+    M, r = spinal.deform((V, F), PRESS, 1.0, estimate=True)
+    assert abs(r.relative_change) < 1e-4 and r.vertices_added > 1000, str(r)
+    assert trimesh.Trimesh(M.vertices, M.faces, process=False).is_watertight
+    assert not igl.predicates.find_self_intersections(M.vertices, M.faces, first_only=True)[0]
+    tm = trimesh.Trimesh(M.vertices, M.faces, process=False)
+    assert abs(tm.volume / r.volume - 1) < 1e-12
+    # the rest mesh's volume is unchanged (new vertices on flat rest edges)
+    rest = trimesh.Trimesh(r.rest_vertices, M.faces, process=False).volume
+    assert abs(rest / trimesh.Trimesh(V, F, process=False).volume - 1) < 1e-14
+    np.testing.assert_array_equal(r.rest_vertices[: len(V)], V)
+    # every vertex, old or new, is Φ(rest): the same steps applied to the rest position
+    np.testing.assert_array_equal(M.vertices, spinal.advect(r.rest_vertices, PRESS, 1.0, r.steps))
+    # the Richardson split agrees with a 16×-steps reference on the refined mesh
+    ref = spinal.advect(r.rest_vertices, PRESS, 1.0, 16 * r.steps)
+    vref = trimesh.Trimesh(ref, M.faces, process=False).volume
+    integration = r.volume / vref - 1
+    assert abs(r.integration_error / integration - 1) < 0.2, (r, integration)
+    assert abs(r.mesh_error - (vref / rest - 1)) < 0.2 * abs(integration)

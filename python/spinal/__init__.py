@@ -9,17 +9,20 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 from . import curves, fields, ph, quaternions
 from ._advect import advect
 from ._core import __version__
+from ._deform import DeformReport, deform
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
 
 __all__ = [
+    "DeformReport",
     "FoldOverWarning",
     "Mesh",
     "__version__",
     "advect",
     "closing_angle",
     "curves",
+    "deform",
     "estimate_tangents",
     "fields",
     "frames",

@@ -124,3 +124,27 @@ def advect(
     t0: float = 0.0,
     progress: bool | Callable[[int, int], object] = False,
 ) -> npt.NDArray[np.float64]: ...
+
+class DeformReport:
+    rest_volume: float
+    volume: float
+    relative_change: float
+    steps: int
+    vertices_added: int
+    passes: int
+    integration_error: float | None
+    mesh_error: float | None
+    rest_vertices: npt.NDArray[np.float64] | None
+
+def deform(
+    mesh: Mesh | Any | tuple[_Array, _Array],
+    field: Field,
+    duration: float,
+    steps: int | None = None,
+    *,
+    refine: float | None = 1.5,
+    max_passes: int = 30,
+    t0: float = 0.0,
+    estimate: bool = False,
+    progress: bool | Callable[[int, int], object] = False,
+) -> tuple[Mesh, DeformReport]: ...

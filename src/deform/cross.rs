@@ -95,12 +95,17 @@ impl Sphere {
             self.center
         };
         let y = x - c;
-        let r = y.length();
-        let d = r - self.radius;
-        if !(r > 0.0) {
+        let r2 = y.length_squared();
+        let outer = self.radius + self.reach;
+        if !(r2 < outer * outer) {
+            return DVec3::ZERO;
+        }
+        if r2 <= self.radius * self.radius {
             return self.velocity;
         }
-        translate(d, y / r, y, self.velocity, self.reach, self.linear)
+        let r = r2.sqrt();
+        let d = r - self.radius;
+        translate(d, y * (1.0 / r), y, self.velocity, self.reach, self.linear)
     }
 
     /// Exact maximum for a sphere: `|v| = |u| max((1 − D)², |(1 − D)² − (1 − D)D′ r|)`
@@ -181,7 +186,7 @@ impl Capsule {
         let y = x - (a + 0.5 * self.ab);
         translate(
             r - self.radius,
-            w / r,
+            w * (1.0 / r),
             y,
             self.velocity,
             self.reach,
@@ -265,8 +270,8 @@ impl Torus {
         let scale = self.speed * self.major / rho;
         let mut v = k * (1.0 - b);
         if db > 0.0 {
-            let e_rho = yp / rho;
-            let n = (e_rho * dr + k * z) / dist;
+            let e_rho = yp * (1.0 / rho);
+            let n = (e_rho * dr + k * z) * (1.0 / dist);
             v += k.cross(e_rho).cross(n) * (db * dr);
         }
         v * scale
@@ -353,7 +358,7 @@ impl StripAcross {
         let (b, db) = blend(d, self.reach, self.linear);
         let mut v = self.velocity * (1.0 - b);
         if db > 0.0 {
-            let n = w / r;
+            let n = w * (1.0 / r);
             let s = self.velocity.length();
             v -= self.tangent.cross(n) * (s * db * self.side.dot(x - self.a));
         }

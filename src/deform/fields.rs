@@ -50,6 +50,25 @@ fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
     Some((ep, e))
 }
 
+/// `R^p` for `p ∈ {2, 3, 4}` (no `powi` call in the hot path).
+#[inline(always)]
+fn pow_p(r: f64, p: u8) -> f64 {
+    match p {
+        2 => r * r,
+        3 => r * r * r,
+        _ => (r * r) * (r * r),
+    }
+}
+
+/// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
+/// points far from the tool cost a few multiplications).
+#[inline(always)]
+fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
+    let outer = rho + reach;
+    let inner = rho - reach;
+    !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
+}
+
 /// Rodrigues rotation of `y` about the unit axis `a` by `theta`.
 #[inline]
 pub fn rotate(a: DVec3, theta: f64, y: DVec3) -> DVec3 {
@@ -78,17 +97,21 @@ impl Translation {
             self.center
         };
         let y = x - c;
-        let r = y.length();
+        let r2 = y.length_squared();
+        if outside_shell(r2, self.radius, self.reach) {
+            return DVec3::ZERO;
+        }
+        let r = r2.sqrt();
         let d = r - self.radius;
         let Some((ep, e)) = falloff(d, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let u = self.velocity;
-        let k = ep / self.reach.powi(self.power as i32);
+        let k = ep / pow_p(self.reach, self.power);
         if !(r > 0.0) {
             return u * (k * e);
         }
-        let n = y / r;
+        let n = y * (1.0 / r);
         let sg = if d < 0.0 { -1.0 } else { 1.0 };
         let half_p = 0.5 * self.power as f64;
         k * (e * u + (half_p * sg) * (y * n.dot(u) - u * r))
@@ -123,18 +146,22 @@ impl Rotation {
             self.center
         };
         let yc = x - c;
-        let rc = yc.length();
+        let rc2 = yc.length_squared();
+        if outside_shell(rc2, self.radius, self.reach) {
+            return DVec3::ZERO;
+        }
+        let rc = rc2.sqrt();
         let d = rc - self.radius;
         let Some((ep, e)) = falloff(d, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let y = x - self.pivot;
-        let k = ep / (3.0 * self.reach.powi(self.power as i32));
+        let k = ep / (3.0 * pow_p(self.reach, self.power));
         let swirl = self.omega.cross(y) * (3.0 * e);
         if !(rc > 0.0) {
             return k * swirl;
         }
-        let n = yc / rc;
+        let n = yc * (1.0 / rc);
         let b = self.omega * y.length_squared() - y * self.omega.dot(y);
         let sg = if d < 0.0 { -1.0 } else { 1.0 };
         k * ((self.power as f64 * sg) * n.cross(b) + swirl)
@@ -195,7 +222,11 @@ impl Swirl {
     #[inline]
     pub fn eval(&self, x: DVec3) -> DVec3 {
         let y = x - self.pivot;
-        let r = y.length();
+        let r2 = y.length_squared();
+        if !(r2 < self.reach * self.reach) {
+            return DVec3::ZERO;
+        }
+        let r = r2.sqrt();
         let h = self.angular(self.axis.dot(y), r);
         if h == 0.0 {
             return DVec3::ZERO;
