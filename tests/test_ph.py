@@ -612,6 +612,24 @@ def test_nearly_straight_curve_keeps_order_four():
     assert sp.deviation.max() <= 1e-12
 
 
+def test_rmf_on_nearly_straight_twisting_cubics_is_accurate():
+    # κ ≈ 2e-4 but τ ≈ 3: on fine segments the Frenet frame and Ω are both ill-conditioned
+    # (Frenet from x′ × x″ gave 1e-5 rad errors at N = 256); via the Euler–Rodrigues frame of
+    # the preimage the RMF matches double reflection on the spline's own samples
+    gentle = spinal.curves.Polynomial([[0, 0, 0], [1, 0, 0], [0, 1e-4, 0], [0, 0, 1e-4]])
+    sp = ph.fit(gentle, segments=256)
+    assert np.all(np.abs(ph.invariants(sp.control_points)["k"]) > 0.999)  # nearly straight
+    s = np.linspace(0, 256, 256 * 40 + 1)
+    T = sp.evaluate(s, 1)
+    T /= np.linalg.norm(T, axis=1)[:, None]
+    for exact in (True, False):
+        F = sp.rmf(s, exact=exact, initial=[0, 1, 0])
+        R = spinal.frames(sp.evaluate(s), T, initial=F[0][:, 0])
+        err = np.arctan2(np.einsum("ij,ij->i", np.cross(R[:, :, 0], F[:, :, 0]), T),
+                         np.einsum("ij,ij->i", R[:, :, 0], F[:, :, 0]))
+        assert np.abs(err).max() < 1e-12
+
+
 def test_adaptive_fit():
     for tol in (1e-3, 1e-6):
         sp = ph.fit(INFLECTION, tol=tol)

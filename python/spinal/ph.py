@@ -470,8 +470,11 @@ class PHSpline:
 
     def frenet(self, s) -> np.ndarray:
         """Rational Frenet frames ``(n, 3, 3)``, columns ``(n, b, t)``: ``t = x′/σ``,
-        ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). On straight cubics (no Frenet frame) the
-        reference vector of :meth:`rmf` is used."""
+        ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). Evaluated as the Euler–Rodrigues frame of the
+        quaternion preimage (columns of the rotation ``A(v)/|A(v)|``), which on a PH cubic is
+        the Frenet frame turned by a constant angle — well conditioned where ``x′ × x″`` is
+        tiny. On straight cubics (no Frenet frame) the reference vector of :meth:`rmf` is
+        used."""
         return self._frames(s, "frenet", None, 0.0)[0]
 
     def rmf(self, s=None, *, initial=None, exact: bool = False, omega_start: float = 0.0,
