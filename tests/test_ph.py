@@ -435,6 +435,33 @@ def test_rational_frame_from_bernstein_coefficients_is_orthonormal():
         np.testing.assert_allclose(np.linalg.det(F), 1, atol=1e-13)
         # the same frame as the direct evaluation (sin Ω̃ b + cos Ω̃ n) in the core
         np.testing.assert_allclose(F, sp.rmf(i + v, omega_start=0.7), atol=1e-13)
+    # the coefficients are MJ's (29) with the Frenet numerators n̂ = σx″ − σ′x′, b̂ = x′ × x″
+    # (Bernstein forms of §3.1) divided by 6L₂sθ
+    f = sp.angle_fit(omega_start=0.7)
+    for i in range(2):
+        d1, d2, d3 = np.diff(sp.control_points[i], axis=0)
+        L1, L3 = np.linalg.norm(d1), np.linalg.norm(d3)
+        L2c = d1 @ d2 / L1
+        bh = np.array([18 * np.cross(d1, d2), 9 * np.cross(d1, d3), 18 * np.cross(d2, d3)])
+        nh = np.array([18 * (L1 * d2 - L2c * d1), 9 * (L1 * d3 - L3 * d1),
+                       18 * (L2c * d3 - L3 * d2)])
+        c, s_ = np.cos(f["phi"][i]), np.sin(f["phi"][i])
+        nphi, bphi = c * nh + s_ * bh, c * bh - s_ * nh
+        G, B = f["sg"][i] * f["gamma"][i], f["beta"][i]
+        c2 = np.array([1, 2, 1])                                 # Bernstein products
+        GB2 = 2 * np.convolve(G * c2, B * c2) / [1, 4, 6, 4, 1]
+        BG = (np.convolve(B * c2, B * c2) - np.convolve(G * c2, G * c2)) / [1, 4, 6, 4, 1]
+
+        def prod(p4, q2):  # degree 4 (scalar) × degree 2 (vector) -> degree 6
+            out = np.zeros((7, 3))
+            for a in range(5):
+                for b in range(3):
+                    out[a + b] += comb(4, a) * comb(2, b) / comb(6, a + b) * p4[a] * q2[b]
+            return out
+
+        mj_f2 = prod(GB2, bphi) + prod(BG, nphi)
+        scale = 6 * np.linalg.norm(np.cross(d1, d2)) / L1
+        np.testing.assert_allclose(mj_f2 / scale, rf["f2"][i], atol=1e-13)
     # continuous across the joint, and equal to the exact RMF there
     F = sp.rmf([1.0 - 1e-12, 1.0], omega_start=0.7)
     np.testing.assert_allclose(F[0], F[1], atol=1e-10)
@@ -628,6 +655,15 @@ def test_rmf_on_nearly_straight_twisting_cubics_is_accurate():
         err = np.arctan2(np.einsum("ij,ij->i", np.cross(R[:, :, 0], F[:, :, 0]), T),
                          np.einsum("ij,ij->i", R[:, :, 0], F[:, :, 0]))
         assert np.abs(err).max() < 1e-12
+    # the Bernstein form of the rational frame is as accurate there
+    rf = sp.rational_frames(initial=[0, 1, 0])
+    v = np.linspace(0, 1, 9)
+    F = sp.rmf((np.arange(0, 256, 15)[:, None] + v).ravel(), initial=[0, 1, 0])
+    F = F.reshape(-1, 9, 3, 3)
+    for j, i in enumerate(range(0, 256, 15)):
+        w = bern(rf["weight"][i], v)[:, None]
+        np.testing.assert_allclose(bern(rf["f2"][i], v) / w, F[j, :, :, 0], atol=1e-13)
+        np.testing.assert_allclose(bern(rf["f3"][i], v) / w, F[j, :, :, 1], atol=1e-13)
 
 
 def test_adaptive_fit():

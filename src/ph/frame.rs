@@ -86,7 +86,7 @@ pub struct Segment {
 }
 
 /// Number of floats in [`Segment::to_row`].
-pub const SEGMENT_ROW: usize = 25;
+pub const SEGMENT_ROW: usize = 34;
 
 impl Segment {
     /// Exact angle `Ω(v) = Ω(0) + 2k[arctan((cv − b)/a) + arctan(b/a)]`, evaluated as
@@ -109,7 +109,8 @@ impl Segment {
         2.0 * self.k * self.a / s3
     }
 
-    /// `[straight, Ω₀, Ω₁, k, a, b, c, φ, sg, λ, λ*, Î, β₀..₂, γ₀..₂, r, w₀, w₁, s₀, s₁]`.
+    /// `[straight, Ω₀, Ω₁, k, a, b, c, φ, sg, λ, λ*, Î, β₀..₂, γ₀..₂, r, w₀, w₁, s₀, s₁, A₀, A₁,
+    /// β_erf]` (the last: the angle of `n` from the Euler–Rodrigues `e₂`).
     pub fn to_row(&self) -> [f64; SEGMENT_ROW] {
         let f = &self.fit;
         [
@@ -138,6 +139,15 @@ impl Segment {
             f.w[1],
             f.s[0],
             f.s[1],
+            self.q[0][0],
+            self.q[0][1],
+            self.q[0][2],
+            self.q[0][3],
+            self.q[1][0],
+            self.q[1][1],
+            self.q[1][2],
+            self.q[1][3],
+            self.beta,
         ]
     }
 }
