@@ -776,3 +776,36 @@ def test_spline_with_a_straight_cubic_carries_the_frame():
         w = bern(rf["weight"][i], v)[:, None]
         np.testing.assert_allclose(bern(rf["f2"][i], v) / w,
                                    sp.rmf(i + v, initial=[0, 0, 1])[:, :, 0], atol=1e-13)
+
+
+def test_garbage_never_gives_nan_and_inputs_are_copied():
+    rng = np.random.default_rng(11)
+    accepted = 0
+    for _ in range(1500):
+        m = int(rng.integers(1, 4))
+        if rng.random() < 0.5:
+            P = rng.integers(-2, 3, size=(m, 4, 3)).astype(float)
+        else:  # small integer preimages: planar, straight, cusps, zero legs
+            A = rng.integers(-1, 2, size=(m, 2, 4)).astype(float)
+            P = ph.from_quaternions(A[:, 0], A[:, 1])
+        P[1:] += (np.cumsum(P[:-1, 3] - P[:-1, 0], axis=0) - P[1:, 0] + P[0, 0])[:, None]
+        try:
+            sp = ph.PHSpline(P)
+        except ValueError as e:
+            assert str(e).startswith("control_points: ")
+            continue
+        accepted += 1
+        s = np.linspace(0, m, 23)
+        outs = [sp.evaluate(s, 2), sp.frenet(s), sp.rmf(s), sp.rmf(s, exact=True),
+                sp.angle(s), sp.surface([[1, 0], [0, 1]]), *sp.rational_frames().values()]
+        assert all(np.isfinite(o).all() for o in outs)
+    assert accepted > 200
+    P = ph.fit(HELIX, segments=3).control_points.copy()
+    sp = ph.PHSpline(P)
+    P[:] = 0
+    assert np.abs(sp.control_points).max() > 0 and not sp.control_points.flags.writeable
+    with pytest.raises(ValueError, match="^control_points: not a PH cubic"):
+        ph.angle_fit(np.eye(4, 3))
+    with pytest.raises(ValueError, match="^curve: bad Hermite data"):
+        ph.fit(np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [2, 1, 0]]),
+               tangents=np.ones((4, 3)), segments=3)

@@ -256,7 +256,7 @@ def evaluate(control_points, v, derivative: int = 0) -> np.ndarray:
     cp, single = _cubics(control_points)
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline for many")
-    return PHSpline(cp, check=False).evaluate(v, derivative)
+    return PHSpline._trusted(cp, np.arange(2.0)).evaluate(v, derivative)
 
 
 _FIT_KEYS = ("straight", "omega0", "omega1", "k", "a", "b", "c", "phi", "sg", "lambda",
@@ -302,6 +302,8 @@ def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = N
     cp, single = _cubics(control_points)
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline.angle_fit")
+    if not _core.ph_is_ph(cp, 1e-7)[0]:
+        raise ValueError("control_points: not a PH cubic (control-polygon test, tolerance 1e-7)")
     om = float(as_float_array(omega_start, "omega_start"))
     ph = None if phi is None else float(as_float_array(phi, "phi"))
     if not np.isfinite(om) or (ph is not None and not np.isfinite(ph)):
@@ -378,16 +380,16 @@ class PHSpline:
     knots : array_like (m + 1,), optional
         Increasing parameter values of the joints in the parametrisation of the curve the
         spline approximates (used by :meth:`parameter`); default ``0, 1, …, m``.
-    check : bool
-        Check that every cubic is PH (control-polygon test, tolerance 1e-7) and that the
-        cubics join.
+
+    Every cubic must be PH (control-polygon test, tolerance 1e-7) and start where the
+    previous one ends, in its end direction (G¹, within ~1.4e-6 rad); ValueError otherwise.
 
     The spline is parametrised by ``s ∈ [0, m]``: cubic ``⌊s⌋`` at ``v = s − ⌊s⌋`` (``s = m``
     is the end of the last cubic). :func:`fit` builds one from a curve or samples and then
     also sets :attr:`deviation` (per segment, the largest distance to the input).
     """
 
-    def __init__(self, control_points, knots=None, *, check: bool = True):
+    def __init__(self, control_points, knots=None):
         cp, _ = _cubics(control_points)
         m = cp.shape[0]
         if m == 0:
@@ -400,23 +402,40 @@ class PHSpline:
                 raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
             if not np.all(np.diff(kn) > 0):
                 raise ValueError("knots: must be strictly increasing")
-        if as_bool(check, "check"):
-            scale = np.abs(cp).max() + 1.0
-            gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
-            if gap.size and gap.max() > 1e-9 * scale:
-                i = int(np.argmax(gap))
-                raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
-                                 f"{i} ends (gap {gap[i]:.3g})")
-            ok = _core.ph_is_ph(cp, 1e-7)
-            if not ok.all():
-                i = int(np.flatnonzero(~ok)[0])
-                raise ValueError(f"control_points: cubic {i} is not a PH cubic")
-        self._cp = cp
+        scale = np.abs(cp).max() + 1.0
+        gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
+        if gap.size and gap.max() > 1e-9 * scale:
+            i = int(np.argmax(gap))
+            raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
+                             f"{i} ends (gap {gap[i]:.3g})")
+        ok = _core.ph_is_ph(cp, 1e-7)
+        if not ok.all():
+            i = int(np.flatnonzero(~ok)[0])
+            raise ValueError(f"control_points: cubic {i} is not a PH cubic (control-polygon "
+                             f"test, tolerance 1e-7)")
+        d_in, d_out = cp[:-1, 3] - cp[:-1, 2], cp[1:, 1] - cp[1:, 0]
+        cos = np.einsum("ij,ij->i", d_in, d_out) / (np.linalg.norm(d_in, axis=1)
+                                                    * np.linalg.norm(d_out, axis=1))
+        if cos.size and not np.all(cos >= 1 - 1e-12):
+            i = int(np.argmin(cos))
+            raise ValueError(f"control_points: cubics {i} and {i + 1} do not join with a "
+                             f"common tangent (G¹; angle {np.arccos(np.clip(cos[i], -1, 1)):.3g} rad)")
+        self._init(cp, kn)
+
+    def _init(self, cp: np.ndarray, kn: np.ndarray) -> None:
+        self._cp = np.array(cp, dtype=float, order="C")       # own copies, read-only
         self._cp.setflags(write=False)
-        self._knots = np.ascontiguousarray(kn, dtype=float)
+        self._knots = np.array(kn, dtype=float, order="C")
         self._knots.setflags(write=False)
         #: Per segment, the largest distance to the fitted input (set by :func:`fit`).
         self.deviation: np.ndarray | None = None
+
+    @classmethod
+    def _trusted(cls, cp: np.ndarray, kn: np.ndarray) -> PHSpline:
+        """A spline from cubics known to be PH (from :func:`hermite`), without the checks."""
+        self = cls.__new__(cls)
+        self._init(cp, kn)
+        return self
 
     # -- geometry -----------------------------------------------------------------------
     @property
@@ -660,9 +679,13 @@ def _bez(cp: np.ndarray, v: np.ndarray, k: int = 0) -> np.ndarray:
 
 def _hermite_batch(p0, t0, p1, t1):
     """Best candidate per row (q, 4, 3) and reason codes (0 = solved)."""
-    cand, counts, codes = _core.ph_hermite(
-        np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
-        np.ascontiguousarray(t1), True, True)
+    try:
+        cand, counts, codes = _core.ph_hermite(
+            np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
+            np.ascontiguousarray(t1), True, True)
+    except ValueError as exc:  # a zero or non-finite tangent, a repeated point
+        raise ValueError(f"curve: bad Hermite data at an interval end (rows are intervals): "
+                         f"{exc}") from None
     return cand.reshape(-1, 2, 4, 3)[:, 0], counts, codes
 
 
@@ -868,7 +891,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
                 raise ValueError("knots: sample knots must be integer rows")
             what = "knots"
         cp = solve(k, what)
-        sp = PHSpline(cp, k, check=False)
+        sp = PHSpline._trusted(cp, k)
         sp.deviation = deviation(cp, k)
         return sp
 
@@ -941,6 +964,6 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
                              f"tol = {tol:g}")
     done.sort(key=lambda x: x[0])
     kn = np.array([x[0] for x in done] + [done[-1][1]])
-    sp = PHSpline(np.stack([x[2] for x in done]), kn, check=False)
+    sp = PHSpline._trusted(np.stack([x[2] for x in done]), kn)
     sp.deviation = np.array([x[3] for x in done])
     return sp
