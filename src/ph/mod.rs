@@ -310,7 +310,7 @@ pub fn twist(a0: Quat, a1: Quat) -> f64 {
 /// On a PH cubic it is the Frenet frame turned about `t` by a constant angle. None where
 /// `A(v)` vanishes (a cusp).
 pub fn erf(a0: Quat, a1: Quat, v: f64) -> Option<(DVec3, DVec3, DVec3)> {
-    let q: Vec<f64> = (0..4).map(|i| a0[i] * (1.0 - v) + a1[i] * v).collect();
+    let q: Quat = std::array::from_fn(|i| a0[i] * (1.0 - v) + a1[i] * v);
     let n2 = q.iter().map(|x| x * x).sum::<f64>();
     if !(n2 > 1e-300) || !n2.is_finite() {
         return None;
