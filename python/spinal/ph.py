@@ -787,7 +787,8 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         ``segments`` uniform intervals (of the parameter, or of the row index), no
         adaptivity.
     knots : array_like, optional
-        Explicit increasing knots (curve parameters, or integer rows including 0 and n − 1).
+        Explicit increasing knots (curve parameters, or integer sample rows); the spline
+        covers [knots[0], knots[-1]].
     tangents : array_like (n, 3), optional
         Tangents of the samples (default :func:`spinal.estimate_tangents`).
     domain : (float, float), optional
