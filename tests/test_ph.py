@@ -435,6 +435,33 @@ def test_rational_frame_from_bernstein_coefficients_is_orthonormal():
         np.testing.assert_allclose(np.linalg.det(F), 1, atol=1e-13)
         # the same frame as the direct evaluation (sin Ω̃ b + cos Ω̃ n) in the core
         np.testing.assert_allclose(F, sp.rmf(i + v, omega_start=0.7), atol=1e-13)
+    # the coefficients are MJ's (29) with the Frenet numerators n̂ = σx″ − σ′x′, b̂ = x′ × x″
+    # (Bernstein forms of §3.1) divided by 6L₂sθ
+    f = sp.angle_fit(omega_start=0.7)
+    for i in range(2):
+        d1, d2, d3 = np.diff(sp.control_points[i], axis=0)
+        L1, L3 = np.linalg.norm(d1), np.linalg.norm(d3)
+        L2c = d1 @ d2 / L1
+        bh = np.array([18 * np.cross(d1, d2), 9 * np.cross(d1, d3), 18 * np.cross(d2, d3)])
+        nh = np.array([18 * (L1 * d2 - L2c * d1), 9 * (L1 * d3 - L3 * d1),
+                       18 * (L2c * d3 - L3 * d2)])
+        c, s_ = np.cos(f["phi"][i]), np.sin(f["phi"][i])
+        nphi, bphi = c * nh + s_ * bh, c * bh - s_ * nh
+        G, B = f["sg"][i] * f["gamma"][i], f["beta"][i]
+        c2 = np.array([1, 2, 1])                                 # Bernstein products
+        GB2 = 2 * np.convolve(G * c2, B * c2) / [1, 4, 6, 4, 1]
+        BG = (np.convolve(B * c2, B * c2) - np.convolve(G * c2, G * c2)) / [1, 4, 6, 4, 1]
+
+        def prod(p4, q2):  # degree 4 (scalar) × degree 2 (vector) -> degree 6
+            out = np.zeros((7, 3))
+            for a in range(5):
+                for b in range(3):
+                    out[a + b] += comb(4, a) * comb(2, b) / comb(6, a + b) * p4[a] * q2[b]
+            return out
+
+        mj_f2 = prod(GB2, bphi) + prod(BG, nphi)
+        scale = 6 * np.linalg.norm(np.cross(d1, d2)) / L1
+        np.testing.assert_allclose(mj_f2 / scale, rf["f2"][i], atol=1e-13)
     # continuous across the joint, and equal to the exact RMF there
     F = sp.rmf([1.0 - 1e-12, 1.0], omega_start=0.7)
     np.testing.assert_allclose(F[0], F[1], atol=1e-10)
@@ -612,6 +639,33 @@ def test_nearly_straight_curve_keeps_order_four():
     assert sp.deviation.max() <= 1e-12
 
 
+def test_rmf_on_nearly_straight_twisting_cubics_is_accurate():
+    # κ ≈ 2e-4 but τ ≈ 3: on fine segments the Frenet frame and Ω are both ill-conditioned
+    # (Frenet from x′ × x″ gave 1e-5 rad errors at N = 256); via the Euler–Rodrigues frame of
+    # the preimage the RMF matches double reflection on the spline's own samples
+    gentle = spinal.curves.Polynomial([[0, 0, 0], [1, 0, 0], [0, 1e-4, 0], [0, 0, 1e-4]])
+    sp = ph.fit(gentle, segments=256)
+    assert np.all(np.abs(ph.invariants(sp.control_points)["k"]) > 0.999)  # nearly straight
+    s = np.linspace(0, 256, 256 * 40 + 1)
+    T = sp.evaluate(s, 1)
+    T /= np.linalg.norm(T, axis=1)[:, None]
+    for exact in (True, False):
+        F = sp.rmf(s, exact=exact, initial=[0, 1, 0])
+        R = spinal.frames(sp.evaluate(s), T, initial=F[0][:, 0])
+        err = np.arctan2(np.einsum("ij,ij->i", np.cross(R[:, :, 0], F[:, :, 0]), T),
+                         np.einsum("ij,ij->i", R[:, :, 0], F[:, :, 0]))
+        assert np.abs(err).max() < 1e-12
+    # the Bernstein form of the rational frame is as accurate there
+    rf = sp.rational_frames(initial=[0, 1, 0])
+    v = np.linspace(0, 1, 9)
+    F = sp.rmf((np.arange(0, 256, 15)[:, None] + v).ravel(), initial=[0, 1, 0])
+    F = F.reshape(-1, 9, 3, 3)
+    for j, i in enumerate(range(0, 256, 15)):
+        w = bern(rf["weight"][i], v)[:, None]
+        np.testing.assert_allclose(bern(rf["f2"][i], v) / w, F[j, :, :, 0], atol=1e-13)
+        np.testing.assert_allclose(bern(rf["f3"][i], v) / w, F[j, :, :, 1], atol=1e-13)
+
+
 def test_adaptive_fit():
     for tol in (1e-3, 1e-6):
         sp = ph.fit(INFLECTION, tol=tol)
@@ -722,3 +776,36 @@ def test_spline_with_a_straight_cubic_carries_the_frame():
         w = bern(rf["weight"][i], v)[:, None]
         np.testing.assert_allclose(bern(rf["f2"][i], v) / w,
                                    sp.rmf(i + v, initial=[0, 0, 1])[:, :, 0], atol=1e-13)
+
+
+def test_garbage_never_gives_nan_and_inputs_are_copied():
+    rng = np.random.default_rng(11)
+    accepted = 0
+    for _ in range(1500):
+        m = int(rng.integers(1, 4))
+        if rng.random() < 0.5:
+            P = rng.integers(-2, 3, size=(m, 4, 3)).astype(float)
+        else:  # small integer preimages: planar, straight, cusps, zero legs
+            A = rng.integers(-1, 2, size=(m, 2, 4)).astype(float)
+            P = ph.from_quaternions(A[:, 0], A[:, 1])
+        P[1:] += (np.cumsum(P[:-1, 3] - P[:-1, 0], axis=0) - P[1:, 0] + P[0, 0])[:, None]
+        try:
+            sp = ph.PHSpline(P)
+        except ValueError as e:
+            assert str(e).startswith("control_points: ")
+            continue
+        accepted += 1
+        s = np.linspace(0, m, 23)
+        outs = [sp.evaluate(s, 2), sp.frenet(s), sp.rmf(s), sp.rmf(s, exact=True),
+                sp.angle(s), sp.surface([[1, 0], [0, 1]]), *sp.rational_frames().values()]
+        assert all(np.isfinite(o).all() for o in outs)
+    assert accepted > 200
+    P = ph.fit(HELIX, segments=3).control_points.copy()
+    sp = ph.PHSpline(P)
+    P[:] = 0
+    assert np.abs(sp.control_points).max() > 0 and not sp.control_points.flags.writeable
+    with pytest.raises(ValueError, match="^control_points: not a PH cubic"):
+        ph.angle_fit(np.eye(4, 3))
+    with pytest.raises(ValueError, match="^curve: bad Hermite data"):
+        ph.fit(np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [2, 1, 0]]),
+               tangents=np.ones((4, 3)), segments=3)

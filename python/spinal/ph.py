@@ -256,7 +256,7 @@ def evaluate(control_points, v, derivative: int = 0) -> np.ndarray:
     cp, single = _cubics(control_points)
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline for many")
-    return PHSpline(cp, check=False).evaluate(v, derivative)
+    return PHSpline._trusted(cp, np.arange(2.0)).evaluate(v, derivative)
 
 
 _FIT_KEYS = ("straight", "omega0", "omega1", "k", "a", "b", "c", "phi", "sg", "lambda",
@@ -270,6 +270,8 @@ def _fit_dict(rows: np.ndarray, single: bool) -> dict:
     d["gamma"] = rows[:, 15:18].copy()
     d["w"] = rows[:, 21:23].copy()
     d["slopes"] = rows[:, 23:25].copy()
+    d["preimage"] = rows[:, 25:33].reshape(-1, 2, 4).copy()
+    d["erf_angle"] = rows[:, 33].copy()
     if single:
         d = {k: (v[0].item() if v.ndim == 1 else v[0]) for k, v in d.items()}
     return d
@@ -293,11 +295,15 @@ def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = N
     ``φ = Ω(0)``.
 
     Returns a dict: ``omega0, omega1, k, a, b, c, phi, sg, lambda, lambda_star, I_min,
-    beta (3,), gamma (3,), w (w₀, w₁), slopes (s₀, s₁), straight``.
+    beta (3,), gamma (3,), w (w₀, w₁), slopes (s₀, s₁), straight``, and the quaternion
+    preimage ``preimage (2, 4)`` (scalar first) with ``erf_angle``, the constant angle of
+    ``n`` from the Euler–Rodrigues ``e₂`` towards ``e₃`` (see :meth:`PHSpline.frenet`).
     """
     cp, single = _cubics(control_points)
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline.angle_fit")
+    if not _core.ph_is_ph(cp, 1e-7)[0]:
+        raise ValueError("control_points: not a PH cubic (control-polygon test, tolerance 1e-7)")
     om = float(as_float_array(omega_start, "omega_start"))
     ph = None if phi is None else float(as_float_array(phi, "phi"))
     if not np.isfinite(om) or (ph is not None and not np.isfinite(ph)):
@@ -347,6 +353,23 @@ def _beval(f: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.tensordot(B, f, axes=(1, 0))
 
 
+def _erf_col(k: int, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Symmetric bilinear form of column ``k`` of ``R(A)|A|²`` (scalar-first ``(m, 4)``):
+    ``col(A, A)`` is ``A i A*``, ``A j A*``, ``A k A*`` for k = 0, 1, 2."""
+    w1, x1, y1, z1 = p.T
+    w2, x2, y2, z2 = q.T
+    if k == 0:
+        c = (w1 * w2 + x1 * x2 - y1 * y2 - z1 * z2, x1 * y2 + y1 * x2 + w1 * z2 + z1 * w2,
+             x1 * z2 + z1 * x2 - w1 * y2 - y1 * w2)
+    elif k == 1:
+        c = (x1 * y2 + y1 * x2 - w1 * z2 - z1 * w2, w1 * w2 - x1 * x2 + y1 * y2 - z1 * z2,
+             y1 * z2 + z1 * y2 + w1 * x2 + x1 * w2)
+    else:
+        c = (x1 * z2 + z1 * x2 + w1 * y2 + y1 * w2, y1 * z2 + z1 * y2 - w1 * x2 - x1 * w2,
+             w1 * w2 - x1 * x2 - y1 * y2 + z1 * z2)
+    return np.stack(c, axis=1)
+
+
 class PHSpline:
     """A G¹ spline of ``m`` PH cubics with rational frames.
 
@@ -357,16 +380,16 @@ class PHSpline:
     knots : array_like (m + 1,), optional
         Increasing parameter values of the joints in the parametrisation of the curve the
         spline approximates (used by :meth:`parameter`); default ``0, 1, …, m``.
-    check : bool
-        Check that every cubic is PH (control-polygon test, tolerance 1e-7) and that the
-        cubics join.
+
+    Every cubic must be PH (control-polygon test, tolerance 1e-7) and start where the
+    previous one ends, in its end direction (G¹, within ~1.4e-6 rad); ValueError otherwise.
 
     The spline is parametrised by ``s ∈ [0, m]``: cubic ``⌊s⌋`` at ``v = s − ⌊s⌋`` (``s = m``
     is the end of the last cubic). :func:`fit` builds one from a curve or samples and then
     also sets :attr:`deviation` (per segment, the largest distance to the input).
     """
 
-    def __init__(self, control_points, knots=None, *, check: bool = True):
+    def __init__(self, control_points, knots=None):
         cp, _ = _cubics(control_points)
         m = cp.shape[0]
         if m == 0:
@@ -379,23 +402,40 @@ class PHSpline:
                 raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
             if not np.all(np.diff(kn) > 0):
                 raise ValueError("knots: must be strictly increasing")
-        if as_bool(check, "check"):
-            scale = np.abs(cp).max() + 1.0
-            gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
-            if gap.size and gap.max() > 1e-9 * scale:
-                i = int(np.argmax(gap))
-                raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
-                                 f"{i} ends (gap {gap[i]:.3g})")
-            ok = _core.ph_is_ph(cp, 1e-7)
-            if not ok.all():
-                i = int(np.flatnonzero(~ok)[0])
-                raise ValueError(f"control_points: cubic {i} is not a PH cubic")
-        self._cp = cp
+        scale = np.abs(cp).max() + 1.0
+        gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
+        if gap.size and gap.max() > 1e-9 * scale:
+            i = int(np.argmax(gap))
+            raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
+                             f"{i} ends (gap {gap[i]:.3g})")
+        ok = _core.ph_is_ph(cp, 1e-7)
+        if not ok.all():
+            i = int(np.flatnonzero(~ok)[0])
+            raise ValueError(f"control_points: cubic {i} is not a PH cubic (control-polygon "
+                             f"test, tolerance 1e-7)")
+        d_in, d_out = cp[:-1, 3] - cp[:-1, 2], cp[1:, 1] - cp[1:, 0]
+        cos = np.einsum("ij,ij->i", d_in, d_out) / (np.linalg.norm(d_in, axis=1)
+                                                    * np.linalg.norm(d_out, axis=1))
+        if cos.size and not np.all(cos >= 1 - 1e-12):
+            i = int(np.argmin(cos))
+            raise ValueError(f"control_points: cubics {i} and {i + 1} do not join with a "
+                             f"common tangent (G¹; angle {np.arccos(np.clip(cos[i], -1, 1)):.3g} rad)")
+        self._init(cp, kn)
+
+    def _init(self, cp: np.ndarray, kn: np.ndarray) -> None:
+        self._cp = np.array(cp, dtype=float, order="C")       # own copies, read-only
         self._cp.setflags(write=False)
-        self._knots = np.ascontiguousarray(kn, dtype=float)
+        self._knots = np.array(kn, dtype=float, order="C")
         self._knots.setflags(write=False)
         #: Per segment, the largest distance to the fitted input (set by :func:`fit`).
         self.deviation: np.ndarray | None = None
+
+    @classmethod
+    def _trusted(cls, cp: np.ndarray, kn: np.ndarray) -> PHSpline:
+        """A spline from cubics known to be PH (from :func:`hermite`), without the checks."""
+        self = cls.__new__(cls)
+        self._init(cp, kn)
+        return self
 
     # -- geometry -----------------------------------------------------------------------
     @property
@@ -470,8 +510,11 @@ class PHSpline:
 
     def frenet(self, s) -> np.ndarray:
         """Rational Frenet frames ``(n, 3, 3)``, columns ``(n, b, t)``: ``t = x′/σ``,
-        ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). On straight cubics (no Frenet frame) the
-        reference vector of :meth:`rmf` is used."""
+        ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). Evaluated as the Euler–Rodrigues frame of the
+        quaternion preimage (columns of the rotation ``A(v)/|A(v)|``), which on a PH cubic is
+        the Frenet frame turned by a constant angle — well conditioned where ``x′ × x″`` is
+        tiny. On straight cubics (no Frenet frame) the reference vector of :meth:`rmf` is
+        used."""
         return self._frames(s, "frenet", None, 0.0)[0]
 
     def rmf(self, s=None, *, initial=None, exact: bool = False, omega_start: float = 0.0,
@@ -511,50 +554,51 @@ class PHSpline:
     def rational_frames(self, *, initial=None, omega_start: float = 0.0) -> dict:
         """Bernstein coefficients of the rational RMF, per cubic (MJ (29), rotated pair).
 
-        With ``n̂ = σx″ − σ′x′`` and ``b̂ = x′ × x″`` (degree 2, ``|n̂| = |b̂| = 6L₂sθσ``),
-        ``n̂_φ = cos φ n̂ + sin φ b̂``, ``b̂_φ = cos φ b̂ − sin φ n̂``, ``G = sg γ``, ``B = β``::
+        MJ write the frame with the Frenet numerators ``n̂ = σx″ − σ′x′``, ``b̂ = x′ × x″``
+        (degree 2, ``|n̂| = |b̂| = 6L₂sθσ``). The same rational functions come better
+        conditioned from the Euler–Rodrigues numerators ``ê₂ = A j A*``, ``ê₃ = A k A*``
+        (degree 2, ``|ê| = σ = |A|²``; ``n̂ ∝ cos β ê₂ + sin β ê₃``, β = ``erf_angle``): with
+        ``ψ = β + φ``, ``ê₂ψ = cos ψ ê₂ + sin ψ ê₃``, ``ê₃ψ = cos ψ ê₃ − sin ψ ê₂``,
+        ``G = sg γ``, ``B = β_W`` (the denominator coefficients of :func:`angle_fit`)::
 
-            f₂ = [2GB b̂_φ + (B² − G²) n̂_φ]/ω,  f₃ = [(B² − G²) b̂_φ − 2GB n̂_φ]/ω,
-            ω = 6L₂sθ σ (B² + G²)
+            f₂ = [2GB ê₃ψ + (B² − G²) ê₂ψ]/ω,  f₃ = [(B² − G²) ê₃ψ − 2GB ê₂ψ]/ω,
+            ω = σ (B² + G²)
 
-        Returns ``{"f2": (m, 7, 3), "f3": (m, 7, 3), "weight": (m, 7), "tangent": (m, 3, 3),
-        "speed": (m, 3)}``: ``r = f2/weight``, ``s = f3/weight`` (degree 6) and
-        ``t = tangent/speed`` (degree 2, ``x′`` over ``σ``). Straight cubics get constant
-        numerators and weight 1.
+        i.e. ``f₂ = sin Ω̃ b + cos Ω̃ n``, ``f₃ = t × f₂``. Returns ``{"f2": (m, 7, 3),
+        "f3": (m, 7, 3), "weight": (m, 7), "tangent": (m, 3, 3), "speed": (m, 3)}``:
+        ``r = f2/weight``, ``s = f3/weight`` (degree 6) and ``t = tangent/speed``
+        (``A i A*``/``|A|²``, degree 2). Straight cubics get constant numerators and weight 1.
         """
         fit = self.angle_fit(initial=initial, omega_start=omega_start)
-        cp = self._cp
-        d = np.diff(cp, axis=1)  # (m, 3, 3) legs
-        d1, d2, d3 = d[:, 0], d[:, 1], d[:, 2]
-        L1 = np.linalg.norm(d1, axis=1)
-        L3 = np.linalg.norm(d3, axis=1)
-        L2c = np.einsum("ij,ij->i", d1, d2) / L1
-        sigma = 3 * np.stack([L1, L2c, L3], axis=1)
-        bh = np.stack([18 * np.cross(d1, d2), 9 * np.cross(d1, d3), 18 * np.cross(d2, d3)], 1)
-        nh = np.stack([18 * (L1[:, None] * d2 - L2c[:, None] * d1),
-                       9 * (L1[:, None] * d3 - L3[:, None] * d1),
-                       18 * (L2c[:, None] * d3 - L3[:, None] * d2)], axis=1)
-        L2s = np.linalg.norm(np.cross(d1, d2), axis=1) / L1  # L₂ sθ
-        cphi, sphi = np.cos(fit["phi"])[:, None, None], np.sin(fit["phi"])[:, None, None]
-        nphi = cphi * nh + sphi * bh
-        bphi = cphi * bh - sphi * nh
+        A0, A1 = fit["preimage"][:, 0], fit["preimage"][:, 1]
+        cols = [np.stack([_erf_col(k, A0, A0), _erf_col(k, A0, A1), _erf_col(k, A1, A1)], 1)
+                for k in range(3)]                      # each (m, 3 coefficients, 3)
+        speed = np.stack([(A0 * A0).sum(1), (A0 * A1).sum(1), (A1 * A1).sum(1)], axis=1)
+        psi = fit["erf_angle"] + fit["phi"]
+        cp_, sp_ = np.cos(psi)[:, None, None], np.sin(psi)[:, None, None]
+        e2 = cp_ * cols[1] + sp_ * cols[2]
+        e3 = cp_ * cols[2] - sp_ * cols[1]
         G = fit["sg"][:, None] * fit["gamma"]
         B = fit["beta"]
         GB2 = 2 * _bmul(G, B)
         BG = _bmul(B, B) - _bmul(G, G)
-        f2 = _bmul(GB2, bphi) + _bmul(BG, nphi)
-        f3 = _bmul(BG, bphi) - _bmul(GB2, nphi)
-        w = 6 * L2s[:, None] * _bmul(sigma, _bmul(B, B) + _bmul(G, G))
-        tangent = 3 * d
-        speed = sigma
+        f2 = _bmul(GB2, e3) + _bmul(BG, e2)
+        f3 = _bmul(BG, e3) - _bmul(GB2, e2)
+        w = _bmul(speed, _bmul(B, B) + _bmul(G, G))
+        tangent = cols[0]
         st = fit["straight"]
         if st.any():
             r = self.rmf(np.flatnonzero(st).astype(float), initial=initial,
                          omega_start=omega_start)[:, :, 0]
-            t = d1[st] / L1[st, None]
+            d = np.diff(self._cp[st], axis=1)
+            t = d[:, 0] / np.linalg.norm(d[:, 0], axis=1)[:, None]
             f2[st] = r[:, None, :]
             f3[st] = np.cross(t, r)[:, None, :]
             w[st] = 1.0
+            L = np.linalg.norm(d, axis=2)
+            tangent[st] = 3 * d
+            speed[st] = 3 * np.stack([L[:, 0], np.einsum("ij,ij->i", d[:, 0], d[:, 1]) / L[:, 0],
+                                      L[:, 2]], axis=1)
         return {"f2": f2, "f3": f3, "weight": w, "tangent": tangent, "speed": speed}
 
     def surface(self, section_ctrl, section_weights=None, *, initial=None,
@@ -635,9 +679,13 @@ def _bez(cp: np.ndarray, v: np.ndarray, k: int = 0) -> np.ndarray:
 
 def _hermite_batch(p0, t0, p1, t1):
     """Best candidate per row (q, 4, 3) and reason codes (0 = solved)."""
-    cand, counts, codes = _core.ph_hermite(
-        np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
-        np.ascontiguousarray(t1), True, True)
+    try:
+        cand, counts, codes = _core.ph_hermite(
+            np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
+            np.ascontiguousarray(t1), True, True)
+    except ValueError as exc:  # a zero or non-finite tangent, a repeated point
+        raise ValueError(f"curve: bad Hermite data at an interval end (rows are intervals): "
+                         f"{exc}") from None
     return cand.reshape(-1, 2, 4, 3)[:, 0], counts, codes
 
 
@@ -739,7 +787,8 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         ``segments`` uniform intervals (of the parameter, or of the row index), no
         adaptivity.
     knots : array_like, optional
-        Explicit increasing knots (curve parameters, or integer rows including 0 and n − 1).
+        Explicit increasing knots (curve parameters, or integer sample rows); the spline
+        covers [knots[0], knots[-1]].
     tangents : array_like (n, 3), optional
         Tangents of the samples (default :func:`spinal.estimate_tangents`).
     domain : (float, float), optional
@@ -843,7 +892,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
                 raise ValueError("knots: sample knots must be integer rows")
             what = "knots"
         cp = solve(k, what)
-        sp = PHSpline(cp, k, check=False)
+        sp = PHSpline._trusted(cp, k)
         sp.deviation = deviation(cp, k)
         return sp
 
@@ -916,6 +965,6 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
                              f"tol = {tol:g}")
     done.sort(key=lambda x: x[0])
     kn = np.array([x[0] for x in done] + [done[-1][1]])
-    sp = PHSpline(np.stack([x[2] for x in done]), kn, check=False)
+    sp = PHSpline._trusted(np.stack([x[2] for x in done]), kn)
     sp.deviation = np.array([x[3] for x in done])
     return sp

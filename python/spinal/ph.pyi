@@ -34,9 +34,7 @@ def fit(
 
 class PHSpline:
     deviation: _F | None
-    def __init__(
-        self, control_points: _Array, knots: _Array | None = None, *, check: bool = True
-    ) -> None: ...
+    def __init__(self, control_points: _Array, knots: _Array | None = None) -> None: ...
     @property
     def control_points(self) -> _F: ...
     @property

@@ -14,10 +14,17 @@
 //! Along a spline the start angle of each segment is taken from the exact end vector of the
 //! previous one (both the exact and the rational frame interpolate it), straight segments
 //! carry the reference vector unchanged.
+//!
+//! Conditioning: on nearly straight cubics `ẋ × ẍ` and the torsion lose ~1/θ² digits
+//! (θ the turn of the control polygon), so `n, b` are evaluated as the Euler–Rodrigues frame
+//! of the quaternion preimage, `R(A(v)/|A(v)|)`, which on a PH cubic is the Frenet frame
+//! turned by a constant `β` (any error in `β` cancels, the start angle is measured in the same
+//! frame), and `Ω̇ = −2K/σ` uses `K/3 = sgn(Δ)√(L₁L₃ − L₂²)` from the preimage
+//! ([`super::twist`]).
 
 use glam::{DMat3, DVec3};
 
-use super::{Cubic, bern2};
+use super::{Cubic, Quat, bern2};
 use crate::error::{InputError, Result};
 use crate::frames::geometry::any_perpendicular;
 
@@ -69,32 +76,41 @@ pub struct Segment {
     pub a: f64,
     pub b: f64,
     pub c: f64,
+    /// `σ/3` in Bernstein form: `(L₁, L₂cθ, L₃)`.
+    pub speed: [f64; 3],
+    /// Quaternion preimage `A₀, A₁` (scalar first).
+    pub q: [Quat; 2],
+    /// Angle of the principal normal from the Euler–Rodrigues `e₂` towards `e₃` (constant).
+    pub beta: f64,
     pub fit: AngleFit,
 }
 
 /// Number of floats in [`Segment::to_row`].
-pub const SEGMENT_ROW: usize = 25;
+pub const SEGMENT_ROW: usize = 34;
 
 impl Segment {
-    /// Exact angle `Ω(v)`.
+    /// Exact angle `Ω(v) = Ω(0) + 2k[arctan((cv − b)/a) + arctan(b/a)]`, evaluated as
+    /// `Ω(0) + 2k·atan2(a v, L₁ − b v)` (the same angle by the arctan addition theorem with
+    /// `a² + b² = cL₁`; no `c`, which cancels on nearly straight cubics).
     pub fn omega(&self, v: f64) -> f64 {
         if self.k == 0.0 || self.straight {
             return self.omega0;
         }
-        self.omega0
-            + 2.0 * self.k * (((self.c * v - self.b) / self.a).atan() + (self.b / self.a).atan())
+        self.omega0 + 2.0 * self.k * (self.a * v).atan2(self.speed[0] - self.b * v)
     }
 
-    /// `Ω̇(v) = −τσ`.
+    /// `Ω̇(v) = −τσ = 2kca/(a² + (cv − b)²) = 2ka/(σ/3)`.
     pub fn omega_dot(&self, v: f64) -> f64 {
         if self.k == 0.0 || self.straight {
             return 0.0;
         }
-        let e = self.c * v - self.b;
-        2.0 * self.k * self.c * self.a / (self.a * self.a + e * e)
+        let w = bern2(v);
+        let s3 = self.speed[0] * w[0] + self.speed[1] * w[1] + self.speed[2] * w[2];
+        2.0 * self.k * self.a / s3
     }
 
-    /// `[straight, Ω₀, Ω₁, k, a, b, c, φ, sg, λ, λ*, Î, β₀..₂, γ₀..₂, r, w₀, w₁, s₀, s₁]`.
+    /// `[straight, Ω₀, Ω₁, k, a, b, c, φ, sg, λ, λ*, Î, β₀..₂, γ₀..₂, r, w₀, w₁, s₀, s₁, A₀, A₁,
+    /// β_erf]` (the last: the angle of `n` from the Euler–Rodrigues `e₂`).
     pub fn to_row(&self) -> [f64; SEGMENT_ROW] {
         let f = &self.fit;
         [
@@ -123,6 +139,15 @@ impl Segment {
             f.w[1],
             f.s[0],
             f.s[1],
+            self.q[0][0],
+            self.q[0][1],
+            self.q[0][2],
+            self.q[0][3],
+            self.q[1][0],
+            self.q[1][1],
+            self.q[1][2],
+            self.q[1][3],
+            self.beta,
         ]
     }
 }
@@ -140,15 +165,17 @@ pub fn frenet(c: &Cubic, v: f64) -> Option<(DVec3, DVec3, DVec3)> {
     Some((b.cross(t), b, t))
 }
 
-/// Angle data of one non-straight cubic started at `Ω(0) = omega0`; `phi = None` is the
-/// centred offset.
-pub fn segment(c: &Cubic, omega0: f64, phi: Option<f64>) -> Segment {
+/// Frame data of one bent cubic without the angles (None for straight cubics, cubics with
+/// a zero leg or a cusp).
+fn bent(c: &Cubic) -> Option<Segment> {
+    if c.is_straight() {
+        return None;
+    }
+    let (a0, a1, _) = c.preimage()?;
+    let (n, _, _) = frenet(c, 0.5)?;
+    let (_, e2, e3) = super::erf(a0, a1, 0.5)?;
     let inv = c.invariants();
-    let mut seg = Segment {
-        straight: false,
-        r: DVec3::ZERO,
-        omega0,
-        omega1: omega0,
+    Some(Segment {
         k: if inv.a > 0.0 && inv.c > 0.0 {
             inv.k
         } else {
@@ -157,11 +184,31 @@ pub fn segment(c: &Cubic, omega0: f64, phi: Option<f64>) -> Segment {
         a: inv.a,
         b: inv.b,
         c: inv.c,
-        fit: AngleFit::default(),
-    };
+        speed: [inv.l[0], inv.l[1] * inv.ctheta, inv.l[2]],
+        q: [a0, a1],
+        beta: n.dot(e3).atan2(n.dot(e2)),
+        ..Segment::default()
+    })
+}
+
+/// Angle data of one non-straight cubic started at `Ω(0) = omega0`; `phi = None` is the
+/// centred offset. None for straight cubics.
+pub fn segment(c: &Cubic, omega0: f64, phi: Option<f64>) -> Option<Segment> {
+    let mut seg = bent(c)?;
+    seg.omega0 = omega0;
     seg.omega1 = seg.omega(1.0);
     seg.fit = fit_angle(&seg, phi);
-    seg
+    Some(seg)
+}
+
+/// The Frenet frame `(n, b, t)` of a bent segment at `v`, evaluated as the Euler–Rodrigues
+/// frame of the preimage turned by the constant `β`: well conditioned also where `ẋ × ẍ`
+/// is tiny (nearly straight cubics), and any error in `β` cancels in the RMF because the
+/// start angle is measured in the same frame.
+pub fn frenet_of(seg: &Segment, v: f64) -> Option<(DVec3, DVec3, DVec3)> {
+    let (t, e2, e3) = super::erf(seg.q[0], seg.q[1], v)?;
+    let (sb, cb) = seg.beta.sin_cos();
+    Some((cb * e2 + sb * e3, cb * e3 - sb * e2, t))
 }
 
 fn simpson(f: impl Fn(f64) -> f64) -> f64 {
@@ -287,11 +334,11 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
             }
             p.normalize()
         }
-        Start::Angle(om) => match cubics.iter().find(|c| !c.is_straight()) {
-            Some(c) => match frenet(c, 0.0) {
-                Some((n, b, _)) => om.sin() * b + om.cos() * n,
-                None => any_perpendicular(t0),
-            },
+        Start::Angle(om) => match cubics
+            .iter()
+            .find_map(|c| bent(c).and_then(|s| frenet_of(&s, 0.0)))
+        {
+            Some((n, b, _)) => om.sin() * b + om.cos() * n,
             None => {
                 let p = any_perpendicular(t0);
                 om.cos() * p + om.sin() * t0.cross(p)
@@ -300,12 +347,9 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
     };
     let mut out = Vec::with_capacity(cubics.len());
     for (i, c) in cubics.iter().enumerate() {
-        let fr = if c.is_straight() {
-            None
-        } else {
-            frenet(c, 0.0).zip(frenet(c, 1.0))
-        };
-        match fr {
+        let found =
+            bent(c).and_then(|seg| Some((frenet_of(&seg, 0.0)?, frenet_of(&seg, 1.0)?, seg)));
+        match found {
             None => {
                 let t = c.d1(0.0).normalize();
                 let p = r - r.dot(t) * t;
@@ -327,10 +371,11 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
                     ..Segment::default()
                 });
             }
-            Some(((n0, b0, _), (n1, b1, _))) => {
-                let om0 = r.dot(b0).atan2(r.dot(n0));
-                let mut seg = segment(c, om0, phi);
-                seg.r = r; // fallback where the Frenet frame is numerically undefined
+            Some(((n0, b0, _), (n1, b1, _), mut seg)) => {
+                seg.omega0 = r.dot(b0).atan2(r.dot(n0));
+                seg.omega1 = seg.omega(1.0);
+                seg.fit = fit_angle(&seg, phi);
+                seg.r = r; // fallback should the frame be undefined somewhere (a cusp)
                 r = seg.omega1.sin() * b1 + seg.omega1.cos() * n1;
                 out.push(seg);
             }
@@ -352,7 +397,11 @@ pub enum Mode {
 /// (A bent PH cubic has κ > 0 on [0, 1]; should `ẋ × ẍ` still underflow, the start vector
 /// projected onto the normal plane stands in, never a NaN.)
 pub fn frame_at(c: &Cubic, seg: &Segment, v: f64, mode: Mode) -> (DMat3, f64) {
-    let fr = if seg.straight { None } else { frenet(c, v) };
+    let fr = if seg.straight {
+        None
+    } else {
+        frenet_of(seg, v)
+    };
     match fr {
         None => {
             let t = c.d1(v).normalize_or(DVec3::Z);
@@ -390,7 +439,7 @@ mod tests {
 
     #[test]
     fn r1_fit_reference() {
-        let seg = segment(&r1(), std::f64::consts::FRAC_PI_2, None);
+        let seg = segment(&r1(), std::f64::consts::FRAC_PI_2, None).unwrap();
         assert!((seg.omega1 - 0.8414599690).abs() < 1e-8, "{}", seg.omega1);
         assert!(
             (seg.fit.imin - 6.686905e-07).abs() < 1e-11,

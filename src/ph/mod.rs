@@ -151,37 +151,38 @@ impl Cubic {
     }
 
     /// Invariants of §1.1 (the cubic is assumed PH).
+    ///
+    /// Evaluated for accuracy on nearly straight cubics, where `L₁L₃ − L₂²`, `L₁ − L₂cθ`
+    /// and `L₁ − 2L₂cθ + L₃` would cancel: `sgn(Δ)√(L₁L₃ − L₂²)` from the preimage
+    /// ([`twist`]), `a² = (L₁L₃ − L₂²) + L₂²sθ²`, `b = d₁·(d₁ − d₂)/L₁`,
+    /// `c = (a² + b²)/L₁` (from `σ(0) = 3L₁`).
     pub fn invariants(&self) -> Invariants {
         let [d1, d2, d3] = self.legs();
         let l = [d1.length(), d2.length(), d3.length()];
+        let cr = d1.cross(d2);
+        let cr2 = cr.length_squared();
         let ctheta = d1.dot(d2) / (l[0] * l[1]);
-        let stheta = d1.cross(d2).length() / (l[0] * l[1]);
-        let delta = d1.cross(d2).dot(d3);
-        let l2c = l[1] * ctheta;
-        let a = (l[0] * l[2] - l2c * l2c).max(0.0).sqrt();
-        let b = l[0] - l2c;
-        let c = l[0] - 2.0 * l2c + l[2];
-        // √(L₁L₃ − L₂²), 0 for planar cubics (below round-off of the difference)
-        let gap = l[0] * l[2] - l[1] * l[1];
-        let root = if gap > 1e-14 * l[0] * l[2] {
-            gap.sqrt()
+        let stheta = cr2.sqrt() / (l[0] * l[1]);
+        let delta = cr.dot(d3);
+        let l2s = cr2.sqrt() / l[0]; // L₂ sθ
+        // sgn(Δ)√(L₁L₃ − L₂²) from the preimage (`twist`); the lengths formula and Δ lose
+        // digits on nearly straight cubics. 0 for planar cubics (at round-off).
+        let signed = match self.preimage() {
+            Some((a0, a1, _)) => twist(a0, a1),
+            None => delta.signum() * (l[0] * l[2] - l[1] * l[1]).max(0.0).sqrt(),
+        };
+        let root = if signed.abs() > 1e-13 * (l[0] * l[2]).sqrt() {
+            signed.abs()
         } else {
             0.0
         };
-        let sgn = if delta > 0.0 {
-            1.0
-        } else if delta < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
-        let k = if a > 0.0 && root > 0.0 {
-            -sgn * root / a
-        } else {
-            0.0
-        };
+        let a = root.hypot(l2s);
+        let b = d1.dot(d1 - d2) / l[0];
+        let c = (a * a + b * b) / l[0];
+        let sgn = if root > 0.0 { signed.signum() } else { 0.0 };
+        let k = if a > 0.0 { -sgn * root / a } else { 0.0 };
         let kappa_over_tau = if root > 0.0 {
-            l[1] * stheta / root * if sgn != 0.0 { sgn } else { 1.0 }
+            sgn * l2s / root
         } else {
             f64::INFINITY
         };
@@ -191,7 +192,7 @@ impl Cubic {
         } else {
             3.0 * l[0].min(l[2])
         };
-        let kappa_max = 6.0 * l[1] * stheta / (sigma_min * sigma_min);
+        let kappa_max = 6.0 * l2s / (sigma_min * sigma_min);
         Invariants {
             l,
             ctheta,
@@ -296,6 +297,41 @@ fn root(d: DVec3) -> Option<Quat> {
     };
     let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]).sqrt();
     Some(qscale(u, len.sqrt() / n))
+}
+
+/// `sgn(Δ)·√(L₁L₃ − L₂²)` of the PH cubic with preimage `A₀, A₁` (= `K/3`,
+/// `K = u₀v₁ − u₁v₀ − p₀q₁ + p₁q₀` for `A = (u, v, p, q)`). Polynomial in the preimage, so
+/// well conditioned where the lengths formula and `Δ` cancel (nearly straight cubics).
+pub fn twist(a0: Quat, a1: Quat) -> f64 {
+    (a0[0] * a1[1] - a1[0] * a0[1] - a0[2] * a1[3] + a1[2] * a0[3]) / 3.0
+}
+
+/// The Euler–Rodrigues frame `(t, e₂, e₃)` at `v`: the columns of the rotation `R(A(v))`.
+/// On a PH cubic it is the Frenet frame turned about `t` by a constant angle. None where
+/// `A(v)` vanishes (a cusp).
+pub fn erf(a0: Quat, a1: Quat, v: f64) -> Option<(DVec3, DVec3, DVec3)> {
+    let q: Quat = std::array::from_fn(|i| a0[i] * (1.0 - v) + a1[i] * v);
+    let n2 = q.iter().map(|x| x * x).sum::<f64>();
+    if !(n2 > 1e-300) || !n2.is_finite() {
+        return None;
+    }
+    let (w, x, y, z) = (q[0], q[1], q[2], q[3]);
+    let t = DVec3::new(
+        w * w + x * x - y * y - z * z,
+        2.0 * (x * y + w * z),
+        2.0 * (x * z - w * y),
+    );
+    let e2 = DVec3::new(
+        2.0 * (x * y - w * z),
+        w * w - x * x + y * y - z * z,
+        2.0 * (y * z + w * x),
+    );
+    let e3 = DVec3::new(
+        2.0 * (x * z + w * y),
+        2.0 * (y * z - w * x),
+        w * w - x * x - y * y + z * z,
+    );
+    Some((t / n2, e2 / n2, e3 / n2))
 }
 
 #[cfg(test)]
