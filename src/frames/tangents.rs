@@ -153,20 +153,32 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
     d
 }
 
-/// `chord_five_point` at a centred stencil: chords `h = (|x₁−x₀|, …, |x₄−x₃|)` of the
-/// samples `x₀ … x₄`, derivative at `x₂` (the same Lagrange weights, unrolled).
+/// The direction of `chord_five_point` at a centred stencil (a positive multiple of the
+/// derivative, to be normalised): chords `h = (|x₁−x₀|, …, |x₄−x₃|)` of the samples
+/// `x₀ … x₄`, derivative at `x₂` (the same Lagrange weights, unrolled).
 #[inline(always)]
 fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
-    let (t0, t1, t3, t4) = (-(h[0] + h[1]), -h[1], h[2], h[2] + h[3]);
-    let w0 = -(t1 * t3 * t4) / ((t0 - t1) * t0 * (t0 - t3) * (t0 - t4));
-    let w1 = -(t0 * t3 * t4) / ((t1 - t0) * t1 * (t1 - t3) * (t1 - t4));
-    let w3 = -(t0 * t1 * t4) / ((t3 - t0) * (t3 - t1) * t3 * (t3 - t4));
-    let w4 = -(t0 * t1 * t3) / ((t4 - t0) * (t4 - t1) * t4 * (t4 - t3));
+    // Positions relative to x₂, scaled by 1/(h₁ + h₂): the direction does not depend on the
+    // scale, and O(1) values keep the products below far from under/overflow.
+    let k = 1.0 / (h[1] + h[2]);
+    let (t0, t1, t3, t4) = (-(h[0] + h[1]) * k, -h[1] * k, h[2] * k, (h[2] + h[3]) * k);
+    // Lagrange weights w_j = n_j / d_j; multiplying all by d₀d₁d₃d₄ (> 0 for
+    // t₀ < t₁ < 0 < t₃ < t₄) leaves the direction and needs no division.
+    let d0 = (t0 - t1) * t0 * (t0 - t3) * (t0 - t4);
+    let d1 = (t1 - t0) * t1 * (t1 - t3) * (t1 - t4);
+    let d3 = (t3 - t0) * (t3 - t1) * t3 * (t3 - t4);
+    let d4 = (t4 - t0) * (t4 - t1) * t4 * (t4 - t3);
+    let (d01, d34) = (d0 * d1, d3 * d4);
+    let w0 = -(t1 * t3 * t4) * (d1 * d34);
+    let w1 = -(t0 * t3 * t4) * (d0 * d34);
+    let w3 = -(t0 * t1 * t4) * (d01 * d4);
+    let w4 = -(t0 * t1 * t3) * (d01 * d3);
     let p = x[2];
     w0 * (x[0] - p) + w1 * (x[1] - p) + w3 * (x[3] - p) + w4 * (x[4] - p)
 }
 
 /// Unnormalised circle tangent at an interior (or periodic) index.
+#[inline]
 fn circle_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     let n = x.len();
     let ii = i as isize;
@@ -510,6 +522,27 @@ mod tests {
             let d: DVec3 = (0..5).map(|k| w[k][1] * x[first + k]).sum();
             let e = chord_five_point(&x, &chords, i, false);
             assert!((d - e).length() < 1e-12 * d.length(), "{i}: {d} vs {e}");
+        }
+    }
+
+    #[test]
+    fn unrolled_centred_stencil_has_the_lagrange_direction() {
+        // very uneven chords too: the division-free weights keep the direction
+        for scale in [1e-9, 1.0, 1e9] {
+            let x: Vec<DVec3> = [0.0, 0.1, 0.35, 0.5, 0.9, 1.0, 1.001, 3.0]
+                .iter()
+                .map(|&u: &f64| scale * DVec3::new(u, u * u, 0.3 * u * u * u))
+                .collect();
+            let chords = ch(&x);
+            for i in 2..x.len() - 2 {
+                let e = chord_five_point(&x, &chords, i, false).normalize();
+                let c = centred_five_point(
+                    [x[i - 2], x[i - 1], x[i], x[i + 1], x[i + 2]],
+                    [chords[i - 2], chords[i - 1], chords[i], chords[i + 1]],
+                )
+                .normalize();
+                assert!((e - c).length() < 1e-13, "{scale} {i}: {e} vs {c}");
+            }
         }
     }
 
