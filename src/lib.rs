@@ -17,6 +17,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod error;
+pub mod flesh;
 pub mod frames;
 mod python;
 pub mod quaternion;

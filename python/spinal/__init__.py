@@ -8,6 +8,7 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 
 from . import curves, quaternions
 from ._core import __version__
+from ._flesh import SpineBinding, flesh
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
@@ -15,10 +16,12 @@ from ._sweep import sweep, tube
 __all__ = [
     "FoldOverWarning",
     "Mesh",
+    "SpineBinding",
     "__version__",
     "closing_angle",
     "curves",
     "estimate_tangents",
+    "flesh",
     "frames",
     "quaternions",
     "sweep",
