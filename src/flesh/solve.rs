@@ -174,15 +174,20 @@ pub fn radial_ratio(alpha: f64) -> (f64, bool) {
         } else {
             return (m, true);
         }
-        let mut next = m - fm / df(m);
+        let step = fm / df(m);
+        let next = m - step;
         if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
+            m = 0.5 * (lo + hi);
+            if hi - lo <= 4.0 * f64::EPSILON * hi {
+                return (m, true);
+            }
+            continue;
         }
-        // quadratic convergence: after a step of 1e-10 the error is ~1e-20
-        if (next - m).abs() <= 1e-10 * m || hi - lo <= 4.0 * f64::EPSILON * hi {
-            // one more exact Newton step without the test
+        // quadratic convergence: after a Newton step of 1e-8 the error is ~1e-16; one more
+        // step reaches the rounding level
+        if step.abs() <= 1e-8 * m {
             let last = next - f(next) / df(next);
-            return (if last > lo && last < hi { last } else { next }, true);
+            return (if last >= lo && last <= hi { last } else { next }, true);
         }
         m = next;
     }
