@@ -296,17 +296,22 @@ def test_local_slab_volumes():
     ds = np.gradient(u)
     dense = np.c_[np.cumsum(np.cos(th) * ds), np.cumsum(np.sin(th) * ds), 0.1 * u]
     edges = np.linspace(-1.2, 1.2, 13)
-    slabs = []
-    for a, b in itertools.pairwise(edges):
-        m = trimesh.creation.box(extents=[b - a, 0.4, 0.3])
-        m.apply_translation([(a + b) / 2, 0.15, 0.05])
-        slabs.append(subdivided(m, 4))
-    for sol in ("none",) + SOLS:
-        errs = np.array([relative_volume_error(m, rest, dense, solution=sol) for m in slabs])
-        if sol == "none":
-            assert errs.max() > 0.1 and errs.min() < -0.1
-        else:
-            assert np.abs(errs).max() < 6e-4, (sol, errs)
+    worst = {}
+    for times in (3, 4):
+        slabs = []
+        for a, b in itertools.pairwise(edges):
+            m = trimesh.creation.box(extents=[b - a, 0.4, 0.3])
+            m.apply_translation([(a + b) / 2, 0.15, 0.05])
+            slabs.append(subdivided(m, times))
+        for sol in ("none",) + SOLS:
+            errs = np.array([relative_volume_error(m, rest, dense, solution=sol)
+                             for m in slabs])
+            worst[sol, times] = np.abs(errs).max()
+            if sol == "none":
+                assert errs.max() > 0.1 and errs.min() < -0.1
+    for sol in SOLS:
+        assert worst[sol, 4] < 2e-4, worst
+        assert worst[sol, 3] / worst[sol, 4] > 3, worst  # mesh-limited: falls with refinement
 
 
 def test_extrusion_twist_table():
@@ -380,8 +385,8 @@ def test_fold_over_is_clamped_and_reported():
         with pytest.warns(spinal.FoldOverWarning) as rec:
             out, clamped = spinal.flesh(V, rest, posed, solution=sol, return_clamped=True)
         assert np.isfinite(out).all()
-        expect = np.flatnonzero(kappa * c > lim + 1e-6)
-        near = np.abs(kappa * c - lim) < 1e-6
+        expect = np.flatnonzero(kappa * c > lim + 1e-3)
+        near = np.abs(kappa * c - lim) < 1e-3  # the model's κ is within O((hκ)²) of κ
         assert set(expect) <= set(clamped) <= set(expect) | set(np.flatnonzero(near))
         assert np.array_equal(rec[0].message.indices, clamped)
         # clamped to the focal point: on the posed spine's centre-of-curvature circle
@@ -443,3 +448,21 @@ def test_bad_input():
     spinal.flesh(V, rest, arc(20, 1.0, 2 / 19))
     assert np.array_equal(rest, r0)
     assert spinal.flesh(np.zeros((0, 3)), rest, rest).shape == (0, 3)
+
+
+@pytest.mark.parametrize("solution", SOLS)
+def test_continuous_across_samples(solution):
+    """The section planes and the curvature turn continuously from edge to edge, so points
+    on both sides of a sample's plane stay together (no creases in animation)."""
+    rest = curve3(60)
+    posed = bent3(60)
+    F = spinal.frames(rest)
+    rng = np.random.default_rng(11)
+    j = rng.integers(5, 55, 200)
+    off = rng.normal(size=(200, 2)) * 0.1
+    base = rest[j] + off[:, :1] * F[j, :, 0] + off[:, 1:] * F[j, :, 1]
+    t = F[j, :, 2]
+    b = spinal.SpineBinding(np.r_[base - 1e-9 * t, base + 1e-9 * t], rest)
+    assert np.all(b.edge[:200] == j - 1) and np.all(b.edge[200:] == j)
+    out = b.deform(posed, solution=solution)
+    assert np.abs(out[:200] - out[200:]).max() < 1e-7

@@ -57,18 +57,28 @@ def _arc(points: np.ndarray) -> np.ndarray:
     return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
 
 
-def _resample(posed: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """Points of the posed polyline at the rest spine's cumulative chord lengths (past its
-    end: along the last edge)."""
-    s1 = _arc(posed)
-    out = np.empty((len(lengths), 3))
-    for j in range(3):
-        out[:, j] = np.interp(lengths, s1, posed[:, j])
-    past = lengths > s1[-1]
-    if past.any():
-        e = posed[-1] - posed[-2]
-        e /= np.linalg.norm(e)
-        out[past] = posed[-1] + (lengths[past] - s1[-1])[:, None] * e
+def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
+    """Compass walk (spec A-9): points on the posed polyline, from its start, whose
+    consecutive distances are the rest spine's chords ``chords``; past its end, along its
+    last edge. Edge lengths are kept exactly, so the discrete stretch is 1 at the samples."""
+    out = np.empty((len(chords) + 1, 3))
+    out[0] = posed[0]
+    seg = 0  # the walk is on segment posed[seg] → posed[seg + 1]
+    last = len(posed) - 2
+    for i, h in enumerate(chords):
+        c = out[i]
+        while True:
+            a, b = posed[seg], posed[seg + 1]
+            e = b - a
+            # |a + t e − c|² = h², the larger root t; the point must lie ahead on the segment
+            ee, ec = e @ e, e @ (a - c)
+            cc = (a - c) @ (a - c) - h * h
+            disc = ec * ec - ee * cc
+            t = (-ec + np.sqrt(max(disc, 0.0))) / ee
+            if t <= 1.0 or seg == last:
+                break
+            seg += 1
+        out[i + 1] = a + t * e
     return out
 
 
@@ -101,10 +111,12 @@ class SpineBinding:
     r"""A shape registered on a rest spine, to be posed many times (Zhuo 2014, §1.1).
 
     Registration finds for every vertex the cross-section of the rest spine it lies in: the
-    spine is the polyline through ``rest_spine`` with unit tangents (and the reference
-    vectors ``r``) of :func:`spinal.frames` — a rotation-minimising frame — interpolated
-    linearly between samples; the cross-section at edge ``k``, parameter ``a`` is the plane
-    through ``C(a)`` normal to the interpolated tangent. A vertex is bound to the nearest such
+    spine is the polyline through ``rest_spine``, with the unit tangents and reference
+    vectors ``r`` of :func:`spinal.frames` (a rotation-minimising frame) at the samples; in
+    between, the tangent is a normalised cubic Hermite interpolation matching the sample
+    curvatures (so sections turn smoothly and the map is continuous across samples) and
+    ``r`` is interpolated linearly and made normal to it. The cross-section at edge ``k``,
+    parameter ``a`` is the plane through ``C(a)`` normal to the interpolated tangent. A vertex is bound to the nearest such
     point (the closest point of the polyline with smoothly turning sections, never the
     nearest sample) and keeps its offset in the interpolated frame. Points past the spine's
     ends use the straight extension of the end.
@@ -192,7 +204,7 @@ class SpineBinding:
                     f"samples (the sample index is the shared parameter), got {len(posed)}"
                 )
             return posed
-        return _resample(posed, self._lengths)
+        return _resample(posed, np.diff(self._lengths))
 
     def deform(
         self,
@@ -229,10 +241,11 @@ class SpineBinding:
         model of the spine used here (linear positions, interpolated tangents) the map has
         Jacobian determinant 1 inside every edge slab, whatever the sampling.
 
-        With ``stretchable=False`` the posed spine is first resampled at the rest spine's
-        cumulative chord lengths, measured along the posed polyline (past its end: along its
-        last edge), so the shape neither slides nor stretches; the small residual stretch
-        of the resampled polyline is still honoured so the volume stays exact. With
+        With ``stretchable=False`` the posed spine is first resampled by a compass walk along
+        its polyline from its first point: sample ``i + 1`` is the next point of the
+        polyline at the rest spine's chord ``|R_{i+1} − R_i|`` from sample ``i`` (past its end:
+        along its last edge), so every edge keeps its rest length and the shape neither slides
+        nor stretches (a posed spine shorter than the rest spine is extended straight). With
         ``stretchable=True`` the posed spine must have the rest spine's sample count and
         sample ``i`` carries the sections of rest sample ``i``: lengthening a part of it
         thins that part (λ > 1), compressing thickens it.

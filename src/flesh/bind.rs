@@ -1,8 +1,9 @@
 //! Registration (spec §1.1 step 2, §2.8 "accurate projection", A-13).
 //!
 //! Each vertex is attached to the cross-section plane it lies in: on edge `k` the plane at
-//! `a` passes through `C(a) = C_k + a E_k` normal to `m(a) = (1 − a) t_k + a t_{k+1}`, and
-//! `(P − C(a))·m(a) = 0` is a quadratic in `a`, solved exactly. Among the roots in `[0, 1]` of
+//! `a` passes through the interpolated position `C(a)` normal to the interpolated tangent
+//! `m(a)` (both cubic in `a`, see [`super::spine`]), and `(P − C(a))·m(a) = 0` is solved to
+//! full precision. Among the roots in `[0, 1]` of
 //! every edge (and the straight extensions past both ends) the one closest to `P` wins — the
 //! closest point of the polyline with the cross-sections turned smoothly from sample to
 //! sample, so no vertex snaps to a sample (§7.1's "slicing") and the offset is exactly
@@ -28,27 +29,56 @@ pub struct Binding {
     pub coords: Vec<f64>,
 }
 
-fn edge_roots(w: DVec3, e: DVec3, t0: DVec3, t1: DVec3) -> [f64; 2] {
-    let d = t1 - t0;
-    // f(a) = (w − a e)·(t0 + a d) = c + b a + q a²
-    let (q, b, c) = (-e.dot(d), w.dot(d) - e.dot(t0), w.dot(t0));
-    let mut out = [f64::NAN; 2];
-    if q.abs() <= 1e-14 * b.abs() {
-        if b != 0.0 {
-            out[0] = -c / b;
+/// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
+/// steps, each refined by the Illinois variant of regula falsi to full precision.
+fn edge_roots(sp: &Spine, k: usize, p: DVec3) -> [f64; 4] {
+    let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
+    let mut out = [f64::NAN; 4];
+    let mut prev = (0.0, f(0.0));
+    for (i, slot) in out.iter_mut().enumerate() {
+        let b = (i + 1) as f64 / 4.0;
+        let fb = f(b);
+        let (mut a0, mut f0) = prev;
+        prev = (b, fb);
+        if f0 == 0.0 {
+            *slot = a0;
+            continue;
         }
-        return out;
-    }
-    let disc = b * b - 4.0 * q * c;
-    if disc < 0.0 {
-        return out;
-    }
-    let s = -0.5 * (b + b.signum() * disc.sqrt());
-    if s != 0.0 {
-        out[0] = s / q;
-        out[1] = c / s;
-    } else {
-        out[0] = 0.0;
+        if (f0 > 0.0) == (fb > 0.0) {
+            continue;
+        }
+        let (mut a1, mut f1) = (b, fb);
+        let mut side = 0i8;
+        for _ in 0..200 {
+            let x = (a0 * f1 - a1 * f0) / (f1 - f0);
+            let x = if x > a0.min(a1) && x < a0.max(a1) {
+                x
+            } else {
+                0.5 * (a0 + a1)
+            };
+            let fx = f(x);
+            if fx == 0.0 || (a1 - a0).abs() <= 1e-15 {
+                a0 = x;
+                a1 = x;
+                break;
+            }
+            if (fx > 0.0) == (f1 > 0.0) {
+                a1 = x;
+                f1 = fx;
+                if side == -1 {
+                    f0 *= 0.5;
+                }
+                side = -1;
+            } else {
+                a0 = x;
+                f0 = fx;
+                if side == 1 {
+                    f1 *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        *slot = 0.5 * (a0 + a1);
     }
     out
 }
@@ -74,17 +104,17 @@ fn locate(sp: &Spine, p: DVec3) -> (usize, f64, f64) {
     for k in 0..n - 1 {
         let w = p - sp.c[k];
         let e = sp.c[k + 1] - sp.c[k];
-        // every point of the edge is at least |w| − |e| away
-        let lo = w.length() - e.length();
+        // every point of the edge's curve (within 1.5 chords of C_k) is at least this far
+        let lo = w.length() - 1.5 * e.length();
         if lo > 0.0 && lo * lo > best.0 {
             continue;
         }
-        for a in edge_roots(w, e, sp.t[k], sp.t[k + 1]) {
+        for a in edge_roots(sp, k, p) {
             if !(-1e-12..=1.0 + 1e-12).contains(&a) {
                 continue;
             }
             let a = a.clamp(0.0, 1.0);
-            let d2 = (w - a * e).length_squared();
+            let d2 = (p - sp.c_at(k, a)).length_squared();
             if d2 < best.0 {
                 best = (d2, k, a, 0.0);
             }

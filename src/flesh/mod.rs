@@ -8,14 +8,15 @@
 //! bend (posed curvature) (§4.2.1, §5.2.1; spec §2.5) — so that `det ∂P1/∂P0 = 1`.
 //!
 //! **Discrete spine model** ([`spine`]). Between samples the position is linear and the unit
-//! tangent is the normalised linear interpolation of the sample tangents; the cross-section
-//! at `(k, a)` is the plane through `C(a)` normal to `t(a)`. In the coordinates
+//! tangent is a normalised cubic Hermite interpolation of the sample tangents whose slopes
+//! match the sample curvature vectors; the cross-section at `(k, a)` is the plane through
+//! `C(a)` normal to `t(a)`. In the coordinates
 //! `(a, α, β)` of that foliation the volume element is exactly `σ(a) (1 − d·κ(a)) da dα dβ`
 //! with `σ = E_k·t(a)` and `κ = (dt/da)/σ` (the spine's speed and curvature vector in this
 //! model), so the thesis' stretchable formulas with `λ = σ1/σ0` make the discrete map exactly
 //! volume preserving inside every edge slab for any sampling, not only in the limit. The
-//! curvature jumps at samples (the map is continuous there only for constant-curvature
-//! pieces); points beyond the end planes use the straight extension of the end (κ = 0).
+//! curvature is continuous across samples, so is the map (up to the O(h³) jump of the speed
+//! ratio); points beyond the end planes use the straight extension of the end (κ = 0).
 //!
 //! Registration (bind) is brute force over the edges with pruning, `O(V n)`; deformation is
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
