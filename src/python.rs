@@ -603,6 +603,26 @@ fn flesh_deform<'py>(
     Ok((out, PyArray1::from_vec(py, flags)))
 }
 
+/// Compass-walk resampling of a posed spine; see `spinal.SpineBinding.posed_spine`.
+#[pyfunction]
+fn flesh_resample<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    chords: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pts = vec3s("posed_spine", &posed_points)?;
+    let ch = slice_of("chords", &chords)?;
+    if pts.len() < 2 || ch.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
+        return Err(PyValueError::new_err(
+            "posed_spine: need at least 2 points and positive chords",
+        ));
+    }
+    let out = py.detach(|| crate::flesh::spine::compass_walk(pts, ch));
+    let n = out.len();
+    let flat: Vec<f64> = bytemuck::cast_slice(&out).to_vec();
+    PyArray1::from_vec(py, flat).reshape([n, 3])
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
@@ -618,6 +638,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(walk_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_deform, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_resample, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

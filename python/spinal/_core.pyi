@@ -98,3 +98,6 @@ def flesh_deform(
     solution: str,
     twist: npt.NDArray[np.float64] | None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def flesh_resample(
+    posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...

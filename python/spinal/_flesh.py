@@ -61,25 +61,7 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
     """Compass walk (spec A-9): points on the posed polyline, from its start, whose
     consecutive distances are the rest spine's chords ``chords``; past its end, along its
     last edge. Edge lengths are kept exactly, so the discrete stretch is 1 at the samples."""
-    out = np.empty((len(chords) + 1, 3))
-    out[0] = posed[0]
-    seg = 0  # the walk is on segment posed[seg] → posed[seg + 1]
-    last = len(posed) - 2
-    for i, h in enumerate(chords):
-        c = out[i]
-        while True:
-            a, b = posed[seg], posed[seg + 1]
-            e = b - a
-            # |a + t e − c|² = h², the larger root t; the point must lie ahead on the segment
-            ee, ec = e @ e, e @ (a - c)
-            cc = (a - c) @ (a - c) - h * h
-            disc = ec * ec - ee * cc
-            t = (-ec + np.sqrt(max(disc, 0.0))) / ee
-            if t <= 1.0 or seg == last:
-                break
-            seg += 1
-        out[i + 1] = a + t * e
-    return out
+    return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
 def _posed_initial(rest: np.ndarray, r0: np.ndarray, posed: np.ndarray) -> np.ndarray:

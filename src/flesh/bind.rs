@@ -101,7 +101,19 @@ fn locate(sp: &Spine, p: DVec3) -> (usize, f64, f64) {
             best = (d2, n - 2, 1.0, tau);
         }
     }
-    for k in 0..n - 1 {
+    // the edges next to the nearest sample first: a good bound prunes almost all others
+    let near =
+        sp.c.iter()
+            .enumerate()
+            .fold((0, f64::INFINITY), |acc, (i, c)| {
+                let d = (p - *c).length_squared();
+                if d < acc.1 { (i, d) } else { acc }
+            })
+            .0;
+    let first = near.saturating_sub(1);
+    let order =
+        (first..(near + 1).min(n - 1)).chain((0..n - 1).filter(|&k| k + 1 < near || k > near));
+    for k in order {
         let w = p - sp.c[k];
         let e = sp.c[k + 1] - sp.c[k];
         // every point of the edge's curve (within 1.5 chords of C_k) is at least this far

@@ -196,3 +196,32 @@ impl Spine {
         }
     }
 }
+
+/// Compass walk (spec A-9): points on the polyline `posed`, from its first point, whose
+/// consecutive distances are `chords` (so every edge keeps its rest length); past the end of
+/// the polyline, along its last edge. `posed` has ≥ 2 distinct consecutive points.
+pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(chords.len() + 1);
+    let mut c = posed[0];
+    out.push(c);
+    let last = posed.len() - 2;
+    let mut seg = 0;
+    for &h in chords {
+        let next = loop {
+            let (a, b) = (posed[seg], posed[seg + 1]);
+            let e = b - a;
+            // |a + t e − c|² = h², the larger root (ahead of c)
+            let (ee, ec) = (e.dot(e), e.dot(a - c));
+            let cc = (a - c).length_squared() - h * h;
+            let disc = (ec * ec - ee * cc).max(0.0);
+            let t = (-ec + disc.sqrt()) / ee;
+            if t <= 1.0 || seg == last {
+                break a + t * e;
+            }
+            seg += 1;
+        };
+        out.push(next);
+        c = next;
+    }
+    out
+}
