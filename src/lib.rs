@@ -18,6 +18,7 @@
 
 pub mod deform;
 pub mod error;
+pub mod flesh;
 pub mod frames;
 pub mod ph;
 mod python;

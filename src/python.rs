@@ -609,6 +609,98 @@ fn advect<'py>(
     Ok(out)
 }
 
+type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
+type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
+
+fn flesh_spine<'py>(
+    arg: &'static str,
+    points: &PyReadonlyArray2<'py, f64>,
+    frames: &PyReadonlyArray3<'py, f64>,
+) -> PyResult<crate::flesh::Spine> {
+    let pts = vec3s(arg, points)?;
+    let fr = slice_of(arg, frames)?;
+    crate::flesh::Spine::new(arg, pts, fr).map_err(to_py)
+}
+
+/// Register vertices on a rest spine; see `spinal.SpineBinding`.
+#[pyfunction]
+fn flesh_bind<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    rest_frames: PyReadonlyArray3<'py, f64>,
+    vertices: PyReadonlyArray2<'py, f64>,
+) -> PyResult<FleshBinding<'py>> {
+    let rest = flesh_spine("rest_spine", &rest_points, &rest_frames)?;
+    let v = vec3s("vertices", &vertices)?;
+    let b = py.detach(|| crate::flesh::bind(&rest, v)).map_err(to_py)?;
+    let nv = b.edge.len();
+    let coords = PyArray1::from_vec(py, b.coords).reshape([nv, crate::flesh::COORDS])?;
+    Ok((PyArray1::from_vec(py, b.edge), coords))
+}
+
+/// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
+#[pyfunction]
+#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist))]
+fn flesh_deform<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    posed_frames: PyReadonlyArray3<'py, f64>,
+    edge: PyReadonlyArray1<'py, i64>,
+    coords: PyReadonlyArray2<'py, f64>,
+    solution: &str,
+    twist: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<FleshPose<'py>> {
+    use crate::flesh::Solution;
+    let sol = match solution {
+        "none" => Solution::None,
+        "normal" => Solution::Normal,
+        "binormal" => Solution::Binormal,
+        "radial" => Solution::Radial,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "solution: unknown value {solution:?}; expected 'none', 'normal', 'binormal' or 'radial'"
+            )));
+        }
+    };
+    let posed = flesh_spine("posed_spine", &posed_points, &posed_frames)?;
+    let edge = slice_of("edge", &edge)?;
+    let coords = slice_of("coords", &coords)?;
+    let tw: &[f64] = match &twist {
+        Some(t) => slice_of("twist", t)?,
+        None => &[],
+    };
+    let nv = edge.len();
+    let out = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
+    let mut flags = vec![0u8; nv];
+    {
+        let mut w = out.readwrite();
+        let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        py.detach(|| crate::flesh::deform(&posed, edge, coords, sol, tw, buf, &mut flags))
+            .map_err(to_py)?;
+    }
+    Ok((out, PyArray1::from_vec(py, flags)))
+}
+
+/// Compass-walk resampling of a posed spine; see `spinal.SpineBinding.posed_spine`.
+#[pyfunction]
+fn flesh_resample<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    chords: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pts = vec3s("posed_spine", &posed_points)?;
+    let ch = slice_of("chords", &chords)?;
+    if pts.len() < 2 || ch.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
+        return Err(PyValueError::new_err(
+            "posed_spine: need at least 2 points and positive chords",
+        ));
+    }
+    let out = py.detach(|| crate::flesh::spine::compass_walk(pts, ch));
+    let n = out.len();
+    let flat: Vec<f64> = bytemuck::cast_slice(&out).to_vec();
+    PyArray1::from_vec(py, flat).reshape([n, 3])
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
@@ -633,6 +725,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(field_eval, m)?)?;
     m.add_function(wrap_pyfunction!(field_info, m)?)?;
     m.add_function(wrap_pyfunction!(advect, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_bind, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_deform, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_resample, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -10,6 +10,7 @@ from . import curves, fields, ph, quaternions
 from ._advect import advect
 from ._core import __version__
 from ._deform import DeformReport, deform
+from ._flesh import SpineBinding, flesh
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
@@ -18,6 +19,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "SpineBinding",
     "__version__",
     "advect",
     "closing_angle",
@@ -25,6 +27,7 @@ __all__ = [
     "deform",
     "estimate_tangents",
     "fields",
+    "flesh",
     "frames",
     "ph",
     "quaternions",

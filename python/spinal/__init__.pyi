@@ -148,3 +148,39 @@ def deform(
     estimate: bool = False,
     progress: bool | Callable[[int, int], object] = False,
 ) -> tuple[Mesh, DeformReport]: ...
+
+class SpineBinding:
+    clamped: npt.NDArray[np.int64]
+    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def edge(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def param(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def arc_length(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def offset(self) -> npt.NDArray[np.float64]: ...
+    def posed_spine(self, posed_spine: _Array, *, stretchable: bool = False) -> npt.NDArray[np.float64]: ...
+    def deform(
+        self,
+        posed_spine: _Array,
+        *,
+        solution: Literal["radial", "normal", "binormal", "none"] = "radial",
+        stretchable: bool = False,
+        twist: float | _Array | None = None,
+        strict: bool = False,
+        return_clamped: bool = False,
+    ) -> Any: ...
+
+def flesh(
+    vertices: _Array,
+    rest_spine: _Array,
+    posed_spine: _Array,
+    *,
+    solution: Literal["radial", "normal", "binormal", "none"] = "radial",
+    stretchable: bool = False,
+    twist: float | _Array | None = None,
+    strict: bool = False,
+    return_clamped: bool = False,
+) -> Any: ...

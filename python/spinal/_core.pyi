@@ -130,3 +130,19 @@ def advect(
     steps: int,
     method: str,
 ) -> npt.NDArray[np.float64]: ...
+def flesh_bind(
+    rest_points: npt.NDArray[np.float64],
+    rest_frames: npt.NDArray[np.float64],
+    vertices: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def flesh_deform(
+    posed_points: npt.NDArray[np.float64],
+    posed_frames: npt.NDArray[np.float64],
+    edge: npt.NDArray[np.int64],
+    coords: npt.NDArray[np.float64],
+    solution: str,
+    twist: npt.NDArray[np.float64] | None,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def flesh_resample(
+    posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...

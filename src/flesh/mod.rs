@@ -1,0 +1,32 @@
+//! Fleshing: spine-driven deformation with local volume preservation (Wei Zhuo, PhD thesis,
+//! Georgia Tech 2014, and Zhuo & Rossignac, CGF 2013; spec `zhuo-fleshing.md`).
+//!
+//! A vertex `P0` is registered on the rest spine by its cross-section (Assumption I, §1.2):
+//! parameter `(k, a)` on edge `k` and offset `d0 ⊥ t0(k, a)` in the interpolated RMF. After the
+//! spine moves, the vertex is rebuilt from the posed spine at the same `(k, a)` with a
+//! corrected offset — unbend (rest curvature), transfer (RMF to RMF, optional twist, stretch),
+//! bend (posed curvature) (§4.2.1, §5.2.1; spec §2.5) — so that `det ∂P1/∂P0 = 1`.
+//!
+//! **Discrete spine model** ([`spine`]). Between samples the position is linear and the unit
+//! tangent is a normalised cubic Hermite interpolation of the sample tangents whose slopes
+//! match the sample curvature vectors; the cross-section at `(k, a)` is the plane through
+//! `C(a)` normal to `t(a)`. In the coordinates
+//! `(a, α, β)` of that foliation the volume element is exactly `σ(a) (1 − d·κ(a)) da dα dβ`
+//! with `σ = E_k·t(a)` and `κ = (dt/da)/σ` (the spine's speed and curvature vector in this
+//! model), so the thesis' stretchable formulas with `λ = σ1/σ0` make the discrete map exactly
+//! volume preserving inside every edge slab for any sampling, not only in the limit. The
+//! curvature is continuous across samples, so is the map (up to the O(h³) jump of the speed
+//! ratio); points beyond the end planes use the straight extension of the end (κ = 0).
+//!
+//! Registration (bind) is brute force over the edges with pruning, `O(V n)`; deformation is
+//! `O(V + n)`, per vertex independent and run in parallel with rayon.
+
+pub mod bind;
+pub mod pose;
+pub mod solve;
+pub mod spine;
+
+pub use bind::{Binding, COORDS, bind};
+pub use pose::deform;
+pub use solve::Solution;
+pub use spine::Spine;

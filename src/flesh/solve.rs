@@ -1,0 +1,276 @@
+//! Offset solutions in one cross-section (Zhuo 2014, Ch. III–V; spec §2.1, §2.5, §2.11).
+//!
+//! Everything works in the 2D coordinates `d = (α, β)` of the cross-section (components along
+//! the RMF columns `r, s` of the spine frame) and the curvature vector `k = κ N` expressed in
+//! the same coordinates (`k ⊥ t`, pointing to the centre of curvature), so the formulas are
+//! frame free (spec §2.5, "frame-free evaluation"): `κ x = d·k`, `κ r cosθ = d·k`.
+//!
+//! * unbend (κ1 = 0 in the thesis' formulas), with the rest curvature `k0`:
+//!   normal Eq. 14 `x* = x0 (1 − ½κ0 x0)`; binormal Eq. 17 `y* = (1 − κ0 x) y0`;
+//!   radial Eq. 20 `r* = r0 √(1 − ⅔ κ0 r0 cosθ0)`.
+//! * stretch by `λ` = new speed / old speed (thesis σ of Ch. V; spec A-2): normal `x/λ`
+//!   along N1, binormal `y/λ` along B1, radial `r/√λ`.
+//! * bend (κ0 = 0) with the posed curvature `k1`, read in the posed frame after the transfer
+//!   normal Eq. 15 in the stable form `x1 = 2x_t/(1 + √(1 − 2κ1 x_t))`; binormal
+//!   Eq. 18 `y1 = y_t/(1 − κ1 x')`; radial Eq. 21 `r1²(1 − ⅔ r1 κ1 cosθ1) = r_t²` with the root
+//!   rule of spec §2.5 (corrected E-8, E-13).
+//!
+//! Existence (spec §2.11, A-20): where no fold-free root exists the offset is clamped to the
+//! largest safe one (normal: the focal point `1/κ1`; radial: `r1 = 1/(κ1 cosθ1)`, the local
+//! maximum of the cubic; binormal: the factor `1 − κ1 x'` is capped below at
+//! [`BINORMAL_MIN_FACTOR`]) and the vertex is reported. Unbending needs `κ0 x0 < 1` (E-12):
+//! points past the rest spine's centre of curvature are clamped there and reported.
+
+use glam::DVec2;
+
+/// Which offset correction to apply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solution {
+    /// The uncorrected map: the same local offset in the posed frame (the industry baseline).
+    None,
+    /// Only the coordinate along the principal normal changes (quadratic, Eq. 11/23).
+    Normal,
+    /// Only the coordinate along the binormal changes (linear, Eq. 12/24).
+    Binormal,
+    /// Only the distance from the spine changes, the angle is kept (cubic, Eq. 13/25).
+    Radial,
+}
+
+/// Below this `1 − κ1 x'` the binormal solution is clamped (spec A-20 default).
+pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
+/// Curvatures below this (1/length units) are treated as straight: the step is the identity.
+pub const TINY_CURVATURE: f64 = 1e-300;
+
+/// Flag bits reported per vertex.
+pub const CLAMPED_BEND: u8 = 1;
+pub const CLAMPED_UNBEND: u8 = 2;
+
+fn unit_normal(k: DVec2, fallback: DVec2) -> (DVec2, f64) {
+    let kk = k.length();
+    if kk > TINY_CURVATURE && kk.is_finite() {
+        (k / kk, kk)
+    } else {
+        (fallback, 0.0)
+    }
+}
+
+/// Unbend `d` (rest cross-section coordinates) with the rest curvature `k0`.
+pub fn unbend(sol: Solution, d: DVec2, k0: DVec2, flags: &mut u8) -> DVec2 {
+    match sol {
+        Solution::None => d,
+        Solution::Normal => {
+            let (n, kk) = unit_normal(k0, DVec2::X);
+            if kk == 0.0 {
+                return d;
+            }
+            let x = d.dot(n);
+            let xc = if kk * x >= 1.0 {
+                *flags |= CLAMPED_UNBEND;
+                1.0 / kk
+            } else {
+                x
+            };
+            d + (xc * (1.0 - 0.5 * kk * xc) - x) * n
+        }
+        Solution::Binormal => {
+            let (n, kk) = unit_normal(k0, DVec2::X);
+            if kk == 0.0 {
+                return d;
+            }
+            let b = n.perp();
+            let (x, y) = (d.dot(n), d.dot(b));
+            let mut f = 1.0 - kk * x;
+            if f < BINORMAL_MIN_FACTOR {
+                *flags |= CLAMPED_UNBEND;
+                f = BINORMAL_MIN_FACTOR;
+            }
+            x * n + f * y * b
+        }
+        Solution::Radial => {
+            let mut c = d.dot(k0); // κ0 r0 cosθ0
+            if c >= 1.0 {
+                *flags |= CLAMPED_UNBEND;
+                c = 1.0;
+            }
+            d * (1.0 - (2.0 / 3.0) * c).sqrt()
+        }
+    }
+}
+
+/// Bend the transferred coordinates `d` (posed frame) with posed curvature `k1` and stretch
+/// `lam` (new/old speed). `fallback` is the direction used as "normal" where `k1 = 0`.
+pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVec2 {
+    match sol {
+        Solution::None => d,
+        Solution::Normal => {
+            let (n, kk) = unit_normal(k1, DVec2::X);
+            let x = d.dot(n);
+            let xt = x / lam;
+            let disc = 1.0 - 2.0 * kk * xt;
+            let x1 = if disc < 0.0 {
+                *flags |= CLAMPED_BEND;
+                1.0 / kk
+            } else {
+                2.0 * xt / (1.0 + disc.sqrt())
+            };
+            d + (x1 - x) * n
+        }
+        Solution::Binormal => {
+            let (n, kk) = unit_normal(k1, DVec2::X);
+            let b = n.perp();
+            let (x, y) = (d.dot(n), d.dot(b));
+            let mut den = 1.0 - kk * x;
+            if den < BINORMAL_MIN_FACTOR {
+                *flags |= CLAMPED_BEND;
+                den = BINORMAL_MIN_FACTOR;
+            }
+            x * n + (y / lam / den) * b
+        }
+        Solution::Radial => {
+            let r = d.length();
+            if r == 0.0 {
+                return d;
+            }
+            let u = d / r;
+            let rt = r / lam.sqrt();
+            let alpha = -(2.0 / 3.0) * rt * u.dot(k1);
+            let (m, ok) = radial_ratio(alpha);
+            if !ok {
+                *flags |= CLAMPED_BEND;
+            }
+            u * (rt * m)
+        }
+    }
+}
+
+/// The fold-free root `m` of `α m³ + m² − 1 = 0` (spec §2.5, corrected root rule) and whether
+/// it exists; without one, the local maximum `m = −2/(3α)` (the focal point).
+pub fn radial_ratio(alpha: f64) -> (f64, bool) {
+    let f = |m: f64| (alpha * m + 1.0) * m * m - 1.0;
+    let df = |m: f64| (3.0 * alpha * m + 2.0) * m;
+    if alpha == 0.0 {
+        return (1.0, true);
+    }
+    let (mut lo, mut hi) = if alpha > 0.0 {
+        (0.0, 1.0)
+    } else {
+        let top = -2.0 / (3.0 * alpha);
+        if alpha * alpha > 4.0 / 27.0 {
+            return (top, false);
+        }
+        (1.0, top)
+    };
+    // safeguarded Newton on the increasing branch [lo, hi], f(lo) ≤ 0 ≤ f(hi), from the
+    // series m = 1 − α/2 + 5α²/8 − α³ + 231α⁴/128 (error ~1e-6 at |α| = 0.05)
+    let a2 = alpha * alpha;
+    let mut m =
+        (1.0 - 0.5 * alpha + 0.625 * a2 - a2 * alpha + (231.0 / 128.0) * a2 * a2).clamp(lo, hi);
+    for _ in 0..100 {
+        let fm = f(m);
+        if fm < 0.0 {
+            lo = m;
+        } else if fm > 0.0 {
+            hi = m;
+        } else {
+            return (m, true);
+        }
+        let step = fm / df(m);
+        let next = m - step;
+        if !(next > lo && next < hi) {
+            m = 0.5 * (lo + hi);
+            if hi - lo <= 4.0 * f64::EPSILON * hi {
+                return (m, true);
+            }
+            continue;
+        }
+        // quadratic convergence: after a Newton step of 1e-8 the error is ~1e-16; one more
+        // step reaches the rounding level
+        if step.abs() <= 1e-8 * m {
+            let last = next - f(next) / df(next);
+            return (if last >= lo && last <= hi { last } else { next }, true);
+        }
+        m = next;
+    }
+    (m, true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radial_reference_values() {
+        // spec §3: r_t = 0.3, κ1 = 1, cosθ = 1 → 0.3413416; cosθ = −1 → 0.2757267
+        let mut fl = 0;
+        let a = bend(
+            Solution::Radial,
+            DVec2::new(0.3, 0.0),
+            DVec2::new(1.0, 0.0),
+            1.0,
+            &mut fl,
+        );
+        assert!((a.x - 0.3413416).abs() < 5e-8, "{a}");
+        let b = bend(
+            Solution::Radial,
+            DVec2::new(-0.3, 0.0),
+            DVec2::new(1.0, 0.0),
+            1.0,
+            &mut fl,
+        );
+        assert!((b.x + 0.2757267).abs() < 5e-8, "{b}");
+        let c = unbend(
+            Solution::Radial,
+            DVec2::new(0.3, 0.0),
+            DVec2::new(1.0, 0.0),
+            &mut fl,
+        );
+        assert!((c.x - 0.2683282).abs() < 5e-8, "{c}");
+        assert_eq!(fl, 0);
+    }
+
+    #[test]
+    fn normal_reference_and_clamp() {
+        let mut fl = 0;
+        let a = bend(
+            Solution::Normal,
+            DVec2::new(0.3, 0.0),
+            DVec2::new(1.0, 0.0),
+            1.0,
+            &mut fl,
+        );
+        assert!((a.x - 0.3675445).abs() < 5e-8);
+        let b = bend(
+            Solution::Normal,
+            DVec2::new(-0.3, 0.0),
+            DVec2::new(1.0, 0.0),
+            1.0,
+            &mut fl,
+        );
+        assert!((b.x + 0.2649111).abs() < 5e-8);
+        assert_eq!(fl, 0);
+        let c = bend(
+            Solution::Normal,
+            DVec2::new(0.6, 0.0),
+            DVec2::new(1.0, 0.0),
+            1.0,
+            &mut fl,
+        );
+        assert_eq!(fl, CLAMPED_BEND);
+        assert_eq!(c.x, 1.0);
+    }
+
+    #[test]
+    fn radial_root_is_a_root_and_limit() {
+        for i in 0..2000 {
+            let alpha = -0.39 + 0.0008 * i as f64;
+            let (m, ok) = radial_ratio(alpha);
+            assert!(m.is_finite());
+            if ok {
+                let f = alpha * m * m * m + m * m - 1.0;
+                assert!(f.abs() < 1e-12, "alpha {alpha} m {m} f {f}");
+            } else {
+                assert!(alpha * alpha > 4.0 / 27.0);
+            }
+        }
+    }
+}

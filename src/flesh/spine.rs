@@ -1,0 +1,227 @@
+//! The discrete spine model (see the module docs of [`crate::flesh`]): positions the cubic
+//! Hermite interpolant of the samples with end slopes `h_k t_j` (`h_k` the chord); unit
+//! tangents `t(a) = m(a)/|m(a)|` with `m` the cubic Hermite interpolant of the sample
+//! tangents whose end derivatives are `σ_k κ_j` (`κ_j` the sample curvature vectors from
+//! central differences of the tangents in chord length, `σ_k = E_k·t_j`), so that the
+//! model's curvature vector `κ = (dt/da)/σ` equals `κ_j` at sample `j` from both sides: the
+//! map is continuous across samples (up to the O(h³) jump of `σ`); RMF reference vectors
+//! interpolated linearly and re-orthogonalised.
+
+use glam::{DVec2, DVec3};
+
+use crate::error::{InputError, Result};
+
+/// A sampled spine with its frames (`t` and `r` columns of `spinal.frames`).
+#[derive(Clone, Debug)]
+pub struct Spine {
+    pub c: Vec<DVec3>,
+    pub t: Vec<DVec3>,
+    pub r: Vec<DVec3>,
+    /// Per edge: `m(a) = m[0] + a m[1] + a² m[2] + a³ m[3]`.
+    pub m: Vec<[DVec3; 4]>,
+    /// Per edge: the position `C(a)` in the same power form.
+    pub p: Vec<[DVec3; 4]>,
+}
+
+/// Sample curvature vectors: central differences of the unit tangents in chord length,
+/// made normal to the tangent (one-sided at the ends).
+fn hermite(p0: DVec3, p1: DVec3, d0: DVec3, d1: DVec3) -> [DVec3; 4] {
+    [
+        p0,
+        d0,
+        3.0 * (p1 - p0) - 2.0 * d0 - d1,
+        2.0 * (p0 - p1) + d0 + d1,
+    ]
+}
+
+#[inline]
+fn cubic(c: &[DVec3; 4], a: f64) -> DVec3 {
+    c[0] + a * (c[1] + a * (c[2] + a * c[3]))
+}
+
+#[inline]
+fn cubic_slope(c: &[DVec3; 4], a: f64) -> DVec3 {
+    c[1] + a * (2.0 * c[2] + 3.0 * a * c[3])
+}
+
+fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
+    let n = c.len();
+    (0..n)
+        .map(|j| {
+            let (a, b) = (j.saturating_sub(1), (j + 1).min(n - 1));
+            let mut len = 0.0;
+            for i in a..b {
+                len += (c[i + 1] - c[i]).length();
+            }
+            let k = (t[b] - t[a]) / len;
+            k - t[j] * t[j].dot(k)
+        })
+        .collect()
+}
+
+/// The spine evaluated at `(k, a)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Local {
+    pub q: DVec3,
+    pub t: DVec3,
+    pub u: DVec3,
+    pub v: DVec3,
+    /// `C'(a) · t(a)`: the speed of the sections along the spine.
+    pub sigma: f64,
+    /// Curvature vector (1/length) in the `(u, v)` coordinates.
+    pub kappa: DVec2,
+}
+
+impl Spine {
+    /// `frames` is row-major `(n, 3, 3)` with columns `(r, s, t)` (the layout of the crate).
+    pub fn new(arg: &'static str, points: &[DVec3], frames: &[f64]) -> Result<Spine> {
+        let n = points.len();
+        if n < 2 {
+            return Err(InputError::new(
+                arg,
+                format!("need at least 2 points, got {n}"),
+            ));
+        }
+        if frames.len() != 9 * n {
+            return Err(InputError::new(arg, "frames do not match the points"));
+        }
+        let mut t = Vec::with_capacity(n);
+        let mut r = Vec::with_capacity(n);
+        for (i, f) in frames.chunks_exact(9).enumerate() {
+            let ri = DVec3::new(f[0], f[3], f[6]);
+            let ti = DVec3::new(f[2], f[5], f[8]);
+            if !(ri.is_finite() && ti.is_finite() && points[i].is_finite()) {
+                return Err(InputError::new(arg, format!("row {i} is not finite")));
+            }
+            t.push(ti);
+            r.push(ri);
+        }
+        for k in 0..n - 1 {
+            let e = points[k + 1] - points[k];
+            // σ = E·t(a) > 0 on the whole edge iff it is at both ends
+            if !(e.dot(t[k]) > 0.0 && e.dot(t[k + 1]) > 0.0) {
+                return Err(InputError::new(
+                    arg,
+                    format!(
+                        "rows {k} and {}: the tangent turns 90° or more within one edge \
+                         (repeated points or a cusp); sample the spine more finely",
+                        k + 1
+                    ),
+                ));
+            }
+            if r[k].dot(r[k + 1]) <= -0.5 {
+                return Err(InputError::new(
+                    arg,
+                    format!("rows {k} and {}: the frame rolls too fast", k + 1),
+                ));
+            }
+        }
+        let kv = curvatures(points, &t);
+        let mut m = Vec::with_capacity(n - 1);
+        let mut pc = Vec::with_capacity(n - 1);
+        for k in 0..n - 1 {
+            let e = points[k + 1] - points[k];
+            let h = e.length();
+            let pos = hermite(points[k], points[k + 1], h * t[k], h * t[k + 1]);
+            // slopes h κ_j: the model's curvature (dt/da)/σ is κ_j at the samples (σ = h)
+            let coef = hermite(t[k], t[k + 1], h * kv[k], h * kv[k + 1]);
+            for i in 0..=8 {
+                let a = i as f64 / 8.0;
+                let sigma = cubic_slope(&pos, a).dot(cubic(&coef, a));
+                if !(sigma > 0.0) || !kv[k].is_finite() {
+                    return Err(InputError::new(
+                        arg,
+                        format!(
+                            "rows {k} and {}: the spine turns too fast between samples; \
+                             sample it more finely",
+                            k + 1
+                        ),
+                    ));
+                }
+            }
+            m.push(coef);
+            pc.push(pos);
+        }
+        Ok(Spine {
+            c: points.to_vec(),
+            t,
+            r,
+            m,
+            p: pc,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.c.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.c.is_empty()
+    }
+
+    /// The unnormalised tangent `m(a)` of edge `k`.
+    #[inline]
+    pub fn m_at(&self, k: usize, a: f64) -> DVec3 {
+        cubic(&self.m[k], a)
+    }
+
+    /// The position `C(a)` on edge `k`.
+    #[inline]
+    pub fn c_at(&self, k: usize, a: f64) -> DVec3 {
+        cubic(&self.p[k], a)
+    }
+
+    /// The model at edge `k`, `a ∈ [0, 1]`.
+    #[inline]
+    pub fn eval(&self, k: usize, a: f64) -> Local {
+        let q = cubic(&self.p[k], a);
+        let e = cubic_slope(&self.p[k], a);
+        let m = cubic(&self.m[k], a);
+        let dt = cubic_slope(&self.m[k], a);
+        let ml = m.length();
+        let t = m / ml;
+        let ta = (dt - t * t.dot(dt)) / ml;
+        let sigma = e.dot(t);
+        let um = self.r[k] + a * (self.r[k + 1] - self.r[k]);
+        let u = (um - t * t.dot(um)).normalize();
+        let v = t.cross(u);
+        let kv = ta / sigma;
+        Local {
+            q,
+            t,
+            u,
+            v,
+            sigma,
+            kappa: DVec2::new(kv.dot(u), kv.dot(v)),
+        }
+    }
+}
+
+/// Compass walk (spec A-9): points on the polyline `posed`, from its first point, whose
+/// consecutive distances are `chords` (so every edge keeps its rest length); past the end of
+/// the polyline, along its last edge. `posed` has ≥ 2 distinct consecutive points.
+pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(chords.len() + 1);
+    let mut c = posed[0];
+    out.push(c);
+    let last = posed.len() - 2;
+    let mut seg = 0;
+    for &h in chords {
+        let next = loop {
+            let (a, b) = (posed[seg], posed[seg + 1]);
+            let e = b - a;
+            // |a + t e − c|² = h², the larger root (ahead of c)
+            let (ee, ec) = (e.dot(e), e.dot(a - c));
+            let cc = (a - c).length_squared() - h * h;
+            let disc = (ec * ec - ee * cc).max(0.0);
+            let t = (-ec + disc.sqrt()) / ee;
+            if t <= 1.0 || seg == last {
+                break a + t * e;
+            }
+            seg += 1;
+        };
+        out.push(next);
+        c = next;
+    }
+    out
+}
