@@ -64,29 +64,45 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
-def _posed_initial(rest: np.ndarray, r0: np.ndarray, posed: np.ndarray) -> np.ndarray:
+def _min_rotation_matrix(t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """The rotation by the smallest angle taking unit ``t0`` to unit ``t1``."""
+    c = float(t0 @ t1)
+    k = np.cross(t0, t1)
+    if c <= -1 + 1e-12:  # half turn about any axis ⟂ t0
+        a = np.cross(t0, [1.0, 0, 0] if abs(t0[0]) < 0.9 else [0, 1.0, 0])
+        a /= np.linalg.norm(a)
+        return 2 * np.outer(a, a) - np.eye(3)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + kx + kx @ kx / (1 + c)
+
+
+def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
     """Reference vector of the posed spine's first frame (spec A-5, made rigid-motion
-    equivariant): ``r0`` turned by the best-fit rotation (Kabsch, weights 1) from the rest to
-    the posed samples; when either spine is straight (the best fit's roll about it is
-    undetermined) by the minimal rotation taking the first tangent to the posed one."""
+    equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal rotation taking
+    the rest start tangent ``t0`` to the posed one ``t1`` and ``ψ`` the twist about ``t0``
+    (swing–twist split) of ``Qᵀ K``, ``K`` the best-fit (Kabsch) rotation of the rest onto the
+    posed samples; ``ψ = 0`` when either spine is straight (the roll about it is then free).
+    A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the inverse roll."""
+    r0, t0 = f0[:, 0], f0[:, 2]
+    q = _min_rotation_matrix(t0, t1)
     a = rest - rest.mean(0)
     b = posed - posed.mean(0)
     u, sv, vt = np.linalg.svd(a.T @ b)
     sa = np.linalg.svd(a, compute_uv=False)
     sb = np.linalg.svd(b, compute_uv=False)
+    psi = 0.0
     if sv[1] > 1e-9 * sv[0] and sa[1] > 1e-9 * sa[0] and sb[1] > 1e-9 * sb[0]:
         d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-        rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-        return rot @ r0
-    return None
-
-
-def _min_rotation(r0, t0, t1):
-    c = float(t0 @ t1)
-    k = np.cross(t0, t1)
-    if c <= -1 + 1e-12:
-        return -r0
-    return r0 * c + np.cross(k, r0) + k * (k @ r0) / (1 + c)
+        k = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+        m = q.T @ k
+        # quaternion (v, w) of m, up to a common factor; its twist about t0 has angle
+        # 2 atan2(v·t0, w)
+        w = 1.0 + np.trace(m)
+        v = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+        psi = 2 * np.arctan2(v @ t0, w)
+    c, s = np.cos(psi), np.sin(psi)
+    rolled = c * r0 + s * np.cross(t0, r0) + (1 - c) * (t0 @ r0) * t0
+    return q @ rolled
 
 
 class SpineBinding:
@@ -233,10 +249,13 @@ class SpineBinding:
         thins that part (λ > 1), compressing thickens it.
 
         The posed frames are the RMF of the posed spine started from the rest spine's first
-        reference vector turned by the best-fit (Kabsch) rotation of rest onto posed samples
-        (by the minimal rotation of the first tangent when either spine is straight); so the
-        identity pose returns the input and a rigid motion of the spine moves the shape
-        rigidly.
+        reference vector turned by the minimal rotation of the first tangent and rolled by the
+        twist (about that tangent) of the best-fit (Kabsch) rotation of rest onto posed
+        samples (no roll when either spine is straight); so the identity pose returns the
+        input, a rigid motion of the spine moves the shape rigidly, and swapping the two
+        spines (the posed one as returned by :meth:`posed_spine`) inverts the map — exactly
+        for ``"radial"`` and ``"none"``; ``"normal"``/``"binormal"`` stretch along the posed
+        spine's N/B (spec A-8), so they invert exactly only where the stretch is 1.
 
         Parameters
         ----------
@@ -276,16 +295,12 @@ class SpineBinding:
             if not np.isfinite(tw).all():
                 raise ValueError("twist: must be finite")
             tw = np.ascontiguousarray(tw)
-        r0 = self._frames[0][:, 0]
-        f0 = self._frames[0][:, 2]
         if self._dim == 2:  # r is the left normal z × t all along a planar RMF
             t1 = posed[1] - posed[0]
             init = np.array([-t1[1], t1[0], 0.0])
         else:
-            init = _posed_initial(self._rest, r0, posed)
-        if init is None:
             t1 = _spine_frames(posed, "posed_spine")[0][:, 2]
-            init = _min_rotation(r0, f0, t1)
+            init = _posed_initial(self._rest, self._frames[0], posed, t1)
         frames1 = _spine_frames(posed, "posed_spine", initial=init)
         sol = solution
         if self._dim == 2 and sol != "none":

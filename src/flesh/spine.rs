@@ -5,7 +5,7 @@
 //! central differences of the tangents in chord length, `σ_k = E_k·t_j`), so that the
 //! model's curvature vector `κ = (dt/da)/σ` equals `κ_j` at sample `j` from both sides: the
 //! map is continuous across samples (up to the O(h³) jump of `σ`); RMF reference vectors
-//! interpolated linearly and re-orthogonalised.
+//! carried to `t(a)` by minimal rotations and blended linearly.
 
 use glam::{DVec2, DVec3};
 
@@ -42,6 +42,14 @@ fn cubic(c: &[DVec3; 4], a: f64) -> DVec3 {
 #[inline]
 fn cubic_slope(c: &[DVec3; 4], a: f64) -> DVec3 {
     c[1] + a * (2.0 * c[2] + 3.0 * a * c[3])
+}
+
+/// `v` turned by the minimal rotation taking unit `from` to unit `to` (not antipodal).
+#[inline]
+fn min_rotate(v: DVec3, from: DVec3, to: DVec3) -> DVec3 {
+    let c = from.dot(to);
+    let k = from.cross(to);
+    v * c + k.cross(v) + k * (k.dot(v) / (1.0 + c))
 }
 
 fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
@@ -182,7 +190,11 @@ impl Spine {
         let t = m / ml;
         let ta = (dt - t * t.dot(dt)) / ml;
         let sigma = e.dot(t);
-        let um = self.r[k] + a * (self.r[k + 1] - self.r[k]);
+        // both sample reference vectors carried to t(a) by minimal rotations, then blended:
+        // equivariant under a common roll of the frames (so swapping spines inverts the map)
+        let r0 = min_rotate(self.r[k], self.t[k], t);
+        let r1 = min_rotate(self.r[k + 1], self.t[k + 1], t);
+        let um = r0 + a * (r1 - r0);
         let u = (um - t * t.dot(um)).normalize();
         let v = t.cross(u);
         let kv = ta / sigma;
