@@ -502,3 +502,114 @@ def test_inverse_swaps_the_spines(solution):
         mid = rest + s * (posed - rest)
         assert np.array_equal(b.deform(mid, solution=solution),
                               spinal.flesh(V, rest, mid, solution=solution))
+
+
+# --- spine surfaces (Ch. VI) ------------------------------------------------------------
+
+
+def plane_grid(n=41, size=2.0):
+    x = np.linspace(-size / 2, size / 2, n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    return np.stack([X, Y, np.zeros_like(X)], axis=-1)
+
+
+def cylinder_grid(n=41, size=2.0, radius=2.0):
+    """The plane rolled onto a cylinder of axis y through (0, 0, radius), chords kept (the
+    grid cells stay congruent rectangles); normal +z toward the axis."""
+    h = size / (n - 1)
+    dth = 2 * np.arcsin(h / (2 * radius))
+    th = (np.arange(n) - (n - 1) / 2) * dth
+    y = np.linspace(-size / 2, size / 2, n)
+    T, Y = np.meshgrid(th, y, indexing="ij")
+    return np.stack([radius * np.sin(T), Y, radius * (1 - np.cos(T))], axis=-1)
+
+
+def test_surface_reference_identity_rigid():
+    rest, posed = plane_grid(), cylinder_grid()
+    P = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, -0.3], [0.0, 0.2, 0.1]])
+    out = spinal.flesh_surface(P, rest, posed)
+    # plane → cylinder R = 2 (m = 0.25, g = 0): h_t = 0.3 → 0.3266799 (spec §3); the grid's
+    # normal interpolation bends by cos(Δθ/2)/R: an O(Δθ²) error, 4× smaller per halving
+    err = abs(out[0, 2] - 0.3266799)
+    fine = spinal.flesh_surface(P[:1], plane_grid(81), cylinder_grid(81))
+    err_fine = abs(fine[0, 2] - 0.3266799)
+    assert err < 5e-5 and err_fine < 1.5e-5 and 3.5 < err / err_fine < 4.5
+    # convex side, thinner: h − h²/4 = −0.3 (Eq. 43 with m = 0.25, g = 0)
+    assert abs(out[1, 2] - (1 - np.sqrt(1.3)) / 0.5) < 5e-5
+    rng = np.random.default_rng(4)
+    V = np.c_[rng.uniform(-0.8, 0.8, (300, 2)), rng.uniform(-0.4, 0.4, 300)]
+    for sol in ("offset", "none"):
+        assert np.abs(spinal.flesh_surface(V, posed, posed, solution=sol) - V).max() < 1e-12
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    R = q * np.sign(np.linalg.det(q))
+    out = spinal.flesh_surface(V, rest, rest @ R.T + [1, 2, 3])
+    assert np.abs(out - (V @ R.T + [1, 2, 3])).max() < 1e-10
+
+
+def test_surface_jacobian_and_volume():
+    rng = np.random.default_rng(6)
+    rest = plane_grid(31)
+    g = plane_grid(31)
+    # a doubly curved, stretched pose
+    X, Y = g[..., 0], g[..., 1]
+    posed = np.stack([1.1 * X, 0.9 * Y + 0.1 * X, 0.25 * X**2 - 0.15 * Y**2 + 0.1 * X * Y],
+                     axis=-1)
+    pts = np.c_[rng.uniform(-0.8, 0.8, (200, 2)), rng.uniform(-0.3, 0.3, 200)]
+    eps = 1e-5
+    probes = [pts] + [pts + s * eps * e for e in np.eye(3) for s in (1, -1)]
+    b = spinal.SurfaceBinding(np.concatenate(probes), rest)
+    cells = b.uv.astype(int).reshape(7, -1, 2)
+    same = (cells == cells[0]).all(axis=(0, 2))
+    for sol, expect in (("offset", True), ("none", False)):
+        out = b.deform(posed, solution=sol).reshape(7, -1, 3)
+        J = np.stack([(out[1 + 2 * k] - out[2 + 2 * k]) / (2 * eps) for k in range(3)], -1)
+        det = np.linalg.det(J)[same]
+        assert same.sum() > 150
+        if expect:
+            assert np.abs(det - 1).max() < 1e-6
+        else:
+            assert np.abs(det - 1).max() > 0.05
+    # closed meshes above and below the surface: volume kept, the uncorrected map does not
+    ball = subdivided(trimesh.creation.icosphere(subdivisions=2, radius=0.2), 1)
+    box = subdivided(trimesh.creation.box(extents=[0.5, 0.4, 0.2]), 4)
+    posed = np.stack([X, 1.1 * Y, 0.35 * X**2 + 0.05 * Y**2], axis=-1)  # bent and stretched
+    for mesh, shift in ((ball, [0.3, 0.1, 0.25]), (box, [-0.3, 0.0, -0.15])):
+        m = mesh.copy()
+        m.apply_translation(shift)
+        v0 = vols(m)[0]
+        e = {}
+        for sol in ("offset", "none"):
+            out = spinal.flesh_surface(m.vertices, rest, posed, solution=sol)
+            v1_tm, v1_igl = vols(trimesh.Trimesh(out, m.faces, process=False))
+            assert abs(v1_tm - v1_igl) < 1e-12 * v1_tm
+            e[sol] = v1_tm / v0 - 1
+        assert abs(e["offset"]) < 2e-4 and abs(e["none"]) > 0.01, e
+
+
+def test_surface_clamp_and_bad_input():
+    rest = plane_grid(21)
+    # plane → sphere R = 0.5 patch: points 0.3 above on the concave side cannot fit
+    g = plane_grid(21, 1.0)
+    X, Y = g[..., 0], g[..., 1]
+    R = 0.5
+    r = np.hypot(X, Y)
+    phi = r / R
+    sc = np.where(r > 0, np.sin(phi) / np.where(r > 0, r, 1), 1 / R) * R
+    posed = np.stack([X * sc, Y * sc, R * (1 - np.cos(phi))], axis=-1)
+    V = np.array([[0.0, 0.0, 0.45], [0.0, 0.0, 0.1]])
+    with pytest.warns(spinal.FoldOverWarning):
+        out, clamped = spinal.flesh_surface(V, plane_grid(21, 1.0), posed, return_clamped=True)
+    assert np.array_equal(clamped, [0]) and np.isfinite(out).all()
+    assert abs(out[0, 2] - 0.5) < 1e-2  # clamped at the focal point (the sphere's centre)
+    with pytest.raises(ValueError, match="^rest_surface:"):
+        spinal.flesh_surface(V, rest[:1], rest)
+    with pytest.raises(ValueError, match="^posed_surface:"):
+        spinal.flesh_surface(V, rest, rest[:-1])
+    with pytest.raises(ValueError, match="^vertices:"):
+        spinal.flesh_surface([[np.nan, 0, 0]], rest, rest)
+    rep = rest.copy()
+    rep[3, 3] = rep[3, 4]
+    with pytest.raises(ValueError, match="^rest_surface:"):
+        spinal.flesh_surface(V, rep, rest)
+    with pytest.raises(ValueError, match="^solution:"):
+        spinal.flesh_surface(V, rest, rest, solution="radial")

@@ -8,7 +8,7 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 
 from . import curves, quaternions
 from ._core import __version__
-from ._flesh import SpineBinding, flesh
+from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
@@ -17,11 +17,13 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "SpineBinding",
+    "SurfaceBinding",
     "__version__",
     "closing_angle",
     "curves",
     "estimate_tangents",
     "flesh",
+    "flesh_surface",
     "frames",
     "quaternions",
     "sweep",

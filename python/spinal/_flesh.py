@@ -356,3 +356,102 @@ def flesh(
         strict=strict,
         return_clamped=return_clamped,
     )
+
+
+def _grid(x, name: str) -> np.ndarray:
+    arr = as_float_array(x, name)
+    if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 2 or arr.shape[1] < 2:
+        raise ValueError(f"{name}: expected a grid of shape (nu, nv, 3), nu, nv ≥ 2, got "
+                         f"{arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name}: must be finite")
+    return np.ascontiguousarray(arr)
+
+
+class SurfaceBinding:
+    r"""A shape registered on a rest spine surface (Zhuo 2014 Ch. VI), to be posed many times.
+
+    The surface is a grid of samples ``(nu, nv, 3)``, bilinear in every cell, with the unit
+    normal interpolated from the sample normals (central differences ``S_u × S_v``, so the
+    normal's side follows the grid's orientation). Every vertex is registered by its foot
+    ``(u, v)`` and signed offset ``h`` along that normal (``P = S(u, v) + h N(u, v)``; the
+    foot is found by Newton's method in the cells around the nearest sample; the smallest
+    ``|h|`` wins). Vertices whose foot lies outside the grid are attached to the border with
+    their offset carried rigidly (not volume preserving; reported as clamped).
+
+    :meth:`deform` keeps every normal segment on the normal of the posed surface at the same
+    ``(u, v)`` and corrects its length with the mean and Gaussian curvature and the area
+    stretch (Eq. 38–43): ``A1 h1 + B1 h1²/2 + C1 h1³/3 = A0 h0 + B0 h0²/2 + C0 h0³/3`` where
+    ``A + B h + C h² = det[S_u + hN_u, S_v + hN_v, N]`` is the model's exact volume element
+    (``B = −2mA``, ``C = gA``), so the map's Jacobian determinant is 1. Where no fold-free
+    root exists, ``h1`` is clamped to the largest fold-free offset ``1/k_max`` (§6.2).
+
+    Parameters
+    ----------
+    vertices : array_like (V, 3)
+    rest_surface : array_like (nu, nv, 3), nu, nv ≥ 2
+    """
+
+    def __init__(self, vertices, rest_surface):
+        g = _grid(rest_surface, "rest_surface")
+        v = as_float_array(vertices, "vertices")
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
+        bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+        if bad.size:
+            raise ValueError(f"vertices: row {bad[0]} is not finite")
+        self._shape = g.shape[:2]
+        self._cell, self._coords = _core.flesh_surface_bind(
+            g.reshape(-1, 3), g.shape[0], g.shape[1], np.ascontiguousarray(v, dtype=np.float64)
+        )
+        self.clamped = np.zeros(0, dtype=np.int64)
+
+    def __len__(self) -> int:
+        return len(self._cell)
+
+    @property
+    def uv(self) -> np.ndarray:
+        """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet."""
+        i, j = np.divmod(self._cell, self._shape[1])
+        return np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
+
+    @property
+    def offset(self) -> np.ndarray:
+        """``(V,)`` signed offsets ``h`` along the rest normal."""
+        return self._coords[:, 2].copy()
+
+    def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
+               return_clamped: bool = False):
+        """The shape on ``posed_surface`` (same grid shape): ``(V, 3)``.
+
+        ``solution="offset"`` (default) corrects the offset (volume preserving);
+        ``"none"`` keeps ``h1 = h0`` (the uncorrected map). Clamped vertices (no fold-free
+        offset, or foot outside the grid) are reported as in :meth:`SpineBinding.deform`.
+        """
+        solution = as_choice(solution, "solution", ("offset", "none"))
+        strict = as_bool(strict, "strict")
+        g = _grid(posed_surface, "posed_surface")
+        if g.shape[:2] != self._shape:
+            raise ValueError(f"posed_surface: expected the rest grid's shape "
+                             f"{self._shape}, got {g.shape[:2]}")
+        out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
+                                                self._cell, self._coords, solution == "offset")
+        clamped = np.flatnonzero(flags).astype(np.int64)
+        self.clamped = clamped
+        if clamped.size:
+            msg = (f"posed_surface: {clamped.size} vertices have no fold-free offset or lie "
+                   f"outside the surface and were clamped, e.g. vertex {clamped[0]}")
+            if strict:
+                raise ValueError(msg)
+            warnings.warn(FoldOverWarning(msg, clamped), stacklevel=2)
+        return (out, clamped) if return_clamped else out
+
+
+def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "offset",
+                  strict: bool = False, return_clamped: bool = False):
+    """Bend a shape with a spine surface and keep its volume locally (Zhuo 2014 Ch. VI).
+
+    One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``.
+    """
+    return SurfaceBinding(vertices, rest_surface).deform(
+        posed_surface, solution=solution, strict=strict, return_clamped=return_clamped)
