@@ -613,3 +613,19 @@ def test_surface_clamp_and_bad_input():
         spinal.flesh_surface(V, rep, rest)
     with pytest.raises(ValueError, match="^solution:"):
         spinal.flesh_surface(V, rest, rest, solution="radial")
+
+
+@pytest.mark.xfail(strict=True, reason="the bilinear cell model's area element and normal "
+                   "derivative jump across cell boundaries (~1e-3 here); needs a C1 "
+                   "(bicubic) surface model like the curve's Hermite one")
+def test_surface_continuous_across_cells():
+    n = 31
+    rest = plane_grid(n)
+    X, Y = rest[..., 0], rest[..., 1]
+    posed = np.stack([X, 1.1 * Y, 0.35 * X**2 + 0.05 * Y**2], axis=-1)
+    rng = np.random.default_rng(0)
+    x0 = -1 + 2 / (n - 1) * 10  # a cell boundary
+    P = np.c_[np.full(100, x0), rng.uniform(-0.2, 0.2, 100), rng.uniform(-0.25, -0.05, 100)]
+    a = spinal.flesh_surface(P - [1e-9, 0, 0], rest, posed)
+    b = spinal.flesh_surface(P + [1e-9, 0, 0], rest, posed)
+    assert np.abs(a - b).max() < 1e-7
