@@ -297,11 +297,18 @@ class SpineBinding:
             tw = np.ascontiguousarray(tw)
         if self._dim == 2:  # r is the left normal z × t all along a planar RMF
             t1 = posed[1] - posed[0]
-            init = np.array([-t1[1], t1[0], 0.0])
+            frames1 = _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0])
         else:
-            t1 = _spine_frames(posed, "posed_spine")[0][:, 2]
+            # the RMF is linear in its initial vector: start from the default one and roll
+            # every frame by the constant angle that brings it to the chosen start
+            frames1 = _spine_frames(posed, "posed_spine")
+            r, s_, t1 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
             init = _posed_initial(self._rest, self._frames[0], posed, t1)
-        frames1 = _spine_frames(posed, "posed_spine", initial=init)
+            g = np.arctan2(init @ s_, init @ r)
+            c, sn = np.cos(g), np.sin(g)
+            rr, ss = frames1[:, :, 0].copy(), frames1[:, :, 1].copy()
+            frames1[:, :, 0] = c * rr + sn * ss
+            frames1[:, :, 1] = c * ss - sn * rr
         sol = solution
         if self._dim == 2 and sol != "none":
             sol = "normal"
