@@ -378,9 +378,10 @@ def _grid(x, name: str) -> np.ndarray:
 class SurfaceBinding:
     r"""A shape registered on a rest spine surface (Zhuo 2014 Ch. VI), to be posed many times.
 
-    The surface is a grid of samples ``(nu, nv, 3)``, bilinear in every cell, with the unit
-    normal interpolated from the sample normals (central differences ``S_u × S_v``, so the
-    normal's side follows the grid's orientation). Every vertex is registered by its foot
+    The surface is a grid of samples ``(nu, nv, 3)``, a bicubic Hermite patch in every cell
+    (derivatives by central differences, C¹ across cells), with the unit normal interpolated
+    the same way from the sample normals (central differences ``S_u × S_v``, so the normal's
+    side follows the grid's orientation); the map is therefore continuous across cells. Every vertex is registered by its foot
     ``(u, v)`` and signed offset ``h`` along that normal (``P = S(u, v) + h N(u, v)``; the
     foot is found by Newton's method in the cells around the nearest sample; the smallest
     ``|h|`` wins). Vertices whose foot lies outside the grid are attached to the border with

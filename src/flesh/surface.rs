@@ -1,9 +1,10 @@
 //! Spine surfaces (Zhuo 2014 Ch. VI; spec §2.9, E-14): a shape bound to a surface keeps its
 //! volume when the surface bends and stretches.
 //!
-//! Model: the surface is a grid of samples, bilinear in every cell `(i, j)`, `(u, v) ∈ [0,1]²`;
-//! the unit normal `N = m/|m|` with `m` the bilinear interpolation of the sample normals
-//! (central differences `S_u × S_v`). A point is `P = S(u, v) + h N(u, v)` (Assumption II:
+//! Model: the surface is a grid of samples, a bicubic Hermite patch (zero twist, derivatives
+//! by central differences) in every cell `(i, j)`, `(u, v) ∈ [0,1]²`; the unit normal
+//! `N = m/|m|` with `m` the same bicubic interpolation of the sample normals (central
+//! differences `S_u × S_v`) — both C¹ across cell edges, so the map is continuous there. A point is `P = S(u, v) + h N(u, v)` (Assumption II:
 //! normal segments stay normal segments). The volume element is exactly
 //! `det[S_u + hN_u, S_v + hN_v, N] = A + B h + C h²` with `A = (S_u×S_v)·N`,
 //! `B = (S_u×N_v + N_u×S_v)·N`, `C = (N_u×N_v)·N` — in the thesis' notation `A = σ`,
@@ -33,6 +34,18 @@ pub struct Surface {
     pub nv: usize,
     pub s: Vec<DVec3>,
     pub n: Vec<DVec3>,
+    /// Per sample: `[∂S/∂i, ∂S/∂j, ∂n/∂i, ∂n/∂j]` by central differences (per grid step).
+    pub d: Vec<[DVec3; 4]>,
+}
+
+fn grid_diff(x: &[DVec3], nu: usize, nv: usize, i: usize, j: usize) -> (DVec3, DVec3) {
+    let at = |i: usize, j: usize| x[i * nv + j];
+    let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nu - 1));
+    let (j0, j1) = (j.saturating_sub(1), (j + 1).min(nv - 1));
+    (
+        (at(i1, j) - at(i0, j)) / (i1 - i0) as f64,
+        (at(i, j1) - at(i, j0)) / (j1 - j0) as f64,
+    )
 }
 
 /// The surface at one point of a cell.
@@ -72,6 +85,21 @@ impl Surface {
             return Err(InputError::new(arg, format!("point {i} is not finite")));
         }
         let at = |i: usize, j: usize| points[i * nv + j];
+        let scale = points
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        for i in 0..nu {
+            for j in 0..nv {
+                for (a, b) in [(i + 1, j), (i, j + 1)] {
+                    if a < nu && b < nv && (at(a, b) - at(i, j)).length() <= 1e-12 * scale {
+                        return Err(InputError::new(
+                            arg,
+                            format!("grid points ({i}, {j}) and ({a}, {b}) repeat the same point"),
+                        ));
+                    }
+                }
+            }
+        }
         let mut n = Vec::with_capacity(nu * nv);
         for i in 0..nu {
             for j in 0..nv {
@@ -88,10 +116,18 @@ impl Surface {
                 n.push(c / l);
             }
         }
+        let mut d = Vec::with_capacity(nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
+                let (su, sv) = grid_diff(points, nu, nv, i, j);
+                let (mu, mv) = grid_diff(&n, nu, nv, i, j);
+                d.push([su, sv, mu, mv]);
+            }
+        }
         for i in 0..nu - 1 {
             for j in 0..nv - 1 {
                 for (a, b) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
-                    let l = eval_raw(points, &n, nv, i, j, a, b);
+                    let l = eval_raw(points, &n, &d, nv, i, j, a, b);
                     let (aa, _, _) = l.abc();
                     if !(aa > 0.0) {
                         return Err(InputError::new(
@@ -107,28 +143,84 @@ impl Surface {
             nv,
             s: points.to_vec(),
             n,
+            d,
         })
     }
 
     #[inline]
     pub fn eval(&self, i: usize, j: usize, u: f64, v: f64) -> SurfLocal {
-        eval_raw(&self.s, &self.n, self.nv, i, j, u, v)
+        eval_raw(&self.s, &self.n, &self.d, self.nv, i, j, u, v)
     }
 }
 
+/// Cubic Hermite basis `(φ0, φ1, ψ0, ψ1)` and its derivative at `x`.
 #[inline]
-fn eval_raw(s: &[DVec3], n: &[DVec3], nv: usize, i: usize, j: usize, u: f64, v: f64) -> SurfLocal {
+fn hermite_basis(x: f64) -> ([f64; 4], [f64; 4]) {
+    let x2 = x * x;
+    let x3 = x2 * x;
+    (
+        [
+            2.0 * x3 - 3.0 * x2 + 1.0,
+            -2.0 * x3 + 3.0 * x2,
+            x3 - 2.0 * x2 + x,
+            x3 - x2,
+        ],
+        [
+            6.0 * x2 - 6.0 * x,
+            -6.0 * x2 + 6.0 * x,
+            3.0 * x2 - 4.0 * x + 1.0,
+            3.0 * x2 - 2.0 * x,
+        ],
+    )
+}
+
+/// Bicubic Hermite patch (zero twist) of corner values `p` and per-step derivatives `du`,
+/// `dv`: value and partials at `(u, v)`; C¹ across cell edges.
+#[inline]
+fn bicubic(p: [DVec3; 4], du: [DVec3; 4], dv: [DVec3; 4], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+    let (bu, bu1) = hermite_basis(u);
+    let (bv, bv1) = hermite_basis(v);
+    let (mut x, mut xu, mut xv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    // corners (a, b) in the order (0,0), (1,0), (0,1), (1,1)
+    for (c, (a, b)) in [(0usize, 0usize), (1, 0), (0, 1), (1, 1)]
+        .into_iter()
+        .enumerate()
+    {
+        x += bu[a] * bv[b] * p[c] + bu[2 + a] * bv[b] * du[c] + bu[a] * bv[2 + b] * dv[c];
+        xu += bu1[a] * bv[b] * p[c] + bu1[2 + a] * bv[b] * du[c] + bu1[a] * bv[2 + b] * dv[c];
+        xv += bu[a] * bv1[b] * p[c] + bu[2 + a] * bv1[b] * du[c] + bu[a] * bv1[2 + b] * dv[c];
+    }
+    (x, xu, xv)
+}
+
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn eval_raw(
+    s: &[DVec3],
+    n: &[DVec3],
+    d: &[[DVec3; 4]],
+    nv: usize,
+    i: usize,
+    j: usize,
+    u: f64,
+    v: f64,
+) -> SurfLocal {
     let k = i * nv + j;
-    let (p00, p10, p01, p11) = (s[k], s[k + nv], s[k + 1], s[k + nv + 1]);
-    let (m00, m10, m01, m11) = (n[k], n[k + nv], n[k + 1], n[k + nv + 1]);
-    let bil = |a: DVec3, b: DVec3, c: DVec3, d: DVec3| {
-        let p = (1.0 - u) * ((1.0 - v) * a + v * c) + u * ((1.0 - v) * b + v * d);
-        let pu = (1.0 - v) * (b - a) + v * (d - c);
-        let pv = (1.0 - u) * (c - a) + u * (d - b);
-        (p, pu, pv)
-    };
-    let (sp, su, sv) = bil(p00, p10, p01, p11);
-    let (m, mu, mv) = bil(m00, m10, m01, m11);
+    let ks = [k, k + nv, k + 1, k + nv + 1];
+    let (sp, su, sv) = bicubic(
+        ks.map(|q| s[q]),
+        ks.map(|q| d[q][0]),
+        ks.map(|q| d[q][1]),
+        u,
+        v,
+    );
+    let (m, mu, mv) = bicubic(
+        ks.map(|q| n[q]),
+        ks.map(|q| d[q][2]),
+        ks.map(|q| d[q][3]),
+        u,
+        v,
+    );
     let ml = m.length();
     let nn = m / ml;
     SurfLocal {
