@@ -701,6 +701,58 @@ fn flesh_resample<'py>(
     PyArray1::from_vec(py, flat).reshape([n, 3])
 }
 
+/// Register vertices on a rest spine surface (grid `nu × nv`); see `spinal.SurfaceBinding`.
+#[pyfunction]
+fn flesh_surface_bind<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    nu: usize,
+    nv: usize,
+    vertices: PyReadonlyArray2<'py, f64>,
+) -> PyResult<FleshBinding<'py>> {
+    let pts = vec3s("rest_surface", &rest_points)?;
+    let v = vec3s("vertices", &vertices)?;
+    let (cell, coords) = py
+        .detach(|| {
+            let rest = crate::flesh::surface::Surface::new("rest_surface", pts, nu, nv)?;
+            crate::flesh::surface::bind_surface(&rest, v)
+        })
+        .map_err(to_py)?;
+    let n = cell.len();
+    let coords =
+        PyArray1::from_vec(py, coords).reshape([n, crate::flesh::surface::SURFACE_COORDS])?;
+    Ok((PyArray1::from_vec(py, cell), coords))
+}
+
+/// Deform vertices registered on a spine surface; see `spinal.SurfaceBinding.deform`.
+#[pyfunction]
+fn flesh_surface_deform<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    nu: usize,
+    nv: usize,
+    cell: PyReadonlyArray1<'py, i64>,
+    coords: PyReadonlyArray2<'py, f64>,
+    corrected: bool,
+) -> PyResult<FleshPose<'py>> {
+    let pts = vec3s("posed_surface", &posed_points)?;
+    let cell = slice_of("cell", &cell)?;
+    let coords = slice_of("coords", &coords)?;
+    let n = cell.len();
+    let out = empty::<f64, numpy::Ix2>(py, &[n, 3])?;
+    let mut flags = vec![0u8; n];
+    {
+        let mut w = out.readwrite();
+        let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        py.detach(|| {
+            let posed = crate::flesh::surface::Surface::new("posed_surface", pts, nu, nv)?;
+            crate::flesh::surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
+        })
+        .map_err(to_py)?;
+    }
+    Ok((out, PyArray1::from_vec(py, flags)))
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
@@ -728,6 +780,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_deform, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_resample, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_surface_bind, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh_surface_deform, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

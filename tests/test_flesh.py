@@ -156,7 +156,8 @@ def test_3d_reference_values():
 
 
 def fd_det(binding, points, posed, eps=1e-5, **kw):
-    """Central-difference det ∂P1/∂P0 at `points`; NaN where a probe changes spine edge."""
+    """Central-difference det ∂P1/∂P0 at `points`; NaN where a probe changes spine edge or
+    is clamped (past the existence limit)."""
     dim = points.shape[1]
     probes = [points]
     for j in range(dim):
@@ -165,11 +166,15 @@ def fd_det(binding, points, posed, eps=1e-5, **kw):
         probes += [points + e, points - e]
     allp = np.concatenate(probes)
     b = spinal.SpineBinding(allp, binding)
-    out = b.deform(posed, **kw).reshape(2 * dim + 1, len(points), dim)
-    edges = b.edge.reshape(2 * dim + 1, len(points))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", spinal.FoldOverWarning)
+        out, clamped = b.deform(posed, return_clamped=True, **kw)
+    out = out.reshape(2 * dim + 1, len(points), dim)
+    edges = b.edge.reshape(2 * dim + 1, len(points)).copy()
+    edges.reshape(-1)[clamped] = -1  # clamped vertices do not keep volume: left out
     J = np.stack([(out[1 + 2 * j] - out[2 + 2 * j]) / (2 * eps) for j in range(dim)], axis=-1)
     det = np.linalg.det(J)
-    det[(edges != edges[0]).any(axis=0)] = np.nan
+    det[(edges != edges[0]).any(axis=0) | (edges < 0).any(axis=0)] = np.nan
     return det
 
 
@@ -466,3 +471,189 @@ def test_continuous_across_samples(solution):
     assert np.all(b.edge[:200] == j - 1) and np.all(b.edge[200:] == j)
     out = b.deform(posed, solution=solution)
     assert np.abs(out[:200] - out[200:]).max() < 1e-7
+
+
+@pytest.mark.parametrize("solution", SOLS + ("none",))
+def test_inverse_swaps_the_spines(solution):
+    """Spec acceptance test 2: the map from the posed to the rest spine undoes the map.
+    Exact for radial (the stretch 1/√λ is isotropic) and the uncorrected map; normal and
+    binormal stretch along the posed spine's N or B (spec A-8 default), so their inverse
+    is exact only where λ = 1: with a non-stretchable spine λ − 1 = O(h²) inside the edges
+    and the round trip converges at that order."""
+    rng = np.random.default_rng(2)
+    errs = []
+    for n in (150, 600):
+        rest, posed = curve3(n), bent3(n)
+        V = rest[rng.integers(n // 15, n - n // 15, 400)] + rng.normal(size=(400, 3)) * 0.08
+        b = spinal.SpineBinding(V, rest)
+        used = b.posed_spine(posed)  # the forward map's resampled posed spine
+        there = b.deform(posed, solution=solution)
+        back = spinal.flesh(there, used, rest, solution=solution)
+        errs.append(np.abs(back - V).max())
+        if solution in ("radial", "none"):
+            there = spinal.flesh(V, rest, posed, solution=solution, stretchable=True)
+            back = spinal.flesh(there, posed, rest, solution=solution, stretchable=True)
+            assert np.abs(back - V).max() < 1e-12
+            assert errs[-1] < 1e-12
+    if solution in ("normal", "binormal"):
+        assert errs[0] < 1e-5 and errs[0] / errs[1] > 10
+    # the same binding poses many times, as flesh() does once
+    for s in (0.5, 1.0):
+        mid = rest + s * (posed - rest)
+        assert np.array_equal(b.deform(mid, solution=solution),
+                              spinal.flesh(V, rest, mid, solution=solution))
+
+
+# --- spine surfaces (Ch. VI) ------------------------------------------------------------
+
+
+def plane_grid(n=41, size=2.0):
+    x = np.linspace(-size / 2, size / 2, n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    return np.stack([X, Y, np.zeros_like(X)], axis=-1)
+
+
+def cylinder_grid(n=41, size=2.0, radius=2.0):
+    """The plane rolled onto a cylinder of axis y through (0, 0, radius), chords kept (the
+    grid cells stay congruent rectangles); normal +z toward the axis."""
+    h = size / (n - 1)
+    dth = 2 * np.arcsin(h / (2 * radius))
+    th = (np.arange(n) - (n - 1) / 2) * dth
+    y = np.linspace(-size / 2, size / 2, n)
+    T, Y = np.meshgrid(th, y, indexing="ij")
+    return np.stack([radius * np.sin(T), Y, radius * (1 - np.cos(T))], axis=-1)
+
+
+def test_surface_reference_identity_rigid():
+    rest, posed = plane_grid(), cylinder_grid()
+    P = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, -0.3], [0.0, 0.2, 0.1]])
+    out = spinal.flesh_surface(P, rest, posed)
+    # plane → cylinder R = 2 (m = 0.25, g = 0): h_t = 0.3 → 0.3266799 (spec §3); the grid's
+    # normal interpolation bends by cos(Δθ/2)/R: an O(Δθ²) error, 4× smaller per halving
+    err = abs(out[0, 2] - 0.3266799)
+    fine = spinal.flesh_surface(P[:1], plane_grid(81), cylinder_grid(81))
+    err_fine = abs(fine[0, 2] - 0.3266799)
+    assert err < 5e-5 and err_fine < 1.5e-5 and 3.5 < err / err_fine < 4.5
+    # convex side, thinner: h − h²/4 = −0.3 (Eq. 43 with m = 0.25, g = 0)
+    assert abs(out[1, 2] - (1 - np.sqrt(1.3)) / 0.5) < 5e-5
+    rng = np.random.default_rng(4)
+    V = np.c_[rng.uniform(-0.8, 0.8, (300, 2)), rng.uniform(-0.4, 0.4, 300)]
+    for sol in ("offset", "none"):
+        assert np.abs(spinal.flesh_surface(V, posed, posed, solution=sol) - V).max() < 1e-12
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    R = q * np.sign(np.linalg.det(q))
+    out = spinal.flesh_surface(V, rest, rest @ R.T + [1, 2, 3])
+    assert np.abs(out - (V @ R.T + [1, 2, 3])).max() < 1e-10
+
+
+def test_surface_jacobian_and_volume():
+    rng = np.random.default_rng(6)
+    rest = plane_grid(31)
+    g = plane_grid(31)
+    # a doubly curved, stretched pose
+    X, Y = g[..., 0], g[..., 1]
+    posed = np.stack([1.1 * X, 0.9 * Y + 0.1 * X, 0.25 * X**2 - 0.15 * Y**2 + 0.1 * X * Y],
+                     axis=-1)
+    pts = np.c_[rng.uniform(-0.8, 0.8, (200, 2)), rng.uniform(-0.3, 0.3, 200)]
+    eps = 1e-5
+    probes = [pts] + [pts + s * eps * e for e in np.eye(3) for s in (1, -1)]
+    b = spinal.SurfaceBinding(np.concatenate(probes), rest)
+    cells = b.uv.astype(int).reshape(7, -1, 2)
+    same = (cells == cells[0]).all(axis=(0, 2))
+    for sol, expect in (("offset", True), ("none", False)):
+        out = b.deform(posed, solution=sol).reshape(7, -1, 3)
+        J = np.stack([(out[1 + 2 * k] - out[2 + 2 * k]) / (2 * eps) for k in range(3)], -1)
+        det = np.linalg.det(J)[same]
+        assert same.sum() > 150
+        if expect:
+            assert np.abs(det - 1).max() < 1e-6
+        else:
+            assert np.abs(det - 1).max() > 0.05
+    # closed meshes above and below the surface: volume kept, the uncorrected map does not
+    # closed meshes above and below the surface: volume kept up to the mesh's sampling
+    # error, which falls 4× per subdivision (C¹ cells); the uncorrected map is far off
+    posed = np.stack([X, 1.1 * Y, 0.35 * X**2 + 0.05 * Y**2], axis=-1)  # bent and stretched
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=0.2)
+    box = subdivided(trimesh.creation.box(extents=[0.5, 0.4, 0.2]), 3)
+    for mesh, shift in ((ball, [0.3, 0.1, 0.25]), (box, [-0.3, 0.0, -0.15])):
+        errs = []
+        for times in (0, 1):
+            m = subdivided(mesh.copy(), times)
+            m.apply_translation(shift)
+            v0 = vols(m)[0]
+            e = {}
+            for sol in ("offset", "none"):
+                out = spinal.flesh_surface(m.vertices, rest, posed, solution=sol)
+                v1_tm, v1_igl = vols(trimesh.Trimesh(out, m.faces, process=False))
+                assert abs(v1_tm - v1_igl) < 1e-12 * v1_tm
+                e[sol] = v1_tm / v0 - 1
+            assert abs(e["none"]) > 0.05, e
+            errs.append(abs(e["offset"]))
+        assert errs[1] < 1.2e-4 and errs[0] / errs[1] > 3.5, errs
+
+
+def test_surface_clamp_and_bad_input():
+    rest = plane_grid(21)
+    # plane → sphere R = 0.5 patch: points 0.3 above on the concave side cannot fit
+    g = plane_grid(21, 1.0)
+    X, Y = g[..., 0], g[..., 1]
+    R = 0.5
+    r = np.hypot(X, Y)
+    phi = r / R
+    sc = np.where(r > 0, np.sin(phi) / np.where(r > 0, r, 1), 1 / R) * R
+    posed = np.stack([X * sc, Y * sc, R * (1 - np.cos(phi))], axis=-1)
+    V = np.array([[0.0, 0.0, 0.45], [0.0, 0.0, 0.1]])
+    with pytest.warns(spinal.FoldOverWarning):
+        out, clamped = spinal.flesh_surface(V, plane_grid(21, 1.0), posed, return_clamped=True)
+    assert np.array_equal(clamped, [0]) and np.isfinite(out).all()
+    assert abs(out[0, 2] - 0.5) < 1e-2  # clamped at the focal point (the sphere's centre)
+    with pytest.raises(ValueError, match="^rest_surface:"):
+        spinal.flesh_surface(V, rest[:1], rest)
+    with pytest.raises(ValueError, match="^posed_surface:"):
+        spinal.flesh_surface(V, rest, rest[:-1])
+    with pytest.raises(ValueError, match="^vertices:"):
+        spinal.flesh_surface([[np.nan, 0, 0]], rest, rest)
+    rep = rest.copy()
+    rep[3, 3] = rep[3, 4]
+    with pytest.raises(ValueError, match="^rest_surface:.*repeat"):
+        spinal.flesh_surface(V, rep, rest)
+    with pytest.raises(ValueError, match="^solution:"):
+        spinal.flesh_surface(V, rest, rest, solution="radial")
+
+
+def test_surface_continuous_across_cells():
+    """Bicubic Hermite cells (C¹ positions and normals): no jump across cell edges (the
+    bilinear model jumped by 1.6e-3 here)."""
+    n = 31
+    rest = plane_grid(n)
+    X, Y = rest[..., 0], rest[..., 1]
+    posed = np.stack([X, 1.1 * Y, 0.35 * X**2 + 0.05 * Y**2], axis=-1)
+    rng = np.random.default_rng(0)
+    x0 = -1 + 2 / (n - 1) * 10  # a cell boundary
+    P = np.c_[np.full(100, x0), rng.uniform(-0.2, 0.2, 100), rng.uniform(-0.25, -0.05, 100)]
+    a = spinal.flesh_surface(P - [1e-9, 0, 0], rest, posed)
+    b = spinal.flesh_surface(P + [1e-9, 0, 0], rest, posed)
+    assert np.abs(a - b).max() < 1e-7
+
+
+def test_planar_area_of_closed_polygons():
+    """2D: the area of closed polygons (shoelace) off the spine is kept by the quadratic
+    solution under bending and stretching; the uncorrected map changes it by percents."""
+    rest = straight(301, 3.0)[:, :2]
+    posed = arc(301, 1.0, 3.0 / 300)[:, :2]
+    posed_s = arc(301, 1.2, 1.2 * 3.0 / 300)[:, :2]  # bent and stretched by 1.2
+    a = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+
+    def area(p):
+        return 0.5 * np.abs(np.dot(p[:, 0], np.roll(p[:, 1], -1))
+                            - np.dot(p[:, 1], np.roll(p[:, 0], -1)))
+
+    for centre, rad in (((0.2, 0.25), 0.15), ((-0.4, -0.2), 0.1), ((0.0, 0.0), 0.3)):
+        poly = np.c_[centre[0] + rad * np.cos(a), centre[1] + rad * np.sin(a)]
+        a0 = area(poly)
+        for pose, st in ((posed, False), (posed_s, True)):
+            err = area(spinal.flesh(poly, rest, pose, stretchable=st)) / a0 - 1
+            base = area(spinal.flesh(poly, rest, pose, solution="none", stretchable=st)) / a0 - 1
+            assert abs(err) < 2e-6, (centre, st, err)
+            if centre != (0.0, 0.0):
+                assert abs(base) > 0.03

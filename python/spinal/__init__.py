@@ -10,7 +10,7 @@ from . import curves, fields, ph, quaternions
 from ._advect import advect
 from ._core import __version__
 from ._deform import DeformReport, deform
-from ._flesh import SpineBinding, flesh
+from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
@@ -20,6 +20,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "SpineBinding",
+    "SurfaceBinding",
     "__version__",
     "advect",
     "closing_angle",
@@ -28,6 +29,7 @@ __all__ = [
     "estimate_tangents",
     "fields",
     "flesh",
+    "flesh_surface",
     "frames",
     "ph",
     "quaternions",

@@ -184,3 +184,30 @@ def flesh(
     strict: bool = False,
     return_clamped: bool = False,
 ) -> Any: ...
+
+class SurfaceBinding:
+    clamped: npt.NDArray[np.int64]
+    def __init__(self, vertices: _Array, rest_surface: _Array) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def uv(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def offset(self) -> npt.NDArray[np.float64]: ...
+    def deform(
+        self,
+        posed_surface: _Array,
+        *,
+        solution: Literal["offset", "none"] = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+    ) -> Any: ...
+
+def flesh_surface(
+    vertices: _Array,
+    rest_surface: _Array,
+    posed_surface: _Array,
+    *,
+    solution: Literal["offset", "none"] = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+) -> Any: ...

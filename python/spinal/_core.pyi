@@ -146,3 +146,14 @@ def flesh_deform(
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...
+def flesh_surface_bind(
+    rest_points: npt.NDArray[np.float64], nu: int, nv: int, vertices: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def flesh_surface_deform(
+    posed_points: npt.NDArray[np.float64],
+    nu: int,
+    nv: int,
+    cell: npt.NDArray[np.int64],
+    coords: npt.NDArray[np.float64],
+    corrected: bool,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...

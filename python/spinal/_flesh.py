@@ -64,29 +64,45 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
-def _posed_initial(rest: np.ndarray, r0: np.ndarray, posed: np.ndarray) -> np.ndarray:
+def _min_rotation_matrix(t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    """The rotation by the smallest angle taking unit ``t0`` to unit ``t1``."""
+    c = float(t0 @ t1)
+    k = np.cross(t0, t1)
+    if c <= -1 + 1e-12:  # half turn about any axis ⟂ t0
+        a = np.cross(t0, [1.0, 0, 0] if abs(t0[0]) < 0.9 else [0, 1.0, 0])
+        a /= np.linalg.norm(a)
+        return 2 * np.outer(a, a) - np.eye(3)
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + kx + kx @ kx / (1 + c)
+
+
+def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
     """Reference vector of the posed spine's first frame (spec A-5, made rigid-motion
-    equivariant): ``r0`` turned by the best-fit rotation (Kabsch, weights 1) from the rest to
-    the posed samples; when either spine is straight (the best fit's roll about it is
-    undetermined) by the minimal rotation taking the first tangent to the posed one."""
+    equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal rotation taking
+    the rest start tangent ``t0`` to the posed one ``t1`` and ``ψ`` the twist about ``t0``
+    (swing–twist split) of ``Qᵀ K``, ``K`` the best-fit (Kabsch) rotation of the rest onto the
+    posed samples; ``ψ = 0`` when either spine is straight (the roll about it is then free).
+    A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the inverse roll."""
+    r0, t0 = f0[:, 0], f0[:, 2]
+    q = _min_rotation_matrix(t0, t1)
     a = rest - rest.mean(0)
     b = posed - posed.mean(0)
     u, sv, vt = np.linalg.svd(a.T @ b)
     sa = np.linalg.svd(a, compute_uv=False)
     sb = np.linalg.svd(b, compute_uv=False)
+    psi = 0.0
     if sv[1] > 1e-9 * sv[0] and sa[1] > 1e-9 * sa[0] and sb[1] > 1e-9 * sb[0]:
         d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-        rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-        return rot @ r0
-    return None
-
-
-def _min_rotation(r0, t0, t1):
-    c = float(t0 @ t1)
-    k = np.cross(t0, t1)
-    if c <= -1 + 1e-12:
-        return -r0
-    return r0 * c + np.cross(k, r0) + k * (k @ r0) / (1 + c)
+        k = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+        m = q.T @ k
+        # quaternion (v, w) of m, up to a common factor; its twist about t0 has angle
+        # 2 atan2(v·t0, w)
+        w = 1.0 + np.trace(m)
+        v = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+        psi = 2 * np.arctan2(v @ t0, w)
+    c, s = np.cos(psi), np.sin(psi)
+    rolled = c * r0 + s * np.cross(t0, r0) + (1 - c) * (t0 @ r0) * t0
+    return q @ rolled
 
 
 class SpineBinding:
@@ -233,10 +249,13 @@ class SpineBinding:
         thins that part (λ > 1), compressing thickens it.
 
         The posed frames are the RMF of the posed spine started from the rest spine's first
-        reference vector turned by the best-fit (Kabsch) rotation of rest onto posed samples
-        (by the minimal rotation of the first tangent when either spine is straight); so the
-        identity pose returns the input and a rigid motion of the spine moves the shape
-        rigidly.
+        reference vector turned by the minimal rotation of the first tangent and rolled by the
+        twist (about that tangent) of the best-fit (Kabsch) rotation of rest onto posed
+        samples (no roll when either spine is straight); so the identity pose returns the
+        input, a rigid motion of the spine moves the shape rigidly, and swapping the two
+        spines (the posed one as returned by :meth:`posed_spine`) inverts the map — exactly
+        for ``"radial"`` and ``"none"``; ``"normal"``/``"binormal"`` stretch along the posed
+        spine's N/B (spec A-8), so they invert exactly only where the stretch is 1.
 
         Parameters
         ----------
@@ -276,17 +295,20 @@ class SpineBinding:
             if not np.isfinite(tw).all():
                 raise ValueError("twist: must be finite")
             tw = np.ascontiguousarray(tw)
-        r0 = self._frames[0][:, 0]
-        f0 = self._frames[0][:, 2]
         if self._dim == 2:  # r is the left normal z × t all along a planar RMF
             t1 = posed[1] - posed[0]
-            init = np.array([-t1[1], t1[0], 0.0])
+            frames1 = _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0])
         else:
-            init = _posed_initial(self._rest, r0, posed)
-        if init is None:
-            t1 = _spine_frames(posed, "posed_spine")[0][:, 2]
-            init = _min_rotation(r0, f0, t1)
-        frames1 = _spine_frames(posed, "posed_spine", initial=init)
+            # the RMF is linear in its initial vector: start from the default one and roll
+            # every frame by the constant angle that brings it to the chosen start
+            frames1 = _spine_frames(posed, "posed_spine")
+            r, s_, t1 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
+            init = _posed_initial(self._rest, self._frames[0], posed, t1)
+            g = np.arctan2(init @ s_, init @ r)
+            c, sn = np.cos(g), np.sin(g)
+            rr, ss = frames1[:, :, 0].copy(), frames1[:, :, 1].copy()
+            frames1[:, :, 0] = c * rr + sn * ss
+            frames1[:, :, 1] = c * ss - sn * rr
         sol = solution
         if self._dim == 2 and sol != "none":
             sol = "normal"
@@ -341,3 +363,103 @@ def flesh(
         strict=strict,
         return_clamped=return_clamped,
     )
+
+
+def _grid(x, name: str) -> np.ndarray:
+    arr = as_float_array(x, name)
+    if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 2 or arr.shape[1] < 2:
+        raise ValueError(f"{name}: expected a grid of shape (nu, nv, 3), nu, nv ≥ 2, got "
+                         f"{arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name}: must be finite")
+    return np.ascontiguousarray(arr)
+
+
+class SurfaceBinding:
+    r"""A shape registered on a rest spine surface (Zhuo 2014 Ch. VI), to be posed many times.
+
+    The surface is a grid of samples ``(nu, nv, 3)``, a bicubic Hermite patch in every cell
+    (derivatives by central differences, C¹ across cells), with the unit normal interpolated
+    the same way from the sample normals (central differences ``S_u × S_v``, so the normal's
+    side follows the grid's orientation); the map is therefore continuous across cells. Every vertex is registered by its foot
+    ``(u, v)`` and signed offset ``h`` along that normal (``P = S(u, v) + h N(u, v)``; the
+    foot is found by Newton's method in the cells around the nearest sample; the smallest
+    ``|h|`` wins). Vertices whose foot lies outside the grid are attached to the border with
+    their offset carried rigidly (not volume preserving; reported as clamped).
+
+    :meth:`deform` keeps every normal segment on the normal of the posed surface at the same
+    ``(u, v)`` and corrects its length with the mean and Gaussian curvature and the area
+    stretch (Eq. 38–43): ``A1 h1 + B1 h1²/2 + C1 h1³/3 = A0 h0 + B0 h0²/2 + C0 h0³/3`` where
+    ``A + B h + C h² = det[S_u + hN_u, S_v + hN_v, N]`` is the model's exact volume element
+    (``B = −2mA``, ``C = gA``), so the map's Jacobian determinant is 1. Where no fold-free
+    root exists, ``h1`` is clamped to the largest fold-free offset ``1/k_max`` (§6.2).
+
+    Parameters
+    ----------
+    vertices : array_like (V, 3)
+    rest_surface : array_like (nu, nv, 3), nu, nv ≥ 2
+    """
+
+    def __init__(self, vertices, rest_surface):
+        g = _grid(rest_surface, "rest_surface")
+        v = as_float_array(vertices, "vertices")
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
+        bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+        if bad.size:
+            raise ValueError(f"vertices: row {bad[0]} is not finite")
+        self._shape = g.shape[:2]
+        self._cell, self._coords = _core.flesh_surface_bind(
+            g.reshape(-1, 3), g.shape[0], g.shape[1], np.ascontiguousarray(v, dtype=np.float64)
+        )
+        self.clamped = np.zeros(0, dtype=np.int64)
+
+    def __len__(self) -> int:
+        return len(self._cell)
+
+    @property
+    def uv(self) -> np.ndarray:
+        """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet."""
+        i, j = np.divmod(self._cell, self._shape[1])
+        return np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
+
+    @property
+    def offset(self) -> np.ndarray:
+        """``(V,)`` signed offsets ``h`` along the rest normal."""
+        return self._coords[:, 2].copy()
+
+    def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
+               return_clamped: bool = False):
+        """The shape on ``posed_surface`` (same grid shape): ``(V, 3)``.
+
+        ``solution="offset"`` (default) corrects the offset (volume preserving);
+        ``"none"`` keeps ``h1 = h0`` (the uncorrected map). Clamped vertices (no fold-free
+        offset, or foot outside the grid) are reported as in :meth:`SpineBinding.deform`.
+        """
+        solution = as_choice(solution, "solution", ("offset", "none"))
+        strict = as_bool(strict, "strict")
+        g = _grid(posed_surface, "posed_surface")
+        if g.shape[:2] != self._shape:
+            raise ValueError(f"posed_surface: expected the rest grid's shape "
+                             f"{self._shape}, got {g.shape[:2]}")
+        out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
+                                                self._cell, self._coords, solution == "offset")
+        clamped = np.flatnonzero(flags).astype(np.int64)
+        self.clamped = clamped
+        if clamped.size:
+            msg = (f"posed_surface: {clamped.size} vertices have no fold-free offset or lie "
+                   f"outside the surface and were clamped, e.g. vertex {clamped[0]}")
+            if strict:
+                raise ValueError(msg)
+            warnings.warn(FoldOverWarning(msg, clamped), stacklevel=2)
+        return (out, clamped) if return_clamped else out
+
+
+def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "offset",
+                  strict: bool = False, return_clamped: bool = False):
+    """Bend a shape with a spine surface and keep its volume locally (Zhuo 2014 Ch. VI).
+
+    One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``.
+    """
+    return SurfaceBinding(vertices, rest_surface).deform(
+        posed_surface, solution=solution, strict=strict, return_clamped=return_clamped)

@@ -25,6 +25,7 @@ pub mod bind;
 pub mod pose;
 pub mod solve;
 pub mod spine;
+pub mod surface;
 
 pub use bind::{Binding, COORDS, bind};
 pub use pose::deform;

@@ -5,7 +5,7 @@
 //! central differences of the tangents in chord length, `σ_k = E_k·t_j`), so that the
 //! model's curvature vector `κ = (dt/da)/σ` equals `κ_j` at sample `j` from both sides: the
 //! map is continuous across samples (up to the O(h³) jump of `σ`); RMF reference vectors
-//! interpolated linearly and re-orthogonalised.
+//! blended in the normal plane of `t_k` and carried to `t(a)` by the minimal rotation.
 
 use glam::{DVec2, DVec3};
 
@@ -21,6 +21,8 @@ pub struct Spine {
     pub m: Vec<[DVec3; 4]>,
     /// Per edge: the position `C(a)` in the same power form.
     pub p: Vec<[DVec3; 4]>,
+    /// Per edge: `r_{k+1}` carried back to `t_k` by the minimal rotation.
+    pub rb: Vec<DVec3>,
 }
 
 /// Sample curvature vectors: central differences of the unit tangents in chord length,
@@ -42,6 +44,14 @@ fn cubic(c: &[DVec3; 4], a: f64) -> DVec3 {
 #[inline]
 fn cubic_slope(c: &[DVec3; 4], a: f64) -> DVec3 {
     c[1] + a * (2.0 * c[2] + 3.0 * a * c[3])
+}
+
+/// `v` turned by the minimal rotation taking unit `from` to unit `to` (not antipodal).
+#[inline]
+fn min_rotate(v: DVec3, from: DVec3, to: DVec3) -> DVec3 {
+    let c = from.dot(to);
+    let k = from.cross(to);
+    v * c + k.cross(v) + k * (k.dot(v) / (1.0 + c))
 }
 
 fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
@@ -142,12 +152,16 @@ impl Spine {
             m.push(coef);
             pc.push(pos);
         }
+        let rb = (0..n - 1)
+            .map(|k| min_rotate(r[k + 1], t[k + 1], t[k]))
+            .collect();
         Ok(Spine {
             c: points.to_vec(),
             t,
             r,
             m,
             p: pc,
+            rb,
         })
     }
 
@@ -182,7 +196,11 @@ impl Spine {
         let t = m / ml;
         let ta = (dt - t * t.dot(dt)) / ml;
         let sigma = e.dot(t);
-        let um = self.r[k] + a * (self.r[k + 1] - self.r[k]);
+        // r_k and r_{k+1} (carried back to t_k) blended in the normal plane of t_k, then
+        // carried to t(a) by the minimal rotation: r_k at a = 0, r_{k+1} at a = 1, and
+        // equivariant under a common roll of the frames (so swapping spines inverts the map)
+        let r0 = self.r[k];
+        let um = min_rotate(r0 + a * (self.rb[k] - r0), self.t[k], t);
         let u = (um - t * t.dot(um)).normalize();
         let v = t.cross(u);
         let kv = ta / sigma;

@@ -1,0 +1,476 @@
+//! Spine surfaces (Zhuo 2014 Ch. VI; spec §2.9, E-14): a shape bound to a surface keeps its
+//! volume when the surface bends and stretches.
+//!
+//! Model: the surface is a grid of samples, a bicubic Hermite patch (zero twist, derivatives
+//! by central differences) in every cell `(i, j)`, `(u, v) ∈ [0,1]²`; the unit normal
+//! `N = m/|m|` with `m` the same bicubic interpolation of the sample normals (central
+//! differences `S_u × S_v`) — both C¹ across cell edges, so the map is continuous there. A point is `P = S(u, v) + h N(u, v)` (Assumption II:
+//! normal segments stay normal segments). The volume element is exactly
+//! `det[S_u + hN_u, S_v + hN_v, N] = A + B h + C h²` with `A = (S_u×S_v)·N`,
+//! `B = (S_u×N_v + N_u×S_v)·N`, `C = (N_u×N_v)·N` — in the thesis' notation `A = σ`,
+//! `B = −2mσ`, `C = gσ` (Eq. 38) — so the corrected offset solves (Eq. 40–43)
+//! `A1 h1 + B1 h1²/2 + C1 h1³/3 = A0 h0 + B0 h0²/2 + C0 h0³/3`, i.e.
+//! `F(h1) = h1 − m1 h1² + g1 h1³/3 = (A0 h0 + B0 h0²/2 + C0 h0³/3)/A1`, root selection of
+//! spec §2.9 (corrected E-14): the root on the branch where `F' = (1 − k_a h)(1 − k_b h) > 0`;
+//! without one, the largest fold-free offset `h_c = 1/k_max` (clamped, reported).
+//! Points whose foot lies outside the grid are attached to the border with their residual
+//! carried rigidly in the local frame (not volume preserving; reported).
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::solve::CLAMPED_BEND;
+use crate::error::{InputError, Result};
+
+/// Flag: the vertex's foot is outside the surface (attached to the border, uncorrected).
+pub const OUTSIDE: u8 = 4;
+/// Numbers stored per vertex: `[u, v, h0, A0, B0, C0, r1, r2, r3]` (r: border residual).
+pub const SURFACE_COORDS: usize = 9;
+
+/// A sampled spine surface.
+#[derive(Clone, Debug)]
+pub struct Surface {
+    pub nu: usize,
+    pub nv: usize,
+    pub s: Vec<DVec3>,
+    pub n: Vec<DVec3>,
+    /// Per sample: `[∂S/∂i, ∂S/∂j, ∂n/∂i, ∂n/∂j]` by central differences (per grid step).
+    pub d: Vec<[DVec3; 4]>,
+}
+
+fn grid_diff(x: &[DVec3], nu: usize, nv: usize, i: usize, j: usize) -> (DVec3, DVec3) {
+    let at = |i: usize, j: usize| x[i * nv + j];
+    let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nu - 1));
+    let (j0, j1) = (j.saturating_sub(1), (j + 1).min(nv - 1));
+    (
+        (at(i1, j) - at(i0, j)) / (i1 - i0) as f64,
+        (at(i, j1) - at(i, j0)) / (j1 - j0) as f64,
+    )
+}
+
+/// The surface at one point of a cell.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfLocal {
+    pub s: DVec3,
+    pub su: DVec3,
+    pub sv: DVec3,
+    pub n: DVec3,
+    pub nu: DVec3,
+    pub nv: DVec3,
+}
+
+impl SurfLocal {
+    /// `(A, B, C)` of the volume element `A + B h + C h²`.
+    pub fn abc(&self) -> (f64, f64, f64) {
+        (
+            self.su.cross(self.sv).dot(self.n),
+            (self.su.cross(self.nv) + self.nu.cross(self.sv)).dot(self.n),
+            self.nu.cross(self.nv).dot(self.n),
+        )
+    }
+
+    /// A local orthonormal frame (e1 along S_u, e2, N).
+    fn frame(&self) -> (DVec3, DVec3) {
+        let e1 = (self.su - self.n * self.n.dot(self.su)).normalize();
+        (e1, self.n.cross(e1))
+    }
+}
+
+impl Surface {
+    pub fn new(arg: &'static str, points: &[DVec3], nu: usize, nv: usize) -> Result<Surface> {
+        if nu < 2 || nv < 2 || points.len() != nu * nv {
+            return Err(InputError::new(arg, "need a grid of at least 2 × 2 points"));
+        }
+        if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+            return Err(InputError::new(arg, format!("point {i} is not finite")));
+        }
+        let at = |i: usize, j: usize| points[i * nv + j];
+        let scale = points
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        for i in 0..nu {
+            for j in 0..nv {
+                for (a, b) in [(i + 1, j), (i, j + 1)] {
+                    if a < nu && b < nv && (at(a, b) - at(i, j)).length() <= 1e-12 * scale {
+                        return Err(InputError::new(
+                            arg,
+                            format!("grid points ({i}, {j}) and ({a}, {b}) repeat the same point"),
+                        ));
+                    }
+                }
+            }
+        }
+        let mut n = Vec::with_capacity(nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
+                let du = at((i + 1).min(nu - 1), j) - at(i.saturating_sub(1), j);
+                let dv = at(i, (j + 1).min(nv - 1)) - at(i, j.saturating_sub(1));
+                let c = du.cross(dv);
+                let l = c.length();
+                if !(l > 1e-300) || !(l > 1e-12 * du.length() * dv.length()) {
+                    return Err(InputError::new(
+                        arg,
+                        format!("grid point ({i}, {j}): degenerate (repeated points)"),
+                    ));
+                }
+                n.push(c / l);
+            }
+        }
+        let mut d = Vec::with_capacity(nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
+                let (su, sv) = grid_diff(points, nu, nv, i, j);
+                let (mu, mv) = grid_diff(&n, nu, nv, i, j);
+                d.push([su, sv, mu, mv]);
+            }
+        }
+        for i in 0..nu - 1 {
+            for j in 0..nv - 1 {
+                for (a, b) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
+                    let l = eval_raw(points, &n, &d, nv, i, j, a, b);
+                    let (aa, _, _) = l.abc();
+                    if !(aa > 0.0) {
+                        return Err(InputError::new(
+                            arg,
+                            format!("cell ({i}, {j}) folds over; sample the surface more finely"),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(Surface {
+            nu,
+            nv,
+            s: points.to_vec(),
+            n,
+            d,
+        })
+    }
+
+    #[inline]
+    pub fn eval(&self, i: usize, j: usize, u: f64, v: f64) -> SurfLocal {
+        eval_raw(&self.s, &self.n, &self.d, self.nv, i, j, u, v)
+    }
+}
+
+/// Cubic Hermite basis `(φ0, φ1, ψ0, ψ1)` and its derivative at `x`.
+#[inline]
+fn hermite_basis(x: f64) -> ([f64; 4], [f64; 4]) {
+    let x2 = x * x;
+    let x3 = x2 * x;
+    (
+        [
+            2.0 * x3 - 3.0 * x2 + 1.0,
+            -2.0 * x3 + 3.0 * x2,
+            x3 - 2.0 * x2 + x,
+            x3 - x2,
+        ],
+        [
+            6.0 * x2 - 6.0 * x,
+            -6.0 * x2 + 6.0 * x,
+            3.0 * x2 - 4.0 * x + 1.0,
+            3.0 * x2 - 2.0 * x,
+        ],
+    )
+}
+
+/// Bicubic Hermite patch (zero twist) of corner values `p` and per-step derivatives `du`,
+/// `dv`: value and partials at `(u, v)`; C¹ across cell edges.
+#[inline]
+fn bicubic(p: [DVec3; 4], du: [DVec3; 4], dv: [DVec3; 4], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+    let (bu, bu1) = hermite_basis(u);
+    let (bv, bv1) = hermite_basis(v);
+    let (mut x, mut xu, mut xv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    // corners (a, b) in the order (0,0), (1,0), (0,1), (1,1)
+    for (c, (a, b)) in [(0usize, 0usize), (1, 0), (0, 1), (1, 1)]
+        .into_iter()
+        .enumerate()
+    {
+        x += bu[a] * bv[b] * p[c] + bu[2 + a] * bv[b] * du[c] + bu[a] * bv[2 + b] * dv[c];
+        xu += bu1[a] * bv[b] * p[c] + bu1[2 + a] * bv[b] * du[c] + bu1[a] * bv[2 + b] * dv[c];
+        xv += bu[a] * bv1[b] * p[c] + bu[2 + a] * bv1[b] * du[c] + bu[a] * bv1[2 + b] * dv[c];
+    }
+    (x, xu, xv)
+}
+
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn eval_raw(
+    s: &[DVec3],
+    n: &[DVec3],
+    d: &[[DVec3; 4]],
+    nv: usize,
+    i: usize,
+    j: usize,
+    u: f64,
+    v: f64,
+) -> SurfLocal {
+    let k = i * nv + j;
+    let ks = [k, k + nv, k + 1, k + nv + 1];
+    let (sp, su, sv) = bicubic(
+        ks.map(|q| s[q]),
+        ks.map(|q| d[q][0]),
+        ks.map(|q| d[q][1]),
+        u,
+        v,
+    );
+    let (m, mu, mv) = bicubic(
+        ks.map(|q| n[q]),
+        ks.map(|q| d[q][2]),
+        ks.map(|q| d[q][3]),
+        u,
+        v,
+    );
+    let ml = m.length();
+    let nn = m / ml;
+    SurfLocal {
+        s: sp,
+        su,
+        sv,
+        n: nn,
+        nu: (mu - nn * nn.dot(mu)) / ml,
+        nv: (mv - nn * nn.dot(mv)) / ml,
+    }
+}
+
+/// Solve `S(u,v) + h N(u,v) = p` in cell `(i, j)` by Newton from the cell centre.
+fn foot(sf: &Surface, i: usize, j: usize, p: DVec3) -> Option<(f64, f64, f64)> {
+    let (mut u, mut v) = (0.5, 0.5);
+    let mut h = (p - sf.eval(i, j, u, v).s).dot(sf.eval(i, j, u, v).n);
+    let mut polish = false;
+    for _ in 0..40 {
+        let l = sf.eval(i, j, u, v);
+        let r = l.s + h * l.n - p;
+        let c0 = l.su + h * l.nu;
+        let c1 = l.sv + h * l.nv;
+        let c2 = l.n;
+        let det = c0.cross(c1).dot(c2);
+        if !(det.abs() > 1e-300) {
+            return None;
+        }
+        // Cramer: J x = r
+        let du = r.cross(c1).dot(c2) / det;
+        let dv = c0.cross(r).dot(c2) / det;
+        let dh = c0.cross(c1).dot(r) / det;
+        u -= du;
+        v -= dv;
+        h -= dh;
+        if !(u.abs() < 10.0 && v.abs() < 10.0) {
+            return None;
+        }
+        if polish {
+            return Some((u, v, h));
+        }
+        // quadratic convergence: one more step after a small one reaches round-off
+        if du.abs() + dv.abs() < 1e-9 && dh.abs() <= 1e-9 * (1.0 + h.abs()) {
+            polish = true;
+        }
+    }
+    None
+}
+
+/// `(|h|, i, j, u, v, h)` of a foot point.
+type Foot = (f64, usize, usize, f64, f64, f64);
+
+fn try_cell(sf: &Surface, i: usize, j: usize, p: DVec3, best: &mut Option<Foot>) {
+    if let Some((u, v, h)) = foot(sf, i, j, p) {
+        let tol = 1e-9;
+        let inside = (-tol..=1.0 + tol).contains(&u) && (-tol..=1.0 + tol).contains(&v);
+        if inside && best.is_none_or(|b| h.abs() < b.0) {
+            *best = Some((h.abs(), i, j, u.clamp(0.0, 1.0), v.clamp(0.0, 1.0), h));
+        }
+    }
+}
+
+/// Register `vertices` on the rest surface: `SURFACE_COORDS` numbers and the cell per vertex.
+pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec<f64>)> {
+    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+        return Err(InputError::new(
+            "vertices",
+            format!("row {i} is not finite"),
+        ));
+    }
+    let nv = vertices.len();
+    let mut cell = vec![0i64; nv];
+    let mut coords = vec![0.0; SURFACE_COORDS * nv];
+    let (nu_, nv_) = (rest.nu, rest.nv);
+    cell.par_iter_mut()
+        .zip(coords.par_chunks_mut(SURFACE_COORDS))
+        .zip(vertices.par_iter())
+        .for_each(|((c, out), &p)| {
+            // nearest sample, then the cells around it (then all cells if needed)
+            let near = rest
+                .s
+                .iter()
+                .enumerate()
+                .fold((0, f64::INFINITY), |acc, (k, s)| {
+                    let d = (p - *s).length_squared();
+                    if d < acc.1 { (k, d) } else { acc }
+                })
+                .0;
+            let (ni, nj) = (near / nv_, near % nv_);
+            let mut best: Option<Foot> = None;
+            for i in ni.saturating_sub(1)..ni.min(nu_ - 2) + 1 {
+                for j in nj.saturating_sub(1)..nj.min(nv_ - 2) + 1 {
+                    try_cell(rest, i, j, p, &mut best);
+                }
+            }
+            if best.is_none() {
+                for i in 0..nu_ - 1 {
+                    for j in 0..nv_ - 1 {
+                        try_cell(rest, i, j, p, &mut best);
+                    }
+                }
+            }
+            let (i, j, u, v, h, resid) = match best {
+                Some((_, i, j, u, v, h)) => (i, j, u, v, h, DVec3::ZERO),
+                None => {
+                    // outside: attach to the nearest sample's corner, residual in the frame
+                    let i = ni.min(nu_ - 2);
+                    let j = nj.min(nv_ - 2);
+                    let (u, v) = ((ni - i) as f64, (nj - j) as f64);
+                    let l = rest.eval(i, j, u, v);
+                    let (e1, e2) = l.frame();
+                    let d = p - l.s;
+                    (
+                        i,
+                        j,
+                        u,
+                        v,
+                        0.0,
+                        DVec3::new(d.dot(e1), d.dot(e2), d.dot(l.n)),
+                    )
+                }
+            };
+            let l = rest.eval(i, j, u, v);
+            let (a, b, cc) = l.abc();
+            *c = (i * nv_ + j) as i64;
+            out.copy_from_slice(&[u, v, h, a, b, cc, resid.x, resid.y, resid.z]);
+        });
+    Ok((cell, coords))
+}
+
+/// The fold-free root of `h − m h² + g h³/3 = t` (spec §2.9) and whether it exists; without
+/// one, `h_c = 1/k_max`.
+pub fn surface_offset(m: f64, g: f64, t: f64) -> (f64, bool) {
+    if t == 0.0 {
+        return (0.0, true);
+    }
+    // h → −h for t < 0: m → −m, g unchanged
+    let (m, sign, t) = if t < 0.0 { (-m, -1.0, -t) } else { (m, 1.0, t) };
+    let f = |h: f64| h * (1.0 + h * (-m + h * g / 3.0));
+    let df = |h: f64| 1.0 + h * (-2.0 * m + h * g);
+    let disc = (m * m - g).max(0.0).sqrt();
+    let kmax = m + disc;
+    let mut hi = if kmax > 0.0 {
+        1.0 / kmax
+    } else {
+        f64::INFINITY
+    };
+    if hi.is_finite() {
+        if f(hi) < t {
+            return (sign * hi, false);
+        }
+    } else {
+        hi = t.max(1e-300);
+        while f(hi) < t {
+            hi *= 2.0;
+        }
+    }
+    let mut lo = 0.0;
+    let mut h = t.min(hi);
+    for _ in 0..200 {
+        let fh = f(h) - t;
+        if fh < 0.0 {
+            lo = h;
+        } else if fh > 0.0 {
+            hi = h;
+        } else {
+            break;
+        }
+        let d = df(h);
+        let next = h - fh / d;
+        let next = if next > lo && next < hi {
+            next
+        } else {
+            0.5 * (lo + hi)
+        };
+        if (next - h).abs() <= 1e-16 * h.abs().max(1e-300) || hi - lo <= 2.0 * f64::EPSILON * hi {
+            h = next;
+            break;
+        }
+        h = next;
+    }
+    (sign * h, true)
+}
+
+/// Deform registered vertices onto the posed surface (same grid shape).
+pub fn deform_surface(
+    posed: &Surface,
+    cell: &[i64],
+    coords: &[f64],
+    corrected: bool,
+    out: &mut [DVec3],
+    flags: &mut [u8],
+) -> Result<()> {
+    let nv = cell.len();
+    if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
+        return Err(InputError::new("coords", "inconsistent array sizes"));
+    }
+    let cells = (posed.nu - 1) * posed.nv;
+    if let Some(i) = cell
+        .iter()
+        .position(|&c| c < 0 || c as usize >= cells || (c as usize) % posed.nv == posed.nv - 1)
+    {
+        return Err(InputError::new(
+            "posed_surface",
+            format!("vertex {i} is bound to a cell the posed grid does not have"),
+        ));
+    }
+    out.par_iter_mut()
+        .zip(flags.par_iter_mut())
+        .zip(cell.par_iter().zip(coords.par_chunks(SURFACE_COORDS)))
+        .for_each(|((o, f), (&c, x))| {
+            let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
+            let l = posed.eval(i, j, x[0], x[1]);
+            let resid = DVec3::new(x[6], x[7], x[8]);
+            if resid != DVec3::ZERO {
+                let (e1, e2) = l.frame();
+                *o = l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n;
+                *f = OUTSIDE;
+                return;
+            }
+            let h0 = x[2];
+            if !corrected {
+                *o = l.s + h0 * l.n;
+                *f = 0;
+                return;
+            }
+            let (a1, b1, c1) = l.abc();
+            let rhs = h0 * (x[3] + h0 * (0.5 * x[4] + h0 * x[5] / 3.0));
+            let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
+            *o = l.s + h1 * l.n;
+            *f = if ok { 0 } else { CLAMPED_BEND };
+        });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_values() {
+        // spec §3: plane → sphere R = 2 (m = 0.5, g = 0.25), cylinder R = 2 (m = 0.25)
+        let (h, ok) = surface_offset(0.5, 0.25, 0.3);
+        assert!(ok && (h - 0.3613575).abs() < 5e-8, "{h}");
+        let (h, ok) = surface_offset(0.5, 0.25, -0.3);
+        assert!(ok && (h + 0.2637024).abs() < 5e-8, "{h}");
+        let (h, ok) = surface_offset(0.5, 0.25, 0.8);
+        assert!(!ok && h == 2.0, "{h}");
+        let (h, ok) = surface_offset(0.25, 0.0, 0.3);
+        assert!(ok && (h - 0.3266799).abs() < 5e-8, "{h}");
+        let (h, ok) = surface_offset(0.0, 0.0, 0.3);
+        assert!(ok && (h - 0.3).abs() < 1e-15);
+    }
+}
