@@ -54,28 +54,29 @@ fn integrate_batch(field: &Field, x: &mut [DVec3], t0: f64, h: f64, steps: usize
     let mut acc = [DVec3::ZERO; LANES];
     for s in 0..steps {
         let t = t0 + h * s as f64;
+        let tm = t + h2;
         match m {
             Method::Rk4 => {
                 for j in 0..n {
-                    k[j] = field.eval(x[j], t);
+                    k[j] = field.eval_in(x[j], t, tm);
                     acc[j] = k[j];
                 }
                 for j in 0..n {
-                    k[j] = field.eval(x[j] + h2 * k[j], t + h2);
+                    k[j] = field.eval_in(x[j] + h2 * k[j], tm, tm);
                     acc[j] += 2.0 * k[j];
                 }
                 for j in 0..n {
-                    k[j] = field.eval(x[j] + h2 * k[j], t + h2);
+                    k[j] = field.eval_in(x[j] + h2 * k[j], tm, tm);
                     acc[j] += 2.0 * k[j];
                 }
                 for j in 0..n {
-                    k[j] = field.eval(x[j] + h * k[j], t + h);
+                    k[j] = field.eval_in(x[j] + h * k[j], t + h, tm);
                     x[j] += h6 * (acc[j] + k[j]);
                 }
             }
             Method::Euler => {
                 for p in x[..n].iter_mut() {
-                    *p += h * field.eval(*p, t);
+                    *p += h * field.eval_in(*p, t, tm);
                 }
             }
         }
