@@ -9,7 +9,7 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 from . import curves, fields, ph, quaternions
 from ._advect import advect
 from ._core import __version__
-from ._deform import DeformReport, deform
+from ._deform import DeformReport, StampReport, deform, stamp
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
@@ -18,6 +18,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "StampReport",
     "__version__",
     "advect",
     "closing_angle",
@@ -28,6 +29,7 @@ __all__ = [
     "frames",
     "ph",
     "quaternions",
+    "stamp",
     "sweep",
     "tube",
 ]

@@ -148,3 +148,23 @@ def deform(
     estimate: bool = False,
     progress: bool | Callable[[int, int], object] = False,
 ) -> tuple[Mesh, DeformReport]: ...
+
+class StampReport:
+    rest_volume: float
+    volume: float
+    relative_change: float
+    dent: npt.NDArray[np.float64]
+    time: npt.NDArray[np.float64]
+    residual: npt.NDArray[np.float64]
+    contact: npt.NDArray[np.int64]
+
+def stamp(
+    mesh: Mesh | Any | tuple[_Array, _Array],
+    start: _Array,
+    end: _Array,
+    radius: float,
+    *,
+    reach: float | None = None,
+    frames: int = 10,
+    iterations: int = 2,
+) -> tuple[Mesh, StampReport]: ...

@@ -130,3 +130,13 @@ def advect(
     steps: int,
     method: str,
 ) -> npt.NDArray[np.float64]: ...
+def stamp(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    start: tuple[float, float, float],
+    end: tuple[float, float, float],
+    radius: float,
+    reach: float,
+    frames: int,
+    iterations: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...

@@ -15,6 +15,7 @@ pub mod advect;
 pub mod cross;
 pub mod fields;
 pub mod path;
+pub mod stamp;
 
 use glam::DVec3;
 
