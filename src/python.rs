@@ -591,13 +591,19 @@ fn advect<'py>(
     let m = match method {
         "rk4" => M::Rk4,
         "euler" => M::Euler,
+        "split" => M::Split,
         _ => {
             return Err(PyValueError::new_err(format!(
-                "method: unknown method {method:?}; expected 'rk4' or 'euler'"
+                "method: unknown method {method:?}; expected 'rk4', 'euler' or 'split'"
             )));
         }
     };
     let field = field_of(&rows)?;
+    if m == M::Split && !field.has_potential() {
+        return Err(PyValueError::new_err(
+            "method: 'split' needs curl potentials; only fields.translation tools have one",
+        ));
+    }
     let x = vec3s("vertices", &points)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
     {

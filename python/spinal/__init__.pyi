@@ -120,7 +120,7 @@ def advect(
     duration: float,
     steps: int | None = None,
     *,
-    method: Literal["rk4", "euler"] = "rk4",
+    method: Literal["rk4", "euler", "split"] = "rk4",
     t0: float = 0.0,
     progress: bool | Callable[[int, int], object] = False,
 ) -> npt.NDArray[np.float64]: ...

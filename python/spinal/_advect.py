@@ -64,7 +64,16 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         sphere. With a path tool (:func:`spinal.fields.along_path`) the steps end at the
         times it passes spine samples (:meth:`Field.breakpoints`), about ``steps`` in all
         (each sub-interval gets ``⌈steps·length/duration⌉ ≥ 1``).
-    method : "rk4" or "euler"
+    method : "rk4", "euler" or "split"
+        ``"split"``: the volume-exact splitting on the curl potential (Feng & Shang; issue-4
+        brief §3.3): three planar Hamiltonian sub-flows ``ẋ_a = ∂_b A_k, ẋ_b = −∂_a A_k``
+        (``curl A = v``), each by the implicit midpoint rule, in a Strang composition —
+        2nd order, with ``det(∂X_{n+1}/∂X_n) = 1`` to round-off at every point (RK4: O(h⁵)
+        per step). Tools moving with one common velocity are integrated co-moving (steady
+        potential ``A + ½ Z × u``). Only for :func:`spinal.fields.translation` tools (sums
+        of them); about 4–6× the cost of an RK4 step. It does not lower the *mesh* volume
+        error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
+        pointwise, for very long runs where RK4's drift (∝ T h⁴) would grow.
     t0 : float
         Start time (tools that move are at ``center + velocity·t``).
     progress : bool or callable
@@ -81,7 +90,7 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
     duration = _real(duration, "duration")
     t0 = _real(t0, "t0")
-    method = as_choice(method, "method", ("rk4", "euler"))
+    method = as_choice(method, "method", ("rk4", "euler", "split"))
     if steps is None:
         steps = field.steps(duration)
     else:

@@ -334,6 +334,43 @@ impl Field {
         }
     }
 
+    /// The common velocity of the tools if they all move with the same one (a frame in which
+    /// the field is steady), else zero.
+    pub fn frame_velocity(&self) -> DVec3 {
+        let mut w = None;
+        for e in &self.elements {
+            let u = match e {
+                Element::Translation(tr) if tr.moving => tr.velocity,
+                _ => DVec3::ZERO,
+            };
+            match w {
+                None => w = Some(u),
+                Some(v) if v != u => return DVec3::ZERO,
+                _ => {}
+            }
+        }
+        w.unwrap_or(DVec3::ZERO)
+    }
+
+    /// Whether every element has a potential for the splitting scheme.
+    pub fn has_potential(&self) -> bool {
+        self.elements
+            .iter()
+            .all(|e| matches!(e, Element::Translation(_)))
+    }
+
+    /// Jacobian of the summed curl potentials (columns `∂A/∂x_j`); zero for elements
+    /// without one (see [`Self::has_potential`]).
+    #[inline]
+    pub fn potential_jacobian(&self, x: DVec3, t: f64) -> glam::DMat3 {
+        self.elements
+            .iter()
+            .fold(glam::DMat3::ZERO, |s, e| match e {
+                Element::Translation(tr) => s + tr.potential_jacobian(x, t),
+                _ => s,
+            })
+    }
+
     /// Sum of the elements' speed bounds.
     pub fn max_speed(&self) -> f64 {
         self.elements.iter().map(Element::max_speed).sum()
