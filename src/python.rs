@@ -591,13 +591,19 @@ fn advect<'py>(
     let m = match method {
         "rk4" => M::Rk4,
         "euler" => M::Euler,
+        "split" => M::Split,
         _ => {
             return Err(PyValueError::new_err(format!(
-                "method: unknown method {method:?}; expected 'rk4' or 'euler'"
+                "method: unknown method {method:?}; expected 'rk4', 'euler' or 'split'"
             )));
         }
     };
     let field = field_of(&rows)?;
+    if m == M::Split && !field.has_potential() {
+        return Err(PyValueError::new_err(
+            "method: 'split' needs curl potentials; only fields.translation tools have one",
+        ));
+    }
     let x = vec3s("vertices", &points)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
     {
@@ -753,6 +759,59 @@ fn flesh_surface_deform<'py>(
     Ok((out, PyArray1::from_vec(py, flags)))
 }
 
+type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
+/// Contact stamper (see `deform::stamp`): a new vertex array and per-frame rows
+/// `(dent, time, residual, contact)`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn stamp<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    start: [f64; 3],
+    end: [f64; 3],
+    radius: f64,
+    reach: f64,
+    frames: usize,
+    iterations: usize,
+) -> PyResult<StampArrays<'py>> {
+    let x = vec3s("vertices", &vertices)?;
+    if faces.shape()[1] != 3 {
+        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
+    }
+    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let f: Vec<[usize; 3]> = f
+        .iter()
+        .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
+        .collect();
+    let mut v = x.to_vec();
+    let rep = py
+        .detach(|| {
+            crate::deform::stamp::stamp(
+                &mut v,
+                &f,
+                DVec3::from(start),
+                DVec3::from(end),
+                radius,
+                reach,
+                frames,
+                iterations,
+            )
+        })
+        .map_err(to_py)?;
+    let n = rep.len();
+    let rows: Vec<f64> = rep
+        .iter()
+        .flat_map(|r| [r.dent, r.time, r.residual, r.contact as f64])
+        .collect();
+    let flat: Vec<f64> = v.iter().flat_map(|p| p.to_array()).collect();
+    Ok((
+        PyArray1::from_vec(py, flat).reshape([v.len(), 3])?,
+        PyArray1::from_vec(py, rows).reshape([n, 4])?,
+    ))
+}
+
 #[pymodule(name = "_core")]
 fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames_sampled, m)?)?;
@@ -777,6 +836,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(field_eval, m)?)?;
     m.add_function(wrap_pyfunction!(field_info, m)?)?;
     m.add_function(wrap_pyfunction!(advect, m)?)?;
+    m.add_function(wrap_pyfunction!(stamp, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_deform, m)?)?;
     m.add_function(wrap_pyfunction!(flesh_resample, m)?)?;

@@ -120,7 +120,7 @@ def advect(
     duration: float,
     steps: int | None = None,
     *,
-    method: Literal["rk4", "euler"] = "rk4",
+    method: Literal["rk4", "euler", "split"] = "rk4",
     t0: float = 0.0,
     progress: bool | Callable[[int, int], object] = False,
 ) -> npt.NDArray[np.float64]: ...
@@ -211,3 +211,23 @@ def flesh_surface(
     strict: bool = False,
     return_clamped: bool = False,
 ) -> Any: ...
+
+class StampReport:
+    rest_volume: float
+    volume: float
+    relative_change: float
+    dent: npt.NDArray[np.float64]
+    time: npt.NDArray[np.float64]
+    residual: npt.NDArray[np.float64]
+    contact: npt.NDArray[np.int64]
+
+def stamp(
+    mesh: Mesh | Any | tuple[_Array, _Array],
+    start: _Array,
+    end: _Array,
+    radius: float,
+    *,
+    reach: float | None = None,
+    frames: int = 10,
+    iterations: int = 2,
+) -> tuple[Mesh, StampReport]: ...

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from . import _core
@@ -59,8 +61,19 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         Number of equal steps. Default ``field.steps(duration)``: each step moves a point by
         at most 1/8 of the field's length scale (``h = ℓ/(8 max|v|)``, at least 4 steps),
         which keeps the integration error 2–3 orders below the mesh error of a 40k-vertex
-        sphere.
-    method : "rk4" or "euler"
+        sphere. With a path tool (:func:`spinal.fields.along_path`) the steps end at the
+        times it passes spine samples (:meth:`Field.breakpoints`), about ``steps`` in all
+        (each sub-interval gets ``⌈steps·length/duration⌉ ≥ 1``).
+    method : "rk4", "euler" or "split"
+        ``"split"``: the volume-exact splitting on the curl potential (Feng & Shang; issue-4
+        brief §3.3): three planar Hamiltonian sub-flows ``ẋ_a = ∂_b A_k, ẋ_b = −∂_a A_k``
+        (``curl A = v``), each by the implicit midpoint rule, in a Strang composition —
+        2nd order, with ``det(∂X_{n+1}/∂X_n) = 1`` to round-off at every point (RK4: O(h⁵)
+        per step). Tools moving with one common velocity are integrated co-moving (steady
+        potential ``A + ½ Z × u``). Only for :func:`spinal.fields.translation` tools (sums
+        of them); about 4–6× the cost of an RK4 step. It does not lower the *mesh* volume
+        error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
+        pointwise, for very long runs where RK4's drift (∝ T h⁴) would grow.
     t0 : float
         Start time (tools that move are at ``center + velocity·t``).
     progress : bool or callable
@@ -77,7 +90,7 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
     duration = _real(duration, "duration")
     t0 = _real(t0, "t0")
-    method = as_choice(method, "method", ("rk4", "euler"))
+    method = as_choice(method, "method", ("rk4", "euler", "split"))
     if steps is None:
         steps = field.steps(duration)
     else:
@@ -86,6 +99,27 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
             raise ValueError(f"steps: must be at least 1, got {steps}")
     if duration == 0.0:
         return x.copy()
+    bp = field.breakpoints()
+    t1 = t0 + duration
+    cuts = bp[(bp > min(t0, t1)) & (bp < max(t0, t1))]
+    if len(cuts):
+        # path tools: end steps at the spine-sample times (their velocity is only C⁰ in t
+        # there), about ``steps`` in all, in proportion to the sub-interval lengths
+        ts = np.concatenate([[t0], cuts if duration > 0 else cuts[::-1], [t1]])
+        ns = [max(1, int(np.ceil(steps * abs(b - a) / abs(duration) - 1e-9)))
+              for a, b in itertools.pairwise(ts)]
+        update, close = _progress_bar(sum(ns), progress) if progress else (None, None)
+        done = 0
+        try:
+            for a, b, n in zip(ts[:-1], ts[1:], ns):
+                x = _core.advect(x, field.rows, float(a), float(b - a) / n, n, method)
+                done += n
+                if update:
+                    update(done)
+        finally:
+            if close:
+                close()
+        return x
     h = duration / steps
     if not progress:
         return _core.advect(x, field.rows, t0, h, steps, method)

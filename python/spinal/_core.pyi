@@ -157,3 +157,13 @@ def flesh_surface_deform(
     coords: npt.NDArray[np.float64],
     corrected: bool,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def stamp(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    start: tuple[float, float, float],
+    end: tuple[float, float, float],
+    radius: float,
+    reach: float,
+    frames: int,
+    iterations: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...

@@ -27,6 +27,11 @@ region function ``D = b(clamp(d/R_f, 0, 1))``, ``b = 4σ³ − 3σ⁴`` (C¹) or
   — ``v = (1 − D)² u + (1 − D)D′[(n·u)Y − (n·Y)u]``, rigid inside the tool;
 * :func:`strip` — along the axis (type I) or across it (type II);
 * :func:`torus` — a torus moving along its axis.
+
+**Tools along a path** — :func:`along_path`: a sphere tool travels along a spine curve at
+constant speed, posed by Hermite positions and the interpolated rotation-minimizing frames
+of :func:`spinal.frames`; it translates (pushes or carries), and optionally rotates with the
+frames, twists or bends the material around it.
 """
 
 from __future__ import annotations
@@ -41,6 +46,7 @@ from ._validate import as_choice, as_float_array, as_points
 
 __all__ = [
     "Field",
+    "along_path",
     "bend",
     "capsule",
     "rotation",
@@ -98,6 +104,17 @@ class Field:
 
     def __len__(self) -> int:
         return len(self._rows)
+
+    def breakpoints(self) -> np.ndarray:
+        """Times at which a path tool (:func:`along_path`) passes a spine sample, sorted: its
+        velocity is only continuous there, so :func:`spinal.advect` ends steps at them."""
+        r = self._rows
+        out = []
+        for i in np.flatnonzero(r[:, 0] == 7):
+            t0, dur, n = r[i, 1], r[i, 2], int(r[i, 11])
+            s = r[i + 1: i + 1 + n, 13]
+            out.append(t0 + dur * (s - s[0]) / (s[-1] - s[0]))
+        return np.unique(np.concatenate(out)) if out else np.zeros(0)
 
     @property
     def max_speed(self) -> float:
@@ -346,3 +363,89 @@ def sum(fields: Iterable[Field]) -> Field:
     if not fields:
         return Field(np.zeros((0, ROW)), ())
     return Field(np.vstack([f.rows for f in fields]), tuple(n for f in fields for n in f._names))
+
+
+def along_path(points, radius, duration, *, kind: str = "translate", tool: str = "push",
+               rate=0.0, frames=None, t0=0.0, reach=None, falloff_power: int = 2,
+               blend: str = "c1") -> Field:
+    """A spherical tool travelling along a spine from ``points[0]`` (at time ``t0``) to
+    ``points[-1]`` (at ``t0 + duration``) at constant speed ``u = L/duration`` in chord
+    length ``L``, deforming the material around it; at rest (zero field) outside that time.
+
+    Pose (issue-4 brief §4): in segment ``k``, ``λ = (σ − S_k)/ΔS_k`` with ``S_k`` the
+    cumulative chord lengths and ``σ = u (t − t0)``,
+
+    * centre ``o(σ)``: cubic Hermite through ``x_k, x_{k+1}`` with tangents ``t_k ΔS_k,
+      t_{k+1} ΔS_k`` (exactly linear on a straight spine), velocity ``ȯ = u do/dσ``;
+    * frame ``Q(σ) = F_k Exp(λ Θ_k)``, ``Θ_k = Log(F_kᵀ F_{k+1})``, ``F_k = [r_k s_k t_k]``
+      the rotation-minimizing frames (``frames``, default :func:`spinal.frames` of the
+      points), world angular velocity ``ω = u F_k Θ_k/ΔS_k``.
+
+    The field at time ``t`` is a sum of divergence-free fields frozen at the pose:
+
+    * ``tool="push"``: the curl :func:`translation` tool at ``o`` with velocity ``ȯ`` (a solid
+      sphere pushing the material; normal velocity ``ȯ·n`` on its surface), or
+      ``tool="carry"``: the :func:`sphere` region translation (the material inside the sphere
+      moves rigidly with ``ȯ``, a point at the centre follows the path);
+    * ``kind="rotate"`` adds the curl :func:`rotation` with ``Ω = ω`` about ``o`` (the region
+      turns with the frames); ``kind="twist"`` adds a :func:`twist` about the moving tangent
+      ``t`` with ``rate`` κ (rad/(length·time)); ``kind="bend"`` a :func:`bend` about the
+      moving reference vector ``r`` with ``rate`` β (rad/(length²·time)); both swirls have
+      the ball support ``radius + reach`` about ``o``.
+
+    The velocity of the pose jumps in its derivative at the sample times
+    (:meth:`Field.breakpoints`): :func:`spinal.advect` ends steps there to keep RK4 4th order.
+
+    Parameters
+    ----------
+    points : (n, 3) spine samples, n ≥ 2, no repeated consecutive points.
+    radius : tool radius ρ > 0.
+    duration : time to travel the whole spine, > 0.
+    kind : "translate", "rotate", "twist" or "bend".
+    tool : "push" (curl tool) or "carry" (region translation).
+    rate : twist or bend rate for ``kind="twist"``/``"bend"``.
+    frames : (n, 3, 3) rotation matrices with columns ``(r, s, t)``; default
+        ``spinal.frames(points)`` (double reflection).
+    t0 : start time.
+    reach : R > 0 (default ``radius``).
+    falloff_power : p in {2, 3, 4} of the curl parts.
+    blend : "c1" or "linear", the region function of ``tool="carry"``.
+    """
+    from ._frames import frames as _frames
+
+    x = as_points(points, "points")
+    _check_finite(x, "points")
+    if len(x) < 2:
+        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
+    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    if not (chords > 0).all():
+        raise ValueError(f"points: consecutive samples {int(np.argmin(chords))} and "
+                         f"{int(np.argmin(chords)) + 1} coincide")
+    rho = _positive(radius, "radius")
+    dur = _positive(duration, "duration")
+    kind = as_choice(kind, "kind", ("translate", "rotate", "twist", "bend"))
+    carry = as_choice(tool, "tool", ("push", "carry")) == "carry"
+    k = _real(rate, "rate")
+    start = _real(t0, "t0")
+    reach = rho if reach is None else _positive(reach, "reach")
+    if frames is None:
+        f = _frames(x)
+    else:
+        f = as_float_array(frames, "frames")
+        if f.shape != (len(x), 3, 3):
+            raise ValueError(f"frames: expected shape {(len(x), 3, 3)}, got {f.shape}")
+        if not np.isfinite(f).all():
+            raise ValueError("frames: must be finite")
+        err = np.abs(np.einsum("nji,njk->nik", f, f) - np.eye(3)).max(axis=(1, 2))
+        if (err > 1e-6).any() or (np.linalg.det(f) <= 0).any():
+            raise ValueError(f"frames: frame {int(np.argmax(err))} is not a rotation matrix")
+    s = np.concatenate([[0.0], np.cumsum(chords)])
+    head = _row(7, start, dur, rho, reach, _power(falloff_power), float(carry), _blend(blend),
+                float(kind == "rotate"), k if kind == "twist" else 0.0,
+                k if kind == "bend" else 0.0, len(x))
+    body = np.zeros((len(x), ROW))
+    body[:, 0] = 8
+    body[:, 1:4] = x
+    body[:, 4:13] = np.transpose(f, (0, 2, 1)).reshape(-1, 9)  # columns r, s, t
+    body[:, 13] = s
+    return Field(np.vstack([head, body]), (f"along_path({kind}, {tool})",))

@@ -117,6 +117,36 @@ impl Translation {
         k * (e * u + (half_p * sg) * (y * n.dot(u) - u * r))
     }
 
+    /// Jacobian `DA` (columns `∂A/∂x_j`) of the potential `A = −(1/(2R^p)) φ(d) (Y × u)` with
+    /// `curl A = V` (the corrected eq. 12.2), for the splitting scheme:
+    /// `∂A/∂x_j = −(1/(2R^p)) [φ′ n_j (Y × u) + φ e_j × u]`, `φ′ = −p sgn(d) e^{p−1}`.
+    #[inline]
+    pub fn potential_jacobian(&self, x: DVec3, t: f64) -> glam::DMat3 {
+        let c = if self.moving {
+            self.center + self.velocity * t
+        } else {
+            self.center
+        };
+        let y = x - c;
+        let r = y.length();
+        let d = r - self.radius;
+        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+            return glam::DMat3::ZERO;
+        };
+        let k = -0.5 / pow_p(self.reach, self.power);
+        let u = self.velocity;
+        let phi = ep * e;
+        let sg = if d < 0.0 { -1.0 } else { 1.0 };
+        let dphi_n = if r > 0.0 {
+            y * (-(self.power as f64) * sg * ep / r)
+        } else {
+            DVec3::ZERO
+        };
+        let yu = y.cross(u);
+        let col = |j: usize, ej: DVec3| k * (yu * dphi_n[j] + phi * ej.cross(u));
+        glam::DMat3::from_cols(col(0, DVec3::X), col(1, DVec3::Y), col(2, DVec3::Z))
+    }
+
     /// Upper bound of |V| outside the tool: `|u| (1 + (p/2) ρ/R)` (reached on the surface).
     pub fn max_speed(&self) -> f64 {
         self.velocity.length() * (1.0 + 0.5 * self.power as f64 * self.radius / self.reach)

@@ -14,6 +14,8 @@
 pub mod advect;
 pub mod cross;
 pub mod fields;
+pub mod path;
+pub mod stamp;
 
 use glam::DVec3;
 
@@ -25,7 +27,7 @@ pub use fields::{Rotation, Swirl, SwirlKind, Translation};
 pub const ROW: usize = 16;
 
 /// One element of a field.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Element {
     Translation(Translation),
     Rotation(Rotation),
@@ -34,6 +36,8 @@ pub enum Element {
     Capsule(Capsule),
     Torus(Torus),
     StripAcross(StripAcross),
+    /// A tool moving along a spine ([`path`]); shared, as it owns its samples.
+    Path(std::sync::Arc<path::PathTool>),
 }
 
 fn v3(r: &[f64], i: usize) -> DVec3 {
@@ -88,6 +92,8 @@ impl Element {
     /// | 4 | capsule `∇p×∇q` (distance-field extension) | `a, b, u, ρ, R_f, linear?, moving` |
     /// | 5 | torus `∇p×∇q` | `c, k, speed, R_t, r_t, R_f, linear?, moving` |
     /// | 6 | strip across `∇p×∇q` | `a, b, m (velocity ⟂ b − a), ρ, R_f, linear?` |
+    /// | 7 | path tool header ([`path`]) | `t0, T, ρ, R, p, carry?, linear?, rotate?, twist, bend, n` |
+    /// | 8 | path sample (`n` rows after a header) | `x, r, s, t, S` (frame columns, arc length) |
     pub fn parse(r: &[f64]) -> Result<Element> {
         if r.len() != ROW {
             return Err(InputError::new(
@@ -166,6 +172,12 @@ impl Element {
                 positive(r[11], "reach")?,
                 flag(r[12]),
             )?),
+            7.0 | 8.0 => {
+                return Err(InputError::new(
+                    "field",
+                    "path rows must come as a header (kind 7) followed by its samples (kind 8)",
+                ));
+            }
             k => {
                 return Err(InputError::new(
                     "field",
@@ -175,8 +187,44 @@ impl Element {
         })
     }
 
+    /// Parse a path header row `h` and its sample rows.
+    fn parse_path(h: &[f64], rows: &[f64]) -> Result<Element> {
+        let flag = |x: f64| x != 0.0;
+        let samples = rows
+            .chunks_exact(ROW)
+            .map(|r| {
+                if r[0] != 8.0 {
+                    return Err(InputError::new(
+                        "field",
+                        "expected a path sample row (kind 8)",
+                    ));
+                }
+                Ok(path::Sample {
+                    x: v3(r, 1),
+                    frame: glam::DMat3::from_cols(v3(r, 4), v3(r, 7), v3(r, 10)),
+                    s: r[13],
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Element::Path(std::sync::Arc::new(path::PathTool::new(
+            samples,
+            h[1],
+            h[2],
+            positive(h[3], "radius")?,
+            positive(h[4], "reach")?,
+            power(h[5])?,
+            flag(h[6]),
+            flag(h[7]),
+            flag(h[8]),
+            h[9],
+            h[10],
+        )?)))
+    }
+
+    /// The velocity at `x`, time `t`, within an integration step containing `tm` (only path
+    /// tools use `tm`: it picks the piece of their piecewise-smooth motion).
     #[inline]
-    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+    pub fn eval(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
         match self {
             Element::Translation(e) => e.eval(x, t),
             Element::Rotation(e) => e.eval(x, t),
@@ -185,6 +233,7 @@ impl Element {
             Element::Capsule(e) => e.eval(x, t),
             Element::Torus(e) => e.eval(x, t),
             Element::StripAcross(e) => e.eval(x),
+            Element::Path(e) => e.eval(x, t, tm),
         }
     }
 
@@ -198,6 +247,7 @@ impl Element {
             Element::Capsule(e) => e.max_speed(),
             Element::Torus(e) => e.max_speed(),
             Element::StripAcross(e) => e.max_speed(),
+            Element::Path(e) => e.max_speed(),
         }
     }
 
@@ -212,6 +262,7 @@ impl Element {
             Element::Capsule(e) => e.reach,
             Element::Torus(e) => e.reach,
             Element::StripAcross(e) => e.reach,
+            Element::Path(e) => e.reach,
         }
     }
 }
@@ -231,25 +282,114 @@ impl Field {
                 format!("expected rows of {ROW} numbers"),
             ));
         }
-        let elements = rows
-            .chunks_exact(ROW)
-            .enumerate()
-            .map(|(i, r)| Element::parse(r).map_err(|e| e.context(&format!("element {i}"))))
-            .collect::<Result<_>>()?;
+        let mut elements = Vec::new();
+        let mut i = 0;
+        while i * ROW < rows.len() {
+            let r = &rows[i * ROW..(i + 1) * ROW];
+            let at = |e: InputError| e.context(&format!("element {i}"));
+            if r[0] == 7.0 {
+                if let Some(j) = r.iter().position(|x| !x.is_finite()) {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("element parameter {j} is not finite"),
+                    )));
+                }
+                let n = r[11];
+                let avail = (rows.len() / ROW - i - 1) as f64;
+                if !(n >= 2.0 && n <= avail && n.fract() == 0.0) {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("path header announces {n} samples, {avail} rows follow"),
+                    )));
+                }
+                let n = n as usize;
+                let body = &rows[(i + 1) * ROW..(i + 1 + n) * ROW];
+                if let Some(j) = body.iter().position(|x| !x.is_finite()) {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("path sample {} is not finite", j / ROW),
+                    )));
+                }
+                elements.push(Element::parse_path(r, body).map_err(at)?);
+                i += n + 1;
+            } else {
+                elements.push(Element::parse(r).map_err(at)?);
+                i += 1;
+            }
+        }
         Ok(Field { elements })
     }
 
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        self.eval_in(x, t, t)
+    }
+
+    /// [`Self::eval`] for a stage of an integration step containing `tm` ([`Element::eval`]).
+    #[inline]
+    pub fn eval_in(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
         match self.elements.as_slice() {
-            [e] => e.eval(x, t),
-            es => es.iter().fold(DVec3::ZERO, |s, e| s + e.eval(x, t)),
+            [e] => e.eval(x, t, tm),
+            es => es.iter().fold(DVec3::ZERO, |s, e| s + e.eval(x, t, tm)),
         }
+    }
+
+    /// The common velocity of the tools if they all move with the same one (a frame in which
+    /// the field is steady), else zero.
+    pub fn frame_velocity(&self) -> DVec3 {
+        let mut w = None;
+        for e in &self.elements {
+            let u = match e {
+                Element::Translation(tr) if tr.moving => tr.velocity,
+                _ => DVec3::ZERO,
+            };
+            match w {
+                None => w = Some(u),
+                Some(v) if v != u => return DVec3::ZERO,
+                _ => {}
+            }
+        }
+        w.unwrap_or(DVec3::ZERO)
+    }
+
+    /// Whether every element has a potential for the splitting scheme.
+    pub fn has_potential(&self) -> bool {
+        self.elements
+            .iter()
+            .all(|e| matches!(e, Element::Translation(_)))
+    }
+
+    /// Jacobian of the summed curl potentials (columns `∂A/∂x_j`); zero for elements
+    /// without one (see [`Self::has_potential`]).
+    #[inline]
+    pub fn potential_jacobian(&self, x: DVec3, t: f64) -> glam::DMat3 {
+        self.elements
+            .iter()
+            .fold(glam::DMat3::ZERO, |s, e| match e {
+                Element::Translation(tr) => s + tr.potential_jacobian(x, t),
+                _ => s,
+            })
     }
 
     /// Sum of the elements' speed bounds.
     pub fn max_speed(&self) -> f64 {
         self.elements.iter().map(Element::max_speed).sum()
+    }
+
+    /// Times at which a path tool passes a spine sample (where its velocity is only C⁰ in t).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self
+            .elements
+            .iter()
+            .filter_map(|e| match e {
+                Element::Path(p) => Some(p.breakpoints()),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        b.sort_by(f64::total_cmp);
+        b.dedup();
+        b
     }
 
     /// Smallest length scale of the elements (∞ for the zero field).

@@ -1,0 +1,397 @@
+//! Tools moving along a path: a spine `x_0 … x_{n−1}` with its frames `F_k = [r_k s_k t_k]`
+//! (the double-reflection RMF of `spinal.frames`), traversed at constant speed in arc length
+//! from time `t0` to `t0 + T` (issue-4 brief §4; the thesis only says that each tool field is
+//! fixed in the tool's object space and moves rigidly with it, Zheng Ch. 11.2).
+//!
+//! Pose at arc length `σ = L (t − t0)/T` (`S_k` the cumulative chord lengths, `L = S_{n−1}`,
+//! `u = L/T`), in segment `k` with `λ = (σ − S_k)/ΔS_k`:
+//!
+//! * position `o(σ)`: the cubic Hermite through `x_k, x_{k+1}` with end tangents `t_k ΔS_k`,
+//!   `t_{k+1} ΔS_k` (C¹ across samples; a straight spine gives exactly `x_k + λ(x_{k+1} − x_k)`),
+//!   velocity `ȯ = (u/ΔS_k) do/dλ`;
+//! * frame `Q(σ) = F_k Exp(λ Θ_k)`, `Θ_k = Log(F_kᵀ F_{k+1})` (body axis-angle; the
+//!   double-reflection transfer is one rotation), so `Q(S_{k+1}) = F_{k+1}` and the world
+//!   angular velocity is the constant `ω = u F_k Θ_k / ΔS_k` on the segment (`Exp(λΘ)Θ = Θ`).
+//!
+//! The field at time `t` is the sum of frozen-parameter divergence-free fields at the pose:
+//!
+//! * the tool's translation with velocity `ȯ`: the curl tool of [`super::fields::Translation`]
+//!   (`push`: a solid sphere pushing the material, normal velocity `ȯ·n` on its surface) or
+//!   von Funck's region translation [`super::cross::Sphere`] (`carry`: rigid `v = ȯ` inside the
+//!   sphere, so a point inside follows `o(t)`);
+//! * optionally the rotation matching the frame's turning, [`super::fields::Rotation`] with
+//!   pivot and centre at `o` and `Ω = ω` (together with the translation the tool's full rigid
+//!   normal velocity `(ȯ + ω × Y)·n`; zero normal part for a sphere);
+//! * optionally a twist about the moving tangent `Q e_z` or a bend about the moving reference
+//!   vector `Q e_x` ([`super::fields::Swirl`], ball support of radius `radius + reach`).
+//!
+//! Each part is divergence-free for frozen parameters, so the sum is divergence-free at every
+//! `t`. Outside `[t0, t0 + T]` the tool rests and the field is zero. `Θ_k` is constant per
+//! segment, so `ω` and `d²o/dt²` jump at the sample times `t0 + T S_k/L`: RK4 keeps its 4th
+//! order only when steps end there (`spinal.advect` splits the integration at those times).
+
+use glam::{DMat3, DQuat, DVec3};
+
+use super::cross::Sphere;
+use super::fields::{Rotation, Swirl, SwirlKind, Translation, rotate};
+use crate::error::{InputError, Result};
+
+/// One spine sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub x: DVec3,
+    pub frame: DMat3,
+    /// Cumulative chord length.
+    pub s: f64,
+}
+
+/// A tool moving along a spine (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathTool {
+    pub samples: Vec<Sample>,
+    /// Per segment: body axis-angle `Θ_k` and `F_k Θ_k / ΔS_k` (world ω per unit speed).
+    theta: Vec<DVec3>,
+    omega: Vec<DVec3>,
+    pub t0: f64,
+    pub duration: f64,
+    pub radius: f64,
+    pub reach: f64,
+    pub power: u8,
+    /// von Funck region translation instead of the pushing curl tool.
+    pub carry: bool,
+    pub linear: bool,
+    pub rotate: bool,
+    pub twist: f64,
+    pub bend: f64,
+}
+
+/// The pose at time `t`: position, velocity, world angular velocity, frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    pub o: DVec3,
+    pub v: DVec3,
+    pub omega: DVec3,
+    pub frame: DMat3,
+}
+
+impl PathTool {
+    /// Build from samples (positions and orthonormal right-handed frames, strictly increasing
+    /// arc length `s`, at least 2) and the parameters.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        samples: Vec<Sample>,
+        t0: f64,
+        duration: f64,
+        radius: f64,
+        reach: f64,
+        power: u8,
+        carry: bool,
+        linear: bool,
+        rotate: bool,
+        twist: f64,
+        bend: f64,
+    ) -> Result<PathTool> {
+        let bad = |m: String| InputError::new("field", m);
+        if samples.len() < 2 {
+            return Err(bad("a path needs at least 2 samples".into()));
+        }
+        if !(duration > 0.0 && duration.is_finite()) {
+            return Err(bad(format!(
+                "path duration must be positive, got {duration}"
+            )));
+        }
+        for (i, p) in samples.iter().enumerate() {
+            let f = p.frame;
+            let e = (f.transpose() * f - DMat3::IDENTITY).to_cols_array();
+            if e.iter().any(|x| !(x.abs() < 1e-6)) || !(f.determinant() > 0.0) {
+                return Err(bad(format!("path frame {i} is not a rotation matrix")));
+            }
+        }
+        let mut theta = Vec::with_capacity(samples.len() - 1);
+        let mut omega = Vec::with_capacity(samples.len() - 1);
+        for (k, w) in samples.windows(2).enumerate() {
+            let ds = w[1].s - w[0].s;
+            if !(ds > 0.0) {
+                return Err(bad(format!(
+                    "path arc length must increase strictly (segment {k})"
+                )));
+            }
+            let rel = DQuat::from_mat3(&(w[0].frame.transpose() * w[1].frame)).normalize();
+            let rel = if rel.w < 0.0 { -rel } else { rel };
+            let (axis, angle) = rel.to_axis_angle();
+            let th = if angle.is_finite() && angle != 0.0 {
+                axis * angle
+            } else {
+                DVec3::ZERO
+            };
+            theta.push(th);
+            omega.push(w[0].frame * th / ds);
+        }
+        Ok(PathTool {
+            samples,
+            theta,
+            omega,
+            t0,
+            duration,
+            radius,
+            reach,
+            power,
+            carry,
+            linear,
+            rotate,
+            twist,
+            bend,
+        })
+    }
+
+    /// Total arc length.
+    pub fn length(&self) -> f64 {
+        self.samples[self.samples.len() - 1].s - self.samples[0].s
+    }
+
+    /// The pose at time `t` (`None` while the tool rests, outside `[t0, t0 + T]`).
+    pub fn pose(&self, t: f64) -> Option<Pose> {
+        self.pose_in(t, t)
+    }
+
+    /// The pose at time `t` of an integration step whose interior contains `tm`: `tm` decides
+    /// whether the tool moves and on which spine segment, so that the stages of a step that
+    /// ends at a sample time (or at `t0`, `t0 + T`) all see the same smooth piece (the pose
+    /// polynomials are evaluated at `t`, slightly outside the segment if `t` is its end).
+    pub fn pose_in(&self, t: f64, tm: f64) -> Option<Pose> {
+        let taum = (tm - self.t0) / self.duration;
+        if !(0.0..=1.0).contains(&taum) {
+            return None;
+        }
+        let s0 = self.samples[0].s;
+        let l = self.length();
+        let sigma = s0 + (t - self.t0) / self.duration * l;
+        let sigma_m = s0 + taum * l;
+        let u = l / self.duration;
+        let n = self.samples.len();
+        let k = self
+            .samples
+            .partition_point(|p| p.s <= sigma_m)
+            .saturating_sub(1)
+            .min(n - 2);
+        let (a, b) = (&self.samples[k], &self.samples[k + 1]);
+        let ds = b.s - a.s;
+        let lam = (sigma - a.s) / ds;
+        let (l2, l3) = (lam * lam, lam * lam * lam);
+        let m0 = a.frame.z_axis * ds;
+        let m1 = b.frame.z_axis * ds;
+        let o = a.x * (2.0 * l3 - 3.0 * l2 + 1.0)
+            + m0 * (l3 - 2.0 * l2 + lam)
+            + b.x * (-2.0 * l3 + 3.0 * l2)
+            + m1 * (l3 - l2);
+        let dodl = (a.x - b.x) * (6.0 * l2 - 6.0 * lam)
+            + m0 * (3.0 * l2 - 4.0 * lam + 1.0)
+            + m1 * (3.0 * l2 - 2.0 * lam);
+        let th = self.theta[k];
+        let ang = th.length();
+        let frame = if ang > 0.0 {
+            let ax = th / ang;
+            let e = |v: DVec3| a.frame * rotate(ax, lam * ang, v);
+            DMat3::from_cols(e(DVec3::X), e(DVec3::Y), e(DVec3::Z))
+        } else {
+            a.frame
+        };
+        Some(Pose {
+            o,
+            v: dodl * (u / ds),
+            omega: self.omega[k] * u,
+            frame,
+        })
+    }
+
+    /// The velocity at `x`, time `t`, within a step containing `tm` (see [`Self::pose_in`]).
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        let Some(p) = self.pose_in(t, tm) else {
+            return DVec3::ZERO;
+        };
+        let outer = self.radius + self.reach;
+        if (x - p.o).length_squared() >= outer * outer {
+            return DVec3::ZERO;
+        }
+        let mut v = if self.carry {
+            Sphere {
+                center: p.o,
+                velocity: p.v,
+                radius: self.radius,
+                reach: self.reach,
+                linear: self.linear,
+                moving: false,
+            }
+            .eval(x, 0.0)
+        } else {
+            Translation {
+                center: p.o,
+                velocity: p.v,
+                radius: self.radius,
+                reach: self.reach,
+                power: self.power,
+                moving: false,
+            }
+            .eval(x, 0.0)
+        };
+        if self.rotate {
+            v += Rotation {
+                center: p.o,
+                pivot: p.o,
+                omega: p.omega,
+                radius: self.radius,
+                reach: self.reach,
+                power: self.power,
+            }
+            .eval(x, 0.0);
+        }
+        if self.twist != 0.0 {
+            v += self.swirl(&p, SwirlKind::Twist).eval(x);
+        }
+        if self.bend != 0.0 {
+            v += self.swirl(&p, SwirlKind::Bend).eval(x);
+        }
+        v
+    }
+
+    fn swirl(&self, p: &Pose, kind: SwirlKind) -> Swirl {
+        let (axis, rate) = match kind {
+            SwirlKind::Twist => (p.frame.z_axis, self.twist),
+            SwirlKind::Bend => (p.frame.x_axis, self.bend),
+        };
+        Swirl {
+            pivot: p.o,
+            axis,
+            rate,
+            reach: self.radius + self.reach,
+            kind,
+            curl_form: false,
+        }
+    }
+
+    /// A bound of `|v|`: the parts' bounds at the largest tool speed and turning rate
+    /// (sampled at 17 points per segment, ×1.05).
+    pub fn max_speed(&self) -> f64 {
+        let u = self.length() / self.duration;
+        let mut vmax: f64 = 0.0;
+        for w in self.samples.windows(2) {
+            let ds = w[1].s - w[0].s;
+            for i in 0..=16 {
+                let lam = i as f64 / 16.0;
+                let l2 = lam * lam;
+                let d = (w[0].x - w[1].x) * (6.0 * l2 - 6.0 * lam)
+                    + w[0].frame.z_axis * ds * (3.0 * l2 - 4.0 * lam + 1.0)
+                    + w[1].frame.z_axis * ds * (3.0 * l2 - 2.0 * lam);
+                vmax = vmax.max(d.length() / ds);
+            }
+        }
+        let vel = DVec3::X * (u * vmax * 1.05);
+        let mut m = if self.carry {
+            Sphere {
+                center: DVec3::ZERO,
+                velocity: vel,
+                radius: self.radius,
+                reach: self.reach,
+                linear: self.linear,
+                moving: false,
+            }
+            .max_speed()
+        } else {
+            Translation {
+                center: DVec3::ZERO,
+                velocity: vel,
+                radius: self.radius,
+                reach: self.reach,
+                power: self.power,
+                moving: false,
+            }
+            .max_speed()
+        };
+        if self.rotate {
+            let w = self.omega.iter().map(|w| w.length()).fold(0.0, f64::max) * u;
+            m += Rotation {
+                center: DVec3::ZERO,
+                pivot: DVec3::ZERO,
+                omega: DVec3::X * w,
+                radius: self.radius,
+                reach: self.reach,
+                power: self.power,
+            }
+            .max_speed();
+        }
+        let pose = Pose {
+            o: DVec3::ZERO,
+            v: DVec3::ZERO,
+            omega: DVec3::ZERO,
+            frame: DMat3::IDENTITY,
+        };
+        if self.twist != 0.0 {
+            m += self.swirl(&pose, SwirlKind::Twist).max_speed();
+        }
+        if self.bend != 0.0 {
+            m += self.swirl(&pose, SwirlKind::Bend).max_speed();
+        }
+        m
+    }
+
+    /// Times at which the tool passes a spine sample (its start and end included).
+    pub fn breakpoints(&self) -> impl Iterator<Item = f64> + '_ {
+        let (s0, l) = (self.samples[0].s, self.length());
+        self.samples
+            .iter()
+            .map(move |p| self.t0 + self.duration * (p.s - s0) / l)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pose_interpolates_samples_and_frames() {
+        // quarter circle of radius 1 in the xy-plane, frames (r = normal, s = z, t = tangent)
+        let n = 9;
+        let samples: Vec<Sample> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::FRAC_PI_2 * i as f64 / (n - 1) as f64;
+                let x = DVec3::new(a.cos(), a.sin(), 0.0);
+                let t = DVec3::new(-a.sin(), a.cos(), 0.0);
+                let r = -x;
+                Sample {
+                    x,
+                    frame: DMat3::from_cols(r, t.cross(r), t),
+                    s: 2.0 * (std::f64::consts::FRAC_PI_4 / (n - 1) as f64).sin() * i as f64,
+                }
+            })
+            .collect();
+        let tool = PathTool::new(
+            samples.clone(),
+            0.5,
+            2.0,
+            0.1,
+            0.1,
+            2,
+            false,
+            false,
+            true,
+            0.0,
+            0.0,
+        )
+        .unwrap();
+        for (i, s) in samples.iter().enumerate() {
+            let t = 0.5 + 2.0 * s.s / tool.length();
+            let p = tool.pose(t).unwrap();
+            assert!((p.o - s.x).length() < 1e-14, "sample {i}");
+            assert!((p.frame - s.frame).abs_diff_eq(DMat3::ZERO, 1e-12));
+        }
+        assert!(tool.pose(0.49).is_none() && tool.pose(2.51).is_none());
+        // ω: about +z at speed u / radius (the chord/arc ratio aside)
+        let p = tool.pose(1.0).unwrap();
+        let u = tool.length() / 2.0;
+        assert!(
+            (p.omega - DVec3::Z * u * (std::f64::consts::FRAC_PI_2 / tool.length())).length()
+                < 1e-12
+        );
+    }
+}
