@@ -91,6 +91,37 @@ fn rk4_batch(v: impl Fn(DVec3, f64, f64) -> DVec3, x: &mut [DVec3], t0: f64, h: 
     }
 }
 
+/// `out[j] = v(p[j], t)` for a sum of elements: the element loop outside, so each element is
+/// dispatched once per batch and its evaluation inlined over the lanes.
+#[inline]
+fn eval_lanes(field: &Field, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
+    use super::Element as E;
+    out.fill(DVec3::ZERO);
+    for e in &field.elements {
+        match e {
+            E::Translation(e) => lanes(out, p, |x| e.eval(x, t)),
+            E::Rotation(e) => lanes(out, p, |x| e.eval(x, t)),
+            E::Swirl(e) => lanes(out, p, |x| e.eval(x)),
+            E::Sphere(e) => lanes(out, p, |x| e.eval(x, t)),
+            E::Capsule(e) => lanes(out, p, |x| e.eval(x, t)),
+            E::Torus(e) => lanes(out, p, |x| e.eval(x, t)),
+            E::StripAcross(e) => lanes(out, p, |x| e.eval(x)),
+            E::Path(e) => {
+                if let Some(pose) = e.pose_in(t, tm) {
+                    lanes(out, p, |x| e.eval_at(x, &pose))
+                }
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn lanes(out: &mut [DVec3], p: &[DVec3], f: impl Fn(DVec3) -> DVec3) {
+    for (o, x) in out.iter_mut().zip(p) {
+        *o += f(*x);
+    }
+}
+
 /// Any field and method.
 #[inline]
 fn integrate_batch_generic(
@@ -111,20 +142,22 @@ fn integrate_batch_generic(
         let tm = t + h2;
         match m {
             Method::Rk4 => {
-                for j in 0..n {
-                    k[j] = field.eval_in(x[j], t, tm);
-                    acc[j] = k[j];
+                let mut p = [DVec3::ZERO; LANES];
+                p[..n].copy_from_slice(&x[..n]);
+                eval_lanes(field, &p[..n], t, tm, &mut k[..n]);
+                acc[..n].copy_from_slice(&k[..n]);
+                for (w, hc, tc) in [(2.0, h2, tm), (2.0, h2, tm), (1.0, h, t + h)] {
+                    for j in 0..n {
+                        p[j] = x[j] + hc * k[j];
+                    }
+                    eval_lanes(field, &p[..n], tc, tm, &mut k[..n]);
+                    if w == 2.0 {
+                        for j in 0..n {
+                            acc[j] += 2.0 * k[j];
+                        }
+                    }
                 }
                 for j in 0..n {
-                    k[j] = field.eval_in(x[j] + h2 * k[j], tm, tm);
-                    acc[j] += 2.0 * k[j];
-                }
-                for j in 0..n {
-                    k[j] = field.eval_in(x[j] + h2 * k[j], tm, tm);
-                    acc[j] += 2.0 * k[j];
-                }
-                for j in 0..n {
-                    k[j] = field.eval_in(x[j] + h * k[j], t + h, tm);
                     x[j] += h6 * (acc[j] + k[j]);
                 }
             }

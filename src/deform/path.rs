@@ -207,9 +207,16 @@ impl PathTool {
     /// The velocity at `x`, time `t`, within a step containing `tm` (see [`Self::pose_in`]).
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
-        let Some(p) = self.pose_in(t, tm) else {
-            return DVec3::ZERO;
-        };
+        match self.pose_in(t, tm) {
+            Some(p) => self.eval_at(x, &p),
+            None => DVec3::ZERO,
+        }
+    }
+
+    /// The velocity at `x` for the tool at pose `p` (the pose is shared by all points at one
+    /// time, so batches compute it once).
+    #[inline]
+    pub fn eval_at(&self, x: DVec3, p: &Pose) -> DVec3 {
         let outer = self.radius + self.reach;
         if (x - p.o).length_squared() >= outer * outer {
             return DVec3::ZERO;
@@ -247,10 +254,10 @@ impl PathTool {
             .eval(x, 0.0);
         }
         if self.twist != 0.0 {
-            v += self.swirl(&p, SwirlKind::Twist).eval(x);
+            v += self.swirl(p, SwirlKind::Twist).eval(x);
         }
         if self.bend != 0.0 {
-            v += self.swirl(&p, SwirlKind::Bend).eval(x);
+            v += self.swirl(p, SwirlKind::Bend).eval(x);
         }
         v
     }
