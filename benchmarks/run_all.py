@@ -26,6 +26,7 @@ HERE = Path(__file__).resolve().parent
 QUICK = {
     "bench_frames.py": ["--max", "1e5", "--repeat", "3"],
     "bench_sweep.py": ["--max", "1e4", "--no-bundle"],
+    "bench_advect.py": ["--max", "1e5", "--repeat", "1"],
 }
 
 
