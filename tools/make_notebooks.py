@@ -182,7 +182,8 @@ print("angle between the PH spline's RMF and the helix's RMF at the joints: max 
       np.abs(Q.spin(F_true, F_ph)).max())
 mesh = spline.sweep(0.15 * np.array([[1, 0], [0, 1], [-1, 0], [0, -1.0]]))
 print(mesh, "watertight:", mesh.is_watertight)
-mesh.plot(window_size=(480, 360))""",
+mesh.plot(screenshot=os.path.join(IMAGES, "ph_sweep.png") if IMAGES else None,
+          window_size=(480, 360))""",
     """md:## Walking on a torus
 
 The walker's frame is rotated across every edge by the dihedral angle, so its path is straight
