@@ -361,3 +361,21 @@ def test_walk_stops_at_the_boundary_and_bad_input():
         Q.walk_mesh(v, f, 0, [0.5, 0.2, 0], [[np.nan, 0]])
     with pytest.raises(ValueError, match="face"):
         Q.walk_mesh(v, f, 10_000, [0.5, 0.2, 0], [[1.0, 0]])
+
+
+def test_walk_long_moves_on_a_closed_mesh():
+    """A long move round a closed surface crosses many edges (no false 'malformed' error);
+    an absurdly long one is refused instead of overflowing to NaN."""
+    import trimesh
+
+    torus = trimesh.creation.torus(major_radius=2, minor_radius=0.7, major_sections=32,
+                                   minor_sections=16)
+    p = torus.vertices[torus.faces[5]].mean(axis=0)
+    res = Q.walk_mesh(torus.vertices, torus.faces, 5, p, [[60.0, 7.0]])
+    assert np.isfinite(res.points).all() and np.isfinite(res.frames).all()
+    assert len(res.path) > 200 and not res.stopped.any()
+    # every point of the path lies on the surface: on the torus within the mesh error
+    R = np.hypot(res.path[:, 0], res.path[:, 1])
+    assert np.abs(np.hypot(R - 2, res.path[:, 2]) - 0.7).max() < 0.05
+    with pytest.raises(ValueError, match="moves: a move of length"):
+        Q.walk_mesh(torus.vertices, torus.faces, 5, p, [[1e300, 0.0]])

@@ -240,10 +240,22 @@ def invariants(control_points) -> dict:
     of the RMF angle, ``|k| ≤ 1``, 0 when planar), ``kappa_over_tau`` (constant ``κ/τ``,
     signed like τ; ``inf`` when planar), ``sigma_min`` (smallest speed on [0, 1]) and
     ``kappa_max = 6L₂sθ/σ_min²``. Values are floats for ``(4, 3)`` input, ``(m,)`` arrays
-    for ``(m, 4, 3)``. The input is assumed PH (check with :func:`is_ph`).
+    for ``(m, 4, 3)``. The input is assumed PH (check with :func:`is_ph`); a control polygon
+    with a zero-length leg, or whose invariants are undefined, raises ValueError.
     """
     cp, single = _cubics(control_points)
+    legs = np.linalg.norm(np.diff(cp, axis=1), axis=2)  # (m, 3)
+    scale = np.abs(cp).max(axis=(1, 2))
+    bad = np.flatnonzero(~(legs > 1e-14 * np.maximum(scale, 1e-300)[:, None]).all(axis=1))
+    if bad.size:
+        raise ValueError(f"control_points: cubic {int(bad[0])} has a zero-length leg of its "
+                         "control polygon (a degenerate polygon is not a PH cubic)")
     rows = _core.ph_invariants(cp)
+    if not np.isfinite(rows[:, [i for i, k in enumerate(_INV_KEYS) if k != "kappa_over_tau"]]
+                       ).all():
+        i = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
+        raise ValueError(f"control_points: the invariants of cubic {i} are undefined (a "
+                         "straight or degenerate polygon)")
     return {k: (float(rows[0, i]) if single else rows[:, i].copy())
             for i, k in enumerate(_INV_KEYS)}
 

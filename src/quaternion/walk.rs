@@ -27,6 +27,8 @@ pub struct Walker<'a> {
     /// face and its local index of the shared edge.
     adj: Vec<[Option<(usize, usize)>; 3]>,
     scale: f64,
+    /// Shortest edge (bounds the number of crossings of a move).
+    min_edge: f64,
 }
 
 /// The state of a walker after a move.
@@ -76,6 +78,12 @@ impl<'a> Walker<'a> {
         );
         let diag = (hi - lo).length();
         let scale = if diag > 0.0 { diag } else { 1.0 };
+        let mut min_edge = f64::INFINITY;
+        for c in &f {
+            for k in 0..3 {
+                min_edge = min_edge.min((vertices[c[(k + 1) % 3]] - vertices[c[k]]).length());
+            }
+        }
         for (i, c) in f.iter().enumerate() {
             let area2 = (vertices[c[1]] - vertices[c[0]])
                 .cross(vertices[c[2]] - vertices[c[0]])
@@ -116,6 +124,7 @@ impl<'a> Walker<'a> {
             f,
             adj,
             scale,
+            min_edge,
         })
     }
 
@@ -195,16 +204,28 @@ impl<'a> Walker<'a> {
             stopped: false,
             ..s
         };
-        let d = mv.x * st.frame.x_axis + mv.y * st.frame.y_axis;
-        let mut left = d.length();
+        // |(dx, dy)| without overflow for huge moves
+        let mut left = mv.x.hypot(mv.y);
         if left == 0.0 {
             return Ok(st);
         }
-        let mut u = d / left;
+        let m = mv / left;
+        let mut u = (m.x * st.frame.x_axis + m.y * st.frame.y_axis).normalize();
         let mut entered: Option<usize> = None;
-        // Each crossing consumes path length or enters a new face; the cap only guards
-        // against a malformed mesh looping forever.
-        for _ in 0..(16 * self.f.len() + 64) {
+        // A straight path crosses at most about length/(shortest edge) edges per face it
+        // visits; the cap guards against a malformed mesh looping forever.
+        let per_edge = left / self.min_edge;
+        if !(per_edge < 1e8) {
+            return Err(InputError::new(
+                "moves",
+                format!(
+                    "a move of length {left:.3e} would cross about {per_edge:.1e} edges of \
+                     this mesh; split it into shorter moves"
+                ),
+            ));
+        }
+        let cap = 64 + 16 * self.f.len() + 4 * per_edge.ceil() as usize;
+        for _ in 0..cap {
             let corners = self.corners(st.face);
             let mut best: Option<(f64, usize)> = None;
             for k in 0..3 {
