@@ -1,5 +1,7 @@
-"""Write the gallery notebooks (source of truth for their cells); run from the repo root:
-``python tools/make_notebooks.py``. The test suite executes the notebooks (nbmake)."""
+"""Write the six gallery notebooks (the source of truth for their cells); run from the repo
+root: ``python tools/make_notebooks.py``. The notebooks are written without outputs; the test
+suite executes them (nbmake). ``SPINAL_WRITE_IMAGES=1`` while executing them refreshes the
+README's pictures in docs/images/."""
 
 from __future__ import annotations
 
@@ -24,6 +26,76 @@ def nb(cells):
                   nbf.v4.new_code_cell(c) for c in cells]
     return book
 
+
+# Notebook 01 sets up pyvista itself (only its last cell renders), so it does not use SETUP.
+frames = nb([
+    """md:# Frames along a curve with spinal
+
+`spinal.frames(points)` returns one rotation matrix per sample, columns `(r, s, t)`: `t` the unit tangent,
+`r` the reference vector, `s = t × r`. This notebook compares the Frenet frame with the rotation-minimising
+frame (RMF) on a curve with an inflection, and measures the convergence order of the RMF methods against the
+closed-form RMF of a helix.""",
+    """import numpy as np
+import matplotlib.pyplot as plt
+import spinal
+from spinal.curves import Bezier, Helix""",
+    """md:## Frenet vs RMF on a curve with an inflection
+
+The Frenet normal points to the centre of curvature, so it flips across the inflection of this S-shaped
+space curve. The RMF (double reflection, the default) turns as little as possible about the tangent.""",
+    """s_curve = Bezier([[0, 0, 0], [1, 1.5, 0.3], [2, -1.5, 0.6], [3, 0, 0.9]])
+u = np.linspace(0, 1, 201)
+x = s_curve.point(u)
+frenet = spinal.frames(s_curve, u=u, method="frenet")
+rmf = spinal.frames(x)
+
+def turning(F):  # angle between consecutive reference vectors (rad)
+    return np.arccos(np.clip(np.einsum("ij,ij->i", F[1:, :, 0], F[:-1, :, 0]), -1, 1))
+
+fig, ax = plt.subplots(figsize=(6, 3))
+ax.plot(u[1:], turning(frenet), label="Frenet")
+ax.plot(u[1:], turning(rmf), label="RMF (double reflection)")
+ax.set_xlabel("u"); ax.set_ylabel("turn of r per step (rad)"); ax.legend()
+print("largest step: Frenet %.3f rad, RMF %.4f rad" % (turning(frenet).max(), turning(rmf).max()))
+assert turning(rmf).max() < 0.1 < turning(frenet).max()""",
+    """md:## Convergence against the closed-form helix RMF
+
+The RMF of a helix is its Frenet frame turned by `−τ s`. Double reflection and RK4 are 4th order,
+the rotation and projection methods 2nd order.""",
+    """helix = Helix(1.0, 0.5)
+c = np.hypot(1.0, 0.5)
+ns = np.array([32, 64, 128, 256, 512, 1024])
+errors = {m: [] for m in ["double_reflection", "rk4", "rotation", "projection"]}
+for n in ns:
+    u = np.linspace(0, 20 / c, n + 1)
+    exact = helix.rmf(u)[:, :, 0]
+    for m in errors:
+        F = (spinal.frames(helix, u=u, method=m) if m == "rk4"
+             else spinal.frames(helix.point(u), helix.d1(u), method=m, initial=exact[0]))
+        errors[m].append(np.linalg.norm(F[:, :, 0] - exact, axis=1).max())
+fig, ax = plt.subplots(figsize=(5, 4))
+for m, e in errors.items():
+    order = np.log2(e[-2] / e[-1])
+    ax.loglog(20 / ns, e, "o-", label=f"{m} (order {order:.2f})")
+ax.set_xlabel("step h"); ax.set_ylabel("max |r - r_exact|"); ax.legend()
+assert abs(np.log2(errors["double_reflection"][-2] / errors["double_reflection"][-1]) - 4) < 0.05""",
+    """md:## A ribbon along the RMF, rendered off-screen with PyVista""",
+    """import os
+import pyvista as pv
+pv.OFF_SCREEN = True
+pv.set_jupyter_backend("static")
+knot = spinal.curves.TorusKnot()
+x = knot.sample(1025)
+F = spinal.frames(x, closed=True)
+w = 0.04
+pts = np.empty((2 * len(x), 3)); pts[0::2] = x - w * F[:, :, 0]; pts[1::2] = x + w * F[:, :, 0]
+ribbon = pv.StructuredGrid(pts[:, 0].reshape(-1, 2), pts[:, 1].reshape(-1, 2), pts[:, 2].reshape(-1, 2))
+pl = pv.Plotter(window_size=(500, 400))
+pl.add_mesh(ribbon, scalars=np.repeat(np.arange(len(x)), 2), cmap="viridis", show_scalar_bar=False)
+if os.environ.get("SPINAL_WRITE_IMAGES"):  # refresh the README picture
+    pl.screenshot(os.path.join("..", "docs", "images", "ribbon.png"))
+pl.show()""",
+])
 
 tubes = nb([
     """md:# Tubes of a fibre bundle
@@ -322,9 +394,21 @@ else:
 ])
 
 
+BOOKS = {"01_frames": frames, "02_tubes": tubes, "03_knot_tube": knot,
+         "04_deformation": deform, "05_fleshing": flesh, "06_quaternion_frames": quat}
+
+
+def write(name: str, book, folder: str = "notebooks") -> str:
+    """Write one notebook with stable cell ids (``<topic>-<index>``), so that regenerating
+    an unchanged notebook gives an unchanged file."""
+    topic = name.split("_", 1)[1].replace("_", "-")
+    for i, cell in enumerate(book.cells):
+        cell["id"] = f"{topic}-{i:02d}"
+    path = f"{folder}/{name}.ipynb"
+    nbf.write(book, path)
+    return path
+
+
 if __name__ == "__main__":
-    for name, book in [("02_tubes", tubes), ("03_knot_tube", knot), ("04_deformation", deform),
-                       ("05_fleshing", flesh),
-                       ("06_quaternion_frames", quat)]:
-        nbf.write(book, f"notebooks/{name}.ipynb")
-        print("wrote", f"notebooks/{name}.ipynb")
+    for name, book in BOOKS.items():
+        print("wrote", write(name, book))
