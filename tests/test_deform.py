@@ -372,14 +372,16 @@ PRESS = fields.translation([0, 0, 1.32], 0.3, [0, 0, -1])  # press depth 0.28 in
 
 
 def volumes(V, F):
+    """Enclosed volume of a closed mesh from two independent implementations: trimesh's
+    mass properties and libigl's own surface integral (``igl.centroid(V, F)`` returns
+    ``(centroid, volume)`` in libigl 2.6)."""
     import igl
     import trimesh
 
     vt = trimesh.Trimesh(V, F, process=False).volume
-    # libigl: signed volume from the divergence theorem on the centred mesh
-    c = V - igl.centroid(V, F)[0]
-    vi = np.einsum("ij,ij->i", c[F[:, 0]], np.cross(c[F[:, 1]], c[F[:, 2]])).sum() / 6
-    return vt, vi
+    _, vi = igl.centroid(np.ascontiguousarray(V, dtype=np.float64),
+                         np.ascontiguousarray(F, dtype=np.int64))
+    return vt, float(vi)
 
 
 def test_rk4_volume_error_falls_16x_per_halving_and_euler_2x():
