@@ -28,7 +28,34 @@ __all__ = ["DeformReport", "StampReport", "deform", "stamp"]
 
 @dataclass(frozen=True)
 class DeformReport:
-    """What :func:`deform` did. Volumes are signed (outward-wound meshes are positive)."""
+    """What :func:`deform` did. Volumes are signed (outward-wound meshes are positive), in the
+    mesh's units cubed.
+
+    Attributes
+    ----------
+    rest_volume : float
+        Volume of the rest mesh (refinement adds vertices on flat rest edges, so it is the
+        input's volume).
+    volume : float
+        Volume of the deformed mesh.
+    relative_change : float
+        ``volume / rest_volume − 1`` (NaN when ``rest_volume`` is 0).
+    steps : int
+        RK4 steps taken.
+    vertices_added : int
+        Vertices added by the refinement, over ``passes`` passes.
+    passes : int
+        Refinement passes that split at least one edge.
+    integration_error : float or None
+        With ``estimate=True``: the Richardson estimate ``(V_n − V_2n)/V_rest · 16/15`` of the
+        part of ``relative_change`` due to time integration; else None.
+    mesh_error : float or None
+        With ``estimate=True``: ``relative_change − integration_error``, the part due to the
+        triangle mesh (flat faces between advected vertices); else None.
+    rest_vertices : ndarray (V', 3) float64 or None
+        Rest positions of the output mesh's vertices (the input's, then the rest midpoints
+        of the split edges), for re-running or checking the deformation.
+    """
 
     rest_volume: float
     volume: float
@@ -189,9 +216,25 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
 
 @dataclass(frozen=True)
 class StampReport:
-    """What :func:`stamp` did, per frame (arrays of length ``frames``): the dent volume
-    removed by snapping, the protrusion's moving time, the volume change of the frame
-    (``residual``, after the secant corrections) and the number of vertices in contact."""
+    """What :func:`stamp` did. Volumes are signed, in the mesh's units cubed; the arrays have
+    one entry per frame (length ``frames``).
+
+    Attributes
+    ----------
+    rest_volume, volume : float
+        Volume of the input mesh and of the stamped mesh.
+    relative_change : float
+        ``volume / rest_volume − 1`` (NaN when ``rest_volume`` is 0).
+    dent : ndarray (frames,) float64
+        Volume removed by snapping the vertices inside the tool to its surface (≥ 0).
+    time : ndarray (frames,) float64
+        The moving time ``t`` of the protrusion: how long the tool's curl translation field
+        (unit velocity along the motion) is integrated, so a length; 0 without contact.
+    residual : ndarray (frames,) float64
+        Volume after the frame minus volume before it, after the secant corrections.
+    contact : ndarray (frames,) int64
+        Number of vertices snapped to the tool in the frame.
+    """
 
     rest_volume: float
     volume: float

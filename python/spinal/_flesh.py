@@ -173,20 +173,31 @@ class SpineBinding:
 
     @property
     def edge(self) -> np.ndarray:
+        """``(V,)`` int64: the rest spine edge ``k`` (between samples ``k`` and ``k + 1``) that
+        holds each vertex's cross-section; ``0`` or ``n − 2`` for vertices past the ends."""
         return self._edge.copy()
 
     @property
     def param(self) -> np.ndarray:
+        """``(V,)`` float64: the parameter ``a ∈ [0, 1]`` of the section on its edge
+        (dimensionless; the section's spine point is ``(1 − a) R_k + a R_{k+1}``). Vertices past
+        the spine's ends get ``a = 0`` on the first edge or ``a = 1`` on the last."""
         return self._coords[:, 0].copy()
 
     @property
     def arc_length(self) -> np.ndarray:
+        """``(V,)`` float64: rest arc length ``S_k + a (S_{k+1} − S_k)`` of each vertex's
+        section along the rest polyline (``S_k`` the cumulative chord lengths), in the units of
+        the input; ``0`` or the total length past the ends."""
         k = self._edge
         s = self._lengths
         return s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
 
     @property
     def offset(self) -> np.ndarray:
+        """``(V, 2)`` float64: each vertex's offset from the spine in its section, as
+        coordinates along the ``r`` and ``s`` columns of the interpolated rest frame (units of
+        the input; in the planar case ``s`` is out of the plane, so the second column is 0)."""
         return self._coords[:, 2:4].copy()
 
     def posed_spine(self, posed_spine, *, stretchable: bool = False) -> np.ndarray:

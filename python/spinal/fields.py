@@ -118,10 +118,16 @@ class Field:
 
     @property
     def max_speed(self) -> float:
+        """A bound of the speed ``|v|`` (length/time): the sum over the elements of each
+        element's bound (closed form where one exists, else a maximum sampled over its
+        support); ``0`` for the zero field. Used by :meth:`steps`."""
         return _core.field_info(self._rows, 1.0)[0]
 
     @property
     def length_scale(self) -> float:
+        """The smallest length over which an element's field falls from its tool value to zero
+        (length): its ``reach`` (for :func:`twist` and :func:`bend`, their ``radius``), the
+        minimum over the elements; ``inf`` for the zero field. Used by :meth:`steps`."""
         return _core.field_info(self._rows, 1.0)[1]
 
     def steps(self, duration: float) -> int:

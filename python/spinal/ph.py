@@ -462,6 +462,7 @@ class PHSpline:
 
     @property
     def segments(self) -> int:
+        """The number ``m`` of PH cubics; the spline parameter ``s`` runs over ``[0, m]``."""
         return self._cp.shape[0]
 
     def __len__(self) -> int:

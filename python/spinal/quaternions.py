@@ -405,15 +405,33 @@ def _level_frames(pts, t, u, eps, closed):
 
 class WalkResult(NamedTuple):
     """Result of :func:`walk_mesh`: the state after every move (row 0 is the start) and the
-    polyline of the walk with every edge crossing."""
+    polyline of the walk with every edge crossing (``k`` moves, ``m`` path points).
 
-    points: np.ndarray  # (k+1, 3)
-    faces: np.ndarray  # (k+1,)
-    frames: np.ndarray  # (k+1, 3, 3) columns e1 (right), e2 (up), e3 (face normal)
-    stopped: np.ndarray  # (k,) bool: the move ended early at a boundary edge
-    path: np.ndarray  # (m, 3) start, crossings and move ends
-    path_faces: np.ndarray  # (m,) face entered at each path point
-    path_moves: np.ndarray  # (m,) index of the move (0 = start)
+    Attributes
+    ----------
+    points : ndarray (k+1, 3) float64
+        The walker's position after every move (mesh units).
+    faces : ndarray (k+1,) int64
+        The face it stands on.
+    frames : ndarray (k+1, 3, 3) float64
+        Its frame, columns ``e₁`` (right), ``e₂`` (up), ``e₃`` (face normal).
+    stopped : ndarray (k,) bool
+        The move ended early at a boundary edge.
+    path : ndarray (m, 3) float64
+        The start, every edge crossing and every move end, in order.
+    path_faces : ndarray (m,) int64
+        The face entered at each path point.
+    path_moves : ndarray (m,) int64
+        The move each path point belongs to (0 = the start).
+    """
+
+    points: np.ndarray
+    faces: np.ndarray
+    frames: np.ndarray
+    stopped: np.ndarray
+    path: np.ndarray
+    path_faces: np.ndarray
+    path_moves: np.ndarray
 
 
 def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkResult:
