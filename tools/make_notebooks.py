@@ -338,59 +338,128 @@ flesh = nb([
 spine's new pose. Curve deformers in animation packages map each point rigidly with the
 local frame (`solution="none"` here) and lose or gain volume wherever the shape sits off the
 spine's centre line; Zhuo's correction moves the offset so that every small piece keeps its
-volume (`"radial"`, `"normal"`, `"binormal"`).""",
-    SETUP + "\nimport trimesh, igl",
+volume (`"radial"`, `"normal"`, `"binormal"`). Volumes are measured twice, by trimesh and by
+libigl (`igl.centroid` returns the centroid and the enclosed volume), after checking that the
+mesh is closed and consistently wound: only then is its enclosed volume defined.""",
+    SETUP + "\nfrom pathlib import Path\nimport trimesh, igl",
     """def arc(n, length, radius):
-    \"\"\"A straight spine along x and the same spine bent into a circular arc (same edge lengths).\"\"\"
+    \"\"\"A straight spine along x and the same spine bent into a circular arc (same edge lengths,
+    bending towards +y).\"\"\"
     s = np.linspace(-length / 2, length / 2, n)
     th = s / radius
     return np.c_[s, 0 * s, 0 * s], np.c_[radius * np.sin(th), radius * (1 - np.cos(th)), 0 * s]
 
 def volumes(V, F):
-    _, iv = igl.centroid(V, F)
-    return trimesh.Trimesh(V, F, process=False).volume, float(iv)""",
+    \"\"\"Enclosed volume by trimesh and by libigl, refusing meshes that do not enclose one.\"\"\"
+    tm = trimesh.Trimesh(V, F, process=False)
+    if not (tm.is_watertight and tm.is_winding_consistent):
+        raise ValueError("the mesh is not closed and consistently wound: no enclosed volume")
+    _, iv = igl.centroid(np.asarray(V, dtype=np.float64), np.asarray(F, dtype=np.int64))
+    return tm.volume, float(iv)
+
+def side_by_side(shapes, F, spine, ghost=None, image=None, camera="xy"):
+    \"\"\"Render {label: vertices} next to each other with the posed spine (and the rest shape as
+    a translucent ghost); write docs/images/<image> when SPINAL_WRITE_IMAGES is set.\"\"\"
+    pl = pv.Plotter(shape=(1, len(shapes)), window_size=(900, 380))
+    for k, (label, V) in enumerate(shapes.items()):
+        pl.subplot(0, k)
+        pl.add_text(label, font_size=10)
+        if ghost is not None:
+            pl.add_mesh(pv.wrap(trimesh.Trimesh(ghost, F, process=False)), color="grey",
+                        opacity=0.25)
+        pl.add_mesh(pv.wrap(trimesh.Trimesh(V, F, process=False)), color="#c8a27a",
+                    smooth_shading=True)
+        pl.add_mesh(pv.lines_from_points(spine), color="#3060a0", line_width=3)
+        pl.camera_position = camera
+    pl.link_views()
+    if IMAGES and image:
+        pl.screenshot(os.path.join(IMAGES, image))
+    pl.show()""",
     """md:## An off-centre bar
 
-A box beside the spine (0.2 to the side of it), bent into an arc of radius 1.""",
+A box centred 0.3 off the spine towards the centre of curvature (and 0.2 along it), bent
+into an arc of radius 1. The uncorrected map squeezes it by the factor `1 − y/R` of the
+frame's rotation about the bent spine: about −30 %. The corrections keep the volume up to
+the mesh error (the box's faces are flat, the map bends them).""",
     """rest, posed = arc(301, 3.0, 1.0)
 box = trimesh.creation.box(extents=[0.3, 0.3, 0.3]).subdivide().subdivide().subdivide()
 box.apply_translation([0.2, 0.3, 0.0])
-v0 = box.volume
+v0, iv0 = volumes(box.vertices, box.faces)
+bent = {}
 for solution in ("none", "radial", "normal", "binormal"):
     V = spinal.flesh(box.vertices, rest, posed, solution=solution)
     tv, iv = volumes(V, box.faces)
-    print(f"{solution:9s} volume change: trimesh {tv / v0 - 1:+.4%}, libigl {iv / v0 - 1:+.4%}")""",
-    """md:## A cow bent along its body
+    bent[solution] = (V, tv / v0 - 1)
+    print(f"{solution:9s} volume change: trimesh {tv / v0 - 1:+.4%}, libigl {iv / iv0 - 1:+.4%}")
+near = np.abs(rest[:, 0] - 0.2) < 0.45                 # the part of the spine beside the box
+side_by_side({f"solution='{s}': {bent[s][1]:+.2%}": bent[s][0] for s in ("none", "radial")},
+             box.faces, posed[near], ghost=box.vertices, image="flesh_bar.png")""",
+    """md:## A second mesh: the cow, or a bunny-like stand-in
 
-The real test mesh (from the shared data folder; skipped when absent): the spine runs
-through the body from tail to head (the cow's up is +y), the legs hang 3–4 units below it.
-Bending the spine into an arc of radius 8 with the legs on the outside, the uncorrected map
-stretches everything below the spine.""",
-    """path = "../../shared/data/meshes/cow.obj"
-if os.path.exists(path):
-    cow = trimesh.load(path, process=False)
-    rest, posed = arc(201, 11.0, 8.0)                    # bend in the x–y plane, legs outside
+The real test mesh `cow.obj` comes from the project's shared data folder (`shared/` beside
+the repository; it is not shipped with spinal). Without it the notebook builds a bunny-like
+closed mesh instead: a sphere displaced along its normals by smooth lobes (head, ears, tail,
+feet), an embedded surface whatever the lobes, since every direction meets it once.""",
+    """def find_shared(name):
+    \"\"\"shared/data/meshes/<name> beside the repository (found from spinal's source folder or
+    from the working directory upwards), or None.\"\"\"
+    for start in (Path(spinal.__file__).resolve().parent, Path.cwd().resolve()):
+        for folder in (start, *start.parents):
+            path = folder / "shared" / "data" / "meshes" / name
+            if path.is_file():
+                return path
+    return None
+
+def bunny_like(subdivisions=5):
+    \"\"\"A closed, watertight bunny-like mesh: a unit icosphere with r(d) = 1 + Σ h exp(−(1 − d·c)/w)
+    (lobes of height h about directions c, angular width ~ √w), stretched to a body along x.\"\"\"
+    sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
+    d = sphere.vertices
+    r = np.ones(len(d))
+    for c, h, w in [([1.0, 0.45, 0.0], 0.3, 0.05),                                  # head
+                    ([0.5, 0.8, 0.38], 0.8, 0.012), ([0.5, 0.8, -0.38], 0.8, 0.012),  # ears
+                    ([-1.0, 0.25, 0.0], 0.25, 0.015),                               # tail
+                    ([0.6, -0.75, 0.3], 0.15, 0.03), ([0.6, -0.75, -0.3], 0.15, 0.03),
+                    ([-0.6, -0.7, 0.35], 0.2, 0.04), ([-0.6, -0.7, -0.35], 0.2, 0.04)]:
+        c = np.asarray(c) / np.linalg.norm(c)
+        r += h * np.exp(-(1 - d @ c) / w)
+    return trimesh.Trimesh(d * r[:, None] * [1.4, 0.9, 0.8], sphere.faces, process=False)
+
+path = find_shared("cow.obj")
+if path is not None:
+    name, mesh = "cow", trimesh.load(path, process=False)
+    # the spine runs through the body from tail to head (the cow's up is +y), the legs hang
+    # 3–4 units below it; bent into an arc of radius 8 with the legs on the outside
+    rest, posed = arc(201, 11.0, 8.0)
     rest += [0.75, 0.8, 0]
     posed += [0.75, 0.8, 0]
-    shapes = {}
-    for solution in ("none", "radial"):
-        V = spinal.flesh(cow.vertices, rest, posed, solution=solution)
-        tv, iv = volumes(V, cow.faces)
-        shapes[solution] = V
-        print(f"cow, {solution:6s}: volume change trimesh {tv / cow.volume - 1:+.3%}, "
-              f"libigl {iv / cow.volume - 1:+.3%}")
-    pl = pv.Plotter(shape=(1, 2), window_size=(900, 380))
-    for k, (solution, V) in enumerate(shapes.items()):
-        pl.subplot(0, k)
-        pl.add_text(f"solution='{solution}'", font_size=10)
-        pl.add_mesh(pv.wrap(trimesh.Trimesh(V, cow.faces, process=False)), color="#c8a27a",
-                    smooth_shading=True)
-        pl.camera_position = "xy"
-    if IMAGES:
-        pl.screenshot(os.path.join(IMAGES, "flesh.png"))
-    pl.show()
+    print("cow.obj from", path)
 else:
-    print("cow.obj not found; skipping the real-mesh example")""",
+    name, mesh = "bunny-like", bunny_like()
+    # the spine runs along the back, the body below it: bent with the belly outside
+    rest, posed = arc(201, 4.4, 3.0)
+    rest += [0, 0.5, 0]
+    posed += [0, 0.5, 0]
+    print("cow.obj not found: using a generated bunny-like mesh")
+print(f"{name}: {len(mesh.vertices)} vertices, watertight {mesh.is_watertight}, "
+      f"consistently wound {mesh.is_winding_consistent}")
+assert mesh.is_watertight and mesh.is_winding_consistent""",
+    """md:## Bent along its spine
+
+The uncorrected map stretches everything on the outside of the bend and squeezes the inside;
+with the body mostly on one side of the spine the volume changes by several per cent. The
+radial correction keeps it.""",
+    """v0, iv0 = volumes(mesh.vertices, mesh.faces)
+print(f"{name} rest volume: trimesh {v0:.6f}, libigl {iv0:.6f}")
+shapes = {}
+for solution in ("none", "radial"):
+    V = spinal.flesh(mesh.vertices, rest, posed, solution=solution)
+    tv, iv = volumes(V, mesh.faces)
+    shapes[f"solution='{solution}': {tv / v0 - 1:+.3%}"] = V
+    print(f"{name}, {solution:6s}: volume change trimesh {tv / v0 - 1:+.3%}, "
+          f"libigl {iv / iv0 - 1:+.3%}")
+side_by_side(shapes, mesh.faces, posed, image="flesh.png" if name == "cow" else None,
+             camera="xy" if name == "cow" else [(1.5, 2.0, 9.0), (0.0, 0.3, 0.0), (0, 1, 0)])""",
 ])
 
 
