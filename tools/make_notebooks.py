@@ -329,6 +329,33 @@ pl.camera.zoom(0.8)
 if IMAGES:
     pl.screenshot(os.path.join(IMAGES, "deform.png"))
 pl.show()""",
+    """md:## Progress of long runs
+
+`progress=True` shows a tqdm bar (notebook-aware) when tqdm is installed and a text line
+`advect: done/total steps` on stderr otherwise; a callable is called as
+`progress(done_steps, total_steps)` about a hundred times per run, for a progress display of
+one's own.""",
+    """W = spinal.advect(V0, tool, 1.2, steps=400, progress=True)
+updates = []
+W2 = spinal.advect(V0, tool, 1.2, steps=400, progress=lambda done, total: updates.append(done))
+print(f"{len(updates)} updates of the callable, the last at {updates[-1]} of 400 steps")
+# the run is done in blocks between updates: only the step times' rounding differs
+print("largest difference from a run without progress: %.1e" %
+      np.abs(W2 - spinal.advect(V0, tool, 1.2, steps=400)).max())""",
+    """md:## Refinement: `spinal.deform`
+
+Where the flow stretches the mesh its triangles no longer follow the surface, and that is
+the remaining volume error. `spinal.deform` advects the mesh, splits every edge that ended
+up longer than `refine ×` the mean rest edge at its *rest* midpoint (the new vertex
+integrated from the rest mesh with the same steps), and repeats until no edge is too long.
+`estimate=True` splits the volume change into integration error (Richardson, from a run with
+twice the steps) and mesh error.""",
+    """change = {}
+for refine in (None, 1.5, 1.0):
+    dented, report = spinal.deform(sphere, tool, 1.2, refine=refine, estimate=True)
+    change[refine] = report.relative_change
+    print(f"refine={refine}:", report)
+assert abs(change[1.0]) < abs(change[1.5]) < abs(change[None]) / 3""",
 ])
 
 flesh = nb([
@@ -391,6 +418,8 @@ for solution in ("none", "radial", "normal", "binormal"):
     tv, iv = volumes(V, box.faces)
     bent[solution] = (V, tv / v0 - 1)
     print(f"{solution:9s} volume change: trimesh {tv / v0 - 1:+.4%}, libigl {iv / iv0 - 1:+.4%}")
+    assert abs(tv / iv - 1) < 1e-12                    # the two volume integrals agree
+assert abs(bent["radial"][1]) < 1e-3 < 0.2 < abs(bent["none"][1])
 near = np.abs(rest[:, 0] - 0.2) < 0.45                 # the part of the spine beside the box
 side_by_side({f"solution='{s}': {bent[s][1]:+.2%}": bent[s][0] for s in ("none", "radial")},
              box.faces, posed[near], ghost=box.vertices, image="flesh_bar.png")""",
@@ -458,6 +487,8 @@ for solution in ("none", "radial"):
     shapes[f"solution='{solution}': {tv / v0 - 1:+.3%}"] = V
     print(f"{name}, {solution:6s}: volume change trimesh {tv / v0 - 1:+.3%}, "
           f"libigl {iv / iv0 - 1:+.3%}")
+    assert abs(tv / iv - 1) < 1e-12
+    assert (abs(tv / v0 - 1) < 1e-4) if solution == "radial" else (abs(tv / v0 - 1) > 0.05)
 side_by_side(shapes, mesh.faces, posed, image="flesh.png" if name == "cow" else None,
              camera="xy" if name == "cow" else [(1.5, 2.0, 9.0), (0.0, 0.3, 0.0), (0, 1, 0)])""",
 ])
