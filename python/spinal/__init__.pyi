@@ -1,61 +1,101 @@
 import os
 import pathlib
-from collections.abc import Sequence
-from typing import Any, Literal, TypeAlias
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal, TypeAlias, overload
 
 import numpy as np
 import numpy.typing as npt
 
 from . import curves as curves
+from . import fields as fields
 from . import ph as ph
 from . import quaternions as quaternions
 from .curves import Curve
+from .fields import Field
+
+__all__ = [
+    "DeformReport",
+    "FoldOverWarning",
+    "Mesh",
+    "SpineBinding",
+    "StampReport",
+    "SurfaceBinding",
+    "__version__",
+    "advect",
+    "closing_angle",
+    "curves",
+    "deform",
+    "estimate_tangents",
+    "fields",
+    "flesh",
+    "flesh_surface",
+    "frames",
+    "ph",
+    "quaternions",
+    "stamp",
+    "sweep",
+    "tube",
+]
 
 __version__: str
 
-Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
-_Array = npt.ArrayLike
+_Array: TypeAlias = npt.ArrayLike
+_F: TypeAlias = npt.NDArray[np.float64]
+_I: TypeAlias = npt.NDArray[np.int64]
+_Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
+_Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
+_Reflection: TypeAlias = Literal["chord", "tangents"]
+_Progress: TypeAlias = bool | Callable[[int, int], object]
+_AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
+_SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
+_SurfaceSolution: TypeAlias = Literal["offset", "none"]
+
+# ---- frames -------------------------------------------------------------------------------
 
 def frames(
     points: _Array | Curve | None,
     tangents: _Array | None = None,
     *,
-    method: Method = "double_reflection",
+    method: _Method = "double_reflection",
     initial: _Array | None = None,
     closed: bool = False,
     end: _Array | None = None,
     turns: int = 0,
-    reflection: Literal["chord", "tangents"] = "chord",
+    reflection: _Reflection = "chord",
     u: int | _Array | None = None,
-    lengths: Sequence[int] | npt.NDArray[np.integer] | None = None,
-    offsets: Sequence[int] | npt.NDArray[np.integer] | None = None,
-) -> npt.NDArray[np.float64]: ...
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
+) -> _F: ...
 def closing_angle(
     points: _Array | Curve | None,
     tangents: _Array | None = None,
     *,
-    method: Method = "double_reflection",
-    reflection: Literal["chord", "tangents"] = "chord",
+    method: _Method = "double_reflection",
+    reflection: _Reflection = "chord",
     u: int | _Array | None = None,
-    lengths: Sequence[int] | npt.NDArray[np.integer] | None = None,
-    offsets: Sequence[int] | npt.NDArray[np.integer] | None = None,
-) -> float | npt.NDArray[np.float64]: ...
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
+) -> float | _F: ...
 def estimate_tangents(
-    points: _Array, *, closed: bool = False, method: Literal["five_point", "five_point_uniform", "circle"] = "five_point"
-) -> npt.NDArray[np.float64]: ...
+    points: _Array,
+    *,
+    closed: bool = False,
+    method: Literal["five_point", "five_point_uniform", "circle"] = "five_point",
+) -> _F: ...
 
-_Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
+# ---- meshes and sweeps --------------------------------------------------------------------
 
 class FoldOverWarning(UserWarning):
-    indices: npt.NDArray[np.int64]
-    def __init__(self, message: str, indices: npt.NDArray[np.int64]) -> None: ...
+    indices: _I
+    def __init__(self, message: str, indices: _I) -> None: ...
 
 class Mesh:
-    vertices: npt.NDArray[np.float64]
-    faces: npt.NDArray[np.int64]
-    normals: npt.NDArray[np.float64] | None
-    uv: npt.NDArray[np.float64] | None
-    fold_over: npt.NDArray[np.int64]
+    vertices: _F
+    faces: _I
+    normals: _F | None
+    uv: _F | None
+    fold_over: _I
     def __init__(
         self,
         vertices: _Array,
@@ -74,7 +114,11 @@ class Mesh:
     def to_pyvista(self) -> Any: ...
     def save(self, path: str | os.PathLike[str]) -> pathlib.Path: ...
     def plot(
-        self, screenshot: str | os.PathLike[str] | None = None, *, window_size: tuple[int, int] = ..., **kwargs: Any
+        self,
+        screenshot: str | os.PathLike[str] | None = None,
+        *,
+        window_size: tuple[int, int] = (800, 600),
+        **kwargs: Any,
     ) -> npt.NDArray[np.uint8] | None: ...
 
 def sweep(
@@ -108,11 +152,7 @@ def tube(
     offsets: _Ints | None = None,
 ) -> Mesh: ...
 
-# ---- deformation (issue 4) ----
-from collections.abc import Callable
-
-from . import fields as fields
-from .fields import Field
+# ---- deformation by divergence-free fields ------------------------------------------------
 
 def advect(
     vertices: _Array,
@@ -122,9 +162,9 @@ def advect(
     *,
     method: Literal["rk4", "euler", "split"] = "rk4",
     t0: float = 0.0,
-    progress: bool | Callable[[int, int], object] = False,
-) -> npt.NDArray[np.float64]: ...
-
+    progress: _Progress = False,
+) -> _F: ...
+@dataclass(frozen=True)
 class DeformReport:
     rest_volume: float
     volume: float
@@ -132,12 +172,12 @@ class DeformReport:
     steps: int
     vertices_added: int
     passes: int
-    integration_error: float | None
-    mesh_error: float | None
-    rest_vertices: npt.NDArray[np.float64] | None
+    integration_error: float | None = None
+    mesh_error: float | None = None
+    rest_vertices: _F | None = None
 
 def deform(
-    mesh: Mesh | Any | tuple[_Array, _Array],
+    mesh: _AnyMesh,
     field: Field,
     duration: float,
     steps: int | None = None,
@@ -146,83 +186,20 @@ def deform(
     max_passes: int = 30,
     t0: float = 0.0,
     estimate: bool = False,
-    progress: bool | Callable[[int, int], object] = False,
+    progress: _Progress = False,
 ) -> tuple[Mesh, DeformReport]: ...
-
-class SpineBinding:
-    clamped: npt.NDArray[np.int64]
-    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
-    def __len__(self) -> int: ...
-    @property
-    def edge(self) -> npt.NDArray[np.int64]: ...
-    @property
-    def param(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def arc_length(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def offset(self) -> npt.NDArray[np.float64]: ...
-    def posed_spine(self, posed_spine: _Array, *, stretchable: bool = False) -> npt.NDArray[np.float64]: ...
-    def deform(
-        self,
-        posed_spine: _Array,
-        *,
-        solution: Literal["radial", "normal", "binormal", "none"] = "radial",
-        stretchable: bool = False,
-        twist: float | _Array | None = None,
-        strict: bool = False,
-        return_clamped: bool = False,
-    ) -> Any: ...
-
-def flesh(
-    vertices: _Array,
-    rest_spine: _Array,
-    posed_spine: _Array,
-    *,
-    solution: Literal["radial", "normal", "binormal", "none"] = "radial",
-    stretchable: bool = False,
-    twist: float | _Array | None = None,
-    strict: bool = False,
-    return_clamped: bool = False,
-) -> Any: ...
-
-class SurfaceBinding:
-    clamped: npt.NDArray[np.int64]
-    def __init__(self, vertices: _Array, rest_surface: _Array) -> None: ...
-    def __len__(self) -> int: ...
-    @property
-    def uv(self) -> npt.NDArray[np.float64]: ...
-    @property
-    def offset(self) -> npt.NDArray[np.float64]: ...
-    def deform(
-        self,
-        posed_surface: _Array,
-        *,
-        solution: Literal["offset", "none"] = "offset",
-        strict: bool = False,
-        return_clamped: bool = False,
-    ) -> Any: ...
-
-def flesh_surface(
-    vertices: _Array,
-    rest_surface: _Array,
-    posed_surface: _Array,
-    *,
-    solution: Literal["offset", "none"] = "offset",
-    strict: bool = False,
-    return_clamped: bool = False,
-) -> Any: ...
-
+@dataclass(frozen=True)
 class StampReport:
     rest_volume: float
     volume: float
     relative_change: float
-    dent: npt.NDArray[np.float64]
-    time: npt.NDArray[np.float64]
-    residual: npt.NDArray[np.float64]
-    contact: npt.NDArray[np.int64]
+    dent: _F
+    time: _F
+    residual: _F
+    contact: _I
 
 def stamp(
-    mesh: Mesh | Any | tuple[_Array, _Array],
+    mesh: _AnyMesh,
     start: _Array,
     end: _Array,
     radius: float,
@@ -231,3 +208,156 @@ def stamp(
     frames: int = 10,
     iterations: int = 2,
 ) -> tuple[Mesh, StampReport]: ...
+
+# ---- fleshing -----------------------------------------------------------------------------
+
+class SpineBinding:
+    clamped: _I
+    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def edge(self) -> _I: ...
+    @property
+    def param(self) -> _F: ...
+    @property
+    def arc_length(self) -> _F: ...
+    @property
+    def offset(self) -> _F: ...
+    def posed_spine(self, posed_spine: _Array, *, stretchable: bool = False) -> _F: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: _Array,
+        *,
+        solution: _SpineSolution = "radial",
+        stretchable: bool = False,
+        twist: float | _Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+    ) -> _F: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: _Array,
+        *,
+        solution: _SpineSolution = "radial",
+        stretchable: bool = False,
+        twist: float | _Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[True],
+    ) -> tuple[_F, _I]: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: _Array,
+        *,
+        solution: _SpineSolution = "radial",
+        stretchable: bool = False,
+        twist: float | _Array | None = None,
+        strict: bool = False,
+        return_clamped: bool = False,
+    ) -> _F | tuple[_F, _I]: ...
+
+@overload
+def flesh(
+    vertices: _Array,
+    rest_spine: _Array,
+    posed_spine: _Array,
+    *,
+    solution: _SpineSolution = "radial",
+    stretchable: bool = False,
+    twist: float | _Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+) -> _F: ...
+@overload
+def flesh(
+    vertices: _Array,
+    rest_spine: _Array,
+    posed_spine: _Array,
+    *,
+    solution: _SpineSolution = "radial",
+    stretchable: bool = False,
+    twist: float | _Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[True],
+) -> tuple[_F, _I]: ...
+@overload
+def flesh(
+    vertices: _Array,
+    rest_spine: _Array,
+    posed_spine: _Array,
+    *,
+    solution: _SpineSolution = "radial",
+    stretchable: bool = False,
+    twist: float | _Array | None = None,
+    strict: bool = False,
+    return_clamped: bool = False,
+) -> _F | tuple[_F, _I]: ...
+
+class SurfaceBinding:
+    clamped: _I
+    def __init__(self, vertices: _Array, rest_surface: _Array) -> None: ...
+    def __len__(self) -> int: ...
+    @property
+    def uv(self) -> _F: ...
+    @property
+    def offset(self) -> _F: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: _Array,
+        *,
+        solution: _SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+    ) -> _F: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: _Array,
+        *,
+        solution: _SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[True],
+    ) -> tuple[_F, _I]: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: _Array,
+        *,
+        solution: _SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+    ) -> _F | tuple[_F, _I]: ...
+
+@overload
+def flesh_surface(
+    vertices: _Array,
+    rest_surface: _Array,
+    posed_surface: _Array,
+    *,
+    solution: _SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+) -> _F: ...
+@overload
+def flesh_surface(
+    vertices: _Array,
+    rest_surface: _Array,
+    posed_surface: _Array,
+    *,
+    solution: _SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[True],
+) -> tuple[_F, _I]: ...
+@overload
+def flesh_surface(
+    vertices: _Array,
+    rest_surface: _Array,
+    posed_surface: _Array,
+    *,
+    solution: _SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+) -> _F | tuple[_F, _I]: ...

@@ -5,6 +5,18 @@ import numpy.typing as npt
 
 from .curves import Curve
 
+__all__ = [
+    "PHSpline",
+    "angle_fit",
+    "evaluate",
+    "fit",
+    "from_quaternions",
+    "hermite",
+    "invariants",
+    "is_ph",
+    "preimage",
+]
+
 _Array: TypeAlias = npt.ArrayLike
 _F: TypeAlias = npt.NDArray[np.float64]
 
