@@ -1,8 +1,9 @@
-from typing import Any, TypeAlias
+from typing import Any, Literal, TypeAlias, overload
 
 import numpy as np
 import numpy.typing as npt
 
+from . import Mesh
 from .curves import Curve
 
 __all__ = [
@@ -20,7 +21,18 @@ __all__ = [
 _Array: TypeAlias = npt.ArrayLike
 _F: TypeAlias = npt.NDArray[np.float64]
 
-def hermite(p0: _Array, t0: _Array, p1: _Array, t1: _Array, *, all: bool = False) -> Any: ...
+@overload
+def hermite(
+    p0: _Array, t0: _Array, p1: _Array, t1: _Array, *, all: Literal[False] = False
+) -> _F: ...
+@overload
+def hermite(
+    p0: _Array, t0: _Array, p1: _Array, t1: _Array, *, all: Literal[True]
+) -> _F | list[_F]: ...
+@overload
+def hermite(
+    p0: _Array, t0: _Array, p1: _Array, t1: _Array, *, all: bool = False
+) -> _F | list[_F]: ...
 def is_ph(control_points: _Array, tol: float = 1e-9) -> bool | npt.NDArray[np.bool_]: ...
 def from_quaternions(
     A0: _Array, A1: _Array, start: _Array = (0.0, 0.0, 0.0), *, scalar_first: bool = False
@@ -99,4 +111,4 @@ class PHSpline:
         exact: bool = False,
         omega_start: float = 0.0,
         **kwargs: Any,
-    ) -> Any: ...
+    ) -> Mesh: ...
