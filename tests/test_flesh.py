@@ -400,14 +400,46 @@ def test_fold_over_is_clamped_and_reported():
             assert np.abs(d).max() < 1e-3
         with pytest.raises(ValueError, match="^posed_spine: .* clamped"):
             spinal.flesh(V, rest, posed, solution=sol, strict=True)
-    with pytest.warns(spinal.FoldOverWarning):
-        out = spinal.flesh(V, rest, arc3(1 / 4.0), solution="binormal")
-    assert np.isfinite(out).all()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         out, clamped = spinal.flesh(V, rest, arc3(1 / 1.5), solution="normal",
                                     return_clamped=True)
     assert clamped.size == 0
+
+
+BINORMAL_MIN_FACTOR = 1e-3  # src/flesh/solve.rs: the factor 1 − κ1 x' is capped below here
+
+
+@pytest.mark.parametrize("kappa", [4.0, 3.5])
+def test_binormal_fold_over_caps_the_factor_and_keeps_the_rest_exact(kappa):
+    """Straight spine → arc of curvature κ (centre (0, 1/κ, 0)): binormal keeps x (toward the
+    centre) and the arc length, and sets z1 = z0 / (1 − κx). The clamped set is exactly the
+    vertices with 1 − κx < 1e-3 (up to the O((hκ)²) difference between the spine model's
+    curvature and κ), where z1 = z0 / 1e-3; every vertex, clamped or not, sits at
+    x in its posed normal plane at angle κs about the centre."""
+    rng = np.random.default_rng(5)
+    rest = straight3()
+    V = np.c_[rng.uniform(-0.5, 0.5, 4000), rng.uniform(-0.3, 0.3, (4000, 2))]
+    s, x, z = V.T
+    R = 1 / kappa
+    with pytest.warns(spinal.FoldOverWarning) as rec:
+        out, clamped = spinal.flesh(V, rest, arc3(R), solution="binormal", return_clamped=True)
+    assert np.array_equal(rec[0].message.indices, clamped)
+    factor = 1 - kappa * x
+    expect = np.flatnonzero(factor < BINORMAL_MIN_FACTOR - 5e-4)
+    near = np.flatnonzero(np.abs(factor - BINORMAL_MIN_FACTOR) <= 5e-4)
+    assert len(expect) > 50  # 339 and 88 clamped
+    assert set(expect) <= set(clamped) <= set(expect) | set(near)
+    # in-plane: x kept along the posed normal, at the arc length s (also past the centre)
+    th = kappa * s
+    np.testing.assert_allclose(out[:, :2], np.c_[(R - x) * np.sin(th), R - (R - x) * np.cos(th)],
+                               atol=1e-4)  # measured 6.7e-5
+    # clamped values: the factor is 1e-3 exactly (stretch λ = 1 + O(h²) on the edge)
+    np.testing.assert_allclose(out[clamped, 2], z[clamped] / BINORMAL_MIN_FACTOR, rtol=3e-4)
+    free = factor > 0.1
+    np.testing.assert_allclose(out[free, 2], z[free] / factor[free], rtol=3e-3)
+    with pytest.raises(ValueError, match="^posed_spine: .* clamped"):
+        spinal.flesh(V, rest, arc3(R), solution="binormal", strict=True)
 
 
 def test_bad_input():
