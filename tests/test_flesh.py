@@ -420,6 +420,10 @@ def test_binormal_fold_over_caps_the_factor_and_keeps_the_rest_exact(kappa):
     rng = np.random.default_rng(5)
     rest = straight3()
     V = np.c_[rng.uniform(-0.5, 0.5, 4000), rng.uniform(-0.3, 0.3, (4000, 2))]
+    # and probes whose factor straddles the cap: 1e-3 ± (0.6e-3 … 1e-2)
+    f = BINORMAL_MIN_FACTOR + np.r_[-1, 1][:, None] * np.geomspace(6e-4, 1e-2, 100)
+    V = np.r_[V, np.c_[rng.uniform(-0.5, 0.5, 200), (1 - f.ravel()) / kappa,
+                       rng.uniform(-0.3, 0.3, 200)]]
     s, x, z = V.T
     R = 1 / kappa
     with pytest.warns(spinal.FoldOverWarning) as rec:
