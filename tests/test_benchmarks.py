@@ -1,11 +1,24 @@
 """The benchmark scripts keep working: a quick run of run_all.py on small sizes (timings are
-not checked here; speed is reported by the benchmarks, not asserted by tests)."""
+not checked here; speed is reported by the benchmarks, not asserted by tests). The summary
+table must hold one row per case of every timing script, with numbers that are those of the
+scripts' own tables in the same report (one run, not a second measurement)."""
 
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import run_all
+
+
+def section(text, heading):
+    """The report's text under ``## heading...`` up to the next ``## ``."""
+    start = text.index(f"## {heading}")
+    end = text.find("\n## ", start + 3)
+    return text[start:end if end > 0 else None]
 
 
 def test_run_all_quick_writes_a_report(tmp_path):
@@ -22,3 +35,51 @@ def test_run_all_quick_writes_a_report(tmp_path):
     assert "| 1,000 points |" in text  # the sweep table
     assert "double_reflection" in text
     assert "| curl translation |" in text or "| translation" in text
+
+    # the summary: printed, written before the per-script sections, one row per case
+    assert "=== summary" in r.stdout
+    assert text.index("## Summary") < text.index("## `python benchmarks/")
+    (summary,) = run_all.md_tables(section(text, "Summary"))
+    by = {}
+    for row in summary:
+        by.setdefault(row["benchmark"], []).append(row)
+    assert set(by) == {"frames", "tubes", "advect", "flesh"}
+    assert len(by["frames"]) == 2 * 3  # 10^3..10^5 points, tangents estimated and given
+    assert [row["case"] for row in by["tubes"]] == ["1,000 points", "10,000 points"]
+    assert len(by["advect"]) == 3 and len(by["flesh"]) == 2
+    for row in summary:
+        assert float(row["spinal"].replace(",", "")) > 0
+    peers = " ".join(row["peers: time (peer / spinal)"] for row in summary)
+    for peer in ("NumPy write floor", "NumPy loop", "VTK strips", "VTK triangles", "NumPy RK4"):
+        assert peer in peers
+
+    # the same run: spinal's and the peers' numbers are those of the scripts' tables
+    (sweep,) = run_all.md_tables(section(text, "`python benchmarks/bench_sweep.py"))
+    for srow, trow in zip(by["tubes"], sweep, strict=True):
+        assert srow["spinal"] == run_all.fmt(float(trow["spinal"]))
+        strips = run_all.num(trow["vtk strips"])
+        assert f"VTK strips {run_all.fmt(strips)} (" in srow["peers: time (peer / spinal)"]
+    (adv,) = run_all.md_tables(section(text, "`python benchmarks/bench_advect.py"))
+    col = next(c for c in adv[0] if c.startswith("spinal") and c.endswith("threads"))
+    for srow, trow in zip(by["advect"], adv, strict=True):
+        ns, t_np = float(trow[col]), float(trow["NumPy"])
+        assert srow["spinal"] == run_all.fmt(ns)
+        ratio = float(re.search(r"NumPy RK4 [\d,.]+ \(([\d,.e+-]+)×\)",
+                                srow["peers: time (peer / spinal)"]).group(1).replace(",", ""))
+        assert abs(ratio / (t_np / ns) - 1) < 0.05  # two significant digits
+
+
+def test_summary_reads_tables_with_pipes_in_headers():
+    text = ("| field | vertices | spinal 2 threads | NumPy | max |Δ| vs NumPy |\n"
+            "|---|---|---|---|---|\n"
+            "| twist | 40,962 | 20.0 | 300 | 2.2e-16 |\n")
+    (table,) = run_all.md_tables(text)
+    assert table == [{"field": "twist", "vertices": "40,962", "spinal 2 threads": "20.0",
+                      "NumPy": "300", "max |Δ| vs NumPy": "2.2e-16"}]
+    out, unreadable = run_all.summary_table({"bench_advect.py": text})
+    assert not unreadable
+    assert "| advect | twist, 40,962 vertices (2 threads) | ns/vertex/step | 20 | " \
+           "NumPy RK4 300 (15×) |" in out
+    # a table the summary cannot read is reported, not skipped silently
+    _, unreadable = run_all.summary_table({"bench_sweep.py": "no table here\n"})
+    assert unreadable == ["bench_sweep.py"]
