@@ -4,8 +4,11 @@ Computes rotation-minimising frames on the torus knot of Wang et al. (2008) and 
 measures their accuracy against an independent closed form (the helix RMF) and the published
 closing angle; sweeps a closed tube around the knot and tubes around a circle, measuring
 their volumes against Pappus' theorem; pushes a dent into a tube with a divergence-free
-field and reports the volume change; writes the frames, a ribbon and the knot tube (PLY and
-OBJ), a convergence table and, when pyvista is installed, a picture to DIR. Needs only NumPy.
+field and reports the volume change; bends a bar that sits off its spine with and without
+Zhuo's volume correction and compares the uncorrected change with its closed form. Writes
+the frames, a convergence table, the meshes (PLY and OBJ, through trimesh when it is
+installed, else spinal's own writer) and, when pyvista is installed, a picture to DIR, and
+prints every path and volume error. Needs only NumPy; takes a few seconds.
 """
 
 from __future__ import annotations
@@ -20,22 +23,45 @@ import spinal
 from spinal.curves import Helix, TorusKnot
 
 
-def ribbon_ply(path: pathlib.Path, x: np.ndarray, F: np.ndarray, width: float) -> None:
-    """Write the developable ribbon x ± width·r as an ASCII PLY triangle strip."""
-    left = x - width * F[:, :, 0]
-    right = x + width * F[:, :, 0]
+def save_mesh(mesh: spinal.Mesh, path: pathlib.Path) -> pathlib.Path:
+    """Write ``mesh`` as PLY or OBJ (by the suffix): with trimesh when it is installed
+    (positions, faces and normals; binary PLY with float32 coordinates, OBJ with 12
+    decimals), otherwise with :meth:`spinal.Mesh.save` (float64 PLY, 17-digit OBJ, and the
+    texture coordinates)."""
+    try:
+        import trimesh
+    except ImportError:
+        return mesh.save(path)
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, vertex_normals=mesh.normals, process=False)
+    if path.suffix == ".obj":
+        tm.export(path, digits=12)
+    else:
+        tm.export(path)
+    return path
+
+
+def mesh_writer() -> str:
+    try:
+        import trimesh
+    except ImportError:
+        return "spinal's built-in writer (trimesh not installed; PLY float64, OBJ 17 digits)"
+    return f"trimesh {trimesh.__version__} (PLY float32, OBJ 12 decimals)"
+
+
+def ribbon(x: np.ndarray, F: np.ndarray, width: float) -> spinal.Mesh:
+    """The developable ribbon x ± width·r as a triangle strip (an open surface)."""
     v = np.empty((2 * len(x), 3))
-    v[0::2], v[1::2] = left, right
-    faces = []
-    for i in range(len(x) - 1):
-        a, b, c, d = 2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3
-        faces += [(a, b, d), (a, d, c)]
-    with open(path, "w") as f:
-        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(v)}\n")
-        f.write("property double x\nproperty double y\nproperty double z\n")
-        f.write(f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n")
-        np.savetxt(f, v, fmt="%.17g")
-        np.savetxt(f, np.c_[np.full(len(faces), 3), faces], fmt="%d")
+    v[0::2], v[1::2] = x - width * F[:, :, 0], x + width * F[:, :, 0]
+    a = 2 * np.arange(len(x) - 1)
+    faces = np.concatenate([np.c_[a, a + 1, a + 3], np.c_[a, a + 3, a + 2]])
+    return spinal.Mesh(v, faces)
+
+
+def square_profile(y0: float, y1: float, z0: float, z1: float, k: int) -> np.ndarray:
+    """The rectangle [y0, y1] × [z0, z1] as a polygon with k vertices per side."""
+    e = np.linspace(0, 1, k, endpoint=False)
+    return np.r_[np.c_[y0 + (y1 - y0) * e, z0 + 0 * e], np.c_[y1 + 0 * e, z0 + (z1 - z0) * e],
+                 np.c_[y1 - (y1 - y0) * e, z1 + 0 * e], np.c_[y0 + 0 * e, z1 - (z1 - z0) * e]]
 
 
 def demo(out: pathlib.Path) -> int:
@@ -47,8 +73,7 @@ def demo(out: pathlib.Path) -> int:
     F = spinal.frames(x, closed=True)
     np.save(out / "torus_knot_frames.npy", F)
     written.append(out / "torus_knot_frames.npy")
-    ribbon_ply(out / "torus_knot_ribbon.ply", x, F, 0.04)
-    written.append(out / "torus_knot_ribbon.ply")
+    written.append(save_mesh(ribbon(x, F, 0.04), out / "torus_knot_ribbon.ply"))
     alpha = spinal.closing_angle(x)
     seam = np.abs(F[-1] - F[0]).max()
 
@@ -71,7 +96,7 @@ def demo(out: pathlib.Path) -> int:
     # A closed tube around the knot, written as PLY and OBJ.
     tube = spinal.tube(x, 0.12, sides=24, closed=True)
     for ext in ("ply", "obj"):
-        written.append(tube.save(out / f"torus_knot_tube.{ext}"))
+        written.append(save_mesh(tube, out / f"torus_knot_tube.{ext}"))
     # Tubes around a circle of radius R: the volume tends to Pappus' 2πR·A (A the polygon's
     # area) at 2nd order in the spine spacing.
     R, r, sides = 1.0, 0.25, 24
@@ -86,13 +111,37 @@ def demo(out: pathlib.Path) -> int:
     ring = spinal.tube(np.c_[R * np.cos(t), R * np.sin(t), 0 * t], r, sides, closed=True)
     tool = spinal.fields.translation([R + r + 0.25, 0, 0], 0.2, [-0.5, 0, 0])
     dented, report = spinal.deform(ring, tool, 0.4, estimate=True)
-    written.append(dented.save(out / "dented_ring.ply"))
+    written.append(save_mesh(dented, out / "dented_ring.ply"))
+
+    # Fleshing: a bar beside its spine (cross-section [0.15, 0.35] × [-0.1, 0.1], centroid
+    # ȳ = 0.25 off the spine, towards the centre of curvature) bent with the spine into an
+    # arc of radius Rb. The uncorrected map (rigid in every normal plane) scales volume by
+    # 1 − y/Rb at distance y towards that centre, in all by 1 − ȳ/Rb; the
+    # radial correction keeps every piece's volume (what is left is the mesh's error).
+    Rb, ybar = 1.0, 0.25
+    xs = np.linspace(-0.5, 0.5, 81)
+    axes = np.tile(np.array([[0.0, 0, 1], [1, 0, 0], [0, 1, 0]]), (len(xs), 1, 1))  # r=y, s=z
+    bar = spinal.sweep(np.c_[xs, 0 * xs, 0 * xs], square_profile(0.15, 0.35, -0.1, 0.1, 8),
+                       frames=axes)
+    arc = np.linspace(-1.5, 1.5, 301)  # arc length along the spine
+    rest_spine = np.c_[arc, 0 * arc, 0 * arc]
+    posed_spine = np.c_[Rb * np.sin(arc / Rb), Rb * (1 - np.cos(arc / Rb)), 0 * arc]
+    bar_change = {}
+    for solution in ("none", "radial"):
+        V = spinal.flesh(bar.vertices, rest_spine, posed_spine, solution=solution)
+        bent = spinal.Mesh(V, bar.faces)
+        bar_change[solution] = bent.volume / bar.volume - 1
+        written.append(save_mesh(bent, out / f"bent_bar_{solution}.ply"))
 
     picture = None
     try:
         import os
 
         os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+        if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                     or os.environ.get("WAYLAND_DISPLAY")):
+            # headless: render through EGL rather than trying (and warning about) X first
+            os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
         tube.plot(screenshot=out / "torus_knot_tube.png", window_size=(640, 480))
         picture = out / "torus_knot_tube.png"
         written.append(picture)
@@ -115,9 +164,16 @@ def demo(out: pathlib.Path) -> int:
     for n, vol, err in ring_rows:
         print(f"    {n:4d} spine points: volume {vol:.9f}, relative error {err:.2e}")
     print(f"  tool pushing a dent into that tube (RK4, {report.steps} steps, "
-          f"+{report.vertices_added} vertices by refinement): relative volume change "
-          f"{report.relative_change:+.2e} (integration {report.integration_error:+.1e}, "
-          f"mesh {report.mesh_error:+.1e})")
+          f"+{report.vertices_added} vertices by refinement): volume {report.volume:.9f}, "
+          f"relative volume change {report.relative_change:+.2e} (integration "
+          f"{report.integration_error:+.1e}, mesh {report.mesh_error:+.1e})")
+    print(f"  bar beside its spine (centroid {ybar} off it, volume {bar.volume:.9f}, "
+          f"{len(bar.vertices)} vertices) bent to radius {Rb}: relative volume change")
+    print(f"    uncorrected (solution='none') {bar_change['none']:+.6e}, closed form "
+          f"−ȳ/R = {-ybar / Rb:+.6e}, difference "
+          f"{bar_change['none'] + ybar / Rb:+.1e}")
+    print(f"    corrected (solution='radial') {bar_change['radial']:+.1e}")
+    print(f"  meshes written by {mesh_writer()}")
     if isinstance(picture, str):
         print(f"  picture: {picture}")
     print("wrote:")
