@@ -19,6 +19,7 @@
 
 pub mod double_reflection;
 pub mod frenet;
+pub mod fused;
 pub mod geometry;
 pub mod projection;
 pub mod rk4;
@@ -100,7 +101,7 @@ pub const STRAIGHT_TOL: f64 = 1e-9;
 /// Largest accepted angle between a prescribed frame's third column and the tangent.
 pub const FRAME_TANGENT_TOL: f64 = 1e-3;
 
-fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) -> Result<DVec3> {
+pub(crate) fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) -> Result<DVec3> {
     match *o {
         Orientation::Vector(v) => {
             if !v.is_finite() {
@@ -199,6 +200,15 @@ impl Curvature<'_> {
 /// curve, the angle from the transported frame to `end` otherwise; 0 without a condition),
 /// before `2π·turns` is added.
 pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
+    match fused::try_open_points(req, out) {
+        Some(angle) => Ok(angle),
+        None => compute_general(req, out),
+    }
+}
+
+/// [`compute_into`] without the fused fast path: one pass per stage, and the only place
+/// that reports input errors.
+pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
     let rows = match (req.points, req.tangents) {
         (Some(p), _) => p.len(),
         (None, Some(t)) => t.len(),

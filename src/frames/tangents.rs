@@ -228,6 +228,9 @@ pub fn estimate(
         .into_par_iter()
         .with_min_len(1 << 12)
         .map(|i| {
+            if five && rule == TangentRule::FivePoint && !closed {
+                return five_point_unit_open(x, i, |j| chords[j]).unwrap_or(DVec3::ZERO);
+            }
             let v = raw_tangent(x, chords, i, closed, rule, five);
             let l = v.length();
             let u = v * (1.0 / l);
@@ -251,6 +254,32 @@ pub fn estimate(
         Some(i) => Err(cusp_error(i)),
         None => Ok(t),
     }
+}
+
+/// The unit five-point chord-length tangent at `i` of an open curve with `n ≥ 5` samples,
+/// guarded against overshoot: what [`estimate`] returns there. `h(j)` is the chord length
+/// `|x_{j+1} − x_j|` (callers pass a table or compute it on the fly: the values must be those
+/// of `validate::chords`). `None` where the estimate vanishes (a cusp).
+#[inline(always)]
+pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> Option<DVec3> {
+    let n = x.len();
+    let v = if i >= 2 && i + 2 < n {
+        centred_five_point(
+            [x[i - 2], x[i - 1], x[i], x[i + 1], x[i + 2]],
+            [h(i - 2), h(i - 1), h(i), h(i + 1)],
+        )
+    } else {
+        // the one-sided stencil on the first or last five samples
+        let first = if i < 2 { 0 } else { n - 5 };
+        let hl = [h(first), h(first + 1), h(first + 2), h(first + 3)];
+        chord_five_point(&x[first..first + 5], &hl, i - first, false)
+    };
+    let l = v.length();
+    let u = v * (1.0 / l);
+    if !(l > 0.0 && u.is_finite()) {
+        return None;
+    }
+    Some(guard_overshoot(x, i, false, u))
 }
 
 /// Smallest accepted cosine between the five-point estimate and the circle (3-point)

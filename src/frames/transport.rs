@@ -64,6 +64,118 @@ fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
     }
 }
 
+/// How a curve of `ext` extended frames is cut into chunks for the parallel scan: `(chunks,
+/// chunk size)`. One chunk unless the step is a rotation, there are several threads and the
+/// curve is long.
+pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
+    let threads = rayon::current_num_threads();
+    let chunks = if is_rotation && threads > 1 && ext >= 2 * PAR_CHUNK {
+        (2 * threads).min(ext / PAR_CHUNK).max(1)
+    } else {
+        1
+    };
+    let cs = ext.div_ceil(chunks).max(1);
+    (ext.div_ceil(cs), cs)
+}
+
+/// What phase 1 of the scan reports per chunk: the start vector it used (the true one for
+/// chunk 0, a provisional one otherwise), its last vector, and the chunk's arc length.
+pub type ChunkEnds = (DVec3, DVec3, f64);
+
+/// The curve data phases 2 and 3 of the scan need, whatever produced phase 1.
+pub struct Finish<B, T, L> {
+    /// Transport across the chunk boundary `i → i + 1` (the step of the method).
+    pub boundary_step: B,
+    /// Unit tangent at extended index `i` (`i = n` is sample 0 of a closed curve).
+    pub tangent: T,
+    /// Length of segment `i` (clamped to the last segment), for the twist.
+    pub seg: L,
+    pub n: usize,
+    pub closed: bool,
+    pub r0: DVec3,
+    pub twist: Twist,
+    pub cs: usize,
+    pub ext: usize,
+}
+
+impl<B, T, L> Finish<B, T, L>
+where
+    B: Fn(usize, DVec3) -> DVec3,
+    T: Fn(usize) -> DVec3,
+    L: Fn(usize) -> f64 + Sync,
+{
+    /// Phases 2 and 3: fix the chunk angles serially, add the twist, turn the written rows
+    /// (`out`: `9·rows` values, provisional frames from phase 1) and return the raw end angle.
+    pub fn run(&self, prov: &[ChunkEnds], out: &mut [f64]) -> f64 {
+        let (n, cs, ext) = (self.n, self.cs, self.ext);
+        let chunks = prov.len();
+        let rows = out.len() / 9;
+        let write_rows = rows.min(ext);
+        let tt = &self.tangent;
+
+        // Phase 2 (serial): the angle that turns each chunk's provisional vectors into the
+        // true ones, the arc length at each chunk start, and the true vector at the far end.
+        let mut theta = vec![0.0; chunks];
+        let mut len_prefix = vec![0.0; chunks + 1];
+        for c in 0..chunks {
+            len_prefix[c + 1] = len_prefix[c] + prov[c].2;
+            if c > 0 {
+                let a = c * cs;
+                let last = rotate_about(prov[c - 1].1, tt(a - 1), theta[c - 1]);
+                let true_start = (self.boundary_step)(a - 1, last);
+                theta[c] = signed_angle(prov[c].0, true_start, tt(a));
+            }
+        }
+        let end_r = rotate_about(prov[chunks - 1].1, tt(ext - 1), theta[chunks - 1]);
+
+        let (raw, total) = match self.twist {
+            Twist::None => (0.0, 0.0),
+            Twist::Closed { turns } => {
+                let a = signed_angle(end_r, self.r0, tt(0));
+                (a, a + std::f64::consts::TAU * turns as f64)
+            }
+            Twist::End { target, turns } => {
+                let a = signed_angle(end_r, target, tt(n - 1));
+                (a, a + std::f64::consts::TAU * turns as f64)
+            }
+        };
+        let length = len_prefix[chunks];
+        let rate = if total != 0.0 && length > 0.0 {
+            total / length
+        } else {
+            0.0
+        };
+
+        // Phase 3 (parallel): turn every row about its tangent by the chunk's correction plus
+        // the twist `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r). Chunks with
+        // nothing to turn (chunk 0 without a twist) are left as they are.
+        if rate != 0.0 || theta.iter().any(|&a| a != 0.0) {
+            let seg = &self.seg;
+            out[..9 * write_rows]
+                .par_chunks_mut(9 * cs)
+                .enumerate()
+                .filter(|(c, _)| rate != 0.0 || theta[*c] != 0.0)
+                .for_each(|(c, buf)| {
+                    let a = c * cs;
+                    let mut arc = len_prefix[c];
+                    let (mut sin, mut cos) = theta[c].sin_cos();
+                    for (off, f) in buf.chunks_exact_mut(9).enumerate() {
+                        if rate != 0.0 {
+                            (sin, cos) = (theta[c] + rate * arc).sin_cos();
+                            arc += seg(a + off);
+                        }
+                        turn_frame(f, cos, sin);
+                    }
+                });
+        }
+        if self.closed && rows == n + 1 {
+            let (head, tail) = out.split_at_mut(9 * n);
+            tail[..9].copy_from_slice(&head[..9]);
+        }
+        raw
+    }
+}
+
 /// Transport `r0` (unit, ⟂ `t[0]`) along the curve and write the frames.
 ///
 /// * `t`: unit tangents of the `n` distinct samples; `closed` adds the segment `n−1 → 0`.
@@ -88,21 +200,13 @@ pub fn transport_into<S: Step>(
     let rows = out.len() / 9;
     debug_assert!(rows == n || (closed && rows == n + 1));
     let tt = |i: usize| t[if i == n { 0 } else { i }];
-
-    let threads = rayon::current_num_threads();
-    let chunks = if step.is_rotation() && threads > 1 && ext >= 2 * PAR_CHUNK {
-        (2 * threads).min(ext / PAR_CHUNK).max(1)
-    } else {
-        1
-    };
-    let cs = ext.div_ceil(chunks);
-    let chunks = ext.div_ceil(cs);
+    let (chunks, cs) = plan(ext, step.is_rotation());
     let bounds = |c: usize| (c * cs, ((c + 1) * cs).min(ext));
     let write_rows = rows.min(ext);
 
-    // Phase 1 (parallel): every chunk transports a provisional start vector (the true one
-    // for chunk 0), writes its rows into `buf`, and reports its start, its last vector and
-    // its length.
+    // Phase 1 (parallel): every chunk transports a provisional start vector (the true one for
+    // chunk 0), writes its rows into `buf`, and reports its start, its last vector and its
+    // length.
     let provisional = |c: usize, buf: &mut [f64]| {
         let (a, b) = bounds(c);
         let s0 = if c == 0 { r0 } else { any_perpendicular(tt(a)) };
@@ -118,7 +222,7 @@ pub fn transport_into<S: Step>(
         }
         (s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>())
     };
-    let mut prov: Vec<(DVec3, DVec3, f64)> = out[..9 * write_rows]
+    let mut prov: Vec<ChunkEnds> = out[..9 * write_rows]
         .par_chunks_mut(9 * cs)
         .enumerate()
         .map(|(c, buf)| provisional(c, buf))
@@ -127,62 +231,16 @@ pub fn transport_into<S: Step>(
     for c in prov.len()..chunks {
         prov.push(provisional(c, &mut []));
     }
-
-    // Phase 2 (serial): the angle that turns each chunk's provisional vectors into the true
-    // ones, the arc length at each chunk start, and the true vector at the far end.
-    let mut theta = vec![0.0; chunks];
-    let mut len_prefix = vec![0.0; chunks + 1];
-    for c in 0..chunks {
-        len_prefix[c + 1] = len_prefix[c] + prov[c].2;
-        if c > 0 {
-            let (a, _) = bounds(c);
-            let last = rotate_about(prov[c - 1].1, tt(a - 1), theta[c - 1]);
-            let true_start = step.step(a - 1, last);
-            theta[c] = signed_angle(prov[c].0, true_start, tt(a));
-        }
+    Finish {
+        boundary_step: |i: usize, r: DVec3| step.step(i, r),
+        tangent: tt,
+        seg: |i: usize| seg[i.min(seg.len() - 1)],
+        n,
+        closed,
+        r0,
+        twist,
+        cs,
+        ext,
     }
-    let end_r = rotate_about(prov[chunks - 1].1, tt(ext - 1), theta[chunks - 1]);
-
-    let (raw, total) = match twist {
-        Twist::None => (0.0, 0.0),
-        Twist::Closed { turns } => {
-            let a = signed_angle(end_r, r0, t[0]);
-            (a, a + std::f64::consts::TAU * turns as f64)
-        }
-        Twist::End { target, turns } => {
-            let a = signed_angle(end_r, target, t[n - 1]);
-            (a, a + std::f64::consts::TAU * turns as f64)
-        }
-    };
-    let length = len_prefix[chunks];
-    let rate = if total != 0.0 && length > 0.0 {
-        total / length
-    } else {
-        0.0
-    };
-
-    // Phase 3 (parallel): turn every row about its tangent by the chunk's correction plus the
-    // twist `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r).
-    if rate != 0.0 || theta.iter().any(|&a| a != 0.0) {
-        out[..9 * write_rows]
-            .par_chunks_mut(9 * cs)
-            .enumerate()
-            .for_each(|(c, buf)| {
-                let (a, _) = bounds(c);
-                let mut arc = len_prefix[c];
-                let (mut sin, mut cos) = theta[c].sin_cos();
-                for (off, f) in buf.chunks_exact_mut(9).enumerate() {
-                    if rate != 0.0 {
-                        (sin, cos) = (theta[c] + rate * arc).sin_cos();
-                        arc += seg[(a + off).min(seg.len() - 1)];
-                    }
-                    turn_frame(f, cos, sin);
-                }
-            });
-    }
-    if closed && rows == n + 1 {
-        let (head, tail) = out.split_at_mut(9 * n);
-        tail[..9].copy_from_slice(&head[..9]);
-    }
-    raw
+    .run(&prov, out)
 }
