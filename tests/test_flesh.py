@@ -289,6 +289,14 @@ def test_refinement_table():
         assert np.all(e[:-1] / e[1:] > 3.8)  # second order in the edge length
         assert e[-1] < 1.1 * e[0] / 4 ** (len(e) - 1)
     assert np.all(np.abs(rows[:, 1] + 0.30) < 0.02)
+    # the finest level (6146 vertices) as printed in the README's table, in percent
+    assert rows[-1, 0] == 6146
+    readme = np.array([-30.00, -0.0006, -0.0015, +0.0017])
+    assert np.all(np.abs(100 * rows[-1, 1:] - readme) <= [0.005, 5e-5, 5e-5, 5e-5]), rows[-1]
+    # the dissertation's finest level is 0.001 % (Fig. 42, 1922 vertices): radial reaches it
+    # here (5.8e-6), normal and binormal stay at 1.5e-5 and 1.7e-5 at 6146 vertices
+    assert abs(rows[-1, 2]) < 1e-5
+    assert np.all(np.abs(rows[-1, 3:]) < 2e-5)
 
 
 def test_local_slab_volumes():
