@@ -264,6 +264,64 @@ def test_camera_closed_path_returns_to_its_start():
     np.testing.assert_allclose(cam[-1], cam[0], atol=1e-12)
 
 
+def _relative_rotvec(cam_b, cam):
+    """Rotation vectors of cam_b[i] · cam[i]ᵀ (world frame): the rotation taking each
+    unbanked camera to the banked one."""
+    return Rotation.from_matrix(np.einsum("nij,nkj->nik", cam_b, cam)).as_rotvec()
+
+
+@pytest.mark.parametrize("mode", ["transport", "up"])
+def test_camera_bank_is_a_roll_about_the_gaze_by_the_bank_angle(mode):
+    """``bank`` rolls each camera about its own gaze and nothing else: the gaze is kept and
+    the banked camera is the unbanked one turned about the gaze by |bank| (scipy's rotation
+    vector of the relative rotation); a scalar is the same roll at every sample."""
+    x, t, _ = helix(100)
+    cam = Q.camera_frames(x, mode=mode, tangents=t)
+    bank = np.linspace(-2.5, 2.5, len(x))
+    bank[len(x) // 2] = 0.0
+    cam_b = Q.camera_frames(x, mode=mode, tangents=t, bank=bank)
+    np.testing.assert_allclose(np.linalg.det(cam_b), 1, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("nji,njk->nik", cam_b, cam_b), np.broadcast_to(
+        np.eye(3), cam_b.shape), atol=1e-12)
+    np.testing.assert_allclose(cam_b[:, :, 2], cam[:, :, 2], atol=1e-15)  # gaze kept
+    rv = _relative_rotvec(cam_b, cam)
+    gaze = -cam[:, :, 2]
+    np.testing.assert_allclose(np.linalg.norm(rv, axis=1), np.abs(bank), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(np.cross(rv, gaze), axis=1), 0, atol=1e-12)
+    np.testing.assert_array_equal(cam_b[len(x) // 2], cam[len(x) // 2])
+    # a scalar bank broadcasts; a full turn is the identity
+    np.testing.assert_allclose(Q.camera_frames(x, mode=mode, tangents=t, bank=0.7),
+                               Q.camera_frames(x, mode=mode, tangents=t,
+                                               bank=np.full(len(x), 0.7)), atol=0)
+    np.testing.assert_allclose(Q.camera_frames(x, mode=mode, tangents=t, bank=2 * np.pi),
+                               cam, atol=1e-14)
+    for bad in (np.zeros(3), np.full(len(x), np.nan), [[0.1]], "a"):
+        with pytest.raises((ValueError, TypeError), match="^bank"):
+            Q.camera_frames(x, mode=mode, tangents=t, bank=bad)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "camera_frames(bank=b) rolls the camera by −b about the gaze: its up turns towards the "
+    "camera's LEFT (up' = cos b·up − sin b·right, python/spinal/quaternions.py lines "
+    "349-353), while the docstring (line 308) says 'positive turning up towards right'"))
+def test_camera_bank_sign_follows_the_docstring():
+    """Independent expectation of the documented sign: a positive bank turns ``up`` towards
+    ``right``, i.e. the camera turns right-handedly about its gaze (a pilot banking right):
+    banked = R(b·gaze) · unbanked, with R from scipy. On a straight path along +x with up
+    +z, right is −y, so a small positive bank tips up towards −y."""
+    x = np.c_[np.linspace(0, 1, 5), np.zeros(5), np.zeros(5)]
+    cam = Q.camera_frames(x)
+    np.testing.assert_allclose(cam[0], [[0, 0, -1], [-1, 0, 0], [0, 1, 0]], atol=1e-15)
+    b = 0.3
+    cam_b = Q.camera_frames(x, bank=b)
+    assert cam_b[0][:, 1] @ cam[0][:, 0] == pytest.approx(np.sin(b))  # up · old right
+    h, t, _ = helix(100)
+    bank = np.linspace(-1.0, 2.0, len(h))
+    cam = Q.camera_frames(h, tangents=t)
+    want = Rotation.from_rotvec(bank[:, None] * -cam[:, :, 2]).as_matrix() @ cam
+    np.testing.assert_allclose(Q.camera_frames(h, tangents=t, bank=bank), want, atol=1e-12)
+
+
 # --- walking on a mesh --------------------------------------------------------------------
 
 
