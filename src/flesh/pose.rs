@@ -53,35 +53,106 @@ pub fn deform(
             ),
         ));
     }
-    out.par_iter_mut()
-        .zip(flags.par_iter_mut())
-        .zip(edge.par_iter().zip(coords.par_chunks(COORDS)))
-        .for_each(|((o, f), (&k, c))| {
-            let k = k as usize;
-            let (a, tau) = (c[0], c[1]);
-            let mut d = DVec2::new(c[2], c[3]);
-            let l = posed.eval(k, a);
-            let lam = l.sigma / c[4];
-            let (k0, k1) = if tau != 0.0 {
-                (DVec2::ZERO, DVec2::ZERO)
-            } else {
-                (DVec2::new(c[5], c[6]), l.kappa)
-            };
-            let mut fl = 0u8;
-            d = unbend(sol, d, k0, &mut fl);
-            if !twist.is_empty() {
-                let phi = twist[k] + a * (twist[k + 1] - twist[k]);
-                let (s, cs) = phi.sin_cos();
-                d = DVec2::new(cs * d.x - s * d.y, s * d.x + cs * d.y);
-            }
-            d = bend(sol, d, k1, lam, &mut fl);
-            let along = if sol == Solution::None {
-                tau
-            } else {
-                lam * tau
-            };
-            *o = l.q + along * l.t + d.x * l.u + d.y * l.v;
-            *f = fl;
-        });
+    let run = match sol {
+        Solution::None => batch::<0>,
+        Solution::Normal => batch::<1>,
+        Solution::Binormal => batch::<2>,
+        Solution::Radial => batch::<3>,
+    };
+    out.par_chunks_mut(TASK)
+        .zip(flags.par_chunks_mut(TASK))
+        .zip(edge.par_chunks(TASK).zip(coords.par_chunks(COORDS * TASK)))
+        .for_each(|((o, f), (e, c))| run(posed, twist, e, c, o, f));
     Ok(())
+}
+
+/// Vertices per parallel task.
+const TASK: usize = 1024;
+/// Vertices evaluated together (see [`Spine::eval_lanes`]).
+const LANES: usize = 4;
+
+const fn solution(s: u8) -> Solution {
+    match s {
+        0 => Solution::None,
+        1 => Solution::Normal,
+        2 => Solution::Binormal,
+        _ => Solution::Radial,
+    }
+}
+
+/// One task's vertices, `LANES` at a time; the solution is a constant of the instance, so
+/// its branch leaves the loop.
+fn batch<const S: u8>(
+    posed: &Spine,
+    twist: &[f64],
+    edge: &[i64],
+    coords: &[f64],
+    out: &mut [DVec3],
+    flags: &mut [u8],
+) {
+    let mut i = 0;
+    while i + LANES <= out.len() {
+        lanes::<S, LANES>(
+            posed,
+            twist,
+            &edge[i..],
+            &coords[COORDS * i..],
+            &mut out[i..],
+            &mut flags[i..],
+        );
+        i += LANES;
+    }
+    while i < out.len() {
+        lanes::<S, 1>(
+            posed,
+            twist,
+            &edge[i..],
+            &coords[COORDS * i..],
+            &mut out[i..],
+            &mut flags[i..],
+        );
+        i += 1;
+    }
+}
+
+#[inline(always)]
+fn lanes<const S: u8, const L: usize>(
+    posed: &Spine,
+    twist: &[f64],
+    edge: &[i64],
+    coords: &[f64],
+    out: &mut [DVec3],
+    flags: &mut [u8],
+) {
+    let sol = solution(S);
+    let k: [usize; L] = std::array::from_fn(|l| edge[l] as usize);
+    let a: [f64; L] = std::array::from_fn(|l| coords[COORDS * l]);
+    let loc = posed.eval_lanes(&k, &a);
+    for l in 0..L {
+        let c = &coords[COORDS * l..COORDS * (l + 1)];
+        let (k, a, tau) = (k[l], c[0], c[1]);
+        let loc = &loc[l];
+        let mut d = DVec2::new(c[2], c[3]);
+        let lam = loc.sigma / c[4];
+        let (k0, k1) = if tau != 0.0 {
+            (DVec2::ZERO, DVec2::ZERO)
+        } else {
+            (DVec2::new(c[5], c[6]), loc.kappa)
+        };
+        let mut fl = 0u8;
+        d = unbend(sol, d, k0, &mut fl);
+        if !twist.is_empty() {
+            let phi = twist[k] + a * (twist[k + 1] - twist[k]);
+            let (s, cs) = phi.sin_cos();
+            d = DVec2::new(cs * d.x - s * d.y, s * d.x + cs * d.y);
+        }
+        d = bend(sol, d, k1, lam, &mut fl);
+        let along = if sol == Solution::None {
+            tau
+        } else {
+            lam * tau
+        };
+        out[l] = loc.q + along * loc.t + d.x * loc.u + d.y * loc.v;
+        flags[l] = fl;
+    }
 }

@@ -188,30 +188,65 @@ impl Spine {
     /// The model at edge `k`, `a ∈ [0, 1]`.
     #[inline]
     pub fn eval(&self, k: usize, a: f64) -> Local {
-        let q = cubic(&self.p[k], a);
-        let e = cubic_slope(&self.p[k], a);
-        let m = cubic(&self.m[k], a);
-        let dt = cubic_slope(&self.m[k], a);
-        let ml = m.length();
-        let t = m / ml;
-        let ta = (dt - t * t.dot(dt)) / ml;
-        let sigma = e.dot(t);
+        self.eval_lanes(&[k], &[a])[0]
+    }
+
+    /// [`Spine::eval`] of `L` points at once, stage by stage across the lanes: the chains
+    /// of square roots and divisions of different points are independent, so the processor
+    /// overlaps them (one point alone waits on each in turn).
+    #[inline(always)]
+    pub fn eval_lanes<const L: usize>(&self, k: &[usize; L], a: &[f64; L]) -> [Local; L] {
         // r_k and r_{k+1} (carried back to t_k) blended in the normal plane of t_k, then
         // carried to t(a) by the minimal rotation: r_k at a = 0, r_{k+1} at a = 1, and
-        // equivariant under a common roll of the frames (so swapping spines inverts the map)
-        let r0 = self.r[k];
-        let um = min_rotate(r0 + a * (self.rb[k] - r0), self.t[k], t);
-        let u = (um - t * t.dot(um)).normalize();
-        let v = t.cross(u);
-        let kv = ta / sigma;
-        Local {
-            q,
-            t,
-            u,
-            v,
-            sigma,
-            kappa: DVec2::new(kv.dot(u), kv.dot(v)),
+        // equivariant under a common roll of the frames (so swapping spines inverts the map).
+        // The rotation keeps lengths, so the blend is normalised by its length before it.
+        let mut q = [DVec3::ZERO; L];
+        let mut e = [DVec3::ZERO; L];
+        let mut m = [DVec3::ZERO; L];
+        let mut dt = [DVec3::ZERO; L];
+        let mut w = [DVec3::ZERO; L];
+        for l in 0..L {
+            let (p, c) = (&self.p[k[l]], &self.m[k[l]]);
+            q[l] = cubic(p, a[l]);
+            e[l] = cubic_slope(p, a[l]);
+            m[l] = cubic(c, a[l]);
+            dt[l] = cubic_slope(c, a[l]);
+            let r0 = self.r[k[l]];
+            w[l] = r0 + a[l] * (self.rb[k[l]] - r0);
         }
+        let mut inv_ml = [0.0; L];
+        let mut inv_w = [0.0; L];
+        for l in 0..L {
+            inv_ml[l] = 1.0 / m[l].length();
+            inv_w[l] = 1.0 / w[l].length();
+        }
+        let mut out = [Local {
+            q: DVec3::ZERO,
+            t: DVec3::ZERO,
+            u: DVec3::ZERO,
+            v: DVec3::ZERO,
+            sigma: 0.0,
+            kappa: DVec2::ZERO,
+        }; L];
+        let mut ta = [DVec3::ZERO; L];
+        for l in 0..L {
+            let t = m[l] * inv_ml[l];
+            ta[l] = (dt[l] - t * t.dot(dt[l])) * inv_ml[l];
+            out[l].q = q[l];
+            out[l].t = t;
+            out[l].sigma = e[l].dot(t);
+        }
+        for l in 0..L {
+            let t = out[l].t;
+            let um = min_rotate(w[l], self.t[k[l]], t) * inv_w[l];
+            let u = um - t * t.dot(um);
+            let v = t.cross(u);
+            let kv = ta[l] * (1.0 / out[l].sigma);
+            out[l].u = u;
+            out[l].v = v;
+            out[l].kappa = DVec2::new(kv.dot(u), kv.dot(v));
+        }
+        out
     }
 }
 
