@@ -300,10 +300,6 @@ def test_camera_bank_is_a_roll_about_the_gaze_by_the_bank_angle(mode):
             Q.camera_frames(x, mode=mode, tangents=t, bank=bad)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "camera_frames(bank=b) rolls the camera by −b about the gaze: its up turns towards the "
-    "camera's LEFT (up' = cos b·up − sin b·right, python/spinal/quaternions.py lines "
-    "349-353), while the docstring (line 308) says 'positive turning up towards right'"))
 def test_camera_bank_sign_follows_the_docstring():
     """Independent expectation of the documented sign: a positive bank turns ``up`` towards
     ``right``, i.e. the camera turns right-handedly about its gaze (a pilot banking right):

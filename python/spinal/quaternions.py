@@ -305,8 +305,8 @@ def camera_frames(
       mismatch to the next regular sample is spread linearly in arc length. (Passing through
       the vertical, a level-horizon camera must turn by about π about its gaze.)
 
-    ``bank``: optional roll angles (scalar or ``(n,)``, radians) about the gaze, positive
-    turning up towards right.
+    ``bank``: optional roll angles (scalar or ``(n,)``, radians) about the gaze, right-handed
+    about the direction of travel: positive turns up towards right (a roll to the right).
     """
     mode = as_choice(mode, "mode", ("transport", "up"))
     closed = as_bool(closed, "closed")
@@ -349,8 +349,9 @@ def camera_frames(
         c, s = np.cos(b)[:, None], np.sin(b)[:, None]
         r, q = f[:, :, 0].copy(), f[:, :, 1].copy()
         f = f.copy()
-        f[:, :, 0] = c * r - s * q
-        f[:, :, 1] = s * r + c * q
+        # a right-handed turn by b about the gaze t: up' = cos b up + sin b (t × up)
+        f[:, :, 0] = c * r + s * q
+        f[:, :, 1] = c * q - s * r
     # spinal frame (r, s, t) = (up, right, gaze)  →  camera (right, up, −gaze)
     return np.stack([f[:, :, 1], f[:, :, 0], -f[:, :, 2]], axis=2)
 
