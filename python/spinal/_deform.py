@@ -2,8 +2,8 @@
 
 Refinement (thesis §13.2, "smoother variant"; thresholds per erratum A-19): a triangle mesh
 follows the flow only at its vertices, so its volume error is O(edge²) of the *deformed*
-edges. Edges stretched beyond ``refine × mean rest edge length`` are split at their **rest**
-midpoint, and the new vertex is placed by integrating that rest point with exactly the same
+edges. Edges stretched beyond ``refine × max(rest length, mean rest edge length)`` are split
+at their **rest** midpoint, and the new vertex is placed by integrating that rest point with exactly the same
 step sequence (``Φ``) as the original vertices — deterministic, so it lands where it would
 have had the rest mesh been finer there from the start. Both triangles sharing the edge are
 bisected (2-to-4, conforming, watertight); the rest volume is unchanged (new vertices lie on
@@ -92,10 +92,11 @@ def _edges(F: np.ndarray):
     return uniq, inv.reshape(-1, 3)
 
 
-def _refine_pass(Vr, W, F, limit, phi):
+def _refine_pass(Vr, W, F, refine, mean_rest, phi):
     edges, slot = _edges(F)
     length = np.linalg.norm(W[edges[:, 0]] - W[edges[:, 1]], axis=1)
-    long = np.flatnonzero(length > limit)
+    rest = np.linalg.norm(Vr[edges[:, 0]] - Vr[edges[:, 1]], axis=1)
+    long = np.flatnonzero(length > refine * np.maximum(rest, mean_rest))
     if len(long) == 0:
         return Vr, W, F, 0
     # faces of each edge
@@ -159,10 +160,12 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     """Deform a closed triangle mesh along a divergence-free field and report the volume.
 
     The vertices are advected with RK4 (:func:`spinal.advect`, default step rule); then, if
-    ``refine`` is a number, every edge longer than ``refine × (mean rest edge length)`` after
-    the deformation is split at its rest midpoint, the new vertex integrated from the rest
-    mesh with the same steps, and its two triangles bisected; repeated (at most
-    ``max_passes`` passes) until no edge is too long. ``refine=None`` only advects.
+    ``refine`` is a number, every edge that the deformation stretched beyond
+    ``refine × max(its rest length, mean rest edge length)`` is split at its rest midpoint,
+    the new vertex integrated from the rest mesh with the same steps, and its two triangles
+    bisected; repeated (at most ``max_passes`` passes) until no edge is too long. Edges that
+    are long already at rest are split only where they stretch, so a mesh with uneven edges
+    is not refined where the tool never reached. ``refine=None`` only advects.
 
     Parameters
     ----------
@@ -197,9 +200,9 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     Vr, Fr, added, passes = V, F, 0, 0
     if refine is not None and len(F):
         e, _ = _edges(F)
-        limit = refine * np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1).mean()
+        mean_rest = np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1).mean()
         while passes < max_passes:
-            Vr, W, Fr, k = _refine_pass(Vr, W, Fr, limit, phi)
+            Vr, W, Fr, k = _refine_pass(Vr, W, Fr, refine, mean_rest, phi)
             if k == 0:
                 break
             added += k
