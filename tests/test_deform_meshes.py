@@ -162,3 +162,17 @@ def test_twist_of_the_rocker_arm(rocker):
     mesh_s = relative_change(Vs, spinal.advect(Vs, field, T, 4 * field.steps(T)), Fs)
     assert 3.5 < mesh / mesh_s < 4.5, (mesh, mesh_s)
     check_deform(m, V, F, field, T)
+
+
+def test_refinement_leaves_unstretched_long_edges_alone(rocker):
+    """The rocker arm's rest edges are uneven (a sixth of them are longer than 1.5x the mean):
+    a tool that never reaches the mesh moves nothing and must split nothing; the old rule
+    (edge > 1.5x the mean rest edge) added 6,633 vertices here."""
+    m, V, F = rocker
+    e = np.sort(np.c_[F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]].reshape(-1, 2), axis=1)
+    length = np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1)
+    assert (length > 1.5 * length.mean()).mean() > 0.1
+    far = fields.translation(V.mean(axis=0) + 10 * np.ptp(V, axis=0), 0.1, [1, 0, 0])
+    M, rep = spinal.deform(m, far, 0.05)
+    assert rep.vertices_added == 0 and rep.passes == 0
+    np.testing.assert_array_equal(M.vertices, V)
