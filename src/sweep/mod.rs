@@ -348,7 +348,9 @@ fn sweep_one(
     // around the profile, central; one-sided at the ends of an open profile) and v.
     struct Column {
         p: DVec2,
-        dp: DVec2,
+        /// `(dp.x, dp.y, dp.x p.x, dp.x p.y, dp.y p.x, dp.y p.y)`: the weights of the ring's
+        /// six cross products in the normal (see below).
+        w: [f64; 6],
         v: f64,
     }
     let column: Vec<Column> = (0..cols)
@@ -359,9 +361,17 @@ fn sweep_one(
             } else {
                 (jj.saturating_sub(1), (jj + 1).min(m - 1))
             };
+            let (pj, dp) = (p.points[jj], p.points[jn] - p.points[jp]);
             Column {
-                p: p.points[jj],
-                dp: p.points[jn] - p.points[jp],
+                p: pj,
+                w: [
+                    dp.x,
+                    dp.y,
+                    dp.x * pj.x,
+                    dp.x * pj.y,
+                    dp.y * pj.x,
+                    dp.y * pj.y,
+                ],
                 v: if j == m { 1.0 } else { p.v[j] },
             }
         })
@@ -401,17 +411,33 @@ fn sweep_one(
                     da += wi * bi.1;
                     db += wi * bi.2;
                 }
+                // The normal S_v × S_u with S_v ∝ e = dp.x b₁ + dp.y b₂ (around the profile)
+                // and S_u = dx + p.x da + p.y db (along the spine) is bilinear in the column's
+                // (dp, p): six cross products per ring, six weights per column.
+                let cr = [
+                    sign * b.1.cross(dx),
+                    sign * b.2.cross(dx),
+                    sign * b.1.cross(da),
+                    sign * b.1.cross(db),
+                    sign * b.2.cross(da),
+                    sign * b.2.cross(db),
+                ];
                 for (c, ((v, nv), w)) in
                     column.iter().zip(rv.iter_mut().zip(rn.iter_mut()).zip(ruv))
                 {
-                    let (pj, dp) = (c.p, c.dp);
-                    let e = dp.x * b.1 + dp.y * b.2;
-                    let su = dx + pj.x * da + pj.y * db;
-                    *nv = (sign * e.cross(su))
-                        .try_normalize()
-                        .or_else(|| (sign * e.cross(cur.t)).try_normalize())
-                        .unwrap_or(cur.t);
-                    *v = b.0 + pj.x * cur.ma + pj.y * cur.mb;
+                    let cw = &c.w;
+                    let nn = cw[0] * cr[0]
+                        + cw[1] * cr[1]
+                        + cw[2] * cr[2]
+                        + cw[3] * cr[3]
+                        + cw[4] * cr[4]
+                        + cw[5] * cr[5];
+                    *nv = nn.try_normalize().unwrap_or_else(|| {
+                        // degenerate spine derivative: the normal of the ring plane
+                        let e = cw[0] * b.1 + cw[1] * b.2;
+                        (sign * e.cross(cur.t)).try_normalize().unwrap_or(cur.t)
+                    });
+                    *v = b.0 + c.p.x * cur.ma + c.p.y * cur.mb;
                     *w = DVec2::new(arc[i], c.v);
                 }
                 // Fold-over: rail edges must advance along both tangents. The rail edge of
