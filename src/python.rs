@@ -533,6 +533,78 @@ fn walk_mesh<'py>(
     ))
 }
 
+type WalksArrays<'py> = (
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, numpy::PyArray4<f64>>,
+    Bound<'py, PyArray2<bool>>,
+);
+
+/// Many walkers on one mesh; see `spinal.quaternions.walk_mesh_many`.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, face, points, directions, moves, k))]
+#[allow(clippy::too_many_arguments)]
+fn walk_mesh_many<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    face: PyReadonlyArray1<'py, i64>,
+    points: PyReadonlyArray2<'py, f64>,
+    directions: Option<PyReadonlyArray2<'py, f64>>,
+    moves: PyReadonlyArray2<'py, f64>,
+    k: usize,
+) -> PyResult<WalksArrays<'py>> {
+    let v = vec3s("vertices", &vertices)?;
+    if faces.shape()[1] != 3 {
+        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
+    }
+    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let fc = slice_of("face", &face)?;
+    let p = vec3s("points", &points)?;
+    let d = directions
+        .as_ref()
+        .map(|d| vec3s("directions", d))
+        .transpose()?;
+    if p.len() != fc.len() || d.is_some_and(|d| d.len() != fc.len()) {
+        return Err(PyValueError::new_err(
+            "points, directions: one row per walker (as many as face)",
+        ));
+    }
+    if moves.shape()[1] != 2 {
+        return Err(PyValueError::new_err("moves: expected shape (w·k, 2)"));
+    }
+    let mv: &[glam::DVec2] = bytemuck::cast_slice(slice_of("moves", &moves)?);
+    let starts: Vec<quaternion::walk::Start> = (0..fc.len())
+        .map(|i| (fc[i], p[i], d.map(|d| d[i])))
+        .collect();
+    let states = py
+        .detach(|| {
+            let w = quaternion::walk::Walker::new(v, f)?;
+            quaternion::walk::walk_many(&w, &starts, mv, k)
+        })
+        .map_err(to_py)?;
+    let nw = starts.len();
+    let pts: Vec<f64> = states.iter().flat_map(|s| s.point.to_array()).collect();
+    let fcs: Vec<i64> = states.iter().map(|s| s.face as i64).collect();
+    let frs: Vec<f64> = states
+        .iter()
+        .flat_map(|s| {
+            let (a, b, c) = (s.frame.x_axis, s.frame.y_axis, s.frame.z_axis);
+            [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
+        })
+        .collect();
+    let stopped: Vec<bool> = states
+        .chunks(k + 1)
+        .flat_map(|w| w[1..].iter().map(|s| s.stopped))
+        .collect();
+    Ok((
+        PyArray1::from_vec(py, pts).reshape([nw, k + 1, 3])?,
+        PyArray1::from_vec(py, fcs).reshape([nw, k + 1])?,
+        PyArray1::from_vec(py, frs).reshape([nw, k + 1, 3, 3])?,
+        PyArray1::from_vec(py, stopped).reshape([nw, k])?,
+    ))
+}
+
 // ---- deformation (issue 4) -------------------------------------------------------------
 
 fn field_of(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<crate::deform::Field> {
@@ -825,6 +897,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quat_path_length, m)?)?;
     m.add_function(wrap_pyfunction!(quat_transport, m)?)?;
     m.add_function(wrap_pyfunction!(walk_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(walk_mesh_many, m)?)?;
     m.add_function(wrap_pyfunction!(ph_hermite, m)?)?;
     m.add_function(wrap_pyfunction!(ph_eval, m)?)?;
     m.add_function(wrap_pyfunction!(ph_invariants, m)?)?;

@@ -433,3 +433,44 @@ def test_walk_long_moves_on_a_closed_mesh():
     assert np.abs(np.hypot(R - 2, res.path[:, 2]) - 0.7).max() < 0.05
     with pytest.raises(ValueError, match="moves: a move of length"):
         Q.walk_mesh(torus.vertices, torus.faces, 5, p, [[1e300, 0.0]])
+
+
+def test_many_walkers_equal_one_walker_at_a_time():
+    """walk_mesh_many is walk_mesh per walker (same states bit for bit), with shared or
+    per-walker moves and directions; bad input names the walker or the argument."""
+    import trimesh
+
+    torus = trimesh.creation.torus(major_radius=2, minor_radius=0.7, major_sections=24,
+                                   minor_sections=12)
+    V, F = torus.vertices, torus.faces
+    rng = np.random.default_rng(3)
+    w, k = 40, 7
+    fc = rng.integers(0, len(F), w)
+    bary = rng.dirichlet([2, 2, 2], w)
+    pts = np.einsum("wj,wjk->wk", bary, V[F[fc]])
+    moves = rng.normal(scale=0.8, size=(w, k, 2))
+    dirs = rng.normal(size=(w, 3))
+    res = Q.walk_mesh_many(V, F, fc, pts, moves, directions=dirs)
+    assert res.points.shape == (w, k + 1, 3) and res.frames.shape == (w, k + 1, 3, 3)
+    assert res.faces.shape == (w, k + 1) and res.stopped.shape == (w, k)
+    for i in range(w):
+        one = Q.walk_mesh(V, F, int(fc[i]), pts[i], moves[i], direction=dirs[i])
+        np.testing.assert_array_equal(res.points[i], one.points)
+        np.testing.assert_array_equal(res.frames[i], one.frames)
+        np.testing.assert_array_equal(res.faces[i], one.faces)
+        np.testing.assert_array_equal(res.stopped[i], one.stopped)
+    shared = Q.walk_mesh_many(V, F, fc, pts, moves[0], directions=dirs[0])
+    one = Q.walk_mesh(V, F, int(fc[5]), pts[5], moves[0], direction=dirs[0])
+    np.testing.assert_array_equal(shared.points[5], one.points)
+    bad = fc.copy()
+    bad[9] = len(F) + 3
+    with pytest.raises(ValueError, match="walker 9"):
+        Q.walk_mesh_many(V, F, bad, pts, moves)
+    with pytest.raises(ValueError, match="^points"):
+        Q.walk_mesh_many(V, F, fc, pts[:-1], moves)
+    with pytest.raises(ValueError, match="^moves"):
+        Q.walk_mesh_many(V, F, fc, pts, moves[:-1])
+    nan = moves.copy()
+    nan[3, 2, 0] = np.nan
+    with pytest.raises(ValueError, match="walker 3"):
+        Q.walk_mesh_many(V, F, fc, pts, nan)

@@ -69,6 +69,20 @@ def quat_transport(
     turns: int,
     closing_row: bool,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
+def walk_mesh_many(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    face: npt.NDArray[np.int64],
+    points: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float64] | None,
+    moves: npt.NDArray[np.float64],
+    k: int,
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.bool_],
+]: ...
 def walk_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],

@@ -34,6 +34,7 @@ from ._validate import as_bool, as_choice, as_float_array, as_int, as_points
 
 __all__ = [
     "WalkResult",
+    "WalksResult",
     "camera_frames",
     "from_quaternions",
     "make_continuous",
@@ -44,6 +45,7 @@ __all__ = [
     "spin",
     "to_quaternions",
     "walk_mesh",
+    "walk_mesh_many",
 ]
 
 
@@ -435,6 +437,16 @@ class WalkResult(NamedTuple):
     path_moves: np.ndarray
 
 
+def _faces(faces) -> np.ndarray:
+    fa = np.asarray(faces)
+    if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
+        raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "
+                         f"{fa.dtype}")
+    if len(fa) == 0:
+        raise ValueError("faces: the mesh has no faces")
+    return np.ascontiguousarray(fa, dtype=np.int64)
+
+
 def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkResult:
     r"""Walk on a triangle mesh with a frame (Ma 1996 §4.2.1).
 
@@ -453,12 +465,7 @@ def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkRes
     faces), a start point off the face, non-finite values.
     """
     v = as_points(vertices, "vertices")
-    fa = np.asarray(faces)
-    if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
-        raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "
-                         f"{fa.dtype}")
-    if len(fa) == 0:
-        raise ValueError("faces: the mesh has no faces")
+    fa = _faces(faces)
     p = as_float_array(point, "point")
     if p.shape != (3,):
         raise ValueError(f"point: expected shape (3,), got {p.shape}")
@@ -473,7 +480,69 @@ def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkRes
         mv = mv[None]
     if mv.ndim != 2 or mv.shape[1] != 2:
         raise ValueError(f"moves: expected shape (k, 2), got {mv.shape}")
-    out = _core.walk_mesh(np.ascontiguousarray(v), np.ascontiguousarray(fa, dtype=np.int64),
+    out = _core.walk_mesh(np.ascontiguousarray(v), fa,
                           as_int(face, "face"), np.ascontiguousarray(p), d,
                           np.ascontiguousarray(mv))
     return WalkResult(*out)
+
+
+class WalksResult(NamedTuple):
+    """Result of :func:`walk_mesh_many`: the state of every walker after every move (``w``
+    walkers, ``k`` moves each; move 0 is the start).
+
+    Attributes
+    ----------
+    points : ndarray (w, k+1, 3) float64
+        Positions (mesh units).
+    faces : ndarray (w, k+1) int64
+        The faces they stand on.
+    frames : ndarray (w, k+1, 3, 3) float64
+        Frames, columns ``e₁`` (right), ``e₂`` (up), ``e₃`` (face normal).
+    stopped : ndarray (w, k) bool
+        The move ended early at a boundary edge.
+    """
+
+    points: np.ndarray
+    faces: np.ndarray
+    frames: np.ndarray
+    stopped: np.ndarray
+
+
+def walk_mesh_many(vertices, faces, face, points, moves, *, directions=None) -> WalksResult:
+    r"""Many walkers on one triangle mesh at once, in parallel: :func:`walk_mesh` for every
+    walker, with the edge adjacency built once.
+
+    ``face`` ``(w,)`` and ``points`` ``(w, 3)`` give the starts, ``moves`` is ``(w, k, 2)``
+    (or ``(k, 2)``, the same moves for every walker), ``directions`` ``None``, ``(3,)`` or
+    ``(w, 3)`` the first directions. Walker ``i`` gives exactly the states of
+    ``walk_mesh(vertices, faces, face[i], points[i], moves[i], direction=directions[i])``
+    (the crossing polylines are not returned). Errors name the walker.
+    """
+    v = as_points(vertices, "vertices")
+    fa = _faces(faces)
+    fc = np.asarray(face)
+    if fc.ndim != 1 or not (fc.size == 0 or np.issubdtype(fc.dtype, np.integer)):
+        raise ValueError(f"face: expected an integer array of shape (w,), got {fc.shape} "
+                         f"{fc.dtype}")
+    w = len(fc)
+    p = as_float_array(points, "points")
+    if p.shape != (w, 3):
+        raise ValueError(f"points: expected shape ({w}, 3) (one start per face), got {p.shape}")
+    d = None
+    if directions is not None:
+        d = as_float_array(directions, "directions")
+        if d.shape == (3,):
+            d = np.broadcast_to(d, (w, 3))
+        if d.shape != (w, 3):
+            raise ValueError(f"directions: expected shape (3,) or ({w}, 3), got {d.shape}")
+        d = np.ascontiguousarray(d)
+    mv = as_float_array(moves, "moves")
+    if mv.ndim == 2 and mv.shape[1] == 2:
+        mv = np.broadcast_to(mv, (w,) + mv.shape)
+    if mv.ndim != 3 or mv.shape[0] != w or mv.shape[2] != 2:
+        raise ValueError(f"moves: expected shape ({w}, k, 2) or (k, 2), got {mv.shape}")
+    k = mv.shape[1]
+    out = _core.walk_mesh_many(np.ascontiguousarray(v), fa,
+                               np.ascontiguousarray(fc, dtype=np.int64), np.ascontiguousarray(p),
+                               d, np.ascontiguousarray(mv.reshape(w * k, 2)), k)
+    return WalksResult(*out)

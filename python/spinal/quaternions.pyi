@@ -5,6 +5,7 @@ import numpy.typing as npt
 
 __all__ = [
     "WalkResult",
+    "WalksResult",
     "camera_frames",
     "from_quaternions",
     "make_continuous",
@@ -15,6 +16,7 @@ __all__ = [
     "spin",
     "to_quaternions",
     "walk_mesh",
+    "walk_mesh_many",
 ]
 
 _Array: TypeAlias = npt.ArrayLike
@@ -70,3 +72,19 @@ def walk_mesh(
     *,
     direction: _Array | None = None,
 ) -> WalkResult: ...
+
+class WalksResult(NamedTuple):
+    points: _F
+    faces: _I
+    frames: _F
+    stopped: npt.NDArray[np.bool_]
+
+def walk_mesh_many(
+    vertices: _Array,
+    faces: _Array,
+    face: _Array,
+    points: _Array,
+    moves: _Array,
+    *,
+    directions: _Array | None = None,
+) -> WalksResult: ...

@@ -296,3 +296,46 @@ impl<'a> Walker<'a> {
         ))
     }
 }
+
+/// Where one of many walkers starts: face, point on it, optional first direction.
+pub type Start = (i64, DVec3, Option<DVec3>);
+
+/// Many walkers on one mesh, in parallel: walker `i` starts at `starts[i]` and makes the
+/// moves `moves[i·k .. (i+1)·k]`. Returns the `k + 1` states of every walker, walker by
+/// walker (the adjacency is built once, by the caller's [`Walker::new`]). The first error
+/// (in walker order) is reported with the walker's index.
+pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Result<Vec<State>> {
+    use rayon::prelude::*;
+    if moves.len() != starts.len() * k {
+        return Err(InputError::new(
+            "moves",
+            format!(
+                "expected {k} moves for each of the {} walkers, got {} in all",
+                starts.len(),
+                moves.len()
+            ),
+        ));
+    }
+    let walks: Vec<Result<Vec<State>>> = starts
+        .par_iter()
+        .enumerate()
+        .map(|(i, &(face, point, dir))| {
+            let ctx = |e: InputError| e.context(&format!("walker {i}"));
+            let mut s = w.start(face, point, dir).map_err(ctx)?;
+            let mut out = Vec::with_capacity(k + 1);
+            out.push(s);
+            let mut crossings = Vec::new();
+            for m in &moves[i * k..(i + 1) * k] {
+                crossings.clear();
+                s = w.step(s, *m, &mut crossings).map_err(ctx)?;
+                out.push(s);
+            }
+            Ok(out)
+        })
+        .collect();
+    let mut all = Vec::with_capacity(starts.len() * (k + 1));
+    for r in walks {
+        all.extend(r?);
+    }
+    Ok(all)
+}
