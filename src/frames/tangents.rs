@@ -178,7 +178,7 @@ fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
 }
 
 /// Unnormalised circle tangent at an interior (or periodic) index.
-#[inline]
+#[inline(always)]
 fn circle_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     let n = x.len();
     let ii = i as isize;
@@ -292,7 +292,7 @@ pub const OVERSHOOT_COS: f64 = 0.5;
 /// the 4th-order estimate there; on a polyline with a kink next to very uneven chords the
 /// interpolating quartic can swing round and point backwards, which the frames would accept
 /// but a sweep would fold over.
-#[inline]
+#[inline(always)]
 fn guard_overshoot(x: &[DVec3], i: usize, closed: bool, u: DVec3) -> DVec3 {
     let n = x.len();
     let w = if closed || (i > 0 && i + 1 < n) {
