@@ -79,6 +79,9 @@ impl Segment {
 pub struct StripAlong {
     pub samples: Vec<AxisSample>,
     segs: Vec<Segment>,
+    /// A sphere containing every segment's hull.
+    centre: DVec3,
+    bound: f64,
     pub speed: f64,
     pub radius: f64,
     pub reach: f64,
@@ -154,9 +157,22 @@ impl StripAlong {
             }
             segs.push(seg);
         }
+        let lo = segs
+            .iter()
+            .fold(DVec3::INFINITY, |m, g| m.min(g.centre - g.radius));
+        let hi = segs
+            .iter()
+            .fold(DVec3::NEG_INFINITY, |m, g| m.max(g.centre + g.radius));
+        let centre = 0.5 * (lo + hi);
+        let bound = segs
+            .iter()
+            .map(|g| (g.centre - centre).length() + g.radius)
+            .fold(0.0, f64::max);
         Ok(StripAlong {
             samples,
             segs,
+            centre,
+            bound,
             speed,
             radius,
             reach,
@@ -182,14 +198,19 @@ impl StripAlong {
                 hi = l;
             }
             let df = w.dot(g2) - g1.length_squared();
-            let mut ln = l - f / df;
-            if !(df < 0.0 && ln > lo && ln < hi) {
-                ln = 0.5 * (lo + hi);
-            }
-            let step = (ln - l).abs();
-            l = ln;
-            if !(step > 1e-15) || !(hi - lo > 1e-16) {
-                break;
+            let newton = l - f / df;
+            if df < 0.0 && newton >= lo && newton <= hi {
+                let step = (newton - l).abs();
+                l = newton;
+                // quadratic convergence: after a Newton step δ ≤ 1e-9 the error is O(δ²)
+                if !(step > 1e-9) {
+                    break;
+                }
+            } else {
+                l = 0.5 * (lo + hi);
+                if !(hi - lo > 1e-16) {
+                    break;
+                }
             }
         }
         l
@@ -200,6 +221,10 @@ impl StripAlong {
         let outer = self.radius + self.reach;
         let o2 = outer * outer;
         let n = self.samples.len();
+        let lim = self.bound + outer;
+        if !((x - self.centre).length_squared() < lim * lim) {
+            return DVec3::ZERO;
+        }
         // the nearest candidate within reach: a foot point (segment, λ) or an end cap
         let mut best = o2;
         let mut hit: Option<(usize, f64)> = None;
