@@ -323,6 +323,7 @@ def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
     ``kind="across"`` (type II, "sweeping"): ``velocity`` perpendicular to the axis;
     ``p = s σ(X)`` (arc length of the closest axis point), ``q = (1 − D) U·(X − start)``,
     ``U = m̂ × t``; the field is zero beyond the end planes (a tangential jump only).
+    For a curved axis (type I) see :func:`strip_curve`.
     """
     a, b = _vec3(start, "start"), _vec3(end, "end")
     u = _vec3(velocity, "velocity")
