@@ -432,7 +432,7 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
     end planes the foot point is the end sample and ``v`` is :func:`sphere`'s field about it
     with velocity ``speed·T_end`` (continuous across the end planes). Exactly divergence-free:
     ``div(J(r) T) = J′ ∇r·T + J T′·∇s = 0`` (``∇r ⟂ T``, ``∇s ∥ T ⟂ T′``). Inside the tube
-    ``v = speed·T``; the flux through each cross-section is zero. ``tests/test_deform.py``
+    ``v = speed·T``; the flux through each cross-section is zero. ``tests/test_deform_tools.py``
     checks it against ``∇p × ∇q`` built from double-reflection frames by finite differences.
 
     Parameters
@@ -604,7 +604,7 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     skipped (the basis is a partition of unity, so ``d ≥ reach`` there).
 
     A sphere's sampled distance reproduces :func:`sphere` with a 3rd-order error in the grid
-    spacing (measured in ``tests/test_deform.py``).
+    spacing (measured in ``tests/test_deform_tools.py``).
 
     Parameters
     ----------
