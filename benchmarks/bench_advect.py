@@ -7,7 +7,9 @@ subprocess) and on all cores, and a NumPy RK4 of the same closed-form field (vec
 vertices, 4 field evaluations per step). The NumPy result is checked against spinal's. The
 last column is the share of points inside the field's support at t = 0 (points outside cost
 a few multiplications: the translation tools are local, the twist moves every point).
-Target (issue 4): ≤ 30 ns/vertex/step.
+Target (issue 4): ≤ 30 ns/vertex/step. A second table times the fields without a NumPy
+counterpart: the strip along a curved axis (a closest-point solve per evaluation) and a
+distance-grid tool (a 64-node tricubic B-spline, 64 coefficients per evaluation).
 
     python benchmarks/bench_advect.py            # 40,962 and 1,000,000 vertices
     python benchmarks/bench_advect.py --max 1e5  # small sizes only
@@ -37,6 +39,20 @@ def cases():
         "sphere ∇p×∇q": (fields.sphere([0, 0, 0.9], 0.3, [1, 0, 0], reach=0.6, moving=False),
                          np_sphere),
         "twist": (fields.twist([0, 0, 0], [0, 0, 1], 4.0, 2.0), np_twist),
+    }
+
+
+def tool_cases():
+    th = np.linspace(-0.6, 0.6, 13)
+    axis = np.c_[np.sin(th), 0.15 * np.sin(2 * th), np.cos(th)]
+    # the sphere of "sphere ∇p×∇q" as a sampled distance, spaced as mesh_tool's default grid
+    h = (0.6 + 1.2) / 55
+    ax = np.arange(-0.9 - 4 * h, 0.9 + 4.5 * h, h)
+    g = np.linalg.norm(np.stack(np.meshgrid(ax, ax, ax, indexing="ij"), -1), axis=-1) - 0.3
+    return {
+        "strip along a curved axis": fields.strip_curve(axis, 0.3, 1.0, reach=0.3),
+        f"distance-grid tool ({len(ax)}³)": fields.sdf_tool(g, np.array([0, 0, 0.9]) + ax[0], h,
+                                                           [1, 0, 0], reach=0.6, moving=False),
     }
 
 
@@ -109,7 +125,8 @@ def best(f, repeat):
 def time_spinal(n, repeat):
     V = points(n)
     out = {}
-    for name, (f, _) in cases().items():
+    every = {name: f for name, (f, _) in cases().items()} | tool_cases()
+    for name, f in every.items():
         spinal.advect(V[:1000], f, T, STEPS)  # warm-up
         out[name] = best(lambda f=f: spinal.advect(V, f, T, STEPS), repeat) / (n * STEPS) * 1e9
     return out
@@ -130,6 +147,7 @@ def main():
     print(f"| field | vertices | spinal 1 thread | spinal {os.cpu_count()} threads | NumPy "
           f"| NumPy / spinal (all) | max |Δ| vs NumPy | moving at t=0 |")
     print("|---|---|---|---|---|---|---|---|")
+    tools = []
     for n in sizes:
         env = dict(os.environ, RAYON_NUM_THREADS="1")
         one = json.loads(subprocess.run([sys.executable, __file__, "--worker", str(n),
@@ -145,6 +163,14 @@ def main():
             moving = (np.abs(f(V)).max(axis=1) > 0).mean()
             print(f"| {name} | {n:,} | {one[name]:.1f} | {allc[name]:.1f} | {t_np:.0f} | "
                   f"{t_np / allc[name]:.0f}× | {diff:.1e} | {moving:.0%} |")
+        tools.append((n, one, allc, V))
+    print(f"\n| field (no NumPy version) | vertices | spinal 1 thread | spinal {os.cpu_count()} "
+          f"threads | moving at t=0 |")
+    print("|---|---|---|---|---|")
+    for n, one, allc, V in tools:
+        for name, f in tool_cases().items():
+            moving = (np.abs(f(V)).max(axis=1) > 0).mean()
+            print(f"| {name} | {n:,} | {one[name]:.1f} | {allc[name]:.1f} | {moving:.0%} |")
 
 
 if __name__ == "__main__":

@@ -132,6 +132,12 @@ def ph_frames(
     omega_start: float,
     phi: float | None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+# Fields cross the binding as (k, 16) float64 rows, row[0] the element kind (layouts in
+# src/deform/mod.rs, `Element::parse`): 0 curl translation, 1 curl rotation, 2 twist/bend,
+# 3 sphere, 4 capsule, 5 torus, 6 strip across; multi-row elements are a header followed by
+# its data rows: 7 path tool + n rows of kind 8, 9 strip along a curved axis + n rows of kind
+# 10 (x, dγ/dS, S), 11 distance-grid tool + ⌈(nx+2)(ny+2)(nz+2)/15⌉ rows of kind 12 (B-spline
+# coefficients). Build them with spinal.fields; the core re-validates every row.
 def field_eval(
     points: npt.NDArray[np.float64], rows: npt.NDArray[np.float64], t: float
 ) -> npt.NDArray[np.float64]: ...

@@ -56,6 +56,8 @@ fn integrate_batch(field: &Field, x: &mut [DVec3], t0: f64, h: f64, steps: usize
         ([E::Swirl(s)], Method::Rk4) => rk4_batch(|p, _, _| s.eval(p), x, t0, h, steps),
         ([E::Translation(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
         ([E::Sphere(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
+        ([E::StripAlong(e)], Method::Rk4) => rk4_batch(|p, _, _| e.eval(p), x, t0, h, steps),
+        ([E::Grid(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
         _ => integrate_batch_generic(field, x, t0, h, steps, m),
     }
 }
@@ -106,6 +108,8 @@ fn eval_lanes(field: &Field, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
             E::Capsule(e) => lanes(out, p, |x| e.eval(x, t)),
             E::Torus(e) => lanes(out, p, |x| e.eval(x, t)),
             E::StripAcross(e) => lanes(out, p, |x| e.eval(x)),
+            E::StripAlong(e) => lanes(out, p, |x| e.eval(x)),
+            E::Grid(e) => lanes(out, p, |x| e.eval(x, t)),
             E::Path(e) => {
                 if let Some(pose) = e.pose_in(t, tm) {
                     lanes(out, p, |x| e.eval_at(x, &pose))

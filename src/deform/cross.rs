@@ -34,7 +34,7 @@ use crate::error::{InputError, Result};
 
 /// `(D, D′)` of the region function at signed distance `d`, reach `rf`.
 #[inline(always)]
-fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
+pub(crate) fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
     let s = d / rf;
     if !(s > 0.0) {
         (0.0, 0.0)
@@ -49,7 +49,7 @@ fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
 
 /// The translation field from `d`, `n`, `Y = X − c`, `u` (`None` outside the support).
 #[inline(always)]
-fn translate(d: f64, n: DVec3, y: DVec3, u: DVec3, rf: f64, linear: bool) -> DVec3 {
+pub(crate) fn translate(d: f64, n: DVec3, y: DVec3, u: DVec3, rf: f64, linear: bool) -> DVec3 {
     if !(d < rf) {
         return DVec3::ZERO;
     }
@@ -63,7 +63,7 @@ fn translate(d: f64, n: DVec3, y: DVec3, u: DVec3, rf: f64, linear: bool) -> DVe
 
 /// `max_σ [(1 − D)² + (1 − D) D′ L(σ)]` sampled on 2049 distances, `L(σ)` a bound of `|Y|`
 /// (a sampled maximum is low by O(spacing²), immaterial for a step-size rule).
-fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64 {
     let n = 2048;
     let mut m: f64 = 1.0;
     for i in 0..=n {

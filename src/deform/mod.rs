@@ -14,8 +14,10 @@
 pub mod advect;
 pub mod cross;
 pub mod fields;
+pub mod grid;
 pub mod path;
 pub mod stamp;
+pub mod tube;
 
 use glam::DVec3;
 
@@ -38,6 +40,10 @@ pub enum Element {
     StripAcross(StripAcross),
     /// A tool moving along a spine ([`path`]); shared, as it owns its samples.
     Path(std::sync::Arc<path::PathTool>),
+    /// A strip of type I along a curved axis ([`tube`]).
+    StripAlong(std::sync::Arc<tube::StripAlong>),
+    /// A free-form tool from a signed-distance grid ([`grid`]).
+    Grid(std::sync::Arc<grid::GridTool>),
 }
 
 fn v3(r: &[f64], i: usize) -> DVec3 {
@@ -94,6 +100,10 @@ impl Element {
     /// | 6 | strip across `∇p×∇q` | `a, b, m (velocity ⟂ b − a), ρ, R_f, linear?` |
     /// | 7 | path tool header ([`path`]) | `t0, T, ρ, R, p, carry?, linear?, rotate?, twist, bend, n` |
     /// | 8 | path sample (`n` rows after a header) | `x, r, s, t, S` (frame columns, arc length) |
+    /// | 9 | strip along a curved axis, header ([`tube`]) | `speed, ρ, R_f, linear?, n` |
+    /// | 10 | axis sample (`n` rows after a header) | `x, m = dγ/dS, S` |
+    /// | 11 | distance-grid tool, header ([`grid`]) | `o, h, nx, ny, nz, u, R_f, linear? + 2 moving?, C` |
+    /// | 12 | grid coefficients (`⌈(nx+2)(ny+2)(nz+2)/15⌉` rows after a header) | 15 numbers |
     pub fn parse(r: &[f64]) -> Result<Element> {
         if r.len() != ROW {
             return Err(InputError::new(
@@ -172,10 +182,11 @@ impl Element {
                 positive(r[11], "reach")?,
                 flag(r[12]),
             )?),
-            7.0 | 8.0 => {
+            7.0..=12.0 if r[0].fract() == 0.0 => {
                 return Err(InputError::new(
                     "field",
-                    "path rows must come as a header (kind 7) followed by its samples (kind 8)",
+                    "path, strip-axis and grid rows must come as a header (kind 7, 9, 11) \
+                     followed by its data rows (kind 8, 10, 12)",
                 ));
             }
             k => {
@@ -221,6 +232,69 @@ impl Element {
         )?)))
     }
 
+    /// Parse a strip-axis header row `h` (kind 9) and its sample rows (kind 10).
+    fn parse_strip(h: &[f64], rows: &[f64]) -> Result<Element> {
+        let samples = rows
+            .chunks_exact(ROW)
+            .map(|r| {
+                if r[0] != 10.0 {
+                    return Err(InputError::new(
+                        "field",
+                        "expected a strip-axis sample row (kind 10)",
+                    ));
+                }
+                Ok(tube::AxisSample {
+                    x: v3(r, 1),
+                    m: v3(r, 4),
+                    s: r[7],
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Element::StripAlong(std::sync::Arc::new(
+            tube::StripAlong::new(
+                samples,
+                h[1],
+                positive(h[2], "radius")?,
+                positive(h[3], "reach")?,
+                h[4] != 0.0,
+            )?,
+        )))
+    }
+
+    /// Parse a grid header row `h` (kind 11) and its coefficient rows (kind 12).
+    fn parse_grid(h: &[f64], n: [usize; 3], rows: &[f64]) -> Result<Element> {
+        let total = (n[0] + 2) * (n[1] + 2) * (n[2] + 2);
+        let mut coef = Vec::with_capacity(rows.len() / ROW * (ROW - 1));
+        for r in rows.chunks_exact(ROW) {
+            if r[0] != 12.0 {
+                return Err(InputError::new(
+                    "field",
+                    "expected a grid coefficient row (kind 12)",
+                ));
+            }
+            coef.extend_from_slice(&r[1..]);
+        }
+        coef.truncate(total);
+        let flags = h[12];
+        if !(flags == 0.0 || flags == 1.0 || flags == 2.0 || flags == 3.0) {
+            return Err(InputError::new(
+                "field",
+                format!("grid flags must be 0, 1, 2 or 3, got {flags}"),
+            ));
+        }
+        Ok(Element::Grid(std::sync::Arc::new(grid::GridTool::new(
+            v3(h, 1),
+            positive(h[4], "grid spacing")?,
+            n,
+            coef,
+            v3(h, 8),
+            v3(h, 13),
+            positive(h[11], "reach")?,
+            flags == 1.0 || flags == 3.0,
+            flags >= 2.0,
+        )?)))
+    }
+
     /// The velocity at `x`, time `t`, within an integration step containing `tm` (only path
     /// tools use `tm`: it picks the piece of their piecewise-smooth motion).
     #[inline]
@@ -234,6 +308,8 @@ impl Element {
             Element::Torus(e) => e.eval(x, t),
             Element::StripAcross(e) => e.eval(x),
             Element::Path(e) => e.eval(x, t, tm),
+            Element::StripAlong(e) => e.eval(x),
+            Element::Grid(e) => e.eval(x, t),
         }
     }
 
@@ -248,6 +324,8 @@ impl Element {
             Element::Torus(e) => e.max_speed(),
             Element::StripAcross(e) => e.max_speed(),
             Element::Path(e) => e.max_speed(),
+            Element::StripAlong(e) => e.max_speed(),
+            Element::Grid(e) => e.max_speed(),
         }
     }
 
@@ -263,6 +341,8 @@ impl Element {
             Element::Torus(e) => e.reach,
             Element::StripAcross(e) => e.reach,
             Element::Path(e) => e.reach,
+            Element::StripAlong(e) => e.reach,
+            Element::Grid(e) => e.reach,
         }
     }
 }
@@ -312,6 +392,62 @@ impl Field {
                 }
                 elements.push(Element::parse_path(r, body).map_err(at)?);
                 i += n + 1;
+            } else if r[0] == 9.0 || r[0] == 11.0 {
+                if let Some(j) = r.iter().position(|x| !x.is_finite()) {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("element parameter {j} is not finite"),
+                    )));
+                }
+                let avail = rows.len() / ROW - i - 1;
+                let count = |x: f64, what: &str| {
+                    if (1.0..=1e6).contains(&x) && x.fract() == 0.0 {
+                        Ok(x as usize)
+                    } else {
+                        Err(at(InputError::new(
+                            "field",
+                            format!("{what} must be a whole number in [1, 1e6], got {x}"),
+                        )))
+                    }
+                };
+                let (k, grid_n) = if r[0] == 9.0 {
+                    (count(r[5], "strip axis sample count")?, None)
+                } else {
+                    let n = [
+                        count(r[5], "grid size")?,
+                        count(r[6], "grid size")?,
+                        count(r[7], "grid size")?,
+                    ];
+                    let total = (n[0] + 2)
+                        .checked_mul(n[1] + 2)
+                        .and_then(|m| m.checked_mul(n[2] + 2))
+                        .filter(|&m| m <= 1 << 31)
+                        .ok_or_else(|| {
+                            at(InputError::new("field", format!("grid {n:?} is too large")))
+                        })?;
+                    (total.div_ceil(ROW - 1), Some(n))
+                };
+                if k > avail {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("header announces {k} data rows, {avail} follow"),
+                    )));
+                }
+                let body = &rows[(i + 1) * ROW..(i + 1 + k) * ROW];
+                if let Some(j) = body.iter().position(|x| !x.is_finite()) {
+                    return Err(at(InputError::new(
+                        "field",
+                        format!("data row {} is not finite", j / ROW),
+                    )));
+                }
+                elements.push(
+                    match grid_n {
+                        None => Element::parse_strip(r, body),
+                        Some(n) => Element::parse_grid(r, n, body),
+                    }
+                    .map_err(at)?,
+                );
+                i += k + 1;
             } else {
                 elements.push(Element::parse(r).map_err(at)?);
                 i += 1;
