@@ -9,9 +9,12 @@ __all__ = [
     "along_path",
     "bend",
     "capsule",
+    "mesh_tool",
     "rotation",
+    "sdf_tool",
     "sphere",
     "strip",
+    "strip_curve",
     "sum",
     "torus",
     "translation",
@@ -125,3 +128,32 @@ def _check_finite(x: npt.NDArray[np.float64], name: str) -> None: ...
 def _real(x: object, name: str) -> float: ...
 def _positive(x: object, name: str) -> float: ...
 def _vec3(x: object, name: str) -> _F: ...
+def strip_curve(
+    points: _Array,
+    radius: float,
+    speed: float,
+    *,
+    reach: float | None = None,
+    blend: _Blend = "c1",
+) -> Field: ...
+def sdf_tool(
+    grid: _Array,
+    origin: _Array,
+    spacing: float,
+    velocity: _Array,
+    *,
+    center: _Array | None = None,
+    reach: float | None = None,
+    blend: _Blend = "c1",
+    moving: bool = True,
+) -> Field: ...
+def mesh_tool(
+    mesh: object,
+    velocity: _Array,
+    *,
+    reach: float | None = None,
+    resolution: int = 64,
+    center: _Array | None = None,
+    blend: _Blend = "c1",
+    moving: bool = True,
+) -> Field: ...
