@@ -27,14 +27,21 @@ use super::transport::Step;
 
 /// One double-reflection step: carries `r` (⟂ `t0`) across the chord `v1` to the normal
 /// plane of `t1`. `t0`, `t1` must be unit vectors.
+///
+/// Written as `r′ = r − (v₁·r) a − (v₂·r) b` with `a = k₁(v₁ − k₂(v₂·v₁) v₂)`, `b = k₂v₂`
+/// (`kᵢ = 2/vᵢ·vᵢ`): `a` and `b` depend on the curve only, so along a curve the chain of
+/// dependent operations from `r_i` to `r_{i+1}` is two independent dot products and two
+/// multiply-subtracts (half that of reflecting twice in turn), and the processor computes
+/// the next steps' `a`, `b` meanwhile.
 #[inline(always)]
 pub fn dr_step(v1: DVec3, t0: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
     let k1 = 2.0 / v1.dot(v1);
-    let rl = r - (k1 * v1.dot(r)) * v1;
     let tl = t0 - (k1 * v1.dot(t0)) * v1;
     let v2 = t1 - tl;
     let k2 = 2.0 / v2.dot(v2);
-    rl - (k2 * v2.dot(rl)) * v2
+    let a = k1 * (v1 - (k2 * v2.dot(v1)) * v2);
+    let b = k2 * v2;
+    r - v1.dot(r) * a - v2.dot(r) * b
 }
 
 /// Double reflection over a sampled curve (points may be empty in tangents-only mode).

@@ -20,13 +20,16 @@ use rayon::prelude::*;
 
 use super::double_reflection::dr_step;
 use super::geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
-use super::tangents::{circle_normal, five_point_unit_open};
+use super::tangents::{circle_normal, five_point_unit_open, five_point_unit_open_lanes};
 use super::transport::{ChunkEnds, Finish, Twist, plan, write_frame};
 use super::validate::{MIN_ALIGNMENT, coincide};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};
 
 /// Samples per block: chords and tangents of a block stay in the L1/L2 cache.
 pub const BLOCK: usize = 1024;
+
+/// Tangents estimated together (see [`five_point_unit_open_lanes`]).
+const LANES: usize = 4;
 
 /// Samples searched serially for the first bend (the default initial vector) before the
 /// search goes parallel.
@@ -181,10 +184,18 @@ fn chunk(
                 (x[j + 1] - x[j]).length()
             }
         };
-        for i in s..te {
-            match five_point_unit_open(x, i, h) {
-                Some(t) => tb[i - s] = t,
-                None => return None,
+        let mut i = s;
+        while i < te {
+            if i >= 2 && i + LANES + 1 < n && i + LANES <= te {
+                let lanes =
+                    five_point_unit_open_lanes::<LANES>(&x[i - 2..], &hb[i - 2 - lo..hi - lo]);
+                for (l, t) in lanes.into_iter().enumerate() {
+                    tb[i + l - s] = t?;
+                }
+                i += LANES;
+            } else {
+                tb[i - s] = five_point_unit_open(x, i, h)?;
+                i += 1;
             }
         }
         if !ok {

@@ -282,6 +282,40 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
     Some(guard_overshoot(x, i, false, u))
 }
 
+/// [`five_point_unit_open`] at the `L` interior samples `i0 … i0 + L − 1` (each with
+/// `i ≥ 2`, `i + 2 < n`), stage by stage across the lanes: the divisions and square roots of
+/// different samples are independent, so the processor overlaps them (one sample alone
+/// waits on each in turn). `xs = x[i0 − 2 .. i0 + L + 2]`, `hs` the chord lengths
+/// `h(i0 − 2) … h(i0 + L)`. Bit for bit the values of [`five_point_unit_open`].
+#[inline(always)]
+pub fn five_point_unit_open_lanes<const L: usize>(xs: &[DVec3], hs: &[f64]) -> [Option<DVec3>; L] {
+    let (xs, hs) = (&xs[..L + 4], &hs[..L + 3]);
+    let mut v = [DVec3::ZERO; L];
+    for (l, vl) in v.iter_mut().enumerate() {
+        *vl = centred_five_point(
+            [xs[l], xs[l + 1], xs[l + 2], xs[l + 3], xs[l + 4]],
+            [hs[l], hs[l + 1], hs[l + 2], hs[l + 3]],
+        );
+    }
+    let mut len = [0.0; L];
+    for l in 0..L {
+        len[l] = v[l].length();
+    }
+    let mut out = [None; L];
+    for l in 0..L {
+        let u = v[l] * (1.0 / len[l]);
+        if len[l] > 0.0 && u.is_finite() {
+            // the circle estimate at the same sample (`circle_raw`)
+            let (a, b) = (xs[l + 2] - xs[l + 1], xs[l + 3] - xs[l + 2]);
+            out[l] = Some(guard_with(
+                u,
+                b.length_squared() * a + a.length_squared() * b,
+            ));
+        }
+    }
+    out
+}
+
 /// Smallest accepted cosine between the five-point estimate and the circle (3-point)
 /// estimate; below it the quartic overshoots (a kink, or wildly uneven spacing) and the
 /// circle estimate is used.
@@ -308,6 +342,12 @@ fn guard_overshoot(x: &[DVec3], i: usize, closed: bool, u: DVec3) -> DVec3 {
         let c = chord.normalize_or_zero();
         2.0 * c.dot(ti) * c - ti
     };
+    guard_with(u, w)
+}
+
+/// `u`, or the circle estimate `w` (unnormalised) where `u` turns more than 60° from it.
+#[inline(always)]
+fn guard_with(u: DVec3, w: DVec3) -> DVec3 {
     // u·ŵ ≥ cos 60° without a square root in the common case
     let d = u.dot(w);
     if d >= 0.0 && d * d >= OVERSHOOT_COS * OVERSHOOT_COS * w.length_squared() {

@@ -149,7 +149,23 @@ where
         // Phase 3 (parallel): turn every row about its tangent by the chunk's correction plus
         // the twist `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r). Chunks with
         // nothing to turn (chunk 0 without a twist) are left as they are.
-        if rate != 0.0 || theta.iter().any(|&a| a != 0.0) {
+        if rate == 0.0 && theta.iter().any(|&a| a != 0.0) {
+            // a constant turn per chunk: split the chunks finely so that all threads share
+            // the rows to turn (chunk 0 has none)
+            const SUB: usize = 1 << 12;
+            let turns: Vec<(f64, f64)> = theta.iter().map(|a| a.sin_cos()).collect();
+            out[9 * cs.min(write_rows)..9 * write_rows]
+                .par_chunks_mut(9 * SUB)
+                .enumerate()
+                .for_each(|(k, buf)| {
+                    // rows cs + k·SUB …; a sub-chunk may straddle two chunks
+                    let first = cs + k * SUB;
+                    for (off, f) in buf.chunks_exact_mut(9).enumerate() {
+                        let (sin, cos) = turns[(first + off) / cs];
+                        turn_frame(f, cos, sin);
+                    }
+                });
+        } else if rate != 0.0 {
             let seg = &self.seg;
             out[..9 * write_rows]
                 .par_chunks_mut(9 * cs)
