@@ -128,31 +128,42 @@ fn lanes<const S: u8, const L: usize>(
     let k: [usize; L] = std::array::from_fn(|l| edge[l] as usize);
     let a: [f64; L] = std::array::from_fn(|l| coords[COORDS * l]);
     let loc = posed.eval_lanes(&k, &a);
+    // unbend and transfer every lane, then bend every lane: the square roots and divisions
+    // of the lanes interleave
+    let mut d = [DVec2::ZERO; L];
+    let mut lam = [0.0; L];
+    let mut k1 = [DVec2::ZERO; L];
+    let mut fl = [0u8; L];
     for l in 0..L {
         let c = &coords[COORDS * l..COORDS * (l + 1)];
         let (k, a, tau) = (k[l], c[0], c[1]);
-        let loc = &loc[l];
-        let mut d = DVec2::new(c[2], c[3]);
-        let lam = loc.sigma / c[4];
-        let (k0, k1) = if tau != 0.0 {
-            (DVec2::ZERO, DVec2::ZERO)
+        lam[l] = loc[l].sigma / c[4];
+        let k0 = if tau != 0.0 {
+            DVec2::ZERO
         } else {
-            (DVec2::new(c[5], c[6]), loc.kappa)
+            k1[l] = loc[l].kappa;
+            DVec2::new(c[5], c[6])
         };
-        let mut fl = 0u8;
-        d = unbend(sol, d, k0, &mut fl);
+        let mut dl = unbend(sol, DVec2::new(c[2], c[3]), k0, &mut fl[l]);
         if !twist.is_empty() {
             let phi = twist[k] + a * (twist[k + 1] - twist[k]);
             let (s, cs) = phi.sin_cos();
-            d = DVec2::new(cs * d.x - s * d.y, s * d.x + cs * d.y);
+            dl = DVec2::new(cs * dl.x - s * dl.y, s * dl.x + cs * dl.y);
         }
-        d = bend(sol, d, k1, lam, &mut fl);
+        d[l] = dl;
+    }
+    for l in 0..L {
+        d[l] = bend(sol, d[l], k1[l], lam[l], &mut fl[l]);
+    }
+    for l in 0..L {
+        let tau = coords[COORDS * l + 1];
+        let (loc, d, lam) = (&loc[l], d[l], lam[l]);
         let along = if sol == Solution::None {
             tau
         } else {
             lam * tau
         };
         out[l] = loc.q + along * loc.t + d.x * loc.u + d.y * loc.v;
-        flags[l] = fl;
+        flags[l] = fl[l];
     }
 }
