@@ -54,8 +54,10 @@ class Mesh:
     @property
     def volume(self) -> float:
         """Signed enclosed volume, ``Σ (a · (b × c)) / 6`` over the faces (divergence
-        theorem); positive for a closed, outward-facing mesh."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
+        theorem); positive for a closed, outward-facing mesh. Summed about the mean vertex,
+        so a small mesh far from the origin keeps its digits."""
+        v = self.vertices - self.vertices.mean(axis=0) if len(self.vertices) else self.vertices
+        a, b, c = (v[self.faces[:, k]] for k in range(3))
         return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
     @property
