@@ -35,7 +35,13 @@ use super::transport::Step;
 /// the next steps' `a`, `b` meanwhile.
 #[inline(always)]
 pub fn dr_step(v1: DVec3, t0: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
-    let k1 = 2.0 / v1.dot(v1);
+    dr_step_with(v1, v1.dot(v1), t0, t1, r)
+}
+
+/// [`dr_step`] with `v1·v1` already at hand (the same value, bit for bit).
+#[inline(always)]
+pub fn dr_step_with(v1: DVec3, v1v1: f64, t0: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
+    let k1 = 2.0 / v1v1;
     let tl = t0 - (k1 * v1.dot(t0)) * v1;
     let v2 = t1 - tl;
     let k2 = 2.0 / v2.dot(v2);

@@ -18,11 +18,11 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::double_reflection::dr_step;
+use super::double_reflection::{dr_step, dr_step_with};
 use super::geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 use super::tangents::{circle_normal, five_point_unit_open, five_point_unit_open_lanes};
 use super::transport::{ChunkEnds, Finish, Twist, plan, write_frame};
-use super::validate::{MIN_ALIGNMENT, coincide};
+use super::validate::{COINCIDE_EPS, MIN_ALIGNMENT, coincide};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};
 
 /// Samples per block: chords and tangents of a block stay in the L1/L2 cache.
@@ -38,8 +38,13 @@ const SERIAL_SEARCH: usize = 256;
 /// `v̂·(t_i + t_{i+1}) > MIN_ALIGNMENT`, as `validate::aligned` tests it.
 #[inline(always)]
 fn aligned(v: DVec3, ti: DVec3, tj: DVec3) -> bool {
+    aligned_with(v, v.length_squared(), ti, tj)
+}
+
+#[inline(always)]
+fn aligned_with(v: DVec3, vv: f64, ti: DVec3, tj: DVec3) -> bool {
     let d = v.dot(ti + tj);
-    d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * v.length_squared()
+    d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * vv
 }
 
 /// Frames of an open curve given by points only (double reflection, five-point tangents,
@@ -64,7 +69,14 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     // The default initial vector: the principal normal at the first sample where the curve
     // bends, carried back to sample 0 (as `Ctx::run`).
     let (scale, diag) = scale_and_diagonal(x);
+    if !(scale.is_finite() && diag.is_finite()) {
+        return None;
+    }
     let noise = 64.0 * f64::EPSILON * scale;
+    // chords longer than this are not repeated points: `coincide` needs
+    // |b − a|_∞ ≤ 8ε·max(|a|_∞, |b|_∞) ≤ 8ε·scale, and |b − a|_∞ ≥ |b − a|/√3 (with a margin
+    // for the rounding of the computed length)
+    let apart = 2.0 * COINCIDE_EPS * scale;
     let normal = |i: usize, ti: DVec3| {
         circle_normal(x, ti, i, false, noise)
             .and_then(|(nrm, kappa)| (kappa * diag > STRAIGHT_TOL).then_some(nrm))
@@ -116,7 +128,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         .enumerate()
         .map(|(c, buf)| {
             let a = c * cs;
-            chunk(x, a, (a + cs).min(n), (c == 0).then_some(r0), buf)
+            chunk(x, apart, a, (a + cs).min(n), (c == 0).then_some(r0), buf)
         })
         .collect();
     let prov: Vec<ChunkEnds> = prov.into_iter().collect::<Option<_>>()?;
@@ -151,6 +163,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
 /// `None`), writing the frames into `buf`; `None` if a check fails in the chunk.
 fn chunk(
     x: &[DVec3],
+    apart: f64,
     a: usize,
     b: usize,
     start: Option<DVec3>,
@@ -158,6 +171,7 @@ fn chunk(
 ) -> Option<ChunkEnds> {
     let n = x.len();
     let mut hb = [0.0f64; BLOCK + 4];
+    let mut qb = [0.0f64; BLOCK + 4];
     let mut tb = [DVec3::ZERO; BLOCK + 1];
     let mut rows = buf.chunks_exact_mut(9);
     let (mut s0, mut r, mut len) = (DVec3::ZERO, DVec3::ZERO, 0.0);
@@ -169,13 +183,22 @@ fn chunk(
         let te = if e < b { e + 1 } else { e };
         let lo = s.saturating_sub(2);
         let hi = (te + 1).min(n - 1);
-        let mut ok = x[s..e].iter().all(|p| p.is_finite());
+        // Non-finite samples need no test of their own: sample i enters its own tangent's
+        // stencil (every term is a difference with x_i), so a NaN or inf there makes that
+        // tangent non-finite, and the block is refused below.
+        let mut ok = true;
         for j in lo..hi {
-            hb[j - lo] = (x[j + 1] - x[j]).length();
+            // `length()` is `dot(self).sqrt()`: keep the square for the checks and steps
+            let c = x[j + 1] - x[j];
+            qb[j - lo] = c.dot(c);
+            hb[j - lo] = qb[j - lo].sqrt();
         }
         for j in s..e.min(n - 1) {
-            ok &= !coincide(x[j], x[j + 1]);
-            len += hb[j - lo];
+            // |b − a|_∞ ≥ h/√3: a chord longer than `apart` cannot coincide (the exact test
+            // of `validate::coincide` runs only on the rare short ones)
+            let hj = hb[j - lo];
+            ok &= hj > apart || !coincide(x[j], x[j + 1]);
+            len += hj;
         }
         let h = |j: usize| {
             if j >= lo && j < hi {
@@ -211,11 +234,11 @@ fn chunk(
                 write_frame(f, r, ti);
             }
             if i + 1 < b {
-                let (v, tj) = (x[i + 1] - x[i], tb[i + 1 - s]);
-                if !aligned(v, ti, tj) {
+                let (v, vv, tj) = (x[i + 1] - x[i], qb[i - lo], tb[i + 1 - s]);
+                if !aligned_with(v, vv, ti, tj) {
                     return None;
                 }
-                r = dr_step(v, ti, tj, r);
+                r = dr_step_with(v, vv, ti, tj, r);
             }
         }
         s = e;
@@ -312,6 +335,16 @@ mod tests {
         assert!(try_open_points(&req(&x), &mut out).is_none());
         x[1500] = DVec3::new(f64::NAN, 0.0, 0.0);
         assert!(try_open_points(&req(&x), &mut out).is_none());
+        for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            for row in [0, 1, 2, 1500, 2997, 2998, 2999] {
+                let mut y = curve(3000, 0);
+                y[row].y = bad;
+                assert!(
+                    try_open_points(&req(&y), &mut out).is_none(),
+                    "{bad} at {row}"
+                );
+            }
+        }
         x[1500] = x[1498]; // a reversal: a cusp or a segment against its tangents
         assert!(try_open_points(&req(&x), &mut out).is_none());
         let x = curve(3000, 0);
