@@ -158,10 +158,17 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
 /// `x₀ … x₄`, derivative at `x₂` (the same Lagrange weights, unrolled).
 #[inline(always)]
 fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
+    let w = centred_weights(h[0], h[1], h[2], h[3]);
+    centred_sum(&x, w)
+}
+
+/// The weights of [`centred_five_point`] for `x₀, x₁, x₃, x₄` (relative to `x₂`).
+#[inline(always)]
+fn centred_weights(h0: f64, h1: f64, h2: f64, h3: f64) -> [f64; 4] {
     // Positions relative to x₂, scaled by 1/(h₁ + h₂): the direction does not depend on the
     // scale, and O(1) values keep the products below far from under/overflow.
-    let k = 1.0 / (h[1] + h[2]);
-    let (t0, t1, t3, t4) = (-(h[0] + h[1]) * k, -h[1] * k, h[2] * k, (h[2] + h[3]) * k);
+    let k = 1.0 / (h1 + h2);
+    let (t0, t1, t3, t4) = (-(h0 + h1) * k, -h1 * k, h2 * k, (h2 + h3) * k);
     // Lagrange weights w_j = n_j / d_j; multiplying all by d₀d₁d₃d₄ (> 0 for
     // t₀ < t₁ < 0 < t₃ < t₄) leaves the direction and needs no division.
     let d0 = (t0 - t1) * t0 * (t0 - t3) * (t0 - t4);
@@ -169,12 +176,18 @@ fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
     let d3 = (t3 - t0) * (t3 - t1) * t3 * (t3 - t4);
     let d4 = (t4 - t0) * (t4 - t1) * t4 * (t4 - t3);
     let (d01, d34) = (d0 * d1, d3 * d4);
-    let w0 = -(t1 * t3 * t4) * (d1 * d34);
-    let w1 = -(t0 * t3 * t4) * (d0 * d34);
-    let w3 = -(t0 * t1 * t4) * (d01 * d4);
-    let w4 = -(t0 * t1 * t3) * (d01 * d3);
+    [
+        -(t1 * t3 * t4) * (d1 * d34),
+        -(t0 * t3 * t4) * (d0 * d34),
+        -(t0 * t1 * t4) * (d01 * d4),
+        -(t0 * t1 * t3) * (d01 * d3),
+    ]
+}
+
+#[inline(always)]
+fn centred_sum(x: &[DVec3], w: [f64; 4]) -> DVec3 {
     let p = x[2];
-    w0 * (x[0] - p) + w1 * (x[1] - p) + w3 * (x[3] - p) + w4 * (x[4] - p)
+    w[0] * (x[0] - p) + w[1] * (x[1] - p) + w[2] * (x[3] - p) + w[3] * (x[4] - p)
 }
 
 /// Unnormalised circle tangent at an interior (or periodic) index.
@@ -290,12 +303,14 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
 #[inline(always)]
 pub fn five_point_unit_open_lanes<const L: usize>(xs: &[DVec3], hs: &[f64]) -> [Option<DVec3>; L] {
     let (xs, hs) = (&xs[..L + 4], &hs[..L + 3]);
+    // the weights lane by lane: plain scalar loops the compiler turns into vector code
+    let mut w = [[0.0; 4]; L];
+    for (l, wl) in w.iter_mut().enumerate() {
+        *wl = centred_weights(hs[l], hs[l + 1], hs[l + 2], hs[l + 3]);
+    }
     let mut v = [DVec3::ZERO; L];
     for (l, vl) in v.iter_mut().enumerate() {
-        *vl = centred_five_point(
-            [xs[l], xs[l + 1], xs[l + 2], xs[l + 3], xs[l + 4]],
-            [hs[l], hs[l + 1], hs[l + 2], hs[l + 3]],
-        );
+        *vl = centred_sum(&xs[l..l + 5], w[l]);
     }
     let mut len = [0.0; L];
     for l in 0..L {
