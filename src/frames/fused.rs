@@ -210,8 +210,8 @@ fn chunk(
         let mut i = s;
         while i < te {
             if i >= 2 && i + LANES + 1 < n && i + LANES <= te {
-                let lanes =
-                    five_point_unit_open_lanes::<LANES>(&x[i - 2..], &hb[i - 2 - lo..hi - lo]);
+                let (a, z) = (i - 2 - lo, hi - lo);
+                let lanes = five_point_unit_open_lanes::<LANES>(&x[i - 2..], &hb[a..z], &qb[a..z]);
                 for (l, t) in lanes.into_iter().enumerate() {
                     tb[i + l - s] = t?;
                 }

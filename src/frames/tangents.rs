@@ -299,10 +299,15 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
 /// `i ≥ 2`, `i + 2 < n`), stage by stage across the lanes: the divisions and square roots of
 /// different samples are independent, so the processor overlaps them (one sample alone
 /// waits on each in turn). `xs = x[i0 − 2 .. i0 + L + 2]`, `hs` the chord lengths
-/// `h(i0 − 2) … h(i0 + L)`. Bit for bit the values of [`five_point_unit_open`].
+/// `h(i0 − 2) … h(i0 + L)` and `qs` their squares (`c·c`, of which `h` is the square root).
+/// Bit for bit the values of [`five_point_unit_open`].
 #[inline(always)]
-pub fn five_point_unit_open_lanes<const L: usize>(xs: &[DVec3], hs: &[f64]) -> [Option<DVec3>; L] {
-    let (xs, hs) = (&xs[..L + 4], &hs[..L + 3]);
+pub fn five_point_unit_open_lanes<const L: usize>(
+    xs: &[DVec3],
+    hs: &[f64],
+    qs: &[f64],
+) -> [Option<DVec3>; L] {
+    let (xs, hs, qs) = (&xs[..L + 4], &hs[..L + 3], &qs[..L + 3]);
     // the weights lane by lane: plain scalar loops the compiler turns into vector code
     let mut w = [[0.0; 4]; L];
     for (l, wl) in w.iter_mut().enumerate() {
@@ -320,12 +325,10 @@ pub fn five_point_unit_open_lanes<const L: usize>(xs: &[DVec3], hs: &[f64]) -> [
     for l in 0..L {
         let u = v[l] * (1.0 / len[l]);
         if len[l] > 0.0 && u.is_finite() {
-            // the circle estimate at the same sample (`circle_raw`)
+            // the circle estimate at the same sample (`circle_raw`; `qs` holds the squared
+            // chords, `a.length_squared()` and `b.length_squared()` bit for bit)
             let (a, b) = (xs[l + 2] - xs[l + 1], xs[l + 3] - xs[l + 2]);
-            out[l] = Some(guard_with(
-                u,
-                b.length_squared() * a + a.length_squared() * b,
-            ));
+            out[l] = Some(guard_with(u, qs[l + 2] * a + qs[l + 1] * b));
         }
     }
     out
