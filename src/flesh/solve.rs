@@ -131,7 +131,10 @@ pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVe
         }
         Solution::Radial => {
             // with r_t = |d|/√λ and û = d/|d|: α = −⅔ r_t û·k1 = −⅔ (d·k1)/√λ and the result
-            // û r_t m = d m/√λ (no norm needed; d = 0 gives α = 0, m = 1)
+            // û r_t m = d m/√λ (no norm needed)
+            if d == DVec2::ZERO {
+                return d; // on the spine: nothing to correct, whatever λ and k1
+            }
             let s = 1.0 / lam.sqrt();
             let alpha = -(2.0 / 3.0) * s * d.dot(k1);
             let (m, ok) = radial_ratio(alpha);
@@ -154,7 +157,7 @@ pub fn radial_ratio(alpha: f64) -> (f64, bool) {
     }
     let a2 = alpha * alpha;
     if a2 <= RADIAL_FAST_2 * RADIAL_FAST_2 {
-        // the series start is within 7.2e-3 of the root for |α| ≤ 1/4 (0.03 at 0.36); one
+        // the series start is within 7.2e-3 of the root for |α| ≤ 1/4 (0.1 at 0.36); one
         // Halley step (cubic convergence) brings it to ~1e-7 (two to ~1e-10 at 0.36) and one
         // Newton step to the rounding level (the unit test checks this against the
         // safeguarded iteration below)
@@ -179,8 +182,12 @@ pub const RADIAL_FAST: f64 = 0.25;
 /// `|α| = 2/√27 ≈ 0.385`); beyond, the safeguarded iteration.
 pub const RADIAL_FAST_2: f64 = 0.36;
 
-/// The safeguarded iteration behind [`radial_ratio`], valid for every `α`.
+/// The safeguarded iteration behind [`radial_ratio`], valid for every finite `α` (a
+/// non-finite one, from degenerate input, gives the uncorrected ratio 1, reported).
 pub fn radial_ratio_safe(alpha: f64) -> (f64, bool) {
+    if !alpha.is_finite() {
+        return (1.0, false);
+    }
     let f = |m: f64| (alpha * m + 1.0) * m * m - 1.0;
     let df = |m: f64| (3.0 * alpha * m + 2.0) * m;
     if alpha == 0.0 {
@@ -308,6 +315,19 @@ mod tests {
             worst < 4.0 * f64::EPSILON,
             "worst relative difference {worst:e}"
         );
+    }
+
+    #[test]
+    fn radial_degenerate_input_never_panics() {
+        let mut fl = 0;
+        // a vertex on the spine stays there whatever the stretch and curvature
+        for lam in [-1.0, 0.0, f64::NAN, 1.0] {
+            let d = bend(Solution::Radial, DVec2::ZERO, DVec2::X, lam, &mut fl);
+            assert_eq!(d, DVec2::ZERO);
+        }
+        assert_eq!(fl, 0);
+        assert_eq!(radial_ratio(f64::NAN), (1.0, false));
+        assert_eq!(radial_ratio(f64::INFINITY), (1.0, false));
     }
 
     #[test]
