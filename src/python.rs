@@ -456,6 +456,20 @@ type WalkArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
 );
 
+/// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.
+fn walker_states(states: &[quaternion::walk::State]) -> (Vec<f64>, Vec<i64>, Vec<f64>) {
+    let pts = states.iter().flat_map(|s| s.point.to_array()).collect();
+    let fcs = states.iter().map(|s| s.face as i64).collect();
+    let frs = states
+        .iter()
+        .flat_map(|s| {
+            let (a, b, c) = (s.frame.x_axis, s.frame.y_axis, s.frame.z_axis);
+            [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
+        })
+        .collect();
+    (pts, fcs, frs)
+}
+
 /// Walk on a triangle mesh; see `spinal.quaternions.walk_mesh`.
 #[pyfunction]
 #[pyo3(signature = (vertices, faces, face, point, direction, moves))]
@@ -508,15 +522,7 @@ fn walk_mesh<'py>(
         })
         .map_err(to_py)?;
     let k = states.len();
-    let pts: Vec<f64> = states.iter().flat_map(|s| s.point.to_array()).collect();
-    let fcs: Vec<i64> = states.iter().map(|s| s.face as i64).collect();
-    let frs: Vec<f64> = states
-        .iter()
-        .flat_map(|s| {
-            let (a, b, c) = (s.frame.x_axis, s.frame.y_axis, s.frame.z_axis);
-            [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
-        })
-        .collect();
+    let (pts, fcs, frs) = walker_states(&states);
     let stopped: Vec<bool> = states[1..].iter().map(|s| s.stopped).collect();
     let m = path.len();
     let pp: Vec<f64> = path.iter().flat_map(|p| p.0.to_array()).collect();
@@ -584,15 +590,7 @@ fn walk_mesh_many<'py>(
         })
         .map_err(to_py)?;
     let nw = starts.len();
-    let pts: Vec<f64> = states.iter().flat_map(|s| s.point.to_array()).collect();
-    let fcs: Vec<i64> = states.iter().map(|s| s.face as i64).collect();
-    let frs: Vec<f64> = states
-        .iter()
-        .flat_map(|s| {
-            let (a, b, c) = (s.frame.x_axis, s.frame.y_axis, s.frame.z_axis);
-            [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
-        })
-        .collect();
+    let (pts, fcs, frs) = walker_states(&states);
     let stopped: Vec<bool> = states
         .chunks(k + 1)
         .flat_map(|w| w[1..].iter().map(|s| s.stopped))

@@ -200,6 +200,20 @@ def _blend(x) -> float:
     return 1.0 if as_choice(x, "blend", ("c1", "linear")) == "linear" else 0.0
 
 
+def _spine_points(points) -> tuple[np.ndarray, np.ndarray]:
+    """A tool's axis or path, ``(n, 3)`` finite with ``n ≥ 2`` and no repeated consecutive
+    samples, and its chord lengths."""
+    x = as_points(points, "points")
+    _check_finite(x, "points")
+    if len(x) < 2:
+        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
+    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    if not (chords > 0).all():
+        i = int(np.argmin(chords))
+        raise ValueError(f"points: consecutive samples {i} and {i + 1} coincide")
+    return x, chords
+
+
 def _row(*parts) -> np.ndarray:
     r = np.zeros(ROW)
     flat = np.concatenate([np.atleast_1d(np.asarray(p, dtype=np.float64)) for p in parts])
@@ -456,14 +470,7 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
     """
     from ._frames import estimate_tangents
 
-    x = as_points(points, "points")
-    _check_finite(x, "points")
-    if len(x) < 2:
-        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
-    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
-    if not (chords > 0).all():
-        i = int(np.argmin(chords))
-        raise ValueError(f"points: consecutive samples {i} and {i + 1} coincide")
+    x, chords = _spine_points(points)
     rho = _positive(radius, "radius")
     sp = _real(speed, "speed")
     reach = rho if reach is None else _positive(reach, "reach")
@@ -784,14 +791,7 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
     """
     from ._frames import frames as _frames
 
-    x = as_points(points, "points")
-    _check_finite(x, "points")
-    if len(x) < 2:
-        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
-    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
-    if not (chords > 0).all():
-        raise ValueError(f"points: consecutive samples {int(np.argmin(chords))} and "
-                         f"{int(np.argmin(chords)) + 1} coincide")
+    x, chords = _spine_points(points)
     rho = _positive(radius, "radius")
     dur = _positive(duration, "duration")
     kind = as_choice(kind, "kind", ("translate", "rotate", "twist", "bend"))
