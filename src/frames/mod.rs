@@ -21,6 +21,7 @@ pub mod double_reflection;
 pub mod frenet;
 pub mod fused;
 pub mod geometry;
+pub mod lanes;
 pub mod projection;
 pub mod rk4;
 pub mod rotation;

@@ -28,6 +28,7 @@
 //!   and at the open ends the 4-point Adams–Moulton weights `9t_0 + 19t_1 − 5t_2 + t_3` and
 //!   its mirror (resolution A16 of the spec). Needs 4 tangents.
 
+use super::lanes::Arith;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -162,12 +163,13 @@ fn centred_five_point(x: [DVec3; 5], h: [f64; 4]) -> DVec3 {
     centred_sum(&x, w)
 }
 
-/// The weights of [`centred_five_point`] for `x₀, x₁, x₃, x₄` (relative to `x₂`).
+/// The weights of [`centred_five_point`] for `x₀, x₁, x₃, x₄` (relative to `x₂`); generic so
+/// that the fused path evaluates the same formula four samples at a time.
 #[inline(always)]
-fn centred_weights(h0: f64, h1: f64, h2: f64, h3: f64) -> [f64; 4] {
+pub(super) fn centred_weights<T: Arith>(h0: T, h1: T, h2: T, h3: T) -> [T; 4] {
     // Positions relative to x₂, scaled by 1/(h₁ + h₂): the direction does not depend on the
     // scale, and O(1) values keep the products below far from under/overflow.
-    let k = 1.0 / (h1 + h2);
+    let k = T::splat(1.0) / (h1 + h2);
     let (t0, t1, t3, t4) = (-(h0 + h1) * k, -h1 * k, h2 * k, (h2 + h3) * k);
     // Lagrange weights w_j = n_j / d_j; multiplying all by d₀d₁d₃d₄ (> 0 for
     // t₀ < t₁ < 0 < t₃ < t₄) leaves the direction and needs no division.

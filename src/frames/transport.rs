@@ -16,6 +16,8 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock, PoisonError};
 
 use super::geometry::{any_perpendicular, rotate_about, signed_angle};
 
@@ -37,8 +39,12 @@ pub enum Twist {
     End { target: DVec3, turns: i64 },
 }
 
-/// Minimum number of frames per chunk before a curve is split across threads.
+/// A curve is split across threads only from `2·PAR_CHUNK` frames on.
 pub const PAR_CHUNK: usize = 1 << 15;
+
+/// Frames per chunk of the parallel scan: a chunk's rows (72 bytes each, 288 KiB) are still
+/// in the core's L2 cache when they are turned.
+pub const SCAN_CHUNK: usize = 1 << 15;
 
 #[inline(always)]
 pub fn write_frame(buf: &mut [f64], r: DVec3, t: DVec3) {
@@ -69,12 +75,11 @@ fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
 /// curve is long.
 pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
     let threads = rayon::current_num_threads();
-    let chunks = if is_rotation && threads > 1 && ext >= 2 * PAR_CHUNK {
-        (2 * threads).min(ext / PAR_CHUNK).max(1)
+    let cs = if is_rotation && threads > 1 && ext >= 2 * PAR_CHUNK {
+        SCAN_CHUNK
     } else {
-        1
+        ext.max(1)
     };
-    let cs = ext.div_ceil(chunks).max(1);
     (ext.div_ceil(cs), cs)
 }
 
@@ -82,7 +87,38 @@ pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
 /// chunk 0, a provisional one otherwise), its last vector, and the chunk's arc length.
 pub type ChunkEnds = (DVec3, DVec3, f64);
 
-/// The curve data phases 2 and 3 of the scan need, whatever produced phase 1.
+/// A chunk once its predecessors are known: its [`ChunkEnds`] and the angle that turns its
+/// provisional vectors into the true ones; `None` when a check failed in it or before it.
+type Resolved = Option<(ChunkEnds, f64)>;
+
+/// Publishes a chunk's state when dropped, so that a chunk that ends early (a failed check,
+/// or a panic) never leaves the chunk after it waiting.
+struct Publish<'a>(&'a OnceLock<Resolved>, Resolved);
+
+impl Drop for Publish<'_> {
+    fn drop(&mut self) {
+        let _ = self.0.set(self.1);
+    }
+}
+
+/// The state of a chunk that has been handed out (its worker is running): spin briefly,
+/// then give the processor away.
+fn wait(cell: &OnceLock<Resolved>) -> Resolved {
+    let mut spins = 0u32;
+    loop {
+        if let Some(v) = cell.get() {
+            return *v;
+        }
+        if spins < 1 << 12 {
+            spins += 1;
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
+}
+
+/// The curve data the scan needs besides the transport of a chunk itself.
 pub struct Finish<B, T, L> {
     /// Transport across the chunk boundary `i → i + 1` (the step of the method).
     pub boundary_step: B,
@@ -100,34 +136,102 @@ pub struct Finish<B, T, L> {
 
 impl<B, T, L> Finish<B, T, L>
 where
-    B: Fn(usize, DVec3) -> DVec3,
-    T: Fn(usize) -> DVec3,
+    B: Fn(usize, DVec3) -> DVec3 + Sync,
+    T: Fn(usize) -> DVec3 + Sync,
     L: Fn(usize) -> f64 + Sync,
 {
-    /// Phases 2 and 3: fix the chunk angles serially, add the twist, turn the written rows
-    /// (`out`: `9·rows` values, provisional frames from phase 1) and return the raw end angle.
-    pub fn run(&self, prov: &[ChunkEnds], out: &mut [f64]) -> f64 {
+    /// The scan: transport every chunk, fix the chunk angles, add the twist; returns the raw
+    /// end angle, or `None` when `work` reported a failed check.
+    ///
+    /// `work(c, start, buf)` transports chunk `c` (extended frames `c·cs … (c+1)·cs − 1`)
+    /// from `start` (`r0` for chunk 0; `None`: a provisional unit vector ⟂ its first
+    /// tangent, of its own choice), writes its rows into `buf` (empty for the extra frame of
+    /// a closed curve) and reports its [`ChunkEnds`].
+    ///
+    /// Chunks are handed out in order to one worker per thread. When chunk `c` is written,
+    /// its worker waits for chunk `c − 1` to be resolved (its owner is running and a step
+    /// ahead, so the wait is short), takes the angle that turns the provisional start into
+    /// the true one, and turns the rows at once, while they are still in its cache: every
+    /// frame is written to memory once. The frames do not depend on the timing: chunk `c > 0`
+    /// always starts from its provisional vector.
+    pub fn scan<W>(&self, work: W, out: &mut [f64]) -> Option<f64>
+    where
+        W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
+    {
         let (n, cs, ext) = (self.n, self.cs, self.ext);
-        let chunks = prov.len();
+        let chunks = ext.div_ceil(cs);
         let rows = out.len() / 9;
         let write_rows = rows.min(ext);
         let tt = &self.tangent;
+        // without an end condition the chunk angle is the whole correction: turn at once
+        let turn_now = matches!(self.twist, Twist::None);
 
-        // Phase 2 (serial): the angle that turns each chunk's provisional vectors into the
-        // true ones, the arc length at each chunk start, and the true vector at the far end.
-        let mut theta = vec![0.0; chunks];
-        let mut len_prefix = vec![0.0; chunks + 1];
-        for c in 0..chunks {
-            len_prefix[c + 1] = len_prefix[c] + prov[c].2;
-            if c > 0 {
-                let a = c * cs;
-                let last = rotate_about(prov[c - 1].1, tt(a - 1), theta[c - 1]);
-                let true_start = (self.boundary_step)(a - 1, last);
-                theta[c] = signed_angle(prov[c].0, true_start, tt(a));
-            }
+        let mut slots: Vec<Mutex<&mut [f64]>> = out[..9 * write_rows]
+            .chunks_mut(9 * cs)
+            .map(Mutex::new)
+            .collect();
+        // a closed curve's extended frame may form a last chunk with no row to write
+        while slots.len() < chunks {
+            slots.push(Mutex::new(&mut []));
         }
-        let end_r = rotate_about(prov[chunks - 1].1, tt(ext - 1), theta[chunks - 1]);
+        let done: Vec<OnceLock<Resolved>> = (0..chunks).map(|_| OnceLock::new()).collect();
+        let next = AtomicUsize::new(0);
+        let failed = AtomicBool::new(false);
 
+        let resolve = |c: usize, buf: &mut [f64]| -> Resolved {
+            let p = work(c, (c == 0).then_some(self.r0), buf)?;
+            if c == 0 {
+                return Some((p, 0.0));
+            }
+            let (prev, prev_angle) = wait(&done[c - 1])?;
+            let a = c * cs;
+            let last = rotate_about(prev.1, tt(a - 1), prev_angle);
+            let true_start = (self.boundary_step)(a - 1, last);
+            let angle = signed_angle(p.0, true_start, tt(a));
+            if turn_now && angle != 0.0 {
+                let (sin, cos) = angle.sin_cos();
+                for f in buf.chunks_exact_mut(9) {
+                    turn_frame(f, cos, sin);
+                }
+            }
+            Some((p, angle))
+        };
+        let worker = || {
+            loop {
+                let c = next.fetch_add(1, Ordering::Relaxed);
+                if c >= chunks {
+                    return;
+                }
+                let mut publish = Publish(&done[c], None);
+                if failed.load(Ordering::Relaxed) {
+                    continue;
+                }
+                let mut slot = slots[c].lock().unwrap_or_else(PoisonError::into_inner);
+                publish.1 = resolve(c, &mut slot);
+                if publish.1.is_none() {
+                    failed.store(true, Ordering::Relaxed);
+                }
+            }
+        };
+        let threads = rayon::current_num_threads().min(chunks);
+        if threads > 1 {
+            rayon::scope(|s| {
+                for _ in 1..threads {
+                    s.spawn(|_| worker());
+                }
+                worker();
+            });
+        } else {
+            worker();
+        }
+        drop(slots);
+        let resolved: Vec<(ChunkEnds, f64)> = done
+            .into_iter()
+            .map(|cell| cell.into_inner().flatten())
+            .collect::<Option<_>>()?;
+
+        let (last, last_angle) = resolved[chunks - 1];
+        let end_r = rotate_about(last.1, tt(ext - 1), last_angle);
         let (raw, total) = match self.twist {
             Twist::None => (0.0, 0.0),
             Twist::Closed { turns } => {
@@ -139,45 +243,32 @@ where
                 (a, a + std::f64::consts::TAU * turns as f64)
             }
         };
-        let length = len_prefix[chunks];
-        let rate = if total != 0.0 && length > 0.0 {
-            total / length
-        } else {
-            0.0
-        };
-
-        // Phase 3 (parallel): turn every row about its tangent by the chunk's correction plus
-        // the twist `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r). Chunks with
-        // nothing to turn (chunk 0 without a twist) are left as they are.
-        if rate == 0.0 && theta.iter().any(|&a| a != 0.0) {
-            // a constant turn per chunk: split the chunks finely so that all threads share
-            // the rows to turn (chunk 0 has none)
-            const SUB: usize = 1 << 12;
-            let turns: Vec<(f64, f64)> = theta.iter().map(|a| a.sin_cos()).collect();
-            out[9 * cs.min(write_rows)..9 * write_rows]
-                .par_chunks_mut(9 * SUB)
-                .enumerate()
-                .for_each(|(k, buf)| {
-                    // rows cs + k·SUB …; a sub-chunk may straddle two chunks
-                    let first = cs + k * SUB;
-                    for (off, f) in buf.chunks_exact_mut(9).enumerate() {
-                        let (sin, cos) = turns[(first + off) / cs];
-                        turn_frame(f, cos, sin);
-                    }
-                });
-        } else if rate != 0.0 {
+        if !turn_now {
+            let mut len_prefix = vec![0.0; chunks + 1];
+            for (c, &(p, _)) in resolved.iter().enumerate() {
+                len_prefix[c + 1] = len_prefix[c] + p.2;
+            }
+            let length = len_prefix[chunks];
+            let rate = if total != 0.0 && length > 0.0 {
+                total / length
+            } else {
+                0.0
+            };
+            // Turn every row about its tangent by the chunk's angle plus the twist
+            // `rate · s`: (r, s) ← (cos φ r + sin φ s, cos φ s − sin φ r).
             let seg = &self.seg;
             out[..9 * write_rows]
                 .par_chunks_mut(9 * cs)
                 .enumerate()
-                .filter(|(c, _)| rate != 0.0 || theta[*c] != 0.0)
+                .filter(|(c, _)| rate != 0.0 || resolved[*c].1 != 0.0)
                 .for_each(|(c, buf)| {
                     let a = c * cs;
+                    let angle = resolved[c].1;
                     let mut arc = len_prefix[c];
-                    let (mut sin, mut cos) = theta[c].sin_cos();
+                    let (mut sin, mut cos) = angle.sin_cos();
                     for (off, f) in buf.chunks_exact_mut(9).enumerate() {
                         if rate != 0.0 {
-                            (sin, cos) = (theta[c] + rate * arc).sin_cos();
+                            (sin, cos) = (angle + rate * arc).sin_cos();
                             arc += seg(a + off);
                         }
                         turn_frame(f, cos, sin);
@@ -188,7 +279,7 @@ where
             let (head, tail) = out.split_at_mut(9 * n);
             tail[..9].copy_from_slice(&head[..9]);
         }
-        raw
+        Some(raw)
     }
 }
 
@@ -216,16 +307,10 @@ pub fn transport_into<S: Step>(
     let rows = out.len() / 9;
     debug_assert!(rows == n || (closed && rows == n + 1));
     let tt = |i: usize| t[if i == n { 0 } else { i }];
-    let (chunks, cs) = plan(ext, step.is_rotation());
-    let bounds = |c: usize| (c * cs, ((c + 1) * cs).min(ext));
-    let write_rows = rows.min(ext);
-
-    // Phase 1 (parallel): every chunk transports a provisional start vector (the true one for
-    // chunk 0), writes its rows into `buf`, and reports its start, its last vector and its
-    // length.
-    let provisional = |c: usize, buf: &mut [f64]| {
-        let (a, b) = bounds(c);
-        let s0 = if c == 0 { r0 } else { any_perpendicular(tt(a)) };
+    let (_, cs) = plan(ext, step.is_rotation());
+    let work = |c: usize, start: Option<DVec3>, buf: &mut [f64]| {
+        let (a, b) = (c * cs, ((c + 1) * cs).min(ext));
+        let s0 = start.unwrap_or_else(|| any_perpendicular(tt(a)));
         let mut rows = buf.chunks_exact_mut(9);
         let mut r = s0;
         for i in a..b {
@@ -236,18 +321,9 @@ pub fn transport_into<S: Step>(
                 r = step.step(i, r);
             }
         }
-        (s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>())
+        Some((s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>()))
     };
-    let mut prov: Vec<ChunkEnds> = out[..9 * write_rows]
-        .par_chunks_mut(9 * cs)
-        .enumerate()
-        .map(|(c, buf)| provisional(c, buf))
-        .collect();
-    // A closed curve's extended frame may form a last chunk with no row to write.
-    for c in prov.len()..chunks {
-        prov.push(provisional(c, &mut []));
-    }
-    Finish {
+    let angle = Finish {
         boundary_step: |i: usize, r: DVec3| step.step(i, r),
         tangent: tt,
         seg: |i: usize| seg[i.min(seg.len() - 1)],
@@ -258,5 +334,8 @@ pub fn transport_into<S: Step>(
         cs,
         ext,
     }
-    .run(&prov, out)
+    .scan(work, out);
+    // `work` never fails, so neither does the scan
+    debug_assert!(angle.is_some());
+    angle.unwrap_or(0.0)
 }
