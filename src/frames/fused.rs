@@ -1,5 +1,6 @@
-//! The fused fast path of the most common call: frames of one open curve from its points
-//! alone, by double reflection with the five-point chord-length tangents.
+//! The fused fast path of the most common calls: frames of one open curve by double
+//! reflection, from its points alone (with the five-point chord-length tangents) or from its
+//! points and given tangents.
 //!
 //! The general driver ([`super::compute_into`]) makes one pass per stage over the whole
 //! curve: finite check, chord lengths, tangents (a fresh `(n, 3)` buffer), alignment check,
@@ -45,24 +46,29 @@ fn aligned_with(v: DVec3, vv: f64, ti: DVec3, tj: DVec3) -> bool {
     d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * vv
 }
 
-/// Frames of an open curve given by points only (double reflection, five-point tangents,
-/// `n ≥ 5`), or `None` when the request is of another kind or any check fails.
+/// Frames of an open curve given by points, with or without tangents (double reflection;
+/// five-point tangents when none are given; `n ≥ 5`), or `None` when the request is of
+/// another kind or any check fails.
 pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     let x = req.points?;
     let n = x.len();
-    if req.tangents.is_some()
+    let given = req.tangents;
+    if given.is_some_and(|t| t.len() != n)
         || req.analytic.is_some()
         || req.closed
         || req.method != Method::DoubleReflection
         || req.tangent_chords
-        || req.tangent_rule != TangentRule::FivePoint
+        || (given.is_none() && req.tangent_rule != TangentRule::FivePoint)
         || n < 5
         || out.len() != 9 * n
     {
         return None;
     }
     let h = |j: usize| (x[j + 1] - x[j]).length();
-    let tan = |i: usize| five_point_unit_open(x, i, h);
+    let tan = |i: usize| match given {
+        Some(t) => unit(t[i]),
+        None => five_point_unit_open(x, i, h),
+    };
 
     // The default initial vector: the principal normal at the first sample where the curve
     // bends, carried back to sample 0 (as `Ctx::run`).
@@ -127,7 +133,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         if a > 0 && !aligned(x[a] - x[a - 1], tan(a - 1)?, tan(a)?) {
             return None;
         }
-        chunk(x, apart, a, (a + cs).min(n), start, buf)
+        chunk(x, given, apart, a, (a + cs).min(n), start, buf)
     };
     // every tangent the scan asks for has passed its chunk's checks by then
     let tt = |i: usize| tan(i).unwrap_or(DVec3::ZERO);
@@ -143,6 +149,43 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         ext: n,
     }
     .scan(work, out)
+}
+
+/// A given tangent made unit, as `tangents::normalize_all` does; `None` where it cannot be.
+#[inline(always)]
+fn unit(v: DVec3) -> Option<DVec3> {
+    let l = v.length();
+    (l > 0.0 && l.is_finite() && (v / l).is_finite()).then(|| v / l)
+}
+
+/// The given tangents `s … te − 1` made unit into `t` (four at a time), or `None` where one
+/// cannot be.
+#[inline(always)]
+fn given_tangents(tg: &[DVec3], s: usize, te: usize, t: &mut [Vec<f64>; 3]) -> Option<()> {
+    let mut bad = 0u32;
+    let mut i = s;
+    while i + L <= te {
+        let g = &tg[i..i + L];
+        let v = V4 {
+            x: F4([g[0].x, g[1].x, g[2].x, g[3].x]),
+            y: F4([g[0].y, g[1].y, g[2].y, g[3].y]),
+            z: F4([g[0].z, g[1].z, g[2].z, g[3].z]),
+        };
+        let l = v.dot(v).sqrt();
+        let u = V4 {
+            x: v.x / l,
+            y: v.y / l,
+            z: v.z / l,
+        };
+        let finite = l.mask(l, |p, q| (p - q) == 0.0);
+        bad |= !(l.mask(F4::splat(0.0), |p, q| p > q) & finite & u.finite_mask()) & 0b1111;
+        u.store(&mut muts(t), i - s);
+        i += L;
+    }
+    for (j, &v) in tg.iter().enumerate().take(te).skip(i) {
+        set(t, j - s, unit(v)?);
+    }
+    (bad == 0).then_some(())
 }
 
 /// Per-block scratch arrays, one value per sample or chord (structure of arrays, so that
@@ -230,6 +273,7 @@ fn live(g: usize, end: usize) -> u32 {
 /// own), so both versions give the same bits.
 fn chunk(
     x: &[DVec3],
+    given: Option<&[DVec3]>,
     apart: f64,
     a: usize,
     b: usize,
@@ -239,9 +283,9 @@ fn chunk(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: `chunk_avx2` only needs the processor to support AVX2, checked just above.
-        return unsafe { chunk_avx2(x, apart, a, b, start, buf) };
+        return unsafe { chunk_avx2(x, given, apart, a, b, start, buf) };
     }
-    chunk_body(x, apart, a, b, start, buf)
+    chunk_body(x, given, apart, a, b, start, buf)
 }
 
 /// [`chunk_body`] compiled for AVX2. Safety: call only where AVX2 is available.
@@ -249,13 +293,14 @@ fn chunk(
 #[target_feature(enable = "avx2")]
 unsafe fn chunk_avx2(
     x: &[DVec3],
+    given: Option<&[DVec3]>,
     apart: f64,
     a: usize,
     b: usize,
     start: Option<DVec3>,
     buf: &mut [f64],
 ) -> Option<ChunkEnds> {
-    chunk_body(x, apart, a, b, start, buf)
+    chunk_body(x, given, apart, a, b, start, buf)
 }
 
 /// The work of [`chunk`].
@@ -269,6 +314,7 @@ unsafe fn chunk_avx2(
 #[inline(always)]
 fn chunk_body(
     x: &[DVec3],
+    given: Option<&[DVec3]>,
     apart: f64,
     a: usize,
     b: usize,
@@ -324,59 +370,63 @@ fn chunk_body(
             return None;
         }
 
-        // interior tangents (i ≥ 2, i + 2 < n): `five_point_unit_open`, four at a time
-        let (i0, i1) = (s.max(2), te.min(n.saturating_sub(2)).max(s.max(2)));
-        let mut bad = 0u32;
-        {
-            let (p, c) = (refs(&w.p), refs(&w.c));
-            let (q, h) = (&w.q[..], &w.h[..]);
-            let mut t = muts(&mut w.t);
-            for g in (i0..i1).step_by(L) {
-                let k = g - lo;
-                let wt = centred_weights(
-                    F4::load(h, k - 2),
-                    F4::load(h, k - 1),
-                    F4::load(h, k),
-                    F4::load(h, k + 1),
-                );
-                let pc = V4::load(&p, k);
-                let v = (V4::load(&p, k - 2) - pc).scale(wt[0])
-                    + (V4::load(&p, k - 1) - pc).scale(wt[1])
-                    + (V4::load(&p, k + 1) - pc).scale(wt[2])
-                    + (V4::load(&p, k + 2) - pc).scale(wt[3]);
-                let l = v.dot(v).sqrt();
-                let u = v.scale(F4::splat(1.0) / l);
-                // the circle estimate (`circle_raw`): |c_i|² c_{i−1} + |c_{i−1}|² c_i
-                let cw = V4::load(&c, k - 1).scale(F4::load(q, k))
-                    + V4::load(&c, k).scale(F4::load(q, k - 1));
-                let d = u.dot(cw);
-                let good = l.mask(zero, |p, q| p > q)
-                    & u.finite_mask()
-                    & d.mask(zero, |p, q| p >= q)
-                    & (d * d).mask(guard2 * cw.dot(cw), |p, q| p >= q);
-                bad |= !good & live(g, i1);
-                u.store(&mut t, g - s);
+        if let Some(tg) = given {
+            given_tangents(tg, s, te, &mut w.t)?;
+        } else {
+            // interior tangents (i ≥ 2, i + 2 < n): `five_point_unit_open`, four at a time
+            let (i0, i1) = (s.max(2), te.min(n.saturating_sub(2)).max(s.max(2)));
+            let mut bad = 0u32;
+            {
+                let (p, c) = (refs(&w.p), refs(&w.c));
+                let (q, h) = (&w.q[..], &w.h[..]);
+                let mut t = muts(&mut w.t);
+                for g in (i0..i1).step_by(L) {
+                    let k = g - lo;
+                    let wt = centred_weights(
+                        F4::load(h, k - 2),
+                        F4::load(h, k - 1),
+                        F4::load(h, k),
+                        F4::load(h, k + 1),
+                    );
+                    let pc = V4::load(&p, k);
+                    let v = (V4::load(&p, k - 2) - pc).scale(wt[0])
+                        + (V4::load(&p, k - 1) - pc).scale(wt[1])
+                        + (V4::load(&p, k + 1) - pc).scale(wt[2])
+                        + (V4::load(&p, k + 2) - pc).scale(wt[3]);
+                    let l = v.dot(v).sqrt();
+                    let u = v.scale(F4::splat(1.0) / l);
+                    // the circle estimate (`circle_raw`): |c_i|² c_{i−1} + |c_{i−1}|² c_i
+                    let cw = V4::load(&c, k - 1).scale(F4::load(q, k))
+                        + V4::load(&c, k).scale(F4::load(q, k - 1));
+                    let d = u.dot(cw);
+                    let good = l.mask(zero, |p, q| p > q)
+                        & u.finite_mask()
+                        & d.mask(zero, |p, q| p >= q)
+                        & (d * d).mask(guard2 * cw.dot(cw), |p, q| p >= q);
+                    bad |= !good & live(g, i1);
+                    u.store(&mut t, g - s);
+                }
             }
-        }
-        if bad != 0 {
-            // a cusp, a non-finite value or an overshoot: the scalar function decides
-            let h = |j: usize| w.h[j - lo];
-            for i in i0..i1 {
+            if bad != 0 {
+                // a cusp, a non-finite value or an overshoot: the scalar function decides
+                let h = |j: usize| w.h[j - lo];
+                for i in i0..i1 {
+                    let t = five_point_unit_open(x, i, h)?;
+                    set(&mut w.t, i - s, t);
+                }
+            }
+            // the samples next to the ends: one-sided stencils
+            for i in (s..te).filter(|&i| i < i0 || i >= i1) {
+                let h = |j: usize| {
+                    if j >= lo && j < hi {
+                        w.h[j - lo]
+                    } else {
+                        (x[j + 1] - x[j]).length()
+                    }
+                };
                 let t = five_point_unit_open(x, i, h)?;
                 set(&mut w.t, i - s, t);
             }
-        }
-        // the samples next to the ends: one-sided stencils
-        for i in (s..te).filter(|&i| i < i0 || i >= i1) {
-            let h = |j: usize| {
-                if j >= lo && j < hi {
-                    w.h[j - lo]
-                } else {
-                    (x[j + 1] - x[j]).length()
-                }
-            };
-            let t = five_point_unit_open(x, i, h)?;
-            set(&mut w.t, i - s, t);
         }
 
         // the curve-only part of every step i → i + 1 inside the chunk, and its check
@@ -555,10 +605,18 @@ mod tests {
             .zip(&two)
             .map(|(p, q)| (p - q).abs())
             .fold(0.0, f64::max);
-        assert!(worst < 1e-12, "chunked scan differs from the serial one by {worst}");
+        assert!(
+            worst < 1e-12,
+            "chunked scan differs from the serial one by {worst}"
+        );
         for _ in 0..3 {
             let (_, again) = run(2, &req);
-            assert!(again.iter().zip(&two).all(|(p, q)| p.to_bits() == q.to_bits()));
+            assert!(
+                again
+                    .iter()
+                    .zip(&two)
+                    .all(|(p, q)| p.to_bits() == q.to_bits())
+            );
         }
         let cs = super::super::transport::SCAN_CHUNK;
         for row in [cs - 1, cs, 3 * cs + 7, n - 1] {
@@ -572,6 +630,77 @@ mod tests {
             let mut out = vec![0.0; 9 * n];
             let err = super::super::compute_into(&bad, &mut out).unwrap_err();
             assert!(err.to_string().contains("points"), "{err}");
+        }
+    }
+
+    /// Given tangents (of any length, slightly off the curve's): the fused path again gives
+    /// the bits of the general one, and declines what the general path refuses.
+    #[test]
+    fn fused_given_tangents_equal_general_bit_for_bit() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            for n in [5, 7, 1100, 70_001] {
+                let x = curve(n, 10);
+                let t: Vec<DVec3> = (0..n)
+                    .map(|i| {
+                        let d = x[(i + 1).min(n - 1)] - x[i.saturating_sub(1)];
+                        d * (1.0 + 0.3 * (i as f64).sin()) + DVec3::splat(1e-3 * (i as f64).cos())
+                    })
+                    .collect();
+                for end in [None, Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5)))] {
+                    let req = Request {
+                        points: Some(&x),
+                        tangents: Some(&t),
+                        end,
+                        ..Default::default()
+                    };
+                    let (a, b, fa, fb) = both(&req);
+                    assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
+                    assert!(
+                        a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
+                        "n {n}, end {end:?}"
+                    );
+                }
+                let mut out = vec![0.0; 9 * n];
+                for (row, bad) in [
+                    (n / 2, DVec3::ZERO),
+                    (n - 1, DVec3::new(f64::NAN, 0.0, 0.0)),
+                    (0, DVec3::new(f64::INFINITY, 1.0, 0.0)),
+                    (n / 3, -t[n / 3]),
+                ] {
+                    let mut u = t.clone();
+                    u[row] = bad;
+                    let req = Request {
+                        points: Some(&x),
+                        tangents: Some(&u),
+                        ..Default::default()
+                    };
+                    assert!(try_open_points(&req, &mut out).is_none(), "{bad} at {row}");
+                    assert!(compute_general(&req, &mut out).is_err(), "{bad} at {row}");
+                }
+            }
+        });
+    }
+
+    /// The run-time choice of the AVX2 build changes no bit (on a processor without AVX2
+    /// both calls run the same code).
+    #[test]
+    fn avx2_build_equals_baseline_build() {
+        let n = 3 * BLOCK + 77;
+        let x = curve(n, 300);
+        let t: Vec<DVec3> = (0..n)
+            .map(|i| x[(i + 1).min(n - 1)] - x[i.saturating_sub(1)])
+            .collect();
+        for given in [None, Some(&t[..])] {
+            let (mut p, mut q) = (vec![0.0; 9 * n], vec![0.0; 9 * n]);
+            let start = Some(any_perpendicular(t[0].normalize()));
+            let a = chunk(&x, given, 1e-300, 0, n, start, &mut p);
+            let b = chunk_body(&x, given, 1e-300, 0, n, start, &mut q);
+            assert!(a.is_some() && b.is_some());
+            assert!(p.iter().zip(&q).all(|(u, v)| u.to_bits() == v.to_bits()));
         }
     }
 
