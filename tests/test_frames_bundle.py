@@ -112,3 +112,20 @@ def test_gil_is_released():
         count += 1
     worker.join()
     assert count > 10_000
+
+
+def test_concurrent_calls_give_the_same_frames():
+    """Four Python threads computing long curves at once share the two-thread pool (the
+    chunks of each scan then wait on each other across busy threads): every result must be
+    the one of a call made alone, bit for bit, with and without an end condition."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    h = Helix(1.0, 0.3, turns=40)
+    curves = [h.sample(200_000 + 3_001 * k) * (1 + 0.1 * k) for k in range(4)]
+    jobs = [{"points": x} for x in curves] + [{"points": x, "end": [0.0, 0.0, 1.0]} for x in curves]
+    alone = [spinal.frames(**j) for j in jobs]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        for _ in range(2):
+            together = list(pool.map(lambda j: spinal.frames(**j), jobs))
+            for a, b in zip(alone, together):
+                assert np.array_equal(a, b)

@@ -3,11 +3,14 @@
 //!
 //! **Parallel prefix scan.** For double reflection and the rotation method a step is a
 //! rotation `Q_i` that depends only on the curve data, so `r_k = Q_{k−1} ⋯ Q_0 r_0`. The
-//! samples are cut into chunks; every chunk is transported in parallel from a provisional
-//! start vector; because each `Q` is a rotation taking `t_a` to `t_b`, the true vector at the
-//! end of a chunk is the provisional one turned about `t_b` by the same angle that separates
-//! the true and provisional start vectors. A serial pass over the chunk boundaries fixes
-//! these angles, and a second parallel pass writes the frames from the true start vectors.
+//! samples are cut into chunks of [`SCAN_CHUNK`] frames; every chunk after the first is
+//! transported from a provisional start vector; because each `Q` is a rotation taking `t_a`
+//! to `t_b`, the true vector at the end of a chunk is the provisional one turned about `t_b`
+//! by the angle that separates the true and provisional start vectors. The chunks go out in
+//! order to one worker per thread; a worker that has written chunk `c` takes the true end of
+//! chunk `c − 1` (its owner started earlier, so it is ready or nearly so), finds its chunk's
+//! angle and turns the rows it has just written while they are still in the cache. With an
+//! end condition the rows are turned once more, by the twist, after the last chunk.
 //!
 //! **Twist** (Wang et al. §6.3, Zheng §7.3). Among all frames `g = cos α r + sin α (t × r)`
 //! that meet a condition at the far end, `∫(κ² + α′²) ds` is least for `α` linear in arc
@@ -83,8 +86,8 @@ pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
     (ext.div_ceil(cs), cs)
 }
 
-/// What phase 1 of the scan reports per chunk: the start vector it used (the true one for
-/// chunk 0, a provisional one otherwise), its last vector, and the chunk's arc length.
+/// What the transport of a chunk reports: the start vector it used (the true one for chunk
+/// 0, a provisional one otherwise), its last vector, and the chunk's arc length.
 pub type ChunkEnds = (DVec3, DVec3, f64);
 
 /// A chunk once its predecessors are known: its [`ChunkEnds`] and the angle that turns its
