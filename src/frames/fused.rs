@@ -2,15 +2,15 @@
 //! reflection, from its points alone (with the five-point chord-length tangents) or from its
 //! points and given tangents.
 //!
-//! The general driver ([`super::compute_into`]) makes one pass per stage over the whole
+//! The general driver ([`super::compute_general`]) makes one pass per stage over the whole
 //! curve: finite check, chord lengths, tangents (a fresh `(n, 3)` buffer), alignment check,
 //! then the transport scan. On long curves these passes and the page faults of the fresh
 //! buffers cost more than the transport itself. Here every chunk of the parallel scan
 //! works through its samples in blocks of [`BLOCK`]: chord lengths and unit tangents of the
 //! block go into small buffers that stay in cache, the checks run on them, and the frames are
-//! written at once. The arithmetic is exactly that of the general path (the same functions
-//! on the same values, the same chunks), so the frames are bit-identical; a test compares
-//! the two.
+//! written at once. The arithmetic is that of the general path: the same formulas, written
+//! for four samples at a time ([`super::lanes`]) with the same IEEE operations in the same
+//! order, on the same chunks, so the frames are bit-identical; tests compare the two.
 //!
 //! Errors are never reported from here: where any check fails (a NaN, a repeated point, a
 //! cusp, a segment against its tangents, a bad `initial`/`end`) this returns `None` and the
@@ -359,9 +359,10 @@ fn chunk_body(
         }
         // repeated points: |b − a|_∞ ≥ h/√3, so a chord longer than `apart` cannot coincide
         // (the exact test of `validate::coincide` runs only on the rare short ones).
-        // Non-finite samples need no test of their own: sample i enters its own tangent's
-        // stencil (every term is a difference with x_i), so a NaN or inf there makes that
-        // tangent non-finite, and the block is refused below.
+        // Non-finite samples need no test of their own: ±inf anywhere already failed the
+        // bounding-box scale; a NaN at sample i enters its own tangent's stencil (every term
+        // is a difference with x_i), or, with given tangents, the chords next to it, so the
+        // tangent or the alignment check of those steps refuses the block below.
         let (j0, j1) = (s - lo, e.min(n - 1) - lo);
         if w.h[j0..j1]
             .iter()
@@ -682,6 +683,24 @@ mod tests {
                     assert!(try_open_points(&req, &mut out).is_none(), "{bad} at {row}");
                     assert!(compute_general(&req, &mut out).is_err(), "{bad} at {row}");
                 }
+                // a NaN point with good tangents: only the chords next to it see it
+                for row in [0, n / 2, n - 1] {
+                    let mut y = x.clone();
+                    y[row].y = f64::NAN;
+                    let req = Request {
+                        points: Some(&y),
+                        tangents: Some(&t),
+                        ..Default::default()
+                    };
+                    assert!(
+                        try_open_points(&req, &mut out).is_none(),
+                        "NaN point at {row}"
+                    );
+                    assert!(
+                        compute_general(&req, &mut out).is_err(),
+                        "NaN point at {row}"
+                    );
+                }
             }
         });
     }
@@ -703,6 +722,55 @@ mod tests {
             assert!(a.is_some() && b.is_some());
             assert!(p.iter().zip(&q).all(|(u, v)| u.to_bits() == v.to_bits()));
         }
+    }
+
+    /// A closed curve of exactly two chunks: its closing frame forms a third chunk with no
+    /// row to write. Two threads give the frames and closing angle of one thread, and the
+    /// frames meet across the seam.
+    #[test]
+    fn closed_curve_with_an_empty_last_chunk() {
+        use super::super::transport::SCAN_CHUNK;
+        let n = 2 * SCAN_CHUNK;
+        let x: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let u = std::f64::consts::TAU * i as f64 / n as f64;
+                let r = 2.0 + (3.0 * u).cos();
+                DVec3::new(r * (2.0 * u).cos(), r * (2.0 * u).sin(), (3.0 * u).sin())
+            })
+            .collect();
+        let req = Request {
+            points: Some(&x),
+            closed: true,
+            ..Default::default()
+        };
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut out = vec![0.0; 9 * n];
+            let angle = pool.install(|| super::super::compute_into(&req, &mut out));
+            (angle.expect("valid closed curve"), out)
+        };
+        let (a1, f1) = run(1);
+        let (a2, f2) = run(2);
+        assert!((a1 - a2).abs() < 1e-12, "closing angle {a1} vs {a2}");
+        let worst = f1
+            .iter()
+            .zip(&f2)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-12, "two threads differ by {worst}");
+        // across the closing segment the last frame, transported, meets the first one
+        // turned back by that segment's share of the closing twist: α·h/L
+        let t = |i: usize| DVec3::new(f2[9 * i + 2], f2[9 * i + 5], f2[9 * i + 8]);
+        let r = |i: usize| DVec3::new(f2[9 * i], f2[9 * i + 3], f2[9 * i + 6]);
+        let back = dr_step(x[0] - x[n - 1], t(n - 1), t(0), r(n - 1));
+        let length: f64 = (0..n).map(|i| (x[(i + 1) % n] - x[i]).length()).sum();
+        let share = a2 * (x[0] - x[n - 1]).length() / length;
+        let gap = signed_angle(back, r(0), t(0));
+        assert!(share.abs() > 1e-6, "the test needs a closing twist");
+        assert!((gap - share).abs() < 1e-9, "seam: {gap} against {share}");
     }
 
     #[test]

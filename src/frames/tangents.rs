@@ -297,45 +297,6 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
     Some(guard_overshoot(x, i, false, u))
 }
 
-/// [`five_point_unit_open`] at the `L` interior samples `i0 … i0 + L − 1` (each with
-/// `i ≥ 2`, `i + 2 < n`), stage by stage across the lanes: the divisions and square roots of
-/// different samples are independent, so the processor overlaps them (one sample alone
-/// waits on each in turn). `xs = x[i0 − 2 .. i0 + L + 2]`, `hs` the chord lengths
-/// `h(i0 − 2) … h(i0 + L)` and `qs` their squares (`c·c`, of which `h` is the square root).
-/// Bit for bit the values of [`five_point_unit_open`].
-#[inline(always)]
-pub fn five_point_unit_open_lanes<const L: usize>(
-    xs: &[DVec3],
-    hs: &[f64],
-    qs: &[f64],
-) -> [Option<DVec3>; L] {
-    let (xs, hs, qs) = (&xs[..L + 4], &hs[..L + 3], &qs[..L + 3]);
-    // the weights lane by lane: plain scalar loops the compiler turns into vector code
-    let mut w = [[0.0; 4]; L];
-    for (l, wl) in w.iter_mut().enumerate() {
-        *wl = centred_weights(hs[l], hs[l + 1], hs[l + 2], hs[l + 3]);
-    }
-    let mut v = [DVec3::ZERO; L];
-    for (l, vl) in v.iter_mut().enumerate() {
-        *vl = centred_sum(&xs[l..l + 5], w[l]);
-    }
-    let mut len = [0.0; L];
-    for l in 0..L {
-        len[l] = v[l].length();
-    }
-    let mut out = [None; L];
-    for l in 0..L {
-        let u = v[l] * (1.0 / len[l]);
-        if len[l] > 0.0 && u.is_finite() {
-            // the circle estimate at the same sample (`circle_raw`; `qs` holds the squared
-            // chords, `a.length_squared()` and `b.length_squared()` bit for bit)
-            let (a, b) = (xs[l + 2] - xs[l + 1], xs[l + 3] - xs[l + 2]);
-            out[l] = Some(guard_with(u, qs[l + 2] * a + qs[l + 1] * b));
-        }
-    }
-    out
-}
-
 /// Smallest accepted cosine between the five-point estimate and the circle (3-point)
 /// estimate; below it the quartic overshoots (a kink, or wildly uneven spacing) and the
 /// circle estimate is used.

@@ -9,8 +9,9 @@
 //! by the angle that separates the true and provisional start vectors. The chunks go out in
 //! order to one worker per thread; a worker that has written chunk `c` takes the true end of
 //! chunk `c − 1` (its owner started earlier, so it is ready or nearly so), finds its chunk's
-//! angle and turns the rows it has just written while they are still in the cache. With an
-//! end condition the rows are turned once more, by the twist, after the last chunk.
+//! angle and, without an end condition, turns the rows it has just written while they are
+//! still in the cache. With an end condition the rows are turned once, by the chunk angle
+//! plus the twist, in a parallel pass after the last chunk.
 //!
 //! **Twist** (Wang et al. §6.3, Zheng §7.3). Among all frames `g = cos α r + sin α (t × r)`
 //! that meet a condition at the far end, `∫(κ² + α′²) ds` is least for `α` linear in arc
@@ -45,8 +46,9 @@ pub enum Twist {
 /// A curve is split across threads only from `2·PAR_CHUNK` frames on.
 pub const PAR_CHUNK: usize = 1 << 15;
 
-/// Frames per chunk of the parallel scan: a chunk's rows (72 bytes each, 288 KiB) are still
-/// in the core's L2 cache when they are turned.
+/// Frames per chunk of the parallel scan. A chunk's rows (72 bytes each, 2.25 MiB) are still
+/// in the shared L3 cache when they are turned; chunks of 4096 frames, whose rows would stay
+/// in a core's L2 cache, were not faster in `benchmarks/bench_frames.py` on a fresh output.
 pub const SCAN_CHUNK: usize = 1 << 15;
 
 #[inline(always)]
@@ -153,10 +155,15 @@ where
     ///
     /// Chunks are handed out in order to one worker per thread. When chunk `c` is written,
     /// its worker waits for chunk `c − 1` to be resolved (its owner is running and a step
-    /// ahead, so the wait is short), takes the angle that turns the provisional start into
-    /// the true one, and turns the rows at once, while they are still in its cache: every
-    /// frame is written to memory once. The frames do not depend on the timing: chunk `c > 0`
-    /// always starts from its provisional vector.
+    /// ahead, so the wait is short) and takes the angle that turns the provisional start
+    /// into the true one. Without an end condition it turns the rows at once, while they are
+    /// still in the cache; with one (an `end` or a closed curve) all rows are turned once,
+    /// by the chunk angle plus the twist, in a parallel pass after the last chunk. The frames
+    /// do not depend on the timing: chunk `c > 0` always starts from its provisional vector.
+    ///
+    /// `work`, `boundary_step` and `tangent` must not use rayon themselves: a worker waiting
+    /// for the chunk before could then run a sibling worker on its own stack, which would
+    /// wait for it in turn.
     pub fn scan<W>(&self, work: W, out: &mut [f64]) -> Option<f64>
     where
         W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
