@@ -133,7 +133,15 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         if a > 0 && !aligned(x[a] - x[a - 1], tan(a - 1)?, tan(a)?) {
             return None;
         }
-        chunk(x, given, apart, a, (a + cs).min(n), start, buf)
+        let job = Job {
+            x,
+            given,
+            apart,
+            a,
+            b: (a + cs).min(n),
+            start,
+        };
+        chunk(job, buf)
     };
     // every tangent the scan asks for has passed its chunk's checks by then
     let tt = |i: usize| tan(i).unwrap_or(DVec3::ZERO);
@@ -263,6 +271,18 @@ fn live(g: usize, end: usize) -> u32 {
     }
 }
 
+/// One chunk's share of the scan: rows `a..b` of the curve `x` (with its `given` tangents,
+/// if any), transported from `start`; chords longer than `apart` cannot be repeated points.
+#[derive(Clone, Copy)]
+struct Job<'a> {
+    x: &'a [DVec3],
+    given: Option<&'a [DVec3]>,
+    apart: f64,
+    a: usize,
+    b: usize,
+    start: Option<DVec3>,
+}
+
 /// Rows `a..b` of the scan: transport from `start` (a provisional vector ⟂ `t_a` when
 /// `None`), writing the frames into `buf`; `None` if a check fails in the chunk.
 ///
@@ -272,36 +292,20 @@ fn live(g: usize, end: usize) -> u32 {
 /// paged-in buffer, best of 30): 46–51 → 39–40 ms on one thread, 27–35 → 24–26 ms on two.
 /// The operations are the same IEEE operations (Rust never fuses a multiply and an add on
 /// its own), so both versions give the same bits (a unit test compares them).
-fn chunk(
-    x: &[DVec3],
-    given: Option<&[DVec3]>,
-    apart: f64,
-    a: usize,
-    b: usize,
-    start: Option<DVec3>,
-    buf: &mut [f64],
-) -> Option<ChunkEnds> {
+fn chunk(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: `chunk_avx2` only needs the processor to support AVX2, checked just above.
-        return unsafe { chunk_avx2(x, given, apart, a, b, start, buf) };
+        return unsafe { chunk_avx2(job, buf) };
     }
-    chunk_body(x, given, apart, a, b, start, buf)
+    chunk_body(job, buf)
 }
 
 /// [`chunk_body`] compiled for AVX2. Safety: call only where AVX2 is available.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn chunk_avx2(
-    x: &[DVec3],
-    given: Option<&[DVec3]>,
-    apart: f64,
-    a: usize,
-    b: usize,
-    start: Option<DVec3>,
-    buf: &mut [f64],
-) -> Option<ChunkEnds> {
-    chunk_body(x, given, apart, a, b, start, buf)
+unsafe fn chunk_avx2(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
+    chunk_body(job, buf)
 }
 
 /// The work of [`chunk`].
@@ -313,15 +317,15 @@ unsafe fn chunk_avx2(
 /// functions that the general path calls, in the same order, so the frames are the same bit
 /// for bit.
 #[inline(always)]
-fn chunk_body(
-    x: &[DVec3],
-    given: Option<&[DVec3]>,
-    apart: f64,
-    a: usize,
-    b: usize,
-    start: Option<DVec3>,
-    buf: &mut [f64],
-) -> Option<ChunkEnds> {
+fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
+    let Job {
+        x,
+        given,
+        apart,
+        a,
+        b,
+        start,
+    } = job;
     let n = x.len();
     let mut w = Scratch::new();
     let mut rows = buf.chunks_exact_mut(9);
@@ -717,8 +721,15 @@ mod tests {
         for given in [None, Some(&t[..])] {
             let (mut p, mut q) = (vec![0.0; 9 * n], vec![0.0; 9 * n]);
             let start = Some(any_perpendicular(t[0].normalize()));
-            let a = chunk(&x, given, 1e-300, 0, n, start, &mut p);
-            let b = chunk_body(&x, given, 1e-300, 0, n, start, &mut q);
+            let job = Job {
+                x: &x,
+                given,
+                apart: 1e-300,
+                a: 0,
+                b: n,
+                start,
+            };
+            let (a, b) = (chunk(job, &mut p), chunk_body(job, &mut q));
             assert!(a.is_some() && b.is_some());
             assert!(p.iter().zip(&q).all(|(u, v)| u.to_bits() == v.to_bits()));
         }
