@@ -1,6 +1,6 @@
 //! The fused fast path of the most common calls: frames of one open curve by double
-//! reflection, from its points alone (with the five-point chord-length tangents) or from its
-//! points and given tangents.
+//! reflection or the rotation method, from its points alone (with the five-point
+//! chord-length tangents) or from its points and given tangents.
 //!
 //! The general driver ([`super::compute_general`]) makes one pass per stage over the whole
 //! curve: finite check, chord lengths, tangents (a fresh `(n, 3)` buffer), alignment check,
@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use super::double_reflection::dr_step;
 use super::geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 use super::lanes::{Arith, F4, L, V4};
+use super::rotation::rotation_step;
 use super::tangents::{OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open};
 use super::transport::{ChunkEnds, Finish, Twist, plan, write_frame};
 use super::validate::{COINCIDE_EPS, MIN_ALIGNMENT, coincide};
@@ -46,9 +47,9 @@ fn aligned_with(v: DVec3, vv: f64, ti: DVec3, tj: DVec3) -> bool {
     d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * vv
 }
 
-/// Frames of an open curve given by points, with or without tangents (double reflection;
-/// five-point tangents when none are given; `n ≥ 5`), or `None` when the request is of
-/// another kind or any check fails.
+/// Frames of an open curve given by points, with or without tangents (double reflection or
+/// the rotation method; five-point tangents when none are given; `n ≥ 5`), or `None` when
+/// the request is of another kind or any check fails.
 pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     let x = req.points?;
     let n = x.len();
@@ -56,7 +57,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     if given.is_some_and(|t| t.len() != n)
         || req.analytic.is_some()
         || req.closed
-        || req.method != Method::DoubleReflection
+        || !matches!(req.method, Method::DoubleReflection | Method::Rotation)
         || req.tangent_chords
         || (given.is_none() && req.tangent_rule != TangentRule::FivePoint)
         || n < 5
@@ -68,6 +69,15 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     let tan = |i: usize| match given {
         Some(t) => unit(t[i]),
         None => five_point_unit_open(x, i, h),
+    };
+    let rotation = req.method == Method::Rotation;
+    // the method's step i → i + 1 (`DoubleReflection::step`, `Rotation::step`)
+    let step = move |i: usize, ti: DVec3, tj: DVec3, r: DVec3| {
+        if rotation {
+            rotation_step(ti, tj, r)
+        } else {
+            dr_step(x[i + 1] - x[i], ti, tj, r)
+        }
     };
 
     // The default initial vector: the principal normal at the first sample where the curve
@@ -109,7 +119,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
                     let (mut r, mut ti) = (p, t0);
                     for i in 0..k {
                         let tj = tan(i + 1)?;
-                        r = dr_step(x[i + 1] - x[i], ti, tj, r);
+                        r = step(i, ti, tj, r);
                         ti = tj;
                     }
                     rotate_about(p, t0, signed_angle(r, nk, ti))
@@ -136,6 +146,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         let job = Job {
             x,
             given,
+            rotation,
             apart,
             a,
             b: (a + cs).min(n),
@@ -146,7 +157,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     // every tangent the scan asks for has passed its chunk's checks by then
     let tt = |i: usize| tan(i).unwrap_or(DVec3::ZERO);
     Finish {
-        boundary_step: |i: usize, r: DVec3| dr_step(x[i + 1] - x[i], tt(i), tt(i + 1), r),
+        boundary_step: |i: usize, r: DVec3| step(i, tt(i), tt(i + 1), r),
         tangent: tt,
         seg: |i: usize| h(i.min(n - 2)),
         n,
@@ -214,6 +225,10 @@ struct Scratch {
     a: [Vec<f64>; 3],
     v2: [Vec<f64>; 3],
     b: [Vec<f64>; 3],
+    /// The rotation method's step instead: axis `t_i × t_{i+1}` (in `a`), its cosine
+    /// `t_i·t_{i+1}` and `1 + cos` ([`rotation_step`]).
+    cos: Vec<f64>,
+    den: Vec<f64>,
     /// The transported reference vectors `r_s …` of the block.
     r: [Vec<f64>; 3],
 }
@@ -233,6 +248,8 @@ impl Scratch {
             a: v3(),
             v2: v3(),
             b: v3(),
+            cos: v(),
+            den: v(),
             r: v3(),
         }
     }
@@ -277,6 +294,8 @@ fn live(g: usize, end: usize) -> u32 {
 struct Job<'a> {
     x: &'a [DVec3],
     given: Option<&'a [DVec3]>,
+    /// The rotation method's step instead of double reflection's.
+    rotation: bool,
     apart: f64,
     a: usize,
     b: usize,
@@ -311,9 +330,10 @@ unsafe fn chunk_avx2(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
 /// The work of [`chunk`].
 ///
 /// Per block of samples the points are copied into coordinate arrays; one loop computes the
-/// chords, one the interior tangents, one the curve-only vectors of every step, each four
-/// samples at a time and free of dependencies between samples; only the transport loop
-/// carries `r` from sample to sample. Every value comes from the operations of the scalar
+/// chords, one the interior tangents, one the curve-only vectors of every step (of double
+/// reflection, or the axis and cosine of the rotation method), each four samples at a time
+/// and free of dependencies between samples; only the transport loop carries `r` from
+/// sample to sample. Every value comes from the operations of the scalar
 /// functions that the general path calls, in the same order, so the frames are the same bit
 /// for bit.
 #[inline(always)]
@@ -321,6 +341,7 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
     let Job {
         x,
         given,
+        rotation,
         apart,
         a,
         b,
@@ -450,6 +471,13 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
                 let d = v1.dot(ti + tj);
                 let ok = d.mask(zero, |p, q| p > q) & (d * d).mask(min2 * vv, |p, q| p > q);
                 misaligned |= !ok & live(m, steps);
+                if rotation {
+                    let c = ti.dot(tj);
+                    ti.cross(tj).store(&mut av, m);
+                    c.store(&mut w.cos, m);
+                    (F4::splat(1.0) + c).store(&mut w.den, m);
+                    continue;
+                }
                 let k1 = two / vv;
                 let tl = ti - v1.scale(k1 * v1.dot(ti));
                 let v2 = tj - tl;
@@ -464,13 +492,23 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
         }
 
         // the transport itself: the only loop that carries a value from sample to sample,
-        // kept to the arithmetic of the step (`dr_step_with`)
+        // kept to the arithmetic of the step (`dr_step_with`, `rotation_step`)
         let cnt = e - s;
         if s == a {
             r = start.unwrap_or_else(|| any_perpendicular(get(&refs(&w.t), 0)));
             s0 = r;
         }
-        {
+        if rotation {
+            let (ax, ay, az) = (&w.a[0][..steps], &w.a[1][..steps], &w.a[2][..steps]);
+            let (cos, den) = (&w.cos[..steps], &w.den[..steps]);
+            let [rx, ry, rz] = &mut w.r;
+            let (rx, ry, rz) = (&mut rx[..steps], &mut ry[..steps], &mut rz[..steps]);
+            for m in 0..steps {
+                (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
+                let a = DVec3::new(ax[m], ay[m], az[m]);
+                r = cos[m] * r + a.cross(r) + a * (a.dot(r) / den[m]);
+            }
+        } else {
             let k0 = s - lo;
             let (cx, cy, cz) = (
                 &w.c[0][k0..k0 + steps],
@@ -551,23 +589,38 @@ mod tests {
         pool.install(|| {
             for (n, straight) in [(5, 0), (6, 0), (1100, 0), (3000, 600), (70_001, 10)] {
                 let x = curve(n, straight);
-                for (initial, end) in [
-                    (None, None),
-                    (Some(Orientation::Vector(DVec3::new(0.0, 0.3, 1.0))), None),
-                    (None, Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5)))),
+                for (initial, end, method) in [
+                    (None, None, Method::DoubleReflection),
+                    (None, None, Method::Rotation),
+                    (
+                        Some(Orientation::Vector(DVec3::new(0.0, 0.3, 1.0))),
+                        None,
+                        Method::DoubleReflection,
+                    ),
+                    (
+                        None,
+                        Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5))),
+                        Method::DoubleReflection,
+                    ),
+                    (
+                        None,
+                        Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5))),
+                        Method::Rotation,
+                    ),
                 ] {
                     let req = Request {
                         points: Some(&x),
                         initial,
                         end,
                         turns: 1,
+                        method,
                         ..Default::default()
                     };
                     let (a, b, fa, fb) = both(&req);
                     assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
                     assert!(
                         a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
-                        "n {n}, initial {initial:?}, end {end:?}"
+                        "n {n}, initial {initial:?}, end {end:?}, {method:?}"
                     );
                 }
             }
@@ -656,19 +709,22 @@ mod tests {
                         d * (1.0 + 0.3 * (i as f64).sin()) + DVec3::splat(1e-3 * (i as f64).cos())
                     })
                     .collect();
-                for end in [None, Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5)))] {
-                    let req = Request {
-                        points: Some(&x),
-                        tangents: Some(&t),
-                        end,
-                        ..Default::default()
-                    };
-                    let (a, b, fa, fb) = both(&req);
-                    assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
-                    assert!(
-                        a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
-                        "n {n}, end {end:?}"
-                    );
+                for method in [Method::DoubleReflection, Method::Rotation] {
+                    for end in [None, Some(Orientation::Vector(DVec3::new(0.2, 1.0, 0.5)))] {
+                        let req = Request {
+                            points: Some(&x),
+                            tangents: Some(&t),
+                            end,
+                            method,
+                            ..Default::default()
+                        };
+                        let (a, b, fa, fb) = both(&req);
+                        assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
+                        assert!(
+                            a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
+                            "n {n}, end {end:?}, {method:?}"
+                        );
+                    }
                 }
                 let mut out = vec![0.0; 9 * n];
                 for (row, bad) in [
@@ -718,12 +774,13 @@ mod tests {
         let t: Vec<DVec3> = (0..n)
             .map(|i| x[(i + 1).min(n - 1)] - x[i.saturating_sub(1)])
             .collect();
-        for given in [None, Some(&t[..])] {
+        for (given, rotation) in [(None, false), (Some(&t[..]), false), (None, true)] {
             let (mut p, mut q) = (vec![0.0; 9 * n], vec![0.0; 9 * n]);
             let start = Some(any_perpendicular(t[0].normalize()));
             let job = Job {
                 x: &x,
                 given,
+                rotation,
                 apart: 1e-300,
                 a: 0,
                 b: n,

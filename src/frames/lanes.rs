@@ -141,6 +141,16 @@ impl V4 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
+    /// As `DVec3::cross`, term for term.
+    #[inline(always)]
+    pub fn cross(self, o: V4) -> V4 {
+        V4 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
     #[inline(always)]
     pub fn scale(self, k: F4) -> V4 {
         V4 {
