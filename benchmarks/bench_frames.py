@@ -8,6 +8,9 @@ double-reflection loop is timed at small n as the peer a user would otherwise wr
 
     python benchmarks/bench_frames.py            # up to 10^7 points
     python benchmarks/bench_frames.py --max 1e6  # quicker
+
+A second table times bundles of many short curves (``lengths=``), 10⁶ points in all (or
+``--max``).
 """
 
 from __future__ import annotations
@@ -97,6 +100,23 @@ def measure(sizes, repeat):
     return rows
 
 
+def bundles(total, repeat):
+    """A streamline bundle: ``total`` points as curves of 10, 100 and 1000 points (helix
+    pieces, each shifted), in one ``spinal.frames(points, lengths=...)`` call."""
+    rng = np.random.default_rng(1)
+    rows = []
+    for length in (10, 100, 1000):
+        m = max(1, total // length)
+        u = np.linspace(0, 4 * np.pi, length)
+        piece = np.c_[np.cos(u), np.sin(u), 0.1 * u]
+        pts = (piece[None] + rng.normal(size=(m, 1, 3))).reshape(-1, 3)
+        lengths = np.full(m, length)
+        s, fl = best_with_floor(lambda p=pts, c=lengths: spinal.frames(p, lengths=c),
+                                len(pts), repeat)
+        rows.append({"curves": m, "length": length, "s": s, "floor": fl})
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e7)
@@ -127,6 +147,14 @@ def main():
               f"{n / s / 1e6:.1f} | {s / r['floor']:.2f} | {s1 / s:.2f} |")
     dr = [r for r in rows if r["n"] == 10**6 and r["method"] == "double_reflection"
           and r["tangents"] == "estimated"]
+    total = int(min(a.max, 1e6))
+    print(f"\nBundles of {total:,} points (double reflection, tangents estimated, all cores):\n")
+    print("| curves × points | ms | ns per point | × write floor |")
+    print("|---|---|---|---|")
+    for r in bundles(total, a.repeat):
+        pts = r["curves"] * r["length"]
+        print(f"| {r['curves']:,} × {r['length']:,} | {1e3 * r['s']:.2f} | "
+              f"{1e9 * r['s'] / pts:.0f} | {r['s'] / r['floor']:.2f} |")
     if dr:
         print(f"\ndouble reflection, 1M points, tangents estimated: "
               f"{dr[0]['s'] / dr[0]['floor']:.2f}× the NumPy write floor (target ≤ 4×)")

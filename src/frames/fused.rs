@@ -180,7 +180,7 @@ fn unit(v: DVec3) -> Option<DVec3> {
 /// The given tangents `s … te − 1` made unit into `t` (four at a time), or `None` where one
 /// cannot be.
 #[inline(always)]
-fn given_tangents(tg: &[DVec3], s: usize, te: usize, t: &mut [Vec<f64>; 3]) -> Option<()> {
+fn given_tangents(tg: &[DVec3], s: usize, te: usize, t: &mut [&mut [f64]; 3]) -> Option<()> {
     let mut bad = 0u32;
     let mut i = s;
     while i + L <= te {
@@ -211,59 +211,70 @@ fn given_tangents(tg: &[DVec3], s: usize, te: usize, t: &mut [Vec<f64>; 3]) -> O
 /// four samples go through each operation together, see [`super::lanes`]). Each has room
 /// for a block, its stencil margins and the padding of the last group of lanes; the padded
 /// lanes compute garbage that nothing reads.
-struct Scratch {
+struct Scratch<'s> {
     /// Points `x_lo …`.
-    p: [Vec<f64>; 3],
+    p: [&'s mut [f64]; 3],
     /// Chords `c_j = x_{j+1} − x_j`, their squares `q_j = c_j·c_j` and lengths `h_j = √q_j`.
-    c: [Vec<f64>; 3],
-    q: Vec<f64>,
-    h: Vec<f64>,
+    c: [&'s mut [f64]; 3],
+    q: &'s mut [f64],
+    h: &'s mut [f64],
     /// Unit tangents `t_s …` of the block (and one past it).
-    t: [Vec<f64>; 3],
+    t: [&'s mut [f64]; 3],
     /// The curve-only vectors of the double-reflection step `i → i + 1`
     /// ([`super::double_reflection::dr_step_with`]): `r′ = r − (c_i·r) a_i − (v2_i·r) b_i`.
-    a: [Vec<f64>; 3],
-    v2: [Vec<f64>; 3],
-    b: [Vec<f64>; 3],
+    a: [&'s mut [f64]; 3],
+    v2: [&'s mut [f64]; 3],
+    b: [&'s mut [f64]; 3],
     /// The rotation method's step instead: axis `t_i × t_{i+1}` (in `a`), its cosine
     /// `t_i·t_{i+1}` and `1 + cos` ([`rotation_step`]).
-    cos: Vec<f64>,
-    den: Vec<f64>,
+    cos: &'s mut [f64],
+    den: &'s mut [f64],
     /// The transported reference vectors `r_s …` of the block.
-    r: [Vec<f64>; 3],
+    r: [&'s mut [f64]; 3],
 }
 
-const ROOM: usize = BLOCK + 16;
+/// Room beyond a block's samples: stencil margins (2 + 2, one tangent past the block) and
+/// the padding of the last group of lanes.
+const MARGIN: usize = 16;
 
-impl Scratch {
-    fn new() -> Self {
-        let v = || vec![0.0; ROOM];
-        let v3 = || [v(), v(), v()];
+impl<'s> Scratch<'s> {
+    /// The arrays for blocks of up to `block` samples (short curves of a bundle need little),
+    /// cut from one allocation `store`.
+    fn new(store: &'s mut Vec<f64>, block: usize) -> Self {
+        let room = block + MARGIN;
+        store.clear();
+        store.resize(25 * room, 0.0);
+        let mut rest: &'s mut [f64] = store;
+        let mut v = || {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(room);
+            rest = tail;
+            head
+        };
         Scratch {
-            p: v3(),
-            c: v3(),
+            p: [v(), v(), v()],
+            c: [v(), v(), v()],
             q: v(),
             h: v(),
-            t: v3(),
-            a: v3(),
-            v2: v3(),
-            b: v3(),
+            t: [v(), v(), v()],
+            a: [v(), v(), v()],
+            v2: [v(), v(), v()],
+            b: [v(), v(), v()],
             cos: v(),
             den: v(),
-            r: v3(),
+            r: [v(), v(), v()],
         }
     }
 }
 
 #[inline(always)]
-fn refs(v: &[Vec<f64>; 3]) -> [&[f64]; 3] {
-    [&v[0][..], &v[1][..], &v[2][..]]
+fn refs<'a>(v: &'a [&mut [f64]; 3]) -> [&'a [f64]; 3] {
+    [&*v[0], &*v[1], &*v[2]]
 }
 
 #[inline(always)]
-fn muts(v: &mut [Vec<f64>; 3]) -> [&mut [f64]; 3] {
+fn muts<'a>(v: &'a mut [&mut [f64]; 3]) -> [&'a mut [f64]; 3] {
     let [x, y, z] = v;
-    [&mut x[..], &mut y[..], &mut z[..]]
+    [&mut **x, &mut **y, &mut **z]
 }
 
 #[inline(always)]
@@ -272,7 +283,7 @@ fn get(v: &[&[f64]; 3], k: usize) -> DVec3 {
 }
 
 #[inline(always)]
-fn set(v: &mut [Vec<f64>; 3], k: usize, w: DVec3) {
+fn set(v: &mut [&mut [f64]; 3], k: usize, w: DVec3) {
     v[0][k] = w.x;
     v[1][k] = w.y;
     v[2][k] = w.z;
@@ -348,7 +359,8 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
         start,
     } = job;
     let n = x.len();
-    let mut w = Scratch::new();
+    let mut store = Vec::new();
+    let mut w = Scratch::new(&mut store, BLOCK.min(b - a));
     let mut rows = buf.chunks_exact_mut(9);
     let (mut s0, mut r, mut len) = (DVec3::ZERO, DVec3::ZERO, 0.0);
     let (min2, guard2) = (
@@ -378,8 +390,8 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
                 let ck = V4::load(&p, k + 1) - V4::load(&p, k);
                 let qk = ck.dot(ck);
                 ck.store(&mut c, k);
-                qk.store(&mut w.q, k);
-                qk.sqrt().store(&mut w.h, k);
+                qk.store(w.q, k);
+                qk.sqrt().store(w.h, k);
             }
         }
         // repeated points: |b − a|_∞ ≥ h/√3, so a chord longer than `apart` cannot coincide
@@ -474,8 +486,8 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
                 if rotation {
                     let c = ti.dot(tj);
                     ti.cross(tj).store(&mut av, m);
-                    c.store(&mut w.cos, m);
-                    (F4::splat(1.0) + c).store(&mut w.den, m);
+                    c.store(w.cos, m);
+                    (F4::splat(1.0) + c).store(w.den, m);
                     continue;
                 }
                 let k1 = two / vv;
