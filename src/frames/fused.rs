@@ -24,7 +24,7 @@ use super::geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signe
 use super::lanes::{Arith, F4, L, V4};
 use super::rotation::rotation_step;
 use super::tangents::{OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open};
-use super::transport::{ChunkEnds, Finish, Twist, plan, write_frame};
+use super::transport::{ChunkEnds, Scan, Twist, plan, write_frame};
 use super::validate::{COINCIDE_EPS, MIN_ALIGNMENT, coincide};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};
 
@@ -156,7 +156,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     };
     // every tangent the scan asks for has passed its chunk's checks by then
     let tt = |i: usize| tan(i).unwrap_or(DVec3::ZERO);
-    Finish {
+    Scan {
         boundary_step: |i: usize, r: DVec3| step(i, tt(i), tt(i + 1), r),
         tangent: tt,
         seg: |i: usize| h(i.min(n - 2)),
@@ -572,6 +572,11 @@ mod tests {
         (a, b, fa, fb)
     }
 
+    /// The same values, bit for bit.
+    fn same_bits(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits())
+    }
+
     /// A curve with uneven spacing, a straight start (the default initial vector is found
     /// past the serial search) and a bend.
     fn curve(n: usize, straight: usize) -> Vec<DVec3> {
@@ -631,7 +636,7 @@ mod tests {
                     let (a, b, fa, fb) = both(&req);
                     assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
                     assert!(
-                        a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
+                        same_bits(&a, &b),
                         "n {n}, initial {initial:?}, end {end:?}, {method:?}"
                     );
                 }
@@ -682,12 +687,7 @@ mod tests {
         );
         for _ in 0..3 {
             let (_, again) = run(2, &req);
-            assert!(
-                again
-                    .iter()
-                    .zip(&two)
-                    .all(|(p, q)| p.to_bits() == q.to_bits())
-            );
+            assert!(same_bits(&again, &two));
         }
         let cs = super::super::transport::SCAN_CHUNK;
         for row in [cs - 1, cs, 3 * cs + 7, n - 1] {
@@ -732,10 +732,7 @@ mod tests {
                         };
                         let (a, b, fa, fb) = both(&req);
                         assert_eq!(fa.to_bits(), fb.to_bits(), "n {n}");
-                        assert!(
-                            a.iter().zip(&b).all(|(p, q)| p.to_bits() == q.to_bits()),
-                            "n {n}, end {end:?}, {method:?}"
-                        );
+                        assert!(same_bits(&a, &b), "n {n}, end {end:?}, {method:?}");
                     }
                 }
                 let mut out = vec![0.0; 9 * n];
@@ -800,7 +797,7 @@ mod tests {
             };
             let (a, b) = (chunk(job, &mut p), chunk_body(job, &mut q));
             assert!(a.is_some() && b.is_some());
-            assert!(p.iter().zip(&q).all(|(u, v)| u.to_bits() == v.to_bits()));
+            assert!(same_bits(&p, &q));
         }
     }
 

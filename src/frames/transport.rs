@@ -124,7 +124,7 @@ fn wait(cell: &OnceLock<Resolved>) -> Resolved {
 }
 
 /// The curve data the scan needs besides the transport of a chunk itself.
-pub struct Finish<B, T, L> {
+pub struct Scan<B, T, L> {
     /// Transport across the chunk boundary `i → i + 1` (the step of the method).
     pub boundary_step: B,
     /// Unit tangent at extended index `i` (`i = n` is sample 0 of a closed curve).
@@ -139,7 +139,7 @@ pub struct Finish<B, T, L> {
     pub ext: usize,
 }
 
-impl<B, T, L> Finish<B, T, L>
+impl<B, T, L> Scan<B, T, L>
 where
     B: Fn(usize, DVec3) -> DVec3 + Sync,
     T: Fn(usize) -> DVec3 + Sync,
@@ -333,7 +333,7 @@ pub fn transport_into<S: Step>(
         }
         Some((s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>()))
     };
-    let angle = Finish {
+    let angle = Scan {
         boundary_step: |i: usize, r: DVec3| step.step(i, r),
         tangent: tt,
         seg: |i: usize| seg[i.min(seg.len() - 1)],
