@@ -20,6 +20,7 @@ import numpy as np
 from . import _core
 from ._advect import advect
 from ._mesh import Mesh
+from ._mesh import signed_volume as _volume
 from ._validate import as_float_array, as_int
 from .fields import Field, _positive, _real
 
@@ -75,12 +76,6 @@ class DeformReport:
             s += (f"; integration {self.integration_error:+.2e}, "
                   f"mesh {self.mesh_error:+.2e}")
         return s
-
-
-def _volume(V: np.ndarray, F: np.ndarray) -> float:
-    c = V - V.mean(axis=0)  # centred: no cancellation far from the origin
-    a, b, d = c[F[:, 0]], c[F[:, 1]], c[F[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, d)).sum() / 6.0)
 
 
 def _edges(F: np.ndarray):

@@ -20,6 +20,15 @@ class FoldOverWarning(UserWarning):
         self.indices = indices
 
 
+def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
+    """Signed volume ``Σ (a · (b × c)) / 6`` of the triangles ``F`` over vertices ``V``
+    (divergence theorem; positive for a closed, outward-facing mesh), summed about the mean
+    vertex so that a small mesh far from the origin keeps its digits."""
+    v = V - V.mean(axis=0) if len(V) else V
+    a, b, c = (v[F[:, k]] for k in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
 class Mesh:
     """A triangle mesh: what :func:`spinal.sweep` and :func:`spinal.tube` return.
 
@@ -56,9 +65,7 @@ class Mesh:
         """Signed enclosed volume, ``Σ (a · (b × c)) / 6`` over the faces (divergence
         theorem); positive for a closed, outward-facing mesh. Summed about the mean vertex,
         so a small mesh far from the origin keeps its digits."""
-        v = self.vertices - self.vertices.mean(axis=0) if len(self.vertices) else self.vertices
-        a, b, c = (v[self.faces[:, k]] for k in range(3))
-        return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+        return signed_volume(self.vertices, self.faces)
 
     @property
     def area(self) -> float:

@@ -652,29 +652,34 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
 
 
 def _closed_mesh(mesh):
-    from ._deform import _mesh_arrays
+    from ._deform import _edges, _mesh_arrays
 
     V, F = _mesh_arrays(mesh)
     if not len(F):
         raise ValueError("mesh: has no faces")
-    directed = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    und = np.sort(directed, axis=1)
-    _, inv, cnt = np.unique(und, axis=0, return_inverse=True, return_counts=True)
+    # every undirected edge, in the order of the slots 0→1 of all faces, then 1→2, then 2→0
+    uniq, slot = _edges(F)
+    ids = slot.T.ravel()
+    cnt = np.bincount(ids, minlength=len(uniq))[ids]
     if (cnt != 2).any():
-        e = und[np.argmax(cnt[inv.ravel()] != 2)]
-        raise ValueError(f"mesh: not watertight: edge ({e[0]}, {e[1]}) belongs to "
-                         f"{cnt[inv.ravel()][np.argmax(cnt[inv.ravel()] != 2)]} faces "
-                         f"(a closed tool needs exactly 2)")
+        k = np.argmax(cnt != 2)
+        e = uniq[ids[k]]
+        raise ValueError(f"mesh: not watertight: edge ({e[0]}, {e[1]}) belongs to {cnt[k]} "
+                         f"faces (a closed tool needs exactly 2)")
+    directed = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
     _, dcnt = np.unique(directed, axis=0, return_counts=True)
     if (dcnt != 1).any():
         raise ValueError("mesh: faces are not consistently oriented")
-    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    # about the mean vertex, as `Mesh.volume`, so that a small tool far away keeps its digits
+    mean = V.mean(axis=0)
+    c0 = V - mean
+    a, b, c = c0[F[:, 0]], c0[F[:, 1]], c0[F[:, 2]]
     six = np.einsum("ij,ij->i", a, np.cross(b, c))
     vol = six.sum() / 6
     if not vol > 0:
         raise ValueError(f"mesh: encloses a non-positive volume ({vol:.4g}); faces must be "
                          f"oriented outwards")
-    centroid = (six[:, None] * (a + b + c)).sum(axis=0) / (24 * vol)
+    centroid = mean + (six[:, None] * (a + b + c)).sum(axis=0) / (24 * vol)
     return V, F, centroid
 
 
