@@ -234,6 +234,14 @@ fn slice_of<'a, T: numpy::Element>(
         .map_err(|_| PyValueError::new_err(format!("{arg}: array must be C-contiguous")))
 }
 
+/// The `(F, 3)` index rows of `faces`.
+fn triangles<'a>(faces: &'a PyReadonlyArray2<'_, i64>) -> PyResult<&'a [[i64; 3]]> {
+    if faces.shape()[1] != 3 {
+        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
+    }
+    Ok(bytemuck::cast_slice(slice_of("faces", faces)?))
+}
+
 type MeshArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<i64>>,
@@ -483,10 +491,7 @@ fn walk_mesh<'py>(
     moves: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<WalkArrays<'py>> {
     let v = vec3s("vertices", &vertices)?;
-    if faces.shape()[1] != 3 {
-        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
-    }
-    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let f = triangles(&faces)?;
     let p = slice_of("point", &point)?;
     if p.len() != 3 {
         return Err(PyValueError::new_err("point: expected 3 values"));
@@ -561,10 +566,7 @@ fn walk_mesh_many<'py>(
     k: usize,
 ) -> PyResult<WalksArrays<'py>> {
     let v = vec3s("vertices", &vertices)?;
-    if faces.shape()[1] != 3 {
-        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
-    }
-    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let f = triangles(&faces)?;
     let fc = slice_of("face", &face)?;
     let p = vec3s("points", &points)?;
     let d = directions
@@ -847,10 +849,7 @@ fn stamp<'py>(
     iterations: usize,
 ) -> PyResult<StampArrays<'py>> {
     let x = vec3s("vertices", &vertices)?;
-    if faces.shape()[1] != 3 {
-        return Err(PyValueError::new_err("faces: expected shape (F, 3)"));
-    }
-    let f: &[[i64; 3]] = bytemuck::cast_slice(slice_of("faces", &faces)?);
+    let f = triangles(&faces)?;
     let f: Vec<[usize; 3]> = f
         .iter()
         .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
