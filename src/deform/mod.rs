@@ -367,13 +367,26 @@ impl Field {
         while i * ROW < rows.len() {
             let r = &rows[i * ROW..(i + 1) * ROW];
             let at = |e: InputError| e.context(&format!("element {i}"));
-            if r[0] == 7.0 {
-                if let Some(j) = r.iter().position(|x| !x.is_finite()) {
-                    return Err(at(InputError::new(
+            // a header row and the `k` data rows after it (paths, strips, grids), all finite
+            let header = || match r.iter().position(|x| !x.is_finite()) {
+                Some(j) => Err(at(InputError::new(
+                    "field",
+                    format!("element parameter {j} is not finite"),
+                ))),
+                None => Ok(()),
+            };
+            let body = |k: usize, what: &str| {
+                let body = &rows[(i + 1) * ROW..(i + 1 + k) * ROW];
+                match body.iter().position(|x| !x.is_finite()) {
+                    Some(j) => Err(at(InputError::new(
                         "field",
-                        format!("element parameter {j} is not finite"),
-                    )));
+                        format!("{what} {} is not finite", j / ROW),
+                    ))),
+                    None => Ok(body),
                 }
+            };
+            if r[0] == 7.0 {
+                header()?;
                 let n = r[11];
                 let avail = (rows.len() / ROW - i - 1) as f64;
                 if !(n >= 2.0 && n <= avail && n.fract() == 0.0) {
@@ -383,22 +396,10 @@ impl Field {
                     )));
                 }
                 let n = n as usize;
-                let body = &rows[(i + 1) * ROW..(i + 1 + n) * ROW];
-                if let Some(j) = body.iter().position(|x| !x.is_finite()) {
-                    return Err(at(InputError::new(
-                        "field",
-                        format!("path sample {} is not finite", j / ROW),
-                    )));
-                }
-                elements.push(Element::parse_path(r, body).map_err(at)?);
+                elements.push(Element::parse_path(r, body(n, "path sample")?).map_err(at)?);
                 i += n + 1;
             } else if r[0] == 9.0 || r[0] == 11.0 {
-                if let Some(j) = r.iter().position(|x| !x.is_finite()) {
-                    return Err(at(InputError::new(
-                        "field",
-                        format!("element parameter {j} is not finite"),
-                    )));
-                }
+                header()?;
                 let avail = rows.len() / ROW - i - 1;
                 let count = |x: f64, what: &str| {
                     if (1.0..=1e6).contains(&x) && x.fract() == 0.0 {
@@ -433,13 +434,7 @@ impl Field {
                         format!("header announces {k} data rows, {avail} follow"),
                     )));
                 }
-                let body = &rows[(i + 1) * ROW..(i + 1 + k) * ROW];
-                if let Some(j) = body.iter().position(|x| !x.is_finite()) {
-                    return Err(at(InputError::new(
-                        "field",
-                        format!("data row {} is not finite", j / ROW),
-                    )));
-                }
+                let body = body(k, "data row")?;
                 elements.push(
                     match grid_n {
                         None => Element::parse_strip(r, body),
