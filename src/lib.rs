@@ -2,12 +2,18 @@
 //!
 //! The crate is split in two layers:
 //!
-//! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`quaternion`], [`ph`],
-//!   [`error`]); they work on `glam::DVec3` slices and flat `f64` output buffers and return
-//!   [`error::InputError`] for bad input, never panicking on user data;
-//! * one thin binding module (`python`, compiled into the `spinal._core` extension) that
-//!   converts NumPy arrays, releases the GIL around the heavy calls and maps errors to
-//!   Python exceptions.
+//! * plain Rust modules that know nothing of Python: [`frames`] (moving frames of sampled
+//!   and analytic curves), [`sweep`] (sweeps and tubes), [`quaternion`] (quaternions of
+//!   frames, walkers on triangle meshes), [`ph`] (Pythagorean-hodograph cubics), [`deform`]
+//!   (volume-preserving deformation by divergence-free fields, advection, the contact
+//!   stamper), [`flesh`] (spine-driven deformation with local volume preservation, on a
+//!   spine or a spine surface) and [`error`]. They work on `glam::DVec3` slices and
+//!   flat `f64` output buffers and return [`error::InputError`] for bad input, never
+//!   panicking on user data;
+//! * the binding folder `src/python/` (module `python`, compiled into the `spinal._core`
+//!   extension): one thin file per concept that converts NumPy arrays and option strings,
+//!   releases the GIL around the heavy calls and maps errors to Python exceptions. It holds
+//!   no algorithms, and only it names the Python crates (a test checks the rest of `src/`).
 //!
 //! Frame layout everywhere: frame `i` occupies `out[9 i .. 9 i + 9]` in row-major order of
 //! the 3×3 matrix whose **columns** are `(r, s, t)`, i.e. `[r.x, s.x, t.x, r.y, s.y, t.y,

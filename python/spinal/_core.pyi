@@ -100,7 +100,9 @@ def walk_mesh(
     npt.NDArray[np.int64],
 ]: ...
 
-# PH cubics (spinal.ph)
+# PH cubics (spinal.ph). ph_hermite returns (candidates (m, 24): up to two cubics of 4
+# control points per row, counts (m,), reason codes (m,)); ph_frame_setup returns one row of
+# 34 floats per segment (src/ph/frame.rs, `Segment::to_row`).
 def ph_hermite(
     p0: npt.NDArray[np.float64],
     t0: npt.NDArray[np.float64],

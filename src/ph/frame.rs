@@ -424,6 +424,37 @@ pub fn frame_at(c: &Cubic, seg: &Segment, v: f64, mode: Mode) -> (DMat3, f64) {
     }
 }
 
+/// Frames (row-major, columns `r, s, t`, as NumPy sees an `(n, 3, 3)` array) and their
+/// angles from the principal normal at the global parameters `s` of a G¹ PH spline (see
+/// [`super::locate`]), in parallel: [`setup`] once, then [`frame_at`] per parameter.
+/// `frames` and `angles` hold one entry per parameter.
+pub fn frames_at(
+    cubics: &[Cubic],
+    s: &[f64],
+    start: Start,
+    phi: Option<f64>,
+    mode: Mode,
+    frames: &mut [[f64; 9]],
+    angles: &mut [f64],
+) -> Result<()> {
+    use rayon::prelude::*;
+    debug_assert!(frames.len() == s.len() && angles.len() == s.len());
+    super::check_params(cubics.len(), s)?;
+    let segs = setup(cubics, start, phi)?;
+    frames
+        .par_iter_mut()
+        .zip(angles.par_iter_mut())
+        .zip(s.par_iter())
+        .for_each(|((f, a), &x)| {
+            let (i, v) = super::locate(cubics.len(), x);
+            let (m, om) = frame_at(&cubics[i], &segs[i], v, mode);
+            // glam is column-major; the NumPy frame is row-major with columns r, s, t
+            *f = m.transpose().to_cols_array();
+            *a = om;
+        });
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -447,5 +478,35 @@ mod tests {
             seg.fit.imin
         );
         assert!((seg.fit.lambda - -0.1625470092).abs() < 1e-6);
+    }
+
+    #[test]
+    fn frames_at_agrees_with_frame_at_per_segment() {
+        let c = [
+            r1(),
+            Cubic::new([
+                r1().b[3],
+                r1().b[3] + DVec3::Z,
+                r1().b[3] + 2.0 * DVec3::Z,
+                r1().b[3] + 3.0 * DVec3::Z,
+            ]),
+        ];
+        let s = [0.0, 0.3, 1.0, 1.7, 2.0];
+        let start = Start::Angle(0.4);
+        let segs = setup(&c, start, None).unwrap();
+        for mode in [Mode::Frenet, Mode::Exact, Mode::Rational] {
+            let mut f = vec![[0.0; 9]; s.len()];
+            let mut a = vec![0.0; s.len()];
+            frames_at(&c, &s, start, None, mode, &mut f, &mut a).unwrap();
+            for (k, &x) in s.iter().enumerate() {
+                let (i, v) = crate::ph::locate(c.len(), x);
+                let (m, om) = frame_at(&c[i], &segs[i], v, mode);
+                assert_eq!(f[k], m.transpose().to_cols_array());
+                assert_eq!(a[k], om);
+            }
+        }
+        let mut f = vec![[0.0; 9]; 1];
+        let e = frames_at(&c, &[-0.5], start, None, Mode::Exact, &mut f, &mut [0.0]).unwrap_err();
+        assert_eq!(e.arg, "s");
     }
 }

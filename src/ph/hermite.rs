@@ -33,6 +33,7 @@
 use glam::DVec3;
 
 use super::Cubic;
+use crate::error::{InputError, Result};
 use crate::frames::geometry::any_perpendicular;
 
 /// `|t₀ − t₁|` below which tangents count as parallel (angle < 1e-8 rad).
@@ -190,6 +191,84 @@ pub fn hermite(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Solutions {
     }
 }
 
+/// Floats per row of [`Rows::candidates`]: two cubics of four control points.
+pub const CANDIDATE_ROW: usize = 24;
+
+/// [`hermite`] on many data sets (one per row), packed for NumPy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rows {
+    /// `m × 24` floats: row `i` holds the control points of its 0, 1 or 2 cubics
+    /// (shortest polygon first), zeros after them.
+    pub candidates: Vec<f64>,
+    /// Number of cubics of each row.
+    pub counts: Vec<i64>,
+    /// [`NoSolution::code`] of each row without a cubic, 0 elsewhere.
+    pub codes: Vec<i64>,
+}
+
+/// G¹ Hermite interpolation of rows `(p0[i], t0[i], p1[i], t1[i])`; the tangents need not be
+/// unit (they are normalised). Every row is checked (finite, non-zero tangents, `p₀ ≠ p₁`);
+/// with `all = false` the first row without a solution is an error, otherwise its reason
+/// is recorded in [`Rows::codes`]. With `batch` the messages name the row.
+pub fn hermite_rows(
+    p0: &[DVec3],
+    t0: &[DVec3],
+    p1: &[DVec3],
+    t1: &[DVec3],
+    all: bool,
+    batch: bool,
+) -> Result<Rows> {
+    let m = p0.len();
+    if t0.len() != m || p1.len() != m || t1.len() != m {
+        return Err(InputError::new(
+            "p0, t0, p1, t1",
+            "must have the same number of rows",
+        ));
+    }
+    let mut out = Rows {
+        candidates: vec![0.0; m * CANDIDATE_ROW],
+        counts: vec![0; m],
+        codes: vec![0; m],
+    };
+    for i in 0..m {
+        let at = |arg: &'static str, msg: &str| {
+            let msg = if batch {
+                format!("row {i}: {msg}")
+            } else {
+                msg.to_string()
+            };
+            InputError::new(arg, msg)
+        };
+        for (arg, v) in [("p0", p0[i]), ("t0", t0[i]), ("p1", p1[i]), ("t1", t1[i])] {
+            if !v.is_finite() {
+                return Err(at(arg, "contains non-finite values"));
+            }
+        }
+        for (arg, v) in [("t0", t0[i]), ("t1", t1[i])] {
+            if !(v.length() > 0.0) {
+                return Err(at(arg, "zero tangent vector"));
+            }
+        }
+        if p0[i] == p1[i] {
+            return Err(at("p1", "equals p0 (no segment to interpolate)"));
+        }
+        let sol = hermite(p0[i], t0[i].normalize(), p1[i], t1[i].normalize());
+        if let Some(r) = sol.reason {
+            if !all {
+                return Err(at("p0, t0, p1, t1", r.message()));
+            }
+            out.codes[i] = r.code();
+        }
+        out.counts[i] = sol.cubics.len() as i64;
+        for (j, c) in sol.cubics.iter().enumerate() {
+            let o = i * CANDIDATE_ROW + j * 12;
+            let f: &[f64] = bytemuck::cast_slice(&c.b);
+            out.candidates[o..o + 12].copy_from_slice(f);
+        }
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -272,5 +351,63 @@ mod tests {
     fn parallel_not_straight_has_no_solution() {
         let sol = hermite(DVec3::ZERO, DVec3::Y, DVec3::X, DVec3::Y);
         assert_eq!(sol.reason, Some(NoSolution::Parallel));
+    }
+
+    #[test]
+    fn hermite_rows_packs_each_row_and_names_bad_rows() {
+        let s = 1.25f64.sqrt();
+        let (p0, t0) = (DVec3::X, DVec3::new(0.0, 1.0, 0.5) / s);
+        let (p1, t1) = (
+            DVec3::new(0.0, 1.0, std::f64::consts::FRAC_PI_4),
+            DVec3::new(-1.0, 0.0, 0.5) / s,
+        );
+        // row 0: the helix quarter turn with unnormalised tangents; row 1: parallel, no cubic
+        let rows = hermite_rows(
+            &[p0, DVec3::ZERO],
+            &[2.0 * t0, DVec3::Y],
+            &[p1, DVec3::X],
+            &[3.0 * t1, DVec3::Y],
+            true,
+            true,
+        )
+        .unwrap();
+        let want = hermite(p0, (2.0 * t0).normalize(), p1, (3.0 * t1).normalize());
+        assert_eq!(rows.counts, vec![2, 0]);
+        assert_eq!(rows.codes, vec![0, NoSolution::Parallel.code()]);
+        assert_eq!(rows.candidates.len(), 2 * CANDIDATE_ROW);
+        for (j, c) in want.cubics.iter().enumerate() {
+            for (k, b) in c.b.iter().enumerate() {
+                let o = j * 12 + 3 * k;
+                assert_eq!(rows.candidates[o..o + 3], b.to_array());
+            }
+        }
+        assert!(rows.candidates[CANDIDATE_ROW..].iter().all(|&x| x == 0.0));
+        // all = false: the row without a cubic is an error naming it
+        let e = hermite_rows(
+            &[DVec3::ZERO],
+            &[DVec3::Y],
+            &[DVec3::X],
+            &[DVec3::Y],
+            false,
+            true,
+        )
+        .unwrap_err();
+        assert_eq!(e.arg, "p0, t0, p1, t1");
+        assert!(e.msg.starts_with("row 0: no PH cubic"), "{}", e.msg);
+        let e = hermite_rows(
+            &[DVec3::X],
+            &[DVec3::ZERO],
+            &[DVec3::Y],
+            &[DVec3::Y],
+            true,
+            false,
+        )
+        .unwrap_err();
+        assert_eq!((e.arg, e.msg.as_str()), ("t0", "zero tangent vector"));
+        let e = hermite_rows(&[DVec3::X], &[], &[DVec3::Y], &[DVec3::Y], true, false).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p0, t0, p1, t1: must have the same number of rows"
+        );
     }
 }

@@ -20,6 +20,9 @@ pub mod frame;
 pub mod hermite;
 
 use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::error::{InputError, Result};
 
 /// A quaternion `(w, x, y, z)` (Hamilton product).
 pub type Quat = [f64; 4];
@@ -334,6 +337,76 @@ pub fn erf(a0: Quat, a1: Quat, v: f64) -> Option<(DVec3, DVec3, DVec3)> {
     Some((t / n2, e2 / n2, e3 / n2))
 }
 
+/// Segment index and local parameter `v` of the global spline parameter `s = segment + v`
+/// on `m ≥ 1` segments (`s = m` is the end of the last segment, `v = 1`).
+pub fn locate(m: usize, s: f64) -> (usize, f64) {
+    let seg = (s.floor().max(0.0) as usize).min(m - 1);
+    (seg, s - seg as f64)
+}
+
+/// Check global parameters `s` of a spline of `m` segments: at least one segment, every
+/// value finite and within `[0, m]`.
+pub fn check_params(m: usize, s: &[f64]) -> Result<()> {
+    if m == 0 {
+        return Err(InputError::new("control_points", "no segments"));
+    }
+    if s.iter()
+        .any(|x| !(x.is_finite() && *x >= 0.0 && *x <= m as f64))
+    {
+        return Err(InputError::new(
+            "s",
+            format!("values must be finite and within [0, {m}]"),
+        ));
+    }
+    Ok(())
+}
+
+/// Points (`derivative = 0`) or derivatives of order 1..=3 with respect to the local `v`
+/// of the spline `cubics` at the global parameters `s` (see [`locate`]), in parallel.
+pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVec3>> {
+    check_params(cubics.len(), s)?;
+    if derivative > 3 {
+        return Err(InputError::new("derivative", "must be 0, 1, 2 or 3"));
+    }
+    Ok(s.par_iter()
+        .map(|&x| {
+            let (i, v) = locate(cubics.len(), x);
+            cubics[i].derivative(derivative, v)
+        })
+        .collect())
+}
+
+/// [`Cubic::from_quaternions`] row by row (preimages scalar first).
+pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result<Vec<Cubic>> {
+    if a1.len() != a0.len() || start.len() != a0.len() {
+        return Err(InputError::new(
+            "A0, A1, start",
+            "must have the same number of rows",
+        ));
+    }
+    Ok((0..a0.len())
+        .map(|i| Cubic::from_quaternions(a0[i], a1[i], start[i]))
+        .collect())
+}
+
+/// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a
+/// zero-length leg is an error naming it.
+pub fn preimage_rows(cubics: &[Cubic]) -> Result<Vec<[f64; 9]>> {
+    cubics
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let (q0, q1, res) = c.preimage().ok_or_else(|| {
+                InputError::new(
+                    "control_points",
+                    format!("cubic {i} has a control-polygon leg of zero length (not a PH cubic)"),
+                )
+            })?;
+            Ok([q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3], res])
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -359,5 +432,62 @@ mod tests {
             let a = root(d).unwrap();
             assert!((aib(a, a) - d).length() < 1e-15);
         }
+    }
+
+    fn two_segments() -> Vec<Cubic> {
+        let a = Cubic::from_quaternions([0.3, -1.2, 0.7, 0.4], [-0.5, 0.2, 1.1, -0.9], DVec3::ZERO);
+        let b = Cubic::from_quaternions([1.0, 0.2, -0.3, 0.1], [0.4, 0.9, 0.2, -0.6], a.b[3]);
+        vec![a, b]
+    }
+
+    #[test]
+    fn eval_at_locates_segments_and_checks_parameters() {
+        let c = two_segments();
+        let s = [0.0, 0.25, 1.0, 1.5, 2.0];
+        for d in 0..4 {
+            let got = eval_at(&c, &s, d).unwrap();
+            let want = [
+                c[0].derivative(d, 0.0),
+                c[0].derivative(d, 0.25),
+                c[1].derivative(d, 0.0),
+                c[1].derivative(d, 0.5),
+                c[1].derivative(d, 1.0),
+            ];
+            assert_eq!(got, want);
+        }
+        assert_eq!(locate(2, 2.0), (1, 1.0));
+        let e = eval_at(&c, &[2.5], 0).unwrap_err();
+        assert_eq!(e.to_string(), "s: values must be finite and within [0, 2]");
+        assert!(eval_at(&c, &[f64::NAN], 0).is_err());
+        let e = eval_at(&c, &[0.5], 4).unwrap_err();
+        assert_eq!(e.to_string(), "derivative: must be 0, 1, 2 or 3");
+        let e = eval_at(&[], &[0.0], 0).unwrap_err();
+        assert_eq!(e.to_string(), "control_points: no segments");
+    }
+
+    #[test]
+    fn quaternion_rows_round_trip() {
+        let c = two_segments();
+        let rows = preimage_rows(&c).unwrap();
+        let a0: Vec<Quat> = rows.iter().map(|r| [r[0], r[1], r[2], r[3]]).collect();
+        let a1: Vec<Quat> = rows.iter().map(|r| [r[4], r[5], r[6], r[7]]).collect();
+        assert!(rows.iter().all(|r| r[8] < 1e-12));
+        let back = from_quaternion_rows(&a0, &a1, &[c[0].b[0], c[1].b[0]]).unwrap();
+        for (x, y) in back.iter().zip(&c) {
+            for k in 0..4 {
+                assert!((x.b[k] - y.b[k]).length() < 1e-12);
+            }
+        }
+        let e = from_quaternion_rows(&a0, &a1[..1], &[DVec3::ZERO; 2]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "A0, A1, start: must have the same number of rows"
+        );
+        let flat = Cubic::new([DVec3::ZERO, DVec3::ZERO, DVec3::X, DVec3::Y]);
+        let e = preimage_rows(&[c[0], flat]).unwrap_err();
+        assert!(
+            e.to_string().starts_with("control_points: cubic 1 has"),
+            "{e}"
+        );
     }
 }

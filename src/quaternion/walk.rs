@@ -297,6 +297,60 @@ impl<'a> Walker<'a> {
     }
 }
 
+/// A point of a walker's path: where it stood or crossed an edge, the face it is on (the
+/// face entered, at a crossing), and the move it belongs to (0 for the start, `k + 1` for
+/// the crossings and the end point of move `k`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    pub point: DVec3,
+    pub face: usize,
+    pub step: usize,
+}
+
+/// One walker's whole walk: the `moves.len() + 1` states (start first) and the path through
+/// every edge crossing.
+#[derive(Debug, Clone)]
+pub struct Walk {
+    pub states: Vec<State>,
+    pub path: Vec<PathPoint>,
+}
+
+/// One walker from `(face, point, direction)` (see [`Walker::start`]) making `moves` in turn
+/// (see [`Walker::step`]); records every state and the crossing path.
+pub fn walk_path(
+    w: &Walker,
+    face: i64,
+    point: DVec3,
+    direction: Option<DVec3>,
+    moves: &[DVec2],
+) -> Result<Walk> {
+    let mut s = w.start(face, point, direction)?;
+    let mut states = Vec::with_capacity(moves.len() + 1);
+    states.push(s);
+    let mut path = vec![PathPoint {
+        point: s.point,
+        face: s.face,
+        step: 0,
+    }];
+    let mut crossings = Vec::new();
+    for (k, m) in moves.iter().enumerate() {
+        crossings.clear();
+        s = w.step(s, *m, &mut crossings)?;
+        path.extend(crossings.iter().map(|&(point, face)| PathPoint {
+            point,
+            face,
+            step: k + 1,
+        }));
+        path.push(PathPoint {
+            point: s.point,
+            face: s.face,
+            step: k + 1,
+        });
+        states.push(s);
+    }
+    Ok(Walk { states, path })
+}
+
 /// Where one of many walkers starts: face, point on it, optional first direction.
 pub type Start = (i64, DVec3, Option<DVec3>);
 
@@ -338,4 +392,72 @@ pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Res
         all.extend(r?);
     }
     Ok(all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed unit cube as 12 consistently oriented triangles.
+    fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
+        let v: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1], // z = 0
+            [4, 5, 7, 6], // z = 1
+            [0, 1, 5, 4], // y = 0
+            [2, 6, 7, 3], // y = 1
+            [0, 4, 6, 2], // x = 0
+            [1, 3, 7, 5], // x = 1
+        ];
+        let f = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        (v, f)
+    }
+
+    #[test]
+    fn walk_path_agrees_with_steps_by_hand() {
+        let (v, f) = cube();
+        let w = Walker::new(&v, &f).unwrap();
+        let p = DVec3::new(0.4, 0.2, 1.0);
+        let moves = [
+            DVec2::new(0.3, 0.1),
+            DVec2::new(1.7, -0.4),
+            DVec2::new(0.0, 0.0),
+            DVec2::new(-0.2, 2.5),
+        ];
+        let walk = walk_path(&w, 2, p, None, &moves).unwrap();
+        // by hand
+        let mut s = w.start(2, p, None).unwrap();
+        let mut states = vec![s];
+        let mut path = vec![(s.point, s.face, 0)];
+        for (k, m) in moves.iter().enumerate() {
+            let mut crossings = Vec::new();
+            s = w.step(s, *m, &mut crossings).unwrap();
+            path.extend(crossings.iter().map(|&(q, g)| (q, g, k + 1)));
+            path.push((s.point, s.face, k + 1));
+            states.push(s);
+        }
+        assert_eq!(walk.states.len(), moves.len() + 1);
+        for (a, b) in walk.states.iter().zip(&states) {
+            assert_eq!(
+                (a.point, a.face, a.frame, a.stopped),
+                (b.point, b.face, b.frame, b.stopped)
+            );
+        }
+        let got: Vec<_> = walk
+            .path
+            .iter()
+            .map(|q| (q.point, q.face, q.step))
+            .collect();
+        assert_eq!(got, path);
+        // the long moves cross edges of the cube
+        assert!(walk.path.len() > moves.len() + 2);
+        // a start off the face is an error of the start
+        let e = walk_path(&w, 2, DVec3::splat(5.0), None, &moves).unwrap_err();
+        assert_eq!(e.arg, "point");
+    }
 }

@@ -1,0 +1,297 @@
+//! Conversions between NumPy arrays and the slices of the core, the option strings and their
+//! enums, and [`InputError`] to Python's `ValueError`. The Python package hands in
+//! C-contiguous arrays of the right dtype; every check here names the offending argument.
+
+use glam::{DMat3, DQuat, DVec2, DVec3};
+use numpy::ndarray::Dimension;
+use numpy::{
+    Element, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray, PyReadonlyArray1,
+    PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::error::InputError;
+use crate::frames::{Method, Orientation, TangentRule};
+use crate::{deform, flesh, ph};
+
+/// `ValueError("arg: message")`, so `?` works on core results.
+impl From<InputError> for PyErr {
+    fn from(e: InputError) -> PyErr {
+        PyValueError::new_err(e.to_string())
+    }
+}
+
+/// A `ValueError` with the given message.
+pub fn value_error(msg: impl Into<String>) -> PyErr {
+    PyValueError::new_err(msg.into())
+}
+
+/// The data of a C-contiguous array.
+pub fn slice_of<'a, T: Element>(
+    arg: &str,
+    a: &'a PyReadonlyArray<'_, T, impl Dimension>,
+) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|_| value_error(format!("{arg}: array must be C-contiguous")))
+}
+
+/// The rows of an `(n, 3)` array as vectors.
+pub fn vec3s<'a>(arg: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [DVec3]> {
+    if a.shape()[1] != 3 {
+        return Err(value_error(format!(
+            "{arg}: expected shape (n, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    Ok(bytemuck::cast_slice(slice_of(arg, a)?))
+}
+
+/// The rows of an `(n, 2)` array as 2-vectors; `shape` is the expected shape in the message.
+pub fn vec2s<'a>(
+    arg: &str,
+    shape: &str,
+    a: &'a PyReadonlyArray2<'_, f64>,
+) -> PyResult<&'a [DVec2]> {
+    if a.shape()[1] != 2 {
+        return Err(value_error(format!("{arg}: expected shape {shape}")));
+    }
+    Ok(bytemuck::cast_slice(slice_of(arg, a)?))
+}
+
+/// One vector of exactly 3 values; `msg` says so when it has another length.
+pub fn vec3_of(arg: &str, a: &PyReadonlyArray1<'_, f64>, msg: &str) -> PyResult<DVec3> {
+    match slice_of(arg, a)? {
+        &[x, y, z] => Ok(DVec3::new(x, y, z)),
+        _ => Err(value_error(format!("{arg}: {msg}"))),
+    }
+}
+
+/// The rows of a `(k, 3, 3)` array of frames (row-major, as NumPy sees them).
+pub fn frames_of<'a>(arg: &str, a: &'a PyReadonlyArray3<'_, f64>) -> PyResult<&'a [[f64; 9]]> {
+    if a.shape()[1..] != [3, 3] {
+        return Err(value_error(format!(
+            "{arg}: expected shape (n, 3, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    Ok(bytemuck::cast_slice(slice_of(arg, a)?))
+}
+
+/// The `(F, 3)` index rows of `faces`.
+pub fn triangles<'a>(faces: &'a PyReadonlyArray2<'_, i64>) -> PyResult<&'a [[i64; 3]]> {
+    if faces.shape()[1] != 3 {
+        return Err(value_error("faces: expected shape (F, 3)"));
+    }
+    Ok(bytemuck::cast_slice(slice_of("faces", faces)?))
+}
+
+/// The rows of an `(n, 4)` array as quaternions `(x, y, z, w)`.
+pub fn quats<'a>(arg: &str, a: &'a PyReadonlyArray2<'_, f64>) -> PyResult<&'a [DQuat]> {
+    if a.shape()[1] != 4 {
+        return Err(value_error(format!(
+            "{arg}: expected shape (n, 4), got {:?}",
+            a.shape()
+        )));
+    }
+    Ok(bytemuck::cast_slice(slice_of(arg, a)?))
+}
+
+/// Curve offsets (`offsets[c] .. offsets[c + 1]` are the rows of curve `c`).
+pub fn offsets_of(offsets: &PyReadonlyArray1<'_, i64>) -> PyResult<Vec<usize>> {
+    slice_of("offsets", offsets)?
+        .iter()
+        .map(|&o| usize::try_from(o))
+        .collect::<Result<_, _>>()
+        .map_err(|_| value_error("offsets: must be non-negative"))
+}
+
+/// Start or end orientations of curves: reference vectors `(k, 3)` and/or frames
+/// `(k, 3, 3)` (row-major with columns `r, s, t`); `arg` is `"initial"` or `"end"`.
+pub fn orientations(
+    arg: &str,
+    vectors: Option<PyReadonlyArray2<'_, f64>>,
+    frames: Option<PyReadonlyArray3<'_, f64>>,
+) -> PyResult<Vec<Orientation>> {
+    let mut out = Vec::new();
+    if let Some(v) = vectors {
+        out.extend(vec3s(arg, &v)?.iter().map(|p| Orientation::Vector(*p)));
+    }
+    if let Some(f) = frames {
+        let s = slice_of(arg, &f)?;
+        // row-major (rows of the matrix) -> glam's column-major: transpose
+        out.extend(s.chunks_exact(9).map(|a| {
+            let mut cols = [0.0; 9];
+            cols.copy_from_slice(a);
+            Orientation::Frame(DMat3::from_cols_array(&cols).transpose())
+        }));
+    }
+    Ok(out)
+}
+
+/// PH cubics from control points `(m, 4, 3)`.
+pub fn cubics_of(a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
+    let sh = a.shape();
+    if sh[1] != 4 || sh[2] != 3 {
+        return Err(value_error(format!(
+            "control_points: expected shape (m, 4, 3), got {sh:?}"
+        )));
+    }
+    let flat: &[DVec3] = bytemuck::cast_slice(slice_of("control_points", a)?);
+    Ok(flat
+        .chunks_exact(4)
+        .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]]))
+        .collect())
+}
+
+/// `numpy.empty(shape, dtype)`: NumPy's allocator reuses freed heap memory for small arrays
+/// and asks for transparent huge pages for large ones, and nothing is zeroed, so an output
+/// that is written once costs about what NumPy's own write floor costs. Every caller writes
+/// every element before the array reaches Python.
+pub fn empty<'py, T: Element, D: Dimension>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArray<T, D>>> {
+    let np = py.import("numpy")?;
+    let shape = pyo3::types::PyTuple::new(py, shape)?;
+    let a = np.getattr("empty")?.call1((shape, numpy::dtype::<T>(py)))?;
+    Ok(a.cast_into::<PyArray<T, D>>()?)
+}
+
+/// The data of a freshly allocated output array, for writing.
+pub fn slice_mut<'a, T: Element, D: Dimension>(
+    a: &'a mut PyReadwriteArray<'_, T, D>,
+) -> PyResult<&'a mut [T]> {
+    a.as_slice_mut().map_err(|e| value_error(e.to_string()))
+}
+
+/// Flat data as an `(m, len / m)` array (`(0, 0)` when `m = 0`).
+pub fn rows_of<'py>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    m: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let width = data.len().checked_div(m).unwrap_or(0);
+    PyArray1::from_vec(py, data).reshape([m, width])
+}
+
+/// Vectors as an `(n, 3)` array.
+pub fn vec3_array<'py>(py: Python<'py>, v: Vec<DVec3>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = v.len();
+    PyArray1::from_vec(py, bytemuck::allocation::cast_vec::<DVec3, f64>(v)).reshape([n, 3])
+}
+
+/// Quaternions `(x, y, z, w)` as an `(n, 4)` array.
+pub fn quat_array<'py>(py: Python<'py>, q: Vec<DQuat>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = q.len();
+    PyArray1::from_vec(py, bytemuck::allocation::cast_vec::<DQuat, f64>(q)).reshape([n, 4])
+}
+
+/// Read a string option: `"{arg}: unknown {what} 'x'; expected 'a', 'b' or 'c'"` when it is
+/// not one of `choices` (listed in that order).
+fn choice<T: Copy>(
+    obj: Borrowed<'_, '_, PyAny>,
+    arg: &str,
+    what: &str,
+    choices: &[(&str, T)],
+) -> PyResult<T> {
+    let s: &str = obj.extract()?;
+    if let Some(&(_, v)) = choices.iter().find(|(name, _)| *name == s) {
+        return Ok(v);
+    }
+    let names: Vec<String> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
+    let list = match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => names.join(""),
+    };
+    Err(value_error(format!(
+        "{arg}: unknown {what} {s:?}; expected {list}"
+    )))
+}
+
+impl FromPyObject<'_, '_> for Method {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "method",
+            "method",
+            &[
+                ("double_reflection", Method::DoubleReflection),
+                ("projection", Method::Projection),
+                ("rotation", Method::Rotation),
+                ("frenet", Method::Frenet),
+                ("rk4", Method::Rk4),
+            ],
+        )
+    }
+}
+
+impl FromPyObject<'_, '_> for TangentRule {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "method",
+            "tangent estimate",
+            &[
+                ("five_point", TangentRule::FivePoint),
+                ("five_point_uniform", TangentRule::FivePointUniform),
+                ("circle", TangentRule::Circle),
+            ],
+        )
+    }
+}
+
+impl FromPyObject<'_, '_> for ph::frame::Mode {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        use ph::frame::Mode;
+        choice(
+            obj,
+            "mode",
+            "frame",
+            &[
+                ("frenet", Mode::Frenet),
+                ("exact", Mode::Exact),
+                ("rational", Mode::Rational),
+            ],
+        )
+    }
+}
+
+impl FromPyObject<'_, '_> for deform::advect::Method {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        use deform::advect::Method as M;
+        choice(
+            obj,
+            "method",
+            "method",
+            &[("rk4", M::Rk4), ("euler", M::Euler), ("split", M::Split)],
+        )
+    }
+}
+
+impl FromPyObject<'_, '_> for flesh::Solution {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        use flesh::Solution as S;
+        choice(
+            obj,
+            "solution",
+            "value",
+            &[
+                ("none", S::None),
+                ("normal", S::Normal),
+                ("binormal", S::Binormal),
+                ("radial", S::Radial),
+            ],
+        )
+    }
+}

@@ -1,0 +1,137 @@
+//! Skinning on a spine or a spine surface (`spinal.SpineBinding`, `spinal.SurfaceBinding`);
+//! the algorithms are in [`crate::flesh`].
+
+use glam::DVec3;
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
+use pyo3::prelude::*;
+
+use super::convert::{empty, slice_mut, slice_of, value_error, vec3_array, vec3s};
+use crate::flesh::{self, Solution, surface};
+
+type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
+type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
+
+/// A spine from its points `(n, 3)` and frames `(n, 3, 3)`, both named `arg`.
+fn spine_of<'py>(
+    arg: &'static str,
+    points: &PyReadonlyArray2<'py, f64>,
+    frames: &PyReadonlyArray3<'py, f64>,
+) -> PyResult<flesh::Spine> {
+    let pts = vec3s(arg, points)?;
+    let fr = slice_of(arg, frames)?;
+    Ok(flesh::Spine::new(arg, pts, fr)?)
+}
+
+/// Register vertices on a rest spine; see `spinal.SpineBinding`.
+#[pyfunction]
+pub fn flesh_bind<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    rest_frames: PyReadonlyArray3<'py, f64>,
+    vertices: PyReadonlyArray2<'py, f64>,
+) -> PyResult<FleshBinding<'py>> {
+    let rest = spine_of("rest_spine", &rest_points, &rest_frames)?;
+    let v = vec3s("vertices", &vertices)?;
+    let b = py.detach(|| flesh::bind(&rest, v))?;
+    let nv = b.edge.len();
+    let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
+    Ok((PyArray1::from_vec(py, b.edge), coords))
+}
+
+/// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
+#[pyfunction]
+#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist))]
+pub fn flesh_deform<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    posed_frames: PyReadonlyArray3<'py, f64>,
+    edge: PyReadonlyArray1<'py, i64>,
+    coords: PyReadonlyArray2<'py, f64>,
+    solution: Solution,
+    twist: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<FleshPose<'py>> {
+    let posed = spine_of("posed_spine", &posed_points, &posed_frames)?;
+    let edge = slice_of("edge", &edge)?;
+    let coords = slice_of("coords", &coords)?;
+    let tw: &[f64] = match &twist {
+        Some(t) => slice_of("twist", t)?,
+        None => &[],
+    };
+    let nv = edge.len();
+    let out = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
+    let mut flags = vec![0u8; nv];
+    {
+        let mut w = out.readwrite();
+        let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        py.detach(|| flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags))?;
+    }
+    Ok((out, PyArray1::from_vec(py, flags)))
+}
+
+/// Compass-walk resampling of a posed spine; see `spinal.SpineBinding.posed_spine`.
+#[pyfunction]
+pub fn flesh_resample<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    chords: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let pts = vec3s("posed_spine", &posed_points)?;
+    let ch = slice_of("chords", &chords)?;
+    if pts.len() < 2 || ch.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
+        return Err(value_error(
+            "posed_spine: need at least 2 points and positive chords",
+        ));
+    }
+    let out = py.detach(|| flesh::spine::compass_walk(pts, ch));
+    vec3_array(py, out)
+}
+
+/// Register vertices on a rest spine surface (grid `nu × nv`); see `spinal.SurfaceBinding`.
+#[pyfunction]
+pub fn flesh_surface_bind<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    nu: usize,
+    nv: usize,
+    vertices: PyReadonlyArray2<'py, f64>,
+) -> PyResult<FleshBinding<'py>> {
+    let pts = vec3s("rest_surface", &rest_points)?;
+    let v = vec3s("vertices", &vertices)?;
+    let (cell, coords) = py.detach(|| {
+        let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
+        surface::bind_surface(&rest, v)
+    })?;
+    let n = cell.len();
+    let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
+    Ok((PyArray1::from_vec(py, cell), coords))
+}
+
+/// Deform vertices registered on a spine surface; see `spinal.SurfaceBinding.deform`.
+#[pyfunction]
+pub fn flesh_surface_deform<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    nu: usize,
+    nv: usize,
+    cell: PyReadonlyArray1<'py, i64>,
+    coords: PyReadonlyArray2<'py, f64>,
+    corrected: bool,
+) -> PyResult<FleshPose<'py>> {
+    let pts = vec3s("posed_surface", &posed_points)?;
+    let cell = slice_of("cell", &cell)?;
+    let coords = slice_of("coords", &coords)?;
+    let n = cell.len();
+    let out = empty::<f64, numpy::Ix2>(py, &[n, 3])?;
+    let mut flags = vec![0u8; n];
+    {
+        let mut w = out.readwrite();
+        let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        py.detach(|| {
+            let posed = surface::Surface::new("posed_surface", pts, nu, nv)?;
+            surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
+        })?;
+    }
+    Ok((out, PyArray1::from_vec(py, flags)))
+}

@@ -1,0 +1,99 @@
+//! The Python binding layer (`spinal._core`), one thin file per concept: it converts NumPy
+//! arrays to slices ([`convert`]), releases the GIL around the heavy calls and maps
+//! [`InputError`](crate::InputError) to `ValueError`. It holds no algorithms; the Python
+//! package (`python/spinal`) normalises arguments (dtype, layout, shapes) before calling in
+//! here, so these functions expect C-contiguous arrays of the right dtype. The core modules
+//! never name pyo3 (checked by a test below).
+
+mod convert;
+mod deform;
+mod flesh;
+mod frames;
+mod ph;
+mod quaternion;
+mod sweep;
+
+use pyo3::prelude::*;
+
+#[pymodule(name = "_core")]
+fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(frames::frames_sampled, m)?)?;
+    m.add_function(wrap_pyfunction!(frames::frames_analytic, m)?)?;
+    m.add_function(wrap_pyfunction!(frames::estimate_tangents, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_from_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_to_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_continuous, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_slerp, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_path_length, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_transport, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::walk_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::walk_mesh_many, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_hermite, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_invariants, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_is_ph, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_from_quaternions, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_preimage, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_frame_setup, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(deform::field_eval, m)?)?;
+    m.add_function(wrap_pyfunction!(deform::field_info, m)?)?;
+    m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
+    m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_resample, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_surface_bind, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_surface_deform, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    /// Every `.rs` file under `dir`, recursively.
+    fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+        let entries = std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        for entry in entries {
+            let path = entry.expect("directory entry").path();
+            if path.is_dir() {
+                rust_files(&path, out);
+            } else if path.extension().is_some_and(|x| x == "rs") {
+                out.push(path);
+            }
+        }
+    }
+
+    /// The core (everything in `src/` outside `src/python/`) never names pyo3 or the numpy
+    /// crate, so it builds, tests and benches without Python.
+    #[test]
+    fn core_never_names_pyo3() {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let binding = src.join("python");
+        let mut files = Vec::new();
+        rust_files(&src, &mut files);
+        assert!(files.len() > 10, "found only {files:?}");
+        let offenders: Vec<String> = files
+            .iter()
+            .filter(|p| !p.starts_with(&binding))
+            .filter_map(|p| {
+                let text = std::fs::read_to_string(p).expect("readable source file");
+                let hits: Vec<String> = text
+                    .lines()
+                    .enumerate()
+                    .filter(|(_, l)| l.contains("pyo3") || l.contains("numpy::"))
+                    .map(|(i, l)| format!("{}:{}: {}", p.display(), i + 1, l.trim()))
+                    .collect();
+                (!hits.is_empty()).then(|| hits.join("\n"))
+            })
+            .collect();
+        assert!(
+            offenders.is_empty(),
+            "the core must not name pyo3 or numpy:: (the binding lives in src/python/):\n{}",
+            offenders.join("\n")
+        );
+    }
+}

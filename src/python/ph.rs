@@ -1,0 +1,188 @@
+//! PH cubics (`spinal.ph`): control points arrive as C-contiguous `(m, 4, 3)` float64
+//! arrays, outputs leave as rows that the Python layer reshapes; the algorithms are in
+//! [`crate::ph`].
+
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+};
+use pyo3::prelude::*;
+
+use super::convert::{cubics_of, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s};
+use super::frames::FramesAndAngles;
+use crate::ph::{self, frame::Mode};
+
+type HermiteArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// G¹ Hermite interpolation, one row per data set: `(candidates (m, 24), counts (m,),
+/// reasons (m,))`; with `all = False` the first row without a solution raises.
+#[pyfunction]
+#[pyo3(signature = (p0, t0, p1, t1, all, batch))]
+pub fn ph_hermite<'py>(
+    py: Python<'py>,
+    p0: PyReadonlyArray2<'py, f64>,
+    t0: PyReadonlyArray2<'py, f64>,
+    p1: PyReadonlyArray2<'py, f64>,
+    t1: PyReadonlyArray2<'py, f64>,
+    all: bool,
+    batch: bool,
+) -> PyResult<HermiteArrays<'py>> {
+    let (p0, t0) = (vec3s("p0", &p0)?, vec3s("t0", &t0)?);
+    let (p1, t1) = (vec3s("p1", &p1)?, vec3s("t1", &t1)?);
+    let rows = py.detach(|| ph::hermite::hermite_rows(p0, t0, p1, t1, all, batch))?;
+    Ok((
+        rows_of(py, rows.candidates, p0.len())?,
+        PyArray1::from_vec(py, rows.counts),
+        PyArray1::from_vec(py, rows.codes),
+    ))
+}
+
+/// Points or derivatives (order 0..3, with respect to the local v) at global parameters
+/// `s = segment + v`.
+#[pyfunction]
+pub fn ph_eval<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    s: PyReadonlyArray1<'py, f64>,
+    derivative: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let s = slice_of("s", &s)?;
+    let out = py.detach(|| ph::eval_at(&cubics, s, derivative))?;
+    rows_of(py, bytemuck::allocation::cast_vec(out), s.len())
+}
+
+/// `[L1, L2, L3, cθ, sθ, Δ, a, b, c, k, κ/τ, σ_min, κ_max]` per cubic.
+#[pyfunction]
+pub fn ph_invariants<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let mut out = Vec::with_capacity(cubics.len() * 13);
+    for c in &cubics {
+        let v = c.invariants();
+        out.extend_from_slice(&[
+            v.l[0],
+            v.l[1],
+            v.l[2],
+            v.ctheta,
+            v.stheta,
+            v.delta,
+            v.a,
+            v.b,
+            v.c,
+            v.k,
+            v.kappa_over_tau,
+            v.sigma_min,
+            v.kappa_max,
+        ]);
+    }
+    let m = cubics.len();
+    PyArray1::from_vec(py, out).reshape([m, 13])
+}
+
+/// Control-polygon PH test per cubic.
+#[pyfunction]
+pub fn ph_is_ph<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    tol: f64,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let cubics = cubics_of(&control_points)?;
+    let out: Vec<bool> = cubics.iter().map(|c| c.is_ph(tol)).collect();
+    Ok(PyArray1::from_vec(py, out))
+}
+
+/// Control points `(m, 12)` from quaternion preimages `(m, 4)` (scalar first) and starts.
+#[pyfunction]
+pub fn ph_from_quaternions<'py>(
+    py: Python<'py>,
+    a0: PyReadonlyArray2<'py, f64>,
+    a1: PyReadonlyArray2<'py, f64>,
+    start: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let q0: &[ph::Quat] = bytemuck::cast_slice(quats("A0", &a0)?);
+    let q1: &[ph::Quat] = bytemuck::cast_slice(quats("A1", &a1)?);
+    let st = vec3s("start", &start)?;
+    let cubics = ph::from_quaternion_rows(q0, q1, st)?;
+    let m = cubics.len();
+    let out: Vec<f64> = cubics
+        .iter()
+        .flat_map(|c| c.b)
+        .flat_map(|p| p.to_array())
+        .collect();
+    rows_of(py, out, m)
+}
+
+/// Quaternion preimages `(m, 9)`: `A0` (4, scalar first), `A1` (4), residual.
+#[pyfunction]
+pub fn ph_preimage<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let rows = ph::preimage_rows(&cubics)?;
+    let m = rows.len();
+    rows_of(py, rows.concat(), m)
+}
+
+/// How the RMF starts: a reference vector `initial` or the angle `omega_start`.
+fn start_of(
+    initial: Option<PyReadonlyArray1<'_, f64>>,
+    omega_start: f64,
+) -> PyResult<ph::frame::Start> {
+    Ok(match initial {
+        Some(v) => ph::frame::Start::Vector(vec3_of("initial", &v, "expected 3 components")?),
+        None => ph::frame::Start::Angle(omega_start),
+    })
+}
+
+/// Per-segment frame data `(m, 34)`, one row of `ph::frame::Segment::to_row` per cubic.
+#[pyfunction]
+#[pyo3(signature = (control_points, initial, omega_start, phi))]
+pub fn ph_frame_setup<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+    omega_start: f64,
+    phi: Option<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let cubics = cubics_of(&control_points)?;
+    let start = start_of(initial, omega_start)?;
+    let segs = py.detach(|| ph::frame::setup(&cubics, start, phi))?;
+    let out: Vec<f64> = segs.iter().flat_map(|s| s.to_row()).collect();
+    rows_of(py, out, segs.len())
+}
+
+/// Frames `(n, 3, 3)` (columns r, s, t) and their angles from the principal normal at
+/// global parameters `s`; `mode` is "frenet", "exact" or "rational".
+#[pyfunction]
+#[pyo3(signature = (control_points, s, mode, initial, omega_start, phi))]
+pub fn ph_frames<'py>(
+    py: Python<'py>,
+    control_points: PyReadonlyArray3<'py, f64>,
+    s: PyReadonlyArray1<'py, f64>,
+    mode: Mode,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
+    omega_start: f64,
+    phi: Option<f64>,
+) -> PyResult<FramesAndAngles<'py>> {
+    let cubics = cubics_of(&control_points)?;
+    let s = slice_of("s", &s)?;
+    let start = start_of(initial, omega_start)?;
+    let n = s.len();
+    let out = empty::<f64, numpy::Ix3>(py, &[n, 3, 3])?;
+    let angles = empty::<f64, numpy::Ix1>(py, &[n])?;
+    {
+        let mut rw = out.readwrite();
+        let frames: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        let mut ra = angles.readwrite();
+        let a = slice_mut(&mut ra)?;
+        py.detach(|| ph::frame::frames_at(&cubics, s, start, phi, mode, frames, a))?;
+    }
+    Ok((out, angles))
+}

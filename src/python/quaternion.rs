@@ -1,0 +1,236 @@
+//! Quaternions of frames and walkers on triangle meshes (`spinal.quaternions`); the
+//! algorithms are in [`crate::quaternion`].
+
+use glam::DQuat;
+use numpy::{
+    PyArray1, PyArray2, PyArray3, PyArray4, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3,
+};
+use pyo3::prelude::*;
+
+use super::convert::{
+    empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles, value_error, vec2s,
+    vec3_of, vec3s,
+};
+use crate::quaternion::{self, walk};
+
+/// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
+#[pyfunction]
+pub fn quat_from_frames<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArray3<'py, f64>,
+    continuous: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let fr = frames_of("frames", &frames)?;
+    let q = py.detach(|| quaternion::from_frames(fr, continuous))?;
+    quat_array(py, q)
+}
+
+/// Frames of quaternions `(x, y, z, w)`.
+#[pyfunction]
+pub fn quat_to_frames<'py>(
+    py: Python<'py>,
+    q: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let qs = quats("quaternions", &q)?;
+    let out = empty::<f64, numpy::Ix3>(py, &[qs.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        py.detach(|| quaternion::to_frames(qs, buf))?;
+    }
+    Ok(out)
+}
+
+/// Sign-continuous copy of quaternions `(x, y, z, w)`.
+#[pyfunction]
+pub fn quat_continuous<'py>(
+    py: Python<'py>,
+    q: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let mut v = quats("q", &q)?.to_vec();
+    quaternion::make_continuous(&mut v);
+    quat_array(py, v)
+}
+
+/// Row-wise slerp of quaternions `(x, y, z, w)`.
+#[pyfunction]
+pub fn quat_slerp<'py>(
+    py: Python<'py>,
+    q0: PyReadonlyArray2<'py, f64>,
+    q1: PyReadonlyArray2<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b, us) = (quats("q0", &q0)?, quats("q1", &q1)?, slice_of("u", &u)?);
+    if a.len() != b.len() || a.len() != us.len() {
+        return Err(value_error(
+            "q0, q1 and u must have the same number of rows",
+        ));
+    }
+    let mut out = vec![DQuat::IDENTITY; a.len()];
+    py.detach(|| quaternion::slerp_many(a, b, us, &mut out))?;
+    quat_array(py, out)
+}
+
+/// Length of a quaternion curve on S³.
+#[pyfunction]
+pub fn quat_path_length(
+    py: Python<'_>,
+    q: PyReadonlyArray2<'_, f64>,
+    closed: bool,
+) -> PyResult<f64> {
+    let qs = quats("quaternions", &q)?;
+    Ok(py.detach(|| quaternion::path_length(qs, closed))?)
+}
+
+/// Parallel transport as a quaternion recurrence; returns (quaternions, closing angle).
+#[pyfunction]
+pub fn quat_transport<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tangents: PyReadonlyArray2<'py, f64>,
+    r0: PyReadonlyArray1<'py, f64>,
+    closed: bool,
+    turns: i64,
+    closing_row: bool,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
+    let x = vec3s("points", &points)?;
+    let t = vec3s("tangents", &tangents)?;
+    let r = slice_of("initial", &r0)?;
+    if r.len() != 3 || t.len() != x.len() || t.len() < 2 {
+        return Err(value_error(
+            "points and tangents must have the same n >= 2 rows and initial 3 values",
+        ));
+    }
+    let r = glam::DVec3::new(r[0], r[1], r[2]);
+    let rows = t.len() + usize::from(closed && closing_row);
+    let mut out = vec![DQuat::IDENTITY; rows];
+    let angle = py.detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))?;
+    Ok((quat_array(py, out)?, angle))
+}
+
+/// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.
+fn walker_states(states: &[walk::State]) -> (Vec<f64>, Vec<i64>, Vec<f64>) {
+    let pts = states.iter().flat_map(|s| s.point.to_array()).collect();
+    let fcs = states.iter().map(|s| s.face as i64).collect();
+    let frs = states
+        .iter()
+        .flat_map(|s| s.frame.transpose().to_cols_array())
+        .collect();
+    (pts, fcs, frs)
+}
+
+type WalkArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
+);
+
+/// Walk on a triangle mesh; see `spinal.quaternions.walk_mesh`. Returns the states
+/// (points, faces, frames, stopped per move) and the crossing path (points, faces, moves).
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, face, point, direction, moves))]
+pub fn walk_mesh<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    face: i64,
+    point: PyReadonlyArray1<'py, f64>,
+    direction: Option<PyReadonlyArray1<'py, f64>>,
+    moves: PyReadonlyArray2<'py, f64>,
+) -> PyResult<WalkArrays<'py>> {
+    let v = vec3s("vertices", &vertices)?;
+    let f = triangles(&faces)?;
+    let p = vec3_of("point", &point, "expected 3 values")?;
+    let d = direction
+        .as_ref()
+        .map(|d| slice_of("direction", d))
+        .transpose()?;
+    let mv = vec2s("moves", "(k, 2)", &moves)?;
+    let d = match d {
+        Some(&[x, y, z]) => Some(glam::DVec3::new(x, y, z)),
+        Some(_) => return Err(value_error("direction: expected 3 values")),
+        None => None,
+    };
+    let walk = py.detach(|| {
+        let w = walk::Walker::new(v, f)?;
+        walk::walk_path(&w, face, p, d, mv)
+    })?;
+    let (states, path) = (&walk.states, &walk.path);
+    let k = states.len();
+    let (pts, fcs, frs) = walker_states(states);
+    let stopped: Vec<bool> = states[1..].iter().map(|s| s.stopped).collect();
+    let m = path.len();
+    let pp: Vec<f64> = path.iter().flat_map(|p| p.point.to_array()).collect();
+    let pf: Vec<i64> = path.iter().map(|p| p.face as i64).collect();
+    let pm: Vec<i64> = path.iter().map(|p| p.step as i64).collect();
+    Ok((
+        PyArray1::from_vec(py, pts).reshape([k, 3])?,
+        PyArray1::from_vec(py, fcs),
+        PyArray1::from_vec(py, frs).reshape([k, 3, 3])?,
+        PyArray1::from_vec(py, stopped),
+        PyArray1::from_vec(py, pp).reshape([m, 3])?,
+        PyArray1::from_vec(py, pf),
+        PyArray1::from_vec(py, pm),
+    ))
+}
+
+type WalksArrays<'py> = (
+    Bound<'py, PyArray3<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray4<f64>>,
+    Bound<'py, PyArray2<bool>>,
+);
+
+/// Many walkers on one mesh; see `spinal.quaternions.walk_mesh_many`.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, face, points, directions, moves, k))]
+#[allow(clippy::too_many_arguments)]
+pub fn walk_mesh_many<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    face: PyReadonlyArray1<'py, i64>,
+    points: PyReadonlyArray2<'py, f64>,
+    directions: Option<PyReadonlyArray2<'py, f64>>,
+    moves: PyReadonlyArray2<'py, f64>,
+    k: usize,
+) -> PyResult<WalksArrays<'py>> {
+    let v = vec3s("vertices", &vertices)?;
+    let f = triangles(&faces)?;
+    let fc = slice_of("face", &face)?;
+    let p = vec3s("points", &points)?;
+    let d = directions
+        .as_ref()
+        .map(|d| vec3s("directions", d))
+        .transpose()?;
+    if p.len() != fc.len() || d.is_some_and(|d| d.len() != fc.len()) {
+        return Err(value_error(
+            "points, directions: one row per walker (as many as face)",
+        ));
+    }
+    let mv = vec2s("moves", "(w·k, 2)", &moves)?;
+    let starts: Vec<walk::Start> = (0..fc.len())
+        .map(|i| (fc[i], p[i], d.map(|d| d[i])))
+        .collect();
+    let states = py.detach(|| {
+        let w = walk::Walker::new(v, f)?;
+        walk::walk_many(&w, &starts, mv, k)
+    })?;
+    let nw = starts.len();
+    let (pts, fcs, frs) = walker_states(&states);
+    let stopped: Vec<bool> = states
+        .chunks(k + 1)
+        .flat_map(|w| w[1..].iter().map(|s| s.stopped))
+        .collect();
+    Ok((
+        PyArray1::from_vec(py, pts).reshape([nw, k + 1, 3])?,
+        PyArray1::from_vec(py, fcs).reshape([nw, k + 1])?,
+        PyArray1::from_vec(py, frs).reshape([nw, k + 1, 3, 3])?,
+        PyArray1::from_vec(py, stopped).reshape([nw, k])?,
+    ))
+}
