@@ -30,7 +30,7 @@ import numpy as np
 
 from . import _core
 from ._frames import estimate_tangents, frames
-from ._validate import as_bool, as_choice, as_float_array, as_frames, as_int, as_points
+from ._validate import as_bool, as_choice, as_float_array, as_frames, as_int, as_points, as_vector
 
 __all__ = [
     "WalkResult",
@@ -454,15 +454,8 @@ def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkRes
     """
     v = as_points(vertices, "vertices")
     fa = _faces(faces)
-    p = as_float_array(point, "point")
-    if p.shape != (3,):
-        raise ValueError(f"point: expected shape (3,), got {p.shape}")
-    d = None
-    if direction is not None:
-        d = as_float_array(direction, "direction")
-        if d.shape != (3,):
-            raise ValueError(f"direction: expected shape (3,), got {d.shape}")
-        d = np.ascontiguousarray(d)
+    p = as_vector(point, "point")
+    d = None if direction is None else as_vector(direction, "direction")
     mv = as_float_array(moves, "moves")
     if mv.ndim == 1 and mv.shape == (2,):
         mv = mv[None]
