@@ -105,19 +105,44 @@ def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.n
     return q @ rolled
 
 
+def _vertices(vertices, dim: int) -> np.ndarray:
+    """``(V, dim)`` vertices as ``(V, 3)`` (the planar case gets z = 0)."""
+    v = as_float_array(vertices, "vertices")
+    if v.ndim != 2 or v.shape[1] != dim:
+        raise ValueError(
+            f"vertices: expected shape (V, {dim}) like rest_spine's columns, got {v.shape}"
+        )
+    if dim == 2:
+        v = np.c_[v, np.zeros(len(v))]
+    return np.ascontiguousarray(v, dtype=np.float64)
+
+
+def _rest_frames(rest: np.ndarray, dim: int) -> np.ndarray:
+    """The RMF of the rest spine; in the plane started with ``r`` in the plane (so the
+    binormal stays out of it)."""
+    if dim == 2:
+        t0 = rest[1] - rest[0]
+        return _spine_frames(rest, "rest_spine", initial=np.array([-t0[1], t0[0], 0.0]))
+    return _spine_frames(rest, "rest_spine")
+
+
 class SpineBinding:
     r"""A shape registered on a rest spine, to be posed many times (Zhuo 2014, §1.1).
 
     Registration finds for every vertex the cross-section of the rest spine it lies in: the
-    spine is the polyline through ``rest_spine``, with the unit tangents and reference
-    vectors ``r`` of :func:`spinal.frames` (a rotation-minimising frame) at the samples; in
-    between, the tangent is a normalised cubic Hermite interpolation matching the sample
-    curvatures (so sections turn smoothly and the map is continuous across samples) and
-    ``r`` is interpolated linearly and made normal to it. The cross-section at edge ``k``,
-    parameter ``a`` is the plane through ``C(a)`` normal to the interpolated tangent. A vertex is bound to the nearest such
-    point (the closest point of the polyline with smoothly turning sections, never the
-    nearest sample) and keeps its offset in the interpolated frame. Points past the spine's
-    ends use the straight extension of the end.
+    spine runs through the samples ``rest_spine``, with the unit tangents ``t_k`` and
+    reference vectors ``r`` of :func:`spinal.frames` (a rotation-minimising frame) at the
+    samples. Between samples ``k`` and ``k + 1`` the position ``C(a)``, ``a ∈ [0, 1]``, is the
+    cubic Hermite interpolant of the two samples with end slopes ``h t_k`` and ``h t_{k+1}``
+    (``h`` the chord length); the tangent is a normalised cubic Hermite interpolation of the
+    sample tangents matching the sample curvatures (so sections turn smoothly and the map
+    is continuous across samples); ``r`` is the blend of ``r_k`` and ``r_{k+1}`` (carried back
+    to ``t_k``) in the normal plane of ``t_k``, carried to the interpolated tangent by the
+    minimal rotation. The cross-section at edge ``k``, parameter ``a`` is the plane through
+    ``C(a)`` normal to the interpolated tangent. A vertex is bound to the nearest such
+    point (the closest point of the interpolated spine with smoothly turning sections, never
+    the nearest sample) and keeps its offset in the interpolated frame. Points past the
+    spine's ends use the straight extension of the end.
 
     Parameters
     ----------
@@ -144,28 +169,12 @@ class SpineBinding:
 
     def __init__(self, vertices, rest_spine):
         rest, dim = _spine(rest_spine, "rest_spine")
-        v = as_float_array(vertices, "vertices")
-        if v.ndim != 2 or v.shape[1] != dim:
-            raise ValueError(
-                f"vertices: expected shape (V, {dim}) like rest_spine's columns, got {v.shape}"
-            )
-        bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
-        if bad.size:
-            raise ValueError(f"vertices: row {bad[0]} is not finite")
-        if dim == 2:
-            v = np.c_[v, np.zeros(len(v))]
-            # planar: keep the binormal out of the plane, r in the plane
-            t0 = rest[1] - rest[0]
-            init = np.array([-t0[1], t0[0], 0.0])
-            self._frames = _spine_frames(rest, "rest_spine", initial=init)
-        else:
-            self._frames = _spine_frames(rest, "rest_spine")
+        v = _vertices(vertices, dim)
+        self._frames = _rest_frames(rest, dim)
         self._dim = dim
         self._rest = rest
         self._lengths = _arc(rest)
-        self._edge, self._coords = _core.flesh_bind(
-            rest, self._frames, np.ascontiguousarray(v, dtype=np.float64)
-        )
+        self._edge, self._coords = _core.flesh_bind(rest, self._frames, v)
         self.clamped = np.zeros(0, dtype=np.int64)
 
     def __len__(self) -> int:
@@ -180,7 +189,8 @@ class SpineBinding:
     @property
     def param(self) -> np.ndarray:
         """``(V,)`` float64: the parameter ``a ∈ [0, 1]`` of the section on its edge
-        (dimensionless; the section's spine point is ``(1 − a) R_k + a R_{k+1}``). Vertices past
+        (dimensionless; the section's spine point is the cubic Hermite ``C(a)`` between ``R_k``
+        and ``R_{k+1}``, see the class notes). Vertices past
         the spine's ends get ``a = 0`` on the first edge or ``a = 1`` on the last."""
         return self._coords[:, 0].copy()
 
@@ -247,7 +257,7 @@ class SpineBinding:
         ``κ`` is the curvature toward the centre of curvature; ``λ = σ1/σ0`` the stretch
         (new/old speed of the spine at the vertex's parameter). The binormal coordinate and
         the radial angle are read in the posed frame after the transfer (spec A-7). In the
-        model of the spine used here (linear positions, interpolated tangents) the map has
+        model of the spine used here (cubic Hermite positions and tangents) the map has
         Jacobian determinant 1 inside every edge slab, whatever the sampling.
 
         With ``stretchable=False`` the posed spine is first resampled by a compass walk along
@@ -295,48 +305,59 @@ class SpineBinding:
         solution = as_choice(solution, "solution", SOLUTIONS)
         strict = as_bool(strict, "strict")
         posed = self.posed_spine(posed_spine, stretchable=stretchable)
-        n = len(self._rest)
-        tw = None
-        if twist is not None:
-            tw = as_float_array(twist, "twist")
-            if tw.ndim == 0:
-                tw = np.full(n, float(tw))
-            if tw.shape != (n,):
-                raise ValueError(f"twist: expected a number or shape ({n},), got {tw.shape}")
-            if not np.isfinite(tw).all():
-                raise ValueError("twist: must be finite")
-            tw = np.ascontiguousarray(tw)
-        if self._dim == 2:  # r is the left normal z × t all along a planar RMF
-            t1 = posed[1] - posed[0]
-            frames1 = _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0])
-        else:
-            # the RMF is linear in its initial vector: start from the default one and roll
-            # every frame by the constant angle that brings it to the chosen start
-            frames1 = _spine_frames(posed, "posed_spine")
-            r, s_, t1 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
-            init = _posed_initial(self._rest, self._frames[0], posed, t1)
-            g = np.arctan2(init @ s_, init @ r)
-            c, sn = np.cos(g), np.sin(g)
-            rr, ss = frames1[:, :, 0].copy(), frames1[:, :, 1].copy()
-            frames1[:, :, 0] = c * rr + sn * ss
-            frames1[:, :, 1] = c * ss - sn * rr
+        tw = None if twist is None else _twist(twist, len(self._rest))
+        frames1 = self._posed_frames(posed)
         sol = solution
         if self._dim == 2 and sol != "none":
             sol = "normal"
         out, flags = _core.flesh_deform(posed, frames1, self._edge, self._coords, sol, tw)
-        clamped = np.flatnonzero(flags).astype(np.int64)
-        self.clamped = clamped
-        if clamped.size:
-            msg = (
-                f"posed_spine: {clamped.size} vertices have no fold-free offset (bent past the "
-                f"existence limit) and were clamped, e.g. vertex {clamped[0]}"
-            )
-            if strict:
-                raise ValueError(msg)
-            warnings.warn(FoldOverWarning(msg, clamped), stacklevel=2)
+        self.clamped = _report_clamped(flags, strict)
         if self._dim == 2:
             out = np.ascontiguousarray(out[:, :2])
-        return (out, clamped) if return_clamped else out
+        return (out, self.clamped) if return_clamped else out
+
+    def _posed_frames(self, posed: np.ndarray) -> np.ndarray:
+        """The frames of the posed spine: its RMF started from the reference vector of
+        :func:`_posed_initial` (in the plane: ``r`` the left normal ``z × t``)."""
+        if self._dim == 2:  # r is the left normal z × t all along a planar RMF
+            t1 = posed[1] - posed[0]
+            return _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0])
+        # the RMF is linear in its initial vector: start from the default one and roll
+        # every frame by the constant angle that brings it to the chosen start
+        frames1 = _spine_frames(posed, "posed_spine")
+        r, s_, t1 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
+        init = _posed_initial(self._rest, self._frames[0], posed, t1)
+        g = np.arctan2(init @ s_, init @ r)
+        c, sn = np.cos(g), np.sin(g)
+        rr, ss = frames1[:, :, 0].copy(), frames1[:, :, 1].copy()
+        frames1[:, :, 0] = c * rr + sn * ss
+        frames1[:, :, 1] = c * ss - sn * rr
+        return frames1
+
+
+def _twist(twist, n: int) -> np.ndarray:
+    """``twist`` as ``(n,)`` angles (a number is used for every sample); the core checks
+    the values."""
+    tw = as_float_array(twist, "twist")
+    if tw.ndim == 0:
+        tw = np.full(n, float(tw))
+    if tw.shape != (n,):
+        raise ValueError(f"twist: expected a number or shape ({n},), got {tw.shape}")
+    return np.ascontiguousarray(tw)
+
+
+def _report_clamped(flags: np.ndarray, strict: bool) -> np.ndarray:
+    """Indices of the clamped vertices; warned about (raised with ``strict``)."""
+    clamped = np.flatnonzero(flags).astype(np.int64)
+    if clamped.size:
+        msg = (
+            f"posed_spine: {clamped.size} vertices have no fold-free offset (bent past the "
+            f"existence limit) and were clamped, e.g. vertex {clamped[0]}"
+        )
+        if strict:
+            raise ValueError(msg)
+        warnings.warn(FoldOverWarning(msg, clamped), stacklevel=3)
+    return clamped
 
 
 def flesh(
@@ -381,8 +402,6 @@ def _grid(x, name: str) -> np.ndarray:
     if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 2 or arr.shape[1] < 2:
         raise ValueError(f"{name}: expected a grid of shape (nu, nv, 3), nu, nv ≥ 2, got "
                          f"{arr.shape}")
-    if not np.isfinite(arr).all():
-        raise ValueError(f"{name}: must be finite")
     return np.ascontiguousarray(arr)
 
 
@@ -416,9 +435,6 @@ class SurfaceBinding:
         v = as_float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
-        bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
-        if bad.size:
-            raise ValueError(f"vertices: row {bad[0]} is not finite")
         self._shape = g.shape[:2]
         self._cell, self._coords = _core.flesh_surface_bind(
             g.reshape(-1, 3), g.shape[0], g.shape[1], np.ascontiguousarray(v, dtype=np.float64)

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._validate import as_bool, as_choice, as_float_array, as_int, as_points
+from ._validate import as_bool, as_choice, as_float_array, as_int, as_offsets, as_points
 from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames"]
@@ -15,30 +15,6 @@ __all__ = ["closing_angle", "estimate_tangents", "frames"]
 METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point", "five_point_uniform", "circle")
-
-
-def _offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]:
-    """CSR-style offsets (C + 1,) and whether the call is a bundle."""
-    if lengths is not None and offsets is not None:
-        raise TypeError("lengths, offsets: pass one of them, not both")
-    if lengths is None and offsets is None:
-        return np.array([0, rows], dtype=np.int64), False
-    name = "lengths" if lengths is not None else "offsets"
-    arr = np.asarray(lengths if lengths is not None else offsets)
-    if arr.dtype.kind not in "iu" or arr.ndim != 1:
-        raise TypeError(f"{name}: expected a 1-D array of integers, got {arr.dtype} {arr.shape}")
-    arr = arr.astype(np.int64)
-    if lengths is not None:
-        if np.any(arr < 0):
-            raise ValueError("lengths: must be non-negative")
-        out = np.concatenate([[0], np.cumsum(arr)]).astype(np.int64)
-    else:
-        out = arr
-        if out.size == 0 or out[0] != 0 or np.any(np.diff(out) < 0):
-            raise ValueError("offsets: must start at 0 and never decrease")
-    if out[-1] != rows:
-        raise ValueError(f"{name}: the curves cover {out[-1]} rows but points has {rows}")
-    return np.ascontiguousarray(out), True
 
 
 def _orientation(x: Any, name: str, curves: int, bundle: bool):
@@ -66,11 +42,9 @@ def _analytic(curve: Curve, u: Any):
         uu = curve.parameters(int(u))
     else:
         uu = as_float_array(u, "u")
-        if uu.ndim != 1 or uu.size < 2:
+        if uu.ndim != 1 or uu.size < 2:  # the midpoints below need two values
             raise ValueError(f"u: expected a 1-D array of at least 2 values, got shape {uu.shape}")
     uu = np.ascontiguousarray(uu)
-    if not np.all(np.isfinite(uu)):
-        raise ValueError("u: contains non-finite values")
     full = np.empty(2 * uu.size - 1)
     full[0::2] = uu
     full[1::2] = 0.5 * (uu[:-1] + uu[1:])
@@ -102,24 +76,20 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         return out, np.array([angle]), False
     if u is not None:
         raise TypeError("u: only used with an analytic curve from spinal.curves")
-    if method == "rk4":
-        raise ValueError(
-            "method: 'rk4' integrates the RMF ODE and needs x′ and x″; pass an analytic curve "
-            "from spinal.curves with u=..., e.g. frames(spinal.curves.Helix(), u=200, method='rk4')"
-        )
     pts = None if points is None else as_points(points, "points")
     tgs = None if tangents is None else as_points(tangents, "tangents")
     if pts is None and (tgs is None or reflection != "tangents"):
         raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
-    if pts is not None and tgs is not None and pts.shape != tgs.shape:
-        raise ValueError(f"tangents: shape {tgs.shape} does not match points {pts.shape}")
     rows = (pts if pts is not None else tgs).shape[0]
-    offs, bundle = _offsets(rows, lengths, offsets)
+    offs, bundle = as_offsets(rows, lengths, offsets)
     curves = offs.size - 1
     iv, if_ = _orientation(initial, "initial", curves, bundle)
     ev, ef = _orientation(end, "end", curves, bundle)
+    # reflection="tangents": the chords of double reflection come from a quadrature of the
+    # tangents (the core's `tangent_chords` flag)
+    chords_from_tangents = reflection == "tangents"
     out, angles = _core.frames_sampled(
-        pts, tgs, offs, method, "five_point", reflection == "tangents", closed,
+        pts, tgs, offs, method, "five_point", chords_from_tangents, closed,
         iv, if_, ev, ef, turns,
     )
     return out, angles, bundle
@@ -298,6 +268,4 @@ def estimate_tangents(points, *, closed: bool = False, method: str = "five_point
     """
     method = as_choice(method, "method", TANGENT_RULES)
     pts = as_points(points, "points")
-    if pts.shape[0] < 2:
-        raise ValueError(f"points: need at least 2 points, got {pts.shape[0]}")
     return _core.estimate_tangents(pts, as_bool(closed, "closed"), method)

@@ -7,10 +7,17 @@ import warnings
 import numpy as np
 
 from . import _core
-from ._frames import _offsets
 from ._frames import frames as _frames
 from ._mesh import FoldOverWarning, Mesh
-from ._validate import as_bool, as_float_array, as_int, as_points
+from ._validate import (
+    as_bool,
+    as_float_array,
+    as_frames,
+    as_int,
+    as_offsets,
+    as_per_row,
+    as_points,
+)
 
 __all__ = ["sweep", "tube"]
 
@@ -26,19 +33,6 @@ def _ranges(rows: np.ndarray) -> str:
             parts.append(str(start) if start == prev else f"{start}–{prev}")
         start = prev = r
     return ", ".join(parts)
-
-
-def _per_row(x, name: str, n: int, *, pair: bool) -> np.ndarray:
-    """Broadcast a scalar, (n,) or (for pairs) (n, 2) argument."""
-    a = as_float_array(x, name)
-    if a.ndim == 0:
-        a = np.full(n, float(a))
-    if a.shape == (n,):
-        return np.ascontiguousarray(np.stack([a, a], axis=1) if pair else a)
-    if pair and a.shape == (n, 2):
-        return np.ascontiguousarray(a)
-    expect = f"a scalar, ({n},)" + (f" or ({n}, 2)" if pair else "")
-    raise ValueError(f"{name}: expected {expect}, got shape {a.shape}")
 
 
 def sweep(
@@ -130,18 +124,16 @@ def sweep(
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")
-    offs, bundle = _offsets(n, lengths, offsets)
+    offs, bundle = as_offsets(n, lengths, offsets)
     if frames is None:
-        kw = {"lengths": np.diff(offs)} if bundle else {}
+        kw = {"offsets": offs} if bundle else {}
         fr = _frames(pts, closed=closed, **kw)
     else:
-        fr = as_float_array(frames, "frames")
-        if fr.shape != (n, 3, 3):
-            raise ValueError(f"frames: expected shape ({n}, 3, 3) to match points, got {fr.shape}")
-    sc = np.ones((n, 2)) if scale is None else _per_row(scale, "scale", n, pair=True)
-    tw = None if twist is None else _per_row(twist, "twist", n, pair=False)
+        fr, _ = as_frames(frames, "frames", rows=n)
+    sc = np.ones((n, 2)) if scale is None else as_per_row(scale, "scale", n, pair=True)
+    tw = None if twist is None else as_per_row(twist, "twist", n)
     v, f, nrm, uv, folds = _core.sweep_mesh(
-        pts, np.ascontiguousarray(fr), sc, tw, offs, np.ascontiguousarray(prof),
+        pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams,
     )
     if folds.size:
@@ -179,12 +171,14 @@ def tube(
     by the radius slope. Other arguments as in :func:`sweep`.
     """
     sides = as_int(sides, "sides")
-    if sides < 3:
+    if sides < 3:  # the core sees only the polygon built here
         raise ValueError(f"sides: a tube needs at least 3 sides, got {sides}")
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
     pts = as_points(points, "points")
-    rad = _per_row(radius, "radius", pts.shape[0], pair=False)
+    rad = as_per_row(radius, "radius", pts.shape[0])
+    # the core checks the scale it is given (and would name `scale`): the radius is checked
+    # here, where its name is known
     if not np.all(rad > 0):
         bad = int(np.flatnonzero(~(rad > 0))[0])
         raise ValueError(f"radius: must be positive and finite, got {rad[bad]} at row {bad}")

@@ -1,7 +1,12 @@
-"""Argument conversion shared by the public functions.
+"""Argument conversion shared by the public functions: one helper per kind of argument.
+
+These only coerce types and shapes (dtype, number of dimensions, shape, Python types,
+choices of a string): array-likes become C-contiguous float64 arrays of the shape the core
+expects. Values (NaN/inf, lengths, repeated points, rotation matrices, …) are checked once,
+by the Rust core, whose messages name the Python argument as well.
 
 Every check raises ``TypeError`` (not numbers at all) or ``ValueError`` (numbers of the
-wrong shape or value) with a message that starts with the argument's name.
+wrong shape) with a message that starts with the argument's name.
 """
 
 from __future__ import annotations
@@ -41,9 +46,70 @@ def as_points(x: Any, name: str = "points") -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
-def as_int(x: Any, name: str) -> int:
+def as_frames(x: Any, name: str = "frames", rows: int | None = None) -> tuple[np.ndarray, bool]:
+    """An ``(n, 3, 3)`` C-contiguous float64 array (a single ``(3, 3)`` frame becomes one row)
+    and whether the input was a single frame. ``rows``: the required ``n`` (then only
+    ``(rows, 3, 3)`` is accepted)."""
+    f = as_float_array(x, name)
+    if rows is not None:
+        if f.shape != (rows, 3, 3):
+            raise ValueError(f"{name}: expected shape ({rows}, 3, 3) to match points, "
+                             f"got {f.shape}")
+        return np.ascontiguousarray(f), False
+    single = f.ndim == 2
+    if single:
+        f = f[None]
+    if f.ndim != 3 or f.shape[1:] != (3, 3):
+        raise ValueError(f"{name}: expected shape (3, 3) or (n, 3, 3), got {np.shape(x)}")
+    return np.ascontiguousarray(f), single
+
+
+def as_vector(x: Any, name: str, width: int = 3) -> np.ndarray:
+    """A ``(width,)`` C-contiguous float64 array."""
+    v = as_float_array(x, name)
+    if v.shape != (width,):
+        raise ValueError(f"{name}: expected shape ({width},), got {v.shape}")
+    return np.ascontiguousarray(v)
+
+
+def as_per_row(x: Any, name: str, n: int, *, pair: bool = False) -> np.ndarray:
+    """A scalar, ``(n,)`` or (``pair``) ``(n, 2)`` argument broadcast to ``(n,)`` or ``(n, 2)``."""
+    a = as_float_array(x, name)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape == (n,):
+        return np.ascontiguousarray(np.stack([a, a], axis=1) if pair else a)
+    if pair and a.shape == (n, 2):
+        return np.ascontiguousarray(a)
+    expect = f"a scalar, ({n},)" + (f" or ({n}, 2)" if pair else "")
+    raise ValueError(f"{name}: expected {expect}, got shape {a.shape}")
+
+
+def as_offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]:
+    """CSR-style offsets ``(C + 1,)`` int64 of a bundle given by ``lengths`` or ``offsets``
+    (neither: one curve of ``rows`` rows), and whether the call is a bundle. Only the types
+    are checked here; the core checks the values (non-negative lengths adding up to the
+    rows, offsets from 0)."""
+    if lengths is not None and offsets is not None:
+        raise TypeError("lengths, offsets: pass one of them, not both")
+    if lengths is None and offsets is None:
+        return np.array([0, rows], dtype=np.int64), False
+    name = "lengths" if lengths is not None else "offsets"
+    arr = np.asarray(lengths if lengths is not None else offsets)
+    if arr.dtype.kind not in "iu" or arr.ndim != 1:
+        raise TypeError(f"{name}: expected a 1-D array of integers, got {arr.dtype} {arr.shape}")
+    arr = arr.astype(np.int64)
+    if lengths is not None:
+        arr = np.concatenate([[0], np.cumsum(arr)]).astype(np.int64)
+    return np.ascontiguousarray(arr), True
+
+
+def as_int(x: Any, name: str, minimum: int | None = None) -> int:
+    """A Python int (not a bool), at least ``minimum`` when given."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
+    if minimum is not None and x < minimum:
+        raise ValueError(f"{name}: must be >= {minimum}, got {int(x)}")
     return int(x)
 
 

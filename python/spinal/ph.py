@@ -382,6 +382,108 @@ def _erf_col(k: int, p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.stack(c, axis=1)
 
 
+def _spline_knots(knots, m: int) -> np.ndarray:
+    """The ``(m + 1,)`` joint parameters of a spline of ``m`` cubics (default ``0 … m``)."""
+    if knots is None:
+        return np.arange(m + 1, dtype=float)
+    kn = _finite(as_float_array(knots, "knots"), "knots")
+    if kn.shape != (m + 1,):
+        raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
+    if not np.all(np.diff(kn) > 0):
+        raise ValueError("knots: must be strictly increasing")
+    return kn
+
+
+def _check_spline(cp: np.ndarray) -> None:
+    """Cubics ``(m, 4, 3)`` that join end to end (within 1e-9 of the scale), are PH
+    (tolerance 1e-7) and share the tangent direction at every joint (G¹)."""
+    scale = np.abs(cp).max() + 1.0
+    gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
+    if gap.size and gap.max() > 1e-9 * scale:
+        i = int(np.argmax(gap))
+        raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
+                         f"{i} ends (gap {gap[i]:.3g})")
+    ok = _core.ph_is_ph(cp, 1e-7)
+    if not ok.all():
+        i = int(np.flatnonzero(~ok)[0])
+        raise ValueError(f"control_points: cubic {i} is not a PH cubic (control-polygon "
+                         f"test, tolerance 1e-7)")
+    d_in, d_out = cp[:-1, 3] - cp[:-1, 2], cp[1:, 1] - cp[1:, 0]
+    cos = np.einsum("ij,ij->i", d_in, d_out) / (np.linalg.norm(d_in, axis=1)
+                                                * np.linalg.norm(d_out, axis=1))
+    if cos.size and not np.all(cos >= 1 - 1e-12):
+        i = int(np.argmin(cos))
+        raise ValueError(f"control_points: cubics {i} and {i + 1} do not join with a "
+                         f"common tangent (G¹; angle {np.arccos(np.clip(cos[i], -1, 1)):.3g} rad)")
+
+
+def _rational_numerators(fit: dict) -> dict:
+    """Bernstein numerators of the rational RMF of bent cubics from :func:`angle_fit` data
+    (see :meth:`PHSpline.rational_frames`): ``f2, f3`` (m, 7, 3), ``weight`` (m, 7),
+    ``tangent`` (m, 3, 3) and ``speed`` (m, 3)."""
+    A0, A1 = fit["preimage"][:, 0], fit["preimage"][:, 1]
+    cols = [np.stack([_erf_col(k, A0, A0), _erf_col(k, A0, A1), _erf_col(k, A1, A1)], 1)
+            for k in range(3)]                      # each (m, 3 coefficients, 3)
+    speed = np.stack([(A0 * A0).sum(1), (A0 * A1).sum(1), (A1 * A1).sum(1)], axis=1)
+    psi = fit["erf_angle"] + fit["phi"]
+    cp_, sp_ = np.cos(psi)[:, None, None], np.sin(psi)[:, None, None]
+    e2 = cp_ * cols[1] + sp_ * cols[2]
+    e3 = cp_ * cols[2] - sp_ * cols[1]
+    G = fit["sg"][:, None] * fit["gamma"]
+    B = fit["beta"]
+    GB2 = 2 * _bmul(G, B)
+    BG = _bmul(B, B) - _bmul(G, G)
+    return {"f2": _bmul(GB2, e3) + _bmul(BG, e2), "f3": _bmul(BG, e3) - _bmul(GB2, e2),
+            "weight": _bmul(speed, _bmul(B, B) + _bmul(G, G)), "tangent": cols[0],
+            "speed": speed}
+
+
+def _straighten(rf: dict, st: np.ndarray, cp: np.ndarray, r: np.ndarray) -> None:
+    """Overwrite the rows ``st`` (a boolean mask) of ``rf`` — the straight cubics ``cp``
+    (k, 4, 3) — with constant numerators: ``r`` (k, 3) the reference vectors, weight 1, and
+    the polynomial tangent ``3d`` with its speed."""
+    d = np.diff(cp, axis=1)
+    t = d[:, 0] / np.linalg.norm(d[:, 0], axis=1)[:, None]
+    rf["f2"][st] = r[:, None, :]
+    rf["f3"][st] = np.cross(t, r)[:, None, :]
+    rf["weight"][st] = 1.0
+    L = np.linalg.norm(d, axis=2)
+    rf["tangent"][st] = 3 * d
+    rf["speed"][st] = 3 * np.stack([L[:, 0], np.einsum("ij,ij->i", d[:, 0], d[:, 1]) / L[:, 0],
+                                    L[:, 2]], axis=1)
+
+
+def _section(section_ctrl, section_weights) -> tuple[np.ndarray, np.ndarray]:
+    """Cross-section control points ``(m + 1, 2)`` and their positive weights."""
+    c = _finite(as_float_array(section_ctrl, "section_ctrl"), "section_ctrl")
+    if c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1:
+        raise ValueError(f"section_ctrl: expected shape (m + 1, 2), got {c.shape}")
+    if section_weights is None:
+        return c, np.ones(c.shape[0])
+    wj = _finite(as_float_array(section_weights, "section_weights"), "section_weights")
+    if wj.shape != (c.shape[0],):
+        raise ValueError(f"section_weights: expected shape ({c.shape[0]},), got "
+                         f"{wj.shape}")
+    if not np.all(wj > 0):
+        raise ValueError("section_weights: must be positive")
+    return c, wj
+
+
+def _sweep_patches(cp: np.ndarray, rf: dict, c: np.ndarray, wj: np.ndarray) -> np.ndarray:
+    """Homogeneous control points ``(segments, 10, m + 1, 4)`` of the rational sweep of the
+    section ``(c, wj)`` along cubics ``cp`` with the rational frame ``rf``."""
+    om = _elevate(rf["weight"], 9)                    # (m, 10)
+    xom = _bmul(cp, rf["weight"])                     # (m, 10, 3)
+    F2 = _elevate(rf["f2"], 9)
+    F3 = _elevate(rf["f3"], 9)
+    C0, C2, C3 = wj, wj * c[:, 0], wj * c[:, 1]
+    num = (xom[:, :, None, :] * C0[None, None, :, None]
+           + F2[:, :, None, :] * C2[None, None, :, None]
+           + F3[:, :, None, :] * C3[None, None, :, None])
+    wt = om[:, :, None] * C0[None, None, :]
+    return np.concatenate([num, wt[..., None]], axis=3)
+
+
 class PHSpline:
     """A G¹ spline of ``m`` PH cubics with rational frames.
 
@@ -406,32 +508,8 @@ class PHSpline:
         m = cp.shape[0]
         if m == 0:
             raise ValueError("control_points: no cubics")
-        if knots is None:
-            kn = np.arange(m + 1, dtype=float)
-        else:
-            kn = _finite(as_float_array(knots, "knots"), "knots")
-            if kn.shape != (m + 1,):
-                raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
-            if not np.all(np.diff(kn) > 0):
-                raise ValueError("knots: must be strictly increasing")
-        scale = np.abs(cp).max() + 1.0
-        gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
-        if gap.size and gap.max() > 1e-9 * scale:
-            i = int(np.argmax(gap))
-            raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
-                             f"{i} ends (gap {gap[i]:.3g})")
-        ok = _core.ph_is_ph(cp, 1e-7)
-        if not ok.all():
-            i = int(np.flatnonzero(~ok)[0])
-            raise ValueError(f"control_points: cubic {i} is not a PH cubic (control-polygon "
-                             f"test, tolerance 1e-7)")
-        d_in, d_out = cp[:-1, 3] - cp[:-1, 2], cp[1:, 1] - cp[1:, 0]
-        cos = np.einsum("ij,ij->i", d_in, d_out) / (np.linalg.norm(d_in, axis=1)
-                                                    * np.linalg.norm(d_out, axis=1))
-        if cos.size and not np.all(cos >= 1 - 1e-12):
-            i = int(np.argmin(cos))
-            raise ValueError(f"control_points: cubics {i} and {i + 1} do not join with a "
-                             f"common tangent (G¹; angle {np.arccos(np.clip(cos[i], -1, 1)):.3g} rad)")
+        kn = _spline_knots(knots, m)
+        _check_spline(cp)
         self._init(cp, kn)
 
     def _init(self, cp: np.ndarray, kn: np.ndarray) -> None:
@@ -583,36 +661,13 @@ class PHSpline:
         (``A i A*``/``|A|²``, degree 2). Straight cubics get constant numerators and weight 1.
         """
         fit = self.angle_fit(initial=initial, omega_start=omega_start)
-        A0, A1 = fit["preimage"][:, 0], fit["preimage"][:, 1]
-        cols = [np.stack([_erf_col(k, A0, A0), _erf_col(k, A0, A1), _erf_col(k, A1, A1)], 1)
-                for k in range(3)]                      # each (m, 3 coefficients, 3)
-        speed = np.stack([(A0 * A0).sum(1), (A0 * A1).sum(1), (A1 * A1).sum(1)], axis=1)
-        psi = fit["erf_angle"] + fit["phi"]
-        cp_, sp_ = np.cos(psi)[:, None, None], np.sin(psi)[:, None, None]
-        e2 = cp_ * cols[1] + sp_ * cols[2]
-        e3 = cp_ * cols[2] - sp_ * cols[1]
-        G = fit["sg"][:, None] * fit["gamma"]
-        B = fit["beta"]
-        GB2 = 2 * _bmul(G, B)
-        BG = _bmul(B, B) - _bmul(G, G)
-        f2 = _bmul(GB2, e3) + _bmul(BG, e2)
-        f3 = _bmul(BG, e3) - _bmul(GB2, e2)
-        w = _bmul(speed, _bmul(B, B) + _bmul(G, G))
-        tangent = cols[0]
+        rf = _rational_numerators(fit)
         st = fit["straight"]
         if st.any():
             r = self.rmf(np.flatnonzero(st).astype(float), initial=initial,
                          omega_start=omega_start)[:, :, 0]
-            d = np.diff(self._cp[st], axis=1)
-            t = d[:, 0] / np.linalg.norm(d[:, 0], axis=1)[:, None]
-            f2[st] = r[:, None, :]
-            f3[st] = np.cross(t, r)[:, None, :]
-            w[st] = 1.0
-            L = np.linalg.norm(d, axis=2)
-            tangent[st] = 3 * d
-            speed[st] = 3 * np.stack([L[:, 0], np.einsum("ij,ij->i", d[:, 0], d[:, 1]) / L[:, 0],
-                                      L[:, 2]], axis=1)
-        return {"f2": f2, "f3": f3, "weight": w, "tangent": tangent, "speed": speed}
+            _straighten(rf, st, self._cp[st], r)
+        return rf
 
     def surface(self, section_ctrl, section_weights=None, *, initial=None,
                 omega_start: float = 0.0) -> np.ndarray:
@@ -629,29 +684,9 @@ class PHSpline:
         ``θ > 90°``) although ``ω > 0`` on ``[0, 1]``; NURBS exporters that need positive
         weights must subdivide or elevate.
         """
-        c = _finite(as_float_array(section_ctrl, "section_ctrl"), "section_ctrl")
-        if c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1:
-            raise ValueError(f"section_ctrl: expected shape (m + 1, 2), got {c.shape}")
-        if section_weights is None:
-            wj = np.ones(c.shape[0])
-        else:
-            wj = _finite(as_float_array(section_weights, "section_weights"), "section_weights")
-            if wj.shape != (c.shape[0],):
-                raise ValueError(f"section_weights: expected shape ({c.shape[0]},), got "
-                                 f"{wj.shape}")
-            if not np.all(wj > 0):
-                raise ValueError("section_weights: must be positive")
+        c, wj = _section(section_ctrl, section_weights)
         rf = self.rational_frames(initial=initial, omega_start=omega_start)
-        om = _elevate(rf["weight"], 9)                    # (m, 10)
-        xom = _bmul(self._cp, rf["weight"])               # (m, 10, 3)
-        F2 = _elevate(rf["f2"], 9)
-        F3 = _elevate(rf["f3"], 9)
-        C0, C2, C3 = wj, wj * c[:, 0], wj * c[:, 1]
-        num = (xom[:, :, None, :] * C0[None, None, :, None]
-               + F2[:, :, None, :] * C2[None, None, :, None]
-               + F3[:, :, None, :] * C3[None, None, :, None])
-        wt = om[:, :, None] * C0[None, None, :]
-        return np.concatenate([num, wt[..., None]], axis=3)
+        return _sweep_patches(self._cp, rf, c, wj)
 
     def sweep(self, profile, *, n_per_segment: int = 16, initial=None, exact: bool = False,
               omega_start: float = 0.0, **kwargs):
@@ -770,6 +805,69 @@ def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float
     return out
 
 
+def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
+                   diag: float) -> np.ndarray:
+    """Starting knots of the adaptive fit: uniform (4 intervals of a curve, every ⌈n/8⌉-th
+    row of samples), the inflections (κ minima with κ·diag < 1e-6, or rows where the
+    discrete binormal flips), then intervals halved until the tangent turns by less than
+    π/2 on each (8-point scan)."""
+    if analytic:
+        h_min = 1e-6 * (hi - lo)
+        infl = [x for x in _inflections(curve, lo, hi, 256, diag)
+                if lo + h_min < x < hi - h_min]
+        # uniform knots give way to nearby inflections (no sliver intervals)
+        k = {x for x in np.linspace(lo, hi, 5).tolist()
+             if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
+        k.update(infl)
+    else:
+        n = pts.shape[0]
+        k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
+        d = np.diff(pts, axis=0)
+        bn = np.cross(d[:-1], d[1:])
+        bl = np.linalg.norm(bn, axis=1)
+        ok = bl > 1e-12 * np.linalg.norm(d[:-1], axis=1) * np.linalg.norm(d[1:], axis=1)
+        bn = bn / np.where(ok, bl, 1.0)[:, None]
+        for j in range(len(bn) - 1):
+            if ok[j] and ok[j + 1] and bn[j] @ bn[j + 1] < 0:  # rows j+1 and j+2
+                k.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
+        h_min = 1.0
+    k = np.array(sorted(k))
+    for _ in range(64):
+        sub = k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.linspace(0, 1, 9)
+        if not analytic:
+            sub = np.round(sub)
+        t0 = data(k[:-1])[1]
+        ts = data(sub.ravel())[1].reshape(sub.shape[0], 9, 3)
+        turn = (ts * t0[:, None]).sum(-1).min(axis=1) <= 0
+        split = turn & (np.diff(k) > h_min)
+        if not split.any():
+            break
+        mid = (k[:-1] + k[1:])[split] / 2
+        k = np.union1d(k, np.floor(mid) if not analytic else mid)
+    return k
+
+
+def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
+    """The knots of a fit with ``segments`` uniform intervals or explicit ``knots``, and the
+    name of the argument that set them."""
+    if segments is not None:
+        N = as_int(segments, "segments", minimum=1)
+        k = np.linspace(lo, hi, N + 1)
+        if not analytic:
+            k = np.unique(np.round(k))
+            if k.size != N + 1:
+                raise ValueError(f"segments: {N} intervals need at least {N + 1} samples")
+        return k, "segments"
+    k = _finite(as_float_array(knots, "knots"), "knots")
+    if k.ndim != 1 or k.size < 2 or not np.all(np.diff(k) > 0):
+        raise ValueError("knots: expected a strictly increasing 1-D array of >= 2 values")
+    if k[0] < lo or k[-1] > hi:
+        raise ValueError(f"knots: must lie within [{lo:g}, {hi:g}]")
+    if not analytic and not np.all(k == np.round(k)):
+        raise ValueError("knots: sample knots must be integer rows")
+    return k, "knots"
+
+
 def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=None,
         max_segments: int = 4096) -> PHSpline:
     """Convert a curve into a G¹ spline of PH cubics (Maurer & Jüttler §3.3).
@@ -835,6 +933,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         lo, hi = float(lo), float(hi)
         if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
             raise ValueError(f"domain: expected a finite interval (lo, hi), got {domain!r}")
+        pts = None
         probe = curve.point(np.linspace(lo, hi, 257))
         diag = float(np.linalg.norm(probe.max(0) - probe.min(0)))
 
@@ -885,25 +984,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         return _dev_rows(cp, pts, k[:-1].astype(np.intp), k[1:].astype(np.intp))
 
     if segments is not None or knots is not None:
-        if segments is not None:
-            N = as_int(segments, "segments")
-            if N < 1:
-                raise ValueError(f"segments: must be >= 1, got {N}")
-            k = np.linspace(lo, hi, N + 1)
-            if not analytic:
-                k = np.unique(np.round(k))
-                if k.size != N + 1:
-                    raise ValueError(f"segments: {N} intervals need at least {N + 1} samples")
-            what = "segments"
-        else:
-            k = _finite(as_float_array(knots, "knots"), "knots")
-            if k.ndim != 1 or k.size < 2 or not np.all(np.diff(k) > 0):
-                raise ValueError("knots: expected a strictly increasing 1-D array of >= 2 values")
-            if k[0] < lo or k[-1] > hi:
-                raise ValueError(f"knots: must lie within [{lo:g}, {hi:g}]")
-            if not analytic and not np.all(k == np.round(k)):
-                raise ValueError("knots: sample knots must be integer rows")
-            what = "knots"
+        k, what = _fixed_knots(segments, knots, analytic, lo, hi)
         cp = solve(k, what)
         sp = PHSpline._trusted(cp, k)
         sp.deviation = deviation(cp, k)
@@ -912,39 +993,8 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
     tol = 1e-5 * diag if tol is None else float(as_float_array(tol, "tol"))
     if not (tol > 0 and np.isfinite(tol)):
         raise ValueError(f"tol: must be positive and finite, got {tol}")
-    # initial knots: uniform, inflections, tangent turn < π/2 (8-point scan)
-    if analytic:
-        h_min = 1e-6 * (hi - lo)
-        infl = [x for x in _inflections(curve, lo, hi, 256, diag)
-                if lo + h_min < x < hi - h_min]
-        # uniform knots give way to nearby inflections (no sliver intervals)
-        k = {x for x in np.linspace(lo, hi, 5).tolist()
-             if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
-        k.update(infl)
-    else:
-        k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
-        d = np.diff(pts, axis=0)
-        bn = np.cross(d[:-1], d[1:])
-        bl = np.linalg.norm(bn, axis=1)
-        ok = bl > 1e-12 * np.linalg.norm(d[:-1], axis=1) * np.linalg.norm(d[1:], axis=1)
-        bn = bn / np.where(ok, bl, 1.0)[:, None]
-        for j in range(len(bn) - 1):
-            if ok[j] and ok[j + 1] and bn[j] @ bn[j + 1] < 0:  # rows j+1 and j+2
-                k.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
-        h_min = 1.0
-    k = np.array(sorted(k))
-    for _ in range(64):
-        sub = k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.linspace(0, 1, 9)
-        if not analytic:
-            sub = np.round(sub)
-        t0 = data(k[:-1])[1]
-        ts = data(sub.ravel())[1].reshape(sub.shape[0], 9, 3)
-        turn = (ts * t0[:, None]).sum(-1).min(axis=1) <= 0
-        split = turn & (np.diff(k) > h_min)
-        if not split.any():
-            break
-        mid = (k[:-1] + k[1:])[split] / 2
-        k = np.union1d(k, np.floor(mid) if not analytic else mid)
+    k = _initial_knots(curve, pts, data, analytic, lo, hi, diag)
+    h_min = 1e-6 * (hi - lo) if analytic else 1.0
     # work queue, processed in batches
     pending = [(k[i], k[i + 1]) for i in range(len(k) - 1)]
     done: list[tuple[float, float, np.ndarray, float]] = []

@@ -30,7 +30,7 @@ import numpy as np
 
 from . import _core
 from ._frames import estimate_tangents, frames
-from ._validate import as_bool, as_choice, as_float_array, as_int, as_points
+from ._validate import as_bool, as_choice, as_float_array, as_frames, as_int, as_points, as_vector
 
 __all__ = [
     "WalkResult",
@@ -68,16 +68,6 @@ def _quats(x, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
     return _to_xyzw(q, scalar_first), single
 
 
-def _frames_arg(x, name: str = "frames") -> tuple[np.ndarray, bool]:
-    f = as_float_array(x, name)
-    single = f.ndim == 2
-    if single:
-        f = f[None]
-    if f.ndim != 3 or f.shape[1:] != (3, 3):
-        raise ValueError(f"{name}: expected shape (3, 3) or (n, 3, 3), got {np.shape(x)}")
-    return np.ascontiguousarray(f), single
-
-
 def to_quaternions(frames, *, scalar_first: bool = False, continuous: bool = True) -> np.ndarray:
     """Unit quaternions of frames: ``(n, 3, 3)`` → ``(n, 4)`` (a single ``(3, 3)`` → ``(4,)``).
 
@@ -91,7 +81,7 @@ def to_quaternions(frames, *, scalar_first: bool = False, continuous: bool = Tru
     Raises ValueError for a row that is not a rotation matrix (orthonormal to 1e-6,
     ``det = +1``; a reflection has no quaternion).
     """
-    f, single = _frames_arg(frames)
+    f, single = as_frames(frames)
     q = _core.quat_from_frames(f, as_bool(continuous, "continuous"))
     q = _from_xyzw(q, as_bool(scalar_first, "scalar_first"))
     return q[0] if single else q
@@ -149,7 +139,7 @@ def slerp_frames(frames, new_u, key_u=None) -> np.ndarray:
     at constant speed about a fixed axis (Ma's key frames for camera paths). Returns
     ``(k, 3, 3)``.
     """
-    f, _ = _frames_arg(frames)
+    f, _ = as_frames(frames)
     n = len(f)
     if n < 2:
         raise ValueError(f"frames: need at least 2 key frames, got {n}")
@@ -223,10 +213,8 @@ def quaternion_frames(
     sf = as_bool(scalar_first, "scalar_first")
     turns = as_int(turns, "turns")
     pts = as_points(points, "points")
-    if method == "frenet":
-        if initial is not None or turns:
-            raise ValueError("initial, turns: not used by method='frenet'")
-        f = frames(pts, tangents, method="frenet", closed=closed)
+    if method == "frenet":  # the core refuses initial and turns for the Frenet frame
+        f = frames(pts, tangents, method="frenet", closed=closed, initial=initial, turns=turns)
         return _from_xyzw(_core.quat_from_frames(f, True), sf)
     n = len(pts)
     if n < 2:
@@ -259,7 +247,7 @@ def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) ->
     per turn of any helix). Accepts ``(n, 4)`` quaternions or ``(n, 3, 3)`` frames."""
     a = as_float_array(q, "q")
     if a.ndim == 3:
-        a = _core.quat_from_frames(_frames_arg(a, "q")[0], True)
+        a = _core.quat_from_frames(as_frames(a, "q")[0], True)
     else:
         a, _ = _quats(a, "q", as_bool(scalar_first, "scalar_first"))
     return float(_core.quat_path_length(a, as_bool(closed, "closed")))
@@ -270,8 +258,8 @@ def spin(a, b) -> np.ndarray | float:
     into frame ``b``'s about ``a``'s tangent — the twist between two frames with the same
     tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``.
     """
-    fa, sa = _frames_arg(a, "a")
-    fb, sb = _frames_arg(b, "b")
+    fa, sa = as_frames(a, "a")
+    fb, sb = as_frames(b, "b")
     ra, sa_, rb = fa[:, :, 0], fa[:, :, 1], fb[:, :, 0]
     ang = np.arctan2(np.einsum("ij,ij->i", rb, sa_), np.einsum("ij,ij->i", rb, ra))
     return float(ang[0]) if (sa and sb) else ang
@@ -466,15 +454,8 @@ def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkRes
     """
     v = as_points(vertices, "vertices")
     fa = _faces(faces)
-    p = as_float_array(point, "point")
-    if p.shape != (3,):
-        raise ValueError(f"point: expected shape (3,), got {p.shape}")
-    d = None
-    if direction is not None:
-        d = as_float_array(direction, "direction")
-        if d.shape != (3,):
-            raise ValueError(f"direction: expected shape (3,), got {d.shape}")
-        d = np.ascontiguousarray(d)
+    p = as_vector(point, "point")
+    d = None if direction is None else as_vector(direction, "direction")
     mv = as_float_array(moves, "moves")
     if mv.ndim == 1 and mv.shape == (2,):
         mv = mv[None]

@@ -127,7 +127,9 @@ impl Sphere {
 /// distance-field extension of the region translation, `Y = X − (a + b)/2`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Capsule {
+    /// First end of the capsule's axis segment (world units).
     pub a: DVec3,
+    /// Second end of the capsule's axis segment (world units).
     pub b: DVec3,
     pub velocity: DVec3,
     pub radius: f64,
@@ -287,7 +289,9 @@ impl Torus {
 /// Straight strip (segment a–b, radius ρ) pushing sideways with velocity m ⟂ (b − a).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StripAcross {
+    /// First end of the strip's axis segment (world units).
     pub a: DVec3,
+    /// Second end of the strip's axis segment (world units).
     pub b: DVec3,
     pub velocity: DVec3,
     pub radius: f64,

@@ -39,6 +39,7 @@ use crate::error::{InputError, Result};
 /// One spine sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
+    /// Position of the spine sample (world units).
     pub x: DVec3,
     pub frame: DMat3,
     /// Cumulative chord length.
@@ -52,6 +53,7 @@ pub struct PathTool {
     /// Per segment: body axis-angle `Θ_k` and `F_k Θ_k / ΔS_k` (world ω per unit speed).
     theta: Vec<DVec3>,
     omega: Vec<DVec3>,
+    /// Start time of the motion along the spine.
     pub t0: f64,
     pub duration: f64,
     pub radius: f64,
@@ -68,7 +70,9 @@ pub struct PathTool {
 /// The pose at time `t`: position, velocity, world angular velocity, frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pose {
+    /// Position (world units).
     pub o: DVec3,
+    /// Velocity (world units per unit time).
     pub v: DVec3,
     pub omega: DVec3,
     pub frame: DMat3,

@@ -47,8 +47,11 @@ use crate::error::{InputError, Result};
 /// One axis sample: position, derivative `dγ/dS`, cumulative chord length.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisSample {
+    /// Position `γ` on the axis (world units).
     pub x: DVec3,
+    /// Derivative `dγ/dS` (per unit chord length).
     pub m: DVec3,
+    /// Cumulative chord length `S`.
     pub s: f64,
 }
 

@@ -16,7 +16,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::spine::Spine;
+use super::spine::SpineModel;
 use crate::error::{InputError, Result};
 
 /// Numbers stored per vertex besides the edge index.
@@ -31,7 +31,7 @@ pub struct Binding {
 
 /// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
 /// steps, each refined by the Illinois variant of regula falsi to full precision.
-fn edge_roots(sp: &Spine, k: usize, p: DVec3) -> [f64; 4] {
+fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
     let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
     let mut out = [f64::NAN; 4];
     let mut prev = (0.0, f(0.0));
@@ -84,7 +84,7 @@ fn edge_roots(sp: &Spine, k: usize, p: DVec3) -> [f64; 4] {
 }
 
 /// Register one vertex: `(k, a, τ)`.
-fn locate(sp: &Spine, p: DVec3) -> (usize, f64, f64) {
+fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
     let n = sp.len();
     let mut best = (f64::INFINITY, 0usize, 0.0f64, 0.0f64);
     // straight extensions past both ends
@@ -149,7 +149,7 @@ fn locate(sp: &Spine, p: DVec3) -> (usize, f64, f64) {
 }
 
 /// Register `vertices` on the rest spine.
-pub fn bind(rest: &Spine, vertices: &[DVec3]) -> Result<Binding> {
+pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
     if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "vertices",

@@ -7,10 +7,12 @@
 //! corrected offset — unbend (rest curvature), transfer (RMF to RMF, optional twist, stretch),
 //! bend (posed curvature) (§4.2.1, §5.2.1; spec §2.5) — so that `det ∂P1/∂P0 = 1`.
 //!
-//! **Discrete spine model** ([`spine`]). Between samples the position is linear and the unit
-//! tangent is a normalised cubic Hermite interpolation of the sample tangents whose slopes
-//! match the sample curvature vectors; the cross-section at `(k, a)` is the plane through
-//! `C(a)` normal to `t(a)`. In the coordinates
+//! **Discrete spine model** ([`spine`]). Between samples `k` and `k + 1` the position `C(a)`
+//! is the cubic Hermite interpolant of the two samples with end slopes `h_k t_k`, `h_k t_{k+1}`
+//! (`h_k` the chord length, `t_j` the sample unit tangents), and the unit tangent is a
+//! normalised cubic Hermite interpolation of the sample tangents whose slopes match the
+//! sample curvature vectors; the cross-section at `(k, a)` is the plane through `C(a)`
+//! normal to `t(a)`. In the coordinates
 //! `(a, α, β)` of that foliation the volume element is exactly `σ(a) (1 − d·κ(a)) da dα dβ`
 //! with `σ = E_k·t(a)` and `κ = (dt/da)/σ` (the spine's speed and curvature vector in this
 //! model), so the thesis' stretchable formulas with `λ = σ1/σ0` make the discrete map exactly
@@ -30,4 +32,7 @@ pub mod surface;
 pub use bind::{Binding, COORDS, bind};
 pub use pose::deform;
 pub use solve::Solution;
-pub use spine::Spine;
+pub use spine::SpineModel;
+/// The former name of [`SpineModel`] (renamed so that it is not confused with the sweep's
+/// `sweep::Spine`); kept until the binding uses the new name.
+pub use spine::SpineModel as Spine;

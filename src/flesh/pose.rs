@@ -13,13 +13,13 @@ use rayon::prelude::*;
 
 use super::bind::COORDS;
 use super::solve::{Solution, bend, unbend};
-use super::spine::Spine;
+use super::spine::SpineModel;
 use crate::error::{InputError, Result};
 
 /// Deform a registered shape. `twist` is empty or one angle (rad) per spine sample.
 /// Writes the vertices to `out` and the per-vertex flags (see [`super::solve`]) to `flags`.
 pub fn deform(
-    posed: &Spine,
+    posed: &SpineModel,
     edge: &[i64],
     coords: &[f64],
     sol: Solution,
@@ -68,7 +68,7 @@ pub fn deform(
 
 /// Vertices per parallel task.
 const TASK: usize = 1024;
-/// Vertices evaluated together (see [`Spine::eval_lanes`]).
+/// Vertices evaluated together (see [`SpineModel::eval_lanes`]).
 const LANES: usize = 4;
 
 const fn solution(s: u8) -> Solution {
@@ -83,7 +83,7 @@ const fn solution(s: u8) -> Solution {
 /// One task's vertices, `LANES` at a time; the solution is a constant of the instance, so
 /// its branch leaves the loop.
 fn batch<const S: u8>(
-    posed: &Spine,
+    posed: &SpineModel,
     twist: &[f64],
     edge: &[i64],
     coords: &[f64],
@@ -117,7 +117,7 @@ fn batch<const S: u8>(
 
 #[inline(always)]
 fn lanes<const S: u8, const L: usize>(
-    posed: &Spine,
+    posed: &SpineModel,
     twist: &[f64],
     edge: &[i64],
     coords: &[f64],

@@ -13,9 +13,12 @@ use crate::error::{InputError, Result};
 
 /// A sampled spine with its frames (`t` and `r` columns of `spinal.frames`).
 #[derive(Clone, Debug)]
-pub struct Spine {
+pub struct SpineModel {
+    /// Sample points `C_j` (input units).
     pub c: Vec<DVec3>,
+    /// Unit tangents `t_j` at the samples (the `t` columns of the frames).
     pub t: Vec<DVec3>,
+    /// RMF reference vectors `r_j` at the samples (the `r` columns).
     pub r: Vec<DVec3>,
     /// Per edge: `m(a) = m[0] + a m[1] + a² m[2] + a³ m[3]`.
     pub m: Vec<[DVec3; 4]>,
@@ -25,8 +28,6 @@ pub struct Spine {
     pub rb: Vec<DVec3>,
 }
 
-/// Sample curvature vectors: central differences of the unit tangents in chord length,
-/// made normal to the tangent (one-sided at the ends).
 fn hermite(p0: DVec3, p1: DVec3, d0: DVec3, d1: DVec3) -> [DVec3; 4] {
     [
         p0,
@@ -54,6 +55,8 @@ fn min_rotate(v: DVec3, from: DVec3, to: DVec3) -> DVec3 {
     v * c + k.cross(v) + k * (k.dot(v) / (1.0 + c))
 }
 
+/// Sample curvature vectors: central differences of the unit tangents in chord length,
+/// made normal to the tangent (one-sided at the ends).
 fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
     let n = c.len();
     (0..n)
@@ -72,9 +75,13 @@ fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
 /// The spine evaluated at `(k, a)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Local {
+    /// Position `C(a)` (input units).
     pub q: DVec3,
+    /// Unit tangent `t(a)`.
     pub t: DVec3,
+    /// Interpolated RMF reference vector (unit, ⟂ `t`).
     pub u: DVec3,
+    /// `t × u`, completing the right-handed frame `(u, v, t)`.
     pub v: DVec3,
     /// `C'(a) · t(a)`: the speed of the sections along the spine.
     pub sigma: f64,
@@ -82,9 +89,9 @@ pub struct Local {
     pub kappa: DVec2,
 }
 
-impl Spine {
+impl SpineModel {
     /// `frames` is row-major `(n, 3, 3)` with columns `(r, s, t)` (the layout of the crate).
-    pub fn new(arg: &'static str, points: &[DVec3], frames: &[f64]) -> Result<Spine> {
+    pub fn new(arg: &'static str, points: &[DVec3], frames: &[f64]) -> Result<SpineModel> {
         let n = points.len();
         if n < 2 {
             return Err(InputError::new(
@@ -155,7 +162,7 @@ impl Spine {
         let rb = (0..n - 1)
             .map(|k| min_rotate(r[k + 1], t[k + 1], t[k]))
             .collect();
-        Ok(Spine {
+        Ok(SpineModel {
             c: points.to_vec(),
             t,
             r,
@@ -191,7 +198,7 @@ impl Spine {
         self.eval_lanes(&[k], &[a])[0]
     }
 
-    /// [`Spine::eval`] of `L` points at once, stage by stage across the lanes: the chains
+    /// [`SpineModel::eval`] of `L` points at once, stage by stage across the lanes: the chains
     /// of square roots and divisions of different points are independent, so the processor
     /// overlaps them (one point alone waits on each in turn).
     #[inline(always)]

@@ -30,9 +30,13 @@ pub const SURFACE_COORDS: usize = 9;
 /// A sampled spine surface.
 #[derive(Clone, Debug)]
 pub struct Surface {
+    /// Grid rows (first index `i`).
     pub nu: usize,
+    /// Grid columns (second index `j`); sample `(i, j)` is row `i·nv + j`.
     pub nv: usize,
+    /// Surface samples `S_ij`, row-major (input units).
     pub s: Vec<DVec3>,
+    /// Unit normals at the samples, `S_i × S_j` by central differences.
     pub n: Vec<DVec3>,
     /// Per sample: `[∂S/∂i, ∂S/∂j, ∂n/∂i, ∂n/∂j]` by central differences (per grid step).
     pub d: Vec<[DVec3; 4]>,
@@ -51,11 +55,17 @@ fn grid_diff(x: &[DVec3], nu: usize, nv: usize, i: usize, j: usize) -> (DVec3, D
 /// The surface at one point of a cell.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfLocal {
+    /// The point `S(u, v)` (input units).
     pub s: DVec3,
+    /// `∂S/∂u` (per grid step).
     pub su: DVec3,
+    /// `∂S/∂v` (per grid step).
     pub sv: DVec3,
+    /// Unit normal `N(u, v)`.
     pub n: DVec3,
+    /// `∂N/∂u` (per grid step; ⟂ N).
     pub nu: DVec3,
+    /// `∂N/∂v` (per grid step; ⟂ N).
     pub nv: DVec3,
 }
 

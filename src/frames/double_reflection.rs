@@ -52,9 +52,13 @@ pub fn dr_step_with(v1: DVec3, v1v1: f64, t0: DVec3, t1: DVec3, r: DVec3) -> DVe
 
 /// Double reflection over a sampled curve (points may be empty in tangents-only mode).
 pub struct DoubleReflection<'a> {
+    /// Sample points `x_i` (empty in tangents-only mode).
     pub x: &'a [DVec3],
+    /// Unit tangents `t_i` at the samples.
     pub t: &'a [DVec3],
+    /// The samples form a loop (the segment from the last to the first is included).
     pub closed: bool,
+    /// Chords from the 4th-order quadrature of the tangents instead of `x_{i+1} − x_i`.
     pub tangent_chords: bool,
 }
 

@@ -113,8 +113,11 @@ impl Neg for F4 {
 /// A 3-vector of four samples: `x`, `y`, `z` each an [`F4`].
 #[derive(Debug, Clone, Copy)]
 pub struct V4 {
+    /// The `x` components of the four vectors.
     pub x: F4,
+    /// The `y` components of the four vectors.
     pub y: F4,
+    /// The `z` components of the four vectors.
     pub z: F4,
 }
 

@@ -59,8 +59,11 @@ pub enum Orientation {
 /// Exact derivatives of an analytic curve at `u_0, (u_0+u_1)/2, u_1, …, u_m` (2m + 1 rows).
 #[derive(Debug, Clone, Copy)]
 pub struct Analytic<'a> {
+    /// Parameter values `u_0 < … < u_m` of the samples.
     pub u: &'a [f64],
+    /// First derivative `x′(u)` at the samples and midpoints (2m + 1 rows).
     pub d1: &'a [DVec3],
+    /// Second derivative `x″(u)` at the samples and midpoints (2m + 1 rows).
     pub d2: &'a [DVec3],
 }
 
@@ -125,12 +128,8 @@ pub(crate) fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) 
             if !m.is_finite() {
                 return Err(InputError::new(arg, "contains a non-finite value"));
             }
-            let e = m.transpose() * m - DMat3::IDENTITY;
-            let off = e
-                .to_cols_array()
-                .iter()
-                .fold(0.0_f64, |a, v| a.max(v.abs()));
-            if off > 1e-6 || m.determinant() <= 0.0 {
+            // the columns of mᵀ are the rows of m: the row-major layout `is_rotation` reads
+            if !validate::is_rotation(&m.transpose().to_cols_array()) {
                 return Err(InputError::new(
                     arg,
                     "is not a rotation matrix: its columns (r, s, t) must be orthonormal \
@@ -195,6 +194,21 @@ impl Curvature<'_> {
     }
 }
 
+/// `tangents` must have one row per point.
+fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
+    if points.len() == tangents.len() {
+        return Ok(());
+    }
+    Err(InputError::new(
+        "tangents",
+        format!(
+            "shape ({}, 3) does not match points ({}, 3): one tangent per point",
+            tangents.len(),
+            points.len()
+        ),
+    ))
+}
+
 /// Compute the frames of one curve into `out` (`9 × rows` values, row-major `(rows, 3, 3)`).
 ///
 /// Returns the raw end angle of the boundary condition (the closing angle for a closed
@@ -215,17 +229,14 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         (None, Some(t)) => t.len(),
         (None, None) => return Err(InputError::new("points", "points or tangents are required")),
     };
-    if let (Some(p), Some(t)) = (req.points, req.tangents)
-        && p.len() != t.len()
-    {
-        return Err(InputError::new(
-            "tangents",
-            format!("has {} rows but points has {}", t.len(), p.len()),
-        ));
+    if let (Some(p), Some(t)) = (req.points, req.tangents) {
+        rows_match(p, t)?;
     }
     if rows < 2 {
         return Err(InputError::new(
-            if req.points.is_some() {
+            if req.analytic.is_some() {
+                "u"
+            } else if req.points.is_some() {
                 "points"
             } else {
                 "tangents"
@@ -265,7 +276,9 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
     if req.method == Method::Rk4 && req.analytic.is_none() {
         return Err(InputError::new(
             "method",
-            "'rk4' needs an analytic curve (x′ and x″): pass a spinal.curves object with u",
+            "'rk4' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass a \
+             spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), u=200, \
+             method='rk4')",
         ));
     }
     if req.tangent_chords && req.method != Method::DoubleReflection && req.method != Method::Frenet
@@ -427,8 +440,10 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
             return Err(InputError::new(
                 if req.initial.is_some() {
                     "initial"
-                } else {
+                } else if req.end.is_some() {
                     "end"
+                } else {
+                    "turns"
                 },
                 "is not used by method='frenet': the Frenet frame is fixed by the curve",
             ));
@@ -567,15 +582,10 @@ pub fn compute_many(
         .map(<[DVec3]>::len)
         .or(template.tangents.map(<[DVec3]>::len))
         .unwrap_or(0);
-    if offsets.first() != Some(&0)
-        || offsets.last() != Some(&total)
-        || offsets.windows(2).any(|w| w[1] < w[0])
-    {
-        return Err(InputError::new(
-            "lengths",
-            format!("curve lengths must be non-negative and add up to the {total} rows"),
-        ));
+    if let (Some(p), Some(t)) = (template.points, template.tangents) {
+        rows_match(p, t)?;
     }
+    validate::offsets(offsets, total)?;
     if out.len() != 9 * total {
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }

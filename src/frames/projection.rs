@@ -18,7 +18,9 @@ pub fn projection_step(d: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
 }
 
 pub struct Projection<'a> {
+    /// Sample points `x_i` (the chords `x_{i+1} − x_i` are the projection directions).
     pub x: &'a [DVec3],
+    /// Unit tangents `t_i` at the samples.
     pub t: &'a [DVec3],
 }
 

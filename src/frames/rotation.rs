@@ -19,6 +19,7 @@ pub fn rotation_step(t0: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
 }
 
 pub struct Rotation<'a> {
+    /// Unit tangents `t_i` at the samples.
     pub t: &'a [DVec3],
 }
 

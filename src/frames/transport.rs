@@ -131,11 +131,17 @@ pub struct Scan<B, T, L> {
     pub tangent: T,
     /// Length of segment `i` (clamped to the last segment), for the twist.
     pub seg: L,
+    /// Number of distinct samples of the curve.
     pub n: usize,
+    /// The curve is a loop.
     pub closed: bool,
+    /// Unit reference vector at sample 0 (⟂ its tangent).
     pub r0: DVec3,
+    /// Boundary condition whose twist is spread in arc length.
     pub twist: Twist,
+    /// Chunk size: extended frames per parallel task.
     pub cs: usize,
+    /// Number of extended frames (`n`, plus one for a closed curve's return to sample 0).
     pub ext: usize,
 }
 

@@ -155,3 +155,54 @@ pub fn is_rotation(f: &[f64; 9]) -> bool {
         && q.dot(t).abs() < 1e-6
         && r.cross(q).dot(t) > 0.0
 }
+
+/// Check CSR-style curve offsets (`offsets[c]..offsets[c + 1]` are the rows of curve `c`)
+/// over `rows` rows. The Python functions take `lengths` (converted to offsets by a
+/// cumulative sum, so they start at 0) or `offsets`; a rule broken by either is named by
+/// the argument whose words describe it.
+pub fn offsets(offsets: &[usize], rows: usize) -> Result<()> {
+    match offsets.first() {
+        None => return Err(InputError::new("offsets", "must not be empty (start at 0)")),
+        Some(&o) if o != 0 => {
+            return Err(InputError::new(
+                "offsets",
+                format!("must start at 0, got {o}"),
+            ));
+        }
+        _ => {}
+    }
+    if let Some(c) = offsets.windows(2).position(|w| w[1] < w[0]) {
+        return Err(InputError::new(
+            "lengths",
+            format!(
+                "must be non-negative: curve {c} has length {} (offsets must never decrease)",
+                offsets[c + 1] as i64 - offsets[c] as i64
+            ),
+        ));
+    }
+    let last = offsets[offsets.len() - 1];
+    if last != rows {
+        return Err(InputError::new(
+            "lengths",
+            format!("the curves cover {last} rows but the input has {rows}"),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_name_the_broken_rule() {
+        assert!(offsets(&[0, 3, 5], 5).is_ok());
+        assert_eq!(offsets(&[], 5).unwrap_err().arg, "offsets");
+        assert_eq!(offsets(&[1, 5], 5).unwrap_err().arg, "offsets");
+        let e = offsets(&[0, 4, 2, 5], 5).unwrap_err();
+        assert_eq!(e.arg, "lengths");
+        assert!(e.msg.contains("curve 1 has length -2"), "{e}");
+        let e = offsets(&[0, 2, 4], 5).unwrap_err();
+        assert!(e.msg.contains("cover 4 rows but the input has 5"), "{e}");
+    }
+}

@@ -34,9 +34,13 @@ pub const SIMPSON_N: usize = 20;
 /// The fitted rational angle function of one segment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct AngleFit {
+    /// Angle offset `φ` (rad) of `Ω̃ = φ + 2 sg arctan W`.
     pub phi: f64,
+    /// `sg = sign k` (±1).
     pub sg: f64,
+    /// End values `w₀, w₁` of `w = sg·tan((Ω − φ)/2)`.
     pub w: [f64; 2],
+    /// End slopes `s₀, s₁` of `w` (per unit `v`).
     pub s: [f64; 2],
     pub lambda_star: f64,
     pub lambda: f64,
@@ -67,14 +71,21 @@ impl AngleFit {
 /// Frame data of one spline segment.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Segment {
+    /// The cubic is a straight segment (the reference vector is carried unchanged).
     pub straight: bool,
     /// Reference vector at the start (carried unchanged along a straight segment).
     pub r: DVec3,
+    /// RMF angle `Ω(0)` (rad, from `n` towards `b`) at the start.
     pub omega0: f64,
+    /// RMF angle `Ω(1)` (rad) at the end.
     pub omega1: f64,
+    /// The factor `k` of the cubic's [`super::Invariants`] (0 when planar).
     pub k: f64,
+    /// `a` of the speed (see [`super::Invariants`]).
     pub a: f64,
+    /// `b` of the speed (see [`super::Invariants`]).
     pub b: f64,
+    /// `c` of the speed (see [`super::Invariants`]).
     pub c: f64,
     /// `σ/3` in Bernstein form: `(L₁, L₂cθ, L₃)`.
     pub speed: [f64; 3],

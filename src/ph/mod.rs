@@ -63,19 +63,26 @@ pub fn bern2(v: f64) -> [f64; 3] {
 /// A cubic Bézier curve by its four control points.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cubic {
+    /// Control points `b₀ … b₃`.
     pub b: [DVec3; 4],
 }
 
 /// The scalar invariants of a PH cubic (meaningful only for PH control polygons).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Invariants {
+    /// Leg lengths `L₁, L₂, L₃` of the control polygon, `Lᵢ = |bᵢ − bᵢ₋₁|`.
     pub l: [f64; 3],
     pub ctheta: f64,
     pub stheta: f64,
+    /// `Δ = det[d₁, d₂, d₃]` of the legs (its sign is the sign of the torsion).
     pub delta: f64,
+    /// `a = √(L₁L₃ − L₂²cθ²)` of the speed `σ(v) = 3(c v² − 2b v + L₁)`.
     pub a: f64,
+    /// `b = L₁ − L₂cθ` of the speed.
     pub b: f64,
+    /// `c = L₁ − 2L₂cθ + L₃` of the speed.
     pub c: f64,
+    /// `k = −sgn(Δ)√(L₁L₃ − L₂²)/a` (|k| ≤ 1; 0 for planar cubics), the factor of the RMF angle.
     pub k: f64,
     /// `κ/τ` (constant along a PH cubic; ±∞ for planar ones).
     pub kappa_over_tau: f64,

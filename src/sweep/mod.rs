@@ -75,6 +75,7 @@ pub struct Mesh {
     pub vertices: Vec<DVec3>,
     pub faces: Vec<[i64; 3]>,
     pub normals: Vec<DVec3>,
+    /// Texture coordinates: `u` spine arc length, `v` profile arc length / perimeter.
     pub uv: Vec<DVec2>,
     /// Spine rows (global, as given) starting a segment where the sweep folds over.
     pub folds: Vec<usize>,
@@ -270,6 +271,7 @@ pub struct MeshMut<'a> {
     pub vertices: &'a mut [DVec3],
     pub faces: &'a mut [[i64; 3]],
     pub normals: &'a mut [DVec3],
+    /// Texture coordinates `(u, v)`, as in [`Mesh::uv`].
     pub uv: &'a mut [DVec2],
 }
 
@@ -516,15 +518,7 @@ fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
 pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options) -> Result<Layout> {
     let curves = offsets.len().saturating_sub(1);
     let n = all.points.len();
-    if offsets.first() != Some(&0)
-        || offsets.last() != Some(&n)
-        || offsets.windows(2).any(|w| w[1] < w[0])
-    {
-        return Err(InputError::new(
-            "lengths",
-            format!("curve lengths must be non-negative and add up to the {n} rows"),
-        ));
-    }
+    validate::offsets(offsets, n)?;
     if !(opts.miter_limit >= 1.0) {
         return Err(InputError::new(
             "miter_limit",

@@ -17,7 +17,9 @@ use crate::error::{InputError, Result};
 /// A validated profile.
 #[derive(Debug, Clone)]
 pub struct Profile {
+    /// Profile vertices `(a, b)` along the frame's `(r, s)` columns.
     pub points: Vec<DVec2>,
+    /// The profile is a closed polygon (else an open polyline).
     pub closed: bool,
     /// Signed area (closed profiles; 0 for open ones).
     pub area: f64,
