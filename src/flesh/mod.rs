@@ -33,6 +33,3 @@ pub use bind::{Binding, COORDS, bind};
 pub use pose::deform;
 pub use solve::Solution;
 pub use spine::SpineModel;
-/// The former name of [`SpineModel`] (renamed so that it is not confused with the sweep's
-/// `sweep::Spine`); kept until the binding uses the new name.
-pub use spine::SpineModel as Spine;

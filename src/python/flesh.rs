@@ -18,10 +18,10 @@ fn spine_of<'py>(
     arg: &'static str,
     points: &PyReadonlyArray2<'py, f64>,
     frames: &PyReadonlyArray3<'py, f64>,
-) -> PyResult<flesh::Spine> {
+) -> PyResult<flesh::SpineModel> {
     let pts = vec3s(arg, points)?;
     let fr = slice_of(arg, frames)?;
-    Ok(flesh::Spine::new(arg, pts, fr)?)
+    Ok(flesh::SpineModel::new(arg, pts, fr)?)
 }
 
 /// Register vertices on a rest spine; see `spinal.SpineBinding`.
