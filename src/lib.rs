@@ -3,8 +3,8 @@
 //! The crate is split in two layers:
 //!
 //! * plain Rust modules that know nothing of Python ([`frames`], [`sweep`], [`quaternion`], [`ph`],
-//!   [`error`]); they work on `glam::DVec3` slices and flat `f64` output buffers and return
-//!   [`error::InputError`] for bad input, never panicking on user data;
+//!   [`math`], [`error`]); they work on `glam::DVec3` slices and flat `f64` output buffers and
+//!   return [`error::InputError`] for bad input, never panicking on user data;
 //! * one thin binding module (`python`, compiled into the `spinal._core` extension) that
 //!   converts NumPy arrays, releases the GIL around the heavy calls and maps errors to
 //!   Python exceptions.
@@ -20,6 +20,7 @@ pub mod deform;
 pub mod error;
 pub mod flesh;
 pub mod frames;
+pub mod math;
 pub mod ph;
 mod python;
 pub mod quaternion;
