@@ -125,12 +125,7 @@ pub(crate) fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) 
             if !m.is_finite() {
                 return Err(InputError::new(arg, "contains a non-finite value"));
             }
-            let e = m.transpose() * m - DMat3::IDENTITY;
-            let off = e
-                .to_cols_array()
-                .iter()
-                .fold(0.0_f64, |a, v| a.max(v.abs()));
-            if off > 1e-6 || m.determinant() <= 0.0 {
+            if !crate::math::rotation::is_rotation(&m) {
                 return Err(InputError::new(
                     arg,
                     "is not a rotation matrix: its columns (r, s, t) must be orthonormal \
