@@ -7,7 +7,8 @@
 //!   frames, walkers on triangle meshes), [`ph`] (Pythagorean-hodograph cubics), [`deform`]
 //!   (volume-preserving deformation by divergence-free fields, advection, the contact
 //!   stamper), [`flesh`] (spine-driven deformation with local volume preservation, on a
-//!   spine or a spine surface) and [`error`]. They work on `glam::DVec3` slices and
+//!   spine or a spine surface), [`math`] (the shared kernels: cubics, rotations, mesh
+//!   measures) and [`error`]. They work on `glam::DVec3` slices and
 //!   flat `f64` output buffers and return [`error::InputError`] for bad input, never
 //!   panicking on user data;
 //! * the binding folder `src/python/` (module `python`, compiled into the `spinal._core`
@@ -26,6 +27,7 @@ pub mod deform;
 pub mod error;
 pub mod flesh;
 pub mod frames;
+pub mod math;
 pub mod ph;
 mod python;
 pub mod quaternion;

@@ -256,9 +256,9 @@ pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::fields::rotate;
     use super::super::{Element, Swirl, SwirlKind};
     use super::*;
+    use crate::math::rotation::rodrigues;
 
     #[test]
     fn rk4_on_a_swirl_is_fourth_order() {
@@ -274,7 +274,7 @@ mod tests {
             elements: vec![Element::Swirl(s)],
         };
         let x0 = DVec3::new(0.6, 0.2, 0.7);
-        let exact = rotate(DVec3::Z, s.angular(x0.z, x0.length()), x0);
+        let exact = rodrigues(x0, DVec3::Z, s.angular(x0.z, x0.length()));
         let err =
             |n: usize| (integrate(&f, x0, 0.0, 1.0 / n as f64, n, Method::Rk4) - exact).length();
         let ratio = err(8) / err(16);

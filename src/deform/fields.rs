@@ -35,6 +35,8 @@
 
 use glam::DVec3;
 
+use crate::math::rotation::rodrigues;
+
 /// `(R − |d|)^(p−1)` and `(R − |d|)` for `|d| < R`, `None` outside the support.
 #[inline(always)]
 fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
@@ -67,13 +69,6 @@ fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
     let outer = rho + reach;
     let inner = rho - reach;
     !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
-}
-
-/// Rodrigues rotation of `y` about the unit axis `a` by `theta`.
-#[inline]
-pub fn rotate(a: DVec3, theta: f64, y: DVec3) -> DVec3 {
-    let (s, c) = theta.sin_cos();
-    y * c + a.cross(y) * s + a * (a.dot(y) * (1.0 - c))
 }
 
 /// Sphere tool translating with velocity `u` (curl field, eq. 12.1–12.2 corrected).
@@ -171,7 +166,7 @@ impl Rotation {
         let w = self.omega.length();
         let arm = self.center - self.pivot;
         let c = if w > 0.0 && arm != DVec3::ZERO && t != 0.0 {
-            self.pivot + rotate(self.omega / w, w * t, arm)
+            self.pivot + rodrigues(arm, self.omega / w, w * t)
         } else {
             self.center
         };

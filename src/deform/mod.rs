@@ -217,18 +217,20 @@ impl Element {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let spec = path::PathToolSpec {
+            t0: h[1],
+            duration: h[2],
+            radius: positive(h[3], "radius")?,
+            reach: positive(h[4], "reach")?,
+            power: power(h[5])?,
+            carry: flag(h[6]),
+            linear: flag(h[7]),
+            rotate: flag(h[8]),
+            twist: h[9],
+            bend: h[10],
+        };
         Ok(Element::Path(std::sync::Arc::new(path::PathTool::new(
-            samples,
-            h[1],
-            h[2],
-            positive(h[3], "radius")?,
-            positive(h[4], "reach")?,
-            power(h[5])?,
-            flag(h[6]),
-            flag(h[7]),
-            flag(h[8]),
-            h[9],
-            h[10],
+            samples, spec,
         )?)))
     }
 
@@ -340,7 +342,7 @@ impl Element {
             Element::Capsule(e) => e.reach,
             Element::Torus(e) => e.reach,
             Element::StripAcross(e) => e.reach,
-            Element::Path(e) => e.reach,
+            Element::Path(e) => e.spec.reach,
             Element::StripAlong(e) => e.reach,
             Element::Grid(e) => e.reach,
         }

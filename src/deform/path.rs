@@ -30,11 +30,13 @@
 //! segment, so `ω` and `d²o/dt²` jump at the sample times `t0 + T S_k/L`: RK4 keeps its 4th
 //! order only when steps end there (`spinal.advect` splits the integration at those times).
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DMat3, DVec3};
 
 use super::cross::Sphere;
-use super::fields::{Rotation, Swirl, SwirlKind, Translation, rotate};
+use super::fields::{Rotation, Swirl, SwirlKind, Translation};
 use crate::error::{InputError, Result};
+use crate::math::cubic::Hermite;
+use crate::math::rotation::{is_rotation, quat_from_mat3, rodrigues};
 
 /// One spine sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,17 +55,30 @@ pub struct PathTool {
     /// Per segment: body axis-angle `Θ_k` and `F_k Θ_k / ΔS_k` (world ω per unit speed).
     theta: Vec<DVec3>,
     omega: Vec<DVec3>,
-    /// Start time of the motion along the spine.
+    pub spec: PathToolSpec,
+}
+
+/// The parameters of a [`PathTool`] besides its spine samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathToolSpec {
+    /// Start time of the motion.
     pub t0: f64,
+    /// Duration `T` of the motion (> 0).
     pub duration: f64,
+    /// Tool radius.
     pub radius: f64,
+    /// Reach of the field beyond the tool.
     pub reach: f64,
+    /// Power of the curl tool's blend.
     pub power: u8,
     /// von Funck region translation instead of the pushing curl tool.
     pub carry: bool,
     pub linear: bool,
+    /// Add the rotation matching the frame's turning.
     pub rotate: bool,
+    /// Twist rate about the moving tangent (0: none).
     pub twist: f64,
+    /// Bend rate about the moving reference vector (0: none).
     pub bend: f64,
 }
 
@@ -81,20 +96,8 @@ pub struct Pose {
 impl PathTool {
     /// Build from samples (positions and orthonormal right-handed frames, strictly increasing
     /// arc length `s`, at least 2) and the parameters.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        samples: Vec<Sample>,
-        t0: f64,
-        duration: f64,
-        radius: f64,
-        reach: f64,
-        power: u8,
-        carry: bool,
-        linear: bool,
-        rotate: bool,
-        twist: f64,
-        bend: f64,
-    ) -> Result<PathTool> {
+    pub fn new(samples: Vec<Sample>, spec: PathToolSpec) -> Result<PathTool> {
+        let duration = spec.duration;
         let bad = |m: String| InputError::new("field", m);
         if samples.len() < 2 {
             return Err(bad("a path needs at least 2 samples".into()));
@@ -105,9 +108,7 @@ impl PathTool {
             )));
         }
         for (i, p) in samples.iter().enumerate() {
-            let f = p.frame;
-            let e = (f.transpose() * f - DMat3::IDENTITY).to_cols_array();
-            if e.iter().any(|x| !(x.abs() < 1e-6)) || !(f.determinant() > 0.0) {
+            if !is_rotation(&p.frame) {
                 return Err(bad(format!("path frame {i} is not a rotation matrix")));
             }
         }
@@ -120,7 +121,7 @@ impl PathTool {
                     "path arc length must increase strictly (segment {k})"
                 )));
             }
-            let rel = DQuat::from_mat3(&(w[0].frame.transpose() * w[1].frame)).normalize();
+            let rel = quat_from_mat3(&(w[0].frame.transpose() * w[1].frame));
             let rel = if rel.w < 0.0 { -rel } else { rel };
             let (axis, angle) = rel.to_axis_angle();
             let th = if angle.is_finite() && angle != 0.0 {
@@ -135,17 +136,15 @@ impl PathTool {
             samples,
             theta,
             omega,
-            t0,
-            duration,
-            radius,
-            reach,
-            power,
-            carry,
-            linear,
-            rotate,
-            twist,
-            bend,
+            spec,
         })
+    }
+
+    /// The position's Hermite data on the segment from `a` to `b` (end tangents `t ΔS`).
+    #[inline]
+    fn segment(a: &Sample, b: &Sample) -> Hermite {
+        let ds = b.s - a.s;
+        Hermite::new(a.x, b.x, a.frame.z_axis * ds, b.frame.z_axis * ds)
     }
 
     /// Total arc length.
@@ -163,15 +162,15 @@ impl PathTool {
     /// ends at a sample time (or at `t0`, `t0 + T`) all see the same smooth piece (the pose
     /// polynomials are evaluated at `t`, slightly outside the segment if `t` is its end).
     pub fn pose_in(&self, t: f64, tm: f64) -> Option<Pose> {
-        let taum = (tm - self.t0) / self.duration;
+        let taum = (tm - self.spec.t0) / self.spec.duration;
         if !(0.0..=1.0).contains(&taum) {
             return None;
         }
         let s0 = self.samples[0].s;
         let l = self.length();
-        let sigma = s0 + (t - self.t0) / self.duration * l;
+        let sigma = s0 + (t - self.spec.t0) / self.spec.duration * l;
         let sigma_m = s0 + taum * l;
-        let u = l / self.duration;
+        let u = l / self.spec.duration;
         let n = self.samples.len();
         let k = self
             .samples
@@ -181,21 +180,13 @@ impl PathTool {
         let (a, b) = (&self.samples[k], &self.samples[k + 1]);
         let ds = b.s - a.s;
         let lam = (sigma - a.s) / ds;
-        let (l2, l3) = (lam * lam, lam * lam * lam);
-        let m0 = a.frame.z_axis * ds;
-        let m1 = b.frame.z_axis * ds;
-        let o = a.x * (2.0 * l3 - 3.0 * l2 + 1.0)
-            + m0 * (l3 - 2.0 * l2 + lam)
-            + b.x * (-2.0 * l3 + 3.0 * l2)
-            + m1 * (l3 - l2);
-        let dodl = (a.x - b.x) * (6.0 * l2 - 6.0 * lam)
-            + m0 * (3.0 * l2 - 4.0 * lam + 1.0)
-            + m1 * (3.0 * l2 - 2.0 * lam);
+        let curve = Self::segment(a, b);
+        let (o, dodl) = (curve.value(lam), curve.slope(lam));
         let th = self.theta[k];
         let ang = th.length();
         let frame = if ang > 0.0 {
             let ax = th / ang;
-            let e = |v: DVec3| a.frame * rotate(ax, lam * ang, v);
+            let e = |v: DVec3| a.frame * rodrigues(v, ax, lam * ang);
             DMat3::from_cols(e(DVec3::X), e(DVec3::Y), e(DVec3::Z))
         } else {
             a.frame
@@ -221,17 +212,17 @@ impl PathTool {
     /// time, so batches compute it once).
     #[inline]
     pub fn eval_at(&self, x: DVec3, p: &Pose) -> DVec3 {
-        let outer = self.radius + self.reach;
+        let outer = self.spec.radius + self.spec.reach;
         if (x - p.o).length_squared() >= outer * outer {
             return DVec3::ZERO;
         }
-        let mut v = if self.carry {
+        let mut v = if self.spec.carry {
             Sphere {
                 center: p.o,
                 velocity: p.v,
-                radius: self.radius,
-                reach: self.reach,
-                linear: self.linear,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                linear: self.spec.linear,
                 moving: false,
             }
             .eval(x, 0.0)
@@ -239,28 +230,28 @@ impl PathTool {
             Translation {
                 center: p.o,
                 velocity: p.v,
-                radius: self.radius,
-                reach: self.reach,
-                power: self.power,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                power: self.spec.power,
                 moving: false,
             }
             .eval(x, 0.0)
         };
-        if self.rotate {
+        if self.spec.rotate {
             v += Rotation {
                 center: p.o,
                 pivot: p.o,
                 omega: p.omega,
-                radius: self.radius,
-                reach: self.reach,
-                power: self.power,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                power: self.spec.power,
             }
             .eval(x, 0.0);
         }
-        if self.twist != 0.0 {
+        if self.spec.twist != 0.0 {
             v += self.swirl(p, SwirlKind::Twist).eval(x);
         }
-        if self.bend != 0.0 {
+        if self.spec.bend != 0.0 {
             v += self.swirl(p, SwirlKind::Bend).eval(x);
         }
         v
@@ -268,14 +259,14 @@ impl PathTool {
 
     fn swirl(&self, p: &Pose, kind: SwirlKind) -> Swirl {
         let (axis, rate) = match kind {
-            SwirlKind::Twist => (p.frame.z_axis, self.twist),
-            SwirlKind::Bend => (p.frame.x_axis, self.bend),
+            SwirlKind::Twist => (p.frame.z_axis, self.spec.twist),
+            SwirlKind::Bend => (p.frame.x_axis, self.spec.bend),
         };
         Swirl {
             pivot: p.o,
             axis,
             rate,
-            reach: self.radius + self.reach,
+            reach: self.spec.radius + self.spec.reach,
             kind,
             curl_form: false,
         }
@@ -284,27 +275,24 @@ impl PathTool {
     /// A bound of `|v|`: the parts' bounds at the largest tool speed and turning rate
     /// (sampled at 17 points per segment, ×1.05).
     pub fn max_speed(&self) -> f64 {
-        let u = self.length() / self.duration;
+        let u = self.length() / self.spec.duration;
         let mut vmax: f64 = 0.0;
         for w in self.samples.windows(2) {
             let ds = w[1].s - w[0].s;
+            let curve = Self::segment(&w[0], &w[1]);
             for i in 0..=16 {
-                let lam = i as f64 / 16.0;
-                let l2 = lam * lam;
-                let d = (w[0].x - w[1].x) * (6.0 * l2 - 6.0 * lam)
-                    + w[0].frame.z_axis * ds * (3.0 * l2 - 4.0 * lam + 1.0)
-                    + w[1].frame.z_axis * ds * (3.0 * l2 - 2.0 * lam);
+                let d = curve.slope(i as f64 / 16.0);
                 vmax = vmax.max(d.length() / ds);
             }
         }
         let vel = DVec3::X * (u * vmax * 1.05);
-        let mut m = if self.carry {
+        let mut m = if self.spec.carry {
             Sphere {
                 center: DVec3::ZERO,
                 velocity: vel,
-                radius: self.radius,
-                reach: self.reach,
-                linear: self.linear,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                linear: self.spec.linear,
                 moving: false,
             }
             .max_speed()
@@ -312,22 +300,22 @@ impl PathTool {
             Translation {
                 center: DVec3::ZERO,
                 velocity: vel,
-                radius: self.radius,
-                reach: self.reach,
-                power: self.power,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                power: self.spec.power,
                 moving: false,
             }
             .max_speed()
         };
-        if self.rotate {
+        if self.spec.rotate {
             let w = self.omega.iter().map(|w| w.length()).fold(0.0, f64::max) * u;
             m += Rotation {
                 center: DVec3::ZERO,
                 pivot: DVec3::ZERO,
                 omega: DVec3::X * w,
-                radius: self.radius,
-                reach: self.reach,
-                power: self.power,
+                radius: self.spec.radius,
+                reach: self.spec.reach,
+                power: self.spec.power,
             }
             .max_speed();
         }
@@ -337,10 +325,10 @@ impl PathTool {
             omega: DVec3::ZERO,
             frame: DMat3::IDENTITY,
         };
-        if self.twist != 0.0 {
+        if self.spec.twist != 0.0 {
             m += self.swirl(&pose, SwirlKind::Twist).max_speed();
         }
-        if self.bend != 0.0 {
+        if self.spec.bend != 0.0 {
             m += self.swirl(&pose, SwirlKind::Bend).max_speed();
         }
         m
@@ -351,7 +339,7 @@ impl PathTool {
         let (s0, l) = (self.samples[0].s, self.length());
         self.samples
             .iter()
-            .map(move |p| self.t0 + self.duration * (p.s - s0) / l)
+            .map(move |p| self.spec.t0 + self.spec.duration * (p.s - s0) / l)
     }
 }
 
@@ -376,20 +364,19 @@ mod tests {
                 }
             })
             .collect();
-        let tool = PathTool::new(
-            samples.clone(),
-            0.5,
-            2.0,
-            0.1,
-            0.1,
-            2,
-            false,
-            false,
-            true,
-            0.0,
-            0.0,
-        )
-        .unwrap();
+        let spec = PathToolSpec {
+            t0: 0.5,
+            duration: 2.0,
+            radius: 0.1,
+            reach: 0.1,
+            power: 2,
+            carry: false,
+            linear: false,
+            rotate: true,
+            twist: 0.0,
+            bend: 0.0,
+        };
+        let tool = PathTool::new(samples.clone(), spec).unwrap();
         for (i, s) in samples.iter().enumerate() {
             let t = 0.5 + 2.0 * s.s / tool.length();
             let p = tool.pose(t).unwrap();

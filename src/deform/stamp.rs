@@ -7,7 +7,8 @@
 //!
 //! 1. vertices inside the tool (`d = |X − c_k| − ρ < 0`) snap to its surface,
 //!    `X ← c_k + ρ (X − c_k)/|X − c_k|`; the dent `δv = V_before − V_snapped` is measured as
-//!    the change of the mesh's signed volume `Σ X₀·(X₁ × X₂)/6`;
+//!    the change of the mesh's signed volume `Σ X₀·(X₁ × X₂)/6` (summed about the mean
+//!    vertex, [`crate::math::mesh::signed_volume`]);
 //! 2. over the triangles with no contact vertex, the protrusion rate uses the tool's curl
 //!    translation field `v` (brief §1.2, static tool at `c_k`, velocity `û`, `R` = reach):
 //!    `Σ A_tri v_bary`, `v_bary = max(v(barycentre)·n_tri, 0)` (A-15; the thesis leaves
@@ -27,6 +28,7 @@ use super::advect::{Method, integrate};
 use super::fields::Translation;
 use super::{Element, Field};
 use crate::error::{InputError, Result};
+use crate::math::mesh::signed_volume as volume;
 
 /// What one frame did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,14 +41,6 @@ pub struct StampFrame {
     pub residual: f64,
     /// Vertices in contact (snapped this frame).
     pub contact: usize,
-}
-
-/// Signed volume of a closed triangle mesh (divergence theorem).
-pub fn volume(v: &[DVec3], f: &[[usize; 3]]) -> f64 {
-    f.iter()
-        .map(|t| v[t[0]].dot(v[t[1]].cross(v[t[2]])))
-        .sum::<f64>()
-        / 6.0
 }
 
 /// Press a sphere of `radius` from `start` to `end` into the mesh `(v, f)` in `frames` moves

@@ -43,6 +43,7 @@ use glam::DVec3;
 
 use super::cross::{blend, translate};
 use crate::error::{InputError, Result};
+use crate::math::cubic::{Hermite, Power};
 
 /// One axis sample: position, derivative `dγ/dS`, cumulative chord length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,11 +58,8 @@ pub struct AxisSample {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Segment {
-    /// Power-basis coefficients of `γ(λ)`.
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    d: DVec3,
+    /// `γ(λ)` in power form.
+    curve: Power,
     /// Bounding sphere of the Bézier hull.
     centre: DVec3,
     radius: f64,
@@ -70,10 +68,7 @@ struct Segment {
 impl Segment {
     #[inline(always)]
     fn at(&self, l: f64) -> (DVec3, DVec3, DVec3) {
-        let g = self.a + l * (self.b + l * (self.c + l * self.d));
-        let g1 = self.b + l * (2.0 * self.c + l * (3.0 * self.d));
-        let g2 = 2.0 * self.c + (6.0 * l) * self.d;
-        (g, g1, g2)
+        self.curve.at(l)
     }
 }
 
@@ -120,19 +115,16 @@ impl StripAlong {
                     "strip axis arc length must increase strictly (segment {k})"
                 )));
             }
-            let (x0, x1) = (w[0].x, w[1].x);
-            let (m0, m1) = (w[0].m * ds, w[1].m * ds);
-            let hull = [x0, x0 + m0 / 3.0, x1 - m1 / 3.0, x1];
+            let x0 = w[0].x;
+            let data = Hermite::new(x0, w[1].x, w[0].m * ds, w[1].m * ds);
+            let hull = data.bezier().b;
             let centre = 0.25 * (hull[0] + hull[1] + hull[2] + hull[3]);
             let radius = hull
                 .iter()
                 .map(|p| (*p - centre).length())
                 .fold(0.0, f64::max);
             let seg = Segment {
-                a: x0,
-                b: m0,
-                c: 3.0 * (x1 - x0) - 2.0 * m0 - m1,
-                d: 2.0 * (x0 - x1) + m0 + m1,
+                curve: data.power(),
                 centre,
                 radius,
             };

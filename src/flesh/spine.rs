@@ -10,6 +10,8 @@
 use glam::{DVec2, DVec3};
 
 use crate::error::{InputError, Result};
+use crate::math::cubic::{Hermite, Power};
+use crate::math::rotation::minimal_rotate;
 
 /// A sampled spine with its frames (`t` and `r` columns of `spinal.frames`).
 #[derive(Clone, Debug)]
@@ -20,39 +22,12 @@ pub struct SpineModel {
     pub t: Vec<DVec3>,
     /// RMF reference vectors `r_j` at the samples (the `r` columns).
     pub r: Vec<DVec3>,
-    /// Per edge: `m(a) = m[0] + a m[1] + a² m[2] + a³ m[3]`.
-    pub m: Vec<[DVec3; 4]>,
+    /// Per edge: `m(a)` in power form.
+    pub m: Vec<Power>,
     /// Per edge: the position `C(a)` in the same power form.
-    pub p: Vec<[DVec3; 4]>,
+    pub p: Vec<Power>,
     /// Per edge: `r_{k+1}` carried back to `t_k` by the minimal rotation.
     pub rb: Vec<DVec3>,
-}
-
-fn hermite(p0: DVec3, p1: DVec3, d0: DVec3, d1: DVec3) -> [DVec3; 4] {
-    [
-        p0,
-        d0,
-        3.0 * (p1 - p0) - 2.0 * d0 - d1,
-        2.0 * (p0 - p1) + d0 + d1,
-    ]
-}
-
-#[inline]
-fn cubic(c: &[DVec3; 4], a: f64) -> DVec3 {
-    c[0] + a * (c[1] + a * (c[2] + a * c[3]))
-}
-
-#[inline]
-fn cubic_slope(c: &[DVec3; 4], a: f64) -> DVec3 {
-    c[1] + a * (2.0 * c[2] + 3.0 * a * c[3])
-}
-
-/// `v` turned by the minimal rotation taking unit `from` to unit `to` (not antipodal).
-#[inline]
-fn min_rotate(v: DVec3, from: DVec3, to: DVec3) -> DVec3 {
-    let c = from.dot(to);
-    let k = from.cross(to);
-    v * c + k.cross(v) + k * (k.dot(v) / (1.0 + c))
 }
 
 /// Sample curvature vectors: central differences of the unit tangents in chord length,
@@ -139,12 +114,12 @@ impl SpineModel {
         for k in 0..n - 1 {
             let e = points[k + 1] - points[k];
             let h = e.length();
-            let pos = hermite(points[k], points[k + 1], h * t[k], h * t[k + 1]);
+            let pos = Hermite::new(points[k], points[k + 1], h * t[k], h * t[k + 1]).power();
             // slopes h κ_j: the model's curvature (dt/da)/σ is κ_j at the samples (σ = h)
-            let coef = hermite(t[k], t[k + 1], h * kv[k], h * kv[k + 1]);
+            let coef = Hermite::new(t[k], t[k + 1], h * kv[k], h * kv[k + 1]).power();
             for i in 0..=8 {
                 let a = i as f64 / 8.0;
-                let sigma = cubic_slope(&pos, a).dot(cubic(&coef, a));
+                let sigma = pos.d1(a).dot(coef.value(a));
                 if !(sigma > 0.0) || !kv[k].is_finite() {
                     return Err(InputError::new(
                         arg,
@@ -160,7 +135,7 @@ impl SpineModel {
             pc.push(pos);
         }
         let rb = (0..n - 1)
-            .map(|k| min_rotate(r[k + 1], t[k + 1], t[k]))
+            .map(|k| minimal_rotate(t[k + 1], t[k], r[k + 1]))
             .collect();
         Ok(SpineModel {
             c: points.to_vec(),
@@ -183,13 +158,13 @@ impl SpineModel {
     /// The unnormalised tangent `m(a)` of edge `k`.
     #[inline]
     pub fn m_at(&self, k: usize, a: f64) -> DVec3 {
-        cubic(&self.m[k], a)
+        self.m[k].value(a)
     }
 
     /// The position `C(a)` on edge `k`.
     #[inline]
     pub fn c_at(&self, k: usize, a: f64) -> DVec3 {
-        cubic(&self.p[k], a)
+        self.p[k].value(a)
     }
 
     /// The model at edge `k`, `a ∈ [0, 1]`.
@@ -214,10 +189,10 @@ impl SpineModel {
         let mut w = [DVec3::ZERO; L];
         for l in 0..L {
             let (p, c) = (&self.p[k[l]], &self.m[k[l]]);
-            q[l] = cubic(p, a[l]);
-            e[l] = cubic_slope(p, a[l]);
-            m[l] = cubic(c, a[l]);
-            dt[l] = cubic_slope(c, a[l]);
+            q[l] = p.value(a[l]);
+            e[l] = p.d1(a[l]);
+            m[l] = c.value(a[l]);
+            dt[l] = c.d1(a[l]);
             let r0 = self.r[k[l]];
             w[l] = r0 + a[l] * (self.rb[k[l]] - r0);
         }
@@ -245,7 +220,7 @@ impl SpineModel {
         }
         for l in 0..L {
             let t = out[l].t;
-            let um = min_rotate(w[l], self.t[k[l]], t) * inv_w[l];
+            let um = minimal_rotate(self.t[k[l]], t, w[l]) * inv_w[l];
             let u = um - t * t.dot(um);
             let v = t.cross(u);
             let kv = ta[l] * (1.0 / out[l].sigma);

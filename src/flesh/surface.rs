@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use super::solve::CLAMPED_BEND;
 use crate::error::{InputError, Result};
+use crate::math::cubic::basis;
 
 /// Flag: the vertex's foot is outside the surface (attached to the border, uncorrected).
 pub const OUTSIDE: u8 = 4;
@@ -163,33 +164,12 @@ impl Surface {
     }
 }
 
-/// Cubic Hermite basis `(φ0, φ1, ψ0, ψ1)` and its derivative at `x`.
-#[inline]
-fn hermite_basis(x: f64) -> ([f64; 4], [f64; 4]) {
-    let x2 = x * x;
-    let x3 = x2 * x;
-    (
-        [
-            2.0 * x3 - 3.0 * x2 + 1.0,
-            -2.0 * x3 + 3.0 * x2,
-            x3 - 2.0 * x2 + x,
-            x3 - x2,
-        ],
-        [
-            6.0 * x2 - 6.0 * x,
-            -6.0 * x2 + 6.0 * x,
-            3.0 * x2 - 4.0 * x + 1.0,
-            3.0 * x2 - 2.0 * x,
-        ],
-    )
-}
-
 /// Bicubic Hermite patch (zero twist) of corner values `p` and per-step derivatives `du`,
 /// `dv`: value and partials at `(u, v)`; C¹ across cell edges.
 #[inline]
 fn bicubic(p: [DVec3; 4], du: [DVec3; 4], dv: [DVec3; 4], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
-    let (bu, bu1) = hermite_basis(u);
-    let (bv, bv1) = hermite_basis(v);
+    let (bu, bu1) = basis(u);
+    let (bv, bv1) = basis(v);
     let (mut x, mut xu, mut xv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
     // corners (a, b) in the order (0,0), (1,0), (0,1), (1,1)
     for (c, (a, b)) in [(0usize, 0usize), (1, 0), (0, 1), (1, 1)]

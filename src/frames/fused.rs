@@ -27,6 +27,7 @@ use super::tangents::{OVERSHOOT_COS, centred_weights, circle_normal, five_point_
 use super::transport::{ChunkEnds, Scan, Twist, plan, write_frame};
 use super::validate::{COINCIDE_EPS, MIN_ALIGNMENT, coincide};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};
+use crate::math::rotation::minimal_rotate_with;
 
 /// Samples per block: chords and tangents of a block stay in the L1/L2 cache.
 pub const BLOCK: usize = 1024;
@@ -518,7 +519,7 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
             for m in 0..steps {
                 (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
                 let a = DVec3::new(ax[m], ay[m], az[m]);
-                r = cos[m] * r + a.cross(r) + a * (a.dot(r) / den[m]);
+                r = minimal_rotate_with(a, cos[m], den[m], r);
             }
         } else {
             let k0 = s - lo;

@@ -2,28 +2,16 @@
 //!
 //! * `rotate_about(v, t, θ)`: rotation of a vector `v ⟂ t` by the angle θ about the unit
 //!   axis `t` (right-handed, counter-clockwise seen from the tip of `t`):
-//!   `cos θ · v + sin θ · (t × v)`.
+//!   `cos θ · v + sin θ · (t × v)` (from [`crate::math::rotation`]).
 //! * `signed_angle(a, b, t)`: the angle that turns `a` into `b` about `t`,
-//!   `atan2((a × b)·t, a·b) ∈ (−π, π]`.
+//!   `atan2((a × b)·t, a·b) ∈ (−π, π]` (from [`crate::math::rotation`]).
 //! * `any_perpendicular(t)`: a deterministic unit vector ⟂ `t`: the world axis least aligned
 //!   with `t` (first such axis on ties), projected onto the normal plane and normalised.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-#[inline]
-pub fn rotate_about(v: DVec3, t: DVec3, angle: f64) -> DVec3 {
-    if angle == 0.0 {
-        return v;
-    }
-    let (s, c) = angle.sin_cos();
-    c * v + s * t.cross(v)
-}
-
-#[inline]
-pub fn signed_angle(a: DVec3, b: DVec3, t: DVec3) -> f64 {
-    a.cross(b).dot(t).atan2(a.dot(b))
-}
+pub use crate::math::rotation::{rotate_about, signed_angle};
 
 pub fn any_perpendicular(t: DVec3) -> DVec3 {
     let a = t.abs();

@@ -128,8 +128,7 @@ pub(crate) fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) 
             if !m.is_finite() {
                 return Err(InputError::new(arg, "contains a non-finite value"));
             }
-            // the columns of mᵀ are the rows of m: the row-major layout `is_rotation` reads
-            if !validate::is_rotation(&m.transpose().to_cols_array()) {
+            if !crate::math::rotation::is_rotation(&m) {
                 return Err(InputError::new(
                     arg,
                     "is not a rotation matrix: its columns (r, s, t) must be orthonormal \

@@ -10,12 +10,13 @@
 use glam::DVec3;
 
 use super::transport::Step;
+use crate::math::rotation::minimal_rotate;
 
+/// `r` carried from `t0` to `t1` by the minimal rotation (the shared kernel, same arithmetic
+/// as the fused path's step).
 #[inline(always)]
 pub fn rotation_step(t0: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
-    let a = t0.cross(t1);
-    let c = t0.dot(t1);
-    c * r + a.cross(r) + a * (a.dot(r) / (1.0 + c))
+    minimal_rotate(t0, t1, r)
 }
 
 pub struct Rotation<'a> {

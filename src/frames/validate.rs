@@ -10,10 +10,11 @@
 //!   under which double reflection degenerates (`v₂ → 0`, TOG §4.4) and the rotation method
 //!   meets opposite tangents.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 use crate::error::{InputError, Result};
+use crate::math::rotation;
 
 /// Relative round-off tolerance for coinciding points.
 pub const COINCIDE_EPS: f64 = 8.0 * f64::EPSILON;
@@ -141,19 +142,8 @@ pub fn aligned(
 /// Is `f` (row-major 3×3, columns `r, s, t`) a rotation matrix to 10⁻⁶ (orthonormal columns,
 /// det > 0)? False for any non-finite entry.
 pub fn is_rotation(f: &[f64; 9]) -> bool {
-    let r = DVec3::new(f[0], f[3], f[6]);
-    let q = DVec3::new(f[1], f[4], f[7]);
-    let t = DVec3::new(f[2], f[5], f[8]);
-    r.is_finite()
-        && q.is_finite()
-        && t.is_finite()
-        && (r.length_squared() - 1.0).abs() < 1e-6
-        && (q.length_squared() - 1.0).abs() < 1e-6
-        && (t.length_squared() - 1.0).abs() < 1e-6
-        && r.dot(q).abs() < 1e-6
-        && r.dot(t).abs() < 1e-6
-        && q.dot(t).abs() < 1e-6
-        && r.cross(q).dot(t) > 0.0
+    // row-major f read as column-major is the transpose: transpose back (exact)
+    rotation::is_rotation(&DMat3::from_cols_array(f).transpose())
 }
 
 /// Check CSR-style curve offsets (`offsets[c]..offsets[c + 1]` are the rows of curve `c`)

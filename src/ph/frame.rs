@@ -26,7 +26,7 @@ use glam::{DMat3, DVec3};
 
 use super::{Cubic, Quat, bern2};
 use crate::error::{InputError, Result};
-use crate::frames::geometry::any_perpendicular;
+use crate::frames::geometry::{any_perpendicular, rotate_about};
 
 /// Simpson subintervals of the objective `Î(λ)` (MJ (41)).
 pub const SIMPSON_N: usize = 20;
@@ -352,7 +352,7 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
             Some((n, b, _)) => om.sin() * b + om.cos() * n,
             None => {
                 let p = any_perpendicular(t0);
-                om.cos() * p + om.sin() * t0.cross(p)
+                rotate_about(p, t0, om)
             }
         },
     };

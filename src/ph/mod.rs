@@ -24,6 +24,9 @@ use rayon::prelude::*;
 
 use crate::error::{InputError, Result};
 
+use crate::math::cubic::Bezier;
+pub use crate::math::cubic::bern2;
+
 /// A quaternion `(w, x, y, z)` (Hamilton product).
 pub type Quat = [f64; 4];
 
@@ -53,14 +56,7 @@ fn qscale(a: Quat, s: f64) -> Quat {
     [a[0] * s, a[1] * s, a[2] * s, a[3] * s]
 }
 
-/// Bernstein basis of degree 2 at `v`.
-#[inline]
-pub fn bern2(v: f64) -> [f64; 3] {
-    let u = 1.0 - v;
-    [u * u, 2.0 * u * v, v * v]
-}
-
-/// A cubic Bézier curve by its four control points.
+/// A cubic Bézier curve by its four control points (evaluated by [`Bezier`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cubic {
     /// Control points `b₀ … b₃`.
@@ -98,53 +94,40 @@ impl Cubic {
         Cubic { b }
     }
 
+    /// The curve as a [`Bezier`] (its evaluation kernels).
+    #[inline]
+    pub fn bezier(&self) -> Bezier {
+        Bezier::new(self.b)
+    }
+
+    /// The legs `bᵢ − bᵢ₋₁`.
     pub fn legs(&self) -> [DVec3; 3] {
-        [
-            self.b[1] - self.b[0],
-            self.b[2] - self.b[1],
-            self.b[3] - self.b[2],
-        ]
+        self.bezier().legs()
     }
 
     /// Point `x(v)` (de Casteljau).
     pub fn point(&self, v: f64) -> DVec3 {
-        let [p0, p1, p2, p3] = self.b;
-        let a = p0.lerp(p1, v);
-        let b = p1.lerp(p2, v);
-        let c = p2.lerp(p3, v);
-        let d = a.lerp(b, v);
-        let e = b.lerp(c, v);
-        d.lerp(e, v)
+        self.bezier().point(v)
     }
 
     /// `ẋ(v) = 3 Σ dᵢ Bᵢ²(v)`.
     pub fn d1(&self, v: f64) -> DVec3 {
-        let [d1, d2, d3] = self.legs();
-        let w = bern2(v);
-        3.0 * (d1 * w[0] + d2 * w[1] + d3 * w[2])
+        self.bezier().d1(v)
     }
 
     /// `ẍ(v) = 6((d₂ − d₁)(1 − v) + (d₃ − d₂)v)`.
     pub fn d2(&self, v: f64) -> DVec3 {
-        let [d1, d2, d3] = self.legs();
-        6.0 * ((d2 - d1) * (1.0 - v) + (d3 - d2) * v)
+        self.bezier().d2(v)
     }
 
     /// `x⃛ = 6(d₃ − 2d₂ + d₁)`.
     pub fn d3(&self) -> DVec3 {
-        let [d1, d2, d3] = self.legs();
-        6.0 * (d3 - 2.0 * d2 + d1)
+        self.bezier().d3()
     }
 
-    /// Derivative of order `k` (0..=3) at `v`.
+    /// Derivative of order `k` (0..=3) at `v` (zero above 3).
     pub fn derivative(&self, k: usize, v: f64) -> DVec3 {
-        match k {
-            0 => self.point(v),
-            1 => self.d1(v),
-            2 => self.d2(v),
-            3 => self.d3(),
-            _ => DVec3::ZERO,
-        }
+        self.bezier().derivative(k, v)
     }
 
     /// True when the control polygon is (numerically) a straight line run forwards.

@@ -30,40 +30,20 @@ use rayon::prelude::*;
 
 use crate::error::{InputError, Result};
 use crate::frames::validate;
+use crate::math::rotation;
 
 const GRAIN: usize = 1 << 12;
 
 /// The unit quaternion of a row-major rotation matrix (columns `r, s, t`), Shepperd's
-/// method. The result is normalised; its sign is not canonical.
+/// method ([`rotation::quat_from_mat3`]). The result is normalised; its sign is not canonical.
 pub fn from_matrix(f: &[f64; 9]) -> DQuat {
-    // R[row][col] = f[3 row + col]
-    let (r00, r01, r02) = (f[0], f[1], f[2]);
-    let (r10, r11, r12) = (f[3], f[4], f[5]);
-    let (r20, r21, r22) = (f[6], f[7], f[8]);
-    let tr = r00 + r11 + r22;
-    let q = if tr >= r00 && tr >= r11 && tr >= r22 {
-        let w = 0.5 * (1.0 + tr).max(0.0).sqrt();
-        let k = 0.25 / w;
-        DQuat::from_xyzw((r21 - r12) * k, (r02 - r20) * k, (r10 - r01) * k, w)
-    } else if r00 >= r11 && r00 >= r22 {
-        let x = 0.5 * (1.0 + r00 - r11 - r22).max(0.0).sqrt();
-        let k = 0.25 / x;
-        DQuat::from_xyzw(x, (r01 + r10) * k, (r02 + r20) * k, (r21 - r12) * k)
-    } else if r11 >= r22 {
-        let y = 0.5 * (1.0 - r00 + r11 - r22).max(0.0).sqrt();
-        let k = 0.25 / y;
-        DQuat::from_xyzw((r01 + r10) * k, y, (r12 + r21) * k, (r02 - r20) * k)
-    } else {
-        let z = 0.5 * (1.0 - r00 - r11 + r22).max(0.0).sqrt();
-        let k = 0.25 / z;
-        DQuat::from_xyzw((r02 + r20) * k, (r12 + r21) * k, z, (r10 - r01) * k)
-    };
-    q.normalize()
+    // row-major f read as column-major is the transpose: transpose back (exact)
+    rotation::quat_from_mat3(&DMat3::from_cols_array(f).transpose())
 }
 
 /// The row-major rotation matrix of a unit quaternion.
 pub fn to_matrix(q: DQuat) -> [f64; 9] {
-    let m = DMat3::from_quat(q);
+    let m = rotation::mat3_from_quat(q);
     let (a, b, c) = (m.x_axis, m.y_axis, m.z_axis);
     [a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z]
 }
@@ -187,23 +167,6 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
         .sum())
 }
 
-/// The quaternion rotating unit `a` onto unit `b` about `a × b`, `normalise(1 + a·b, a × b)`;
-/// None when `b ≈ −a` (a reversal, the axis is undefined).
-#[inline]
-fn rotation_between(a: DVec3, b: DVec3) -> Option<DQuat> {
-    let c = a.dot(b);
-    if !(1.0 + c > 1e-12) {
-        return None;
-    }
-    let v = a.cross(b);
-    Some(DQuat::from_xyzw(v.x, v.y, v.z, 1.0 + c).normalize())
-}
-
-/// Signed angle from `a` to `b` about the unit axis `t`, in (−π, π].
-fn signed_angle(a: DVec3, b: DVec3, t: DVec3) -> f64 {
-    a.cross(b).dot(t).atan2(a.dot(b))
-}
-
 /// Parallel transport as a quaternion curve.
 ///
 /// * `x`: the points (for arc lengths; `n` rows), `t`: unit tangents (`n` rows);
@@ -232,7 +195,7 @@ pub fn transport(
     out[0] = q0;
     let step = |i: usize| {
         let j = if i + 1 == n { 0 } else { i + 1 };
-        rotation_between(t[i], t[j]).ok_or_else(|| {
+        rotation::minimal_rotation_quat(t[i], t[j]).ok_or_else(|| {
             InputError::new(
                 "tangents",
                 format!(
@@ -252,7 +215,7 @@ pub fn transport(
     // One more step closes the loop; compare the carried r with r0.
     let q_end = (step(n - 1)? * out[n - 1]).normalize();
     let r_end = q_end * DVec3::X;
-    let alpha = signed_angle(r_end, r0, t[0]);
+    let alpha = rotation::signed_angle(r_end, r0, t[0]);
     let total = alpha + std::f64::consts::TAU * turns as f64;
     let mut arc = Vec::with_capacity(n + 1);
     let mut acc = 0.0;

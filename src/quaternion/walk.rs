@@ -13,11 +13,10 @@
 //! A walk stops at a boundary edge. A path that hits a vertex exactly is nudged along the
 //! edge by a round-off amount (Ma assumes it never happens).
 
-use std::collections::HashMap;
-
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
 use crate::error::{InputError, Result};
+use crate::math::mesh;
 
 /// A triangle mesh prepared for walking: faces and edge adjacency.
 pub struct Walker<'a> {
@@ -95,28 +94,30 @@ impl<'a> Walker<'a> {
                 ));
             }
         }
-        let mut edges: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
-        for (i, c) in f.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (c[k], c[(k + 1) % 3]);
-                edges.entry((a.min(b), a.max(b))).or_default().push((i, k));
-            }
+        let (edges, slot) = mesh::edges(&f);
+        let count = mesh::edge_counts(&slot, edges.len());
+        if let Some(e) = count.iter().position(|&c| c > 2) {
+            let [a, b] = edges[e];
+            return Err(InputError::new(
+                "faces",
+                format!(
+                    "the edge between vertices {a} and {b} is shared by {} faces (the mesh \
+                     must be manifold)",
+                    count[e]
+                ),
+            ));
         }
+        // faces on both sides of each interior edge: the first slot seen waits for the second
+        let mut first: Vec<Option<(usize, usize)>> = vec![None; edges.len()];
         let mut adj = vec![[None; 3]; f.len()];
-        for ((a, b), list) in &edges {
-            if list.len() > 2 {
-                return Err(InputError::new(
-                    "faces",
-                    format!(
-                        "the edge between vertices {a} and {b} is shared by {} faces (the \
-                         mesh must be manifold)",
-                        list.len()
-                    ),
-                ));
-            }
-            if let [(f1, k1), (f2, k2)] = list[..] {
-                adj[f1][k1] = Some((f2, k2));
-                adj[f2][k2] = Some((f1, k1));
+        for (i, s) in slot.iter().enumerate() {
+            for (k, &e) in s.iter().enumerate() {
+                if let Some((f1, k1)) = first[e] {
+                    adj[f1][k1] = Some((i, k));
+                    adj[i][k] = Some((f1, k1));
+                } else {
+                    first[e] = Some((i, k));
+                }
             }
         }
         Ok(Walker {

@@ -1,0 +1,18 @@
+//! Shared maths kernels, each written once and used by the frame, sweep, deformation,
+//! fleshing and PH modules.
+//!
+//! * [`cubic`]: the cubic segment on a local parameter `λ ∈ [0, 1]` in its three forms:
+//!   Hermite data `(p₀, p₁, d₀, d₁)` ([`cubic::Hermite`], with the basis functions
+//!   [`cubic::basis`]), power form ([`cubic::Power`], Horner evaluation of the value and the
+//!   first three derivatives) and Bézier form ([`cubic::Bezier`], de Casteljau and Bernstein
+//!   derivatives), with the conversions between them.
+//! * [`rotation`]: the minimal rotation taking one unit vector to another (vector and
+//!   quaternion forms), Rodrigues' rotation about an axis, the signed angle about an axis,
+//!   3×3 rotation matrix ↔ unit quaternion (Shepperd's method), and the test whether a
+//!   matrix is a rotation.
+//! * [`mesh`]: signed volume of a closed triangle mesh and its undirected edges (for
+//!   manifold checks and adjacency).
+
+pub mod cubic;
+pub mod mesh;
+pub mod rotation;
