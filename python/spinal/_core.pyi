@@ -18,6 +18,7 @@ def frames_sampled(
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
     turns: int,
+    points_arg: str = "points",
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def frames_analytic(
     points: npt.NDArray[np.float64],

@@ -13,7 +13,7 @@ import warnings
 import numpy as np
 
 from . import _core
-from ._frames import frames as _frames
+from ._frames import _spine_frames
 from ._mesh import FoldOverWarning
 from ._validate import as_bool, as_choice, as_float_array
 
@@ -41,16 +41,6 @@ def _spine(x, name: str) -> tuple[np.ndarray, int]:
 
 def _scale(a: np.ndarray) -> float:
     return max(float(np.abs(a).max(initial=0.0)), 1e-300)
-
-
-def _spine_frames(points: np.ndarray, name: str, initial=None) -> np.ndarray:
-    try:
-        return _frames(points, initial=initial)
-    except ValueError as exc:  # re-address the message to our argument
-        msg = str(exc)
-        if msg.startswith("points"):
-            msg = name + msg[len("points") :]
-        raise ValueError(msg) from None
 
 
 def _arc(points: np.ndarray) -> np.ndarray:

@@ -57,7 +57,7 @@ def _analytic(curve: Curve, u: Any):
 
 
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-             lengths, offsets):
+             lengths, offsets, points_arg="points"):
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -76,7 +76,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         return out, np.array([angle]), False
     if u is not None:
         raise TypeError("u: only used with an analytic curve from spinal.curves")
-    pts = None if points is None else as_points(points, "points")
+    pts = None if points is None else as_points(points, points_arg)
     tgs = None if tangents is None else as_points(tangents, "tangents")
     if pts is None and (tgs is None or reflection != "tangents"):
         raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
@@ -90,9 +90,17 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     chords_from_tangents = reflection == "tangents"
     out, angles = _core.frames_sampled(
         pts, tgs, offs, method, "five_point", chords_from_tangents, closed,
-        iv, if_, ev, ef, turns,
+        iv, if_, ev, ef, turns, points_arg,
     )
     return out, angles, bundle
+
+
+def _spine_frames(points, name: str, initial=None) -> np.ndarray:
+    """The default frames of one curve passed to a spinal function as ``name`` (errors about
+    the points name it)."""
+    out, _, _ = _compute(points, None, "double_reflection", initial, False, None, 0, "chord",
+                         None, None, None, points_arg=name)
+    return out
 
 
 def frames(

@@ -22,6 +22,16 @@ impl From<InputError> for PyErr {
     }
 }
 
+/// The error as a `ValueError` naming `to` where the core named its argument `from` (a
+/// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
+pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {
+    if e.arg == from {
+        PyValueError::new_err(format!("{to}: {}", e.msg))
+    } else {
+        e.into()
+    }
+}
+
 /// A `ValueError` with the given message.
 pub fn value_error(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())

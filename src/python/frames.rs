@@ -7,15 +7,19 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, offsets_of, orientations, slice_mut, slice_of, vec3_array, vec3s};
+use super::convert::{
+    empty, offsets_of, orientations, renamed, slice_mut, slice_of, vec3_array, vec3s,
+};
 use crate::frames::{self, Analytic, Method, Request, TangentRule};
 
 pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// Frames of one or many sampled curves; see `spinal.frames` for the meaning.
+/// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
+/// the points name `points_arg` (the argument the caller's user passed them as).
 #[pyfunction]
 #[pyo3(signature = (points, tangents, offsets, method, tangent_rule, tangent_chords, closed,
-                    initial_vectors, initial_frames, end_vectors, end_frames, turns))]
+                    initial_vectors, initial_frames, end_vectors, end_frames, turns,
+                    points_arg="points"))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_sampled<'py>(
     py: Python<'py>,
@@ -31,6 +35,7 @@ pub fn frames_sampled<'py>(
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
     turns: i64,
+    points_arg: &str,
 ) -> PyResult<FramesAndAngles<'py>> {
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
@@ -57,7 +62,8 @@ pub fn frames_sampled<'py>(
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| frames::compute_many(&template, &offsets, &initial, &end, buf))?
+        py.detach(|| frames::compute_many(&template, &offsets, &initial, &end, buf))
+            .map_err(|e| renamed(e, "points", points_arg))?
     };
     Ok((out, PyArray1::from_vec(py, angles)))
 }
