@@ -9,7 +9,7 @@ curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mes
 from . import curves, fields, ph, quaternions
 from ._advect import advect
 from ._core import __version__
-from ._deform import DeformReport, StampReport, deform, stamp
+from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
@@ -19,6 +19,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "RefinementWarning",
     "SpineBinding",
     "StampReport",
     "SurfaceBinding",

@@ -18,6 +18,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "RefinementWarning",
     "SpineBinding",
     "StampReport",
     "SurfaceBinding",
@@ -175,6 +176,14 @@ class DeformReport:
     integration_error: float | None = None
     mesh_error: float | None = None
     rest_vertices: _F | None = None
+    converged: bool = True
+    edges_over_threshold: int = 0
+    max_vertices: int | None = None
+    torn_vertices: int = 0
+    step_vertices: _I | None = None
+    timings: dict[str, float] | None = None
+
+class RefinementWarning(UserWarning): ...
 
 def deform(
     mesh: _AnyMesh,
@@ -187,6 +196,7 @@ def deform(
     t0: float = 0.0,
     estimate: bool = False,
     progress: _Progress = False,
+    max_vertices: int | None = None,
 ) -> tuple[Mesh, DeformReport]: ...
 @dataclass(frozen=True)
 class StampReport:

@@ -1,30 +1,39 @@
-"""``spinal.deform``: advect a triangle mesh and refine its stretched edges from the rest mesh.
+"""``spinal.deform``: carry a closed triangle mesh along a divergence-free field, refining the
+edges that the flow stretches while it integrates (Rust core, ``src/deform/refine.rs``).
 
-Refinement (thesis §13.2, "smoother variant"; thresholds per erratum A-19): a triangle mesh
-follows the flow only at its vertices, so its volume error is O(edge²) of the *deformed*
-edges. Edges stretched beyond ``refine × max(rest length, mean rest edge length)`` are split
-at their **rest** midpoint, and the new vertex is placed by integrating that rest point with exactly the same
-step sequence (``Φ``) as the original vertices — deterministic, so it lands where it would
-have had the rest mesh been finer there from the start. Both triangles sharing the edge are
-bisected (2-to-4, conforming, watertight); the rest volume is unchanged (new vertices lie on
-flat rest edges). Passes repeat, longest edges first, until no edge exceeds the threshold.
+Refinement (Zheng's thesis §13.2, with the smoother variant's placement): after every
+integration step, an edge longer than ``refine × max(its rest length, mean rest edge)`` is
+split — the longest edge of both its triangles first (Rivara's longest-edge bisection), both
+triangles bisected (conforming, watertight) — and the new vertex is the rest midpoint carried
+by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow tears an edge
+apart (the tangential slip at the surface of a curl translation tool) the chord midpoint is
+used instead. The work is bounded by ``max_vertices``; when the bound stops the refinement the
+report says so and a :class:`RefinementWarning` is issued.
 """
 
 from __future__ import annotations
 
+import time
+import warnings
 from dataclasses import dataclass
 from dataclasses import field as _dc_field
 
 import numpy as np
 
 from . import _core
-from ._advect import advect
+from ._advect import _progress_bar, advect
 from ._mesh import Mesh
 from ._mesh import signed_volume as _volume
-from ._validate import as_float_array, as_int
+from ._validate import as_bool, as_float_array, as_int
 from .fields import Field, _positive, _real
 
-__all__ = ["DeformReport", "StampReport", "deform", "stamp"]
+__all__ = ["DeformReport", "RefinementWarning", "StampReport", "deform", "stamp"]
+
+
+class RefinementWarning(UserWarning):
+    """:func:`spinal.deform` stopped refining at its ``max_vertices`` (or ``max_passes``) bound
+    with edges still longer than the threshold: the mesh is less resolved than asked for (see
+    ``DeformReport.converged`` and ``edges_over_threshold``)."""
 
 
 @dataclass(frozen=True)
@@ -55,7 +64,23 @@ class DeformReport:
         triangle mesh (flat faces between advected vertices); else None.
     rest_vertices : ndarray (V', 3) float64 or None
         Rest positions of the output mesh's vertices (the input's, then the rest midpoints
-        of the split edges), for re-running or checking the deformation.
+        of the split edges), for re-running or checking the deformation: every vertex is the
+        flow of its rest position, except the ``torn_vertices`` placed at a chord midpoint.
+    converged : bool
+        False when ``max_vertices`` (or ``max_passes``) stopped the refinement with edges
+        still over the threshold (a :class:`RefinementWarning` was issued).
+    edges_over_threshold : int
+        Edges longer than the threshold at the end (0 when converged).
+    max_vertices : int or None
+        The vertex bound the refinement ran under (None without refinement).
+    torn_vertices : int
+        New vertices placed at the chord midpoint of an edge the flow tore apart (the exact
+        image of its rest midpoint fell farther than a quarter of the edge from it).
+    step_vertices : ndarray (steps,) int64 or None
+        Vertex count after each integration step.
+    timings : dict or None
+        Wall time in seconds of each phase: ``"integrate"`` (the mesh's vertices),
+        ``"refine"`` (edge tests, new vertices, splits), ``"volume"``, ``"estimate"``.
     """
 
     rest_volume: float
@@ -67,11 +92,20 @@ class DeformReport:
     integration_error: float | None = None  # relative, Richardson estimate (estimate=True)
     mesh_error: float | None = None  # relative_change − integration_error
     rest_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
+    converged: bool = True
+    edges_over_threshold: int = 0
+    max_vertices: int | None = None
+    torn_vertices: int = 0
+    step_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
+    timings: dict | None = _dc_field(default=None, repr=False, compare=False)
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
              f"(relative change {self.relative_change:+.3e}); {self.steps} RK4 steps; "
              f"{self.vertices_added} vertices added in {self.passes} passes")
+        if not self.converged:
+            s += (f"; refinement stopped at max_vertices={self.max_vertices} with "
+                  f"{self.edges_over_threshold} edges over the threshold")
         if self.integration_error is not None:
             s += (f"; integration {self.integration_error:+.2e}, "
                   f"mesh {self.mesh_error:+.2e}")
@@ -85,48 +119,6 @@ def _edges(F: np.ndarray):
     key = np.sort(e, axis=1)
     uniq, inv = np.unique(key, axis=0, return_inverse=True)
     return uniq, inv.reshape(-1, 3)
-
-
-def _refine_pass(Vr, W, F, refine, mean_rest, phi):
-    edges, slot = _edges(F)
-    length = np.linalg.norm(W[edges[:, 0]] - W[edges[:, 1]], axis=1)
-    rest = np.linalg.norm(Vr[edges[:, 0]] - Vr[edges[:, 1]], axis=1)
-    long = np.flatnonzero(length > refine * np.maximum(rest, mean_rest))
-    if len(long) == 0:
-        return Vr, W, F, 0
-    # faces of each edge
-    order = np.argsort(slot.ravel(), kind="stable")
-    ids = slot.ravel()[order]
-    start = np.searchsorted(ids, np.arange(len(edges)))
-    count = np.bincount(ids, minlength=len(edges))
-    long = long[np.argsort(-length[long], kind="stable")]
-    used = np.zeros(len(F), dtype=bool)
-    pick_faces, pick_slots, pick_edges = [], [], []
-    for e in long:
-        fs = order[start[e]:start[e] + count[e]]
-        faces = fs // 3
-        if used[faces].any():
-            continue
-        used[faces] = True
-        pick_edges.append(e)
-        pick_faces.append(faces)
-        pick_slots.append(fs % 3)
-    pe = np.asarray(pick_edges)
-    m = len(Vr) + np.arange(len(pe))
-    mid = 0.5 * (Vr[edges[pe, 0]] + Vr[edges[pe, 1]])
-    Vr = np.concatenate([Vr, mid])
-    W = np.concatenate([W, phi(mid)])
-    newm = np.repeat(m, [len(f) for f in pick_faces])
-    faces = np.concatenate(pick_faces)
-    slots = np.concatenate(pick_slots)
-    rows = F[faces]
-    p = rows[np.arange(len(rows)), slots]
-    q = rows[np.arange(len(rows)), (slots + 1) % 3]
-    r = rows[np.arange(len(rows)), (slots + 2) % 3]
-    F = F.copy()
-    F[faces] = np.c_[p, newm, r]
-    F = np.concatenate([F, np.c_[newm, q, r]])
-    return Vr, W, F, len(pe)
 
 
 def _mesh_arrays(mesh):
@@ -151,25 +143,47 @@ def _mesh_arrays(mesh):
 
 
 def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: int = 30,
-           t0=0.0, estimate: bool = False, progress=False) -> tuple[Mesh, DeformReport]:
+           t0=0.0, estimate: bool = False, progress=False,
+           max_vertices=None) -> tuple[Mesh, DeformReport]:
     """Deform a closed triangle mesh along a divergence-free field and report the volume.
 
-    The vertices are advected with RK4 (:func:`spinal.advect`, default step rule); then, if
-    ``refine`` is a number, every edge that the deformation stretched beyond
-    ``refine × max(its rest length, mean rest edge length)`` is split at its rest midpoint,
-    the new vertex integrated from the rest mesh with the same steps, and its two triangles
-    bisected; repeated (at most ``max_passes`` passes) until no edge is too long. Edges that
-    are long already at rest are split only where they stretch, so a mesh with uneven edges
-    is not refined where the tool never reached. ``refine=None`` only advects.
+    The vertices are advected with RK4 (the steps of :func:`spinal.advect`, default step
+    rule). With ``refine`` a number ``τ ≥ 1``, after every step each edge longer than
+    ``τ × max(its rest length, mean rest edge length)`` is split at its rest midpoint — the
+    new vertex is that point carried by the steps so far, then carried on with the mesh —
+    longest edges first, both triangles bisected (Zheng's thesis §13.2; Rivara's
+    longest-edge bisection keeps triangles from getting thinner). Edges that are long already
+    at rest are split only where they stretch, so a tool that never reaches the mesh adds no
+    vertex. Where the flow tears an edge apart (across the tangential slip at the surface of
+    a :func:`spinal.fields.translation` tool, whose field is only continuous in its normal
+    part there) the new vertex goes to the edge's chord midpoint. ``refine=None`` only
+    advects.
+
+    The work is bounded: at most ``max_vertices`` vertices and ``max_passes`` passes after
+    each step. When a bound stops the refinement with edges still too long, the report has
+    ``converged=False`` and the count of those edges, and a :class:`spinal.RefinementWarning`
+    is issued.
 
     Parameters
     ----------
     mesh : spinal.Mesh, trimesh.Trimesh, or a ``(vertices, faces)`` pair
-        A closed, consistently wound triangle mesh (the rest mesh; not modified).
-    field, duration, steps, t0, progress : as in :func:`spinal.advect`.
+        A closed, consistently wound, edge-manifold triangle mesh (the rest mesh; not
+        modified).
+    field, duration, steps, t0 : as in :func:`spinal.advect`.
+    refine : float ≥ 1 or None
+        The split threshold τ (default 1.5, Zheng's "1.5 × the mean initial edge length").
+    max_passes : int ≥ 0
+        Refinement passes after each step (each splits a set of edges with disjoint
+        triangles).
+    max_vertices : int, optional
+        Upper bound of the refined mesh's vertex count (default ``8 × len(vertices)``).
     estimate : bool
         Also split the volume change into integration error (Richardson,
-        ``(V_n − V_2n)·16/15`` from a rerun with twice the steps) and mesh error.
+        ``(V_n − V_2n)·16/15`` from a rerun of the refined rest mesh with twice the steps) and
+        mesh error.
+    progress : bool or callable
+        As in :func:`spinal.advect`: a bar, or ``progress(done_steps, total_steps)``. Ctrl-C
+        stops the call between steps (``KeyboardInterrupt``).
 
     Returns
     -------
@@ -185,31 +199,61 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     if n < 1:
         raise ValueError(f"steps: must be at least 1, got {n}")
     if refine is not None:
-        refine = _positive(refine, "refine")
+        refine = _real(refine, "refine")
+        if not refine >= 1:
+            raise ValueError(f"refine: must be at least 1 (an edge is split when it grows "
+                             f"beyond refine × its rest length), got {refine}")
     max_passes = as_int(max_passes, "max_passes")
+    if max_passes < 0:
+        raise ValueError(f"max_passes: must be ≥ 0, got {max_passes}")
+    if max_vertices is None:
+        max_vertices = 8 * len(V)
+    else:
+        max_vertices = as_int(max_vertices, "max_vertices")
+        if max_vertices < len(V):
+            raise ValueError(f"max_vertices: must be at least the mesh's {len(V)} vertices, "
+                             f"got {max_vertices}")
+    estimate = as_bool(estimate, "estimate")
+    if not (isinstance(progress, bool) or callable(progress)):
+        raise TypeError(f"progress: expected a bool or a callable, got {type(progress).__name__}")
+    bar = []  # (update, close) of the progress bar, made when the core reports the step count
 
-    def phi(x, n=n):
-        return advect(x, field, duration, n, t0=t0)
+    def tick(done, total):
+        if not bar:
+            bar.append(_progress_bar(total, progress))
+        bar[0][0](done)
 
-    W = advect(V, field, duration, n, t0=t0, progress=progress)
-    Vr, Fr, added, passes = V, F, 0, 0
-    if refine is not None and len(F):
-        e, _ = _edges(F)
-        mean_rest = np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1).mean()
-        while passes < max_passes:
-            Vr, W, Fr, k = _refine_pass(Vr, W, Fr, refine, mean_rest, phi)
-            if k == 0:
-                break
-            added += k
-            passes += 1
+    try:
+        W, Vr, Fr, counts, stats = _core.deform_mesh(
+            V, F, field.rows, t0, duration, n, refine, max_vertices, max_passes,
+            tick if progress else None)
+    finally:
+        if bar:
+            bar[0][1]()
+    passes, torn, over, bounded, t_int, t_ref = stats
+    clock = time.perf_counter()
     rest, vol = _volume(Vr, Fr), _volume(W, Fr)
     change = vol / rest - 1 if rest != 0 else float("nan")
+    timings = {"integrate": t_int, "refine": t_ref, "volume": time.perf_counter() - clock,
+               "estimate": 0.0}
     integ = mesh_err = None
     if estimate:
+        clock = time.perf_counter()
+        W1 = W if torn == 0 else advect(Vr, field, duration, n, t0=t0)
         W2 = advect(Vr, field, duration, 2 * n, t0=t0)
-        integ = (vol - _volume(W2, Fr)) / rest * 16 / 15
+        integ = (_volume(W1, Fr) - _volume(W2, Fr)) / rest * 16 / 15
         mesh_err = change - integ
-    return Mesh(W, Fr), DeformReport(rest, vol, change, n, added, passes, integ, mesh_err, Vr)
+        timings["estimate"] = time.perf_counter() - clock
+    converged = not bounded
+    if not converged:
+        warnings.warn(RefinementWarning(
+            f"deform: refinement stopped at max_vertices={max_vertices} (or max_passes="
+            f"{max_passes} per step) with {over} edges still longer than refine × their rest "
+            f"length; raise max_vertices or use more steps"), stacklevel=2)
+    report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
+                          converged, over, max_vertices if refine is not None else None, torn,
+                          counts, timings)
+    return Mesh(W, Fr), report
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ const CHUNK: usize = 256;
 #[inline]
 pub fn integrate(field: &Field, x: DVec3, t0: f64, h: f64, steps: usize, m: Method) -> DVec3 {
     let mut b = [x];
-    integrate_batch(field, &mut b, t0, h, steps, m);
+    integrate_batch(field, &mut b, t0, h, 0..steps, m);
     b[0]
 }
 
@@ -46,9 +46,17 @@ pub fn integrate(field: &Field, x: DVec3, t0: f64, h: f64, steps: usize, m: Meth
 /// latency; `LANES` independent path lines interleave and keep the pipelines full.
 const LANES: usize = 16;
 
-/// `B ≤ LANES` path lines in lock-step.
+/// `B ≤ LANES` path lines in lock-step, steps `j ∈ steps` at times `t0 + h·j` (a run split in
+/// parts gives the bits of the whole run).
 #[inline]
-fn integrate_batch(field: &Field, x: &mut [DVec3], t0: f64, h: f64, steps: usize, m: Method) {
+fn integrate_batch(
+    field: &Field,
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+    m: Method,
+) {
     use super::Element as E;
     // one dispatch per batch instead of per evaluation: a single-element field is evaluated
     // by a monomorphised loop the compiler can inline and schedule across the lanes
@@ -64,14 +72,20 @@ fn integrate_batch(field: &Field, x: &mut [DVec3], t0: f64, h: f64, steps: usize
 
 /// RK4 on `B ≤ LANES` path lines in lock-step with the evaluator `v(x, t, t_mid)`.
 #[inline(always)]
-fn rk4_batch(v: impl Fn(DVec3, f64, f64) -> DVec3, x: &mut [DVec3], t0: f64, h: f64, steps: usize) {
+fn rk4_batch(
+    v: impl Fn(DVec3, f64, f64) -> DVec3,
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+) {
     let n = x.len().min(LANES);
     let x = &mut x[..n];
     let h2 = 0.5 * h;
     let h6 = h / 6.0;
     let mut k = [DVec3::ZERO; LANES];
     let mut acc = [DVec3::ZERO; LANES];
-    for s in 0..steps {
+    for s in steps {
         let t = t0 + h * s as f64;
         let tm = t + h2;
         for j in 0..n {
@@ -133,7 +147,7 @@ fn integrate_batch_generic(
     x: &mut [DVec3],
     t0: f64,
     h: f64,
-    steps: usize,
+    steps: std::ops::Range<usize>,
     m: Method,
 ) {
     let n = x.len().min(LANES);
@@ -141,7 +155,7 @@ fn integrate_batch_generic(
     let h6 = h / 6.0;
     let mut k = [DVec3::ZERO; LANES];
     let mut acc = [DVec3::ZERO; LANES];
-    for s in 0..steps {
+    for s in steps {
         let t = t0 + h * s as f64;
         let tm = t + h2;
         match m {
@@ -233,12 +247,25 @@ pub fn advect_in_place(
     steps: usize,
     m: Method,
 ) {
-    if field.elements.is_empty() || steps == 0 || h == 0.0 {
+    advect_steps(field, points, t0, h, 0..steps, m);
+}
+
+/// Advect `points` in place by the steps `j ∈ steps` of the run `t0 + h·j`: the steps of a
+/// run taken in several calls give the same bits as one call.
+pub fn advect_steps(
+    field: &Field,
+    points: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+    m: Method,
+) {
+    if field.elements.is_empty() || steps.is_empty() || h == 0.0 {
         return;
     }
     points.par_chunks_mut(CHUNK).for_each(|c| {
         for b in c.chunks_mut(LANES) {
-            integrate_batch(field, b, t0, h, steps, m);
+            integrate_batch(field, b, t0, h, steps.clone(), m);
         }
     });
 }
@@ -334,7 +361,7 @@ mod timing {
                 let mut x = x0.clone();
                 let t = std::time::Instant::now();
                 for b in x.chunks_mut(LANES) {
-                    integrate_batch(&f, b, 0.0, 0.3 / 16.0, 16, Method::Rk4);
+                    integrate_batch(&f, b, 0.0, 0.3 / 16.0, 0..16, Method::Rk4);
                 }
                 best = best.min(t.elapsed().as_secs_f64());
                 std::hint::black_box(&x);

@@ -16,6 +16,7 @@ pub mod cross;
 pub mod fields;
 pub mod grid;
 pub mod path;
+pub mod refine;
 pub mod stamp;
 pub mod tube;
 
