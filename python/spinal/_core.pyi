@@ -1,5 +1,7 @@
 """Type stubs for the compiled core (``spinal._core``). Use the wrappers in ``spinal``."""
 
+from collections.abc import Callable
+
 import numpy as np
 import numpy.typing as npt
 
@@ -153,6 +155,24 @@ def advect(
     steps: int,
     method: str,
 ) -> npt.NDArray[np.float64]: ...
+def deform_mesh(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    rows: npt.NDArray[np.float64],
+    t0: float,
+    duration: float,
+    steps: int,
+    refine: float | None,
+    max_vertices: int,
+    max_passes: int,
+    progress: Callable[[int, int], object] | None,
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.int64],
+    tuple[int, int, int, bool, float, float],
+]: ...
 def flesh_bind(
     rest_points: npt.NDArray[np.float64],
     rest_frames: npt.NDArray[np.float64],

@@ -22,6 +22,58 @@ impl From<InputError> for PyErr {
     }
 }
 
+/// Calls back into Python between the steps of a long computation, for the core's
+/// `tick(done, total) -> bool`: checks for signals (Ctrl-C raises `KeyboardInterrupt` there)
+/// at least every [`Ticker::INTERVAL`] and calls `progress(done, total)` after every step
+/// when given. A Python error stops the computation (the tick returns `false`) and is kept
+/// for [`Ticker::finish`].
+pub struct Ticker {
+    progress: Option<Py<PyAny>>,
+    last: std::time::Instant,
+    error: Option<PyErr>,
+}
+
+impl Ticker {
+    /// How often the signals are checked without a progress callback.
+    pub const INTERVAL: std::time::Duration = std::time::Duration::from_millis(50);
+
+    pub fn new(progress: Option<Py<PyAny>>) -> Ticker {
+        Ticker {
+            progress,
+            last: std::time::Instant::now(),
+            error: None,
+        }
+    }
+
+    /// Continue (true) or stop (false) after `done` of `total` steps.
+    pub fn tick(&mut self, done: usize, total: usize) -> bool {
+        if self.progress.is_none() && self.last.elapsed() < Self::INTERVAL {
+            return true;
+        }
+        self.last = std::time::Instant::now();
+        let progress = &self.progress;
+        let r = Python::attach(|py| -> PyResult<()> {
+            py.check_signals()?;
+            if let Some(p) = progress {
+                p.bind(py).call1((done, total))?;
+            }
+            Ok(())
+        });
+        match r {
+            Ok(()) => true,
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
+        }
+    }
+
+    /// The Python error that stopped the computation, if any.
+    pub fn finish(self) -> PyResult<()> {
+        self.error.map_or(Ok(()), Err)
+    }
+}
+
 /// The error as a `ValueError` naming `to` where the core named its argument `from` (a
 /// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
 pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {

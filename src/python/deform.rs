@@ -5,8 +5,10 @@ use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use super::convert::{empty, slice_mut, slice_of, triangles, value_error, vec3_array, vec3s};
-use crate::deform::{self, advect::Method};
+use super::convert::{
+    Ticker, empty, slice_mut, slice_of, triangles, value_error, vec3_array, vec3s,
+};
+use crate::deform::{self, advect::Method, refine};
 
 /// A field from its `(k, ROW)` element rows (see `_core.pyi` for the layouts).
 fn field_of(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<deform::Field> {
@@ -76,6 +78,74 @@ pub fn advect<'py>(
         py.detach(|| deform::advect::advect_in_place(&field, o, t0, h, steps, method));
     }
     Ok(out)
+}
+
+type DeformArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    (usize, usize, usize, bool, f64, f64),
+);
+
+/// Deform a closed mesh along a field, refining after every step (see `deform::refine`):
+/// `(vertices, rest_vertices, faces, vertices after each step, (passes, torn vertices, edges
+/// over the threshold, bounded, integration seconds, refinement seconds))`. `refine=None`
+/// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
+/// every step when given.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, rows, t0, duration, steps, refine, max_vertices,
+                    max_passes, progress))]
+#[allow(clippy::too_many_arguments)]
+pub fn deform_mesh<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    rows: PyReadonlyArray2<'py, f64>,
+    t0: f64,
+    duration: f64,
+    steps: usize,
+    refine: Option<f64>,
+    max_vertices: usize,
+    max_passes: usize,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<DeformArrays<'py>> {
+    let field = field_of(&rows)?;
+    let x = vec3s("mesh", &vertices)?;
+    // negative indices become out of range, which the core reports
+    let f: Vec<[usize; 3]> = triangles(&faces)?
+        .iter()
+        .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
+        .collect();
+    let opts = refine.map(|ratio| refine::Refinement {
+        ratio,
+        max_vertices,
+        max_passes,
+    });
+    let mut ticker = Ticker::new(progress);
+    let out = py.detach(|| {
+        let runs = refine::schedule(&field, t0, duration, steps);
+        refine::deform(&field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
+    })?;
+    ticker.finish()?;
+    let d = out.ok_or_else(|| value_error("deform: stopped"))?;
+    let faces: Vec<i64> = d.faces.iter().flatten().map(|&i| i as i64).collect();
+    let nf = d.faces.len();
+    let counts: Vec<i64> = d.step_vertices.iter().map(|&c| c as i64).collect();
+    Ok((
+        vec3_array(py, d.vertices)?,
+        vec3_array(py, d.rest)?,
+        PyArray1::from_vec(py, faces).reshape([nf, 3])?,
+        PyArray1::from_vec(py, counts),
+        (
+            d.passes,
+            d.torn,
+            d.over_threshold,
+            d.bounded,
+            d.time_integrate,
+            d.time_refine,
+        ),
+    ))
 }
 
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
