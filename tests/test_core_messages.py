@@ -4,6 +4,7 @@ names the argument the user can act on and lists the choices of an option."""
 import numpy as np
 import pytest
 
+import spinal
 from spinal import _core
 
 PTS = np.ascontiguousarray(np.c_[np.arange(4.0), np.zeros(4), np.zeros(4)])
@@ -28,7 +29,7 @@ def test_option_strings_name_the_argument_and_list_the_choices():
         _core.ph_frames(np.random.rand(1, 4, 3), np.zeros(1), "x", None, 0.0, None)
     with pytest.raises(ValueError, match=r"^method: unknown method \"x\"; expected 'rk4', "
                        r"'euler' or 'split'"):
-        _core.advect(PTS, np.zeros((1, 16)), 0.0, 0.1, 1, "x")
+        _core.advect(PTS, spinal.fields.translation([0, 0, 0], 1, [1, 0, 0]), 0.0, 0.1, 1, "x")
     with pytest.raises(ValueError, match=r"^solution: unknown value \"x\"; expected 'none', "
                        r"'normal', 'binormal' or 'radial'"):
         _core.flesh_deform(PTS, np.zeros((4, 3, 3)), np.zeros(0, dtype=np.int64),

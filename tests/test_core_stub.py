@@ -29,7 +29,7 @@ def core_functions() -> dict[str, list[str]]:
     out = {}
     for name in dir(_core):
         f = getattr(_core, name)
-        if name.startswith("_") or not callable(f):
+        if name.startswith("_") or not callable(f) or inspect.isclass(f):
             continue
         out[name] = list(inspect.signature(f).parameters)
     return out
@@ -65,6 +65,20 @@ def test_stub_check_catches_a_broken_stub():
     assert mismatches(stub_functions(renamed), core) == [want]
     dropped = text.replace("def quat_continuous(", "def _quat_continuous(", 1)
     assert "quat_continuous: in _core, not in the stub" in mismatches(stub_functions(dropped), core)
+
+
+def test_stub_classes_match_the_compiled_module():
+    """The compiled classes (``Field``) and their public methods are in the stub."""
+    tree = ast.parse(STUB.read_text(encoding="utf-8"))
+    stub = {n.name: {m.name for m in n.body if isinstance(m, ast.FunctionDef)}
+            for n in tree.body if isinstance(n, ast.ClassDef)}
+    core = {n: getattr(_core, n) for n in dir(_core)
+            if not n.startswith("_") and inspect.isclass(getattr(_core, n))}
+    assert stub.keys() == core.keys()
+    for name, cls in core.items():
+        methods = {m for m in vars(cls) if not m.startswith("__") or m in (
+            "__call__", "__add__", "__radd__", "__len__", "__reduce__")}
+        assert methods <= stub[name], (name, methods - stub[name])
 
 
 @pytest.mark.parametrize("name", sorted(core_functions()))

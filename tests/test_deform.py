@@ -303,8 +303,8 @@ def test_sum_and_evaluation_conventions():
     # a moving tool is at center + velocity·t
     np.testing.assert_allclose(f(x + 0.25 * U, t=0.25), f(x), atol=1e-14)
     assert not fields.translation(C, RHO, [0, 0, 0])(x).any()
-    with pytest.raises(ValueError, match="read-only"):
-        f.rows[0, 0] = 2.0
+    with pytest.raises(AttributeError):  # immutable
+        f.max_speed = 2.0
 
 
 # ---- advection -----------------------------------------------------------------------------
@@ -549,18 +549,41 @@ def test_bad_input(call, exc, start):
     np.testing.assert_array_equal(V, V0)
 
 
-def test_core_rejects_malformed_rows_without_panicking():
+def test_core_constructors_name_the_argument_without_panicking():
+    """The compiled constructors check every value themselves (called here without the
+    Python wrappers' type coercion), and advect takes only compiled fields."""
     from spinal import _core
 
-    row = fields.translation([0, 0, 0], 1, [1, 0, 0]).rows.copy()
-    x = np.zeros((1, 3))
-    for i, value in ((0, 9.0), (7, -1.0), (9, 2.5), (3, np.nan)):
-        bad = row.copy()
-        bad[0, i] = value
-        with pytest.raises(ValueError, match="^field"):
-            _core.field_eval(x, bad, 0.0)
-    with pytest.raises(ValueError, match="^field"):
-        _core.advect(x, np.zeros((1, 5)), 0.0, 0.1, 1, "rk4")
+    ok = ([0.0, 0, 0], 1.0, [1.0, 0, 0], None, 2, True)
+    for i, value, arg in ((1, -1.0, "radius"), (4, 9, "falloff_power"),
+                          (0, [np.nan, 0, 0], "center"), (2, [1e200, 1e200, 0], "velocity"),
+                          (3, 0.0, "reach")):
+        args = list(ok)
+        args[i] = value
+        with pytest.raises(ValueError, match=f"^{arg}"):
+            _core.field_translation(*args)
+    with pytest.raises(ValueError, match="^axis"):
+        _core.field_rotation([0.0, 0, 0], 1.0, [0.0, 0, 0], 1.0, None, None, 2)
+    with pytest.raises(ValueError, match="^blend"):
+        _core.field_sphere([0.0, 0, 0], 1.0, [1.0, 0, 0], None, "c2", True)
+    with pytest.raises(TypeError):
+        _core.advect(np.zeros((1, 3)), np.zeros((1, 16)), 0.0, 0.1, 1, "rk4")
+
+
+def test_fields_pickle_by_rebuilding():
+    import pickle
+
+    f = (fields.translation([0, 0, 1.2], 0.3, [0, 0, -1], falloff_power=4)
+         + fields.twist([0, 0, 0], [0, 0, 1], 2.0, 1.0, form="curl")
+         + fields.along_path([[0, 0, 0], [1, 0, 0], [2, 0.5, 0]], 0.2, 1.0, kind="rotate"))
+    g = pickle.loads(pickle.dumps(f))
+    assert repr(g) == repr(f) and len(g) == len(f) == 3
+    x = ball([0.5, 0, 0.5], 1.0, 500)
+    for t in (0.0, 0.3, 0.7):
+        np.testing.assert_array_equal(g(x, t), f(x, t))
+    np.testing.assert_array_equal(g.breakpoints(), f.breakpoints())
+    z = pickle.loads(pickle.dumps(fields.sum([])))
+    assert len(z) == 0 and not z(x).any()
 
 
 def test_refinement_from_the_rest_mesh_keeps_a_long_stroke_below_1e_4():

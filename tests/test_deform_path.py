@@ -138,7 +138,7 @@ def test_rk4_is_fourth_order_with_steps_ending_at_the_samples(seed=7):
         # crosses: one O(h³) local error, so the ratio falls from ~16 towards 8
         lo = 13 if kind in ("translate", "rotate") else 7
         assert np.all((ratios > lo) & (ratios < 19)), (kind, err, ratios)
-        plain = np.abs(spinal._core.advect(x, f.rows, 0.0, 1 / 256, 256, "rk4") - ref).max()
+        plain = np.abs(spinal._core.advect(x, f, 0.0, 1 / 256, 256, "rk4") - ref).max()
         assert plain > 5 * err[2], (kind, plain, err[2])
 
 
@@ -189,20 +189,25 @@ def test_bad_input(kw, match):
         fields.along_path(args.pop("points"), args.pop("radius"), args.pop("duration"), **args)
 
 
-def test_core_rejects_malformed_path_rows():
-    f = fields.along_path([[0, 0, 0], [1, 0, 0], [2, 0.5, 0]], 0.2, 1.0)
-    rows = f.rows.copy()
-    for bad in (rows[:2], rows[1:]):
-        with pytest.raises(ValueError, match="field"):
-            spinal._core.field_info(np.ascontiguousarray(bad), 1.0)
-    r = rows.copy()
-    r[0, 11] = 7  # announces more samples than follow
-    with pytest.raises(ValueError, match="samples"):
-        spinal._core.field_info(r, 1.0)
-    r = rows.copy()
-    r[2, 13] = r[1, 13]  # arc length not increasing
-    with pytest.raises(ValueError, match="increase"):
-        spinal._core.field_info(r, 1.0)
+def test_core_path_constructor_names_the_argument():
+    """The compiled constructor checks the samples and frames itself (called here without
+    the Python wrapper)."""
+    pts = np.array([[0, 0, 0], [1, 0, 0], [2, 0.5, 0]], dtype=float)
+    frames = spinal.frames(pts)
+    args = {"radius": 0.2, "duration": 1.0, "kind": "translate", "tool": "push", "rate": 0.0,
+            "t0": 0.0, "reach": None, "falloff_power": 2, "blend": "c1"}
+    with pytest.raises(ValueError, match="^points: need at least 2"):
+        spinal._core.field_path(pts[:1], frames[:1], *args.values())
+    rep = pts.copy()
+    rep[2] = rep[1]
+    with pytest.raises(ValueError, match="^points: consecutive samples 1 and 2 coincide"):
+        spinal._core.field_path(rep, frames, *args.values())
+    bad = frames.copy()
+    bad[1] *= 2
+    with pytest.raises(ValueError, match="^frames: frame 1 is not a rotation"):
+        spinal._core.field_path(pts, bad, *args.values())
+    with pytest.raises(ValueError, match="^duration"):
+        spinal._core.field_path(pts, frames, 0.2, -1.0, *list(args.values())[2:])
 
 
 # ---- contact stamper (brief §2.8) ----------------------------------------------------------
@@ -271,7 +276,7 @@ def test_split_is_volume_exact_pointwise_second_order_and_matches_the_mesh_floor
     def det(f, method):  # 4th-order central differences of the one-step map
 
         def step(y):
-            return _core.advect(y, f.rows, 0.0, h, 1, method)
+            return _core.advect(y, f, 0.0, h, 1, method)
 
         cols = [(8 * (step(x + eps * e) - step(x - eps * e))
                  - (step(x + 2 * eps * e) - step(x - 2 * eps * e))) / (12 * eps)

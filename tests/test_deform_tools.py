@@ -234,8 +234,9 @@ def test_sampled_sphere_distance_reproduces_the_sphere_field_at_third_order():
     for h in (0.05, 0.025, 0.0125):
         d, o = sphere_grid(h)
         f = fields.sdf_tool(d, o, h, U, moving=False)  # default centre and reach: C, ρ
-        np.testing.assert_allclose(f.rows[0, 13:16], C, atol=1e-14)
-        assert abs(f.rows[0, 11] - rho) < 1e-14
+        # the default centre and reach are C and ρ: the same field as when given
+        given = fields.sdf_tool(d, o, h, U, moving=False, center=C, reach=rho)
+        np.testing.assert_allclose(f(x), given(x), rtol=0, atol=1e-12)
         errs.append(np.abs(f(x) - vr).max() / np.abs(vr).max())
     orders = np.log2(np.divide(errs[:-1], errs[1:]))
     assert np.all((orders > 2.8) & (orders < 3.3)), (errs, orders)
@@ -416,37 +417,36 @@ def test_grid_and_mesh_tool_bad_input():
     np.testing.assert_array_equal(F, F0)
 
 
-def test_core_rejects_malformed_strip_and_grid_rows():
-    x = np.zeros((1, 3))
-    s = fields.strip_curve(ARC, RHO, SPEED, reach=RF).rows
+def test_core_strip_and_grid_constructors_refuse_bad_input():
+    """The compiled constructors check the axis and the grid themselves (called here without
+    the Python wrappers), naming the argument, never panicking."""
+    from spinal.fields import _clamped_spline_slopes, _spline_prefilter
+
+    x = np.ascontiguousarray(ARC)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
+    tan = spinal.estimate_tangents(x)
+    m = _clamped_spline_slopes(x, s, tan[0], tan[-1])
+    ok = (RHO, SPEED, RF, "c1")
+    _core.field_strip_curve(x, m, s, *ok)
+    flat = s.copy()
+    flat[3] = flat[2]  # arc length not increasing
+    with pytest.raises(ValueError, match="increase"):
+        _core.field_strip_curve(x, m, flat, *ok)
+    with pytest.raises(ValueError, match="bends too sharply"):  # a sharper bend than allowed
+        _core.field_strip_curve(0.2 * x, m, 0.2 * s, *ok)
+    with pytest.raises(ValueError, match="^radius"):
+        _core.field_strip_curve(x, m, s, -RHO, SPEED, RF, "c1")
     d, o = sphere_grid(0.05)
-    g = fields.sdf_tool(d, o, 0.05, U).rows
-    cases = []
-    for rows in (s, g):
-        cases.append(rows[:-1])  # a data row missing
-        r = rows.copy()
-        r[1, 0] = 8.0  # a data row of the wrong kind
-        cases.append(r)
-        r = rows.copy()
-        r[2, 3] = np.nan
-        cases.append(r)
-        cases.append(rows[1:])  # data rows without their header
-    r = s.copy()
-    r[3, 7] = r[2, 7]  # arc length not increasing
-    cases.append(r)
-    r = s.copy()
-    r[1:, 1:4] *= 0.2  # a sharper bend than radius + reach allows
-    r[1:, 7] *= 0.2
-    cases.append(r)
-    r = g.copy()
-    r[0, 12] = 5.0  # flags
-    cases.append(r)
-    r = g.copy()
-    r[0, 11] = 2.0  # a reach whose support reaches the grid's edge
-    cases.append(r)
-    r = g.copy()
-    r[0, 5] = 1e7  # absurd size
-    cases.append(r)
-    for rows in cases:
-        with pytest.raises(ValueError, match="^field"):
-            _core.field_eval(x, np.ascontiguousarray(rows), 0.0)
+    coef = np.ascontiguousarray(_spline_prefilter(d))
+    grid = (o, 0.05, U, C, 0.4, "c1", True, "sdf_tool")
+    _core.field_grid(coef, *grid)
+    with pytest.raises(ValueError, match="^grid: the field's support"):
+        _core.field_grid(coef, o, 0.05, U, C, 2.0, "c1", True, "sdf_tool")
+    with pytest.raises(ValueError, match="^spacing: grid too coarse"):
+        _core.field_grid(coef, o, 0.05, U, C, 0.1, "c1", True, "sdf_tool")
+    bad = coef.copy()
+    bad[3, 3, 3] = np.nan
+    with pytest.raises(ValueError, match="^grid"):
+        _core.field_grid(bad, *grid)
+    with pytest.raises(ValueError, match="^grid"):
+        _core.field_grid(coef[:4, :4, :4].copy(), *grid)

@@ -7,10 +7,13 @@ import itertools
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_int, as_points
-from .fields import Field, _check_finite, _real
+from ._validate import as_choice, as_finite, as_int, as_points
+from .fields import Field
 
 __all__ = ["advect"]
+
+# the most steps a call takes (the default step rule refuses more too)
+MAX_STEPS = 100_000_000
 
 
 def _progress_bar(total: int, progress):
@@ -65,8 +68,8 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         times it passes spine samples (:meth:`Field.breakpoints`), about ``steps`` in all
         (each sub-interval gets ``⌈steps·length/duration⌉ ≥ 1``).
     method : "rk4", "euler" or "split"
-        ``"split"``: the volume-exact splitting on the curl potential (Feng & Shang; issue-4
-        brief §3.3): three planar Hamiltonian sub-flows ``ẋ_a = ∂_b A_k, ẋ_b = −∂_a A_k``
+        ``"split"``: the volume-exact splitting on the curl potential (Feng & Shang 1995,
+        volume-preserving algorithms for source-free dynamical systems): three planar Hamiltonian sub-flows ``ẋ_a = ∂_b A_k, ẋ_b = −∂_a A_k``
         (``curl A = v``), each by the implicit midpoint rule, in a Strang composition —
         2nd order, with ``det(∂X_{n+1}/∂X_n) = 1`` to round-off at every point (RK4: O(h⁵)
         per step). Tools moving with one common velocity are integrated co-moving (steady
@@ -85,20 +88,19 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
     (n, 3) float64 array of the moved points.
     """
     x = as_points(vertices, "vertices")
-    _check_finite(x, "vertices")
     if not isinstance(field, Field):
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
-    duration = _real(duration, "duration")
-    t0 = _real(t0, "t0")
+    duration = as_finite(duration, "duration")
+    t0 = as_finite(t0, "t0")
     method = as_choice(method, "method", ("rk4", "euler", "split"))
     if steps is None:
         steps = field.steps(duration)
     else:
         steps = as_int(steps, "steps")
-        if steps < 1:
-            raise ValueError(f"steps: must be at least 1, got {steps}")
-    if duration == 0.0:
-        return x.copy()
+        if not 1 <= steps <= MAX_STEPS:
+            raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {steps}")
+    if duration == 0.0:  # an unchanged copy (the core still checks the points)
+        return _core.advect(x, field, t0, 0.0, 1, method)
     bp = field.breakpoints()
     t1 = t0 + duration
     cuts = bp[(bp > min(t0, t1)) & (bp < max(t0, t1))]
@@ -112,7 +114,7 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         done = 0
         try:
             for a, b, n in zip(ts[:-1], ts[1:], ns):
-                x = _core.advect(x, field.rows, float(a), float(b - a) / n, n, method)
+                x = _core.advect(x, field, float(a), float(b - a) / n, n, method)
                 done += n
                 if update:
                     update(done)
@@ -122,14 +124,14 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         return x
     h = duration / steps
     if not progress:
-        return _core.advect(x, field.rows, t0, h, steps, method)
+        return _core.advect(x, field, t0, h, steps, method)
     update, close = _progress_bar(steps, progress)
     block = max(1, steps // 100)
     done = 0
     try:
         while done < steps:
             n = min(block, steps - done)
-            x = _core.advect(x, field.rows, t0 + done * h, h, n, method)
+            x = _core.advect(x, field, t0 + done * h, h, n, method)
             done += n
             update(done)
     finally:

@@ -1,6 +1,7 @@
 """Type stubs for the compiled core (``spinal._core``). Use the wrappers in ``spinal``."""
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -143,13 +144,99 @@ def ph_frames(
 # its data rows: 7 path tool + n rows of kind 8, 9 strip along a curved axis + n rows of kind
 # 10 (x, dγ/dS, S), 11 distance-grid tool + ⌈(nx+2)(ny+2)(nz+2)/15⌉ rows of kind 12 (B-spline
 # coefficients). Build them with spinal.fields; the core re-validates every row.
-def field_eval(
-    points: npt.NDArray[np.float64], rows: npt.NDArray[np.float64], t: float
-) -> npt.NDArray[np.float64]: ...
-def field_info(rows: npt.NDArray[np.float64], duration: float) -> tuple[float, float, int]: ...
+_V3: TypeAlias = npt.NDArray[np.float64] | Sequence[float]
+
+class Field:
+    """A compiled divergence-free field (``spinal.fields.Field``)."""
+
+    def __call__(self, points: npt.ArrayLike, t: float | None = None) -> npt.NDArray[np.float64]: ...
+    def __add__(self, other: Field) -> Field: ...
+    def __radd__(self, other: Field | int) -> Field: ...
+    def __len__(self) -> int: ...
+    def breakpoints(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def max_speed(self) -> float: ...
+    @property
+    def length_scale(self) -> float: ...
+    def steps(self, duration: float) -> int: ...
+    def __reduce__(self) -> tuple[object, tuple[list[object]]]: ...
+    def _with_recipe(self, name: str, args: tuple[object, ...], kwargs: dict[str, object]) -> Field: ...
+
+def field_translation(
+    center: _V3, radius: float, velocity: _V3, reach: float | None, falloff_power: int, moving: bool
+) -> Field: ...
+def field_rotation(
+    center: _V3,
+    radius: float,
+    axis: _V3,
+    angular_speed: float,
+    pivot: _V3 | None,
+    reach: float | None,
+    falloff_power: int,
+) -> Field: ...
+def field_swirl(center: _V3, axis: _V3, rate: float, radius: float, form: str, bend: bool) -> Field: ...
+def field_sphere(
+    center: _V3, radius: float, velocity: _V3, reach: float | None, blend: str, moving: bool
+) -> Field: ...
+def field_capsule(
+    start: _V3,
+    end: _V3,
+    radius: float,
+    velocity: _V3,
+    reach: float | None,
+    blend: str,
+    moving: bool,
+) -> Field: ...
+def field_strip(
+    start: _V3, end: _V3, radius: float, velocity: _V3, kind: str, reach: float | None, blend: str
+) -> Field: ...
+def field_torus(
+    center: _V3,
+    axis: _V3,
+    major: float,
+    minor: float,
+    speed: float,
+    reach: float | None,
+    blend: str,
+    moving: bool,
+) -> Field: ...
+def field_strip_curve(
+    points: npt.NDArray[np.float64],
+    slopes: npt.NDArray[np.float64],
+    arc: npt.NDArray[np.float64],
+    radius: float,
+    speed: float,
+    reach: float | None,
+    blend: str,
+) -> Field: ...
+def field_grid(
+    coefficients: npt.NDArray[np.float64],
+    origin: _V3,
+    spacing: float,
+    velocity: _V3,
+    center: _V3,
+    reach: float,
+    blend: str,
+    moving: bool,
+    name: str,
+) -> Field: ...
+def field_path(
+    points: npt.NDArray[np.float64],
+    frames: npt.NDArray[np.float64],
+    radius: float,
+    duration: float,
+    kind: str,
+    tool: str,
+    rate: float,
+    t0: float,
+    reach: float | None,
+    falloff_power: int,
+    blend: str,
+) -> Field: ...
+def field_zero() -> Field: ...
 def advect(
     points: npt.NDArray[np.float64],
-    rows: npt.NDArray[np.float64],
+    field: Field,
     t0: float,
     h: float,
     steps: int,
@@ -158,7 +245,7 @@ def advect(
 def deform_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
-    rows: npt.NDArray[np.float64],
+    field: Field,
     t0: float,
     duration: float,
     steps: int,

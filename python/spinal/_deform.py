@@ -21,11 +21,11 @@ from dataclasses import field as _dc_field
 import numpy as np
 
 from . import _core
-from ._advect import _progress_bar, advect
-from ._mesh import Mesh
+from ._advect import MAX_STEPS, _progress_bar, advect
+from ._mesh import Mesh, mesh_arrays
 from ._mesh import signed_volume as _volume
-from ._validate import as_bool, as_float_array, as_int
-from .fields import Field, _positive, _real
+from ._validate import as_bool, as_finite, as_int, as_vector
+from .fields import Field
 
 __all__ = ["DeformReport", "RefinementWarning", "StampReport", "deform", "stamp"]
 
@@ -112,36 +112,6 @@ class DeformReport:
         return s
 
 
-def _edges(F: np.ndarray):
-    """Unique edges (m, 2), and the edge id of every face slot (nf, 3); slot k is the edge
-    F[k] → F[k+1]."""
-    e = np.stack([F, np.roll(F, -1, axis=1)], axis=-1).reshape(-1, 2)
-    key = np.sort(e, axis=1)
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    return uniq, inv.reshape(-1, 3)
-
-
-def _mesh_arrays(mesh):
-    if isinstance(mesh, tuple) and len(mesh) == 2:
-        V, F = mesh
-    elif hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
-        V, F = mesh.vertices, mesh.faces
-    else:
-        raise TypeError("mesh: expected a spinal.Mesh, a trimesh.Trimesh or (vertices, faces)")
-    V = np.ascontiguousarray(as_float_array(V, "mesh"), dtype=np.float64)
-    F = np.asarray(F)
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise ValueError(f"mesh: vertices must have shape (n, 3), got {V.shape}")
-    if not np.isfinite(V).all():
-        raise ValueError("mesh: vertices must be finite")
-    if F.ndim != 2 or F.shape[1] != 3 or F.dtype.kind not in "iu":
-        raise ValueError(f"mesh: faces must be an (m, 3) integer array, got {F.shape} {F.dtype}")
-    F = np.ascontiguousarray(F, dtype=np.int64)
-    if len(F) and (F.min() < 0 or F.max() >= len(V)):
-        raise ValueError("mesh: face indices out of range")
-    return V, F
-
-
 def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: int = 30,
            t0=0.0, estimate: bool = False, progress=False,
            max_vertices=None) -> tuple[Mesh, DeformReport]:
@@ -190,16 +160,16 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     (Mesh, DeformReport)
         The deformed (refined) mesh and the volume report.
     """
-    V, F = _mesh_arrays(mesh)
+    V, F = mesh_arrays(mesh)
     if not isinstance(field, Field):
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
-    duration = _real(duration, "duration")
-    t0 = _real(t0, "t0")
+    duration = as_finite(duration, "duration")
+    t0 = as_finite(t0, "t0")
     n = field.steps(duration) if steps is None else as_int(steps, "steps")
-    if n < 1:
-        raise ValueError(f"steps: must be at least 1, got {n}")
+    if not 1 <= n <= MAX_STEPS:
+        raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {n}")
     if refine is not None:
-        refine = _real(refine, "refine")
+        refine = as_finite(refine, "refine")
         if not refine >= 1:
             raise ValueError(f"refine: must be at least 1 (an edge is split when it grows "
                              f"beyond refine × its rest length), got {refine}")
@@ -225,7 +195,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
 
     try:
         W, Vr, Fr, counts, stats = _core.deform_mesh(
-            V, F, field.rows, t0, duration, n, refine, max_vertices, max_passes,
+            V, F, field, t0, duration, n, refine, max_vertices, max_passes,
             tick if progress else None)
     finally:
         if bar:
@@ -254,6 +224,13 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
                           converged, over, max_vertices if refine is not None else None, torn,
                           counts, timings)
     return Mesh(W, Fr), report
+
+
+def _positive(x, name: str) -> float:
+    x = as_finite(x, name)
+    if not x > 0:
+        raise ValueError(f"{name}: must be positive, got {x}")
+    return x
 
 
 @dataclass(frozen=True)
@@ -289,8 +266,8 @@ class StampReport:
 
 def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
           iterations: int = 2) -> tuple[Mesh, StampReport]:
-    """Press a sphere into a closed mesh in contact only (thesis §11.2.6, the "stamper";
-    issue-4 brief §2.8), giving the dented volume back as a protrusion around the contact.
+    """Press a sphere into a closed mesh in contact only (thesis §11.2.6, the "stamper"),
+    giving the dented volume back as a protrusion around the contact.
 
     The tool centre moves from ``start`` to ``end`` in ``frames`` equal moves. Each frame:
 
@@ -320,10 +297,8 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     -------
     (Mesh, StampReport)
     """
-    from .fields import _vec3
-
-    V, F = _mesh_arrays(mesh)
-    a, b = _vec3(start, "start"), _vec3(end, "end")
+    V, F = mesh_arrays(mesh)
+    a, b = as_vector(start, "start"), as_vector(end, "end")
     rho = _positive(radius, "radius")
     reach = rho if reach is None else _positive(reach, "reach")
     frames = as_int(frames, "frames")

@@ -8,7 +8,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FoldOverWarning", "Mesh"]
+from ._validate import as_float_array
+
+__all__ = ["FoldOverWarning", "Mesh", "edges", "mesh_arrays"]
 
 
 class FoldOverWarning(UserWarning):
@@ -27,6 +29,38 @@ def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
     v = V - V.mean(axis=0) if len(V) else V
     a, b, c = (v[F[:, k]] for k in range(3))
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def edges(F: np.ndarray):
+    """Unique edges (m, 2), and the edge id of every face slot (nf, 3); slot k is the edge
+    F[k] → F[k+1]."""
+    e = np.stack([F, np.roll(F, -1, axis=1)], axis=-1).reshape(-1, 2)
+    key = np.sort(e, axis=1)
+    uniq, inv = np.unique(key, axis=0, return_inverse=True)
+    return uniq, inv.reshape(-1, 3)
+
+
+def mesh_arrays(mesh):
+    """``(vertices (V, 3) float64, faces (F, 3) int64)`` of a spinal.Mesh, a trimesh.Trimesh or a
+    ``(vertices, faces)`` pair, named ``mesh`` in errors."""
+    if isinstance(mesh, tuple) and len(mesh) == 2:
+        V, F = mesh
+    elif hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        V, F = mesh.vertices, mesh.faces
+    else:
+        raise TypeError("mesh: expected a spinal.Mesh, a trimesh.Trimesh or (vertices, faces)")
+    V = np.ascontiguousarray(as_float_array(V, "mesh"), dtype=np.float64)
+    F = np.asarray(F)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"mesh: vertices must have shape (n, 3), got {V.shape}")
+    if not np.isfinite(V).all():
+        raise ValueError("mesh: vertices must be finite")
+    if F.ndim != 2 or F.shape[1] != 3 or F.dtype.kind not in "iu":
+        raise ValueError(f"mesh: faces must be an (m, 3) integer array, got {F.shape} {F.dtype}")
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    if len(F) and (F.min() < 0 or F.max() >= len(V)):
+        raise ValueError("mesh: face indices out of range")
+    return V, F
 
 
 class Mesh:

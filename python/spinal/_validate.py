@@ -104,6 +104,24 @@ def as_offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]
     return np.ascontiguousarray(arr), True
 
 
+def as_real(x: Any, name: str) -> float:
+    """A Python float from a real number (not a bool): the type only, any value."""
+    if isinstance(x, bool) or not isinstance(x, numbers.Real):
+        if isinstance(x, np.ndarray) and x.shape == () and x.dtype.kind in "iuf":
+            x = x.item()
+        else:
+            raise TypeError(f"{name}: expected a real number, got {type(x).__name__}")
+    return float(x)
+
+
+def as_finite(x: Any, name: str) -> float:
+    """A finite Python float (for values that no core check sees)."""
+    x = as_real(x, name)
+    if not np.isfinite(x):
+        raise ValueError(f"{name}: must be finite, got {x}")
+    return x
+
+
 def as_int(x: Any, name: str, minimum: int | None = None) -> int:
     """A Python int (not a bool), at least ``minimum`` when given."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):

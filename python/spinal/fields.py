@@ -1,4 +1,4 @@
-"""Divergence-free velocity fields for volume-preserving deformation (issue 4).
+"""Divergence-free velocity fields for volume-preserving deformation.
 
 A field is a small immutable object describing a closed-form velocity field ``v(X, t)`` with
 ``div v = 0`` exactly; evaluate it with ``field(points, t=0.0) -> (n, 3)``, add fields with
@@ -9,8 +9,8 @@ Units: lengths in the mesh's units, time in the caller's units; a velocity is le
 an angular speed rad/time (right-handed about the axis), a twist rate rad/(length·time), a
 bend rate rad/(length²·time).
 
-**Curl fields** (Zheng's thesis Ch. 12, signs and scales corrected as in the issue-4 brief,
-errata A-16/A-17): ``V = c·curl(φ(d) B)`` with ``d`` the signed distance to a spherical tool,
+**Curl fields** (Zheng's thesis Ch. 12, with the printed fields' sign and scale corrected so
+that the tool's surface moves with the tool, see ``src/deform/fields.rs``): ``V = c·curl(φ(d) B)`` with ``d`` the signed distance to a spherical tool,
 ``φ = (R − |d|)^p`` zero beyond the reach ``R`` (``p = 2`` as in the thesis: the field is C⁰
 at ``|d| = R``; ``falloff_power=4`` makes it C²):
 
@@ -42,13 +42,16 @@ frames, twists or bends the material around it.
 
 from __future__ import annotations
 
+import functools
 import numbers
 from collections.abc import Iterable
 
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_float_array, as_points
+from ._core import Field
+from ._mesh import edges, mesh_arrays
+from ._validate import as_bool, as_float_array, as_int, as_points, as_real, as_vector
 
 __all__ = [
     "Field",
@@ -67,160 +70,35 @@ __all__ = [
     "twist",
 ]
 
-ROW = 16
+
+def _recorded(ctor):
+    """The constructor, with the call remembered by the field it returns: a field pickles as
+    the calls that built it (``Field.__reduce__`` → :func:`_rebuild`)."""
+
+    @functools.wraps(ctor)
+    def build(*args, **kwargs):
+        return ctor(*args, **kwargs)._with_recipe(ctor.__name__, args, kwargs)
+
+    return build
 
 
-class Field:
-    """A divergence-free velocity field: a sum of elements (see the module docstring).
-
-    Build fields with the constructors of :mod:`spinal.fields`; they are immutable.
-
-    ``field(points, t=0.0)`` returns the ``(n, 3)`` velocities at time ``t`` (tools that move
-    are at ``center + velocity·t``). ``f + g`` is the sum field. ``max_speed`` is a bound of
-    ``|v|`` used by the step rule, ``length_scale`` the smallest reach (the length over which
-    the field changes), ``steps(duration)`` the number of RK4 steps that
-    :func:`spinal.advect` takes when ``steps=None``.
-    """
-
-    __slots__ = ("_names", "_rows")
-
-    def __init__(self, rows: np.ndarray, names: tuple[str, ...]):
-        rows = np.array(rows, dtype=np.float64, copy=True).reshape(-1, ROW)
-        rows.flags.writeable = False
-        _core.field_info(rows, 1.0)  # validates every row
-        self._rows = rows
-        self._names = names
-
-    @property
-    def rows(self) -> np.ndarray:
-        """The elements as read-only rows of 16 floats (the layout of ``spinal._core``)."""
-        return self._rows
-
-    def __call__(self, points, t: float = 0.0) -> np.ndarray:
-        x = as_points(points, "points")
-        _check_finite(x, "points")
-        return _core.field_eval(x, self._rows, _real(t, "t"))
-
-    def __add__(self, other: Field) -> Field:
-        if not isinstance(other, Field):
-            return NotImplemented
-        return Field(np.vstack([self._rows, other._rows]), self._names + other._names)
-
-    def __radd__(self, other):
-        if isinstance(other, numbers.Number) and other == 0:  # builtin sum()
-            return self
-        return NotImplemented
-
-    def __len__(self) -> int:
-        return len(self._rows)
-
-    def breakpoints(self) -> np.ndarray:
-        """Times at which a path tool (:func:`along_path`) passes a spine sample, sorted: its
-        velocity is only continuous there, so :func:`spinal.advect` ends steps at them."""
-        r = self._rows
-        out = []
-        for i in np.flatnonzero(r[:, 0] == 7):
-            t0, dur, n = r[i, 1], r[i, 2], int(r[i, 11])
-            s = r[i + 1: i + 1 + n, 13]
-            out.append(t0 + dur * (s - s[0]) / (s[-1] - s[0]))
-        return np.unique(np.concatenate(out)) if out else np.zeros(0)
-
-    @property
-    def max_speed(self) -> float:
-        """A bound of the speed ``|v|`` (length/time): the sum over the elements of each
-        element's bound (closed form where one exists, else a maximum sampled over its
-        support); ``0`` for the zero field. Used by :meth:`steps`."""
-        return _core.field_info(self._rows, 1.0)[0]
-
-    @property
-    def length_scale(self) -> float:
-        """The smallest length over which an element's field falls from its tool value to zero
-        (length): its ``reach`` (for :func:`twist` and :func:`bend`, their ``radius``), the
-        minimum over the elements; ``inf`` for the zero field. Used by :meth:`steps`."""
-        return _core.field_info(self._rows, 1.0)[1]
-
-    def steps(self, duration: float) -> int:
-        """Default step count: ``max(4, ⌈|duration|·8·max_speed/length_scale⌉)`` (a step moves
-        a point by at most 1/8 of the length scale)."""
-        return _core.field_info(self._rows, _real(duration, "duration"))[2]
-
-    def __repr__(self) -> str:
-        return f"spinal.fields.Field({' + '.join(self._names) or 'zero'})"
+def _rebuild(recipe) -> Field:
+    """The field of a pickled recipe: the sum of ``name(*args, **kwargs)`` over its calls."""
+    out = _core.field_zero()
+    for name, args, kwargs in recipe:
+        out = out + globals()[name](*args, **kwargs)
+    return out
 
 
-def _check_finite(x: np.ndarray, name: str) -> None:
-    bad = ~np.isfinite(x).all(axis=-1)
-    if bad.any():
-        raise ValueError(f"{name}: row {int(np.argmax(bad))} is not finite (NaN or inf)")
-
-
-def _real(x, name: str) -> float:
-    if isinstance(x, bool) or not isinstance(x, numbers.Real):
-        if isinstance(x, np.ndarray) and x.shape == () and x.dtype.kind in "iuf":
-            x = x.item()
-        else:
-            raise TypeError(f"{name}: expected a real number, got {type(x).__name__}")
-    x = float(x)
-    if not np.isfinite(x):
-        raise ValueError(f"{name}: must be finite, got {x}")
-    return x
-
-
-def _positive(x, name: str) -> float:
-    x = _real(x, name)
-    if not x > 0:
-        raise ValueError(f"{name}: must be positive, got {x}")
-    return x
-
-
-def _vec3(x, name: str) -> np.ndarray:
-    a = as_float_array(x, name)
-    if a.shape != (3,):
-        raise ValueError(f"{name}: expected 3 numbers, got shape {a.shape}")
-    if not np.isfinite(a).all():
-        raise ValueError(f"{name}: must be finite, got {a}")
-    return a
-
-
-def _axis(x, name: str = "axis") -> np.ndarray:
-    a = _vec3(x, name)
-    n = np.linalg.norm(a)
-    if not n > 0:
-        raise ValueError(f"{name}: must be a non-zero vector")
-    return a / n
+def _opt(x, name: str) -> float | None:
+    return None if x is None else as_real(x, name)
 
 
 def _power(x) -> int:
-    if isinstance(x, bool) or not isinstance(x, numbers.Integral) or int(x) not in (2, 3, 4):
-        raise ValueError(f"falloff_power: must be 2, 3 or 4, got {x!r}")
-    return int(x)
+    return as_int(x, "falloff_power")
 
 
-def _blend(x) -> float:
-    return 1.0 if as_choice(x, "blend", ("c1", "linear")) == "linear" else 0.0
-
-
-def _spine_points(points) -> tuple[np.ndarray, np.ndarray]:
-    """A tool's axis or path, ``(n, 3)`` finite with ``n ≥ 2`` and no repeated consecutive
-    samples, and its chord lengths."""
-    x = as_points(points, "points")
-    _check_finite(x, "points")
-    if len(x) < 2:
-        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
-    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
-    if not (chords > 0).all():
-        i = int(np.argmin(chords))
-        raise ValueError(f"points: consecutive samples {i} and {i + 1} coincide")
-    return x, chords
-
-
-def _row(*parts) -> np.ndarray:
-    r = np.zeros(ROW)
-    flat = np.concatenate([np.atleast_1d(np.asarray(p, dtype=np.float64)) for p in parts])
-    r[: len(flat)] = flat
-    return r
-
-
+@_recorded
 def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
                 moving: bool = True) -> Field:
     """A spherical tool moving with constant ``velocity``, pushing the material around it.
@@ -232,7 +110,7 @@ def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
     with ``Y = X − c(t)``, ``c(t) = center + velocity·t`` (``moving=False``: the tool stays at
     ``center``), ``d = |Y| − radius``, ``n = Y/|Y|``, ``e = R − |d|``, ``R = reach``
     (default: ``radius``, which keeps a 40k-vertex icosphere's volume error below 1e-4; the
-    spec's 0.5·radius does not). On the tool surface the normal velocity equals ``u·n``:
+    0.5·radius does not). On the tool surface the normal velocity equals ``u·n``:
     material neither enters the tool nor separates from it.
 
     Parameters
@@ -243,13 +121,12 @@ def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
     reach : R > 0, width of the region around the tool that moves.
     falloff_power : p in {2, 3, 4}; 2 is the thesis's ``(R − |d|)²`` (C⁰ at ``|d| = R``).
     """
-    c, u = _vec3(center, "center"), _vec3(velocity, "velocity")
-    rho = _positive(radius, "radius")
-    reach = rho if reach is None else _positive(reach, "reach")
-    return Field(_row(0, c, u, rho, reach, _power(falloff_power), float(bool(moving))),
-                 ("translation",))
+    return _core.field_translation(
+        as_vector(center, "center"), as_real(radius, "radius"), as_vector(velocity, "velocity"),
+        _opt(reach, "reach"), _power(falloff_power), as_bool(moving, "moving"))
 
 
+@_recorded
 def rotation(center, radius, axis, angular_speed, *, pivot=None, reach=None,
              falloff_power: int = 2) -> Field:
     """A spherical tool turning at ``angular_speed`` (rad/time, right-handed) about ``axis``
@@ -264,24 +141,19 @@ def rotation(center, radius, axis, angular_speed, *, pivot=None, reach=None,
     gives a pure swirl ``h(r) a × Y`` (zero normal velocity, an exact rotation on every
     sphere about the pivot).
     """
-    c = _vec3(center, "center")
-    rho = _positive(radius, "radius")
-    a = _axis(axis)
-    w = _real(angular_speed, "angular_speed")
-    o = c if pivot is None else _vec3(pivot, "pivot")
-    reach = rho if reach is None else _positive(reach, "reach")
-    return Field(_row(1, c, o, w * a, rho, reach, _power(falloff_power)), ("rotation",))
+    return _core.field_rotation(
+        as_vector(center, "center"), as_real(radius, "radius"), as_vector(axis, "axis"),
+        as_real(angular_speed, "angular_speed"),
+        None if pivot is None else as_vector(pivot, "pivot"), _opt(reach, "reach"),
+        _power(falloff_power))
 
 
 def _swirl(center, axis, rate, radius, form, bend: bool) -> Field:
-    o = _vec3(center, "center")
-    a = _axis(axis)
-    k = _real(rate, "rate")
-    r = _positive(radius, "radius")
-    curl = as_choice(form, "form", ("rate", "curl")) == "curl"
-    return Field(_row(2, o, a, k, r, float(bend), float(curl)), ("bend" if bend else "twist",))
+    return _core.field_swirl(as_vector(center, "center"), as_vector(axis, "axis"),
+                             as_real(rate, "rate"), as_real(radius, "radius"), form, bend)
 
 
+@_recorded
 def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
     """Twist about ``axis`` through ``center``: angle rate ``κ z`` (rad/time) at height
     ``z = a·(X − center)``, fading to 0 at distance ``radius`` from the centre.
@@ -294,6 +166,7 @@ def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
     return _swirl(center, axis, rate, radius, form, False)
 
 
+@_recorded
 def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
     """The thesis's "bend" (eq. 12.6, a differential swirl): angle rate ``β r²`` about
     ``axis`` through ``center``, ``r = |X − center|``, fading to 0 at ``radius``.
@@ -305,6 +178,7 @@ def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
     return _swirl(center, axis, rate, radius, form, True)
 
 
+@_recorded
 def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
            moving: bool = True) -> Field:
     """von Funck's region translation around a sphere (``r_i = radius``,
@@ -314,29 +188,28 @@ def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
 
     rigid (``v = u``) inside the sphere, zero beyond ``radius + reach``.
     """
-    c, u = _vec3(center, "center"), _vec3(velocity, "velocity")
-    rho = _positive(radius, "radius")
-    reach = rho if reach is None else _positive(reach, "reach")
-    return Field(_row(3, c, u, rho, reach, _blend(blend), float(bool(moving))), ("sphere",))
+    return _core.field_sphere(
+        as_vector(center, "center"), as_real(radius, "radius"), as_vector(velocity, "velocity"),
+        _opt(reach, "reach"), blend, as_bool(moving, "moving"))
 
 
+@_recorded
 def capsule(start, end, radius, velocity, *, reach=None, blend: str = "c1",
             moving: bool = True) -> Field:
     """Region translation around a capsule (segment ``start``–``end``, ``radius``): the exact
     distance-field extension of :func:`sphere` to a free-form tool, ``Y = X − midpoint``,
     ``d`` the capsule's signed distance, ``n = ∇d``. Divergence-free for any C¹ distance.
     """
-    a, b = _vec3(start, "start"), _vec3(end, "end")
-    u = _vec3(velocity, "velocity")
-    rho = _positive(radius, "radius")
-    reach = rho if reach is None else _positive(reach, "reach")
-    return Field(_row(4, a, b, u, rho, reach, _blend(blend), float(bool(moving))), ("capsule",))
+    return _core.field_capsule(
+        as_vector(start, "start"), as_vector(end, "end"), as_real(radius, "radius"),
+        as_vector(velocity, "velocity"), _opt(reach, "reach"), blend, as_bool(moving, "moving"))
 
 
+@_recorded
 def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
           blend: str = "c1") -> Field:
     """A straight strip (a capsule from ``start`` to ``end``) moving the material around it
-    (thesis §11.2.2–11.2.3, naming per erratum A-14).
+    (thesis §11.2.2–11.2.3; type I moves the material along the strip, type II across it).
 
     ``kind="along"`` (type I, "sticking"): ``velocity`` parallel to the axis; the material
     around slides along the strip (the :func:`capsule` field, static).
@@ -345,26 +218,12 @@ def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
     ``U = m̂ × t``; the field is zero beyond the end planes (a tangential jump only).
     For a curved axis (type I) see :func:`strip_curve`.
     """
-    a, b = _vec3(start, "start"), _vec3(end, "end")
-    u = _vec3(velocity, "velocity")
-    rho = _positive(radius, "radius")
-    reach = rho if reach is None else _positive(reach, "reach")
-    kind = as_choice(kind, "kind", ("along", "across"))
-    length = np.linalg.norm(b - a)
-    if not length > 0:
-        raise ValueError("end: must differ from start")
-    t = (b - a) / length
-    s = np.linalg.norm(u)
-    along = float(u @ t)
-    if kind == "along":
-        if abs(abs(along) - s) > 1e-9 * s:
-            raise ValueError("velocity: must be parallel to the strip axis for kind='along'")
-        return Field(_row(4, a, b, u, rho, reach, _blend(blend), 0.0), ("strip(along)",))
-    if abs(along) > 1e-9 * s:
-        raise ValueError("velocity: must be perpendicular to the strip axis for kind='across'")
-    return Field(_row(6, a, b, u, rho, reach, _blend(blend)), ("strip(across)",))
+    return _core.field_strip(
+        as_vector(start, "start"), as_vector(end, "end"), as_real(radius, "radius"),
+        as_vector(velocity, "velocity"), kind, _opt(reach, "reach"), blend)
 
 
+@_recorded
 def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
           moving: bool = True) -> Field:
     """A torus (major radius ``major``, tube radius ``minor``) moving along its ``axis`` with
@@ -374,14 +233,26 @@ def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
 
     with ``ρ`` the distance to the axis. Needs ``minor + reach < major``.
     """
-    c, k = _vec3(center, "center"), _axis(axis)
-    big, small = _positive(major, "major"), _positive(minor, "minor")
-    s = _real(speed, "speed")
-    reach = small if reach is None else _positive(reach, "reach")
-    if not small + reach < big:
-        raise ValueError(f"minor: minor + reach ({small + reach}) must be below major ({big})")
-    return Field(_row(5, c, k, s, big, small, reach, _blend(blend), float(bool(moving))),
-                 ("torus",))
+    return _core.field_torus(
+        as_vector(center, "center"), as_vector(axis, "axis"), as_real(major, "major"),
+        as_real(minor, "minor"), as_real(speed, "speed"), _opt(reach, "reach"), blend,
+        as_bool(moving, "moving"))
+
+
+def _spine_points(points) -> tuple[np.ndarray, np.ndarray]:
+    """A strip's axis, ``(n, 3)`` finite with ``n ≥ 2`` and no repeated consecutive samples,
+    and its chord lengths."""
+    x = as_points(points, "points")
+    bad = ~np.isfinite(x).all(axis=1)
+    if bad.any():
+        raise ValueError(f"points: row {int(np.argmax(bad))} is not finite (NaN or inf)")
+    if len(x) < 2:
+        raise ValueError(f"points: need at least 2 samples, got {len(x)}")
+    chords = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    if not (chords > 0).all():
+        i = int(np.argmin(chords))
+        raise ValueError(f"points: consecutive samples {i} and {i + 1} coincide")
+    return x, chords
 
 
 def _clamped_spline_slopes(x: np.ndarray, s: np.ndarray, m0: np.ndarray,
@@ -430,8 +301,9 @@ def _hermite_dense(x, m, s, per: int = 16):
     return g, g1, g2
 
 
+@_recorded
 def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Field:
-    """A strip of type I along a curved axis (thesis §11.2.2, "sticking"; A-14): the material
+    """A strip of type I along a curved axis (thesis §11.2.2, "sticking", type I): the material
     within ``radius`` of the axis flows along it at ``speed`` (length/time, from
     ``points[0]`` towards ``points[-1]``; negative: backwards), leaves at the head, comes back
     outside (within ``radius + reach``) and re-enters at the tail. Static (the strip does not
@@ -471,13 +343,11 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
     from ._frames import estimate_tangents
 
     x, chords = _spine_points(points)
-    rho = _positive(radius, "radius")
-    sp = _real(speed, "speed")
-    reach = rho if reach is None else _positive(reach, "reach")
-    lin = _blend(blend)
     s = np.concatenate([[0.0], np.cumsum(chords)])
     tan = estimate_tangents(x)
     m = _clamped_spline_slopes(x, s, tan[0], tan[-1])
+    rho = as_real(radius, "radius")
+    reach = rho if reach is None else as_real(reach, "reach")
     outer = rho + reach
     g, g1, g2 = _hermite_dense(x, m, s)
     kappa = (np.linalg.norm(g2, axis=2) / np.einsum("kij,kij->ki", g1, g1)).max(axis=1)
@@ -506,13 +376,7 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
                 f"points: the axis comes within {dist[a, b]:.4g} < 2·(radius + reach) = "
                 f"{2 * outer:.4g} of itself (segments {ka} and {kb}); the closest point "
                 f"would be ambiguous")
-    head = _row(9, sp, rho, reach, lin, len(x))
-    body = np.zeros((len(x), ROW))
-    body[:, 0] = 10
-    body[:, 1:4] = x
-    body[:, 4:7] = m
-    body[:, 7] = s
-    return Field(np.vstack([head, body]), ("strip_curve",))
+    return _core.field_strip_curve(x, m, s, rho, as_real(speed, "speed"), reach, blend)
 
 
 def _spline_prefilter(values: np.ndarray) -> np.ndarray:
@@ -546,20 +410,11 @@ def _spline_prefilter(values: np.ndarray) -> np.ndarray:
     return c
 
 
-def _cell_min(c: np.ndarray) -> np.ndarray:
-    """Smallest coefficient of each cell's 4×4×4 stencil (a lower bound of the spline)."""
-    for axis in range(3):
-        a = np.moveaxis(c, axis, 0)
-        a = np.minimum(np.minimum(a[:-3], a[1:-2]), np.minimum(a[2:-1], a[3:]))
-        c = np.moveaxis(a, 0, axis)
-    return c
-
-
-MIN_CELLS_PER_REACH = 4
-
-
-def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name, what):
-    u = _vec3(velocity, "velocity")
+def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name):
+    """The tool of a sampled distance: the default centre and reach from the samples, the
+    B-spline coefficients, then the core (which checks the spacing against the reach and that
+    the support stays inside the grid)."""
+    u = as_vector(velocity, "velocity")
     if not (values <= 0).any():
         raise ValueError("grid: no node is inside the tool (all distances are positive)")
     if center is None:
@@ -569,36 +424,18 @@ def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name,
         ww = w[w > 0]
         c = origin + (idx * ww[:, None]).sum(axis=0) / ww.sum() * h
     else:
-        c = _vec3(center, "center")
+        c = as_vector(center, "center")
     if reach is None:
         idx = np.argwhere(values <= 0)
         nodes = origin + idx * h
         reach = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
     else:
-        reach = _positive(reach, "reach")
-    if not reach >= MIN_CELLS_PER_REACH * h:
-        raise ValueError(
-            f"{what}: grid too coarse: spacing {h:.4g} must be at most reach/"
-            f"{MIN_CELLS_PER_REACH} = {reach / MIN_CELLS_PER_REACH:.4g} (the blend region needs "
-            f"{MIN_CELLS_PER_REACH} cells)")
-    coef = _spline_prefilter(values)
-    cm = _cell_min(coef)
-    edge = np.ones(cm.shape, dtype=bool)
-    edge[1:-1, 1:-1, 1:-1] = False
-    if (cm[edge] < reach).any():
-        raise ValueError(
-            "grid: the field's support (distance < reach) reaches the edge of the grid; pad "
-            "the grid so that the distance is ≥ reach on its outer cells")
-    flags = _blend(blend) + 2.0 * float(bool(moving))
-    head = _row(11, origin, h, values.shape, u, reach, flags, c)
-    flat = coef.ravel()
-    k = -(-len(flat) // (ROW - 1))
-    body = np.zeros((k, ROW))
-    body[:, 0] = 12
-    body[:, 1:] = np.concatenate([flat, np.zeros(k * (ROW - 1) - len(flat))]).reshape(k, -1)
-    return Field(np.vstack([head, body]), (name,))
+        reach = as_real(reach, "reach")
+    coef = np.ascontiguousarray(_spline_prefilter(values))
+    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
 
 
+@_recorded
 def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend: str = "c1",
              moving: bool = True) -> Field:
     """A free-form tool given by its signed distance sampled on a grid, translating with
@@ -645,20 +482,25 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
         raise ValueError(f"grid: value at node {i} is not finite")
     if a.size > 300**3:
         raise ValueError(f"grid: {a.size} nodes is too many (at most 300³)")
-    o = _vec3(origin, "origin")
-    h = _positive(spacing, "spacing")
+    o = as_vector(origin, "origin")
+    h = as_real(spacing, "spacing")
+    if not h > 0:
+        raise ValueError(f"spacing: must be positive, got {h}")
     return _grid_field(np.array(a, dtype=np.float64), o, h, velocity, center, reach, blend,
-                       moving, "sdf_tool", "spacing")
+                       moving, "sdf_tool")
+
+
+# cells per reach that the blend region needs (the core refuses coarser grids, naming
+# `spacing`; `mesh_tool` chooses its spacing and names `resolution`)
+MIN_CELLS_PER_REACH = 4
 
 
 def _closed_mesh(mesh):
-    from ._deform import _edges, _mesh_arrays
-
-    V, F = _mesh_arrays(mesh)
+    V, F = mesh_arrays(mesh)
     if not len(F):
         raise ValueError("mesh: has no faces")
     # every undirected edge, in the order of the slots 0→1 of all faces, then 1→2, then 2→0
-    uniq, slot = _edges(F)
+    uniq, slot = edges(F)
     ids = slot.T.ravel()
     cnt = np.bincount(ids, minlength=len(uniq))[ids]
     if (cnt != 2).any():
@@ -683,6 +525,7 @@ def _closed_mesh(mesh):
     return V, F, centroid
 
 
+@_recorded
 def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
               blend: str = "c1", moving: bool = True) -> Field:
     """A free-form tool given as a closed triangle mesh, translating with ``velocity``: the
@@ -706,9 +549,10 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
     blend, moving : as for :func:`sdf_tool`.
     """
     V, F, centroid = _closed_mesh(mesh)
-    c = centroid if center is None else _vec3(center, "center")
-    rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else _positive(reach,
-                                                                                  "reach")
+    c = centroid if center is None else as_vector(center, "center")
+    rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else as_real(reach, "reach")
+    if not rf > 0:
+        raise ValueError(f"reach: must be positive, got {rf}")
     res = resolution
     if isinstance(res, bool) or not isinstance(res, numbers.Integral):
         raise TypeError(f"resolution: expected an integer, got {type(res).__name__}")
@@ -734,20 +578,20 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
     P = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     d = igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0]
     return _grid_field(np.ascontiguousarray(d.reshape(tuple(shape))), origin, h, velocity, c,
-                       rf, blend, moving, "mesh_tool", "resolution")
+                       rf, blend, moving, "mesh_tool")
 
 
 def sum(fields: Iterable[Field]) -> Field:
     """The sum of fields (still divergence-free; velocities add where supports overlap)."""
-    fields = list(fields)
+    out = _core.field_zero()
     for i, f in enumerate(fields):
         if not isinstance(f, Field):
             raise TypeError(f"fields: item {i} is a {type(f).__name__}, not a spinal.fields.Field")
-    if not fields:
-        return Field(np.zeros((0, ROW)), ())
-    return Field(np.vstack([f.rows for f in fields]), tuple(n for f in fields for n in f._names))
+        out = out + f
+    return out
 
 
+@_recorded
 def along_path(points, radius, duration, *, kind: str = "translate", tool: str = "push",
                rate=0.0, frames=None, t0=0.0, reach=None, falloff_power: int = 2,
                blend: str = "c1") -> Field:
@@ -755,7 +599,7 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
     ``points[-1]`` (at ``t0 + duration``) at constant speed ``u = L/duration`` in chord
     length ``L``, deforming the material around it; at rest (zero field) outside that time.
 
-    Pose (issue-4 brief §4): in segment ``k``, ``λ = (σ − S_k)/ΔS_k`` with ``S_k`` the
+    Pose: in segment ``k``, ``λ = (σ − S_k)/ΔS_k`` with ``S_k`` the
     cumulative chord lengths and ``σ = u (t − t0)``,
 
     * centre ``o(σ)``: cubic Hermite through ``x_k, x_{k+1}`` with tangents ``t_k ΔS_k,
@@ -796,32 +640,11 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
     """
     from ._frames import frames as _frames
 
-    x, chords = _spine_points(points)
-    rho = _positive(radius, "radius")
-    dur = _positive(duration, "duration")
-    kind = as_choice(kind, "kind", ("translate", "rotate", "twist", "bend"))
-    carry = as_choice(tool, "tool", ("push", "carry")) == "carry"
-    k = _real(rate, "rate")
-    start = _real(t0, "t0")
-    reach = rho if reach is None else _positive(reach, "reach")
-    if frames is None:
-        f = _frames(x)
-    else:
-        f = as_float_array(frames, "frames")
-        if f.shape != (len(x), 3, 3):
-            raise ValueError(f"frames: expected shape {(len(x), 3, 3)}, got {f.shape}")
-        if not np.isfinite(f).all():
-            raise ValueError("frames: must be finite")
-        err = np.abs(np.einsum("nji,njk->nik", f, f) - np.eye(3)).max(axis=(1, 2))
-        if (err > 1e-6).any() or (np.linalg.det(f) <= 0).any():
-            raise ValueError(f"frames: frame {int(np.argmax(err))} is not a rotation matrix")
-    s = np.concatenate([[0.0], np.cumsum(chords)])
-    head = _row(7, start, dur, rho, reach, _power(falloff_power), float(carry), _blend(blend),
-                float(kind == "rotate"), k if kind == "twist" else 0.0,
-                k if kind == "bend" else 0.0, len(x))
-    body = np.zeros((len(x), ROW))
-    body[:, 0] = 8
-    body[:, 1:4] = x
-    body[:, 4:13] = np.transpose(f, (0, 2, 1)).reshape(-1, 9)  # columns r, s, t
-    body[:, 13] = s
-    return Field(np.vstack([head, body]), (f"along_path({kind}, {tool})",))
+    x = as_points(points, "points")
+    f = _frames(x) if frames is None else as_float_array(frames, "frames")
+    if f.shape != (len(x), 3, 3):
+        raise ValueError(f"frames: expected shape {(len(x), 3, 3)}, got {f.shape}")
+    return _core.field_path(x, np.ascontiguousarray(f), as_real(radius, "radius"),
+                            as_real(duration, "duration"), kind, tool, as_real(rate, "rate"),
+                            as_real(t0, "t0"), _opt(reach, "reach"), _power(falloff_power),
+                            blend)

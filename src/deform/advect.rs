@@ -1,6 +1,6 @@
 //! Advection of points along a field: `dX/dt = v(X, t)`, path lines independent, in parallel.
 //!
-//! The thesis gives no integrator (erratum A-11). Classical RK4 with the tool poses evaluated
+//! The thesis gives no integrator. Classical RK4 with the tool poses evaluated
 //! at the stage times:
 //!
 //! ```text
@@ -57,22 +57,17 @@ fn integrate_batch(
     steps: std::ops::Range<usize>,
     m: Method,
 ) {
-    use super::Element as E;
-    // one dispatch per batch instead of per evaluation: a single-element field is evaluated
-    // by a monomorphised loop the compiler can inline and schedule across the lanes
-    match (field.elements.as_slice(), m) {
-        ([E::Swirl(s)], Method::Rk4) => rk4_batch(|p, _, _| s.eval(p), x, t0, h, steps),
-        ([E::Translation(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
-        ([E::Sphere(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
-        ([E::StripAlong(e)], Method::Rk4) => rk4_batch(|p, _, _| e.eval(p), x, t0, h, steps),
-        ([E::Grid(e)], Method::Rk4) => rk4_batch(|p, t, _| e.eval(p, t), x, t0, h, steps),
+    // one virtual call per batch instead of per evaluation: a single-tool field runs the
+    // tool's own RK4 loop, in which its evaluation is inlined across the lanes
+    match (field.tools.as_slice(), m) {
+        ([tool], Method::Rk4) => tool.rk4_lanes(x, t0, h, steps),
         _ => integrate_batch_generic(field, x, t0, h, steps, m),
     }
 }
 
 /// RK4 on `B ≤ LANES` path lines in lock-step with the evaluator `v(x, t, t_mid)`.
 #[inline(always)]
-fn rk4_batch(
+pub(crate) fn rk4_batch(
     v: impl Fn(DVec3, f64, f64) -> DVec3,
     x: &mut [DVec3],
     t0: f64,
@@ -107,36 +102,55 @@ fn rk4_batch(
     }
 }
 
-/// `out[j] = v(p[j], t)` for a sum of elements: the element loop outside, so each element is
-/// dispatched once per batch and its evaluation inlined over the lanes.
+/// `out[j] += v(p[j], t)` for a sum of tools: the tool loop outside, so each tool is called
+/// once per batch with its evaluation inlined over the lanes.
 #[inline]
 fn eval_lanes(field: &Field, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
-    use super::Element as E;
-    out.fill(DVec3::ZERO);
-    for e in &field.elements {
-        match e {
-            E::Translation(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::Rotation(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::Swirl(e) => lanes(out, p, |x| e.eval(x)),
-            E::Sphere(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::Capsule(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::Torus(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::StripAcross(e) => lanes(out, p, |x| e.eval(x)),
-            E::StripAlong(e) => lanes(out, p, |x| e.eval(x)),
-            E::Grid(e) => lanes(out, p, |x| e.eval(x, t)),
-            E::Path(e) => {
-                if let Some(pose) = e.pose_in(t, tm) {
-                    lanes(out, p, |x| e.eval_at(x, &pose))
-                }
-            }
-        }
+    for e in &field.tools {
+        e.add_lanes(p, t, tm, out);
     }
 }
 
+/// RK4 on `B ≤ LANES` path lines in lock-step with a batch evaluator
+/// `add(points, t, t_mid, out)` that writes the velocities into a zeroed `out`.
 #[inline(always)]
-fn lanes(out: &mut [DVec3], p: &[DVec3], f: impl Fn(DVec3) -> DVec3) {
-    for (o, x) in out.iter_mut().zip(p) {
-        *o += f(*x);
+pub(crate) fn rk4_lanes_with(
+    add: impl Fn(&[DVec3], f64, f64, &mut [DVec3]),
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+) {
+    let n = x.len().min(LANES);
+    let h2 = 0.5 * h;
+    let h6 = h / 6.0;
+    let mut k = [DVec3::ZERO; LANES];
+    let mut acc = [DVec3::ZERO; LANES];
+    let mut p = [DVec3::ZERO; LANES];
+    let eval = |p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]| {
+        out.fill(DVec3::ZERO);
+        add(p, t, tm, out);
+    };
+    for s in steps {
+        let t = t0 + h * s as f64;
+        let tm = t + h2;
+        p[..n].copy_from_slice(&x[..n]);
+        eval(&p[..n], t, tm, &mut k[..n]);
+        acc[..n].copy_from_slice(&k[..n]);
+        for (w, hc, tc) in [(2.0, h2, tm), (2.0, h2, tm), (1.0, h, t + h)] {
+            for j in 0..n {
+                p[j] = x[j] + hc * k[j];
+            }
+            eval(&p[..n], tc, tm, &mut k[..n]);
+            if w == 2.0 {
+                for j in 0..n {
+                    acc[j] += 2.0 * k[j];
+                }
+            }
+        }
+        for j in 0..n {
+            x[j] += h6 * (acc[j] + k[j]);
+        }
     }
 }
 
@@ -151,50 +165,31 @@ fn integrate_batch_generic(
     m: Method,
 ) {
     let n = x.len().min(LANES);
+    if m == Method::Rk4 {
+        rk4_lanes_with(
+            |p, t, tm, out| eval_lanes(field, p, t, tm, out),
+            x,
+            t0,
+            h,
+            steps,
+        );
+        return;
+    }
     let h2 = 0.5 * h;
-    let h6 = h / 6.0;
-    let mut k = [DVec3::ZERO; LANES];
-    let mut acc = [DVec3::ZERO; LANES];
     for s in steps {
         let t = t0 + h * s as f64;
         let tm = t + h2;
-        match m {
-            Method::Rk4 => {
-                let mut p = [DVec3::ZERO; LANES];
-                p[..n].copy_from_slice(&x[..n]);
-                eval_lanes(field, &p[..n], t, tm, &mut k[..n]);
-                acc[..n].copy_from_slice(&k[..n]);
-                for (w, hc, tc) in [(2.0, h2, tm), (2.0, h2, tm), (1.0, h, t + h)] {
-                    for j in 0..n {
-                        p[j] = x[j] + hc * k[j];
-                    }
-                    eval_lanes(field, &p[..n], tc, tm, &mut k[..n]);
-                    if w == 2.0 {
-                        for j in 0..n {
-                            acc[j] += 2.0 * k[j];
-                        }
-                    }
-                }
-                for j in 0..n {
-                    x[j] += h6 * (acc[j] + k[j]);
-                }
-            }
-            Method::Euler => {
-                for p in x[..n].iter_mut() {
-                    *p += h * field.eval_in(*p, t, tm);
-                }
-            }
-            Method::Split => {
-                for p in x[..n].iter_mut() {
-                    *p = split_step(field, *p, t, h);
-                }
-            }
+        for p in x[..n].iter_mut() {
+            *p = match m {
+                Method::Split => split_step(field, *p, t, h),
+                _ => *p + h * field.eval_in(*p, t, tm),
+            };
         }
     }
 }
 
 /// One Strang step `Φ₀(h/2) Φ₁(h/2) Φ₂(h) Φ₁(h/2) Φ₀(h/2)` of the splitting on the curl
-/// potential `A` (`curl A = v`; Feng & Shang 1995, issue-4 brief §3.3) from time `t`.
+/// potential `A` (`curl A = v`; Feng & Shang 1995) from time `t`.
 /// Sub-flow `k`, `(a, b) = (k+1, k+2) mod 3`: `ẋ_a = ∂_b A_k`, `ẋ_b = −∂_a A_k`, `x_k`
 /// fixed — a planar Hamiltonian flow with `H = A_k`, advanced by the implicit midpoint rule
 /// (symplectic, so area-preserving in `(x_a, x_b)`; the 3-D Jacobian is block-triangular with
@@ -260,7 +255,7 @@ pub fn advect_steps(
     steps: std::ops::Range<usize>,
     m: Method,
 ) {
-    if field.elements.is_empty() || steps.is_empty() || h == 0.0 {
+    if field.tools.is_empty() || steps.is_empty() || h == 0.0 {
         return;
     }
     points.par_chunks_mut(CHUNK).for_each(|c| {
@@ -283,7 +278,7 @@ pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Element, Swirl, SwirlKind};
+    use super::super::{Swirl, SwirlKind};
     use super::*;
     use crate::math::rotation::rodrigues;
 
@@ -297,9 +292,7 @@ mod tests {
             kind: SwirlKind::Twist,
             curl_form: false,
         };
-        let f = Field {
-            elements: vec![Element::Swirl(s)],
-        };
+        let f = Field::single(s);
         let x0 = DVec3::new(0.6, 0.2, 0.7);
         let exact = rodrigues(x0, DVec3::Z, s.angular(x0.z, x0.length()));
         let err =
@@ -311,8 +304,10 @@ mod tests {
 
 #[cfg(test)]
 mod timing {
+    use super::super::{Sphere, Swirl, SwirlKind, Translation};
     use super::*;
 
+    /// ns per vertex per RK4 step: `cargo test --release -- --ignored --nocapture time_fields`.
     #[test]
     #[ignore]
     fn time_fields() {
@@ -323,39 +318,48 @@ mod timing {
                 DVec3::new(a.sin(), a.cos(), (a * 0.37).sin())
             })
             .collect();
-        for (name, row) in [
+        let down = DVec3::new(0.0, 0.0, -1.0);
+        let fields = [
             (
                 "translation",
-                [
-                    0.0, 0., 0., 1.32, 0., 0., -1., 0.3, 0.3, 2., 1., 0., 0., 0., 0., 0.,
-                ],
+                Field::single(
+                    Translation::new(DVec3::new(0., 0., 1.32), 0.3, down, None, 2, true).unwrap(),
+                ),
             ),
             (
                 "twist",
-                [
-                    2.0, 0., 0., 0., 0., 0., 1., 4., 2., 0., 0., 0., 0., 0., 0., 0.,
-                ],
+                Field::single(
+                    Swirl::new(DVec3::ZERO, DVec3::Z, 4.0, 2.0, SwirlKind::Twist, false).unwrap(),
+                ),
             ),
             (
                 "twist out",
-                [
-                    2.0, 0., 0., 5., 0., 0., 1., 4., 2., 0., 0., 0., 0., 0., 0., 0.,
-                ],
+                Field::single(
+                    Swirl::new(
+                        DVec3::new(5., 0., 0.),
+                        DVec3::Z,
+                        4.0,
+                        2.0,
+                        SwirlKind::Twist,
+                        false,
+                    )
+                    .unwrap(),
+                ),
             ),
             (
                 "translation in",
-                [
-                    0.0, 0., 0., 0., 0., 0., -1., 0.6, 1.0, 2., 1., 0., 0., 0., 0., 0.,
-                ],
+                Field::single(
+                    Translation::new(DVec3::ZERO, 0.6, down, Some(1.0), 2, true).unwrap(),
+                ),
             ),
             (
                 "sphere in",
-                [
-                    3.0, 0., 0., 0., 0., 0., -1., 0.6, 1.0, 0., 0., 0., 0., 0., 0., 0.,
-                ],
+                Field::single(
+                    Sphere::new(DVec3::ZERO, 0.6, down, Some(1.0), false, false).unwrap(),
+                ),
             ),
-        ] {
-            let f = Field::parse(&row).unwrap();
+        ];
+        for (name, f) in fields {
             let mut best = f64::INFINITY;
             for _ in 0..3 {
                 let mut x = x0.clone();

@@ -1,13 +1,13 @@
 //! Cross-product fields `v = ∇p × ∇q` (von Funck, Theisel & Seidel 2006; Zheng's thesis
 //! Ch. 11), divergence-free by the identity `div(∇p × ∇q) = 0` for any C² scalars p, q.
 //!
-//! Region function (brief §2, erratum A-12): `D = b(σ)`, `σ = clamp(d/R_f, 0, 1)`, with `d` the
+//! Region function (von Funck et al. 2006): `D = b(σ)`, `σ = clamp(d/R_f, 0, 1)`, with `d` the
 //! signed distance to the tool and `R_f` the reach; von Funck's C¹ blend `b = 4σ³ − 3σ⁴`
 //! (`b′ = 12σ²(1 − σ)`), or Zheng's linear `b = σ` (C⁰). `D = 0` inside the tool, `v = 0`
 //! where `d ≥ R_f`.
 //!
-//! * **Translation of a region** (§11.1, §11.2.1, and the exact distance-field extension
-//!   §2.2 of the brief): `p = (1 − D) N·Y`, `q = (1 − D) B·Y`, `N × B = u/|u|`, `Y = X − c`.
+//! * **Translation of a region** (§11.1, §11.2.1, and the exact distance-field extension of
+//!   von Funck et al. 2006): `p = (1 − D) N·Y`, `q = (1 − D) B·Y`, `N × B = u/|u|`, `Y = X − c`.
 //!   Because `N(B·Y) − B(N·Y) = Y × (N × B)`, the field does not depend on the choice of
 //!   `N, B` and is linear in the velocity `u`:
 //!
@@ -19,7 +19,7 @@
 //!   Zheng's strip of type I on a straight axis when `u` is along the axis, where
 //!   `∇(N·(X − γ)) = N` exactly).
 //! * **Strip of type II**, flow across a straight strip (§11.2.3, S increasing along the
-//!   axis t, A-14): `p = s σ(X)` (arc-length parameter of the closest axis point, clamped),
+//!   axis t, type II): `p = s σ(X)` (arc-length parameter of the closest axis point, clamped),
 //!   `q = (1 − D) U·(X − a)`, `U = m̂ × t`; `v = s [(1 − D) m̂ − D′ (U·(X − a)) t × n]`
 //!   between the end planes, 0 beyond them (a tangential jump: the flux is continuous).
 //! * **Torus** moving along its axis k (§11.2.4): the two half-torus fields of the thesis sum
@@ -30,6 +30,7 @@
 
 use glam::DVec3;
 
+use super::{Field, Tool, bounded, finite, finite3, positive, reach_or, unit};
 use crate::error::{InputError, Result};
 
 /// `(D, D′)` of the region function at signed distance `d`, reach `rf`.
@@ -87,6 +88,29 @@ pub struct Sphere {
 }
 
 impl Sphere {
+    /// The tool of `spinal.fields.sphere`, validated; `reach` defaults to `radius`.
+    pub fn new(
+        center: DVec3,
+        radius: f64,
+        velocity: DVec3,
+        reach: Option<f64>,
+        linear: bool,
+        moving: bool,
+    ) -> Result<Sphere> {
+        let radius = positive("radius", radius)?;
+        bounded(
+            "velocity",
+            Sphere {
+                center: finite3("center", center)?,
+                velocity: finite3("velocity", velocity)?,
+                radius,
+                reach: reach_or(reach, radius)?,
+                linear,
+                moving,
+            },
+        )
+    }
+
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
         let c = if self.moving {
@@ -148,28 +172,35 @@ fn closest(x: DVec3, a: DVec3, ab: DVec3, inv_len2: f64) -> (DVec3, f64) {
 }
 
 impl Capsule {
+    /// The tool of `spinal.fields.capsule` (segment `start`–`end`), validated; `reach`
+    /// defaults to `radius`.
     pub fn new(
-        a: DVec3,
-        b: DVec3,
-        velocity: DVec3,
+        start: DVec3,
+        end: DVec3,
         radius: f64,
-        reach: f64,
+        velocity: DVec3,
+        reach: Option<f64>,
         linear: bool,
         moving: bool,
     ) -> Result<Capsule> {
+        let (a, b) = (finite3("start", start)?, finite3("end", end)?);
+        let radius = positive("radius", radius)?;
         let ab = b - a;
         let l2 = ab.length_squared();
-        Ok(Capsule {
-            a,
-            b,
-            velocity,
-            radius,
-            reach,
-            linear,
-            moving,
-            ab,
-            inv_len2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
-        })
+        bounded(
+            "velocity",
+            Capsule {
+                a,
+                b,
+                velocity: finite3("velocity", velocity)?,
+                radius,
+                reach: reach_or(reach, radius)?,
+                linear,
+                moving,
+                ab,
+                inv_len2: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
+            },
+        )
     }
 
     #[inline]
@@ -217,37 +248,44 @@ pub struct Torus {
 }
 
 impl Torus {
+    /// The tool of `spinal.fields.torus`, validated; `reach` defaults to `minor`, and
+    /// `minor + reach < major` keeps the field away from the axis.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         center: DVec3,
         axis: DVec3,
-        speed: f64,
         major: f64,
         minor: f64,
-        reach: f64,
+        speed: f64,
+        reach: Option<f64>,
         linear: bool,
         moving: bool,
     ) -> Result<Torus> {
+        let (major, minor) = (positive("major", major)?, positive("minor", minor)?);
+        let reach = reach_or(reach, minor)?;
         if !(minor + reach < major) {
             return Err(InputError::new(
-                "field",
+                "minor",
                 format!(
-                    "torus: minor + reach ({}) must be below the major radius ({major}) so the \
-                     field stays away from the axis",
+                    "minor + reach ({}) must be below major ({major}) so that the field stays \
+                     away from the axis",
                     minor + reach
                 ),
             ));
         }
-        Ok(Torus {
-            center,
-            axis,
-            speed,
-            major,
-            minor,
-            reach,
-            linear,
-            moving,
-        })
+        bounded(
+            "speed",
+            Torus {
+                center: finite3("center", center)?,
+                axis: unit("axis", axis)?,
+                speed: finite("speed", speed)?,
+                major,
+                minor,
+                reach,
+                linear,
+                moving,
+            },
+        )
     }
 
     #[inline]
@@ -304,28 +342,27 @@ pub struct StripAcross {
 }
 
 impl StripAcross {
+    /// The sideways strip of `spinal.fields.strip(kind="across")`, validated.
     pub fn new(
-        a: DVec3,
-        b: DVec3,
-        velocity: DVec3,
+        start: DVec3,
+        end: DVec3,
         radius: f64,
-        reach: f64,
+        velocity: DVec3,
+        reach: Option<f64>,
         linear: bool,
     ) -> Result<StripAcross> {
+        let (a, b) = (finite3("start", start)?, finite3("end", end)?);
+        let velocity = finite3("velocity", velocity)?;
+        let radius = positive("radius", radius)?;
+        let reach = reach_or(reach, radius)?;
+        let t = strip_axis(a, b)?;
         let ab = b - a;
         let l = ab.length();
-        if !(l > 0.0) {
-            return Err(InputError::new(
-                "field",
-                "strip: the two end points coincide",
-            ));
-        }
-        let t = ab / l;
         let s = velocity.length();
         if (velocity.dot(t)).abs() > 1e-9 * s {
             return Err(InputError::new(
-                "field",
-                "strip: the velocity of a sideways strip must be perpendicular to its axis",
+                "velocity",
+                "must be perpendicular to the strip axis for kind='across'",
             ));
         }
         let side = if s > 0.0 {
@@ -374,3 +411,69 @@ impl StripAcross {
         self.velocity.length() * speed_factor(self.reach, self.linear, |d| rho + d)
     }
 }
+
+/// The unit axis of a strip from `a` to `b`.
+fn strip_axis(a: DVec3, b: DVec3) -> Result<DVec3> {
+    let l = (b - a).length();
+    if l > 0.0 && l.is_finite() {
+        Ok((b - a) / l)
+    } else {
+        Err(InputError::new("end", "must differ from start"))
+    }
+}
+
+/// The straight strip of `spinal.fields.strip`: `across = false` (type I, the material slides
+/// along the strip: a static [`Capsule`], `velocity` parallel to the axis) or `true` (type
+/// II, [`StripAcross`], `velocity` perpendicular to it).
+pub fn strip(
+    start: DVec3,
+    end: DVec3,
+    radius: f64,
+    velocity: DVec3,
+    across: bool,
+    reach: Option<f64>,
+    linear: bool,
+) -> Result<Field> {
+    if across {
+        return Ok(Field::single(StripAcross::new(
+            start, end, radius, velocity, reach, linear,
+        )?));
+    }
+    let (a, b) = (finite3("start", start)?, finite3("end", end)?);
+    let u = finite3("velocity", velocity)?;
+    let t = strip_axis(a, b)?;
+    let s = u.length();
+    if (u.dot(t).abs() - s).abs() > 1e-9 * s {
+        return Err(InputError::new(
+            "velocity",
+            "must be parallel to the strip axis for kind='along'",
+        ));
+    }
+    Ok(Field::single(Capsule::new(
+        a, b, radius, u, reach, linear, false,
+    )?))
+}
+
+/// `impl Tool` for a tool with `eval(x, t)` and `max_speed()` whose length scale is `reach`.
+macro_rules! tool {
+    ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr) => {
+        impl Tool for $t {
+            #[inline]
+            fn velocity(&self, $x: DVec3, $time: f64, _tm: f64) -> DVec3 {
+                let $s = self;
+                $eval
+            }
+            fn max_speed(&self) -> f64 {
+                <$t>::max_speed(self)
+            }
+            fn length_scale(&self) -> f64 {
+                self.reach
+            }
+        }
+    };
+}
+
+tool!(Sphere, |s, x, t| s.eval(x, t));
+tool!(Capsule, |s, x, t| s.eval(x, t));
+tool!(Torus, |s, x, t| s.eval(x, t));
+tool!(StripAcross, |s, x, _t| s.eval(x));

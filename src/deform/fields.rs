@@ -1,5 +1,5 @@
-//! Curl fields `V = c · curl(φ(d) B(Y))` (Zheng, thesis Ch. 12, eq. 12.1–12.6), with the
-//! corrections of the issue-4 brief (errata ).
+//! Curl fields `V = c · curl(φ(d) B(Y))` (Zheng, thesis Ch. 12, eq. 12.1–12.6), with the sign
+//! and scale of the printed fields corrected as derived below.
 //!
 //! Notation: `Y = X − pivot`, `d` the signed distance to the tool (negative inside), `n = ∇d`,
 //! `R` the reach (the field vanishes where `|d| ≥ R`), falloff `φ = (R − |d|)^p`, `p ∈ {2,3,4}`
@@ -7,7 +7,7 @@
 //! `curl(φB) = φ′ n × B + φ curl B` and `φ′ = −p sgn(d) (R − |d|)^{p−1}`:
 //!
 //! * **translation** (eq. 12.1–12.2): `B = Y × i`, `curl B = −2i`. The printed field flows
-//!   *into* the front of the tool with a speed-independent magnitude; the corrected
+//!   *into* the front of the tool with a speed-independent magnitude; the corrected
 //!   field is `V = −(1/(2R^p)) curl(φ (Y × u))`, linear in the tool velocity `u`:
 //!
 //!   `V = (e^{p−1}/R^p) [ e u + (p/2) sgn(d) ((n·u) Y − (n·Y) u) ]`,  `e = R − |d|`,
@@ -19,7 +19,7 @@
 //!   `V = (e^{p−1}/(3R^p)) [ p sgn(d) n × B + 3 e Ω × Y ]`,
 //!
 //!   whose normal component on the tool surface is `(Ω × Y)·n` (a rigidly turning tool);
-//! * **twist, bend** (eq. 12.4–12.6, printed without falloff and turning clockwise, A-17):
+//! * **twist, bend** (eq. 12.4–12.6, printed without falloff and turning clockwise):
 //!   swirls `v = h(z, r) a × Y` (`z = a·Y`, `r = |Y|`), divergence-free because
 //!   `∇h ∈ span(a, Y) ⟂ a × Y`. With `q = r/R` and support `r < R`:
 //!   - rate form (default): twist `h = κ z (1 − q)²`, bend `h = β r² (1 − q)²`;
@@ -33,8 +33,10 @@
 //! is off the pivot. Swirls are exact rotations on every sphere `r = const` (`z, r` are
 //! invariants), which gives the closed-form flows used by the tests.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
+use super::{Tool, bounded, falloff as falloff_power, finite, finite3, positive, reach_or, unit};
+use crate::error::Result;
 use crate::math::rotation::rodrigues;
 
 /// `(R − |d|)^(p−1)` and `(R − |d|)` for `|d| < R`, `None` outside the support.
@@ -84,6 +86,28 @@ pub struct Translation {
 }
 
 impl Translation {
+    /// The tool of `spinal.fields.translation`, validated (errors name its arguments);
+    /// `reach` defaults to `radius`.
+    pub fn new(
+        center: DVec3,
+        radius: f64,
+        velocity: DVec3,
+        reach: Option<f64>,
+        power: i64,
+        moving: bool,
+    ) -> Result<Translation> {
+        let radius = positive("radius", radius)?;
+        let tool = Translation {
+            center: finite3("center", center)?,
+            velocity: finite3("velocity", velocity)?,
+            radius,
+            reach: reach_or(reach, radius)?,
+            power: falloff_power(power)?,
+            moving,
+        };
+        bounded("velocity", tool)
+    }
+
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
         let c = if self.moving {
@@ -148,6 +172,29 @@ impl Translation {
     }
 }
 
+impl Tool for Translation {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
+        self.eval(x, t)
+    }
+    fn max_speed(&self) -> f64 {
+        Translation::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.reach
+    }
+    fn potential_jacobian(&self, x: DVec3, t: f64) -> Option<DMat3> {
+        Some(Translation::potential_jacobian(self, x, t))
+    }
+    fn rigid_velocity(&self) -> DVec3 {
+        if self.moving {
+            self.velocity
+        } else {
+            DVec3::ZERO
+        }
+    }
+}
+
 /// Sphere tool turning with angular velocity `Ω` about `pivot` (eq. 12.3 corrected).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rotation {
@@ -161,6 +208,31 @@ pub struct Rotation {
 }
 
 impl Rotation {
+    /// The tool of `spinal.fields.rotation`, validated; `pivot` defaults to `center`,
+    /// `reach` to `radius`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        center: DVec3,
+        radius: f64,
+        axis: DVec3,
+        angular_speed: f64,
+        pivot: Option<DVec3>,
+        reach: Option<f64>,
+        power: i64,
+    ) -> Result<Rotation> {
+        let center = finite3("center", center)?;
+        let radius = positive("radius", radius)?;
+        let tool = Rotation {
+            center,
+            pivot: pivot.map_or(Ok(center), |p| finite3("pivot", p))?,
+            omega: unit("axis", axis)? * finite("angular_speed", angular_speed)?,
+            radius,
+            reach: reach_or(reach, radius)?,
+            power: falloff_power(power)?,
+        };
+        bounded("angular_speed", tool)
+    }
+
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
         let w = self.omega.length();
@@ -199,6 +271,19 @@ impl Rotation {
     }
 }
 
+impl Tool for Rotation {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
+        self.eval(x, t)
+    }
+    fn max_speed(&self) -> f64 {
+        Rotation::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.reach
+    }
+}
+
 /// Which swirl.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SwirlKind {
@@ -221,6 +306,26 @@ pub struct Swirl {
 }
 
 impl Swirl {
+    /// The swirl of `spinal.fields.twist` / `bend`, validated (`radius` is its support).
+    pub fn new(
+        center: DVec3,
+        axis: DVec3,
+        rate: f64,
+        radius: f64,
+        kind: SwirlKind,
+        curl_form: bool,
+    ) -> Result<Swirl> {
+        let tool = Swirl {
+            pivot: finite3("center", center)?,
+            axis: unit("axis", axis)?,
+            rate: finite("rate", rate)?,
+            reach: positive("radius", radius)?,
+            kind,
+            curl_form,
+        };
+        bounded("rate", tool)
+    }
+
     /// Angular speed `h` (rad per time, right-handed about the axis) at `z = a·Y`, `r = |Y|`.
     #[inline]
     pub fn angular(&self, z: f64, r: f64) -> f64 {
@@ -268,6 +373,19 @@ impl Swirl {
             m = m.max((self.angular(r, r) * r).abs());
         }
         m
+    }
+}
+
+impl Tool for Swirl {
+    #[inline]
+    fn velocity(&self, x: DVec3, _t: f64, _tm: f64) -> DVec3 {
+        self.eval(x)
+    }
+    fn max_speed(&self) -> f64 {
+        Swirl::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.reach
     }
 }
 

@@ -1,6 +1,6 @@
 //! Free-form tool from a sampled signed distance: Zheng's "extended spherical" field
-//! (thesis §11.2.1, §11.2.5 and the distance-field extension of §2.3 item 1 / §4.2 item 3 of
-//! the brief) with the tool's distance interpolated by a C² tricubic B-spline.
+//! (thesis §11.2.1, §11.2.5, with the exact distance-field extension of the sphere's
+//! region translation) with the tool's distance interpolated by a C² tricubic B-spline.
 //!
 //! **Distance.** The grid holds the coefficients `c_{ijk}` (one ghost layer on each side) of
 //! the uniform cubic B-spline `d(X) = Σ c_{ijk} β(ξ − i) β(η − j) β(ζ − k)`,
@@ -145,10 +145,14 @@ impl GridTool {
                         || j == c[1] - 1
                         || k == c[2] - 1;
                     if edge {
-                        return Err(bad(format!(
-                            "sdf grid: the support (distance < reach {reach}) reaches the grid \
-                             boundary at cell ({i}, {j}, {k})"
-                        )));
+                        return Err(InputError::new(
+                            "grid",
+                            format!(
+                                "the field's support (distance < reach {reach}) reaches the edge \
+                                 of the grid at cell ({i}, {j}, {k}); pad the grid so that the \
+                                 distance is ≥ reach on its outer cells"
+                            ),
+                        ));
                     }
                     let mid = origin
                         + DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * spacing;
@@ -261,6 +265,64 @@ impl GridTool {
             * speed_factor(rf, self.linear, |d| {
                 y[((d / rf * BUCKETS as f64) as usize).min(BUCKETS - 1)]
             })
+    }
+}
+
+/// Cells per reach below which a grid is too coarse for the blend region.
+pub const MIN_CELLS_PER_REACH: f64 = 4.0;
+
+/// The tool of `spinal.fields.sdf_tool` from its B-spline coefficients, validated: finite
+/// vectors, positive spacing and reach, at least [`MIN_CELLS_PER_REACH`] cells per reach,
+/// and a support that stays inside the grid ([`GridTool::new`]).
+#[allow(clippy::too_many_arguments)]
+pub fn grid_tool(
+    origin: DVec3,
+    spacing: f64,
+    n: [usize; 3],
+    coef: Vec<f64>,
+    velocity: DVec3,
+    center: DVec3,
+    reach: f64,
+    linear: bool,
+    moving: bool,
+) -> Result<GridTool> {
+    let origin = super::finite3("origin", origin)?;
+    let velocity = super::finite3("velocity", velocity)?;
+    let center = super::finite3("center", center)?;
+    let spacing = super::positive("spacing", spacing)?;
+    let reach = super::positive("reach", reach)?;
+    if !(reach >= MIN_CELLS_PER_REACH * spacing) {
+        return Err(InputError::new(
+            "spacing",
+            format!(
+                "grid too coarse: spacing {spacing:.4} must be at most reach/{MIN_CELLS_PER_REACH} \
+                 = {:.4} (the blend region needs {MIN_CELLS_PER_REACH} cells)",
+                reach / MIN_CELLS_PER_REACH
+            ),
+        ));
+    }
+    if let Some(i) = coef.iter().position(|c| !c.is_finite()) {
+        return Err(InputError::new(
+            "grid",
+            format!("spline coefficient {i} is not finite"),
+        ));
+    }
+    let tool = GridTool::new(
+        origin, spacing, n, coef, velocity, center, reach, linear, moving,
+    )?;
+    super::bounded("velocity", tool)
+}
+
+impl super::Tool for GridTool {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
+        self.eval(x, t)
+    }
+    fn max_speed(&self) -> f64 {
+        GridTool::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.reach
     }
 }
 

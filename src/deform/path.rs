@@ -1,6 +1,6 @@
 //! Tools moving along a path: a spine `x_0 … x_{n−1}` with its frames `F_k = [r_k s_k t_k]`
 //! (the double-reflection RMF of `spinal.frames`), traversed at constant speed in arc length
-//! from time `t0` to `t0 + T` (issue-4 brief §4; the thesis only says that each tool field is
+//! from time `t0` to `t0 + T` (the thesis only says that each tool field is
 //! fixed in the tool's object space and moves rigidly with it, Zheng Ch. 11.2).
 //!
 //! Pose at arc length `σ = L (t − t0)/T` (`S_k` the cumulative chord lengths, `L = S_{n−1}`,
@@ -34,6 +34,7 @@ use glam::{DMat3, DVec3};
 
 use super::cross::Sphere;
 use super::fields::{Rotation, Swirl, SwirlKind, Translation};
+use super::{Tool, falloff, finite, positive, reach_or};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{is_rotation, quat_from_mat3, rodrigues};
@@ -340,6 +341,166 @@ impl PathTool {
         self.samples
             .iter()
             .map(move |p| self.spec.t0 + self.spec.duration * (p.s - s0) / l)
+    }
+}
+
+/// What a path tool does besides translating (`kind` of `spinal.fields.along_path`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathKind {
+    /// Only the translation along the spine.
+    Translate,
+    /// Also turn the material with the frames.
+    Rotate,
+    /// Also twist about the moving tangent.
+    Twist,
+    /// Also bend about the moving reference vector.
+    Bend,
+}
+
+/// The arguments of `spinal.fields.along_path`, as the user gives them.
+#[derive(Debug, Clone, Copy)]
+pub struct PathArgs<'a> {
+    /// Spine samples `(n, 3)`.
+    pub points: &'a [DVec3],
+    /// Rotation-minimising frames at the samples, columns `(r, s, t)`.
+    pub frames: &'a [DMat3],
+    /// Tool radius ρ.
+    pub radius: f64,
+    /// Time to travel the whole spine.
+    pub duration: f64,
+    /// What the tool does besides translating.
+    pub kind: PathKind,
+    /// von Funck's region translation ("carry") instead of the curl tool ("push").
+    pub carry: bool,
+    /// Twist or bend rate for `kind` twist or bend.
+    pub rate: f64,
+    /// Start time.
+    pub t0: f64,
+    /// Reach beyond the tool (default `radius`).
+    pub reach: Option<f64>,
+    /// Falloff power of the curl parts.
+    pub power: i64,
+    /// Linear region function for `carry`.
+    pub linear: bool,
+}
+
+impl PathTool {
+    /// The tool of `spinal.fields.along_path`, validated (errors name its arguments): at least
+    /// 2 finite samples with no repeated consecutive point, one rotation per sample.
+    pub fn from_args(a: PathArgs<'_>) -> Result<PathTool> {
+        let x = a.points;
+        if x.len() < 2 {
+            return Err(InputError::new(
+                "points",
+                format!("need at least 2 samples, got {}", x.len()),
+            ));
+        }
+        if let Some(i) = x.iter().position(|p| !p.is_finite()) {
+            return Err(InputError::new(
+                "points",
+                format!("row {i} is not finite (NaN or inf)"),
+            ));
+        }
+        if a.frames.len() != x.len() {
+            return Err(InputError::new(
+                "frames",
+                format!(
+                    "expected shape ({}, 3, 3), got {} frames",
+                    x.len(),
+                    a.frames.len()
+                ),
+            ));
+        }
+        if let Some(i) = a.frames.iter().position(|f| !is_rotation(f)) {
+            return Err(InputError::new(
+                "frames",
+                format!("frame {i} is not a rotation matrix"),
+            ));
+        }
+        let mut s = 0.0;
+        let mut samples = Vec::with_capacity(x.len());
+        for (i, (p, f)) in x.iter().zip(a.frames).enumerate() {
+            if i > 0 {
+                let chord = p.distance(x[i - 1]);
+                if !(chord > 0.0) {
+                    return Err(InputError::new(
+                        "points",
+                        format!("consecutive samples {} and {i} coincide", i - 1),
+                    ));
+                }
+                s += chord;
+            }
+            samples.push(Sample {
+                x: *p,
+                frame: *f,
+                s,
+            });
+        }
+        let radius = positive("radius", a.radius)?;
+        let spec = PathToolSpec {
+            t0: finite("t0", a.t0)?,
+            duration: positive("duration", a.duration)?,
+            radius,
+            reach: reach_or(a.reach, radius)?,
+            power: falloff(a.power)?,
+            carry: a.carry,
+            linear: a.linear,
+            rotate: a.kind == PathKind::Rotate,
+            twist: if a.kind == PathKind::Twist {
+                finite("rate", a.rate)?
+            } else {
+                0.0
+            },
+            bend: if a.kind == PathKind::Bend {
+                finite("rate", a.rate)?
+            } else {
+                0.0
+            },
+        };
+        let tool = PathTool::new(samples, spec)?;
+        let speed = tool.max_speed();
+        if !speed.is_finite() {
+            return Err(InputError::new(
+                "duration",
+                format!("is too small: the tool's speed bound is {speed}"),
+            ));
+        }
+        Ok(tool)
+    }
+}
+
+impl Tool for PathTool {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        self.eval(x, t, tm)
+    }
+    fn max_speed(&self) -> f64 {
+        PathTool::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.spec.reach
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        PathTool::breakpoints(self).collect()
+    }
+    /// The pose once per batch, then the frozen-pose field at every point.
+    #[inline]
+    fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
+        if let Some(pose) = self.pose_in(t, tm) {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += self.eval_at(*x, &pose);
+            }
+        }
+    }
+    #[inline]
+    fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
+        super::advect::rk4_lanes_with(
+            |p, t, tm, out| self.add_lanes(p, t, tm, out),
+            x,
+            t0,
+            h,
+            steps,
+        );
     }
 }
 

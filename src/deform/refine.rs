@@ -499,7 +499,7 @@ pub fn deform(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deform::{Element, Translation};
+    use crate::deform::Translation;
 
     /// An octahedron subdivided `k` times and pushed onto the unit sphere.
     fn sphere(k: usize) -> (Vec<DVec3>, Vec<[usize; 3]>) {
@@ -552,16 +552,14 @@ mod tests {
     }
 
     fn drag(center: DVec3, radius: f64, velocity: DVec3) -> Field {
-        Field {
-            elements: vec![Element::Translation(Translation {
-                center,
-                velocity,
-                radius,
-                reach: radius,
-                power: 2,
-                moving: true,
-            })],
-        }
+        Field::single(Translation {
+            center,
+            velocity,
+            radius,
+            reach: radius,
+            power: 2,
+            moving: true,
+        })
     }
 
     #[test]

@@ -24,9 +24,9 @@
 
 use glam::DVec3;
 
+use super::Field;
 use super::advect::{Method, integrate};
 use super::fields::Translation;
-use super::{Element, Field};
 use crate::error::{InputError, Result};
 use crate::math::mesh::signed_volume as volume;
 
@@ -102,16 +102,14 @@ pub fn stamp(
         }
         let snapped = volume(v, f);
         let dent = before - snapped;
-        let field = Field {
-            elements: vec![Element::Translation(Translation {
-                center: c,
-                velocity: u,
-                radius,
-                reach,
-                power: 2,
-                moving: false,
-            })],
-        };
+        let field = Field::single(Translation {
+            center: c,
+            velocity: u,
+            radius,
+            reach,
+            power: 2,
+            moving: false,
+        });
         movable.fill(false);
         let mut rate = 0.0;
         for t in f {

@@ -304,6 +304,35 @@ impl StripAlong {
     }
 }
 
+/// The strip of `spinal.fields.strip_curve` from its axis samples (positions, derivatives
+/// `dγ/dS` of the clamped C² spline, cumulative chord lengths), validated: `radius` and
+/// `reach` (default `radius`) positive, `speed` finite, then [`StripAlong::new`]'s checks.
+pub fn strip_along(
+    samples: Vec<AxisSample>,
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    linear: bool,
+) -> Result<StripAlong> {
+    let radius = super::positive("radius", radius)?;
+    let reach = super::reach_or(reach, radius)?;
+    let speed = super::finite("speed", speed)?;
+    StripAlong::new(samples, speed, radius, reach, linear)
+}
+
+impl super::Tool for StripAlong {
+    #[inline]
+    fn velocity(&self, x: DVec3, _t: f64, _tm: f64) -> DVec3 {
+        self.eval(x)
+    }
+    fn max_speed(&self) -> f64 {
+        StripAlong::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.reach
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -251,7 +251,7 @@ pub fn quat_array<'py>(py: Python<'py>, q: Vec<DQuat>) -> PyResult<Bound<'py, Py
 
 /// Read a string option: `"{arg}: unknown {what} 'x'; expected 'a', 'b' or 'c'"` when it is
 /// not one of `choices` (listed in that order).
-fn choice<T: Copy>(
+pub fn choice<T: Copy>(
     obj: Borrowed<'_, '_, PyAny>,
     arg: &str,
     what: &str,

@@ -2,80 +2,38 @@
 //! the algorithms are in [`crate::deform`].
 
 use glam::DVec3;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::convert::{
-    Ticker, empty, slice_mut, slice_of, triangles, value_error, vec3_array, vec3s,
-};
+use super::convert::{Ticker, empty, slice_mut, triangles, value_error, vec3_array, vec3s};
+use super::fields::PyField;
 use crate::deform::{self, advect::Method, refine};
-
-/// A field from its `(k, ROW)` element rows (see `_core.pyi` for the layouts).
-fn field_of(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<deform::Field> {
-    if rows.shape()[1] != deform::ROW {
-        return Err(value_error(format!(
-            "field: expected element rows of shape (k, {}), got {:?}",
-            deform::ROW,
-            rows.shape()
-        )));
-    }
-    Ok(deform::Field::parse(slice_of("field", rows)?)?)
-}
-
-/// Velocities of a field at points; see `spinal.fields`.
-#[pyfunction]
-pub fn field_eval<'py>(
-    py: Python<'py>,
-    points: PyReadonlyArray2<'py, f64>,
-    rows: PyReadonlyArray2<'py, f64>,
-    t: f64,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let field = field_of(&rows)?;
-    let x = vec3s("points", &points)?;
-    let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
-    {
-        let mut w = out.readwrite();
-        let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        py.detach(|| deform::advect::eval_into(&field, x, t, o));
-    }
-    Ok(out)
-}
-
-/// `(max_speed, length_scale, default steps for duration)` of a field.
-#[pyfunction]
-pub fn field_info(rows: PyReadonlyArray2<'_, f64>, duration: f64) -> PyResult<(f64, f64, usize)> {
-    let field = field_of(&rows)?;
-    Ok((
-        field.max_speed(),
-        field.length_scale(),
-        field.default_steps(duration),
-    ))
-}
 
 /// Advect points: `steps` steps of size `h` from `t0`; a new array.
 #[pyfunction]
 pub fn advect<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    rows: PyReadonlyArray2<'py, f64>,
+    field: PyRef<'py, PyField>,
     t0: f64,
     h: f64,
     steps: usize,
     method: Method,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let field = field_of(&rows)?;
+    let field = &field.field;
     if method == Method::Split && !field.has_potential() {
         return Err(value_error(
             "method: 'split' needs curl potentials; only fields.translation tools have one",
         ));
     }
     let x = vec3s("vertices", &points)?;
+    deform::finite_rows("vertices", x)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
     {
         let mut w = out.readwrite();
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
-        py.detach(|| deform::advect::advect_in_place(&field, o, t0, h, steps, method));
+        py.detach(|| deform::advect::advect_in_place(field, o, t0, h, steps, method));
     }
     Ok(out)
 }
@@ -94,14 +52,14 @@ type DeformArrays<'py> = (
 /// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
 /// every step when given.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, rows, t0, duration, steps, refine, max_vertices,
+#[pyo3(signature = (vertices, faces, field, t0, duration, steps, refine, max_vertices,
                     max_passes, progress))]
 #[allow(clippy::too_many_arguments)]
 pub fn deform_mesh<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, i64>,
-    rows: PyReadonlyArray2<'py, f64>,
+    field: PyRef<'py, PyField>,
     t0: f64,
     duration: f64,
     steps: usize,
@@ -110,7 +68,7 @@ pub fn deform_mesh<'py>(
     max_passes: usize,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<DeformArrays<'py>> {
-    let field = field_of(&rows)?;
+    let field = &field.field;
     let x = vec3s("mesh", &vertices)?;
     // negative indices become out of range, which the core reports
     let f: Vec<[usize; 3]> = triangles(&faces)?
@@ -124,8 +82,8 @@ pub fn deform_mesh<'py>(
     });
     let mut ticker = Ticker::new(progress);
     let out = py.detach(|| {
-        let runs = refine::schedule(&field, t0, duration, steps);
-        refine::deform(&field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
+        let runs = refine::schedule(field, t0, duration, steps);
+        refine::deform(field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
     })?;
     ticker.finish()?;
     let d = out.ok_or_else(|| value_error("deform: stopped"))?;

@@ -7,6 +7,7 @@
 
 mod convert;
 mod deform;
+mod fields;
 mod flesh;
 mod frames;
 mod ph;
@@ -37,8 +38,18 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ph::ph_preimage, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_frame_setup, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_frames, m)?)?;
-    m.add_function(wrap_pyfunction!(deform::field_eval, m)?)?;
-    m.add_function(wrap_pyfunction!(deform::field_info, m)?)?;
+    m.add_class::<fields::PyField>()?;
+    m.add_function(wrap_pyfunction!(fields::field_translation, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_rotation, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_swirl, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_sphere, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_capsule, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_strip, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_torus, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_strip_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_path, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_zero, m)?)?;
     m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;

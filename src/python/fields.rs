@@ -1,0 +1,575 @@
+//! Velocity fields as compiled objects (`spinal.fields`): each constructor validates its
+//! arguments and builds its tool once in the core ([`crate::deform`]); a [`PyField`] holds
+//! the built tools (shared, never re-parsed) and the constructor calls that made them, so that
+//! it pickles by rebuilding.
+
+use glam::{DMat3, DVec3};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use super::convert::{choice, empty, slice_mut, slice_of, value_error, vec3s};
+use crate::deform::{
+    self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, grid, path, tube,
+};
+
+/// A divergence-free velocity field: a sum of tools built by the constructors of
+/// `spinal.fields` (see its module docstring for the maths).
+///
+/// `field(points, t=0.0)` returns the `(n, 3)` velocities at time `t`; `f + g` (and the
+/// builtin `sum`) is the sum field; `max_speed` bounds `|v|`, `length_scale` is the smallest
+/// reach, `steps(duration)` the default RK4 step count of `spinal.advect`, `breakpoints()`
+/// the times at which a path tool passes a spine sample. Fields are immutable and pickle by
+/// rebuilding from their constructor arguments.
+#[pyclass(frozen, name = "Field", module = "spinal.fields")]
+pub struct PyField {
+    /// The built tools.
+    pub field: Field,
+    /// One name per constructor call, for `repr`.
+    names: Vec<String>,
+    /// One `(constructor name, args, kwargs)` per constructor call, for pickling.
+    recipe: Vec<Py<PyAny>>,
+}
+
+impl PyField {
+    fn new(field: Field, name: &str) -> PyField {
+        PyField {
+            field,
+            names: vec![name.to_string()],
+            recipe: Vec::new(),
+        }
+    }
+
+    fn plus(&self, py: Python<'_>, other: &PyField) -> PyField {
+        PyField {
+            field: self.field.plus(&other.field),
+            names: self.names.iter().chain(&other.names).cloned().collect(),
+            recipe: self
+                .recipe
+                .iter()
+                .chain(&other.recipe)
+                .map(|r| r.clone_ref(py))
+                .collect(),
+        }
+    }
+}
+
+#[pymethods]
+impl PyField {
+    /// Velocities `(n, 3)` at `points` and time `t`.
+    #[pyo3(signature = (points, t = None))]
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        t: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let validate = py.import("spinal._validate")?;
+        let arr = validate.getattr("as_points")?.call1((points, "points"))?;
+        let t: f64 = match t {
+            Some(t) => validate.getattr("as_real")?.call1((t, "t"))?.extract()?,
+            None => 0.0,
+        };
+        let arr: PyReadonlyArray2<'py, f64> = arr.extract()?;
+        let x = vec3s("points", &arr)?;
+        deform::finite_rows("points", x)?;
+        let t = deform::finite("t", t)?;
+        let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+        {
+            let mut w = out.readwrite();
+            let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+            let field = &self.field;
+            py.detach(|| deform::advect::eval_into(field, x, t, o));
+        }
+        Ok(out)
+    }
+
+    fn __add__(&self, py: Python<'_>, other: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        match other.cast::<PyField>() {
+            Ok(o) => Ok(Py::new(py, self.plus(py, o.get()))?.into_any()),
+            Err(_) => Ok(py.NotImplemented()),
+        }
+    }
+
+    /// `0 + field` (the builtin `sum` starts from 0).
+    fn __radd__(slf: &Bound<'_, Self>, other: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        let py = slf.py();
+        if let Ok(o) = other.cast::<PyField>() {
+            return Ok(Py::new(py, o.get().plus(py, slf.get()))?.into_any());
+        }
+        let zero = other
+            .extract::<f64>()
+            .is_ok_and(|x| x == 0.0 && !other.is_instance_of::<pyo3::types::PyBool>());
+        Ok(if zero {
+            slf.clone().into_any().unbind()
+        } else {
+            py.NotImplemented()
+        })
+    }
+
+    /// The number of tools.
+    fn __len__(&self) -> usize {
+        self.field.tools.len()
+    }
+
+    /// Times at which a path tool passes a spine sample, sorted: the velocity is only
+    /// continuous in time there, so `spinal.advect` ends steps at them.
+    fn breakpoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.field.breakpoints())
+    }
+
+    /// A bound of the speed `|v|` (length/time): the sum over the tools of each tool's
+    /// bound (closed form where one exists, else a maximum sampled over its support); 0 for
+    /// the zero field. Used by `steps`.
+    #[getter]
+    fn max_speed(&self) -> f64 {
+        self.field.max_speed()
+    }
+
+    /// The smallest length over which a tool's field falls from its tool value to zero: its
+    /// reach (for twist and bend, their radius), the minimum over the tools; inf for the zero
+    /// field. Used by `steps`.
+    #[getter]
+    fn length_scale(&self) -> f64 {
+        self.field.length_scale()
+    }
+
+    /// Default step count: `max(4, ⌈|duration|·8·max_speed/length_scale⌉)` (a step moves a
+    /// point by at most 1/8 of the length scale); more than 10⁸ steps raises `ValueError`.
+    fn steps(&self, duration: f64) -> PyResult<usize> {
+        let d = deform::finite("duration", duration)?;
+        Ok(self.field.default_steps(d)?)
+    }
+
+    fn __repr__(&self) -> String {
+        let names = if self.names.is_empty() {
+            "zero".to_string()
+        } else {
+            self.names.join(" + ")
+        };
+        format!("spinal.fields.Field({names})")
+    }
+
+    /// Pickle support: rebuilt by calling the constructors again.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let rebuild = py.import("spinal.fields")?.getattr("_rebuild")?;
+        let recipe: Vec<Py<PyAny>> = self.recipe.iter().map(|r| r.clone_ref(py)).collect();
+        PyTuple::new(
+            py,
+            [
+                rebuild.unbind(),
+                PyTuple::new(py, [recipe])?.into_any().unbind(),
+            ],
+        )
+    }
+
+    /// The same field, remembering that `name(*args, **kwargs)` made it (for pickling).
+    fn _with_recipe(
+        &self,
+        py: Python<'_>,
+        name: &str,
+        args: Bound<'_, PyTuple>,
+        kwargs: Bound<'_, PyDict>,
+    ) -> PyResult<PyField> {
+        let entry = PyTuple::new(
+            py,
+            [
+                name.into_pyobject(py)?.into_any(),
+                args.into_any(),
+                kwargs.into_any(),
+            ],
+        )?;
+        Ok(PyField {
+            field: self.field.clone(),
+            names: self.names.clone(),
+            recipe: vec![entry.into_any().unbind()],
+        })
+    }
+}
+
+/// Region function of the cross-product fields.
+#[derive(Clone, Copy)]
+pub struct Blend(bool);
+
+impl FromPyObject<'_, '_> for Blend {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "blend",
+            "blend",
+            &[("c1", Blend(false)), ("linear", Blend(true))],
+        )
+    }
+}
+
+/// Twist and bend: the rate form or the thesis's curl form.
+#[derive(Clone, Copy)]
+pub struct CurlForm(bool);
+
+impl FromPyObject<'_, '_> for CurlForm {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "form",
+            "form",
+            &[("rate", CurlForm(false)), ("curl", CurlForm(true))],
+        )
+    }
+}
+
+/// A straight strip along its axis or across it.
+#[derive(Clone, Copy)]
+pub struct Across(bool);
+
+impl FromPyObject<'_, '_> for Across {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "kind",
+            "kind",
+            &[("along", Across(false)), ("across", Across(true))],
+        )
+    }
+}
+
+/// A path tool that pushes (curl tool) or carries (region translation).
+#[derive(Clone, Copy)]
+pub struct Carry(bool);
+
+impl FromPyObject<'_, '_> for Carry {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        choice(
+            obj,
+            "tool",
+            "tool",
+            &[("push", Carry(false)), ("carry", Carry(true))],
+        )
+    }
+}
+
+impl FromPyObject<'_, '_> for path::PathKind {
+    type Error = PyErr;
+    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        use path::PathKind as K;
+        choice(
+            obj,
+            "kind",
+            "kind",
+            &[
+                ("translate", K::Translate),
+                ("rotate", K::Rotate),
+                ("twist", K::Twist),
+                ("bend", K::Bend),
+            ],
+        )
+    }
+}
+
+/// `spinal.fields.translation`.
+#[pyfunction]
+pub fn field_translation(
+    center: [f64; 3],
+    radius: f64,
+    velocity: [f64; 3],
+    reach: Option<f64>,
+    falloff_power: i64,
+    moving: bool,
+) -> PyResult<PyField> {
+    let t = Translation::new(
+        center.into(),
+        radius,
+        velocity.into(),
+        reach,
+        falloff_power,
+        moving,
+    )?;
+    Ok(PyField::new(Field::single(t), "translation"))
+}
+
+/// `spinal.fields.rotation`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_rotation(
+    center: [f64; 3],
+    radius: f64,
+    axis: [f64; 3],
+    angular_speed: f64,
+    pivot: Option<[f64; 3]>,
+    reach: Option<f64>,
+    falloff_power: i64,
+) -> PyResult<PyField> {
+    let r = Rotation::new(
+        center.into(),
+        radius,
+        axis.into(),
+        angular_speed,
+        pivot.map(DVec3::from),
+        reach,
+        falloff_power,
+    )?;
+    Ok(PyField::new(Field::single(r), "rotation"))
+}
+
+/// `spinal.fields.twist` (`bend = false`) and `spinal.fields.bend`.
+#[pyfunction]
+pub fn field_swirl(
+    center: [f64; 3],
+    axis: [f64; 3],
+    rate: f64,
+    radius: f64,
+    form: CurlForm,
+    bend: bool,
+) -> PyResult<PyField> {
+    let kind = if bend {
+        SwirlKind::Bend
+    } else {
+        SwirlKind::Twist
+    };
+    let s = Swirl::new(center.into(), axis.into(), rate, radius, kind, form.0)?;
+    Ok(PyField::new(
+        Field::single(s),
+        if bend { "bend" } else { "twist" },
+    ))
+}
+
+/// `spinal.fields.sphere`.
+#[pyfunction]
+pub fn field_sphere(
+    center: [f64; 3],
+    radius: f64,
+    velocity: [f64; 3],
+    reach: Option<f64>,
+    blend: Blend,
+    moving: bool,
+) -> PyResult<PyField> {
+    let s = Sphere::new(
+        center.into(),
+        radius,
+        velocity.into(),
+        reach,
+        blend.0,
+        moving,
+    )?;
+    Ok(PyField::new(Field::single(s), "sphere"))
+}
+
+/// `spinal.fields.capsule`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_capsule(
+    start: [f64; 3],
+    end: [f64; 3],
+    radius: f64,
+    velocity: [f64; 3],
+    reach: Option<f64>,
+    blend: Blend,
+    moving: bool,
+) -> PyResult<PyField> {
+    let c = Capsule::new(
+        start.into(),
+        end.into(),
+        radius,
+        velocity.into(),
+        reach,
+        blend.0,
+        moving,
+    )?;
+    Ok(PyField::new(Field::single(c), "capsule"))
+}
+
+/// `spinal.fields.strip`.
+#[pyfunction]
+pub fn field_strip(
+    start: [f64; 3],
+    end: [f64; 3],
+    radius: f64,
+    velocity: [f64; 3],
+    kind: Across,
+    reach: Option<f64>,
+    blend: Blend,
+) -> PyResult<PyField> {
+    let f = deform::cross::strip(
+        start.into(),
+        end.into(),
+        radius,
+        velocity.into(),
+        kind.0,
+        reach,
+        blend.0,
+    )?;
+    Ok(PyField::new(
+        f,
+        if kind.0 {
+            "strip(across)"
+        } else {
+            "strip(along)"
+        },
+    ))
+}
+
+/// `spinal.fields.torus`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_torus(
+    center: [f64; 3],
+    axis: [f64; 3],
+    major: f64,
+    minor: f64,
+    speed: f64,
+    reach: Option<f64>,
+    blend: Blend,
+    moving: bool,
+) -> PyResult<PyField> {
+    let t = Torus::new(
+        center.into(),
+        axis.into(),
+        major,
+        minor,
+        speed,
+        reach,
+        blend.0,
+        moving,
+    )?;
+    Ok(PyField::new(Field::single(t), "torus"))
+}
+
+/// `spinal.fields.strip_curve` from its axis: samples `(n, 3)`, derivatives `dγ/dS` `(n, 3)`
+/// and cumulative chord lengths `(n,)`.
+#[pyfunction]
+pub fn field_strip_curve(
+    points: PyReadonlyArray2<'_, f64>,
+    slopes: PyReadonlyArray2<'_, f64>,
+    arc: PyReadonlyArray1<'_, f64>,
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    blend: Blend,
+) -> PyResult<PyField> {
+    let (x, m, s) = (
+        vec3s("points", &points)?,
+        vec3s("points", &slopes)?,
+        slice_of("points", &arc)?,
+    );
+    if m.len() != x.len() || s.len() != x.len() {
+        return Err(value_error(
+            "points: samples, slopes and arc lengths differ in length",
+        ));
+    }
+    let samples = x
+        .iter()
+        .zip(m)
+        .zip(s)
+        .map(|((x, m), s)| tube::AxisSample {
+            x: *x,
+            m: *m,
+            s: *s,
+        })
+        .collect();
+    let tool = tube::strip_along(samples, radius, speed, reach, blend.0)?;
+    Ok(PyField::new(Field::single(tool), "strip_curve"))
+}
+
+/// `spinal.fields.sdf_tool` / `mesh_tool` from the B-spline coefficients `(nx+2, ny+2,
+/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_grid(
+    coefficients: PyReadonlyArray3<'_, f64>,
+    origin: [f64; 3],
+    spacing: f64,
+    velocity: [f64; 3],
+    center: [f64; 3],
+    reach: f64,
+    blend: Blend,
+    moving: bool,
+    name: &str,
+) -> PyResult<PyField> {
+    let sh = coefficients.shape();
+    if sh.iter().any(|&k| k < 6) {
+        return Err(value_error(format!(
+            "grid: expected at least 4 nodes per axis, got shape {sh:?}"
+        )));
+    }
+    let n = [sh[0] - 2, sh[1] - 2, sh[2] - 2];
+    let coef = slice_of("grid", &coefficients)?.to_vec();
+    let tool = grid::grid_tool(
+        origin.into(),
+        spacing,
+        n,
+        coef,
+        velocity.into(),
+        center.into(),
+        reach,
+        blend.0,
+        moving,
+    )?;
+    Ok(PyField::new(Field::single(tool), name))
+}
+
+/// `spinal.fields.along_path`: spine samples `(n, 3)` and their frames `(n, 3, 3)` (columns
+/// `r, s, t`).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_path(
+    points: PyReadonlyArray2<'_, f64>,
+    frames: PyReadonlyArray3<'_, f64>,
+    radius: f64,
+    duration: f64,
+    kind: path::PathKind,
+    tool: Carry,
+    rate: f64,
+    t0: f64,
+    reach: Option<f64>,
+    falloff_power: i64,
+    blend: Blend,
+) -> PyResult<PyField> {
+    let x = vec3s("points", &points)?;
+    let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
+    // row-major (n, 3, 3) -> glam's column-major: transpose
+    let fr: Vec<DMat3> = rows
+        .iter()
+        .map(|r| DMat3::from_cols_array(r).transpose())
+        .collect();
+    let args = path::PathArgs {
+        points: x,
+        frames: &fr,
+        radius,
+        duration,
+        kind,
+        carry: tool.0,
+        rate,
+        t0,
+        reach,
+        power: falloff_power,
+        linear: blend.0,
+    };
+    let name = format!(
+        "along_path({}, {})",
+        match kind {
+            path::PathKind::Translate => "translate",
+            path::PathKind::Rotate => "rotate",
+            path::PathKind::Twist => "twist",
+            path::PathKind::Bend => "bend",
+        },
+        if tool.0 { "carry" } else { "push" }
+    );
+    let p = path::PathTool::from_args(args)?;
+    Ok(PyField::new(Field::single(p), &name))
+}
+
+/// The zero field (an empty sum).
+#[pyfunction]
+pub fn field_zero() -> PyField {
+    PyField {
+        field: Field::default(),
+        names: Vec::new(),
+        recipe: Vec::new(),
+    }
+}
