@@ -265,6 +265,54 @@ pub fn advect_steps(
     });
 }
 
+/// `Ok` if `field` can be integrated by `m` (the splitting needs curl potentials).
+pub fn check_method(field: &Field, m: Method) -> crate::error::Result<()> {
+    if m == Method::Split && !field.has_potential() {
+        return Err(crate::error::InputError::new(
+            "method",
+            "'split' needs curl potentials; only fields.translation tools have one",
+        ));
+    }
+    Ok(())
+}
+
+/// [`advect_steps`] over `0..steps` in blocks, calling `tick(done, steps)` after each block;
+/// a block is sized to take about [`BLOCK_SECONDS`] (measured on the one before), so a caller
+/// that checks for interrupts in `tick` hears from it several times a second whatever the
+/// input size. Returns `false` when `tick` stopped it (the points are then partly advected).
+/// The bits equal one [`advect_steps`] call.
+pub fn advect_ticked(
+    field: &Field,
+    points: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: usize,
+    m: Method,
+    tick: &mut dyn FnMut(usize, usize) -> bool,
+) -> bool {
+    let mut done = 0;
+    let mut block = 1usize;
+    while done < steps {
+        let k = block.min(steps - done);
+        let clock = std::time::Instant::now();
+        advect_steps(field, points, t0, h, done..done + k, m);
+        done += k;
+        if !tick(done, steps) {
+            return false;
+        }
+        let dt = clock.elapsed().as_secs_f64();
+        block = if dt > 0.0 {
+            (k as f64 * BLOCK_SECONDS / dt).clamp(1.0, 1e9) as usize
+        } else {
+            k.saturating_mul(2)
+        };
+    }
+    true
+}
+
+/// Wall time aimed at per block of [`advect_ticked`], seconds.
+pub const BLOCK_SECONDS: f64 = 0.02;
+
 /// Evaluate the field at `points` into `out`.
 pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3]) {
     out.par_chunks_mut(CHUNK)
@@ -278,7 +326,7 @@ pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Swirl, SwirlKind};
+    use super::super::{Swirl, SwirlKind, Translation};
     use super::*;
     use crate::math::rotation::rodrigues;
 
@@ -299,6 +347,34 @@ mod tests {
             |n: usize| (integrate(&f, x0, 0.0, 1.0 / n as f64, n, Method::Rk4) - exact).length();
         let ratio = err(8) / err(16);
         assert!((14.0..18.0).contains(&ratio), "ratio {ratio}");
+    }
+
+    #[test]
+    fn ticked_advection_has_the_bits_of_one_call_and_stops_when_told() {
+        let f = Field::single(
+            Translation::new(DVec3::new(0.0, 0.0, 1.2), 0.5, DVec3::NEG_Z, None, 2, true).unwrap(),
+        );
+        let x0: Vec<DVec3> = (0..500)
+            .map(|i| DVec3::new((i as f64 * 0.1).sin(), (i as f64 * 0.37).cos(), 0.9))
+            .collect();
+        let mut once = x0.clone();
+        advect_in_place(&f, &mut once, 0.0, 0.01, 300, Method::Rk4);
+        let mut ticked = x0.clone();
+        let mut calls = Vec::new();
+        assert!(advect_ticked(&f, &mut ticked, 0.0, 0.01, 300, Method::Rk4, &mut |d, n| {
+            calls.push((d, n));
+            true
+        }));
+        assert_eq!(ticked, once);
+        assert_eq!(calls.last(), Some(&(300, 300)));
+        assert!(calls.windows(2).all(|w| w[0].0 < w[1].0));
+        let mut stopped = x0.clone();
+        let mut seen = 0;
+        assert!(!advect_ticked(&f, &mut stopped, 0.0, 0.01, 300, Method::Rk4, &mut |d, _| {
+            seen = d;
+            false
+        }));
+        assert_eq!(seen, 1); // the first block is one step
     }
 }
 

@@ -9,7 +9,8 @@ use super::convert::{Ticker, empty, slice_mut, triangles, value_error, vec3_arra
 use super::fields::PyField;
 use crate::deform::{self, advect::Method, refine};
 
-/// Advect points: `steps` steps of size `h` from `t0`; a new array.
+/// Advect points: `steps` steps of size `h` from `t0`; a new array. Ctrl-C stops it between
+/// blocks of steps (`KeyboardInterrupt`).
 #[pyfunction]
 pub fn advect<'py>(
     py: Python<'py>,
@@ -21,20 +22,22 @@ pub fn advect<'py>(
     method: Method,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let field = &field.field;
-    if method == Method::Split && !field.has_potential() {
-        return Err(value_error(
-            "method: 'split' needs curl potentials; only fields.translation tools have one",
-        ));
-    }
+    deform::advect::check_method(field, method)?;
     let x = vec3s("vertices", &points)?;
     deform::finite_rows("vertices", x)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+    let mut ticker = Ticker::new(None);
     {
         let mut w = out.readwrite();
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
-        py.detach(|| deform::advect::advect_in_place(field, o, t0, h, steps, method));
+        py.detach(|| {
+            deform::advect::advect_ticked(field, o, t0, h, steps, method, &mut |d, n| {
+                ticker.tick(d, n)
+            })
+        });
     }
+    ticker.finish()?;
     Ok(out)
 }
 
