@@ -200,6 +200,14 @@ def flesh_surface_deform(
     coords: npt.NDArray[np.float64],
     corrected: bool,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def strip_axis(
+    points: npt.NDArray[np.float64],
+    s: npt.NDArray[np.float64],
+    m0: tuple[float, float, float],
+    m1: tuple[float, float, float],
+    radius: float,
+    reach: float,
+) -> npt.NDArray[np.float64]: ...
 def stamp(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],

@@ -253,15 +253,17 @@ impl Element {
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Element::StripAlong(std::sync::Arc::new(
-            tube::StripAlong::new(
-                samples,
-                h[1],
-                positive(h[2], "radius")?,
-                positive(h[3], "reach")?,
-                h[4] != 0.0,
-            )?,
-        )))
+        // the axis checks name `points` (the samples of `spinal.fields.strip_curve`, checked
+        // there through `tube::strip_axis`); here they are about rows, which name `field`
+        let axis = tube::StripAlong::new(
+            samples,
+            h[1],
+            positive(h[2], "radius")?,
+            positive(h[3], "reach")?,
+            h[4] != 0.0,
+        )
+        .map_err(|e| InputError::new("field", e.msg))?;
+        Ok(Element::StripAlong(std::sync::Arc::new(axis)))
     }
 
     /// Parse a grid header row `h` (kind 11) and its coefficient rows (kind 12).

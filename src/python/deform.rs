@@ -2,7 +2,9 @@
 //! the algorithms are in [`crate::deform`].
 
 use glam::DVec3;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 
 use super::convert::{
@@ -146,6 +148,26 @@ pub fn deform_mesh<'py>(
             d.time_refine,
         ),
     ))
+}
+
+/// The slopes `dγ/dS` of the clamped C² spline through a strip axis, which is checked for a
+/// tube of `radius + reach` (see `deform::tube::strip_axis`; errors name `points`).
+#[pyfunction]
+pub fn strip_axis<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    s: PyReadonlyArray1<'py, f64>,
+    m0: [f64; 3],
+    m1: [f64; 3],
+    radius: f64,
+    reach: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let x = vec3s("points", &points)?;
+    let s = slice_of("points", &s)?;
+    let axis = py.detach(|| {
+        deform::tube::strip_axis(x, s, DVec3::from(m0), DVec3::from(m1), radius, reach)
+    })?;
+    vec3_array(py, axis.into_iter().map(|a| a.m).collect())
 }
 
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);

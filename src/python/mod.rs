@@ -42,6 +42,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
+    m.add_function(wrap_pyfunction!(deform::strip_axis, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_resample, m)?)?;
