@@ -420,22 +420,21 @@ def test_grid_and_mesh_tool_bad_input():
 def test_core_strip_and_grid_constructors_refuse_bad_input():
     """The compiled constructors check the axis and the grid themselves (called here without
     the Python wrappers), naming the argument, never panicking."""
-    from spinal.fields import _clamped_spline_slopes, _spline_prefilter
+    from spinal.fields import _spline_prefilter
 
     x = np.ascontiguousarray(ARC)
-    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
-    tan = spinal.estimate_tangents(x)
-    m = _clamped_spline_slopes(x, s, tan[0], tan[-1])
     ok = (RHO, SPEED, RF, "c1")
-    _core.field_strip_curve(x, m, s, *ok)
-    flat = s.copy()
-    flat[3] = flat[2]  # arc length not increasing
-    with pytest.raises(ValueError, match="increase"):
-        _core.field_strip_curve(x, m, flat, *ok)
-    with pytest.raises(ValueError, match="bends too sharply"):  # a sharper bend than allowed
-        _core.field_strip_curve(0.2 * x, m, 0.2 * s, *ok)
+    _core.field_strip_curve(x, *ok)
+    rep = x.copy()
+    rep[3] = rep[2]
+    with pytest.raises(ValueError, match="^points: consecutive samples 2 and 3 coincide"):
+        _core.field_strip_curve(rep, *ok)
+    with pytest.raises(ValueError, match="^points: the axis bends too sharply"):
+        _core.field_strip_curve(0.2 * x, *ok)
     with pytest.raises(ValueError, match="^radius"):
-        _core.field_strip_curve(x, m, s, -RHO, SPEED, RF, "c1")
+        _core.field_strip_curve(x, -RHO, SPEED, RF, "c1")
+    with pytest.raises(ValueError, match="^speed"):
+        _core.field_strip_curve(x, RHO, np.nan, RF, "c1")
     d, o = sphere_grid(0.05)
     coef = np.ascontiguousarray(_spline_prefilter(d))
     grid = (o, 0.05, U, C, 0.4, "c1", True, "sdf_tool")

@@ -202,8 +202,6 @@ def field_torus(
 ) -> Field: ...
 def field_strip_curve(
     points: npt.NDArray[np.float64],
-    slopes: npt.NDArray[np.float64],
-    arc: npt.NDArray[np.float64],
     radius: float,
     speed: float,
     reach: float | None,

@@ -29,6 +29,10 @@ from .fields import Field
 
 __all__ = ["DeformReport", "RefinementWarning", "StampReport", "deform", "stamp"]
 
+# bounds of the stamper's work: frames per call, secant corrections per frame
+MAX_FRAMES = 1_000_000
+MAX_ITERATIONS = 1000
+
 
 class RefinementWarning(UserWarning):
     """:func:`spinal.deform` stopped refining at its ``max_vertices`` (or ``max_passes``) bound
@@ -290,8 +294,13 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     start, end : (3,) tool centre at the first and last frame.
     radius : tool radius ρ > 0.
     reach : R > 0 of the protrusion field (default ``radius``).
-    frames : number of moves ≥ 1.
-    iterations : secant corrections per frame ≥ 0.
+    frames : number of moves, 1 … 1,000,000.
+    iterations : secant corrections per frame, 0 … 1000.
+
+    Ctrl-C stops it between frames (``KeyboardInterrupt``). A tool that swallows every vertex
+    of the mesh or touches every triangle in a frame raises ``ValueError`` naming ``radius``;
+    a dent with no free triangle within ``reach`` facing the tool's field (nothing to carry
+    the protrusion) raises ``ValueError`` naming ``reach``.
 
     Returns
     -------
@@ -302,11 +311,11 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     rho = _positive(radius, "radius")
     reach = rho if reach is None else _positive(reach, "reach")
     frames = as_int(frames, "frames")
-    if frames < 1:
-        raise ValueError(f"frames: must be at least 1, got {frames}")
+    if not 1 <= frames <= MAX_FRAMES:
+        raise ValueError(f"frames: must be at least 1 and at most {MAX_FRAMES:,}, got {frames}")
     iterations = as_int(iterations, "iterations")
-    if iterations < 0:
-        raise ValueError(f"iterations: must be ≥ 0, got {iterations}")
+    if not 0 <= iterations <= MAX_ITERATIONS:
+        raise ValueError(f"iterations: must be ≥ 0 and at most {MAX_ITERATIONS}, got {iterations}")
     W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations)
     rest, vol = _volume(V, F), _volume(W, F)
     change = vol / rest - 1 if rest != 0 else float("nan")

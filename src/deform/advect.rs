@@ -361,19 +361,35 @@ mod tests {
         advect_in_place(&f, &mut once, 0.0, 0.01, 300, Method::Rk4);
         let mut ticked = x0.clone();
         let mut calls = Vec::new();
-        assert!(advect_ticked(&f, &mut ticked, 0.0, 0.01, 300, Method::Rk4, &mut |d, n| {
-            calls.push((d, n));
-            true
-        }));
+        assert!(advect_ticked(
+            &f,
+            &mut ticked,
+            0.0,
+            0.01,
+            300,
+            Method::Rk4,
+            &mut |d, n| {
+                calls.push((d, n));
+                true
+            }
+        ));
         assert_eq!(ticked, once);
         assert_eq!(calls.last(), Some(&(300, 300)));
         assert!(calls.windows(2).all(|w| w[0].0 < w[1].0));
         let mut stopped = x0.clone();
         let mut seen = 0;
-        assert!(!advect_ticked(&f, &mut stopped, 0.0, 0.01, 300, Method::Rk4, &mut |d, _| {
-            seen = d;
-            false
-        }));
+        assert!(!advect_ticked(
+            &f,
+            &mut stopped,
+            0.0,
+            0.01,
+            300,
+            Method::Rk4,
+            &mut |d, _| {
+                seen = d;
+                false
+            }
+        ));
         assert_eq!(seen, 1); // the first block is one step
     }
 }

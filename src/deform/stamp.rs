@@ -21,6 +21,12 @@
 //! This is a volume *balance*, not a divergence-free flow: the snap is not a flow, and only
 //! the protruding vertices move; what is tested is the mesh volume change per frame (the
 //! residual after the secant steps) and that no vertex ends inside the tool.
+//!
+//! A frame that cannot give the dent back is refused rather than reported with a silent
+//! volume change: a tool containing every vertex (the snap would wrap the mesh around the
+//! tool; nothing is left outside to protrude), no triangle free of contact, or a dent with
+//! protrusion rate `Σ A_tri v_bary = 0` (no free triangle within `reach` of the tool facing
+//! the field).
 
 use glam::DVec3;
 
@@ -45,6 +51,8 @@ pub struct StampFrame {
 
 /// Press a sphere of `radius` from `start` to `end` into the mesh `(v, f)` in `frames` moves
 /// (see the module docs). `v` is modified in place; face indices must be valid.
+/// `tick(done, frames)` is called after every frame; when it returns `false` the stamper
+/// stops there and returns the frames done so far.
 #[allow(clippy::too_many_arguments)]
 pub fn stamp(
     v: &mut [DVec3],
@@ -55,6 +63,7 @@ pub fn stamp(
     reach: f64,
     frames: usize,
     iterations: usize,
+    tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Vec<StampFrame>> {
     let travel = end - start;
     let len = travel.length();
@@ -100,6 +109,15 @@ pub fn stamp(
                 nc += 1;
             }
         }
+        if nc > 0 && nc == v.len() {
+            return Err(InputError::new(
+                "radius",
+                format!(
+                    "the tool (radius {radius}) swallows the whole mesh at frame {k}: every \
+                     vertex is inside it, none is left to carry the dented volume"
+                ),
+            ));
+        }
         let snapped = volume(v, f);
         let dent = before - snapped;
         let field = Field::single(Translation {
@@ -112,10 +130,12 @@ pub fn stamp(
         });
         movable.fill(false);
         let mut rate = 0.0;
+        let mut free = 0;
         for t in f {
             if t.iter().any(|&i| contact[i]) {
                 continue;
             }
+            free += 1;
             let (a, b, cc) = (v[t[0]], v[t[1]], v[t[2]]);
             let an = 0.5 * (b - a).cross(cc - a); // area × unit normal
             let w = field.eval((a + b + cc) / 3.0, 0.0).dot(an);
@@ -126,13 +146,35 @@ pub fn stamp(
                 }
             }
         }
-        if !(dent > 0.0 && rate > 0.0) {
+        if nc > 0 && free == 0 {
+            return Err(InputError::new(
+                "radius",
+                format!(
+                    "the tool (radius {radius}) leaves no triangle free of contact at frame \
+                     {k}: nothing can protrude to give the dented volume back"
+                ),
+            ));
+        }
+        if dent > 0.0 && !(rate > 0.0) {
+            return Err(InputError::new(
+                "reach",
+                format!(
+                    "no triangle free of contact within reach ({reach}) of the tool faces \
+                     its field at frame {k}: nothing can protrude to give the dented volume \
+                     back (use a larger reach, or a finer mesh)"
+                ),
+            ));
+        }
+        if !(dent > 0.0) {
             out.push(StampFrame {
                 dent: dent.max(0.0),
                 time: 0.0,
                 residual: snapped - before,
                 contact: nc,
             });
+            if !tick(k, frames) {
+                break;
+            }
             continue;
         }
         let idx: Vec<usize> = (0..v.len()).filter(|&i| movable[i]).collect();
@@ -155,6 +197,99 @@ pub fn stamp(
             residual: after - before,
             contact: nc,
         });
+        if !tick(k, frames) {
+            break;
+        }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit octahedron, outward wound.
+    fn octahedron() -> (Vec<DVec3>, Vec<[usize; 3]>) {
+        let v = vec![
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+        ];
+        let f = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        (v, f)
+    }
+
+    fn go(z1: f64, radius: f64, reach: f64, frames: usize) -> Result<Vec<StampFrame>> {
+        let (mut v, f) = octahedron();
+        let start = DVec3::new(0.0, 0.0, 1.5);
+        let end = DVec3::new(0.0, 0.0, z1);
+        stamp(
+            &mut v,
+            &f,
+            start,
+            end,
+            radius,
+            reach,
+            frames,
+            2,
+            &mut |_, _| true,
+        )
+    }
+
+    #[test]
+    fn a_tool_swallowing_the_mesh_is_refused() {
+        let e = go(0.1, 10.0, 10.0, 1).unwrap_err();
+        assert_eq!(e.arg, "radius");
+        assert!(e.msg.contains("swallows the whole mesh at frame 1"), "{e}");
+    }
+
+    #[test]
+    fn a_tool_touching_every_triangle_is_refused() {
+        // at the origin with radius 0.9 the tool holds no vertex; at (0, 0, 0.3) with radius
+        // 0.9 it holds +Z and, at distance √(1 + 0.09) > 0.9, none of the equator: the top
+        // four triangles touch it, the bottom four are free. With radius 1.1 the equator is
+        // inside too (√1.09 < 1.1), −Z is not (1.3): every triangle touches the tool.
+        let e = go(0.3, 1.1, 1.0, 1).unwrap_err();
+        assert_eq!(e.arg, "radius");
+        assert!(
+            e.msg.contains("no triangle free of contact at frame 1"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_dent_with_nothing_in_reach_to_protrude_is_refused() {
+        // the tool dents +Z (moved in by 0.05); the free (bottom) triangles are beyond reach
+        let (mut v, f) = octahedron();
+        let (a, b) = (DVec3::new(0.0, 0.0, 1.5), DVec3::new(0.0, 0.0, 1.05));
+        let e = stamp(&mut v, &f, a, b, 0.1, 0.2, 1, 2, &mut |_, _| true).unwrap_err();
+        assert_eq!(e.arg, "reach");
+        assert!(e.msg.contains("at frame 1"), "{e}");
+    }
+
+    #[test]
+    fn the_tick_stops_between_frames() {
+        let (mut v, f) = octahedron();
+        let (a, b) = (DVec3::new(0.0, 0.0, 3.0), DVec3::new(0.0, 0.0, 2.0));
+        let mut seen = Vec::new();
+        let out = stamp(&mut v, &f, a, b, 0.3, 0.3, 10, 2, &mut |d, n| {
+            seen.push((d, n));
+            d < 3
+        })
+        .unwrap();
+        assert_eq!(out.len(), 3);
+        assert_eq!(seen, vec![(1, 10), (2, 10), (3, 10)]);
+    }
 }

@@ -1,10 +1,10 @@
-//! Strip of type I along a curved axis (Zheng's thesis §11.2.2, "sticking"; naming per
-//! erratum A-14): the material inside a tube of radius ρ about an axis curve `γ` flows along
+//! Strip of type I along a curved axis (Zheng's thesis §11.2.2, "sticking"): the material inside a tube of radius ρ about an axis curve `γ` flows along
 //! the axis, leaves at the head, returns outside the tube and re-enters at the tail.
 //!
 //! **Axis.** The C¹ piecewise cubic Hermite curve through the samples `x_k` with derivatives
-//! `m_k = dγ/dS` at the cumulative chord lengths `S_k` (the Python side passes the clamped C²
-//! cubic spline's derivatives, so `γ` is C²). Segment `k`, `λ ∈ [0, 1]`:
+//! `m_k = dγ/dS` at the cumulative chord lengths `S_k` (`spinal.fields.strip_curve` uses the
+//! clamped C² cubic spline's derivatives, [`clamped_spline_slopes`] in [`strip_curve`], so
+//! `γ` is C²). Segment `k`, `λ ∈ [0, 1]`:
 //! `γ(λ) = a + bλ + cλ² + dλ³` with `a = x_k`, `b = m_k ΔS_k`,
 //! `c = 3(x_{k+1} − x_k) − (2m_k + m_{k+1}) ΔS_k`, `d = 2(x_k − x_{k+1}) + (m_k + m_{k+1}) ΔS_k`.
 //!
@@ -34,8 +34,12 @@
 //! **Where it is valid.** The foot point must be unique within `r < ρ + R_f`: curvature times
 //! `ρ + R_f + segment arc length` below 1 (checked here on 16 points per segment; it also makes
 //! `(X − γ)·γ′` monotone on every segment within reach, so one bracketed root per segment)
-//! and no approach of distant parts of the axis closer than `2(ρ + R_f)` (checked by the
-//! Python constructor). The foot point is found by safeguarded Newton on
+//! and no approach of distant parts of the axis closer than `2(ρ + R_f)`: no two of the 16
+//! points per segment closer than that whose chord-length parameters differ by more than
+//! `π(ρ + R_f)` ([`self_approach`], a uniform grid of cells of size `2(ρ + R_f)`, the classic
+//! fixed-radius near-neighbour search; Bentley, Stanat and Williams, "The complexity of
+//! finding fixed-radius near neighbors", Inf. Proc. Letters 6 (1977)). Both name `points`, the
+//! samples the axis was built from. The foot point is found by safeguarded Newton on
 //! `F(λ) = (X − γ(λ))·γ′(λ)` in each segment whose Bézier hull is within reach and whose end
 //! values bracket a root; the nearest candidate wins.
 
@@ -94,12 +98,18 @@ impl StripAlong {
         reach: f64,
         linear: bool,
     ) -> Result<StripAlong> {
-        let bad = |m: String| InputError::new("field", m);
+        // every check is about the axis samples (`points` of `spinal.fields.strip_curve`);
+        // [`super::Element::parse_strip`] renames them `field` for rows
+        let bad = |m: String| InputError::new("points", m);
+        let axis = bad;
         if samples.len() < 2 {
-            return Err(bad("a strip axis needs at least 2 samples".into()));
+            return Err(axis("a strip axis needs at least 2 samples".into()));
         }
         if !speed.is_finite() {
-            return Err(bad(format!("strip speed must be finite, got {speed}")));
+            return Err(InputError::new(
+                "speed",
+                format!("strip speed must be finite, got {speed}"),
+            ));
         }
         for (i, p) in samples.iter().enumerate() {
             if !(p.m.length() > 0.0) {
@@ -108,6 +118,12 @@ impl StripAlong {
         }
         let outer = radius + reach;
         let mut segs = Vec::with_capacity(samples.len() - 1);
+        // the axis at `PER` parameters per segment (and the last sample), with their
+        // chord-length parameters, for the self-approach check
+        let mut dense = Vec::with_capacity(PER * (samples.len() - 1) + 1);
+        let mut param = Vec::with_capacity(dense.capacity());
+        // (segment, curvature × (radius + reach + arc), curvature) of the worst bend
+        let mut worst: (usize, f64, f64) = (0, 0.0, 0.0);
         for (k, w) in samples.windows(2).enumerate() {
             let ds = w[1].s - w[0].s;
             if !(ds > 0.0) {
@@ -132,25 +148,51 @@ impl StripAlong {
             let mut kmax: f64 = 0.0;
             let mut arc = 0.0;
             let mut prev = x0;
-            for i in 0..=16 {
-                let l = i as f64 / 16.0;
+            for i in 0..=PER {
+                let l = i as f64 / PER as f64;
                 let (g, g1, g2) = seg.at(l);
                 let s2 = g1.length_squared();
                 if !(s2 > 0.0) {
-                    return Err(bad(format!("strip axis has a cusp in segment {k}")));
+                    return Err(axis(format!("the axis has a cusp in segment {k}")));
                 }
                 kmax = kmax.max(g2.length() / s2);
                 arc += (g - prev).length();
                 prev = g;
+                if i < PER {
+                    dense.push(g);
+                    param.push(w[0].s + ds * l);
+                }
             }
-            if !(kmax * (outer + 1.01 * arc) < 1.0) {
-                return Err(bad(format!(
-                    "strip axis bends too sharply in segment {k}: curvature {kmax:.4} times \
-                     radius + reach + segment length ({:.4}) must stay below 1",
-                    outer + 1.01 * arc
-                )));
+            let w = kmax * (outer + 1.01 * arc);
+            // the worst segment (the first NaN, else the largest) is the one reported
+            if !worst.1.is_nan() && (w.is_nan() || w > worst.1) {
+                worst = (k, w, kmax);
             }
             segs.push(seg);
+        }
+        if !(worst.1 < 1.0) {
+            let (k, w, kmax) = worst;
+            return Err(axis(format!(
+                "the axis bends too sharply in segment {k}: curvature {} × (radius + reach + \
+                 segment length) = {} must stay below 1 (use a smaller radius or reach, or \
+                 sample the bend more finely)",
+                g4(kmax),
+                g4(w)
+            )));
+        }
+        let last = samples[samples.len() - 1];
+        dense.push(last.x);
+        param.push(last.s);
+        if let Some((i, j, d)) = self_approach(&dense, &param, outer) {
+            let seg = |i: usize| (i / PER).min(segs.len() - 1);
+            return Err(axis(format!(
+                "the axis comes within {} < 2·(radius + reach) = {} of itself (segments {} \
+                 and {}); the closest point would be ambiguous",
+                g4(d),
+                g4(2.0 * outer),
+                seg(i),
+                seg(j)
+            )));
         }
         let lo = segs
             .iter()
@@ -333,6 +375,218 @@ impl super::Tool for StripAlong {
     }
 }
 
+/// Derivatives `dγ/dS` at the knots of the clamped C² cubic spline through `x` at the
+/// increasing parameters `s`, with end derivatives `m0`, `m1` (de Boor, "A Practical Guide to
+/// Splines", Ch. IV: the tridiagonal system for the slopes, solved by the Thomas algorithm;
+/// strictly diagonally dominant, so no pivoting). Row `k` (`1 ≤ k ≤ n − 2`, `h_k = s_{k+1} − s_k`,
+/// `δ_k = (x_{k+1} − x_k)/h_k`):
+/// `h_k m_{k−1} + 2(h_{k−1} + h_k) m_k + h_{k−1} m_{k+1} = 3(h_k δ_{k−1} + h_{k−1} δ_k)`.
+/// `x` and `s` have the same length ≥ 2.
+pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Vec<DVec3> {
+    let n = x.len();
+    let mut m = vec![DVec3::ZERO; n];
+    m[0] = m0;
+    m[n - 1] = m1;
+    if n <= 2 {
+        return m;
+    }
+    let h: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
+    let delta = |k: usize| (x[k + 1] - x[k]) / h[k];
+    // interior row i is knot k = i + 1: lower h_{i+1}, diagonal 2(h_i + h_{i+1}), upper h_i
+    let k = n - 2;
+    let mut c = vec![0.0; k];
+    let mut d = vec![DVec3::ZERO; k];
+    let rhs = |i: usize| {
+        let mut r = 3.0 * (h[i + 1] * delta(i) + h[i] * delta(i + 1));
+        if i == 0 {
+            r -= h[1] * m0;
+        }
+        if i == k - 1 {
+            r -= h[k - 1] * m1;
+        }
+        r
+    };
+    let diag = |i: usize| 2.0 * (h[i] + h[i + 1]);
+    c[0] = h[0] / diag(0);
+    d[0] = rhs(0) / diag(0);
+    for i in 1..k {
+        let w = diag(i) - h[i + 1] * c[i - 1];
+        c[i] = h[i] / w;
+        d[i] = (rhs(i) - h[i + 1] * d[i - 1]) / w;
+    }
+    for i in (0..k - 1).rev() {
+        d[i] = d[i] - c[i] * d[i + 1];
+    }
+    m[1..n - 1].copy_from_slice(&d);
+    m
+}
+
+/// The strip of `spinal.fields.strip_curve` from its axis samples `points`: at least 2
+/// finite samples with no repeated consecutive point, parametrised by cumulative chord length
+/// `S`; the axis is the clamped C² cubic spline through them ([`clamped_spline_slopes`]) with
+/// the five-point unit tangents of `spinal.estimate_tangents` as end derivatives; then
+/// [`strip_along`]'s checks (errors name `points`, `radius`, `speed`, `reach`).
+pub fn strip_curve(
+    points: &[DVec3],
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    linear: bool,
+) -> Result<StripAlong> {
+    if points.len() < 2 {
+        return Err(InputError::new(
+            "points",
+            format!("need at least 2 samples, got {}", points.len()),
+        ));
+    }
+    super::finite_rows("points", points)?;
+    let mut s = Vec::with_capacity(points.len());
+    s.push(0.0);
+    for (i, w) in points.windows(2).enumerate() {
+        let chord = w[0].distance(w[1]);
+        if !(chord > 0.0) {
+            return Err(InputError::new(
+                "points",
+                format!("consecutive samples {i} and {} coincide", i + 1),
+            ));
+        }
+        s.push(s[i] + chord);
+    }
+    let tangents = crate::frames::tangents::estimate_rows(
+        points,
+        false,
+        crate::frames::TangentRule::FivePoint,
+    )?;
+    let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1]);
+    let samples = points
+        .iter()
+        .zip(&m)
+        .zip(&s)
+        .map(|((&x, &m), &s)| AxisSample { x, m, s })
+        .collect();
+    strip_along(samples, radius, speed, reach, linear)
+}
+
+/// Points per segment at which the axis is checked.
+const PER: usize = 16;
+
+/// `x` with 4 significant digits, like C's `%.4g`.
+fn g4(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    if !(1e-4..1e4).contains(&a) {
+        return format!("{x:.3e}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// The first pair `(i, j, |p_i − p_j|)` (smallest `i`, then smallest `j`) of points of the
+/// polyline `p` closer than `2·outer` whose parameters `t` (increasing) differ by more than
+/// `π·outer`; `None` if there is none.
+///
+/// Fixed-radius near neighbours on a uniform grid of cells of size `2·outer`: a point's
+/// partners lie in its own cell or the 26 around it. A cell keeps the runs of consecutive
+/// indices that pass through it. Along a run, the polyline length `L` bounds the chord,
+/// `|p_i − p_j′| ≥ |p_i − p_j| − (L_j′ − L_j)`, so after a point at distance `d ≥ 2·outer`
+/// the scan jumps (binary search on `L`) to the first point at least `d − 2·outer` further
+/// along: a finely sampled axis costs O(log) per run and point, not its sampling density.
+fn self_approach(p: &[DVec3], t: &[f64], outer: f64) -> Option<(usize, usize, f64)> {
+    use std::collections::HashMap;
+    let n = p.len();
+    if n < 2 {
+        return None;
+    }
+    let two = 2.0 * outer;
+    let near = std::f64::consts::PI * outer;
+    let mut len = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    len.push(acc);
+    for w in p.windows(2) {
+        acc += (w[1] - w[0]).length();
+        len.push(acc);
+    }
+    // rounding in `L` (a sum of up to n lengths) must never make the scan skip a point
+    let slack = 1e-9 * acc;
+    let lo = p.iter().fold(DVec3::INFINITY, |m, x| m.min(*x));
+    // `as` saturates: far-out points share the outermost cells, which is still correct
+    let key = |x: DVec3| {
+        let q = ((x - lo) / two).floor();
+        [q.x as i64, q.y as i64, q.z as i64]
+    };
+    // the maximal runs of consecutive indices in each cell (one hash per run, not per point)
+    let mut cells: HashMap<[i64; 3], Vec<(usize, usize)>> = HashMap::new();
+    let mut run = (key(p[0]), 0);
+    for (i, x) in p.iter().enumerate().skip(1) {
+        let k = key(*x);
+        if k != run.0 {
+            cells.entry(run.0).or_default().push((run.1, i));
+            run = (k, i);
+        }
+    }
+    cells.entry(run.0).or_default().push((run.1, n));
+    let mut around: Vec<(usize, usize)> = Vec::new();
+    let mut here = None;
+    let mut first = 0; // the first index with t > t_i + π·outer
+    for i in 0..n {
+        let k = key(p[i]);
+        if here != Some(k) {
+            here = Some(k);
+            around.clear();
+            let mut seen: Vec<[i64; 3]> = Vec::with_capacity(27);
+            for dx in -1..=1i64 {
+                for dy in -1..=1i64 {
+                    for dz in -1..=1i64 {
+                        let c = [
+                            k[0].saturating_add(dx),
+                            k[1].saturating_add(dy),
+                            k[2].saturating_add(dz),
+                        ];
+                        if seen.contains(&c) {
+                            continue;
+                        }
+                        seen.push(c);
+                        if let Some(runs) = cells.get(&c) {
+                            around.extend_from_slice(runs);
+                        }
+                    }
+                }
+            }
+        }
+        while first < n && !(t[first] > t[i] + near) {
+            first += 1;
+        }
+        let mut hit: Option<(usize, f64)> = None;
+        for &(a, b) in &around {
+            let mut j = a.max(first);
+            let end = hit.map_or(b, |(h, _)| b.min(h));
+            while j < end {
+                let d = (p[j] - p[i]).length();
+                if d < two {
+                    hit = Some((j, d));
+                    break;
+                }
+                let gap = d - two - slack;
+                j += 1;
+                if gap > 0.0 && j < end {
+                    j += len[j..end].partition_point(|&l| l - len[j - 1] <= gap);
+                }
+            }
+        }
+        if let Some((j, d)) = hit {
+            return Some((i, j, d));
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -366,6 +620,138 @@ mod tests {
 
     #[test]
     fn sharp_bends_are_refused() {
-        assert!(StripAlong::new(arc(9, 0.3, 1.5), 1.0, 0.2, 0.2, false).is_err());
+        let e = StripAlong::new(arc(9, 0.3, 1.5), 1.0, 0.2, 0.2, false).unwrap_err();
+        assert_eq!(e.arg, "points");
+        assert!(
+            e.msg.starts_with("the axis bends too sharply in segment "),
+            "{e}"
+        );
+        assert!(e.msg.contains("must stay below 1"), "{e}");
+    }
+
+    #[test]
+    fn an_axis_coming_back_near_itself_is_refused() {
+        // 5.5 of 2π rad of a unit circle: the ends are 2 sin(0.39) = 0.76 apart
+        let e = StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.2, 0.2, false).unwrap_err();
+        assert_eq!(e.arg, "points");
+        assert!(
+            e.msg.starts_with("the axis comes within 0.7") && e.msg.contains("(segments 0 and"),
+            "{e}"
+        );
+        // the same arc with a narrower tube is fine
+        assert!(StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.15, 0.15, false).is_ok());
+    }
+
+    /// A brute-force check of [`self_approach`] on a hairpin and on random walks.
+    #[test]
+    fn the_grid_search_finds_the_first_pair_of_the_brute_force_search() {
+        let brute = |p: &[DVec3], t: &[f64], outer: f64| {
+            for i in 0..p.len() {
+                for j in 0..p.len() {
+                    let d = (p[i] - p[j]).length();
+                    if d < 2.0 * outer && (t[i] - t[j]).abs() > std::f64::consts::PI * outer {
+                        return Some((i, j, d));
+                    }
+                }
+            }
+            None
+        };
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for case in 0..40 {
+            let n = 50 + 10 * case;
+            let mut p = vec![DVec3::ZERO];
+            for _ in 1..n {
+                let step = DVec3::new(rnd(), rnd(), rnd()) * 0.2 + DVec3::X * 0.05;
+                p.push(*p.last().unwrap() + step);
+            }
+            let t: Vec<f64> = (0..n).map(|i| 0.15 * i as f64).collect();
+            for outer in [0.01, 0.05, 0.1, 0.3] {
+                assert_eq!(self_approach(&p, &t, outer), brute(&p, &t, outer));
+            }
+        }
+        // a hairpin: two straight legs 0.5 apart, joined by a half circle
+        let mut p = Vec::new();
+        for i in 0..=200 {
+            p.push(DVec3::new(i as f64 * 0.01, 0.0, 0.0));
+        }
+        for i in 1..50 {
+            let a = std::f64::consts::PI * i as f64 / 50.0;
+            p.push(DVec3::new(2.0 + 0.25 * a.sin(), 0.25 - 0.25 * a.cos(), 0.0));
+        }
+        for i in 0..=200 {
+            p.push(DVec3::new(2.0 - i as f64 * 0.01, 0.5, 0.0));
+        }
+        let mut t = vec![0.0];
+        for w in p.windows(2) {
+            t.push(t.last().unwrap() + (w[1] - w[0]).length());
+        }
+        for outer in [0.2, 0.249, 0.251, 0.3] {
+            assert_eq!(self_approach(&p, &t, outer), brute(&p, &t, outer));
+        }
+        assert!(self_approach(&p, &t, 0.249).is_none());
+        assert!(self_approach(&p, &t, 0.251).is_some());
+    }
+
+    #[test]
+    fn the_clamped_spline_of_a_cubic_is_the_cubic() {
+        // γ(S) = (S, S² − S, S³/4) at uneven parameters, with its own end derivatives
+        let g = |t: f64| DVec3::new(t, t * t - t, 0.25 * t * t * t);
+        let dg = |t: f64| DVec3::new(1.0, 2.0 * t - 1.0, 0.75 * t * t);
+        let s = [0.0, 0.3, 0.5, 1.1, 1.2, 2.0, 2.7];
+        let x: Vec<DVec3> = s.iter().map(|&t| g(t)).collect();
+        let m = clamped_spline_slopes(&x, &s, dg(0.0), dg(2.7));
+        for (mk, &t) in m.iter().zip(&s) {
+            assert!((*mk - dg(t)).length() < 1e-13, "{mk} {}", dg(t));
+        }
+        let two = clamped_spline_slopes(&x[..2], &s[..2], DVec3::X, DVec3::Y);
+        assert_eq!(two, vec![DVec3::X, DVec3::Y]);
+        let three = clamped_spline_slopes(&x[..3], &s[..3], dg(0.0), dg(0.5));
+        assert!((three[1] - dg(0.3)).length() < 1e-13);
+    }
+
+    #[test]
+    fn strip_curve_names_its_arguments() {
+        let x: Vec<DVec3> = arc(40, 1.0, 5.5).iter().map(|a| a.x).collect();
+        let e = strip_curve(&x, 0.2, 1.0, Some(0.2), false).unwrap_err();
+        assert_eq!(e.arg, "points");
+        assert!(e.msg.contains("comes within"), "{e}");
+        let ok = strip_curve(&x, 0.1, 1.0, Some(0.1), false).unwrap();
+        assert_eq!(ok.samples.len(), 40);
+        assert_eq!(
+            strip_curve(&x[..1], 0.1, 1.0, None, false).unwrap_err().arg,
+            "points"
+        );
+        let mut rep = x.clone();
+        rep[3] = rep[2];
+        assert!(
+            strip_curve(&rep, 0.1, 1.0, None, false)
+                .unwrap_err()
+                .msg
+                .contains("coincide")
+        );
+        assert_eq!(
+            strip_curve(&x, -0.1, 1.0, None, false).unwrap_err().arg,
+            "radius"
+        );
+        assert_eq!(
+            strip_curve(&x, 0.1, f64::NAN, None, false).unwrap_err().arg,
+            "speed"
+        );
+    }
+
+    #[test]
+    fn g4_is_four_significant_digits() {
+        assert_eq!(g4(0.7614), "0.7614");
+        assert_eq!(g4(0.76142), "0.7614");
+        assert_eq!(g4(0.8), "0.8");
+        assert_eq!(g4(12.0), "12");
+        assert_eq!(g4(1234.56), "1235");
+        assert_eq!(g4(2.5e-7), "2.500e-7");
     }
 }

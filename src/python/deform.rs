@@ -112,7 +112,7 @@ pub fn deform_mesh<'py>(
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Contact stamper (see `deform::stamp`): a new vertex array and per-frame rows
-/// `(dent, time, residual, contact)`.
+/// `(dent, time, residual, contact)`. Ctrl-C stops it between frames.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn stamp<'py>(
@@ -133,6 +133,7 @@ pub fn stamp<'py>(
         .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
         .collect();
     let mut v = x.to_vec();
+    let mut ticker = Ticker::new(None);
     let rep = py.detach(|| {
         deform::stamp::stamp(
             &mut v,
@@ -143,8 +144,13 @@ pub fn stamp<'py>(
             reach,
             frames,
             iterations,
+            &mut |d, n| ticker.tick(d, n),
         )
     })?;
+    ticker.finish()?;
+    if rep.len() < frames {
+        return Err(value_error("stamp: stopped"));
+    }
     let n = rep.len();
     let rows: Vec<f64> = rep
         .iter()

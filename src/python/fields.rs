@@ -5,8 +5,7 @@
 
 use glam::{DMat3, DVec3};
 use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
-    PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -440,39 +439,18 @@ pub fn field_torus(
     Ok(PyField::new(Field::single(t), "torus"))
 }
 
-/// `spinal.fields.strip_curve` from its axis: samples `(n, 3)`, derivatives `dγ/dS` `(n, 3)`
-/// and cumulative chord lengths `(n,)`.
+/// `spinal.fields.strip_curve` from its axis samples `(n, 3)`.
 #[pyfunction]
 pub fn field_strip_curve(
+    py: Python<'_>,
     points: PyReadonlyArray2<'_, f64>,
-    slopes: PyReadonlyArray2<'_, f64>,
-    arc: PyReadonlyArray1<'_, f64>,
     radius: f64,
     speed: f64,
     reach: Option<f64>,
     blend: Blend,
 ) -> PyResult<PyField> {
-    let (x, m, s) = (
-        vec3s("points", &points)?,
-        vec3s("points", &slopes)?,
-        slice_of("points", &arc)?,
-    );
-    if m.len() != x.len() || s.len() != x.len() {
-        return Err(value_error(
-            "points: samples, slopes and arc lengths differ in length",
-        ));
-    }
-    let samples = x
-        .iter()
-        .zip(m)
-        .zip(s)
-        .map(|((x, m), s)| tube::AxisSample {
-            x: *x,
-            m: *m,
-            s: *s,
-        })
-        .collect();
-    let tool = tube::strip_along(samples, radius, speed, reach, blend.0)?;
+    let x = vec3s("points", &points)?;
+    let tool = py.detach(|| tube::strip_curve(x, radius, speed, reach, blend.0))?;
     Ok(PyField::new(Field::single(tool), "strip_curve"))
 }
 

@@ -1,0 +1,79 @@
+"""Work limits of spinal.fields.strip_curve: the axis checks (curvature, no distant parts
+within 2(radius + reach) of each other) run in the Rust core, the second on a uniform grid, so
+the cost grows about linearly with the number of samples (it was quadratic: a 2,000-sample
+straight axis took about a minute).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from spinal import fields
+
+# ---- strip_curve: the axis checks ------------------------------------------------------------
+
+
+def line(n, length=20.0):
+    return np.c_[np.linspace(0, length, n), np.zeros(n), np.zeros(n)]
+
+
+def test_a_2000_sample_axis_builds_and_flows_along_it():
+    f = fields.strip_curve(line(2000), 0.1, 1.0)
+    x = np.array([[5.0, 0.05, 0.0], [13.3, 0.0, -0.07], [19.0, 0.0, 0.0]])
+    np.testing.assert_allclose(f(x), [[1, 0, 0]] * 3, atol=1e-12)
+    assert np.abs(f([[5.0, 0.5, 0.0]])).max() == 0  # beyond radius + reach
+
+
+def best_time(fn, repeat=3):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def test_construction_scales_about_linearly():
+    """8× the samples cost about 8× (measured 5,000 → 40,000: 0.05 s → 0.3 s); the old
+    all-pairs check cost 64× (2,000 samples: about a minute). Best of 3 against load."""
+    n = 5000
+    small = best_time(lambda: fields.strip_curve(line(n), 0.1, 1.0))
+    big = best_time(lambda: fields.strip_curve(line(8 * n), 0.1, 1.0))
+    assert big / small < 24, (small, big)
+
+
+def test_a_finely_sampled_axis_coming_back_is_still_refused():
+    th = np.linspace(0, 5.5, 4000)
+    axis = np.c_[np.cos(th), np.sin(th), np.zeros_like(th)]
+    t = time.perf_counter()
+    with pytest.raises(ValueError, match=r"^points: the axis comes within 0\.\d+ < "
+                       r"2·\(radius \+ reach\) = 0\.8 of itself \(segments 0 and \d+\); the "
+                       r"closest point would be ambiguous$"):
+        fields.strip_curve(axis, 0.2, 1.0)
+    assert time.perf_counter() - t < 30  # once about 3 minutes
+    fields.strip_curve(axis, 0.15, 1.0)  # a narrower tube: the ends are 0.76 > 0.6 apart
+
+
+def test_a_helix_is_refused_only_when_its_turns_are_within_twice_the_reach():
+    """Three turns of pitch 0.5 in 3,000 samples: the turns are 0.5 apart along the axis."""
+    u = np.linspace(0, 6 * np.pi, 3000)
+    axis = np.c_[np.cos(u), np.sin(u), 0.5 * u / (2 * np.pi)]
+    fields.strip_curve(axis, 0.12, 1.0)  # 2 · 0.24 < 0.5
+    with pytest.raises(ValueError, match=r"^points: the axis comes within 0\.\d+ < 2·\(radius "
+                       r"\+ reach\) = 0\.52 of itself \(segments 0 and \d+\)"):
+        fields.strip_curve(axis, 0.13, 1.0)
+
+
+def test_the_curvature_check_names_points_and_the_worst_segment():
+    th = np.r_[np.linspace(0, 1, 10), 1 + np.linspace(0, 1, 6)[1:] ** 2 * 0.8]
+    axis = np.c_[np.cos(th), np.sin(th), np.zeros_like(th)] * np.r_[np.ones(10), 1 - 0.6 * (
+        np.linspace(0, 1, 6)[1:])][:, None]
+    with pytest.raises(ValueError, match=r"^points: the axis bends too sharply in segment "
+                       r"(\d+): curvature [\d.]+ × \(radius \+ reach \+ segment length\) = "
+                       r"[\d.]+ must stay below 1") as e:
+        fields.strip_curve(axis, 0.2, 1.0)
+    k = int(str(e.value).split("segment ")[1].split(":")[0])
+    assert k >= 9  # the sharp end, not the gentle arc
