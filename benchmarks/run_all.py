@@ -30,6 +30,7 @@ QUICK = {
     "bench_frames.py": ["--max", "1e5", "--repeat", "3"],
     "bench_sweep.py": ["--max", "1e4", "--no-bundle"],
     "bench_advect.py": ["--max", "1e5", "--repeat", "1"],
+    "bench_deform.py": ["--quick"],
 }
 
 
@@ -174,8 +175,17 @@ def flesh_rows(text):
     return rows
 
 
+def deform_rows(text):
+    """The drag rows of bench_deform.py (no peer: the time of spinal.deform, refinement
+    included)."""
+    table = md_tables(text)[0]
+    return [(f"drag, {r['input vertices']} → {r['output vertices']} vertices", "ms",
+             1e3 * num(r["time s"]), []) for r in table if r["case"] == "drag"]
+
+
 SUMMARY = {"bench_frames.py": ("frames", frames_rows), "bench_sweep.py": ("tubes", sweep_rows),
-           "bench_advect.py": ("advect", advect_rows), "bench_flesh.py": ("flesh", flesh_rows)}
+           "bench_advect.py": ("advect", advect_rows), "bench_flesh.py": ("flesh", flesh_rows),
+           "bench_deform.py": ("deform", deform_rows)}
 
 
 def fmt(x: float) -> str:

@@ -30,7 +30,7 @@ def test_run_all_quick_writes_a_report(tmp_path):
     assert r.returncode == 0, r.stderr[-3000:]
     text = report.read_text()
     for name in ("bench_frames.py", "bench_sweep.py", "bench_advect.py", "bench_flesh.py",
-                 "accuracy_frames.py"):
+                 "bench_deform.py", "accuracy_frames.py"):
         assert f"benchmarks/{name}" in text
     assert "| 1,000 points |" in text  # the sweep table
     assert "double_reflection" in text
@@ -43,10 +43,11 @@ def test_run_all_quick_writes_a_report(tmp_path):
     by = {}
     for row in summary:
         by.setdefault(row["benchmark"], []).append(row)
-    assert set(by) == {"frames", "tubes", "advect", "flesh"}
+    assert set(by) == {"frames", "tubes", "advect", "flesh", "deform"}
     assert len(by["frames"]) == 2 * 3  # 10^3..10^5 points, tangents estimated and given
     assert [row["case"] for row in by["tubes"]] == ["1,000 points", "10,000 points"]
     assert len(by["advect"]) == 3 and len(by["flesh"]) == 2
+    assert [row["case"].split(" →")[0] for row in by["deform"]] == ["drag, 642", "drag, 2,562"]
     for row in summary:
         assert float(row["spinal"].replace(",", "")) > 0
     peers = " ".join(row["peers: time (peer / spinal)"] for row in summary)
@@ -68,6 +69,12 @@ def test_run_all_quick_writes_a_report(tmp_path):
         ratio = float(re.search(r"NumPy RK4 [\d,.]+ \(([\d,.e+-]+)×\)",
                                 srow["peers: time (peer / spinal)"]).group(1).replace(",", ""))
         assert abs(ratio / (t_np / ns) - 1) < 0.05  # two significant digits
+    # bench_deform.py: every drag row, converged or not, with a volume and a verdict
+    (deform,) = run_all.md_tables(section(text, "`python benchmarks/bench_deform.py"))
+    drags = [r for r in deform if r["case"] == "drag"]
+    for srow, trow in zip(by["deform"], drags, strict=True):
+        assert srow["spinal"] == run_all.fmt(1e3 * float(trow["time s"]))
+        assert abs(float(trow["volume change"])) < 0.05 and trow["targets"]
 
 
 def test_summary_reads_tables_with_pipes_in_headers():
