@@ -264,7 +264,8 @@ impl Field {
             return Err(InputError::new(
                 "steps",
                 format!(
-                    "the default step rule needs {n:.3e} steps (|duration| {:e} · 8 · max_speed                      {v:e} / length_scale {l:e}), more than {MAX_STEPS}; pass steps= explicitly",
+                    "the default step rule needs {n:.3e} steps (|duration| {:e} · 8 · max_speed \
+                     {v:e} / length_scale {l:e}), more than {MAX_STEPS}; pass steps= explicitly",
                     duration.abs()
                 ),
             ));
