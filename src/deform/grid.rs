@@ -314,6 +314,9 @@ pub fn grid_tool(
 }
 
 impl super::Tool for GridTool {
+    fn wants_locality(&self) -> bool {
+        true
+    }
     #[inline]
     fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
         self.eval(x, t)

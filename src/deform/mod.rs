@@ -63,6 +63,13 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
         DVec3::ZERO
     }
 
+    /// Whether an evaluation reads a large table at a place that depends on the point (a
+    /// distance grid, a spline's segments): then path lines are integrated in a spatial order
+    /// so that neighbouring lanes share cache lines ([`advect::advect_ticked`]).
+    fn wants_locality(&self) -> bool {
+        false
+    }
+
     /// `out[j] += v(p[j], t)` for a batch of points.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {

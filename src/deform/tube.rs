@@ -363,6 +363,9 @@ pub fn strip_along(
 }
 
 impl super::Tool for StripAlong {
+    fn wants_locality(&self) -> bool {
+        true
+    }
     #[inline]
     fn velocity(&self, x: DVec3, _t: f64, _tm: f64) -> DVec3 {
         self.eval(x)
