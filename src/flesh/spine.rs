@@ -232,10 +232,30 @@ impl SpineModel {
     }
 }
 
-/// Compass walk (spec A-9): points on the polyline `posed`, from its first point, whose
-/// consecutive distances are `chords` (so every edge keeps its rest length); past the end of
-/// the polyline, along its last edge. `posed` has ≥ 2 distinct consecutive points.
-pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
+/// Compass walk (Zhuo's thesis, the discrete stretch of the posed spine): points on the
+/// polyline `posed`, from its first point, whose consecutive distances are `chords` (so every
+/// edge keeps its rest length); past the end of the polyline, along its last edge. `posed`
+/// needs ≥ 2 distinct consecutive points and the chords must be positive (errors name
+/// `posed_spine` and `rest_spine`, whose chords they are).
+pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec<DVec3>> {
+    use crate::error::InputError;
+    if posed.len() < 2 {
+        return Err(InputError::new(
+            "posed_spine",
+            format!("need at least 2 points, got {}", posed.len()),
+        ));
+    }
+    if let Some(i) = chords.iter().position(|h| !(h.is_finite() && *h > 0.0)) {
+        return Err(InputError::new(
+            "rest_spine",
+            format!("chord {i} is not positive and finite"),
+        ));
+    }
+    Ok(walk_chords(posed, chords))
+}
+
+/// The walk of [`compass_walk`] on checked input.
+fn walk_chords(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
     let mut out = Vec::with_capacity(chords.len() + 1);
     let mut c = posed[0];
     out.push(c);

@@ -7,7 +7,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, slice_mut, slice_of, value_error, vec3_array, vec3s};
+use super::convert::{empty, slice_mut, slice_of, vec3_array, vec3s};
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
@@ -79,12 +79,7 @@ pub fn flesh_resample<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let pts = vec3s("posed_spine", &posed_points)?;
     let ch = slice_of("chords", &chords)?;
-    if pts.len() < 2 || ch.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
-        return Err(value_error(
-            "posed_spine: need at least 2 points and positive chords",
-        ));
-    }
-    let out = py.detach(|| flesh::spine::compass_walk(pts, ch));
+    let out = py.detach(|| flesh::spine::compass_walk(pts, ch))?;
     vec3_array(py, out)
 }
 
