@@ -209,7 +209,58 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
 
 /// [`compute_into`] without the fused fast path: one pass per stage, and the only place
 /// that reports input errors.
+///
+/// The stages, in the order their errors are reported: the shapes and values of the input
+/// (`check_input`), the distinct samples of a closed curve (`distinct_samples`), the chord
+/// lengths, the unit tangents (`unit_tangents`), the segments against the tangents
+/// (`check_segments`); then the frames, Frenet (`frenet_frames`) or transported with the
+/// boundary condition (`transport_frames`).
 pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
+    let rows = check_input(req, out)?;
+    let n = distinct_samples(req, rows)?;
+    let closed = req.closed;
+    let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);
+    let chords = if x.is_empty() {
+        Vec::new()
+    } else {
+        validate::chords(x, closed)?
+    };
+    let t = unit_tangents(req, x, &chords, n)?;
+    let dr = DoubleReflection {
+        x,
+        t: &t,
+        closed,
+        tangent_chords: req.tangent_chords,
+    };
+    check_segments(req, &dr)?;
+    let seg = segment_lengths(req, x, n, chords);
+    let curvature = curvature_source(req, x, n);
+    if req.method == Method::Frenet {
+        return frenet_frames(req, &dr, &seg, &curvature, out);
+    }
+    let ctx = Ctx {
+        req,
+        t: &t,
+        seg: &seg,
+        curvature: &curvature,
+        closed,
+    };
+    transport_frames(&ctx, &dr, out)
+}
+
+/// The shapes and values of the input, and the options that fit together; returns the
+/// number of rows.
+fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
+    let rows = check_shapes(req, out)?;
+    if let Some(a) = req.analytic {
+        check_analytic(&a, rows)?;
+    }
+    check_options(req)?;
+    Ok(rows)
+}
+
+/// Row counts of the sample arrays and the output buffer, and finite samples.
+fn check_shapes(req: &Request, out: &[f64]) -> Result<usize> {
     let rows = match (req.points, req.tangents) {
         (Some(p), _) => p.len(),
         (None, Some(t)) => t.len(),
@@ -242,26 +293,35 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
     if let Some(t) = req.tangents {
         validate::finite("tangents", t)?;
     }
-    if let Some(a) = req.analytic {
-        if a.u.len() != rows || a.d1.len() != 2 * rows - 1 || a.d2.len() != 2 * rows - 1 {
-            return Err(InputError::new(
-                "u",
-                "analytic samples have inconsistent lengths",
-            ));
-        }
-        validate::finite_scalars("u", a.u)?;
-        validate::finite("points", a.d1)?;
-        validate::finite("points", a.d2)?;
-        if let Some(i) = a.u.windows(2).position(|w| !(w[1] > w[0])) {
-            return Err(InputError::new(
-                "u",
-                format!(
-                    "parameter values must increase strictly (index {i} to {})",
-                    i + 1
-                ),
-            ));
-        }
+    Ok(rows)
+}
+
+/// The analytic samples: `rows` parameter values increasing strictly, `2·rows − 1` finite
+/// derivatives of each order.
+fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
+    if a.u.len() != rows || a.d1.len() != 2 * rows - 1 || a.d2.len() != 2 * rows - 1 {
+        return Err(InputError::new(
+            "u",
+            "analytic samples have inconsistent lengths",
+        ));
     }
+    validate::finite_scalars("u", a.u)?;
+    validate::finite("points", a.d1)?;
+    validate::finite("points", a.d2)?;
+    if let Some(i) = a.u.windows(2).position(|w| !(w[1] > w[0])) {
+        return Err(InputError::new(
+            "u",
+            format!(
+                "parameter values must increase strictly (index {i} to {})",
+                i + 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The method, the tangents-only chords, the input they need and the end condition.
+fn check_options(req: &Request) -> Result<()> {
     if req.method == Method::Rk4 && req.analytic.is_none() {
         return Err(InputError::new(
             "method",
@@ -287,40 +347,41 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
             "cannot be combined with closed=True (a closed curve's end is its start)",
         ));
     }
+    Ok(())
+}
 
-    // Closed curves: drop a repeated first sample at the end.
-    let mut n = rows;
-    if req.closed {
-        let repeat = match (req.points, req.tangents) {
-            (Some(p), _) => validate::coincide(p[rows - 1], p[0]),
-            (None, Some(t)) => validate::coincide(t[rows - 1], t[0]),
-            _ => false,
-        };
-        if repeat {
-            n = rows - 1;
-        } else if req.analytic.is_some() {
-            return Err(InputError::new(
-                "u",
-                "closed=True on an analytic curve needs u to span whole periods \
-                 (x(u_last) = x(u_first))",
-            ));
-        }
-        if n < 3 {
-            return Err(InputError::new(
-                "points",
-                format!("a closed curve needs at least 3 distinct points, got {n}"),
-            ));
-        }
+/// The number of distinct samples: a closed curve drops a repeated first sample at the end.
+fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
+    if !req.closed {
+        return Ok(rows);
     }
-    let closed = req.closed;
-    let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);
-    let chords = if x.is_empty() {
-        Vec::new()
-    } else {
-        validate::chords(x, closed)?
+    let repeat = match (req.points, req.tangents) {
+        (Some(p), _) => validate::coincide(p[rows - 1], p[0]),
+        (None, Some(t)) => validate::coincide(t[rows - 1], t[0]),
+        _ => false,
     };
+    let mut n = rows;
+    if repeat {
+        n = rows - 1;
+    } else if req.analytic.is_some() {
+        return Err(InputError::new(
+            "u",
+            "closed=True on an analytic curve needs u to span whole periods \
+             (x(u_last) = x(u_first))",
+        ));
+    }
+    if n < 3 {
+        return Err(InputError::new(
+            "points",
+            format!("a closed curve needs at least 3 distinct points, got {n}"),
+        ));
+    }
+    Ok(n)
+}
 
-    // Unit tangents.
+/// Unit tangents of the `n` distinct samples: the analytic derivative, the given tangents or
+/// the estimate from the points `x` (with their `chords`).
+fn unit_tangents(req: &Request, x: &[DVec3], chords: &[f64], n: usize) -> Result<Vec<DVec3>> {
     let t: Vec<DVec3> = if let Some(a) = req.analytic {
         if let Some(j) = a.d1.par_iter().position_first(|d| !(d.length() > 0.0)) {
             return Err(InputError::new(
@@ -351,7 +412,7 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         })?;
         t
     } else {
-        tangents::estimate(x, &chords, closed, req.tangent_rule)?
+        tangents::estimate(x, chords, req.closed, req.tangent_rule)?
     };
     if req.tangent_chords && n < 4 {
         return Err(InputError::new(
@@ -359,20 +420,21 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
             format!("tangents-only double reflection needs at least 4 samples, got {n}"),
         ));
     }
+    Ok(t)
+}
 
-    let dr = DoubleReflection {
-        x,
-        t: &t,
-        closed,
-        tangent_chords: req.tangent_chords,
-    };
+/// Every segment must run along its tangents; the projection method also needs each chord
+/// to cross the next normal plane.
+fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()> {
+    let (t, closed) = (dr.t, dr.closed);
+    let n = t.len();
     if req.method != Method::Rk4 {
         let what = if req.tangent_chords {
             "tangents"
         } else {
             "points"
         };
-        validate::aligned(&t, closed, |i| dr.chord(i), what)?;
+        validate::aligned(t, closed, |i| dr.chord(i), what)?;
     }
     if req.method == Method::Projection {
         let m = if closed { n } else { n - 1 };
@@ -389,10 +451,14 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
             ));
         }
     }
+    Ok(())
+}
 
-    // Segment lengths for the twist distribution.
-    let m = if closed { n } else { n - 1 };
-    let seg: Vec<f64> = if let Some(a) = req.analytic {
+/// Segment lengths for the twist distribution: Simpson's rule on the analytic speed, the
+/// chords of the points, or 1 per segment for tangents alone.
+fn segment_lengths(req: &Request, x: &[DVec3], n: usize, chords: Vec<f64>) -> Vec<f64> {
+    let m = if req.closed { n } else { n - 1 };
+    if let Some(a) = req.analytic {
         (0..m)
             .into_par_iter()
             .map(|i| {
@@ -407,9 +473,12 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         chords
     } else {
         vec![1.0; m]
-    };
+    }
+}
 
-    let curvature = if let Some(a) = req.analytic {
+/// Where the principal normal comes from (see [`Curvature`]).
+fn curvature_source<'a>(req: &Request<'a>, x: &'a [DVec3], n: usize) -> Curvature<'a> {
+    if let Some(a) = req.analytic {
         Curvature::Analytic(
             a.d1,
             a.d2,
@@ -420,50 +489,56 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         Curvature::Points(x, 64.0 * f64::EPSILON * scale, diag)
     } else {
         Curvature::Tangents
-    };
+    }
+}
 
-    if req.method == Method::Frenet {
-        if req.initial.is_some() || req.end.is_some() || req.turns != 0 {
-            return Err(InputError::new(
-                if req.initial.is_some() {
-                    "initial"
-                } else {
-                    "end"
-                },
-                "is not used by method='frenet': the Frenet frame is fixed by the curve",
-            ));
-        }
-        let normals: Vec<Option<DVec3>> = (0..n)
-            .into_par_iter()
-            .map(|i| curvature.normal(&t, i, closed))
-            .collect();
-        if normals.iter().any(Option::is_some) {
-            frenet::frenet_into(&dr, &normals, &seg, closed, out);
-            return Ok(0.0);
-        }
-        transport_into(
-            &dr,
-            &t,
-            &seg,
-            closed,
-            any_perpendicular(t[0]),
-            Twist::None,
-            out,
-        );
+/// The Frenet frames (no boundary condition applies); a curve straight everywhere gets the
+/// transported frame instead.
+fn frenet_frames(
+    req: &Request,
+    dr: &DoubleReflection,
+    seg: &[f64],
+    curvature: &Curvature,
+    out: &mut [f64],
+) -> Result<f64> {
+    if req.initial.is_some() || req.end.is_some() || req.turns != 0 {
+        return Err(InputError::new(
+            if req.initial.is_some() {
+                "initial"
+            } else {
+                "end"
+            },
+            "is not used by method='frenet': the Frenet frame is fixed by the curve",
+        ));
+    }
+    let (t, closed) = (dr.t, dr.closed);
+    let normals: Vec<Option<DVec3>> = (0..t.len())
+        .into_par_iter()
+        .map(|i| curvature.normal(t, i, closed))
+        .collect();
+    if normals.iter().any(Option::is_some) {
+        frenet::frenet_into(dr, &normals, seg, closed, out);
         return Ok(0.0);
     }
-
-    let ctx = Ctx {
-        req,
-        t: &t,
-        seg: &seg,
-        curvature: &curvature,
+    transport_into(
+        dr,
+        t,
+        seg,
         closed,
-    };
+        any_perpendicular(t[0]),
+        Twist::None,
+        out,
+    );
+    Ok(0.0)
+}
+
+/// The frames of a transport method, with the boundary condition of the request.
+fn transport_frames(ctx: &Ctx, dr: &DoubleReflection, out: &mut [f64]) -> Result<f64> {
+    let (req, t) = (ctx.req, ctx.t);
     match req.method {
-        Method::DoubleReflection => ctx.run(&dr, out),
-        Method::Rotation => ctx.run(&rotation::Rotation { t: &t }, out),
-        Method::Projection => ctx.run(&projection::Projection { x, t: &t }, out),
+        Method::DoubleReflection => ctx.run(dr, out),
+        Method::Rotation => ctx.run(&rotation::Rotation { t }, out),
+        Method::Projection => ctx.run(&projection::Projection { x: dr.x, t }, out),
         Method::Rk4 => {
             let a = req
                 .analytic
@@ -477,12 +552,12 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
                 &rk4::Rk4 {
                     u: a.u,
                     omega: &omega,
-                    t: &t,
+                    t,
                 },
                 out,
             )
         }
-        Method::Frenet => unreachable!("handled above"),
+        Method::Frenet => unreachable!("frenet_frames handles it"),
     }
 }
 
