@@ -292,68 +292,59 @@ fn sweep_one(
     rowbase: usize,
     out: MeshMut,
 ) -> Vec<usize> {
-    let m = p.len();
-    let r_n = plan.rings;
-    let cols = plan.cols;
-    let x = &s.points[..r_n];
-    let arc = &plan.arc;
-    let closed = opts.closed;
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
-    let grain = (4096 / cols).max(1);
+    let grain = (4096 / plan.cols).max(1);
     // Winding: normals to the right of the profile's direction, outward for closed profiles.
     let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
-    let tangent = |k: usize| columns(&s.frames[k]).2;
-    // Ring k of the smooth swept surface: centre and the images of the profile axes.
-    let base = |k: usize| -> (DVec3, DVec3, DVec3) {
-        let (r, q, _) = columns(&s.frames[k]);
-        let sc = s.scale[k];
-        let (sn, cs) = if s.twist.is_empty() {
-            (0.0, 1.0)
-        } else {
-            s.twist[k].sin_cos()
-        };
-        (x[k], sc.x * (cs * r + sn * q), sc.y * (cs * q - sn * r))
+    let rings = Rings {
+        s,
+        x: &s.points[..plan.rings],
+        plan,
+        p,
+        column: profile_columns(p, plan.cols),
+        closed: opts.closed,
+        miter_limit: opts.miter_limit,
+        sign,
+        rowbase,
     };
-    let mitre_at = |k: usize| mitre(x, tangent(k), k, closed, opts.miter_limit);
+    let folds = rings.write(out.vertices, out.normals, out.uv, grain);
+    let edges = if p.closed { p.len() } else { p.len() - 1 };
+    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
+    write_side_faces(side, plan, edges, vbase, sign, grain);
+    if plan.caps {
+        write_caps(caps, plan, p, vbase);
+    }
+    folds
+}
 
-    // One pass over the stored rings: positions (mitred), normals of the smooth surface
-    // (un-mitred: the mitre is a discretisation correction and would tilt them), uv, and the
-    // fold-over test of the segment starting there. Stored ring `i` is spine sample
-    // `i mod rings`, stored column `j` is profile vertex `j mod m` (the duplicates of split
-    // seams carry u = L and v = 1). Nothing is read back from the outputs but the ring just
-    // written; rings go in blocks so that each ring's geometry is computed once.
-    #[derive(Clone, Copy)]
-    struct Geo {
-        k: usize,
-        /// Centre and profile axes of the smooth surface.
-        b: (DVec3, DVec3, DVec3),
-        /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
-        /// `x + a_j·ma + b_j·mb`.
-        ma: DVec3,
-        mb: DVec3,
-        t: DVec3,
-    }
-    let geo = |k: usize| {
-        let b = base(k);
-        let (mf, mk) = mitre_at(k);
-        Geo {
-            k,
-            b,
-            ma: b.1 + (mf * b.1.dot(mk)) * mk,
-            mb: b.2 + (mf * b.2.dot(mk)) * mk,
-            t: tangent(k),
-        }
-    };
-    // Per stored column: the profile vertex, the difference of its neighbours (the derivative
-    // around the profile, central; one-sided at the ends of an open profile) and v.
-    struct Column {
-        p: DVec2,
-        /// `(dp.x, dp.y, dp.x p.x, dp.x p.y, dp.y p.x, dp.y p.y)`: the weights of the ring's
-        /// six cross products in the normal (see below).
-        w: [f64; 6],
-        v: f64,
-    }
-    let column: Vec<Column> = (0..cols)
+/// One ring of the smooth swept surface.
+#[derive(Clone, Copy)]
+struct Geo {
+    /// Spine sample.
+    k: usize,
+    /// Centre and profile axes of the smooth surface.
+    b: (DVec3, DVec3, DVec3),
+    /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
+    /// `x + a_j·ma + b_j·mb`.
+    ma: DVec3,
+    mb: DVec3,
+    t: DVec3,
+}
+
+/// Per stored column: the profile vertex, the difference of its neighbours (the derivative
+/// around the profile, central; one-sided at the ends of an open profile) and v.
+struct Column {
+    p: DVec2,
+    /// `(dp.x, dp.y, dp.x p.x, dp.x p.y, dp.y p.x, dp.y p.y)`: the weights of the ring's
+    /// six cross products in the normal (see [`Rings::write_ring`]).
+    w: [f64; 6],
+    v: f64,
+}
+
+/// The stored columns of a profile (`cols`: one more than the profile for split seams).
+fn profile_columns(p: &Profile, cols: usize) -> Vec<Column> {
+    let m = p.len();
+    (0..cols)
         .map(|j| {
             let jj = if j == m { 0 } else { j };
             let (jp, jn) = if p.closed {
@@ -375,96 +366,202 @@ fn sweep_one(
                 v: if j == m { 1.0 } else { p.v[j] },
             }
         })
-        .collect();
-    let block = grain * cols;
-    let folds: Vec<usize> = out
-        .vertices
-        .par_chunks_mut(block)
-        .zip(out.normals.par_chunks_mut(block))
-        .zip(out.uv.par_chunks_mut(block))
-        .enumerate()
-        .flat_map_iter(|(bi, ((bv, bn), bu))| {
-            let i0 = bi * grain;
-            let mut folds = Vec::new();
-            let mut prev = geo((i0 + r_n - 1) % r_n);
-            let mut cur = geo(i0 % r_n);
-            let rings = bv
-                .chunks_mut(cols)
-                .zip(bn.chunks_mut(cols))
-                .zip(bu.chunks_mut(cols));
-            for (di, ((rv, rn), ruv)) in rings.enumerate() {
-                let i = i0 + di;
-                let k = cur.k;
-                let next = geo((i + 1) % r_n);
-                let b = cur.b;
-                // d/ds of the ring: the same weights on centres and axes.
-                let (idx, w) = spine_weights(arc, k, r_n, closed);
-                let (mut dx, mut da, mut db) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-                for (&ii, &wi) in idx.iter().zip(&w) {
-                    let bi = match ii {
-                        _ if ii == k => b,
-                        _ if ii == next.k => next.b,
-                        _ if ii == prev.k => prev.b,
-                        _ => base(ii),
-                    };
-                    dx += wi * bi.0;
-                    da += wi * bi.1;
-                    db += wi * bi.2;
-                }
-                // The normal S_v × S_u with S_v ∝ e = dp.x b₁ + dp.y b₂ (around the profile)
-                // and S_u = dx + p.x da + p.y db (along the spine) is bilinear in the column's
-                // (dp, p): six cross products per ring, six weights per column.
-                let cr = [
-                    sign * b.1.cross(dx),
-                    sign * b.2.cross(dx),
-                    sign * b.1.cross(da),
-                    sign * b.1.cross(db),
-                    sign * b.2.cross(da),
-                    sign * b.2.cross(db),
-                ];
-                for (c, ((v, nv), w)) in
-                    column.iter().zip(rv.iter_mut().zip(rn.iter_mut()).zip(ruv))
-                {
-                    let cw = &c.w;
-                    let nn = cw[0] * cr[0]
-                        + cw[1] * cr[1]
-                        + cw[2] * cr[2]
-                        + cw[3] * cr[3]
-                        + cw[4] * cr[4]
-                        + cw[5] * cr[5];
-                    *nv = nn.try_normalize().unwrap_or_else(|| {
-                        // degenerate spine derivative: the normal of the ring plane
-                        let e = cw[0] * b.1 + cw[1] * b.2;
-                        (sign * e.cross(cur.t)).try_normalize().unwrap_or(cur.t)
-                    });
-                    *v = b.0 + c.p.x * cur.ma + c.p.y * cur.mb;
-                    *w = DVec2::new(arc[i], c.v);
-                }
-                // Fold-over: rail edges must advance along both tangents. The rail edge of
-                // profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb), so its
-                // components along t and t′ are affine in p.
-                if i < plan.segments {
-                    let (dx0, dma, dmb) = (next.b.0 - b.0, next.ma - cur.ma, next.mb - cur.mb);
-                    let along = |t: DVec3| (dx0.dot(t), DVec2::new(dma.dot(t), dmb.dot(t)));
-                    let ((c1, g1), (c2, g2)) = (along(cur.t), along(next.t));
-                    let folded = p
-                        .points
-                        .iter()
-                        .any(|&pj| !(c1 + pj.dot(g1) > 0.0 && c2 + pj.dot(g2) > 0.0));
-                    if folded {
-                        folds.push(rowbase + i);
-                    }
-                }
-                prev = cur;
-                cur = next;
-            }
-            folds
-        })
-        .collect();
+        .collect()
+}
 
-    // Side faces. Without split seams the last column/ring wraps to the first.
-    let edges = if p.closed { m } else { m - 1 };
-    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
+/// The vertices, normals and uv of one spine's rings, and its fold-over test.
+///
+/// One pass over the stored rings: positions (mitred), normals of the smooth surface
+/// (un-mitred: the mitre is a discretisation correction and would tilt them), uv, and the
+/// fold-over test of the segment starting there. Stored ring `i` is spine sample
+/// `i mod rings`, stored column `j` is profile vertex `j mod m` (the duplicates of split
+/// seams carry u = L and v = 1). Nothing is read back from the outputs but the ring just
+/// written; rings go in blocks so that each ring's geometry is computed once.
+struct Rings<'a> {
+    s: &'a Spine<'a>,
+    /// The distinct spine samples.
+    x: &'a [DVec3],
+    plan: &'a Plan,
+    p: &'a Profile,
+    column: Vec<Column>,
+    closed: bool,
+    miter_limit: f64,
+    /// −1 where the faces are wound the other way (clockwise closed profiles).
+    sign: f64,
+    /// Global row of spine sample 0 (for the fold reports).
+    rowbase: usize,
+}
+
+impl Rings<'_> {
+    #[inline]
+    fn tangent(&self, k: usize) -> DVec3 {
+        columns(&self.s.frames[k]).2
+    }
+
+    /// Ring `k` of the smooth swept surface: centre and the images of the profile axes.
+    #[inline]
+    fn base(&self, k: usize) -> (DVec3, DVec3, DVec3) {
+        let s = self.s;
+        let (r, q, _) = columns(&s.frames[k]);
+        let sc = s.scale[k];
+        let (sn, cs) = if s.twist.is_empty() {
+            (0.0, 1.0)
+        } else {
+            s.twist[k].sin_cos()
+        };
+        (
+            self.x[k],
+            sc.x * (cs * r + sn * q),
+            sc.y * (cs * q - sn * r),
+        )
+    }
+
+    #[inline]
+    fn geo(&self, k: usize) -> Geo {
+        let b = self.base(k);
+        let (mf, mk) = mitre(self.x, self.tangent(k), k, self.closed, self.miter_limit);
+        Geo {
+            k,
+            b,
+            ma: b.1 + (mf * b.1.dot(mk)) * mk,
+            mb: b.2 + (mf * b.2.dot(mk)) * mk,
+            t: self.tangent(k),
+        }
+    }
+
+    /// All stored rings, `grain` rings per parallel task; returns the fold-over rows.
+    fn write(
+        &self,
+        vertices: &mut [DVec3],
+        normals: &mut [DVec3],
+        uv: &mut [DVec2],
+        grain: usize,
+    ) -> Vec<usize> {
+        let (r_n, cols) = (self.plan.rings, self.plan.cols);
+        let block = grain * cols;
+        vertices
+            .par_chunks_mut(block)
+            .zip(normals.par_chunks_mut(block))
+            .zip(uv.par_chunks_mut(block))
+            .enumerate()
+            .flat_map_iter(|(bi, ((bv, bn), bu))| {
+                let i0 = bi * grain;
+                let mut folds = Vec::new();
+                let mut prev = self.geo((i0 + r_n - 1) % r_n);
+                let mut cur = self.geo(i0 % r_n);
+                let rings = bv
+                    .chunks_mut(cols)
+                    .zip(bn.chunks_mut(cols))
+                    .zip(bu.chunks_mut(cols));
+                for (di, ((rv, rn), ruv)) in rings.enumerate() {
+                    let i = i0 + di;
+                    let next = self.geo((i + 1) % r_n);
+                    self.write_ring(i, [&prev, &cur, &next], rv, rn, ruv);
+                    if i < self.plan.segments && self.folds_over(&cur, &next) {
+                        folds.push(self.rowbase + i);
+                    }
+                    prev = cur;
+                    cur = next;
+                }
+                folds
+            })
+            .collect()
+    }
+
+    /// d/ds of ring `cur` (three-point rule in arc length): the same weights on centres and
+    /// axes; the neighbouring rings are at hand.
+    #[inline]
+    fn spine_derivative(&self, [prev, cur, next]: [&Geo; 3]) -> (DVec3, DVec3, DVec3) {
+        let k = cur.k;
+        let (idx, w) = spine_weights(&self.plan.arc, k, self.plan.rings, self.closed);
+        let (mut dx, mut da, mut db) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+        for (&ii, &wi) in idx.iter().zip(&w) {
+            let bi = match ii {
+                _ if ii == k => cur.b,
+                _ if ii == next.k => next.b,
+                _ if ii == prev.k => prev.b,
+                _ => self.base(ii),
+            };
+            dx += wi * bi.0;
+            da += wi * bi.1;
+            db += wi * bi.2;
+        }
+        (dx, da, db)
+    }
+
+    /// Stored ring `i` (the geometry of `cur` between its neighbours): vertices, normals, uv.
+    #[inline]
+    fn write_ring(
+        &self,
+        i: usize,
+        geo: [&Geo; 3],
+        rv: &mut [DVec3],
+        rn: &mut [DVec3],
+        ruv: &mut [DVec2],
+    ) {
+        let cur = geo[1];
+        let (b, sign) = (cur.b, self.sign);
+        let (dx, da, db) = self.spine_derivative(geo);
+        // The normal S_v × S_u with S_v ∝ e = dp.x b₁ + dp.y b₂ (around the profile)
+        // and S_u = dx + p.x da + p.y db (along the spine) is bilinear in the column's
+        // (dp, p): six cross products per ring, six weights per column.
+        let cr = [
+            sign * b.1.cross(dx),
+            sign * b.2.cross(dx),
+            sign * b.1.cross(da),
+            sign * b.1.cross(db),
+            sign * b.2.cross(da),
+            sign * b.2.cross(db),
+        ];
+        let u = self.plan.arc[i];
+        for (c, ((v, nv), w)) in self
+            .column
+            .iter()
+            .zip(rv.iter_mut().zip(rn.iter_mut()).zip(ruv))
+        {
+            let cw = &c.w;
+            let nn = cw[0] * cr[0]
+                + cw[1] * cr[1]
+                + cw[2] * cr[2]
+                + cw[3] * cr[3]
+                + cw[4] * cr[4]
+                + cw[5] * cr[5];
+            *nv = nn.try_normalize().unwrap_or_else(|| {
+                // degenerate spine derivative: the normal of the ring plane
+                let e = cw[0] * b.1 + cw[1] * b.2;
+                (sign * e.cross(cur.t)).try_normalize().unwrap_or(cur.t)
+            });
+            *v = b.0 + c.p.x * cur.ma + c.p.y * cur.mb;
+            *w = DVec2::new(u, c.v);
+        }
+    }
+
+    /// Fold-over of the segment from `cur` to `next`: rail edges must advance along both
+    /// tangents. The rail edge of profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb),
+    /// so its components along t and t′ are affine in p.
+    #[inline]
+    fn folds_over(&self, cur: &Geo, next: &Geo) -> bool {
+        let (dx0, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
+        let along = |t: DVec3| (dx0.dot(t), DVec2::new(dma.dot(t), dmb.dot(t)));
+        let ((c1, g1), (c2, g2)) = (along(cur.t), along(next.t));
+        self.p
+            .points
+            .iter()
+            .any(|&pj| !(c1 + pj.dot(g1) > 0.0 && c2 + pj.dot(g2) > 0.0))
+    }
+}
+
+/// Side faces: two triangles per quad between ring `i` and `i + 1`, `edges` quads per ring
+/// (vertex ids from `vbase`). Without split seams the last column/ring wraps to the first.
+fn write_side_faces(
+    side: &mut [[i64; 3]],
+    plan: &Plan,
+    edges: usize,
+    vbase: usize,
+    sign: f64,
+    grain: usize,
+) {
+    let cols = plan.cols;
     let col = |j: usize| if j == cols { 0 } else { j };
     let row = |i: usize| if i == plan.stored_rings { 0 } else { i };
     side.par_chunks_mut(2 * edges)
@@ -483,18 +580,19 @@ fn sweep_one(
                 }
             }
         });
-    if plan.caps {
-        let tris = p.triangulate();
-        let last = (vbase + (r_n - 1) * cols) as i64;
-        let first = vbase as i64;
-        let k = tris.len();
-        for (c, tr) in tris.iter().enumerate() {
-            let [a, b, d] = tr.map(|v| v as i64);
-            caps[c] = [first + a, first + d, first + b]; // faces −t
-            caps[k + c] = [last + a, last + b, last + d]; // faces +t
-        }
+}
+
+/// Caps: the profile's triangulation on the first ring (facing −t) and the last (+t).
+fn write_caps(caps: &mut [[i64; 3]], plan: &Plan, p: &Profile, vbase: usize) {
+    let tris = p.triangulate();
+    let last = (vbase + (plan.rings - 1) * plan.cols) as i64;
+    let first = vbase as i64;
+    let k = tris.len();
+    for (c, tr) in tris.iter().enumerate() {
+        let [a, b, d] = tr.map(|v| v as i64);
+        caps[c] = [first + a, first + d, first + b]; // faces −t
+        caps[k + c] = [last + a, last + b, last + d]; // faces +t
     }
-    folds
 }
 
 fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
