@@ -341,13 +341,15 @@ unsafe fn chunk_avx2(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
 
 /// The work of [`chunk`].
 ///
-/// Per block of samples the points are copied into coordinate arrays; one loop computes the
-/// chords, one the interior tangents, one the curve-only vectors of every step (of double
-/// reflection, or the axis and cosine of the rotation method), each four samples at a time
-/// and free of dependencies between samples; only the transport loop carries `r` from
-/// sample to sample. Every value comes from the operations of the scalar
-/// functions that the general path calls, in the same order, so the frames are the same bit
-/// for bit.
+/// Per block of samples the points are copied into coordinate arrays ([`load_points`]); one
+/// loop computes the chords ([`block_chords`]), one the interior tangents
+/// ([`estimated_tangents`]), one the curve-only vectors of every step ([`step_vectors`]: of
+/// double reflection, or the axis and cosine of the rotation method), each four samples at a
+/// time and free of dependencies between samples; only the transport loop
+/// ([`transport_rotation`], [`transport_reflection`]) carries `r` from sample to sample.
+/// Every value comes from the operations of the scalar functions that the general path
+/// calls, in the same order, so the frames are the same bit for bit. The steps are
+/// `#[inline(always)]`, so that the AVX2 build compiles them for AVX2 too.
 #[inline(always)]
 fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
     let Job {
@@ -364,186 +366,33 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
     let mut w = Scratch::new(&mut store, BLOCK.min(b - a));
     let mut rows = buf.chunks_exact_mut(9);
     let (mut s0, mut r, mut len) = (DVec3::ZERO, DVec3::ZERO, 0.0);
-    let (min2, guard2) = (
-        F4::splat(MIN_ALIGNMENT * MIN_ALIGNMENT),
-        F4::splat(OVERSHOOT_COS * OVERSHOOT_COS),
-    );
-    let (zero, two) = (F4::splat(0.0), F4::splat(2.0));
     let mut s = a;
     while s < b {
-        let e = (s + BLOCK).min(b);
-        // tangents t_s … t_{te−1} (one past the block for its last step); points of their
-        // stencils x_lo … x_{pe−1}, chords j ∈ [lo, hi)
-        let te = if e < b { e + 1 } else { e };
-        let lo = s.saturating_sub(2);
-        let pe = (te + 2).min(n);
-        let hi = pe - 1;
-        for (k, xk) in x[lo..pe].iter().enumerate() {
-            w.p[0][k] = xk.x;
-            w.p[1][k] = xk.y;
-            w.p[2][k] = xk.z;
-        }
-        // chords: `length()` is `dot(self).sqrt()`; keep the square for the checks and steps
-        {
-            let p = refs(&w.p);
-            let mut c = muts(&mut w.c);
-            for k in (0..hi - lo).step_by(L) {
-                let ck = V4::load(&p, k + 1) - V4::load(&p, k);
-                let qk = ck.dot(ck);
-                ck.store(&mut c, k);
-                qk.store(w.q, k);
-                qk.sqrt().store(w.h, k);
-            }
-        }
-        // repeated points: |b − a|_∞ ≥ h/√3, so a chord longer than `apart` cannot coincide
-        // (the exact test of `validate::coincide` runs only on the rare short ones).
-        // Non-finite samples need no test of their own: ±inf anywhere already failed the
-        // bounding-box scale; a NaN at sample i enters its own tangent's stencil (every term
-        // is a difference with x_i), or, with given tangents, the chords next to it, so the
-        // tangent or the alignment check of those steps refuses the block below.
-        let (j0, j1) = (s - lo, e.min(n - 1) - lo);
-        if w.h[j0..j1]
-            .iter()
-            .fold(false, |acc, &hj| acc | (hj <= apart))
-            && (s..e.min(n - 1)).any(|j| w.h[j - lo] <= apart && coincide(x[j], x[j + 1]))
-        {
+        let blk = Block::new(s, b, n);
+        load_points(&mut w, x, &blk);
+        block_chords(&mut w, &blk);
+        if repeated_point(&w, x, &blk, apart) {
             return None;
         }
-
-        if let Some(tg) = given {
-            given_tangents(tg, s, te, &mut w.t)?;
-        } else {
-            // interior tangents (i ≥ 2, i + 2 < n): `five_point_unit_open`, four at a time
-            let (i0, i1) = (s.max(2), te.min(n.saturating_sub(2)).max(s.max(2)));
-            let mut bad = 0u32;
-            {
-                let (p, c) = (refs(&w.p), refs(&w.c));
-                let (q, h) = (&w.q[..], &w.h[..]);
-                let mut t = muts(&mut w.t);
-                for g in (i0..i1).step_by(L) {
-                    let k = g - lo;
-                    let wt = centred_weights(
-                        F4::load(h, k - 2),
-                        F4::load(h, k - 1),
-                        F4::load(h, k),
-                        F4::load(h, k + 1),
-                    );
-                    let pc = V4::load(&p, k);
-                    let v = (V4::load(&p, k - 2) - pc).scale(wt[0])
-                        + (V4::load(&p, k - 1) - pc).scale(wt[1])
-                        + (V4::load(&p, k + 1) - pc).scale(wt[2])
-                        + (V4::load(&p, k + 2) - pc).scale(wt[3]);
-                    let l = v.dot(v).sqrt();
-                    let u = v.scale(F4::splat(1.0) / l);
-                    // the circle estimate (`circle_raw`): |c_i|² c_{i−1} + |c_{i−1}|² c_i
-                    let cw = V4::load(&c, k - 1).scale(F4::load(q, k))
-                        + V4::load(&c, k).scale(F4::load(q, k - 1));
-                    let d = u.dot(cw);
-                    let good = l.mask(zero, |p, q| p > q)
-                        & u.finite_mask()
-                        & d.mask(zero, |p, q| p >= q)
-                        & (d * d).mask(guard2 * cw.dot(cw), |p, q| p >= q);
-                    bad |= !good & live(g, i1);
-                    u.store(&mut t, g - s);
-                }
-            }
-            if bad != 0 {
-                // a cusp, a non-finite value or an overshoot: the scalar function decides
-                let h = |j: usize| w.h[j - lo];
-                for i in i0..i1 {
-                    let t = five_point_unit_open(x, i, h)?;
-                    set(&mut w.t, i - s, t);
-                }
-            }
-            // the samples next to the ends: one-sided stencils
-            for i in (s..te).filter(|&i| i < i0 || i >= i1) {
-                let h = |j: usize| {
-                    if j >= lo && j < hi {
-                        w.h[j - lo]
-                    } else {
-                        (x[j + 1] - x[j]).length()
-                    }
-                };
-                let t = five_point_unit_open(x, i, h)?;
-                set(&mut w.t, i - s, t);
-            }
+        match given {
+            Some(tg) => given_tangents(tg, s, blk.te, &mut w.t)?,
+            None => estimated_tangents(&mut w, x, &blk)?,
         }
-
-        // the curve-only part of every step i → i + 1 inside the chunk, and its check
-        // (`aligned_with`, `dr_step_with`)
-        let steps = e.min(b - 1).saturating_sub(s);
-        let mut misaligned = 0u32;
-        {
-            let (c, t) = (refs(&w.c), refs(&w.t));
-            let q = &w.q[..];
-            let (mut av, mut v2v, mut bv) = (muts(&mut w.a), muts(&mut w.v2), muts(&mut w.b));
-            for m in (0..steps).step_by(L) {
-                let k = m + s - lo;
-                let (v1, vv) = (V4::load(&c, k), F4::load(q, k));
-                let (ti, tj) = (V4::load(&t, m), V4::load(&t, m + 1));
-                let d = v1.dot(ti + tj);
-                let ok = d.mask(zero, |p, q| p > q) & (d * d).mask(min2 * vv, |p, q| p > q);
-                misaligned |= !ok & live(m, steps);
-                if rotation {
-                    let c = ti.dot(tj);
-                    ti.cross(tj).store(&mut av, m);
-                    c.store(w.cos, m);
-                    (F4::splat(1.0) + c).store(w.den, m);
-                    continue;
-                }
-                let k1 = two / vv;
-                let tl = ti - v1.scale(k1 * v1.dot(ti));
-                let v2 = tj - tl;
-                let k2 = two / v2.dot(v2);
-                (v1 - v2.scale(k2 * v2.dot(v1))).scale(k1).store(&mut av, m);
-                v2.store(&mut v2v, m);
-                v2.scale(k2).store(&mut bv, m);
-            }
-        }
-        if misaligned != 0 {
+        // the steps i → i + 1 inside the chunk
+        let steps = blk.e.min(b - 1).saturating_sub(s);
+        if !step_vectors(&mut w, &blk, steps, rotation) {
             return None;
         }
-
-        // the transport itself: the only loop that carries a value from sample to sample,
-        // kept to the arithmetic of the step (`dr_step_with`, `rotation_step`)
-        let cnt = e - s;
         if s == a {
             r = start.unwrap_or_else(|| any_perpendicular(get(&refs(&w.t), 0)));
             s0 = r;
         }
-        if rotation {
-            let (ax, ay, az) = (&w.a[0][..steps], &w.a[1][..steps], &w.a[2][..steps]);
-            let (cos, den) = (&w.cos[..steps], &w.den[..steps]);
-            let [rx, ry, rz] = &mut w.r;
-            let (rx, ry, rz) = (&mut rx[..steps], &mut ry[..steps], &mut rz[..steps]);
-            for m in 0..steps {
-                (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
-                let a = DVec3::new(ax[m], ay[m], az[m]);
-                r = minimal_rotate_with(a, cos[m], den[m], r);
-            }
+        r = if rotation {
+            transport_rotation(&mut w, steps, r)
         } else {
-            let k0 = s - lo;
-            let (cx, cy, cz) = (
-                &w.c[0][k0..k0 + steps],
-                &w.c[1][k0..k0 + steps],
-                &w.c[2][k0..k0 + steps],
-            );
-            let (ax, ay, az) = (&w.a[0][..steps], &w.a[1][..steps], &w.a[2][..steps]);
-            let (vx, vy, vz) = (&w.v2[0][..steps], &w.v2[1][..steps], &w.v2[2][..steps]);
-            let (bx, by, bz) = (&w.b[0][..steps], &w.b[1][..steps], &w.b[2][..steps]);
-            let [rx, ry, rz] = &mut w.r;
-            let (rx, ry, rz) = (&mut rx[..steps], &mut ry[..steps], &mut rz[..steps]);
-            for m in 0..steps {
-                (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
-                let v1 = DVec3::new(cx[m], cy[m], cz[m]);
-                let (a, v2, b) = (
-                    DVec3::new(ax[m], ay[m], az[m]),
-                    DVec3::new(vx[m], vy[m], vz[m]),
-                    DVec3::new(bx[m], by[m], bz[m]),
-                );
-                r = r - v1.dot(r) * a - v2.dot(r) * b;
-            }
-        }
+            transport_reflection(&mut w, s - blk.lo, steps, r)
+        };
+        let cnt = blk.e - s;
         if steps < cnt {
             // the chunk's last row (no step leaves it inside the chunk)
             set(&mut w.r, steps, r);
@@ -552,12 +401,237 @@ fn chunk_body(job: Job, buf: &mut [f64]) -> Option<ChunkEnds> {
         for (m, f) in (0..cnt).zip(rows.by_ref()) {
             write_frame(f, get(&refs(&w.r), m), get(&refs(&w.t), m));
         }
-        len = w.h[s - lo..e.min(n - 1) - lo]
+        len = w.h[s - blk.lo..blk.e.min(n - 1) - blk.lo]
             .iter()
             .fold(len, |acc, &h| acc + h);
-        s = e;
+        s = blk.e;
     }
     Some((s0, r, len))
+}
+
+/// A block of a chunk: samples `s … e − 1`, their tangents `s … te − 1` (one past the block
+/// for its last step), the points of those tangents' stencils `lo … pe − 1` (the scratch
+/// arrays start at `lo`) and the chords `j ∈ [lo, hi)`.
+#[derive(Clone, Copy)]
+struct Block {
+    s: usize,
+    e: usize,
+    te: usize,
+    lo: usize,
+    pe: usize,
+    hi: usize,
+}
+
+impl Block {
+    /// The block starting at sample `s` of a chunk ending before `b`, on a curve of `n`.
+    #[inline(always)]
+    fn new(s: usize, b: usize, n: usize) -> Self {
+        let e = (s + BLOCK).min(b);
+        let te = if e < b { e + 1 } else { e };
+        let pe = (te + 2).min(n);
+        Block {
+            s,
+            e,
+            te,
+            lo: s.saturating_sub(2),
+            pe,
+            hi: pe - 1,
+        }
+    }
+}
+
+/// The block's points into the coordinate arrays.
+#[inline(always)]
+fn load_points(w: &mut Scratch, x: &[DVec3], blk: &Block) {
+    for (k, xk) in x[blk.lo..blk.pe].iter().enumerate() {
+        w.p[0][k] = xk.x;
+        w.p[1][k] = xk.y;
+        w.p[2][k] = xk.z;
+    }
+}
+
+/// Chords, their squares and lengths: `length()` is `dot(self).sqrt()`; the square is kept
+/// for the checks and steps.
+#[inline(always)]
+fn block_chords(w: &mut Scratch, blk: &Block) {
+    let p = refs(&w.p);
+    let mut c = muts(&mut w.c);
+    for k in (0..blk.hi - blk.lo).step_by(L) {
+        let ck = V4::load(&p, k + 1) - V4::load(&p, k);
+        let qk = ck.dot(ck);
+        ck.store(&mut c, k);
+        qk.store(w.q, k);
+        qk.sqrt().store(w.h, k);
+    }
+}
+
+/// Does the block hold a repeated point (`validate::coincide`)?
+///
+/// `|b − a|_∞ ≥ h/√3`, so a chord longer than `apart` cannot coincide (the exact test runs
+/// only on the rare short ones). Non-finite samples need no test of their own: ±inf anywhere
+/// already failed the bounding-box scale; a NaN at sample i enters its own tangent's stencil
+/// (every term is a difference with x_i), or, with given tangents, the chords next to it, so
+/// the tangent or the alignment check of those steps refuses the block.
+#[inline(always)]
+fn repeated_point(w: &Scratch, x: &[DVec3], blk: &Block, apart: f64) -> bool {
+    let (s, lo, n) = (blk.s, blk.lo, x.len());
+    let (j0, j1) = (s - lo, blk.e.min(n - 1) - lo);
+    w.h[j0..j1]
+        .iter()
+        .fold(false, |acc, &hj| acc | (hj <= apart))
+        && (s..blk.e.min(n - 1)).any(|j| w.h[j - lo] <= apart && coincide(x[j], x[j + 1]))
+}
+
+/// The five-point tangents of the block (`five_point_unit_open`): the interior ones
+/// (`i ≥ 2`, `i + 2 < n`) four at a time, the scalar function where a group fails its checks
+/// and at the samples next to the ends; `None` where one cannot be estimated.
+#[inline(always)]
+fn estimated_tangents(w: &mut Scratch, x: &[DVec3], blk: &Block) -> Option<()> {
+    let (s, te, lo, hi, n) = (blk.s, blk.te, blk.lo, blk.hi, x.len());
+    let (i0, i1) = (s.max(2), te.min(n.saturating_sub(2)).max(s.max(2)));
+    if interior_tangents(w, blk, i0, i1) != 0 {
+        // a cusp, a non-finite value or an overshoot: the scalar function decides
+        let h = |j: usize| w.h[j - lo];
+        for i in i0..i1 {
+            let t = five_point_unit_open(x, i, h)?;
+            set(&mut w.t, i - s, t);
+        }
+    }
+    // the samples next to the ends: one-sided stencils
+    for i in (s..te).filter(|&i| i < i0 || i >= i1) {
+        let h = |j: usize| {
+            if j >= lo && j < hi {
+                w.h[j - lo]
+            } else {
+                (x[j + 1] - x[j]).length()
+            }
+        };
+        let t = five_point_unit_open(x, i, h)?;
+        set(&mut w.t, i - s, t);
+    }
+    Some(())
+}
+
+/// The centred five-point tangents `i0 … i1 − 1`, four at a time, with the checks of
+/// `five_point_unit_open` (a positive finite length, no overshoot against the circle
+/// estimate); returns the mask of the lanes that failed them.
+#[inline(always)]
+fn interior_tangents(w: &mut Scratch, blk: &Block, i0: usize, i1: usize) -> u32 {
+    let (s, lo) = (blk.s, blk.lo);
+    let guard2 = F4::splat(OVERSHOOT_COS * OVERSHOOT_COS);
+    let zero = F4::splat(0.0);
+    let mut bad = 0u32;
+    let (p, c) = (refs(&w.p), refs(&w.c));
+    let (q, h) = (&w.q[..], &w.h[..]);
+    let mut t = muts(&mut w.t);
+    for g in (i0..i1).step_by(L) {
+        let k = g - lo;
+        let wt = centred_weights(
+            F4::load(h, k - 2),
+            F4::load(h, k - 1),
+            F4::load(h, k),
+            F4::load(h, k + 1),
+        );
+        let pc = V4::load(&p, k);
+        let v = (V4::load(&p, k - 2) - pc).scale(wt[0])
+            + (V4::load(&p, k - 1) - pc).scale(wt[1])
+            + (V4::load(&p, k + 1) - pc).scale(wt[2])
+            + (V4::load(&p, k + 2) - pc).scale(wt[3]);
+        let l = v.dot(v).sqrt();
+        let u = v.scale(F4::splat(1.0) / l);
+        // the circle estimate (`circle_raw`): |c_i|² c_{i−1} + |c_{i−1}|² c_i
+        let cw =
+            V4::load(&c, k - 1).scale(F4::load(q, k)) + V4::load(&c, k).scale(F4::load(q, k - 1));
+        let d = u.dot(cw);
+        let good = l.mask(zero, |p, q| p > q)
+            & u.finite_mask()
+            & d.mask(zero, |p, q| p >= q)
+            & (d * d).mask(guard2 * cw.dot(cw), |p, q| p >= q);
+        bad |= !good & live(g, i1);
+        u.store(&mut t, g - s);
+    }
+    bad
+}
+
+/// The curve-only part of the block's `steps` steps (`dr_step_with`: `a`, `v2`, `b`; or the
+/// rotation method's axis, cosine and `1 + cos`) and their check (`aligned_with`); false
+/// where a segment runs against its tangents.
+#[inline(always)]
+fn step_vectors(w: &mut Scratch, blk: &Block, steps: usize, rotation: bool) -> bool {
+    let min2 = F4::splat(MIN_ALIGNMENT * MIN_ALIGNMENT);
+    let (zero, two) = (F4::splat(0.0), F4::splat(2.0));
+    let mut misaligned = 0u32;
+    let (c, t) = (refs(&w.c), refs(&w.t));
+    let q = &w.q[..];
+    let (mut av, mut v2v, mut bv) = (muts(&mut w.a), muts(&mut w.v2), muts(&mut w.b));
+    for m in (0..steps).step_by(L) {
+        let k = m + blk.s - blk.lo;
+        let (v1, vv) = (V4::load(&c, k), F4::load(q, k));
+        let (ti, tj) = (V4::load(&t, m), V4::load(&t, m + 1));
+        let d = v1.dot(ti + tj);
+        let ok = d.mask(zero, |p, q| p > q) & (d * d).mask(min2 * vv, |p, q| p > q);
+        misaligned |= !ok & live(m, steps);
+        if rotation {
+            let c = ti.dot(tj);
+            ti.cross(tj).store(&mut av, m);
+            c.store(w.cos, m);
+            (F4::splat(1.0) + c).store(w.den, m);
+            continue;
+        }
+        let k1 = two / vv;
+        let tl = ti - v1.scale(k1 * v1.dot(ti));
+        let v2 = tj - tl;
+        let k2 = two / v2.dot(v2);
+        (v1 - v2.scale(k2 * v2.dot(v1))).scale(k1).store(&mut av, m);
+        v2.store(&mut v2v, m);
+        v2.scale(k2).store(&mut bv, m);
+    }
+    misaligned == 0
+}
+
+/// The rotation method's transport of `r` over `steps` steps (`rotation_step`), keeping
+/// each `r` before its step; returns the last one. The only loop that carries a value from
+/// sample to sample, kept to the arithmetic of the step.
+#[inline(always)]
+fn transport_rotation(w: &mut Scratch, steps: usize, mut r: DVec3) -> DVec3 {
+    let (ax, ay, az) = (&w.a[0][..steps], &w.a[1][..steps], &w.a[2][..steps]);
+    let (cos, den) = (&w.cos[..steps], &w.den[..steps]);
+    let [rx, ry, rz] = &mut w.r;
+    let (rx, ry, rz) = (&mut rx[..steps], &mut ry[..steps], &mut rz[..steps]);
+    for m in 0..steps {
+        (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
+        let a = DVec3::new(ax[m], ay[m], az[m]);
+        r = minimal_rotate_with(a, cos[m], den[m], r);
+    }
+    r
+}
+
+/// Double reflection's transport of `r` over `steps` steps (`dr_step_with`: `r′ = r −
+/// (c_i·r) a_i − (v2_i·r) b_i`, the chords from scratch index `k0`), keeping each `r`
+/// before its step; returns the last one.
+#[inline(always)]
+fn transport_reflection(w: &mut Scratch, k0: usize, steps: usize, mut r: DVec3) -> DVec3 {
+    let (cx, cy, cz) = (
+        &w.c[0][k0..k0 + steps],
+        &w.c[1][k0..k0 + steps],
+        &w.c[2][k0..k0 + steps],
+    );
+    let (ax, ay, az) = (&w.a[0][..steps], &w.a[1][..steps], &w.a[2][..steps]);
+    let (vx, vy, vz) = (&w.v2[0][..steps], &w.v2[1][..steps], &w.v2[2][..steps]);
+    let (bx, by, bz) = (&w.b[0][..steps], &w.b[1][..steps], &w.b[2][..steps]);
+    let [rx, ry, rz] = &mut w.r;
+    let (rx, ry, rz) = (&mut rx[..steps], &mut ry[..steps], &mut rz[..steps]);
+    for m in 0..steps {
+        (rx[m], ry[m], rz[m]) = (r.x, r.y, r.z);
+        let v1 = DVec3::new(cx[m], cy[m], cz[m]);
+        let (a, v2, b) = (
+            DVec3::new(ax[m], ay[m], az[m]),
+            DVec3::new(vx[m], vy[m], vz[m]),
+            DVec3::new(bx[m], by[m], bz[m]),
+        );
+        r = r - v1.dot(r) * a - v2.dot(r) * b;
+    }
+    r
 }
 
 #[cfg(test)]

@@ -355,3 +355,330 @@ pub fn transport_into<S: Step>(
     debug_assert!(angle.is_some());
     angle.unwrap_or(0.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::double_reflection::DoubleReflection;
+    use super::super::{Method, Orientation, Request, compute_general, compute_into};
+    use super::*;
+    use std::f64::consts::TAU;
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+    }
+
+    /// The same values, bit for bit.
+    fn same_bits(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits())
+    }
+
+    fn worst(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn plan_cuts_only_long_rotation_curves_on_several_threads() {
+        for threads in [1, 2, 3] {
+            pool(threads).install(|| {
+                let many = threads > 1;
+                assert_eq!(plan(0, true), (0, 1), "no frames: no chunk");
+                assert_eq!(plan(1, true), (1, 1));
+                // the longest curve kept in one chunk, and the shortest one cut
+                let long = 2 * PAR_CHUNK;
+                assert_eq!(plan(long - 1, true), (1, long - 1));
+                let cut = |ext: usize| {
+                    if many {
+                        (ext.div_ceil(SCAN_CHUNK), SCAN_CHUNK)
+                    } else {
+                        (1, ext)
+                    }
+                };
+                assert_eq!(plan(long, true), cut(long));
+                // one frame past whole chunks: a last chunk of a single frame
+                assert_eq!(plan(long + 1, true), cut(long + 1));
+                assert_eq!(plan(3 * SCAN_CHUNK + 1, true), cut(3 * SCAN_CHUNK + 1));
+                // a step that depends on r is never cut
+                assert_eq!(plan(4 * long, false), (1, 4 * long));
+                for ext in [1, 2, long - 1, long, long + 1, 5 * long + 3] {
+                    let (chunks, cs) = plan(ext, true);
+                    assert!(chunks * cs >= ext && (chunks - 1) * cs < ext, "{ext}");
+                }
+            });
+        }
+    }
+
+    /// A trefoil knot with its unit tangents, unevenly sampled.
+    fn trefoil(n: usize) -> (Vec<DVec3>, Vec<DVec3>) {
+        (0..n)
+            .map(|i| {
+                let k = TAU / n as f64;
+                let u = k * (i as f64 + 0.3 * (5.0 * k * i as f64).sin());
+                let (c2, s2, c3, s3) = (
+                    (2.0 * u).cos(),
+                    (2.0 * u).sin(),
+                    (3.0 * u).cos(),
+                    (3.0 * u).sin(),
+                );
+                let r = 2.0 + c3;
+                let x = DVec3::new(r * c2, r * s2, s3);
+                let d = DVec3::new(
+                    -3.0 * s3 * c2 - 2.0 * r * s2,
+                    -3.0 * s3 * s2 + 2.0 * r * c2,
+                    3.0 * c3,
+                );
+                (x, d.normalize())
+            })
+            .unzip()
+    }
+
+    /// The frames of the scan computed serially: `r` carried one step after another, then
+    /// every row turned by the twist `total · s / L` at its arc length `s`.
+    fn serial<S: Step>(
+        step: &S,
+        t: &[DVec3],
+        seg: &[f64],
+        closed: bool,
+        r0: DVec3,
+        twist: Twist,
+        rows: usize,
+    ) -> (Vec<f64>, f64) {
+        let n = t.len();
+        let ext = if closed { n + 1 } else { n };
+        let mut r = vec![r0];
+        for i in 0..ext - 1 {
+            r.push(step.step(i, r[i]));
+        }
+        let end = r[ext - 1];
+        let (raw, total) = match twist {
+            Twist::None => (0.0, 0.0),
+            Twist::Closed { turns } => {
+                let a = signed_angle(end, r0, t[0]);
+                (a, a + TAU * turns as f64)
+            }
+            Twist::End { target, turns } => {
+                let a = signed_angle(end, target, t[n - 1]);
+                (a, a + TAU * turns as f64)
+            }
+        };
+        let length: f64 = seg[..ext - 1].iter().sum();
+        let mut out = vec![0.0; 9 * rows];
+        let mut s = 0.0;
+        for (i, f) in out.chunks_exact_mut(9).enumerate() {
+            let ti = t[i % n];
+            write_frame(
+                f,
+                rotate_about(r[i.min(ext - 1)], ti, total * s / length),
+                ti,
+            );
+            s += seg[i.min(seg.len() - 1)];
+        }
+        if closed && rows == n + 1 {
+            let first: [f64; 9] = out[..9].try_into().expect("a frame");
+            out[9 * n..].copy_from_slice(&first);
+        }
+        (out, raw)
+    }
+
+    /// [`Scan`] with chunks of a few frames (so that many chunks, a last chunk of one frame
+    /// and the empty chunk of a closed curve's extra frame all occur) on 1–3 threads: the
+    /// frames and the end angle of the serial transport, and the same bits on every run.
+    #[test]
+    fn scan_with_small_chunks_equals_the_serial_transport() {
+        for n in [2, 3, 4, 5, 6, 9, 11] {
+            let (x, t) = trefoil(n);
+            for closed in [false, true] {
+                if closed && n < 3 {
+                    continue;
+                }
+                let dr = DoubleReflection {
+                    x: &x,
+                    t: &t,
+                    closed,
+                    tangent_chords: false,
+                };
+                let m = if closed { n } else { n - 1 };
+                let seg: Vec<f64> = (0..m).map(|i| (x[(i + 1) % n] - x[i]).length()).collect();
+                let ext = m + 1;
+                let tt = |i: usize| t[if i == n { 0 } else { i }];
+                let r0 = any_perpendicular(t[0]);
+                let target = any_perpendicular(t[n - 1]).cross(t[n - 1]);
+                let twists = if closed {
+                    vec![
+                        Twist::None,
+                        Twist::Closed { turns: 0 },
+                        Twist::Closed { turns: -2 },
+                    ]
+                } else {
+                    vec![Twist::None, Twist::End { target, turns: 1 }]
+                };
+                for twist in twists {
+                    for rows in [n, n + usize::from(closed)] {
+                        let (want, want_raw) = serial(&dr, &t, &seg, closed, r0, twist, rows);
+                        for cs in [1, 2, 3, 5] {
+                            let scan = Scan {
+                                boundary_step: |i: usize, r: DVec3| dr.step(i, r),
+                                tangent: tt,
+                                seg: |i: usize| seg[i.min(seg.len() - 1)],
+                                n,
+                                closed,
+                                r0,
+                                twist,
+                                cs,
+                                ext,
+                            };
+                            // the chunk work of `transport_into`, with chunks of `cs` frames
+                            let work = |c: usize, start: Option<DVec3>, buf: &mut [f64]| {
+                                let (a, b) = (c * cs, ((c + 1) * cs).min(ext));
+                                let s0 = start.unwrap_or_else(|| any_perpendicular(tt(a)));
+                                let mut rows = buf.chunks_exact_mut(9);
+                                let mut r = s0;
+                                for i in a..b {
+                                    if let Some(f) = rows.next() {
+                                        write_frame(f, r, tt(i));
+                                    }
+                                    if i + 1 < b {
+                                        r = dr.step(i, r);
+                                    }
+                                }
+                                Some((s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>()))
+                            };
+                            let mut three: Option<Vec<f64>> = None;
+                            for threads in [1, 2, 3, 3] {
+                                let mut out = vec![0.0; 9 * rows];
+                                let raw = pool(threads)
+                                    .install(|| scan.scan(work, &mut out))
+                                    .expect("no check fails");
+                                let what = format!(
+                                    "n {n}, closed {closed}, {twist:?}, rows {rows}, chunk {cs}, {threads} threads"
+                                );
+                                assert!(
+                                    (raw - want_raw).abs() < 1e-12,
+                                    "{what}: {raw} vs {want_raw}"
+                                );
+                                let w = worst(&out, &want);
+                                assert!(w < 1e-12, "{what}: frames differ by {w:e}");
+                                if threads == 3 {
+                                    if let Some(before) = &three {
+                                        assert!(same_bits(before, &out), "{what}: not repeatable");
+                                    }
+                                    three = Some(out);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// A chunk whose check fails makes the whole scan fail, on any thread count, without
+    /// leaving the other workers waiting.
+    #[test]
+    fn a_failed_chunk_fails_the_scan() {
+        let (n, cs) = (40, 3);
+        let (x, t) = trefoil(n);
+        let dr = DoubleReflection {
+            x: &x,
+            t: &t,
+            closed: false,
+            tangent_chords: false,
+        };
+        let scan = Scan {
+            boundary_step: |i: usize, r: DVec3| dr.step(i, r),
+            tangent: |i: usize| t[i],
+            seg: |_: usize| 1.0,
+            n,
+            closed: false,
+            r0: any_perpendicular(t[0]),
+            twist: Twist::None,
+            cs,
+            ext: n,
+        };
+        for bad in [0, 1, 6, n.div_ceil(cs) - 1] {
+            for threads in [1, 2, 4] {
+                let work = |c: usize, start: Option<DVec3>, _: &mut [f64]| {
+                    let s0 = start.unwrap_or_else(|| any_perpendicular(t[c * cs]));
+                    (c != bad).then_some((s0, s0, 1.0))
+                };
+                let mut out = vec![0.0; 9 * n];
+                let got = pool(threads).install(|| scan.scan(work, &mut out));
+                assert!(got.is_none(), "chunk {bad} failed, {threads} threads");
+            }
+        }
+    }
+
+    /// Through the public drivers (the general path, several chunks on two threads): the
+    /// frames of one thread (one chunk) to 1e-12, and the same bits on every run.
+    #[test]
+    fn chunked_scan_through_the_drivers_equals_the_serial_result() {
+        let n = 3 * SCAN_CHUNK + 5;
+        let (x, t) = trefoil(n);
+        let open = &x[..n - 7];
+        let target = Orientation::Vector(DVec3::new(0.3, 0.2, 1.0));
+        let requests = [
+            // a closed curve: the closing twist
+            Request {
+                points: Some(&x),
+                closed: true,
+                turns: 1,
+                ..Default::default()
+            },
+            // the rotation method with an end condition
+            Request {
+                points: Some(open),
+                method: Method::Rotation,
+                end: Some(target),
+                ..Default::default()
+            },
+            // double reflection without a condition (the rows turned at once)
+            Request {
+                points: Some(open),
+                ..Default::default()
+            },
+            // tangents only: chords from the tangents
+            Request {
+                tangents: Some(&t),
+                tangent_chords: true,
+                closed: true,
+                ..Default::default()
+            },
+        ];
+        for (k, req) in requests.iter().enumerate() {
+            let rows = req.points.or(req.tangents).map_or(0, <[DVec3]>::len);
+            let run = |threads: usize| {
+                let mut out = vec![0.0; 9 * rows];
+                let raw = pool(threads)
+                    .install(|| {
+                        assert_eq!(plan(rows + 1, true).0 > 2, threads > 1);
+                        compute_general(req, &mut out)
+                    })
+                    .expect("valid input");
+                (out, raw)
+            };
+            let (one, raw1) = run(1);
+            let (two, raw2) = run(2);
+            let w = worst(&one, &two);
+            assert!(
+                w < 1e-12,
+                "request {k}: chunks differ from one pass by {w:e}"
+            );
+            assert!((raw1 - raw2).abs() < 1e-12, "request {k}: {raw1} vs {raw2}");
+            for _ in 0..3 {
+                let (again, raw) = run(2);
+                assert!(same_bits(&again, &two) && raw.to_bits() == raw2.to_bits());
+            }
+            // compute_into (which may take the fused path) agrees
+            let mut out = vec![0.0; 9 * rows];
+            pool(2)
+                .install(|| compute_into(req, &mut out))
+                .expect("valid input");
+            assert!(worst(&out, &two) < 1e-12, "request {k}");
+        }
+    }
+}

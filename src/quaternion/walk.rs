@@ -399,18 +399,18 @@ pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Res
 mod tests {
     use super::*;
 
-    /// The closed unit cube as 12 consistently oriented triangles.
+    /// The unit cube `[0, 1]³`, vertex `x + 2y + 4z`, faces wound outwards.
     fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+        let v = (0..8)
+            .map(|i| DVec3::new(f64::from(i & 1), f64::from((i >> 1) & 1), f64::from(i >> 2)))
             .collect();
         let quads = [
-            [0, 2, 3, 1], // z = 0
-            [4, 5, 7, 6], // z = 1
-            [0, 1, 5, 4], // y = 0
-            [2, 6, 7, 3], // y = 1
-            [0, 4, 6, 2], // x = 0
-            [1, 3, 7, 5], // x = 1
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
         ];
         let f = quads
             .iter()
@@ -460,5 +460,198 @@ mod tests {
         // a start off the face is an error of the start
         let e = walk_path(&w, 2, DVec3::splat(5.0), None, &moves).unwrap_err();
         assert_eq!(e.arg, "point");
+    }
+
+    /// A regular tetrahedron around the origin, faces wound outwards.
+    fn tetrahedron() -> (Vec<DVec3>, Vec<[i64; 3]>) {
+        let v = vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        let f = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+            .map(|[a, b, c]: [usize; 3]| {
+                let n = (v[b] - v[a]).cross(v[c] - v[a]);
+                let out = n.dot(v[a] + v[b] + v[c]) > 0.0;
+                if out { [a, b, c] } else { [a, c, b] }.map(|i| i as i64)
+            })
+            .to_vec();
+        (v, f)
+    }
+
+    /// The distance of `p` from face `f` (0 on it: in its plane and inside its edges).
+    fn off_face(w: &Walker, f: usize, p: DVec3) -> f64 {
+        let [a, b, c] = w.corners(f);
+        let n = w.normal(f);
+        let outside = [(a, b), (b, c), (c, a)]
+            .iter()
+            .map(|&(p0, p1)| (-(p1 - p0).cross(p - p0).dot(n) / (p1 - p0).length()).max(0.0))
+            .fold(0.0, f64::max);
+        outside.max((p - a).dot(n).abs())
+    }
+
+    /// The frame is a rotation with `e₃` the normal of the walker's face.
+    fn assert_frame(w: &Walker, s: &State) {
+        let m = s.frame;
+        let off = (m.transpose() * m - DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .fold(0.0_f64, |a, v| a.max(v.abs()));
+        assert!(off < 1e-12 && (m.determinant() - 1.0).abs() < 1e-12, "{m}");
+        assert!((m.z_axis - w.normal(s.face)).length() < 1e-12);
+    }
+
+    /// Moves across several faces: the path (start, edge crossings, end) is as long as the
+    /// move, runs inside the faces it passes, the frames stay rotations on the faces, and
+    /// the reverse move walks back to the start.
+    #[test]
+    fn straight_moves_keep_their_length_and_walk_back() {
+        for (v, f) in [cube(), tetrahedron()] {
+            let w = Walker::new(&v, &f).expect("a closed mesh");
+            for face in 0..f.len() {
+                let [a, b, c] = w.corners(face);
+                let p = 0.5 * a + 0.3 * b + 0.2 * c;
+                for (dir, mv) in [
+                    (None, DVec2::new(2.7, 0.9)),
+                    (Some(c - a), DVec2::new(-1.3, 3.1)),
+                    (Some(DVec3::new(0.3, -0.7, 0.2)), DVec2::new(4.2, -0.4)),
+                ] {
+                    let s0 = w.start(face as i64, p, dir).expect("a point on the face");
+                    assert_frame(&w, &s0);
+                    let mut path = Vec::new();
+                    let s1 = w.step(s0, mv, &mut path).expect("a valid move");
+                    assert!(!s1.stopped && path.len() >= 2, "{} crossings", path.len());
+                    assert_frame(&w, &s1);
+                    // every piece of the path lies in the face it crosses
+                    let mut points = vec![(s0.point, s0.face)];
+                    points.extend(path.iter().copied());
+                    points.push((s1.point, s1.face));
+                    let mut length = 0.0;
+                    for k in 0..points.len() - 1 {
+                        let ((p, fp), (q, fq)) = (points[k], points[k + 1]);
+                        assert!(off_face(&w, fp, p) < 1e-12 && off_face(&w, fp, q) < 1e-12);
+                        assert!(off_face(&w, fq, q) < 1e-12, "crossing {k} off face {fq}");
+                        length += (q - p).length();
+                    }
+                    assert!(
+                        (length - mv.length()).abs() < 1e-12,
+                        "{length} vs {}",
+                        mv.length()
+                    );
+                    let back = w.step(s1, -mv, &mut Vec::new()).expect("a valid move");
+                    assert_eq!(back.face, s0.face);
+                    assert!((back.point - s0.point).length() < 1e-12);
+                    assert!(
+                        (back.frame - s0.frame)
+                            .to_cols_array()
+                            .iter()
+                            .all(|d| d.abs() < 1e-12)
+                    );
+                }
+            }
+        }
+    }
+
+    /// On the cube a move parallel to an edge goes round a belt of four faces: a quarter of
+    /// the way it is on the next face at the known point, after length 4 back at the start
+    /// with the start's frame.
+    #[test]
+    fn belt_around_the_cube_closes() {
+        let (v, f) = cube();
+        let w = Walker::new(&v, &f).expect("a cube");
+        // bottom face (z = 0, normal −z), heading +x
+        let s0 = w
+            .start(1, DVec3::new(0.5, 0.3, 0.0), Some(DVec3::X))
+            .expect("on face 1");
+        for (length, want) in [
+            (1.0, DVec3::new(1.0, 0.3, 0.5)),
+            (2.25, DVec3::new(0.25, 0.3, 1.0)),
+            (3.0, DVec3::new(0.0, 0.3, 0.5)),
+            (4.0, DVec3::new(0.5, 0.3, 0.0)),
+        ] {
+            let s = w
+                .step(s0, DVec2::new(length, 0.0), &mut Vec::new())
+                .expect("a move");
+            assert!(
+                (s.point - want).length() < 1e-12,
+                "{length}: {} vs {want}",
+                s.point
+            );
+        }
+        let s = w
+            .step(s0, DVec2::new(4.0, 0.0), &mut Vec::new())
+            .expect("a move");
+        assert!(
+            (s.frame - s0.frame)
+                .to_cols_array()
+                .iter()
+                .all(|d| d.abs() < 1e-12)
+        );
+    }
+
+    /// A walk stops where it meets the boundary of an open mesh, on the boundary edge.
+    #[test]
+    fn walk_stops_at_the_boundary() {
+        let (v, mut f) = cube();
+        f.drain(2..4); // no top
+        let w = Walker::new(&v, &f).expect("an open box");
+        let s0 = w
+            .start(1, DVec3::new(0.5, 0.3, 0.0), Some(DVec3::X))
+            .expect("on face 1");
+        let s = w
+            .step(s0, DVec2::new(3.0, 0.0), &mut Vec::new())
+            .expect("a move");
+        assert!(s.stopped);
+        assert!(
+            (s.point - DVec3::new(1.0, 0.3, 1.0)).length() < 1e-12,
+            "{}",
+            s.point
+        );
+    }
+
+    /// Many walkers in parallel: each exactly as walked alone; errors name the walker.
+    #[test]
+    fn walk_many_equals_single_walks() {
+        for (v, f) in [cube(), tetrahedron()] {
+            let w = Walker::new(&v, &f).expect("a closed mesh");
+            let k = 4;
+            let starts: Vec<Start> = (0..f.len())
+                .map(|i| {
+                    let [a, b, c] = w.corners(i);
+                    let dir = (i % 2 == 0).then_some(c - b);
+                    (i as i64, (a + b + 2.0 * c) / 4.0, dir)
+                })
+                .collect();
+            let moves: Vec<DVec2> = (0..starts.len() * k)
+                .map(|j| DVec2::new(1.0 + 0.37 * j as f64, (0.9 * j as f64).sin()))
+                .collect();
+            let all = walk_many(&w, &starts, &moves, k).expect("valid walks");
+            assert_eq!(all.len(), starts.len() * (k + 1));
+            for (i, &(face, point, dir)) in starts.iter().enumerate() {
+                let mut s = w.start(face, point, dir).expect("a start");
+                for j in 0..=k {
+                    if j > 0 {
+                        s = w
+                            .step(s, moves[i * k + j - 1], &mut Vec::new())
+                            .expect("a move");
+                    }
+                    let got = all[i * (k + 1) + j];
+                    assert_eq!(got.face, s.face);
+                    assert_eq!(got.stopped, s.stopped);
+                    assert_eq!(got.point.to_array(), s.point.to_array());
+                    assert_eq!(got.frame.to_cols_array(), s.frame.to_cols_array());
+                }
+            }
+            let mut bad = moves.clone();
+            bad[2 * k + 1].x = f64::NAN;
+            let err = walk_many(&w, &starts, &bad, k).unwrap_err();
+            assert_eq!(err.arg, "moves");
+            assert!(err.msg.starts_with("walker 2"), "{err}");
+            assert_eq!(
+                walk_many(&w, &starts, &moves[1..], k).unwrap_err().arg,
+                "moves"
+            );
+        }
     }
 }
