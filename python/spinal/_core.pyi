@@ -258,6 +258,10 @@ def deform_mesh(
     npt.NDArray[np.int64],
     tuple[int, int, int, bool, float, float],
 ]: ...
+def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...
+def minimal_rotation(
+    t0: Sequence[float] | npt.NDArray[np.float64], t1: Sequence[float] | npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
 def flesh_bind(
     rest_points: npt.NDArray[np.float64],
     rest_frames: npt.NDArray[np.float64],

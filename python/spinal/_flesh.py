@@ -54,18 +54,6 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
-def _min_rotation_matrix(t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
-    """The rotation by the smallest angle taking unit ``t0`` to unit ``t1``."""
-    c = float(t0 @ t1)
-    k = np.cross(t0, t1)
-    if c <= -1 + 1e-12:  # half turn about any axis ⟂ t0
-        a = np.cross(t0, [1.0, 0, 0] if abs(t0[0]) < 0.9 else [0, 1.0, 0])
-        a /= np.linalg.norm(a)
-        return 2 * np.outer(a, a) - np.eye(3)
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + kx + kx @ kx / (1 + c)
-
-
 def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
     """Reference vector of the posed spine's first frame (spec A-5, made rigid-motion
     equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal rotation taking
@@ -74,7 +62,7 @@ def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.n
     posed samples; ``ψ = 0`` when either spine is straight (the roll about it is then free).
     A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the inverse roll."""
     r0, t0 = f0[:, 0], f0[:, 2]
-    q = _min_rotation_matrix(t0, t1)
+    q = _core.minimal_rotation(t0, t1)
     a = rest - rest.mean(0)
     b = posed - posed.mean(0)
     u, sv, vt = np.linalg.svd(a.T @ b)

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from . import _core
 from ._validate import as_float_array
 
 __all__ = ["FoldOverWarning", "Mesh", "edges", "mesh_arrays"]
@@ -26,9 +27,8 @@ def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
     """Signed volume ``Σ (a · (b × c)) / 6`` of the triangles ``F`` over vertices ``V``
     (divergence theorem; positive for a closed, outward-facing mesh), summed about the mean
     vertex so that a small mesh far from the origin keeps its digits."""
-    v = V - V.mean(axis=0) if len(V) else V
-    a, b, c = (v[F[:, k]] for k in range(3))
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+    return _core.mesh_volume(np.ascontiguousarray(V, dtype=np.float64),
+                             np.ascontiguousarray(F, dtype=np.int64).reshape(-1, 3))
 
 
 def edges(F: np.ndarray):

@@ -51,6 +51,28 @@ pub fn minimal_rotation_quat(a: DVec3, b: DVec3) -> Option<DQuat> {
     Some(DQuat::from_xyzw(v.x, v.y, v.z, 1.0 + c).normalize())
 }
 
+/// The matrix of the rotation by the smallest angle taking unit `a` to unit `b`
+/// (`I + K + K²/(1 + a·b)`, `K = [a × b]×`); for opposite vectors (`a·b ≤ −1 + 10⁻¹²`) a
+/// half turn about an axis perpendicular to `a` (`a × e_x`, or `a × e_y` when `a` is near
+/// `e_x`).
+pub fn minimal_rotation_matrix(a: DVec3, b: DVec3) -> DMat3 {
+    let c = a.dot(b);
+    if c <= -1.0 + 1e-12 {
+        let e = if a.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+        let axis = a.cross(e).normalize();
+        return DMat3::from_cols(
+            axis * (2.0 * axis.x),
+            axis * (2.0 * axis.y),
+            axis * (2.0 * axis.z),
+        ) - DMat3::IDENTITY;
+    }
+    DMat3::from_cols(
+        minimal_rotate(a, b, DVec3::X),
+        minimal_rotate(a, b, DVec3::Y),
+        minimal_rotate(a, b, DVec3::Z),
+    )
+}
+
 /// Rodrigues' rotation of `v` about the unit `axis` by `angle`.
 #[inline]
 pub fn rodrigues(v: DVec3, axis: DVec3, angle: f64) -> DVec3 {
@@ -128,6 +150,26 @@ pub fn is_rotation(m: &DMat3) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn minimal_rotation_matrix_takes_a_to_b_and_is_a_rotation() {
+        let a = DVec3::new(0.3, -0.5, 0.8).normalize();
+        for b in [
+            DVec3::new(-0.2, 0.9, 0.1).normalize(),
+            a,
+            -a,
+            DVec3::new(0.3, -0.5, 0.81).normalize(),
+        ] {
+            let m = minimal_rotation_matrix(a, b);
+            assert!((m * a - b).length() < 1e-12, "{b}");
+            assert!(is_rotation(&m));
+            // vectors perpendicular to both stay put
+            let k = a.cross(b);
+            if k.length() > 1e-6 {
+                assert!((m * k - k).length() < 1e-12);
+            }
+        }
+    }
     use std::f64::consts::{PI, TAU};
 
     fn units() -> Vec<DVec3> {

@@ -83,6 +83,20 @@ pub fn flesh_resample<'py>(
     vec3_array(py, out)
 }
 
+/// The rotation matrix by the smallest angle taking unit `t0` to unit `t1` (a half turn for
+/// opposite vectors).
+#[pyfunction]
+pub fn minimal_rotation<'py>(
+    py: Python<'py>,
+    t0: [f64; 3],
+    t1: [f64; 3],
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let m = crate::math::rotation::minimal_rotation_matrix(t0.into(), t1.into());
+    // glam is column-major; NumPy's rows are the matrix rows
+    let rows = m.transpose().to_cols_array().to_vec();
+    numpy::PyArray1::from_vec(py, rows).reshape([3, 3])
+}
+
 /// Register vertices on a rest spine surface (grid `nu × nv`); see `spinal.SurfaceBinding`.
 #[pyfunction]
 pub fn flesh_surface_bind<'py>(

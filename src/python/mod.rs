@@ -10,6 +10,7 @@ mod deform;
 mod fields;
 mod flesh;
 mod frames;
+mod mesh;
 mod ph;
 mod quaternion;
 mod sweep;
@@ -53,6 +54,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_volume, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::minimal_rotation, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_resample, m)?)?;
