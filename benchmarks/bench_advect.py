@@ -9,7 +9,8 @@ last column is the share of points inside the field's support at t = 0 (points o
 a few multiplications: the translation tools are local, the twist moves every point).
 Target (issue 4): ≤ 30 ns/vertex/step. A second table times the fields without a NumPy
 counterpart: the strip along a curved axis (a closest-point solve per evaluation) and a
-distance-grid tool (a 64-node tricubic B-spline, 64 coefficients per evaluation).
+distance-grid tool (a 64-node tricubic B-spline, 64 coefficients per evaluation), and the
+curl tools of any shape (rod, sdf_curl, mesh_curl, a keyframed rod; target ≤ 60 ns).
 
     python benchmarks/bench_advect.py            # 40,962 and 1,000,000 vertices
     python benchmarks/bench_advect.py --max 1e5  # small sizes only
@@ -49,10 +50,38 @@ def tool_cases():
     h = (0.6 + 1.2) / 55
     ax = np.arange(-0.9 - 4 * h, 0.9 + 4.5 * h, h)
     g = np.linalg.norm(np.stack(np.meshgrid(ax, ax, ax, indexing="ij"), -1), axis=-1) - 0.3
-    return {
+    out = {
         "strip along a curved axis": fields.strip_curve(axis, 0.3, 1.0, reach=0.3),
         f"distance-grid tool ({len(ax)}³)": fields.sdf_tool(g, np.array([0, 0, 0.9]) + ax[0], h,
                                                            [1, 0, 0], reach=0.6, moving=False),
+    }
+    return out | curl_tool_cases(axis, g, ax, h)
+
+
+def curl_tool_cases(axis, g, ax, h):
+    """The curl tools of any shape: a rod on the strip's axis pressing in, the sampled sphere
+    (and a 2,562-vertex sphere mesh sampled by mesh_curl's default 64-node grid) as curl
+    translations, and the rod following keys along a curve while turning."""
+    import trimesh
+
+    rod = fields.rod(axis, 0.3, velocity=[0, 0, -1], reach=0.3)
+    s = trimesh.creation.icosphere(4)
+    times = np.linspace(0, T, 5)
+    mid = axis.mean(axis=0)
+    keys = mid + np.c_[0.3 * np.sin(4 * times), 0 * times, -times]
+    turn = np.c_[0 * times, 1.5 * times, 0 * times]
+    from scipy.spatial.transform import Rotation
+
+    return {
+        "rod curl tool (curved axis)": rod,
+        f"sdf_curl ({len(ax)}³)": fields.sdf_curl(g, np.array([0, 0, 0.9]) + ax[0], h,
+                                                  velocity=[1, 0, 0], reach=0.6, moving=False),
+        "mesh_curl (2,562-vertex sphere)": fields.mesh_curl(
+            (0.3 * s.vertices + [0, 0, 0.9], s.faces), velocity=[1, 0, 0], reach=0.6,
+            moving=False),
+        "keyframed rod (5 keys, turning)": fields.keyframed(
+            fields.rod(axis, 0.3, velocity=[0, 0, -1], reach=0.3, center=mid), times, keys,
+            Rotation.from_rotvec(turn).as_matrix()),
     }
 
 

@@ -530,6 +530,55 @@ side_by_side(shapes, mesh.faces, posed, image="flesh.png" if name == "cow" else 
 ])
 
 
+def curl_tools_section():
+    """Notebook 04's section on the curl tools of any shape and keyframed tools."""
+    return [
+        """md:## Free-form curl tools and keyframed tools
+
+The curl fields work with the signed distance `d` of any shape (and its exact gradient):
+`fields.rod` (a tube about a spline axis), `fields.sdf_curl` (a sampled distance) and
+`fields.mesh_curl` (a closed mesh) push the material like the sphere above, exactly
+divergence-free. `fields.keyframed` moves a tool's shape rigidly through keys `(t, c, Q)`
+(Hermite positions, slerped orientations). Left: a bent rod pressed into the sphere; right:
+a capsule following a curved key path across the surface while turning.""",
+        """from scipy.spatial.transform import Rotation
+th = np.linspace(-0.5, 0.5, 7)
+axis = np.c_[np.sin(th), 0.2 * np.sin(2 * th), np.cos(th)] * 1.3
+rod = spinal.fields.rod(axis, 0.15, velocity=[0, 0, -1], reach=0.3)
+pressed = spinal.advect(V0, rod, 0.25)
+rod_now = axis + [0, 0, -0.25]
+times = np.linspace(0, 1.0, 6)
+path = np.c_[np.sin(2.4 * times - 1.2), 0.4 * np.sin(3 * times), 1.15 - 0.2 * np.sin(np.pi * times)]
+turns = Rotation.from_rotvec(np.outer(times, [0, 0, 2.0])).as_matrix()
+cap = spinal.fields.rod([[-0.2, 0, 0], [0.2, 0, 0]], 0.12, velocity=[1, 0, 0], reach=0.25)
+keyed = spinal.fields.keyframed(cap, times, path, turns)
+swept = spinal.advect(V0, keyed, 1.0)
+for name, W in (("rod", pressed), ("keyframed capsule", swept)):
+    tv = trimesh.Trimesh(W, F, process=False).volume
+    print(f"{name}: max displacement {np.linalg.norm(W - V0, axis=1).max():.3f}, "
+          f"relative volume change {tv / vol0 - 1:+.2e}")
+    assert abs(tv / vol0 - 1) < 1e-3
+pl = pv.Plotter(shape=(1, 2), window_size=(900, 420))
+pl.subplot(0, 0)
+pl.add_mesh(pv.wrap(trimesh.Trimesh(pressed, F, process=False)), color="#c8a27a",
+            smooth_shading=True)
+pl.add_mesh(pv.Spline(rod_now, 100).tube(radius=0.15), color="#3060a0", opacity=0.6)
+pl.subplot(0, 1)
+pl.add_mesh(pv.wrap(trimesh.Trimesh(swept, F, process=False)), color="#c8a27a",
+            smooth_shading=True)
+pl.add_mesh(pv.Spline(path, 100), color="#a03030", line_width=3)
+end = path[-1] + np.array([[-0.2, 0, 0], [0.2, 0, 0]]) @ turns[-1].T   # the capsule at t = 1
+pl.add_mesh(pv.Line(end[0], end[1]).tube(radius=0.12), color="#3060a0", opacity=0.6)
+pl.link_views()
+pl.camera_position = [(2.5, -3.0, 3.5), (0, 0, 0.3), (0, 0, 1)]
+if IMAGES:
+    pl.screenshot(os.path.join(IMAGES, "curl_tools.png"))
+pl.show()""",
+    ]
+
+
+deform.cells += nb(curl_tools_section()).cells
+
 BOOKS = {"01_frames": frames, "02_tubes": tubes, "03_knot_tube": knot,
          "04_deformation": deform, "05_fleshing": flesh, "06_quaternion_frames": quat}
 

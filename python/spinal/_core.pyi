@@ -232,6 +232,38 @@ def field_path(
     blend: str,
 ) -> Field: ...
 def field_zero() -> Field: ...
+def field_grid_curl(
+    coefficients: npt.NDArray[np.float64],
+    origin: _V3,
+    spacing: float,
+    center: _V3,
+    reach: float,
+    velocity: _V3 | None,
+    angular_velocity: _V3 | None,
+    pivot: _V3 | None,
+    falloff_power: int,
+    moving: bool,
+    name: str,
+) -> Field: ...
+def field_rod(
+    points: npt.NDArray[np.float64],
+    radius: float,
+    center: _V3 | None,
+    reach: float | None,
+    velocity: _V3 | None,
+    angular_velocity: _V3 | None,
+    pivot: _V3 | None,
+    falloff_power: int,
+    moving: bool,
+) -> Field: ...
+def field_keyframed(
+    tool: Field,
+    times: npt.NDArray[np.float64],
+    positions: npt.NDArray[np.float64],
+    matrices: npt.NDArray[np.float64] | None,
+    quaternions: npt.NDArray[np.float64] | None,
+    falloff_power: int | None,
+) -> Field: ...
 def advect(
     points: npt.NDArray[np.float64],
     field: Field,

@@ -34,6 +34,13 @@ region function ``D = b(clamp(d/R_f, 0, 1))``, ``b = 4σ³ − 3σ⁴`` (C¹) or
   (or a closed triangle mesh): the sphere field with the tool's distance ``d``, interpolated
   by a C² tricubic B-spline whose exact gradient gives ``n = ∇d``.
 
+**Curl tools of any shape** (thesis §11.2.5–11.2.6 with the curl fields of Ch. 12): the
+translation and rotation above with the signed distance ``d`` of any shape and its exact
+gradient ``g = ∇d`` in place of the sphere's, divergence-free for any C¹ ``d`` —
+:func:`sdf_curl` (a sampled distance), :func:`mesh_curl` (a closed mesh), :func:`rod` (a tube
+about a spline axis; a capsule). :func:`keyframed` moves the shape of such a tool (or of a
+sphere or grid tool) rigidly through keys ``(t_k, c_k, Q_k)``.
+
 **Tools along a path** — :func:`along_path`: a sphere tool travels along a spine curve at
 constant speed, posed by Hermite positions and the interpolated rotation-minimizing frames
 of :func:`spinal.frames`; it translates (pushes or carries), and optionally rotates with the
@@ -58,8 +65,12 @@ __all__ = [
     "along_path",
     "bend",
     "capsule",
+    "keyframed",
+    "mesh_curl",
     "mesh_tool",
+    "rod",
     "rotation",
+    "sdf_curl",
     "sdf_tool",
     "sphere",
     "strip",
@@ -319,6 +330,13 @@ def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name)
     B-spline coefficients, then the core (which checks the spacing against the reach and that
     the support stays inside the grid)."""
     u = as_vector(velocity, "velocity")
+    coef, c, reach = _grid_spline(values, origin, h, center, reach)
+    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
+
+
+def _grid_spline(values, origin, h, center, reach):
+    """The B-spline coefficients of sampled distances with the tool's centre (default: the
+    volume-fraction centroid of the inside) and reach (default: its bounding radius)."""
     if not (values <= 0).any():
         raise ValueError("grid: no node is inside the tool (all distances are positive)")
     if center is None:
@@ -335,8 +353,7 @@ def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name)
         reach = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
     else:
         reach = as_real(reach, "reach")
-    coef = np.ascontiguousarray(_spline_prefilter(values))
-    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
+    return np.ascontiguousarray(_spline_prefilter(values)), c, reach
 
 
 @_recorded
@@ -377,6 +394,13 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     The distance must be at least ``reach`` on the grid's outer cells (the support may not
     reach the grid's edge): ``ValueError`` naming ``grid`` otherwise.
     """
+    a, o, h = _sdf_samples(grid, origin, spacing)
+    return _grid_field(a, o, h, velocity, center, reach, blend, moving, "sdf_tool")
+
+
+def _sdf_samples(grid, origin, spacing):
+    """The samples of ``sdf_tool``/``sdf_curl`` as a float64 array, checked, with the origin
+    and spacing."""
     a = as_float_array(grid, "grid")
     if a.ndim != 3 or min(a.shape) < 8:
         raise ValueError(f"grid: expected a 3-D array with at least 8 nodes per axis, got "
@@ -390,8 +414,7 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     h = as_real(spacing, "spacing")
     if not h > 0:
         raise ValueError(f"spacing: must be positive, got {h}")
-    return _grid_field(np.array(a, dtype=np.float64), o, h, velocity, center, reach, blend,
-                       moving, "sdf_tool")
+    return np.array(a, dtype=np.float64), o, h
 
 
 # cells per reach that the blend region needs (the core refuses coarser grids, naming
@@ -452,6 +475,13 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
     center : (3,) the tool's centre C (default: the centroid of the enclosed volume).
     blend, moving : as for :func:`sdf_tool`.
     """
+    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center)
+    return _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
+
+
+def _mesh_samples(mesh, reach, resolution, center):
+    """The signed distance of a closed mesh sampled on the grid of :func:`mesh_tool`:
+    samples, origin, spacing, centre and reach."""
     V, F, centroid = _closed_mesh(mesh)
     c = centroid if center is None else as_vector(center, "center")
     rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else as_real(reach, "reach")
@@ -481,8 +511,7 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
     axes = [origin[i] + h * np.arange(shape[i]) for i in range(3)]
     P = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     d = igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0]
-    return _grid_field(np.ascontiguousarray(d.reshape(tuple(shape))), origin, h, velocity, c,
-                       rf, blend, moving, "mesh_tool")
+    return np.ascontiguousarray(d.reshape(tuple(shape))), origin, h, c, rf
 
 
 def sum(fields: Iterable[Field]) -> Field:
@@ -552,3 +581,150 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
                             as_real(duration, "duration"), kind, tool, as_real(rate, "rate"),
                             as_real(t0, "t0"), _opt(reach, "reach"), _power(falloff_power),
                             blend)
+
+
+# ---- curl tools of any shape, keyframed tools ------------------------------------------------
+
+def _motion(velocity, angular_velocity, pivot):
+    return (None if velocity is None else as_vector(velocity, "velocity"),
+            None if angular_velocity is None else as_vector(angular_velocity, "angular_velocity"),
+            None if pivot is None else as_vector(pivot, "pivot"))
+
+
+_CURL_DOC = """
+
+    The curl fields of :func:`translation` and :func:`rotation` (thesis Ch. 12, corrected
+    sign and scale) with the shape's signed distance ``d`` and its exact gradient
+    ``g = ∇d`` in place of the sphere's (the construction of the free-form tools, thesis
+    §11.2.5–11.2.6), ``e = R − |d|``, zero where ``|d| ≥ R``::
+
+        translation  V = −(1/(2R^p)) curl(φ(d) (Y × u))
+                       = (e^{p−1}/R^p) [ e u + (p/2) sgn(d) ((g·u) Y − (g·Y) u) ],  Y = X − C
+        rotation     V = −(1/(3R^p)) curl(φ(d) B),  B = |Y|² Ω − (Ω·Y) Y,  Y = X − pivot
+                       = (e^{p−1}/(3R^p)) [ p sgn(d) g × B + 3e Ω × Y ]
+
+    with ``φ = (R − |d|)^p``. Both are curls of potentials, so ``div V = 0`` exactly for
+    any C¹ ``d`` (interpolated or not); on the tool surface the normal velocity is the tool's
+    rigid motion, ``u·n`` or ``(Ω × Y)·n``. Give exactly one of ``velocity`` (a translation,
+    length/time) and ``angular_velocity`` (a rotation ``Ω``, rad/time, right-handed about
+    ``Ω/|Ω|`` through ``pivot``, default the centre); add two fields for both (each then
+    moves its own copy of the shape), or use :func:`keyframed` for a combined rigid motion.
+    ``moving=True`` carries the shape with the motion (translated by ``u t``, or turned by
+    ``|Ω| t`` about the pivot); ``moving=False`` keeps it where it is (a steady field).
+    ``falloff_power`` ``p ∈ {2, 3, 4}`` (2: C⁰ at ``|d| = R``, 4: C²)."""
+
+
+@_recorded
+def sdf_curl(grid, origin, spacing, *, velocity=None, angular_velocity=None, pivot=None,
+             center=None, reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+    """A curl tool whose shape is a signed distance sampled on a grid (negative inside):
+    ``d`` the C² tricubic B-spline interpolating the samples and ``g`` its exact gradient,
+    as for :func:`sdf_tool` (whose arguments ``grid``, ``origin``, ``spacing``, ``center``
+    and ``reach`` these are; the support ``|d| < reach``, inside the tool too, must stay
+    inside the grid)."""
+    a, o, h = _sdf_samples(grid, origin, spacing)
+    return _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
+                      moving, "sdf_curl")
+
+
+def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, pivot,
+               falloff_power, moving, name):
+    u, w, p = _motion(velocity, angular_velocity, pivot)
+    coef, c, reach = _grid_spline(values, origin, h, center, reach)
+    return _core.field_grid_curl(coef, origin, h, c, reach, u, w, p, _power(falloff_power),
+                                 as_bool(moving, "moving"), name)
+
+
+@_recorded
+def mesh_curl(mesh, *, velocity=None, angular_velocity=None, pivot=None, reach=None,
+              resolution: int = 64, center=None, falloff_power: int = 2,
+              moving: bool = True) -> Field:
+    """A curl tool whose shape is a closed triangle mesh: its signed distance sampled on the
+    grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``; needs
+    libigl), then :func:`sdf_curl`."""
+    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center)
+    return _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
+                      falloff_power, moving, "mesh_curl")
+
+
+@_recorded
+def rod(points, radius, *, velocity=None, angular_velocity=None, pivot=None, center=None,
+        reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+    """A curl tool whose shape is a rod: the tube of ``radius`` ρ about the axis through
+    ``points`` (two points: a capsule).
+
+    **Axis** as for :func:`strip_curve`: the clamped C² cubic spline ``γ`` through the points
+    in chord length, with the end tangents of :func:`spinal.estimate_tangents`.
+    **Distance** ``d = |X − γ(s*)| − ρ`` with ``s*`` the closest point of the axis (the end
+    samples beyond the end planes: round caps), gradient ``g = (X − γ(s*))/|X − γ(s*)|``
+    exactly (the envelope theorem); C¹ where the closest point is unique, which is checked
+    for ``radius + reach`` (curvature and self-approach, ``ValueError`` naming ``points``).
+    ``center`` C defaults to the centroid of the sample polyline, ``reach`` to ``radius``."""
+    u, w, p = _motion(velocity, angular_velocity, pivot)
+    c = None if center is None else as_vector(center, "center")
+    return _core.field_rod(as_points(points, "points"), as_real(radius, "radius"), c,
+                           _opt(reach, "reach"), u, w, p, _power(falloff_power),
+                           as_bool(moving, "moving"))
+
+
+for _ctor in (sdf_curl, mesh_curl, rod):
+    _ctor.__doc__ += _CURL_DOC
+del _ctor
+
+
+@_recorded
+def keyframed(tool, times, positions, orientations=None, *,
+              falloff_power: int | None = None) -> Field:
+    """The shape of ``tool`` following keyframed rigid poses ``(t_k, c_k, Q_k)``: at time ``t``
+    the curl translation with ``u = ċ(t)`` plus, with ``orientations``, the curl rotation with
+    ``Ω = ω(t)`` about ``c(t)`` (the formulas of :func:`sdf_curl`), with the shape's distance
+    at the current pose, ``d(C + Qᵀ(X − c))``, its gradient turned back by ``Q``. On the tool
+    surface the normal velocity is the rigid motion's, ``(ċ + ω × (X − c))·n``. Zero before
+    the first and after the last key (the tool rests there).
+
+    **Shape.** ``tool`` is a field of one tool with a shape: :func:`translation` or
+    :func:`rotation` (their sphere), :func:`sdf_curl`, :func:`mesh_curl`, :func:`rod` (a
+    capsule: two points), :func:`sdf_tool`, :func:`mesh_tool` or another keyframed tool.
+    The shape is taken where the tool is at ``t = 0``; its centre ``C`` goes to ``c_k`` and
+    it is turned by ``Q_k`` about it (``c_k = C``, ``Q_k = I`` leave it in place). The reach
+    is the tool's; ``falloff_power`` defaults to the tool's (2 for sdf_tool/mesh_tool).
+
+    **Interpolation.** Positions: cubic Hermite through the keys with Bessel tangents (the
+    derivative of the parabola through three neighbouring keys, Catmull–Rom's for uniform
+    times), so keys on a line at constant speed give exactly that motion; the velocity
+    ``ċ`` is continuous. Orientations: slerp along the shorter arc,
+    ``Q = Q_k Exp(λ Log(Q_kᵀ Q_{k+1}))``, ``ω = Q_k Log(Q_kᵀ Q_{k+1})/Δt_k`` constant on each
+    interval (it jumps at the keys). The key times are the field's
+    :meth:`Field.breakpoints`, so :func:`spinal.advect` ends steps there and keeps RK4's
+    order.
+
+    For a tool orbiting a pivot this is a translation of the centre plus a spin about it:
+    the same rigid motion (the same normal velocity on the tool) as :func:`rotation` about the
+    pivot, with a different tangential flow.
+
+    Parameters
+    ----------
+    tool : a Field of one tool with a shape (see above).
+    times : (k,) key times, k ≥ 2, strictly increasing.
+    positions : (k, 3) positions of the shape's centre.
+    orientations : (k, 3, 3) rotation matrices or (k, 4) unit quaternions ``(x, y, z, w)``
+        (as :mod:`spinal.quaternions`); None: the shape does not turn.
+    falloff_power : p in {2, 3, 4}, default the tool's.
+    """
+    if not isinstance(tool, Field):
+        raise TypeError(f"tool: expected a spinal.fields.Field, got {type(tool).__name__}")
+    t = as_float_array(times, "times")
+    if t.ndim != 1:
+        raise ValueError(f"times: expected a 1-D array, got shape {t.shape}")
+    x = as_points(positions, "positions")
+    mats = quats = None
+    if orientations is not None:
+        o = as_float_array(orientations, "orientations")
+        if o.ndim == 3 and o.shape[1:] == (3, 3):
+            mats = np.ascontiguousarray(o)
+        elif o.ndim == 2 and o.shape[1] == 4:
+            quats = np.ascontiguousarray(o)
+        else:
+            raise ValueError(f"orientations: expected shape (k, 3, 3) or (k, 4), got {o.shape}")
+    p = None if falloff_power is None else _power(falloff_power)
+    return _core.field_keyframed(tool, np.ascontiguousarray(t), x, mats, quats, p)

@@ -327,6 +327,43 @@ impl super::Tool for GridTool {
     fn length_scale(&self) -> f64 {
         self.reach
     }
+    fn shape(&self) -> Option<super::curl::ToolShape> {
+        Some(super::curl::ToolShape {
+            shape: super::curl::Shape::Grid(std::sync::Arc::new(self.clone())),
+            power: None,
+        })
+    }
+}
+
+impl GridTool {
+    /// An upper bound of `|X − C|` over the cells whose smallest coefficient is below the
+    /// reach (every point with `d < R`, inside the tool included).
+    pub fn support_extent(&self) -> f64 {
+        self.y_max[BUCKETS - 1]
+    }
+
+    /// An upper bound of `|∇d|`: each partial derivative of the B-spline is a spline of one
+    /// degree less whose coefficients are the differences `Δc/h` along that axis (a convex
+    /// combination of them), so `|∂d/∂x_a| ≤ max |Δ_a c|/h`.
+    pub fn slope_bound(&self) -> f64 {
+        let p = [self.n[0] + 2, self.n[1] + 2, self.n[2] + 2];
+        let stride = [p[1] * p[2], p[2], 1];
+        let mut m = [0.0f64; 3];
+        for i in 0..p[0] {
+            for j in 0..p[1] {
+                for k in 0..p[2] {
+                    let at = i * stride[0] + j * stride[1] + k;
+                    for (a, idx) in [i, j, k].into_iter().enumerate() {
+                        if idx + 1 < p[a] {
+                            let diff = (self.coef[at + stride[a]] - self.coef[at]).abs();
+                            m[a] = m[a].max(diff);
+                        }
+                    }
+                }
+            }
+        }
+        DVec3::from(m).length() / self.spacing
+    }
 }
 
 #[cfg(test)]

@@ -13,10 +13,13 @@
 
 pub mod advect;
 pub mod cross;
+pub mod curl;
 pub mod fields;
 pub mod grid;
+pub mod keyframe;
 pub mod path;
 pub mod refine;
+pub mod rod;
 pub mod stamp;
 pub mod tube;
 
@@ -68,6 +71,12 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
     /// so that neighbouring lanes share cache lines ([`advect::advect_ticked`]).
     fn wants_locality(&self) -> bool {
         false
+    }
+
+    /// The tool's shape (its signed distance, centre and reach) for tools that a
+    /// [`keyframe::Keyframed`] tool can pose; `None` for the others.
+    fn shape(&self) -> Option<curl::ToolShape> {
+        None
     }
 
     /// `out[j] += v(p[j], t)` for a batch of points.

@@ -424,18 +424,11 @@ pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Ve
     m
 }
 
-/// The strip of `spinal.fields.strip_curve` from its axis samples `points`: at least 2
-/// finite samples with no repeated consecutive point, parametrised by cumulative chord length
-/// `S`; the axis is the clamped C² cubic spline through them ([`clamped_spline_slopes`]) with
-/// the five-point unit tangents of `spinal.estimate_tangents` as end derivatives; then
-/// [`strip_along`]'s checks (errors name `points`, `radius`, `speed`, `reach`).
-pub fn strip_curve(
-    points: &[DVec3],
-    radius: f64,
-    speed: f64,
-    reach: Option<f64>,
-    linear: bool,
-) -> Result<StripAlong> {
+/// The axis samples of a tube about `points`: at least 2 finite samples with no repeated
+/// consecutive point, parametrised by cumulative chord length `S`, with the derivatives of
+/// the clamped C² cubic spline through them ([`clamped_spline_slopes`]) whose end derivatives
+/// are the five-point unit tangents of `spinal.estimate_tangents` (errors name `points`).
+pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
     if points.len() < 2 {
         return Err(InputError::new(
             "points",
@@ -461,13 +454,24 @@ pub fn strip_curve(
         crate::frames::TangentRule::FivePoint,
     )?;
     let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1]);
-    let samples = points
+    Ok(points
         .iter()
         .zip(&m)
         .zip(&s)
         .map(|((&x, &m), &s)| AxisSample { x, m, s })
-        .collect();
-    strip_along(samples, radius, speed, reach, linear)
+        .collect())
+}
+
+/// The strip of `spinal.fields.strip_curve` about `points` ([`axis_samples`], then
+/// [`strip_along`]'s checks; errors name `points`, `radius`, `speed`, `reach`).
+pub fn strip_curve(
+    points: &[DVec3],
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    linear: bool,
+) -> Result<StripAlong> {
+    strip_along(axis_samples(points)?, radius, speed, reach, linear)
 }
 
 /// Points per segment at which the axis is checked.

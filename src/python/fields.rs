@@ -5,14 +5,16 @@
 
 use glam::{DMat3, DVec3};
 use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
+    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use super::convert::{choice, empty, slice_mut, slice_of, value_error, vec3s};
 use crate::deform::{
-    self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, grid, path, tube,
+    self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
+    keyframe, path, rod, tube,
 };
 
 /// A divergence-free velocity field: a sum of tools built by the constructors of
@@ -550,4 +552,126 @@ pub fn field_zero() -> PyField {
         names: Vec::new(),
         recipe: Vec::new(),
     }
+}
+
+/// The motion of a curl tool from its optional arguments.
+fn motion(
+    velocity: Option<[f64; 3]>,
+    angular_velocity: Option<[f64; 3]>,
+    pivot: Option<[f64; 3]>,
+    center: DVec3,
+) -> PyResult<curl::Motion> {
+    Ok(curl::Motion::new(
+        velocity.map(DVec3::from),
+        angular_velocity.map(DVec3::from),
+        pivot.map(DVec3::from),
+        center,
+    )?)
+}
+
+/// `spinal.fields.sdf_curl` / `mesh_curl` from the B-spline coefficients `(nx+2, ny+2,
+/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_grid_curl(
+    coefficients: PyReadonlyArray3<'_, f64>,
+    origin: [f64; 3],
+    spacing: f64,
+    center: [f64; 3],
+    reach: f64,
+    velocity: Option<[f64; 3]>,
+    angular_velocity: Option<[f64; 3]>,
+    pivot: Option<[f64; 3]>,
+    falloff_power: i64,
+    moving: bool,
+    name: &str,
+) -> PyResult<PyField> {
+    let sh = coefficients.shape();
+    if sh.iter().any(|&k| k < 6) {
+        return Err(value_error(format!(
+            "grid: expected at least 4 nodes per axis, got shape {sh:?}"
+        )));
+    }
+    let n = [sh[0] - 2, sh[1] - 2, sh[2] - 2];
+    let coef = slice_of("grid", &coefficients)?.to_vec();
+    let shape = grid::grid_tool(
+        origin.into(),
+        spacing,
+        n,
+        coef,
+        DVec3::ZERO,
+        center.into(),
+        reach,
+        false,
+        false,
+    )?;
+    let m = motion(velocity, angular_velocity, pivot, shape.center)?;
+    let tool = curl::CurlTool::new(std::sync::Arc::new(shape), m, falloff_power, moving)?;
+    Ok(PyField::new(Field::single(tool), name))
+}
+
+/// `spinal.fields.rod`: a curl tool shaped as the tube about the axis through `points`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn field_rod(
+    py: Python<'_>,
+    points: PyReadonlyArray2<'_, f64>,
+    radius: f64,
+    center: Option<[f64; 3]>,
+    reach: Option<f64>,
+    velocity: Option<[f64; 3]>,
+    angular_velocity: Option<[f64; 3]>,
+    pivot: Option<[f64; 3]>,
+    falloff_power: i64,
+    moving: bool,
+) -> PyResult<PyField> {
+    let x = vec3s("points", &points)?;
+    let rod = py.detach(|| rod::Rod::from_points(x, radius, reach, center.map(DVec3::from)))?;
+    let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
+    let tool = curl::CurlTool::new(std::sync::Arc::new(rod), mo, falloff_power, moving)?;
+    Ok(PyField::new(Field::single(tool), "rod"))
+}
+
+/// `spinal.fields.keyframed`: the shape of `tool` (a field of one tool) following keys;
+/// orientations as rotation matrices `(k, 3, 3)` or quaternions `(k, 4)` `(x, y, z, w)`.
+#[pyfunction]
+pub fn field_keyframed(
+    tool: &PyField,
+    times: PyReadonlyArray1<'_, f64>,
+    positions: PyReadonlyArray2<'_, f64>,
+    matrices: Option<PyReadonlyArray3<'_, f64>>,
+    quaternions: Option<PyReadonlyArray2<'_, f64>>,
+    falloff_power: Option<i64>,
+) -> PyResult<PyField> {
+    let shape = match tool.field.tools.as_slice() {
+        [one] => one.shape(),
+        _ => None,
+    };
+    let Some(shape) = shape else {
+        return Err(value_error(format!(
+            "tool: expected a field of one tool with a shape (translation, rotation, sdf_curl, \
+             mesh_curl, rod, sdf_tool, mesh_tool or keyframed), got {}",
+            tool.__repr__()
+        )));
+    };
+    let t = slice_of("times", &times)?;
+    let x = vec3s("positions", &positions)?;
+    let orientations = match (matrices, quaternions) {
+        (Some(m), _) => {
+            let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("orientations", &m)?);
+            Some(keyframe::Orientations::Matrices(
+                rows.iter()
+                    .map(|r| DMat3::from_cols_array(r).transpose())
+                    .collect(),
+            ))
+        }
+        (None, Some(q)) => {
+            let q = super::convert::quats("orientations", &q)?;
+            Some(keyframe::Orientations::Quaternions(q.to_vec()))
+        }
+        (None, None) => None,
+    };
+    let keys = keyframe::Keys::new(t, x, orientations)?;
+    let f = keyframe::keyframed(shape, keys, falloff_power)?;
+    Ok(PyField::new(f, "keyframed"))
 }

@@ -51,6 +51,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fields::field_grid, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_path, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_zero, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_grid_curl, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_rod, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_keyframed, m)?)?;
     m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;

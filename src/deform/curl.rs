@@ -1,0 +1,484 @@
+//! Curl tools of any shape (Zheng, thesis Ch. 12, eq. 12.1–12.3, for the free-form tools of
+//! §11.2.5–11.2.6): the curl fields of [`super::fields`] with the sphere's distance replaced
+//! by the signed distance `d` of an arbitrary shape and its exact gradient `g = ∇d`.
+//!
+//! With `e = R − |d|`, falloff `φ = e^p` (`p ∈ {2, 3, 4}`) and `φ′ = −p sgn(d) e^{p−1}`,
+//! `curl(φB) = φ′ g × B + φ curl B` gives
+//!
+//! * **translation** `V = −(1/(2R^p)) curl(φ (Y × u))`, `Y = X − C` (`C` the tool's centre),
+//!   `curl(Y × u) = −2u`:
+//!
+//!   `V = (e^{p−1}/R^p) [ e u + (p/2) sgn(d) ((g·u) Y − (g·Y) u) ]`;
+//! * **rotation** `V = −(1/(3R^p)) curl(φ B)`, `B = |Y|²Ω − (Ω·Y)Y`, `Y = X − pivot`,
+//!   `curl B = 3 Y × Ω`:
+//!
+//!   `V = (e^{p−1}/(3R^p)) [ p sgn(d) g × B + 3e Ω × Y ]`.
+//!
+//! Both are curls of potentials that are C¹ where `d` is C¹ (`φ` is C¹ at `|d| = R`), so
+//! `div V = 0` exactly for *any* C¹ distance, interpolated or not, as long as `g` is the
+//! exact gradient of the `d` used. On the tool surface (`d = 0`, `|g| = 1`) the normal
+//! velocity is `u·g` resp. `(Ω × Y)·g`: the material neither enters the tool nor separates
+//! from it. With a sphere's distance (`g = Y/|Y|`) these are the fields of
+//! [`super::fields::Translation`] and [`super::fields::Rotation`].
+//!
+//! **Shapes** ([`Distance`]): a ball (the sphere tools), a rod about a spline axis
+//! ([`super::rod`]) and a sampled distance (a C² tricubic B-spline, [`super::grid`]; the
+//! mesh tools sample a closed mesh's distance onto it).
+//!
+//! **Motion** ([`CurlTool`]): a translation with velocity `u` or a rotation with angular
+//! velocity `Ω` about a pivot; a moving tool carries its shape rigidly (`d` evaluated in the
+//! shape's own frame, `X_b = C + Q(t)ᵀ(X − c(t))`, the gradient turned back, `g = Q g_b`),
+//! a static one keeps it where it was built (a steady field).
+
+use std::sync::Arc;
+
+use glam::{DMat3, DVec3};
+
+use super::grid::GridTool;
+use super::rod::Rod;
+use super::{Tool, bounded, falloff as falloff_power, finite3};
+use crate::error::{InputError, Result};
+
+/// The signed distance of a tool's shape (negative inside), in the shape's own frame.
+pub trait Distance: Send + Sync + std::fmt::Debug {
+    /// `(d, ∇d)` at `x`, or `None` where `|d| ≥ reach` is certain (it may also return a
+    /// distance with `|d| ≥ reach`, which the falloff zeroes). `∇d` must be the exact
+    /// gradient of the `d` returned (it need not be a unit vector).
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)>;
+    /// The reach `R` the shape was built for (the support is `|d| < R`).
+    fn reach(&self) -> f64;
+    /// The tool's centre `C` (the origin of `Y` for a translation).
+    fn center(&self) -> DVec3;
+    /// An upper bound of `|X − C|` over the support `|d| < R`.
+    fn extent(&self) -> f64;
+    /// An upper bound of `|∇d|` over the support (1 for an exact distance).
+    fn gradient_bound(&self) -> f64 {
+        1.0
+    }
+}
+
+impl<D: Distance + ?Sized> Distance for Arc<D> {
+    #[inline(always)]
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
+        (**self).distance(x)
+    }
+    fn reach(&self) -> f64 {
+        (**self).reach()
+    }
+    fn center(&self) -> DVec3 {
+        (**self).center()
+    }
+    fn extent(&self) -> f64 {
+        (**self).extent()
+    }
+    fn gradient_bound(&self) -> f64 {
+        (**self).gradient_bound()
+    }
+}
+
+/// A ball: `d = |X − c| − ρ`, `∇d = (X − c)/|X − c|` (zero at the centre).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ball {
+    pub center: DVec3,
+    pub radius: f64,
+    pub reach: f64,
+}
+
+impl Distance for Ball {
+    #[inline(always)]
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
+        let y = x - self.center;
+        let r2 = y.length_squared();
+        let (outer, inner) = (self.radius + self.reach, self.radius - self.reach);
+        if !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner) {
+            return None;
+        }
+        let r = r2.sqrt();
+        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
+        Some((r - self.radius, g))
+    }
+    fn reach(&self) -> f64 {
+        self.reach
+    }
+    fn center(&self) -> DVec3 {
+        self.center
+    }
+    fn extent(&self) -> f64 {
+        self.radius + self.reach
+    }
+}
+
+impl Distance for GridTool {
+    #[inline(always)]
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
+        GridTool::distance(self, x)
+    }
+    fn reach(&self) -> f64 {
+        self.reach
+    }
+    fn center(&self) -> DVec3 {
+        self.center
+    }
+    fn extent(&self) -> f64 {
+        self.support_extent()
+    }
+    fn gradient_bound(&self) -> f64 {
+        self.slope_bound()
+    }
+}
+
+/// The falloff factors at distance `d`: `k = e^{p−1}/R^p`, `e = R − |d|` and `p sgn(d)`;
+/// `None` outside the support.
+#[derive(Debug, Clone, Copy)]
+pub struct Falloff {
+    pub k: f64,
+    pub e: f64,
+    pub ps: f64,
+}
+
+impl Falloff {
+    #[inline(always)]
+    pub fn at(d: f64, reach: f64, p: u8) -> Option<Falloff> {
+        let e = reach - d.abs();
+        if !(e > 0.0) {
+            return None;
+        }
+        let (ep, rp) = match p {
+            2 => (e, reach * reach),
+            3 => (e * e, reach * reach * reach),
+            _ => (e * e * e, (reach * reach) * (reach * reach)),
+        };
+        let pf = p as f64;
+        Some(Falloff {
+            k: ep / rp,
+            e,
+            ps: if d < 0.0 { -pf } else { pf },
+        })
+    }
+
+    /// The curl translation `(e^{p−1}/R^p)[e u + (p/2) sgn(d)((g·u)Y − (g·Y)u)]`.
+    #[inline(always)]
+    pub fn translate(&self, g: DVec3, y: DVec3, u: DVec3) -> DVec3 {
+        self.k * (self.e * u + (0.5 * self.ps) * (y * g.dot(u) - u * g.dot(y)))
+    }
+
+    /// The curl rotation `(e^{p−1}/(3R^p))[p sgn(d) g × B + 3e Ω × Y]`, `B = |Y|²Ω − (Ω·Y)Y`.
+    #[inline(always)]
+    pub fn rotate(&self, g: DVec3, y: DVec3, omega: DVec3) -> DVec3 {
+        let b = omega * y.length_squared() - y * omega.dot(y);
+        (self.k / 3.0) * (self.ps * g.cross(b) + (3.0 * self.e) * omega.cross(y))
+    }
+}
+
+/// Speed bound of a curl translation with speed `u` of a shape: `|g × (Y × u)| ≤ G L |u|` and
+/// `e ≤ R` give `|V| ≤ |u| (1 + (p/2) G L / R)`.
+pub fn translation_bound(u: f64, shape: &dyn Distance, p: u8) -> f64 {
+    u * (1.0 + 0.5 * p as f64 * shape.gradient_bound() * shape.extent() / shape.reach())
+}
+
+/// Speed bound of a curl rotation with angular speed `w` about a pivot at `arm` from the
+/// centre: `|B| ≤ w L²`, `|Ω × Y| ≤ w L` with `L = arm + extent` give
+/// `|V| ≤ w L (1 + p G L/(3R))`.
+pub fn rotation_bound(w: f64, arm: f64, shape: &dyn Distance, p: u8) -> f64 {
+    let l = arm + shape.extent();
+    w * l * (1.0 + p as f64 * shape.gradient_bound() * l / (3.0 * shape.reach()))
+}
+
+/// How a [`CurlTool`] moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// Translation with velocity `u`.
+    Translate(DVec3),
+    /// Rotation with angular velocity `Ω` (right-handed, rad/time) about `pivot`.
+    Rotate { omega: DVec3, pivot: DVec3 },
+}
+
+impl Motion {
+    /// The motion of exactly one of `velocity` and `angular_velocity` (`pivot`, default the
+    /// centre, only with a rotation), validated (errors name the argument).
+    pub fn new(
+        velocity: Option<DVec3>,
+        angular_velocity: Option<DVec3>,
+        pivot: Option<DVec3>,
+        center: DVec3,
+    ) -> Result<Motion> {
+        match (velocity, angular_velocity) {
+            (Some(u), None) => {
+                if pivot.is_some() {
+                    return Err(InputError::new(
+                        "pivot",
+                        "only applies to a rotation (angular_velocity)",
+                    ));
+                }
+                Ok(Motion::Translate(finite3("velocity", u)?))
+            }
+            (None, Some(w)) => Ok(Motion::Rotate {
+                omega: finite3("angular_velocity", w)?,
+                pivot: pivot.map_or(Ok(center), |p| finite3("pivot", p))?,
+            }),
+            (None, None) => Err(InputError::new(
+                "velocity",
+                "give velocity (a translation) or angular_velocity (a rotation)",
+            )),
+            (Some(_), Some(_)) => Err(InputError::new(
+                "angular_velocity",
+                "give either velocity or angular_velocity, not both (add two fields, or use \
+                 fields.keyframed for a combined rigid motion)",
+            )),
+        }
+    }
+}
+
+/// The pose of a shape at one time: `X_b = C + Qᵀ(X − c)` (its own frame), `g = Q g_b`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Where the shape's centre is.
+    pub c: DVec3,
+    /// Its orientation relative to the shape as built.
+    pub q: DMat3,
+}
+
+impl Pose {
+    /// The distance and its world gradient at `x` for the shape at this pose.
+    #[inline(always)]
+    pub fn distance<D: Distance>(&self, shape: &D, x: DVec3) -> Option<(f64, DVec3)> {
+        let xb = shape.center() + self.q.transpose() * (x - self.c);
+        shape.distance(xb).map(|(d, g)| (d, self.q * g))
+    }
+}
+
+/// A curl tool of any shape: translation or rotation (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurlTool<D> {
+    pub shape: D,
+    pub motion: Motion,
+    pub power: u8,
+    /// The shape moves with the tool; else the field is steady.
+    pub moving: bool,
+}
+
+impl<D: Distance + Clone + Into<Shape>> CurlTool<D> {
+    /// The tool, validated (errors name the Python argument).
+    pub fn new(shape: D, motion: Motion, power: i64, moving: bool) -> Result<CurlTool<D>> {
+        let arg = match motion {
+            Motion::Translate(_) => "velocity",
+            Motion::Rotate { .. } => "angular_velocity",
+        };
+        bounded(
+            arg,
+            CurlTool {
+                shape,
+                motion,
+                power: falloff_power(power)?,
+                moving,
+            },
+        )
+    }
+
+    /// The shape's pose at time `t`.
+    #[inline]
+    pub fn pose(&self, t: f64) -> Pose {
+        let c0 = self.shape.center();
+        if !self.moving || t == 0.0 {
+            return Pose {
+                c: c0,
+                q: DMat3::IDENTITY,
+            };
+        }
+        match self.motion {
+            Motion::Translate(u) => Pose {
+                c: c0 + u * t,
+                q: DMat3::IDENTITY,
+            },
+            Motion::Rotate { omega, pivot } => {
+                let w = omega.length();
+                if !(w > 0.0) {
+                    return Pose {
+                        c: c0,
+                        q: DMat3::IDENTITY,
+                    };
+                }
+                let q = DMat3::from_axis_angle(omega / w, w * t);
+                Pose {
+                    c: pivot + q * (c0 - pivot),
+                    q,
+                }
+            }
+        }
+    }
+
+    /// The velocity at `x` with the shape at `pose`.
+    #[inline(always)]
+    pub fn eval_at(&self, x: DVec3, pose: &Pose) -> DVec3 {
+        let Some((d, g)) = pose.distance(&self.shape, x) else {
+            return DVec3::ZERO;
+        };
+        let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
+            return DVec3::ZERO;
+        };
+        match self.motion {
+            Motion::Translate(u) => f.translate(g, x - pose.c, u),
+            // the pivot stays fixed (a shape off the pivot orbits it)
+            Motion::Rotate { omega, pivot } => f.rotate(g, x - pivot, omega),
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        self.eval_at(x, &self.pose(t))
+    }
+
+    pub fn max_speed(&self) -> f64 {
+        match self.motion {
+            Motion::Translate(u) => translation_bound(u.length(), &self.shape, self.power),
+            Motion::Rotate { omega, pivot } => rotation_bound(
+                omega.length(),
+                (self.shape.center() - pivot).length(),
+                &self.shape,
+                self.power,
+            ),
+        }
+    }
+}
+
+impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
+        self.eval(x, t)
+    }
+    fn max_speed(&self) -> f64 {
+        CurlTool::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.shape.reach()
+    }
+    fn rigid_velocity(&self) -> DVec3 {
+        match self.motion {
+            Motion::Translate(u) if self.moving => u,
+            _ => DVec3::ZERO,
+        }
+    }
+    fn shape(&self) -> Option<ToolShape> {
+        Some(ToolShape {
+            shape: self.shape.clone().into(),
+            power: Some(self.power),
+        })
+    }
+    /// The pose once per batch.
+    #[inline]
+    fn add_lanes(&self, p: &[DVec3], t: f64, _tm: f64, out: &mut [DVec3]) {
+        let pose = self.pose(t);
+        for (o, x) in out.iter_mut().zip(p) {
+            *o += self.eval_at(*x, &pose);
+        }
+    }
+    #[inline]
+    fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
+        super::advect::rk4_lanes_with(
+            |p, t, tm, out| self.add_lanes(p, t, tm, out),
+            x,
+            t0,
+            h,
+            steps,
+        );
+    }
+}
+
+/// A tool's shape, for tools that can be posed by keys ([`super::keyframe`]).
+#[derive(Debug, Clone)]
+pub enum Shape {
+    Ball(Ball),
+    Rod(Arc<Rod>),
+    Grid(Arc<GridTool>),
+}
+
+impl From<Ball> for Shape {
+    fn from(b: Ball) -> Shape {
+        Shape::Ball(b)
+    }
+}
+
+impl From<Arc<Rod>> for Shape {
+    fn from(r: Arc<Rod>) -> Shape {
+        Shape::Rod(r)
+    }
+}
+
+impl From<Arc<GridTool>> for Shape {
+    fn from(g: Arc<GridTool>) -> Shape {
+        Shape::Grid(g)
+    }
+}
+
+/// The shape of a built tool and its falloff power (`None` for tools that are not curl
+/// fields: the keyframed tool then needs one).
+#[derive(Debug, Clone)]
+pub struct ToolShape {
+    pub shape: Shape,
+    pub power: Option<u8>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fields::{Rotation, Translation};
+    use super::*;
+
+    fn div(f: impl Fn(DVec3) -> DVec3, x: DVec3) -> f64 {
+        let h = 1e-6;
+        (0..3)
+            .map(|k| {
+                let mut e = DVec3::ZERO;
+                e[k] = h;
+                (f(x + e)[k] - f(x - e)[k]) / (2.0 * h)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn a_ball_gives_the_sphere_tools() {
+        let c = DVec3::new(0.1, -0.2, 0.3);
+        let ball = Ball {
+            center: c,
+            radius: 0.4,
+            reach: 0.3,
+        };
+        let u = DVec3::new(0.3, -1.0, 0.5);
+        for p in [2, 3, 4] {
+            let tr = Translation::new(c, 0.4, u, Some(0.3), p, true).unwrap();
+            let ct = CurlTool::new(ball, Motion::Translate(u), p, true).unwrap();
+            let om = DVec3::new(0.2, 0.5, -1.0);
+            let pivot = c + DVec3::new(0.5, 0.1, -0.2);
+            let ro = Rotation::new(c, 0.4, om, om.length(), Some(pivot), Some(0.3), p).unwrap();
+            let cr = CurlTool::new(ball, Motion::Rotate { omega: om, pivot }, p, true).unwrap();
+            for i in 0..200 {
+                let a = i as f64 * 0.7;
+                let x = c + DVec3::new(a.sin(), (1.3 * a).cos(), (0.7 * a).sin()) * 0.6;
+                for t in [0.0, 0.3] {
+                    assert!((tr.eval(x, t) - ct.eval(x, t)).length() < 1e-14);
+                    assert!((ro.eval(x, t) - cr.eval(x, t)).length() < 1e-13);
+                }
+                if (x - c).length() > 0.45 && (x - c).length() < 0.65 {
+                    assert!(div(|x| ct.eval(x, 0.1), x).abs() < 1e-7);
+                    assert!(div(|x| cr.eval(x, 0.1), x).abs() < 1e-6);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn motion_needs_exactly_one_velocity() {
+        let z = DVec3::ZERO;
+        assert_eq!(
+            Motion::new(None, None, None, z).unwrap_err().arg,
+            "velocity"
+        );
+        assert_eq!(
+            Motion::new(Some(z), Some(z), None, z).unwrap_err().arg,
+            "angular_velocity"
+        );
+        assert_eq!(
+            Motion::new(Some(z), None, Some(z), z).unwrap_err().arg,
+            "pivot"
+        );
+    }
+}

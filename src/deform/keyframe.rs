@@ -1,0 +1,392 @@
+//! Tools following keyframed rigid poses `(t_k, c_k, Q_k)` (the thesis's tools move rigidly
+//! with their object space, Zheng Ch. 11.2, §11.2.6; the curl fields are those of Ch. 12).
+//!
+//! **Pose.** In key interval `k`, `λ = (t − t_k)/Δt_k`:
+//!
+//! * position: the cubic Hermite segment through `c_k, c_{k+1}` with end slopes `ċ_k Δt_k`,
+//!   `ċ_{k+1} Δt_k`, where `ċ_k` is the derivative of the parabola through the keys
+//!   `k − 1, k, k + 1` (Bessel's tangent: Catmull–Rom's for uniform times; at the ends the
+//!   parabola through the first or last three keys, the chord for two keys). Keys on a line
+//!   at constant speed give exactly that motion. `c(t)` is C¹ in time;
+//! * orientation: slerp, `Q(λ) = Q_k Exp(λ Θ_k)` with `Θ_k = Log(Q_kᵀ Q_{k+1})` (the short
+//!   arc: consecutive quaternions are sign-aligned), world angular velocity
+//!   `ω = Q_k Θ_k / Δt_k`, constant in each interval. `Q(t)` is C⁰ in its rate at the keys.
+//!
+//! **Field** at time `t`: the curl translation of [`super::curl`] with `u = ċ(t)` and
+//! `Y = X − c(t)`, plus (when orientations are given) the curl rotation with `Ω = ω(t)` about
+//! `c(t)`, both with the shape's distance at the current pose, `d(C + Qᵀ(X − c))` and its
+//! gradient turned back by `Q`. Their normal velocity on the tool surface is the rigid
+//! motion's, `(ċ + ω × (X − c))·n`. Zero before the first and after the last key (the tool
+//! rests); the key times are breakpoints, and a step's midpoint time `tm` picks the interval
+//! (and whether the tool moves) for all its stages.
+
+use glam::{DMat3, DQuat, DVec3};
+
+use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound, translation_bound};
+use super::{Tool, falloff};
+use crate::error::{InputError, Result};
+use crate::math::cubic::Hermite;
+use crate::math::rotation::{ROTATION_TOL, is_rotation, mat3_from_quat, quat_from_mat3};
+
+/// Key orientations as the user gives them.
+#[derive(Debug, Clone)]
+pub enum Orientations {
+    /// Rotation matrices.
+    Matrices(Vec<DMat3>),
+    /// Unit quaternions.
+    Quaternions(Vec<DQuat>),
+}
+
+/// Validated keys with their interpolation data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Keys {
+    pub times: Vec<f64>,
+    pub positions: Vec<DVec3>,
+    /// `dc/dt` at the keys.
+    slopes: Vec<DVec3>,
+    /// Key frames and the body rotation vector `Θ_k` of each interval.
+    turns: Option<(Vec<DMat3>, Vec<DVec3>)>,
+}
+
+/// The pose and its rates at one time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyPose {
+    pub pose: Pose,
+    /// `ċ`.
+    pub v: DVec3,
+    /// World angular velocity `ω`.
+    pub omega: DVec3,
+}
+
+impl Keys {
+    /// The keys, validated (errors name `times`, `positions`, `orientations`).
+    pub fn new(
+        times: &[f64],
+        positions: &[DVec3],
+        orientations: Option<Orientations>,
+    ) -> Result<Keys> {
+        let n = times.len();
+        if n < 2 {
+            return Err(InputError::new(
+                "times",
+                format!("need at least 2 keys, got {n}"),
+            ));
+        }
+        if let Some(i) = times.iter().position(|t| !t.is_finite()) {
+            return Err(InputError::new("times", format!("key {i} is not finite")));
+        }
+        if let Some(i) = times.windows(2).position(|w| !(w[1] > w[0])) {
+            return Err(InputError::new(
+                "times",
+                format!(
+                    "must increase strictly: key {} ({}) is not after key {i} ({})",
+                    i + 1,
+                    times[i + 1],
+                    times[i]
+                ),
+            ));
+        }
+        if positions.len() != n {
+            return Err(InputError::new(
+                "positions",
+                format!("expected {n} rows (one per key), got {}", positions.len()),
+            ));
+        }
+        super::finite_rows("positions", positions)?;
+        let dt: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+        let delta: Vec<DVec3> = positions
+            .windows(2)
+            .zip(&dt)
+            .map(|(w, h)| (w[1] - w[0]) / *h)
+            .collect();
+        let mut slopes = Vec::with_capacity(n);
+        for k in 0..n {
+            slopes.push(if n == 2 {
+                delta[0]
+            } else if k == 0 {
+                delta[0] + (delta[0] - delta[1]) * (dt[0] / (dt[0] + dt[1]))
+            } else if k == n - 1 {
+                let (a, b) = (delta[n - 2], delta[n - 3]);
+                a + (a - b) * (dt[n - 2] / (dt[n - 3] + dt[n - 2]))
+            } else {
+                (delta[k - 1] * dt[k] + delta[k] * dt[k - 1]) / (dt[k - 1] + dt[k])
+            });
+        }
+        let turns = match orientations {
+            None => None,
+            Some(o) => {
+                let bad = |m: String| InputError::new("orientations", m);
+                let mut q: Vec<DQuat> = match o {
+                    Orientations::Matrices(m) => {
+                        if let Some(i) = m.iter().position(|f| !is_rotation(f)) {
+                            return Err(bad(format!("key {i} is not a rotation matrix")));
+                        }
+                        m.iter().map(quat_from_mat3).collect()
+                    }
+                    Orientations::Quaternions(q) => {
+                        if let Some(i) = q.iter().position(|q| {
+                            !(q.is_finite() && (q.length() - 1.0).abs() < ROTATION_TOL)
+                        }) {
+                            return Err(bad(format!(
+                                "quaternion {i} is not a unit quaternion (x, y, z, w)"
+                            )));
+                        }
+                        q.iter().map(|q| q.normalize()).collect()
+                    }
+                };
+                if q.len() != n {
+                    return Err(bad(format!(
+                        "expected {n} orientations (one per key), got {}",
+                        q.len()
+                    )));
+                }
+                for k in 1..n {
+                    if q[k].dot(q[k - 1]) < 0.0 {
+                        q[k] = -q[k];
+                    }
+                }
+                let frames = q.iter().map(|q| mat3_from_quat(*q)).collect();
+                let theta = q
+                    .windows(2)
+                    .map(|w| {
+                        let (axis, angle) = (w[0].conjugate() * w[1]).normalize().to_axis_angle();
+                        if angle.is_finite() && angle != 0.0 {
+                            axis * angle
+                        } else {
+                            DVec3::ZERO
+                        }
+                    })
+                    .collect();
+                Some((frames, theta))
+            }
+        };
+        Ok(Keys {
+            times: times.to_vec(),
+            positions: positions.to_vec(),
+            slopes,
+            turns,
+        })
+    }
+
+    /// The position's Hermite data on interval `k`.
+    #[inline]
+    fn segment(&self, k: usize) -> Hermite {
+        let h = self.times[k + 1] - self.times[k];
+        Hermite::new(
+            self.positions[k],
+            self.positions[k + 1],
+            self.slopes[k] * h,
+            self.slopes[k + 1] * h,
+        )
+    }
+
+    /// The pose at time `t` of a step whose midpoint time is `tm` (`None` while the tool
+    /// rests: `tm` before the first or after the last key).
+    pub fn pose_in(&self, t: f64, tm: f64) -> Option<KeyPose> {
+        let n = self.times.len();
+        if !(tm >= self.times[0] && tm <= self.times[n - 1]) {
+            return None;
+        }
+        let k = self
+            .times
+            .partition_point(|s| *s <= tm)
+            .saturating_sub(1)
+            .min(n - 2);
+        let h = self.times[k + 1] - self.times[k];
+        let lam = (t - self.times[k]) / h;
+        let seg = self.segment(k);
+        let (c, v) = (seg.value(lam), seg.slope(lam) / h);
+        let (q, omega) = match &self.turns {
+            None => (DMat3::IDENTITY, DVec3::ZERO),
+            Some((frames, theta)) => {
+                let th = theta[k];
+                let ang = th.length();
+                let q = if ang > 0.0 {
+                    frames[k] * DMat3::from_axis_angle(th / ang, lam * ang)
+                } else {
+                    frames[k]
+                };
+                (q, frames[k] * th / h)
+            }
+        };
+        Some(KeyPose {
+            pose: Pose { c, q },
+            v,
+            omega,
+        })
+    }
+
+    /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`.
+    pub fn rates(&self) -> (f64, f64) {
+        let mut v: f64 = 0.0;
+        for k in 0..self.times.len() - 1 {
+            let seg = self.segment(k);
+            let h = self.times[k + 1] - self.times[k];
+            for i in 0..=16 {
+                v = v.max(seg.slope(i as f64 / 16.0).length() / h);
+            }
+        }
+        let w = match &self.turns {
+            None => 0.0,
+            Some((_, theta)) => theta
+                .iter()
+                .zip(self.times.windows(2))
+                .map(|(th, t)| th.length() / (t[1] - t[0]))
+                .fold(0.0, f64::max),
+        };
+        (1.05 * v, w)
+    }
+}
+
+/// A shape following keys (see the module docs).
+#[derive(Debug, Clone)]
+pub struct Keyframed<D> {
+    pub shape: D,
+    pub keys: Keys,
+    pub power: u8,
+}
+
+impl<D: Distance> Keyframed<D> {
+    /// The tool, validated: a finite speed bound (errors name `times`).
+    pub fn new(shape: D, keys: Keys, power: u8) -> Result<Keyframed<D>> {
+        let tool = Keyframed { shape, keys, power };
+        let s = tool.max_speed();
+        if !s.is_finite() {
+            return Err(InputError::new(
+                "times",
+                format!("keys too close in time: the tool's speed bound is {s}"),
+            ));
+        }
+        Ok(tool)
+    }
+
+    /// The velocity at `x` for the tool at pose `p`.
+    #[inline(always)]
+    pub fn eval_at(&self, x: DVec3, p: &KeyPose) -> DVec3 {
+        let Some((d, g)) = p.pose.distance(&self.shape, x) else {
+            return DVec3::ZERO;
+        };
+        let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
+            return DVec3::ZERO;
+        };
+        let y = x - p.pose.c;
+        let v = f.translate(g, y, p.v);
+        if self.keys.turns.is_some() {
+            v + f.rotate(g, y, p.omega)
+        } else {
+            v
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        match self.keys.pose_in(t, tm) {
+            Some(p) => self.eval_at(x, &p),
+            None => DVec3::ZERO,
+        }
+    }
+
+    pub fn max_speed(&self) -> f64 {
+        let (v, w) = self.keys.rates();
+        translation_bound(v, &self.shape, self.power)
+            + rotation_bound(w, 0.0, &self.shape, self.power)
+    }
+}
+
+/// The keyframed tool of a built tool's shape: `power` (2, 3 or 4) overrides the tool's
+/// falloff power; a tool without one (not a curl field) defaults to 2.
+pub fn keyframed(shape: ToolShape, keys: Keys, power: Option<i64>) -> Result<super::Field> {
+    let p = match (power, shape.power) {
+        (Some(p), _) => falloff(p)?,
+        (None, Some(p)) => p,
+        (None, None) => 2,
+    };
+    Ok(match shape.shape {
+        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p)?),
+        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p)?),
+        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p)?),
+    })
+}
+
+impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        self.eval(x, t, tm)
+    }
+    fn max_speed(&self) -> f64 {
+        Keyframed::max_speed(self)
+    }
+    fn length_scale(&self) -> f64 {
+        self.shape.reach()
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.keys.times.clone()
+    }
+    fn shape(&self) -> Option<ToolShape> {
+        Some(ToolShape {
+            shape: self.shape.clone().into(),
+            power: Some(self.power),
+        })
+    }
+    /// The pose once per batch, then the frozen-pose field at every point.
+    #[inline]
+    fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
+        if let Some(pose) = self.keys.pose_in(t, tm) {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += self.eval_at(*x, &pose);
+            }
+        }
+    }
+    #[inline]
+    fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
+        super::advect::rk4_lanes_with(
+            |p, t, tm, out| self.add_lanes(p, t, tm, out),
+            x,
+            t0,
+            h,
+            steps,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_on_a_line_at_constant_speed_move_linearly() {
+        let u = DVec3::new(0.3, -0.2, 0.1);
+        let times = [0.0, 0.5, 1.5, 2.0];
+        let pos: Vec<DVec3> = times.iter().map(|t| DVec3::ONE + u * *t).collect();
+        let keys = Keys::new(&times, &pos, None).unwrap();
+        for t in [0.1, 0.7, 1.9] {
+            let p = keys.pose_in(t, t).unwrap();
+            assert!((p.pose.c - (DVec3::ONE + u * t)).length() < 1e-15);
+            assert!((p.v - u).length() < 1e-15);
+        }
+        assert!(keys.pose_in(2.1, 2.1).is_none());
+        assert_eq!(
+            Keys::new(&[0.0, 0.0], &pos[..2], None).unwrap_err().arg,
+            "times"
+        );
+    }
+
+    #[test]
+    fn slerp_turns_at_a_constant_rate() {
+        let ax = DVec3::new(1.0, 2.0, -0.5).normalize();
+        let times = [0.0, 1.0, 2.0];
+        let q: Vec<DQuat> = times
+            .iter()
+            .map(|t| DQuat::from_axis_angle(ax, 0.8 * t))
+            .collect();
+        let keys = Keys::new(
+            &times,
+            &[DVec3::ZERO; 3],
+            Some(Orientations::Quaternions(q)),
+        )
+        .unwrap();
+        let p = keys.pose_in(1.3, 1.3).unwrap();
+        assert!((p.omega - ax * 0.8).length() < 1e-14);
+        assert!((p.pose.q - DMat3::from_axis_angle(ax, 0.8 * 1.3)).abs_diff_eq(DMat3::ZERO, 1e-14));
+    }
+}
