@@ -76,14 +76,33 @@ impl Segment {
     }
 }
 
+/// A smooth axis curve through samples: the piecewise cubic Hermite `γ`, checked for a tube
+/// of radius `outer` about it (the foot point of every point within `outer` is unique), with
+/// the closest-point query. Shared by the curved strip and the rod of [`super::rod`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// The samples: positions, derivatives `dγ/dS`, cumulative chord lengths.
+    pub samples: Vec<AxisSample>,
+    segs: Vec<Segment>,
+    /// A sphere (`centre`, `bound`) containing every segment's hull.
+    centre: DVec3,
+    bound: f64,
+}
+
+/// The nearest point of an [`Axis`] to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Foot {
+    /// On segment `k` at local parameter `λ`.
+    Segment(usize, f64),
+    /// An end sample (the point lies beyond the end's normal plane).
+    Cap(usize),
+}
+
 /// Strip of type I along a curved axis (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StripAlong {
-    pub samples: Vec<AxisSample>,
-    segs: Vec<Segment>,
-    /// A sphere containing every segment's hull.
-    centre: DVec3,
-    bound: f64,
+    /// The axis (checked for `radius + reach`).
+    pub axis: Axis,
     pub speed: f64,
     pub radius: f64,
     pub reach: f64,
@@ -91,6 +110,8 @@ pub struct StripAlong {
 }
 
 impl StripAlong {
+    /// The strip about the axis through `samples` (errors name `points` for the axis and
+    /// `speed`).
     pub fn new(
         samples: Vec<AxisSample>,
         speed: f64,
@@ -98,25 +119,38 @@ impl StripAlong {
         reach: f64,
         linear: bool,
     ) -> Result<StripAlong> {
-        // every check is about the axis samples (`points` of `spinal.fields.strip_curve`);
-        // [`super::Element::parse_strip`] renames them `field` for rows
-        let bad = |m: String| InputError::new("points", m);
-        let axis = bad;
-        if samples.len() < 2 {
-            return Err(axis("a strip axis needs at least 2 samples".into()));
-        }
         if !speed.is_finite() {
             return Err(InputError::new(
                 "speed",
                 format!("strip speed must be finite, got {speed}"),
             ));
         }
+        Ok(StripAlong {
+            axis: Axis::new(samples, radius + reach)?,
+            speed,
+            radius,
+            reach,
+            linear,
+        })
+    }
+}
+
+impl Axis {
+    /// The axis through `samples`, checked for a tube of radius `outer`: at least 2
+    /// samples, non-zero derivatives, increasing `S`, no cusp, curvature × (outer + segment
+    /// arc) below 1 and no approach of distant parts closer than `2·outer` (errors name
+    /// `points`).
+    pub fn new(samples: Vec<AxisSample>, outer: f64) -> Result<Axis> {
+        let bad = |m: String| InputError::new("points", m);
+        let axis = bad;
+        if samples.len() < 2 {
+            return Err(axis("a strip axis needs at least 2 samples".into()));
+        }
         for (i, p) in samples.iter().enumerate() {
             if !(p.m.length() > 0.0) {
                 return Err(bad(format!("strip axis derivative {i} is zero")));
             }
         }
-        let outer = radius + reach;
         let mut segs = Vec::with_capacity(samples.len() - 1);
         // the axis at `PER` parameters per segment (and the last sample), with their
         // chord-length parameters, for the self-approach check
@@ -205,15 +239,11 @@ impl StripAlong {
             .iter()
             .map(|g| (g.centre - centre).length() + g.radius)
             .fold(0.0, f64::max);
-        Ok(StripAlong {
+        Ok(Axis {
             samples,
             segs,
             centre,
             bound,
-            speed,
-            radius,
-            reach,
-            linear,
         })
     }
 
@@ -253,19 +283,18 @@ impl StripAlong {
         l
     }
 
+    /// The foot point of `x` within `outer` of the axis (the nearest candidate: a foot on a
+    /// segment or an end cap), if any.
     #[inline]
-    pub fn eval(&self, x: DVec3) -> DVec3 {
-        let outer = self.radius + self.reach;
+    pub fn closest(&self, x: DVec3, outer: f64) -> Option<Foot> {
         let o2 = outer * outer;
         let n = self.samples.len();
         let lim = self.bound + outer;
         if !((x - self.centre).length_squared() < lim * lim) {
-            return DVec3::ZERO;
+            return None;
         }
-        // the nearest candidate within reach: a foot point (segment, λ) or an end cap
         let mut best = o2;
-        let mut hit: Option<(usize, f64)> = None;
-        let mut cap: Option<usize> = None;
+        let mut hit = None;
         for (k, seg) in self.segs.iter().enumerate() {
             let lim = seg.radius + outer;
             if (x - seg.centre).length_squared() >= lim * lim {
@@ -278,16 +307,14 @@ impl StripAlong {
                 let r2 = (x - p0.x).length_squared();
                 if r2 < best {
                     best = r2;
-                    hit = None;
-                    cap = Some(0);
+                    hit = Some(Foot::Cap(0));
                 }
             }
             if k == n - 2 && f1 >= 0.0 {
                 let r2 = (x - p1.x).length_squared();
                 if r2 < best {
                     best = r2;
-                    hit = None;
-                    cap = Some(n - 1);
+                    hit = Some(Foot::Cap(n - 1));
                 }
             }
             if f0 >= 0.0 && f1 < 0.0 {
@@ -295,13 +322,51 @@ impl StripAlong {
                 let r2 = (x - seg.at(l).0).length_squared();
                 if r2 < best {
                     best = r2;
-                    hit = Some((k, l));
-                    cap = None;
+                    hit = Some(Foot::Segment(k, l));
                 }
             }
         }
+        hit
+    }
+
+    /// `γ`, `γ′`, `γ″` (in the local parameter) of segment `k` at `λ`.
+    #[inline]
+    pub fn at(&self, k: usize, l: f64) -> (DVec3, DVec3, DVec3) {
+        self.segs[k].at(l)
+    }
+
+    /// The point of a foot.
+    #[inline]
+    pub fn point(&self, foot: Foot) -> DVec3 {
+        match foot {
+            Foot::Segment(k, l) => self.segs[k].at(l).0,
+            Foot::Cap(e) => self.samples[e].x,
+        }
+    }
+
+    /// The largest distance from `c` of a point of the axis's segment hulls.
+    pub fn extent_about(&self, c: DVec3) -> f64 {
+        self.segs
+            .iter()
+            .map(|g| (g.centre - c).length() + g.radius)
+            .fold(0.0, f64::max)
+    }
+}
+
+impl StripAlong {
+    #[inline]
+    pub fn eval(&self, x: DVec3) -> DVec3 {
+        let foot = self.axis.closest(x, self.radius + self.reach);
+        let hit = match foot {
+            Some(Foot::Segment(k, l)) => Some((k, l)),
+            _ => None,
+        };
+        let cap = match foot {
+            Some(Foot::Cap(e)) => Some(e),
+            _ => None,
+        };
         if let Some((k, l)) = hit {
-            let (g, g1, _) = self.segs[k].at(l);
+            let (g, g1, _) = self.axis.at(k, l);
             let t = g1 * (1.0 / g1.length());
             let r = (x - g).length();
             let d = r - self.radius;
@@ -313,7 +378,7 @@ impl StripAlong {
             return t * (self.speed * g * (g - db * r));
         }
         if let Some(e) = cap {
-            let p = &self.samples[e];
+            let p = &self.axis.samples[e];
             let y = x - p.x;
             let r = y.length();
             let u = p.m * (self.speed / p.m.length());
@@ -729,7 +794,7 @@ mod tests {
         assert_eq!(e.arg, "points");
         assert!(e.msg.contains("comes within"), "{e}");
         let ok = strip_curve(&x, 0.1, 1.0, Some(0.1), false).unwrap();
-        assert_eq!(ok.samples.len(), 40);
+        assert_eq!(ok.axis.samples.len(), 40);
         assert_eq!(
             strip_curve(&x[..1], 0.1, 1.0, None, false).unwrap_err().arg,
             "points"
