@@ -7,7 +7,7 @@ subprocess) and on all cores, and a NumPy RK4 of the same closed-form field (vec
 vertices, 4 field evaluations per step). The NumPy result is checked against spinal's. The
 last column is the share of points inside the field's support at t = 0 (points outside cost
 a few multiplications: the translation tools are local, the twist moves every point).
-Target (issue 4): ≤ 30 ns/vertex/step. A second table times the fields without a NumPy
+Our target: ≤ 30 ns/vertex/step. A second table times the fields without a NumPy
 counterpart: the strip along a curved axis (a closest-point solve per evaluation) and a
 distance-grid tool (a 64-node tricubic B-spline, 64 coefficients per evaluation), and the
 curl tools of any shape (rod, sdf_curl, mesh_curl, a keyframed rod; target ≤ 60 ns).

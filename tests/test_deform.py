@@ -1,10 +1,11 @@
-"""Divergence-free fields and advection (issue 4): spinal.fields, spinal.advect.
+"""Divergence-free fields and advection: spinal.fields, spinal.advect.
 
 Every field is checked against something independent: a NumPy curl / ∇p × ∇q of the
-*potentials* of the brief by finite differences (so signs and scales are those of the
-corrected formulas, not copied from the Rust code), divergence by central differences, exact
-flows (swirls are rotations on spheres; the motion axis of a translation tool is a Riccati
-ODE), measured convergence orders, and mesh volumes from trimesh and libigl.
+*potentials* of Zheng's thesis (Ch. 11, 12) by finite differences (so signs and scales are
+those of the corrected formulas written out here, not copied from the Rust code), divergence
+by central differences, exact flows (swirls are rotations on spheres; the motion axis of a
+translation tool is a Riccati ODE), measured convergence orders, and mesh volumes from
+trimesh and libigl.
 """
 
 from __future__ import annotations
@@ -161,7 +162,7 @@ def test_swirl_closed_forms():
                                atol=1e-14)
     np.testing.assert_allclose(fields.bend(C, A_AX, -3.0, 1.2)(x), (-3 * r**2 * W)[:, None] * ay,
                                atol=1e-14)
-    # rotation tool centred on its pivot: a pure swirl h(r) a × Y (brief 1.3)
+    # rotation tool centred on its pivot: a pure swirl h(r) a × Y (Zheng eq. 12.3)
     om = 1.3
     v = fields.rotation(C, RHO, A_AX, om, reach=R)(x)
     d = r - RHO
@@ -185,7 +186,7 @@ def test_normal_velocity_on_the_tool_surface():
     np.testing.assert_allclose(v, np.broadcast_to(U, v.shape), atol=1e-11)
 
 
-# ---- cross-product fields: v = ∇p × ∇q from the brief's scalars -----------------------------
+# ---- cross-product fields: v = ∇p × ∇q from the thesis's scalars (Ch. 11) --------------------
 
 def cross_cases():
     N, B = basis(U)
@@ -340,7 +341,7 @@ def test_rk4_is_fourth_order_on_exact_swirl_flows_and_euler_first_order():
                 for n in (64, 128, 256)]
         ratios = np.divide(e_eu[:-1], e_eu[1:])
         assert np.all((ratios > 1.8) & (ratios < 2.2)), ratios
-    # a rotation tool spinning about its own centre is a pure swirl too (brief 1.3)
+    # a rotation tool spinning about its own centre is a pure swirl too (Zheng eq. 12.3)
     f = fields.rotation([0, 0, 1.35], 0.3, [1, 0, 0], 2.0, reach=0.3)
     y = V - [0, 0, 1.35]
     r = np.linalg.norm(y, axis=1)
@@ -413,7 +414,7 @@ def test_volume_of_a_40k_icosphere_below_1e_4_integration_and_mesh_error(field, 
     W = spinal.advect(V, field, duration)  # default steps
     np.testing.assert_array_equal(V, V0)  # input untouched
     steps = field.steps(duration)
-    assert steps in (8, 16)  # the step rule of the brief (§3.4)
+    assert steps in (8, 16)  # the default step rule (Field.steps)
     ref = spinal.advect(V, field, duration, 64 * steps)
     (v0t, v0i), (vt, vi), (vrt, vri) = volumes(V, F), volumes(W, F), volumes(ref, F)
     for a, b in ((v0t, v0i), (vt, vi), (vrt, vri)):
@@ -423,7 +424,7 @@ def test_volume_of_a_40k_icosphere_below_1e_4_integration_and_mesh_error(field, 
     mesh = vrt / v0t - 1
     assert abs(total) < 1e-4
     assert abs(integration) < 1e-6 and abs(integration) < abs(mesh) / 100
-    assert abs(abs(mesh) / mesh_floor - 1) < 0.02  # the O(edge²) floor of the brief's table
+    assert abs(abs(mesh) / mesh_floor - 1) < 0.02  # the measured O(edge²) floor (mesh_floor)
     assert np.linalg.norm(W - V, axis=1).max() > 0.1  # the mesh did deform
     assert not igl.predicates.find_self_intersections(W, F, first_only=True)[0]
     if field is PRESS:  # no vertex entered the tool
@@ -587,7 +588,7 @@ def test_fields_pickle_by_rebuilding():
 
 
 def test_refinement_from_the_rest_mesh_keeps_a_long_stroke_below_1e_4():
-    """Brief §5: a 1.0-long press on a 10k icosphere stretches edges 20×; the unrefined mesh
+    """A 1.0-long press on a 10k icosphere stretches edges 20×; the unrefined mesh
     loses 1.7e-2 of its volume, refinement at τ = 1.5 (new vertices integrated from the
     rest mesh) brings it below 1e-4."""
     import igl.predicates

@@ -1,4 +1,4 @@
-"""Divergence-free deformation of a real mesh (issue 4): the rocker arm of Zheng's thesis
+"""Divergence-free deformation of a real mesh: the rocker arm of Zheng's thesis
 tests (shared/data/meshes/rocker-arm.obj, 10,044 vertices, genus 1; read in place, skipped
 when absent). A translation tool is pushed into its flank and a twist turns the whole part,
 with the default step rule, through spinal.advect and spinal.deform. Volumes come from two

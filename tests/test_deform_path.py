@@ -1,4 +1,4 @@
-"""Tools moving along a path (issue 4): spinal.fields.along_path with spinal.advect.
+"""Tools moving along a path: spinal.fields.along_path with spinal.advect.
 
 Checked against independent references: the plain translation tool (a straight spine), a
 NumPy Hermite interpolation of the spine (the carried centre and interior points), divergence
@@ -210,7 +210,7 @@ def test_core_path_constructor_names_the_argument():
         spinal._core.field_path(pts, frames, 0.2, -1.0, *list(args.values())[2:])
 
 
-# ---- contact stamper (brief §2.8) ----------------------------------------------------------
+# ---- contact stamper (Zheng's thesis §11.2.6) -----------------------------------------------
 
 def test_stamper_keeps_the_volume_per_frame_and_stays_outside_the_tool():
     import igl.predicates
@@ -257,7 +257,7 @@ def test_stamper_bad_input(kw, exc, match):
                      **args)
 
 
-# ---- volume-exact splitting (brief §3.3) ---------------------------------------------------
+# ---- volume-exact splitting (method="split") ------------------------------------------------
 
 def test_split_is_volume_exact_pointwise_second_order_and_matches_the_mesh_floor():
     from spinal import _core

@@ -26,9 +26,9 @@ from test_deform import icosphere, volumes
 import spinal
 from spinal import fields
 
-# The drag of the robustness review (row D14): a curl translation tool centred on the unit
-# sphere's surface, moved half a radius sideways. The material inside the tool moves with
-# it, the material outside slips past its surface: the flow tears the surface there.
+# A drag: a curl translation tool centred on the unit sphere's surface, moved half a radius
+# sideways. The material inside the tool moves with it, the material outside slips past its
+# surface: the flow tears the surface there.
 DRAG = fields.translation(center=[0, 0, 0.9], radius=0.9, velocity=[0.5, 0, 0])
 # A smooth press: the tool starts outside the sphere and pushes a dent into it.
 PRESS = fields.translation(center=[0, 0, 1.6], radius=0.5, velocity=[0, 0, -0.5])
@@ -72,7 +72,7 @@ def check_report(M, rep, V, F, tau=1.5):
     return tm
 
 
-# ---- D14: the drag is bounded ----------------------------------------------------------------
+# ---- the drag is bounded ---------------------------------------------------------------------
 
 def test_d14_drag_of_a_small_sphere_is_bounded_and_fast():
     """Before: 49,788 vertices added with max_passes=20 and no warning (the review's 495 s,
@@ -119,7 +119,7 @@ def test_d14_drag_of_a_10k_sphere_keeps_the_volume_within_the_vertex_bound():
         assert len(M.vertices) == rep.max_vertices  # the bound stopped it
 
 
-# ---- D15: refine < 1 is refused; refine = 1 splits nothing that does not move -----------------
+# ---- refine < 1 is refused; refine = 1 splits nothing that does not move ----------------------
 
 @pytest.mark.parametrize("refine", [0.9, 1e-300, 0.0, -1.0, float("nan")])
 def test_d15_refine_below_one_is_refused(refine):

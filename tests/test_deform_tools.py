@@ -1,4 +1,4 @@
-"""Strip of type I along a curved axis and free-form tools from a distance grid (issue 4,
+"""Strip of type I along a curved axis and free-form tools from a distance grid (Zheng's
 thesis §11.2.1, §11.2.2, §11.2.5): spinal.fields.strip_curve, sdf_tool, mesh_tool.
 
 Independent references: the clamped cubic spline of SciPy for the axis, the thesis's

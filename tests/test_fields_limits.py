@@ -19,8 +19,8 @@ from spinal import fields as fl
 
 
 def test_an_overflowing_speed_bound_is_refused_at_construction():
-    """Robustness review D08: a finite velocity of 1e200 made max_speed inf and the step rule
-    fall back to 4 steps; now the constructor refuses it, naming the argument."""
+    """A finite velocity of 1e200 would make max_speed inf (and the step rule fall back to
+    4 steps): the constructor refuses it, naming the argument."""
     with pytest.raises(ValueError, match="^velocity: is too large"):
         fl.translation([0, 0, 1], 0.3, [1e200, 0, 0])
     with pytest.raises(ValueError, match="^angular_speed: is too large"):
@@ -33,8 +33,8 @@ def test_an_overflowing_speed_bound_is_refused_at_construction():
 
 
 def test_step_counts_are_bounded():
-    """Robustness review D24 (advect part): an absurd step count is refused up front, and so
-    is a default step rule that would need more than 1e8 steps."""
+    """An absurd step count is refused up front, and so is a default step rule that would
+    need more than 1e8 steps."""
     x = np.zeros((10, 3))
     f = fl.translation([0, 0, 1.32], 0.3, [0, 0, -1])
     for steps in (2**63, 10**8 + 1, 0):
@@ -61,9 +61,9 @@ print("finished", flush=True)
 
 
 def test_ctrl_c_stops_a_long_advection():
-    """Robustness review D17/D24: SIGINT during one long advect call raises KeyboardInterrupt
-    between blocks of steps (a block is sized to take about 20 ms). Measured here: the child
-    exits 0.2–0.5 s after the signal, most of it interpreter shutdown."""
+    """SIGINT during one long advect call raises KeyboardInterrupt between blocks of steps
+    (a block is sized to take about 20 ms). Measured here: the child exits 0.2–0.5 s after
+    the signal, most of it interpreter shutdown."""
     p = subprocess.Popen([sys.executable, "-c", CHILD], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     try:

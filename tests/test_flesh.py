@@ -1,8 +1,9 @@
 """Fleshing (Zhuo 2014): spine-driven deformation with local volume preservation.
 
-Independent checks: the dissertation's closed-form reference values (spec §3), finite-
-difference Jacobian determinants, trimesh and libigl volumes of closed meshes against the
-uncorrected map, per-slab and per-chunk volumes, refinement, fold-over and bad input.
+Independent checks: closed-form reference values of the dissertation's equations (solved
+by hand, not by spinal), finite-difference Jacobian determinants, trimesh and libigl volumes
+of closed meshes against the uncorrected map, per-slab and per-chunk volumes, refinement,
+fold-over and bad input.
 """
 
 
@@ -100,7 +101,7 @@ def test_binding_is_closest_point_not_nearest_sample():
     assert np.array_equal(b.edge, [5, 0])
 
 
-# --- reference values (spec §3) ---------------------------------------------------------
+# --- reference values (Zhuo's equations solved by hand) ---------------------------------
 
 N = 2001
 H = 2.0 / (N - 1)
@@ -363,12 +364,13 @@ def shoelace(p):
 
 
 def pappus(section, s, on_arc):
-    """Pappus–Guldinus volume (spec A-23) of an extrusion along x ∈ [−1.2, 1.2], from one
-    deformed section polygon (m, 3) at arc length `s`: area × length of the centroid's path.
-    On the unit-radius arc about (0, 1, 0) the section is expressed in (distance from the
-    centre, z) and the centroid path is that distance × the angle 2.4; on the straight
-    spine in (y, z) with path length 2.4. Valid only if the section lies in the spine's
-    normal plane at `s`, which is checked (angle about the centre, resp. x, equal to s)."""
+    """Pappus–Guldinus volume (as the thesis computes Table 1's volumes, §4.2.3) of an
+    extrusion along x ∈ [−1.2, 1.2], from one deformed section polygon (m, 3) at arc length
+    `s`: area × length of the centroid's path. On the unit-radius arc about (0, 1, 0) the
+    section is expressed in (distance from the centre, z) and the centroid path is that
+    distance × the angle 2.4; on the straight spine in (y, z) with path length 2.4. Valid
+    only if the section lies in the spine's normal plane at `s`, which is checked (angle
+    about the centre, resp. x, equal to s)."""
     if on_arc:
         d = section[:, :2] - [0, 1]
         assert np.abs(np.arctan2(d[:, 0], -d[:, 1]) - s).max() < 1e-4  # measured 5e-6
@@ -379,8 +381,8 @@ def pappus(section, s, on_arc):
 
 
 def test_extrusion_twist_table():
-    """Table 1 analogue (spec §8.7, A-23): an L-section extruded along the spine, unbent
-    (arc → line), bent (line → arc) and bent with a π/4 twist. Volumes from the mesh
+    """Analogue of Table 1 of Zhuo 2014 (§4.2.3, Fig. 23): an L-section extruded along the
+    spine, unbent (arc → line), bent (line → arc) and bent with a π/4 twist. Volumes from the mesh
     (trimesh = libigl) and from Pappus on the middle section: corrected ≤ 1.3e-4 (thesis
     1.3e-5 … 2.1e-4). The twist rotates every section, so it changes no corrected volume:
     |twisted − untwisted| is 5e-7 (radial), 5.9e-5 (normal), 1.1e-4 (binormal), the error
@@ -585,9 +587,9 @@ def test_continuous_across_samples(solution):
 
 @pytest.mark.parametrize("solution", SOLS + ("none",))
 def test_inverse_swaps_the_spines(solution):
-    """Spec acceptance test 2: the map from the posed to the rest spine undoes the map.
+    """The map from the posed to the rest spine undoes the map.
     Exact for radial (the stretch 1/√λ is isotropic) and the uncorrected map; normal and
-    binormal stretch along the posed spine's N or B (spec A-8 default), so their inverse
+    binormal stretch along the posed spine's N or B (our choice of order), so their inverse
     is exact only where λ = 1: with a non-stretchable spine λ − 1 = O(h²) inside the edges
     and the round trip converges at that order."""
     rng = np.random.default_rng(2)
@@ -638,7 +640,7 @@ def test_surface_reference_identity_rigid():
     rest, posed = plane_grid(), cylinder_grid()
     P = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, -0.3], [0.0, 0.2, 0.1]])
     out = spinal.flesh_surface(P, rest, posed)
-    # plane → cylinder R = 2 (m = 0.25, g = 0): h_t = 0.3 → 0.3266799 (spec §3); the grid's
+    # plane → cylinder R = 2 (m = 0.25, g = 0): h_t = 0.3 → 0.3266799 (Eq. 43); the grid's
     # normal interpolation bends by cos(Δθ/2)/R: an O(Δθ²) error, 4× smaller per halving
     err = abs(out[0, 2] - 0.3266799)
     fine = spinal.flesh_surface(P[:1], plane_grid(81), cylinder_grid(81))

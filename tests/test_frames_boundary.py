@@ -53,7 +53,8 @@ class Trefoil(Curve):
                                           (Cinquefoil(), -1.407701989),
                                           (Trefoil(), 1.368871103)])
 def test_published_closing_angles(curve, exact):
-    """Closing angles of the thesis's closed curves (spec §1.8(c), ±1e-8)."""
+    """Closing angles of the closed curves of Zheng's thesis (eq. 6.1, 7.9, 7.10; the thesis
+    prints no values: these were computed independently with DR at 2^15 samples), ±1e-8."""
     assert abs(spinal.closing_angle(curve, u=4097) - exact) < 1e-8
     x = curve.sample(4097)
     assert abs(spinal.closing_angle(x) - exact) < 1e-8  # estimated periodic tangents

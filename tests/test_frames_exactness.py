@@ -37,7 +37,7 @@ def test_spherical_curve_is_exact():
         normal = x / np.linalg.norm(x, axis=1, keepdims=True)
         F = spinal.frames(x, t, initial=normal[0])
         assert np.linalg.norm(F[:, :, 0] - normal, axis=1).max() < 1e-13 * max(1, n / 40)
-    # the 2nd-order methods are not exact (spec: rotation 0.37 at n = 16)
+    # the 2nd-order methods are not exact (rotation error measured at 0.37 for n = 16)
     u = np.linspace(0.1, 4 * np.pi - 0.3, 16)
     x, t = v.point(u), v.tangent(u)
     normal = x / np.linalg.norm(x, axis=1, keepdims=True)
@@ -69,7 +69,7 @@ def test_straight_line_random_spacing_exact():
     t = np.tile(d, (x.shape[0], 1))
     for method in ("double_reflection", "rotation", "projection", "frenet"):
         F = spinal.frames(x, t, method=method)
-        assert np.abs(F - F[0]).max() < 1e-14, method  # spec acceptance: 1e-13
+        assert np.abs(F - F[0]).max() < 1e-14, method  # exact to round-off
         np.testing.assert_allclose(F[0][:, 2], d, atol=1e-15)
     # estimated tangents: exact up to the round-off of the 1e-9 gaps (index stencils
     # would point backwards here)

@@ -1,5 +1,6 @@
-"""PH cubics (spinal.ph): the reference cases R1/R2/R3 and the numbers of the issue 6 brief
-(re-computed independently there), closed forms against quadrature, measured orders."""
+"""PH cubics (spinal.ph): three single-cubic reference cases R1/R2/R3 and statistics on random
+data, computed independently of this code (Mäurer & Jüttler give no reproducible example
+data), closed forms against quadrature, measured orders."""
 
 from __future__ import annotations
 
@@ -70,7 +71,7 @@ def test_from_quaternions_invariants_and_round_trip():
         L1, L2, L3 = inv["L1"][i], inv["L2"][i], inv["L3"][i]
         np.testing.assert_allclose(kappa, 6 * L2 * inv["sin_theta"][i] / sigma**2, rtol=1e-10)
         tau_ph = np.sign(inv["delta"][i]) * 6 * np.sqrt(L1 * L3 - L2**2) / sigma**2
-        np.testing.assert_allclose(tau, tau_ph, rtol=1e-8)                  # signed (PH-3)
+        np.testing.assert_allclose(tau, tau_ph, rtol=1e-8)                  # signed (sgn Δ)
         np.testing.assert_allclose(kappa / tau, inv["kappa_over_tau"][i], rtol=1e-8)
     assert np.all(np.abs(inv["k"]) <= 1)
     # preimage -> the same control points, either quaternion convention
@@ -134,7 +135,8 @@ def test_hermite_random_data_solution_counts_and_validity():
     p0, t0, p1, t1 = (rng.standard_normal((n, 3)) for _ in range(4))
     cands = ph.hermite(p0, t0, p1, t1, all=True)
     counts = np.bincount([len(c) for c in cands], minlength=3)
-    # brief: 13,207 / 5,077 / 1,716 of 20,000 (another random stream; 4.5 sigma band)
+    # an independent implementation: 13,207 / 5,077 / 1,716 of 20,000 (another random stream;
+    # 4.5 sigma band)
     np.testing.assert_allclose(counts / n, np.array([13207, 5077, 1716]) / n, atol=0.015)
     for i in range(0, n, 7):
         for c in cands[i]:
@@ -257,7 +259,8 @@ def test_antiparallel_closed_form_and_continuity():
     assert abs(inv2["L1"] - inv["L1"]) < 2e-4 and abs(inv2["L3"] - inv["L3"]) < 2e-4
     assert ph.is_ph(c, 1e-7)
     # approaching t1 = −t0 the solution stays PH to round-off with exact end tangents (the
-    # brief measured PH defects up to 2e-4 at 1 + C = 5e-13 with the printed λ form)
+    # λ form of Mäurer & Jüttler's Table 1 was measured to give PH defects up to 2e-4 at
+    # 1 + C = 5e-13)
     for a in (1e-2, 1e-5, 1e-6, 1e-7, 1e-9, 0.0):
         t1 = -t0 * np.cos(a) + np.cross(ax, -t0) * np.sin(a)
         c = ph.hermite([0, 0, 0], t0, p1, t1)
@@ -510,7 +513,7 @@ def test_spline_sweep_mesh():
 
 
 # ---------------------------------------------------------------------------------------
-# 7. curves -> G¹ PH splines: the brief's tables and the measured orders
+# 7. curves -> G¹ PH splines: independently computed tables and the measured orders
 
 HELIX = spinal.curves.Helix(1.0, 0.5)
 TWISTED = spinal.curves.Polynomial([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])

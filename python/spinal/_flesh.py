@@ -48,19 +48,22 @@ def _arc(points: np.ndarray) -> np.ndarray:
 
 
 def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
-    """Compass walk (spec A-9): points on the posed polyline, from its start, whose
+    """Compass walk (our reading of Zhuo 2014 Ch. IV's "distance between consecutive samples" as
+    the chord, not the arc length): points on the posed polyline, from its start, whose
     consecutive distances are the rest spine's chords ``chords``; past its end, along its
     last edge. Edge lengths are kept exactly, so the discrete stretch is 1 at the samples."""
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
 def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
-    """Reference vector of the posed spine's first frame (spec A-5, made rigid-motion
-    equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal rotation taking
-    the rest start tangent ``t0`` to the posed one ``t1`` and ``ψ`` the twist about ``t0``
-    (swing–twist split) of ``Qᵀ K``, ``K`` the best-fit (Kabsch) rotation of the rest onto the
-    posed samples; ``ψ = 0`` when either spine is straight (the roll about it is then free).
-    A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the inverse roll."""
+    """Reference vector of the posed spine's first frame (a choice of ours: Zhuo 2014 does not
+    say how the posed spine's initial normal is chosen; any choice keeps the volume; this one is
+    rigid-motion equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal
+    rotation taking the rest start tangent ``t0`` to the posed one ``t1`` and ``ψ`` the twist
+    about ``t0`` (swing–twist split) of ``Qᵀ K``, ``K`` the best-fit (Kabsch) rotation of the
+    rest onto the posed samples; ``ψ = 0`` when either spine is straight (the roll about it is
+    then free). A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the
+    inverse roll."""
     r0, t0 = f0[:, 0], f0[:, 2]
     q = _core.minimal_rotation(t0, t1)
     a = rest - rest.mean(0)
@@ -234,7 +237,8 @@ class SpineBinding:
 
         ``κ`` is the curvature toward the centre of curvature; ``λ = σ1/σ0`` the stretch
         (new/old speed of the spine at the vertex's parameter). The binormal coordinate and
-        the radial angle are read in the posed frame after the transfer (spec A-7). In the
+        the radial angle are read in the posed frame after the transfer (as Zhuo's Eq. 21
+        with ``θ1`` implies). In the
         model of the spine used here (cubic Hermite positions and tangents) the map has
         Jacobian determinant 1 inside every edge slab, whatever the sampling.
 
@@ -254,7 +258,9 @@ class SpineBinding:
         input, a rigid motion of the spine moves the shape rigidly, and swapping the two
         spines (the posed one as returned by :meth:`posed_spine`) inverts the map — exactly
         for ``"radial"`` and ``"none"``; ``"normal"``/``"binormal"`` stretch along the posed
-        spine's N/B (spec A-8), so they invert exactly only where the stretch is 1.
+        spine's N/B (the thesis leaves open whether the stretch comes before or after the
+        change of frame; both keep the volume), so they invert exactly only where the stretch
+        is 1.
 
         Parameters
         ----------

@@ -1,9 +1,13 @@
 """Spatial Pythagorean-hodograph (PH) cubics and their rational rotation-minimising frames.
 
-After Maurer & Jüttler, *Rational approximation of rotation minimizing frames using
-Pythagorean-hodograph cubics* (J. Geometry and Graphics 3, 1999), with the errata of the
-issue 6 brief (signed Hermite equation, signed torsion, the integration constant of the
-angle, the sign in the sweep formula).
+After Mäurer & Jüttler, *Rational approximation of rotation minimizing frames using
+Pythagorean-hodograph cubics* (Journal for Geometry and Graphics 3, 1999, §3; "MJ" below,
+with its equation numbers; see docs/references.md), with four corrections to the printed
+formulas: the Hermite equation of Table 1 is used with signed ``λ₁, λ₂`` instead of absolute
+values, the torsion (18) and the angle (30) carry the sign of ``det[d₁, d₂, d₃]`` (the
+printed ``ψ`` is an unsigned angle), the angle is written with ``Ω(0)`` rather than (30)'s
+free constant ``Ω₀``, and the sweep formula (42) has ``(1 − W²) b̂ − 2W n̂`` (the printed
+``+`` breaks orthonormality).
 
 A cubic Bézier curve ``x(v) = Σ bᵢ Bᵢ³(v)``, ``v ∈ [0, 1]``, is *PH* when its speed
 ``σ(v) = |x′(v)|`` is a polynomial (here quadratic). Every spatial PH cubic is the integral of
@@ -88,7 +92,7 @@ def _cubics(x: Any, name: str = "control_points") -> tuple[np.ndarray, bool]:
 
 
 def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
-    """G¹ Hermite interpolation by a PH cubic (Maurer & Jüttler §3.1, corrected).
+    """G¹ Hermite interpolation by a PH cubic (Mäurer & Jüttler §3.2, Table 1, signed).
 
     Finds the PH cubics from ``p0`` to ``p1`` whose end tangents point along ``t0`` and
     ``t1`` (normalised here; lengths are ignored). With ``C = t0·t1``, ``D = p1 − p0`` and the
@@ -181,9 +185,10 @@ def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = Fals
     """The PH cubic with the quaternion preimage ``A(v) = A0(1 − v) + A1 v``.
 
     Its hodograph is ``x′(v) = A(v) i A(v)*`` (vector part), so ``σ = |A|²``. Control points
-    (MJ §2.1): ``b₁ = b₀ + A0 i A0*/3``, ``b₂ = b₁ + (A0 i A1* + A1 i A0*)/6``,
-    ``b₃ = b₂ + A1 i A1*/3`` with ``b₀ = start``. ``A0``, ``A1``: ``(4,)`` or ``(m, 4)``
-    quaternions, ``(x, y, z, w)`` unless ``scalar_first``. Returns ``(4, 3)`` or ``(m, 4, 3)``.
+    (the quaternion form of spatial PH curves): ``b₁ = b₀ + A0 i A0*/3``,
+    ``b₂ = b₁ + (A0 i A1* + A1 i A0*)/6``, ``b₃ = b₂ + A1 i A1*/3`` with ``b₀ = start``.
+    ``A0``, ``A1``: ``(4,)`` or ``(m, 4)`` quaternions, ``(x, y, z, w)`` unless
+    ``scalar_first``. Returns ``(4, 3)`` or ``(m, 4, 3)``.
     """
     sf = as_bool(scalar_first, "scalar_first")
     q0, single = _quats(A0, "A0", sf)
@@ -233,7 +238,7 @@ _INV_KEYS = ("L1", "L2", "L3", "cos_theta", "sin_theta", "delta", "a", "b", "c",
 
 
 def invariants(control_points) -> dict:
-    """Scalar invariants of a PH cubic (Maurer & Jüttler §2, (31); signs per erratum PH-3).
+    """Scalar invariants of a PH cubic (Mäurer & Jüttler (18), (31); torsion signed by ``Δ``).
 
     Keys: ``L1, L2, L3`` (leg lengths), ``cos_theta, sin_theta`` (``θ = ∠(d₁, d₂)``),
     ``delta = det[d₁, d₂, d₃]``, ``a, b, c`` (``σ = 3((cv − b)² + a²)/c``), ``k`` (the factor
@@ -702,7 +707,7 @@ class PHSpline:
 
 
 # ---------------------------------------------------------------------------------------
-# Curve -> G¹ PH spline (Pseudocode C of the brief)
+# Curve -> G¹ PH spline (Mäurer & Jüttler end of §3.2; the adaptive splitting is ours)
 
 _REASONS = {
     1: "no PH cubic: the end tangents are parallel but the chord is not along them",
@@ -870,7 +875,7 @@ def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
 
 def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=None,
         max_segments: int = 4096) -> PHSpline:
-    """Convert a curve into a G¹ spline of PH cubics (Maurer & Jüttler §3.3).
+    """Convert a curve into a G¹ spline of PH cubics (Mäurer & Jüttler §3.2, Theorem 10).
 
     Each interval ``[kᵢ, kᵢ₊₁]`` of the knots gets the PH cubic of :func:`hermite` through
     the curve's points and unit tangents at its ends; neighbouring cubics share the point

@@ -189,7 +189,7 @@ def quaternion_frames(
     r"""Frames along a sampled curve as a sign-continuous quaternion curve ``(n, 4)``.
 
     * ``method="transport"`` (default): discrete parallel transport written with
-      quaternions (Ma §2.4). ``Δq_i = normalise(1 + T_i·T_{i+1}, T_i × T_{i+1})`` rotates
+      quaternions (Ma §2.2.1). ``Δq_i = normalise(1 + T_i·T_{i+1}, T_i × T_{i+1})`` rotates
       ``T_i`` onto ``T_{i+1}`` about their common normal and ``Q_{i+1} = Δq_i Q_i``. These
       are the frames of ``spinal.frames(points, tangents, method="rotation")`` (2nd order
       accurate RMF), computed by an independent recurrence. ``closed=True``: the closing

@@ -1,6 +1,6 @@
-//! The contact "stamper" (Zheng, thesis §11.2.6; issue-4 brief §2.8 with erratum A-15): a
-//! sphere tool pressed into a closed mesh frame by frame, in contact only (no gap), with the
-//! dented volume given back as a protrusion around the contact.
+//! The contact "stamper" (Zheng, *Studies on Motion and Deformation in Graphics*, thesis
+//! 2008, §11.2.6): a sphere tool pressed into a closed mesh frame by frame, in contact only
+//! (no gap), with the dented volume given back as a protrusion around the contact.
 //!
 //! Per frame, the tool centre advances from `c_{k−1}` to `c_k` (straight from `start` to
 //! `end` in `frames` equal moves, direction `û`):
@@ -10,9 +10,11 @@
 //!    the change of the mesh's signed volume `Σ X₀·(X₁ × X₂)/6` (summed about the mean
 //!    vertex, [`crate::math::mesh::signed_volume`]);
 //! 2. over the triangles with no contact vertex, the protrusion rate uses the tool's curl
-//!    translation field `v` (brief §1.2, static tool at `c_k`, velocity `û`, `R` = reach):
-//!    `Σ A_tri v_bary`, `v_bary = max(v(barycentre)·n_tri, 0)` (A-15; the thesis leaves
-//!    `v_bary` undefined);
+//!    translation field `v` (Zheng Ch. 12, eq. 12.1–12.2, see [`super::fields`]; static tool
+//!    at `c_k`, velocity `û`, `R` = reach): `Σ A_tri v_bary`,
+//!    `v_bary = max(v(barycentre)·n_tri, 0)` (a choice of ours: the thesis calls `v_bary` the
+//!    field speed at the barycentre without saying whether it is a magnitude or a normal
+//!    component; the outward normal flux is what makes the protrusion volume);
 //! 3. the vertices of the triangles with `v_bary > 0` move along `v` for the "moving time"
 //!    `t = δv / Σ(A_tri v_bary)` (one RK4 step), the others stay;
 //! 4. `iterations` secant corrections `t ← t · δv / (V_t − V_snapped)` on the measured volume

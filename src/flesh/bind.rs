@@ -1,4 +1,4 @@
-//! Registration (spec §1.1 step 2, §2.8 "accurate projection", A-13).
+//! Registration (Zhuo 2014 §1.1, Fig. 1, the registration step; Ch. VII "accurate projection").
 //!
 //! Each vertex is attached to the cross-section plane it lies in: on edge `k` the plane at
 //! `a` passes through the interpolated position `C(a)` normal to the interpolated tangent

@@ -1,11 +1,11 @@
 //! Fleshing: spine-driven deformation with local volume preservation (Wei Zhuo, PhD thesis,
-//! Georgia Tech 2014, and Zhuo & Rossignac, CGF 2013; spec `zhuo-fleshing.md`).
+//! Georgia Tech 2014, and Zhuo & Rossignac, CGF 2013; see docs/references.md).
 //!
 //! A vertex `P0` is registered on the rest spine by its cross-section (Assumption I, §1.2):
 //! parameter `(k, a)` on edge `k` and offset `d0 ⊥ t0(k, a)` in the interpolated RMF. After the
 //! spine moves, the vertex is rebuilt from the posed spine at the same `(k, a)` with a
 //! corrected offset — unbend (rest curvature), transfer (RMF to RMF, optional twist, stretch),
-//! bend (posed curvature) (§4.2.1, §5.2.1; spec §2.5) — so that `det ∂P1/∂P0 = 1`.
+//! bend (posed curvature) (§4.2.1, §5.2.1) — so that `det ∂P1/∂P0 = 1`.
 //!
 //! **Discrete spine model** ([`spine`]). Between samples `k` and `k + 1` the position `C(a)`
 //! is the cubic Hermite interpolant of the two samples with end slopes `h_k t_k`, `h_k t_{k+1}`

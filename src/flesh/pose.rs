@@ -1,5 +1,8 @@
-//! Reconstruction on the posed spine: unbend – transfer – bend (Zhuo 2014 §4.2.1, §5.2.1;
-//! spec §2.5 with default "stretch after the rotation").
+//! Reconstruction on the posed spine: unbend – transfer – bend (Zhuo 2014 §4.2.1, §5.2.1).
+//! The bend reads the binormal `x` and the radial `θ` in the posed spine's Frenet frame after
+//! the transfer (as Eq. 21's `θ1` implies; the old `x0`, `θ0` break `det = 1`). The thesis
+//! leaves open whether the stretch `x*/σ` is applied before or after the change of frame;
+//! both are exactly volume preserving, and we stretch after the rotation, in the posed frame.
 //!
 //! Per vertex: evaluate the posed spine at the registered `(k, a)`; `λ = σ1/σ0`; unbend the
 //! stored offset with the rest curvature; carry its RMF coordinates over to the posed RMF

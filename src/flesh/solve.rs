@@ -1,24 +1,29 @@
-//! Offset solutions in one cross-section (Zhuo 2014, Ch. III–V; spec §2.1, §2.5, §2.11).
+//! Offset solutions in one cross-section (Zhuo 2014, Ch. III–V: §3.1, §4.2.1, §5.2.1).
 //!
 //! Everything works in the 2D coordinates `d = (α, β)` of the cross-section (components along
 //! the RMF columns `r, s` of the spine frame) and the curvature vector `k = κ N` expressed in
 //! the same coordinates (`k ⊥ t`, pointing to the centre of curvature), so the formulas are
-//! frame free (spec §2.5, "frame-free evaluation"): `κ x = d·k`, `κ r cosθ = d·k`.
+//! frame free (our reformulation: the thesis's maps need the Frenet frame only through
+//! `κ N`): `κ x = d·k`, `κ r cosθ = d·k`.
 //!
 //! * unbend (κ1 = 0 in the thesis' formulas), with the rest curvature `k0`:
 //!   normal Eq. 14 `x* = x0 (1 − ½κ0 x0)`; binormal Eq. 17 `y* = (1 − κ0 x) y0`;
 //!   radial Eq. 20 `r* = r0 √(1 − ⅔ κ0 r0 cosθ0)`.
-//! * stretch by `λ` = new speed / old speed (thesis σ of Ch. V; spec A-2): normal `x/λ`
+//! * stretch by `λ` = new speed / old speed (the thesis's σ of Ch. V): normal `x/λ`
 //!   along N1, binormal `y/λ` along B1, radial `r/√λ`.
 //! * bend (κ0 = 0) with the posed curvature `k1`, read in the posed frame after the transfer
-//!   normal Eq. 15 in the stable form `x1 = 2x_t/(1 + √(1 − 2κ1 x_t))`; binormal
-//!   Eq. 18 `y1 = y_t/(1 − κ1 x')`; radial Eq. 21 `r1²(1 − ⅔ r1 κ1 cosθ1) = r_t²` with the root
-//!   rule of spec §2.5 (corrected E-8, E-13).
+//!   (as Eq. 21's `θ1` implies): normal Eq. 15 in the stable form
+//!   `x1 = 2x_t/(1 + √(1 − 2κ1 x_t))`; binormal Eq. 18 `y1 = y_t/(1 − κ1 x')`; radial Eq. 21
+//!   `r1²(1 − ⅔ r1 κ1 cosθ1) = r_t²`, root rule in [`radial_ratio`]. (§4.2.1 places the
+//!   minimum of `f(m) = α m³ + m² − 1` at `m = 1` and says "if α > 0, λ2 > 0"; as
+//!   `f'(m) = m(3αm + 2)` the minimum is at `m = 0` and the condition is `α < 0`.)
 //!
-//! Existence (spec §2.11, A-20): where no fold-free root exists the offset is clamped to the
+//! Existence (§3.1.2, §4.3): the thesis only says that no valid solution exists past the
+//! limits; a choice of ours: where no fold-free root exists the offset is clamped to the
 //! largest safe one (normal: the focal point `1/κ1`; radial: `r1 = 1/(κ1 cosθ1)`, the local
 //! maximum of the cubic; binormal: the factor `1 − κ1 x'` is capped below at
-//! [`BINORMAL_MIN_FACTOR`]) and the vertex is reported. Unbending needs `κ0 x0 < 1` (E-12):
+//! [`BINORMAL_MIN_FACTOR`]) and the vertex is reported. Unbending needs `κ0 x0 < 1` (§4.2.1
+//! states `|κ0 x0| ≤ 2`, which only keeps `x*` non-negative; a fold-free inverse needs more):
 //! points past the rest spine's centre of curvature are clamped there and reported.
 
 use glam::DVec2;
@@ -36,7 +41,8 @@ pub enum Solution {
     Radial,
 }
 
-/// Below this `1 − κ1 x'` the binormal solution is clamped (spec A-20 default).
+/// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
+/// no policy past the limit).
 pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
 /// Curvatures below this (1/length units) are treated as straight: the step is the identity.
 pub const TINY_CURVATURE: f64 = 1e-300;
@@ -146,8 +152,10 @@ pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVe
     }
 }
 
-/// The fold-free root `m` of `α m³ + m² − 1 = 0` (spec §2.5, corrected root rule) and whether
-/// it exists; without one, the local maximum `m = −2/(3α)` (the focal point).
+/// The fold-free root `m` of `α m³ + m² − 1 = 0` (Zhuo 2014 §4.2.1, Eq. 21 normalised by
+/// `m = r1/r_t`, `α = −⅔ κ1 r_t cosθ1`) and whether it exists: `m = 1` for `α = 0`, the unique
+/// root in `(0, 1)` for `α > 0`, and for `α < 0` the smallest root in `[1, −2/(3α)]`, which
+/// exists iff `α² ≤ 4/27`; without one, the local maximum `m = −2/(3α)` (the focal point).
 #[inline(always)]
 pub fn radial_ratio(alpha: f64) -> (f64, bool) {
     let f = |m: f64| (alpha * m + 1.0) * m * m - 1.0;
@@ -242,7 +250,7 @@ mod tests {
 
     #[test]
     fn radial_reference_values() {
-        // spec §3: r_t = 0.3, κ1 = 1, cosθ = 1 → 0.3413416; cosθ = −1 → 0.2757267
+        // Eq. 21 solved by hand: r_t = 0.3, κ1 = 1, cosθ = 1 → 0.3413416; cosθ = −1 → 0.2757267
         let mut fl = 0;
         let a = bend(
             Solution::Radial,

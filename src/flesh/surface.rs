@@ -1,4 +1,4 @@
-//! Spine surfaces (Zhuo 2014 Ch. VI; spec §2.9, E-14): a shape bound to a surface keeps its
+//! Spine surfaces (Zhuo 2014 Ch. VI, §6.2): a shape bound to a surface keeps its
 //! volume when the surface bends and stretches.
 //!
 //! Model: the surface is a grid of samples, a bicubic Hermite patch (zero twist, derivatives
@@ -10,9 +10,12 @@
 //! `B = (S_u×N_v + N_u×S_v)·N`, `C = (N_u×N_v)·N` — in the thesis' notation `A = σ`,
 //! `B = −2mσ`, `C = gσ` (Eq. 38) — so the corrected offset solves (Eq. 40–43)
 //! `A1 h1 + B1 h1²/2 + C1 h1³/3 = A0 h0 + B0 h0²/2 + C0 h0³/3`, i.e.
-//! `F(h1) = h1 − m1 h1² + g1 h1³/3 = (A0 h0 + B0 h0²/2 + C0 h0³/3)/A1`, root selection of
-//! spec §2.9 (corrected E-14): the root on the branch where `F' = (1 − k_a h)(1 − k_b h) > 0`;
-//! without one, the largest fold-free offset `h_c = 1/k_max` (clamped, reported).
+//! `F(h1) = h1 − m1 h1² + g1 h1³/3 = (A0 h0 + B0 h0²/2 + C0 h0³/3)/A1`. Root selection: the
+//! root on the branch where `F' = (1 − k_a h)(1 − k_b h) > 0`, i.e. below `h_c = 1/k_max`
+//! (`F' = 0` there: a critical point of the cubic, which §6.2 calls an inflection point);
+//! without one, the largest fold-free offset `h_c` (clamped, reported), as §6.2 prescribes.
+//! The validity test printed in §6.2 uses the opposite sign of `m` and lacks a square; we
+//! test `F(h_c) ≥ h_t` directly, which is equivalent to the corrected inequality.
 //! Points whose foot lies outside the grid are attached to the border with their residual
 //! carried rigidly in the local frame (not volume preserving; reported).
 
@@ -340,8 +343,8 @@ pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec
     Ok((cell, coords))
 }
 
-/// The fold-free root of `h − m h² + g h³/3 = t` (spec §2.9) and whether it exists; without
-/// one, `h_c = 1/k_max`.
+/// The fold-free root of `h − m h² + g h³/3 = t` (Zhuo 2014 §6.2, Eq. 43) and whether it
+/// exists; without one, `h_c = 1/k_max`.
 pub fn surface_offset(m: f64, g: f64, t: f64) -> (f64, bool) {
     if t == 0.0 {
         return (0.0, true);
@@ -451,7 +454,8 @@ mod tests {
 
     #[test]
     fn reference_values() {
-        // spec §3: plane → sphere R = 2 (m = 0.5, g = 0.25), cylinder R = 2 (m = 0.25)
+        // Eq. 43 solved by hand: plane → sphere R = 2 (m = 0.5, g = 0.25),
+        // cylinder R = 2 (m = 0.25)
         let (h, ok) = surface_offset(0.5, 0.25, 0.3);
         assert!(ok && (h - 0.3613575).abs() < 5e-8, "{h}");
         let (h, ok) = surface_offset(0.5, 0.25, -0.3);

@@ -6,8 +6,8 @@
 //! arc length). One step from `u_i` to `u_{i+1}` uses `ω` at `u_i`, at the midpoint and at
 //! `u_{i+1}` (2m + 1 curve evaluations for m steps). RK4 does not keep `r ⟂ t`, so after
 //! every step `r` is projected onto the normal plane of `t_{i+1}` and normalised (the
-//! better-behaved form recommended by the spec; the paper's table used an unprojected
-//! variant, which has the same order). Global error O(h⁴).
+//! better-behaved form, a choice of ours: the paper gives no formulas, and its Table III
+//! matches an unprojected variant, which has the same order). Global error O(h⁴).
 
 use glam::DVec3;
 

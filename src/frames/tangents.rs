@@ -26,7 +26,8 @@
 //!   centre of the circle through the sample and its two neighbours (see [`circle_normal`]).
 //! * Tangents-only reflection vector (TOG Eq. 17): `v_1 = 13(t_i + t_{i+1}) − (t_{i−1} + t_{i+2})`,
 //!   and at the open ends the 4-point Adams–Moulton weights `9t_0 + 19t_1 − 5t_2 + t_3` and
-//!   its mirror (resolution A16 of the spec). Needs 4 tangents.
+//!   its mirror (a choice of ours: the paper omits the two end vectors; these weights keep
+//!   the 4th order). Needs 4 tangents.
 
 use super::lanes::Arith;
 use glam::DVec3;

@@ -106,7 +106,7 @@ impl Drop for Publish<'_> {
     }
 }
 
-/// The state of a chunk that has been handed out (its worker is running): spin briefly,
+/// The state of a chunk that has been handed out (its worker is running): spin a little,
 /// then give the processor away.
 fn wait(cell: &OnceLock<Resolved>) -> Resolved {
     let mut spins = 0u32;

@@ -1,4 +1,8 @@
-//! Frames on PH cubics (MJ §3.2–§3.4 with errata PH-3, PH-4; Pseudocodes F, G).
+//! Frames on PH cubics (Mäurer & Jüttler 1999, §3.3–§3.4; "MJ" below, with its equation
+//! numbers). The sign of the angle follows the signed torsion (see the parent module); MJ (30)
+//! leaves an integration constant `Ω₀` that is not `Ω(0)`, so we write the angle with `Ω(0)`
+//! explicitly. The propagation along a spline and the fit of `λ` are ours: the paper gives
+//! neither.
 //!
 //! * Rational Frenet frame: `t = ẋ/σ`, `b ∥ ẋ × ẍ`, `n = b × t` (spinal frame `(n, b, t)`).
 //! * Exact rotation-minimising angle: the RMF reference vector is
@@ -251,8 +255,8 @@ fn objective(seg: &Segment, fit: &AngleFit) -> f64 {
     })
 }
 
-/// Fit of the rational angle function (Pseudocode G): λ = λ* + e^μ, scan μ ∈ [−12, 8]
-/// (201 points), golden section around the best scan point.
+/// Fit of the rational angle function (our minimiser; MJ do not specify one): λ = λ* + e^μ,
+/// scan μ ∈ [−12, 8] (201 points), golden section around the best scan point.
 pub fn fit_angle(seg: &Segment, phi: Option<f64>) -> AngleFit {
     let d_omega = seg.omega1 - seg.omega0;
     if seg.k == 0.0 || d_omega.abs() < 1e-12 {

@@ -1,5 +1,7 @@
-//! G¹ Hermite interpolation by PH cubics (MJ §3.1, Table 1, with the corrected signed
-//! equation of erratum PH-1).
+//! G¹ Hermite interpolation by PH cubics (Mäurer & Jüttler 1999, §3.2, Table 1). Table 1's
+//! equation (*) is printed with `(|λ₁| − X)(|λ₂| − X)`, right only when `λ₁ ≥ 0 ≥ λ₂`; the
+//! leg lengths are `L₁ = λ₁ − X`, `L₃ = −λ₂ − X`, so we solve the signed equation below and
+//! keep the roots with `L₁, L₃ > 0` (correct orientation).
 //!
 //! Given end points `p₀, p₁` and unit tangents `t₀, t₁`, with `C = t₀·t₁`, `D = p₁ − p₀`,
 //! `s² = 1 − C²`, the feet of the common perpendicular of the tangent lines are
@@ -288,7 +290,7 @@ mod tests {
         assert!(sol.cubics[0].is_ph(1e-9) && sol.cubics[1].is_ph(1e-9));
     }
 
-    /// The printed λ form (signed, PH-1), as a reference for the M form.
+    /// Table 1's λ form (with the signed equation), as a reference for the M form.
     fn lambda_form(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Vec<[DVec3; 2]> {
         let (c, d) = (t0.dot(t1), p1 - p0);
         let s2 = t0.cross(t1).length_squared();

@@ -1,6 +1,6 @@
-//! Spatial Pythagorean-hodograph (PH) cubics (Maurer & Jüttler, "Rational approximation of
-//! rotation minimizing frames using Pythagorean-hodograph cubics", J. Geom. Graphics 1999;
-//! notes with the errata in the issue 6 brief).
+//! Spatial Pythagorean-hodograph (PH) cubics (Mäurer & Jüttler, "Rational approximation of
+//! rotation minimizing frames using Pythagorean-hodograph cubics", Journal for Geometry and
+//! Graphics 3, 1999, §3; "MJ" below, with its equation numbers; see docs/references.md).
 //!
 //! A cubic Bézier curve `x(v) = Σ bᵢ Bᵢ³(v)`, `v ∈ [0, 1]`, is PH when its speed
 //! `σ = |ẋ|` is a polynomial. Every spatial PH cubic comes from a linear quaternion
@@ -9,7 +9,10 @@
 //!
 //! * `σ(v) = 3(c v² − 2b v + L₁)` with `a = √(L₁L₃ − L₂²cθ²)`, `b = L₁ − L₂cθ`,
 //!   `c = L₁ − 2L₂cθ + L₃`;
-//! * `κ = 6L₂sθ/σ²`, `τ = sgn(Δ)·6√(L₁L₃ − L₂²)/σ²` (signed, erratum PH-3), κ/τ constant;
+//! * `κ = 6L₂sθ/σ²`, `τ = sgn(Δ)·6√(L₁L₃ − L₂²)/σ²`, κ/τ constant (MJ (18) writes
+//!   `τ = −3L₁L₃ sin ψ/(L₂σ²)` with ψ "the angle between" two vectors, which is unsigned; the
+//!   torsion needs the sign, `sgn(sin ψ) = −sgn(Δ)`, as the standard `det[ẋ, ẍ, x⃛]/|ẋ × ẍ|²`
+//!   confirms);
 //! * `k = −sgn(Δ)√(L₁L₃ − L₂²)/a` (|k| ≤ 1; 0 for planar cubics), the factor of the exact
 //!   rotation-minimising angle ([`frame`]).
 //!
@@ -143,7 +146,7 @@ impl Cubic {
             && d2.dot(d3) > 0.0
     }
 
-    /// Invariants of §1.1 (the cubic is assumed PH).
+    /// Invariants of MJ (18), (31) (the cubic is assumed PH).
     ///
     /// Evaluated for accuracy on nearly straight cubics, where `L₁L₃ − L₂²`, `L₁ − L₂cθ`
     /// and `L₁ − 2L₂cθ + L₃` would cancel: `sgn(Δ)√(L₁L₃ − L₂²)` from the preimage
@@ -232,7 +235,8 @@ impl Cubic {
         (cpsi - target).abs() <= tol
     }
 
-    /// Control points from a quaternion preimage `A₀, A₁` and the start point (MJ §2.1).
+    /// Control points from a quaternion preimage `A₀, A₁` and the start point (the quaternion
+    /// form of spatial PH curves; MJ characterise PH cubics by their control polygon, (17)).
     pub fn from_quaternions(a0: Quat, a1: Quat, start: DVec3) -> Self {
         let b0 = start;
         let b1 = b0 + aib(a0, a0) / 3.0;

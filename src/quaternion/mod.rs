@@ -1,4 +1,4 @@
-//! Quaternion frames (Hanson & Ma 1995; Ma's thesis 1996, seed 004).
+//! Quaternion frames (Hanson & Ma 1995; Ma's thesis 1996; see docs/references.md).
 //!
 //! A frame `F = (r, s, t)` (columns) is the rotation `R(q)` of a unit quaternion
 //! `q = (w, x, y, z)`; `q` and `−q` give the same frame. Arrays here store `(x, y, z, w)`
@@ -10,7 +10,7 @@
 //!   number happens (Ma's Fig. 3.1 tests `> 0` exactly and fails at half turns).
 //! * **Sign continuity**: `q₀` canonical (`w ≥ 0`), then `q_i ← −q_i` whenever
 //!   `q_i·q_{i−1} < 0`, so that neighbours are close on S³ and slerp takes the short arc.
-//! * **Parallel transport** as a quaternion recurrence (Ma §2.4): the rotation taking
+//! * **Parallel transport** as a quaternion recurrence (Ma §2.2.1): the rotation taking
 //!   `T_i` to `T_{i+1}` about `T_i × T_{i+1}` is `Δq_i = normalise(1 + T_i·T_{i+1},
 //!   T_i × T_{i+1})`, and `Q_{i+1} = Δq_i Q_i` (a rotation of the world multiplies on the
 //!   left). This is Bloomenthal's rotation method written with quaternions.
