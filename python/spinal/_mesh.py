@@ -11,7 +11,7 @@ import numpy as np
 from . import _core
 from ._validate import as_float_array
 
-__all__ = ["FoldOverWarning", "Mesh", "edges", "mesh_arrays"]
+__all__ = ["FoldOverWarning", "Mesh", "mesh_arrays"]
 
 
 class FoldOverWarning(UserWarning):
@@ -29,15 +29,6 @@ def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
     vertex so that a small mesh far from the origin keeps its digits."""
     return _core.mesh_volume(np.ascontiguousarray(V, dtype=np.float64),
                              np.ascontiguousarray(F, dtype=np.int64).reshape(-1, 3))
-
-
-def edges(F: np.ndarray):
-    """Unique edges (m, 2), and the edge id of every face slot (nf, 3); slot k is the edge
-    F[k] → F[k+1]."""
-    e = np.stack([F, np.roll(F, -1, axis=1)], axis=-1).reshape(-1, 2)
-    key = np.sort(e, axis=1)
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    return uniq, inv.reshape(-1, 3)
 
 
 def mesh_arrays(mesh):

@@ -57,7 +57,7 @@ import numpy as np
 
 from . import _core
 from ._core import Field
-from ._mesh import edges, mesh_arrays
+from ._mesh import mesh_arrays
 from ._validate import as_bool, as_float_array, as_int, as_points, as_real, as_vector
 
 __all__ = [
@@ -423,33 +423,11 @@ MIN_CELLS_PER_REACH = 4
 
 
 def _closed_mesh(mesh):
+    """Vertices, faces and the enclosed volume's centroid of a closed, outward-wound mesh
+    (the core checks it, naming ``mesh``)."""
     V, F = mesh_arrays(mesh)
-    if not len(F):
-        raise ValueError("mesh: has no faces")
-    # every undirected edge, in the order of the slots 0→1 of all faces, then 1→2, then 2→0
-    uniq, slot = edges(F)
-    ids = slot.T.ravel()
-    cnt = np.bincount(ids, minlength=len(uniq))[ids]
-    if (cnt != 2).any():
-        k = np.argmax(cnt != 2)
-        e = uniq[ids[k]]
-        raise ValueError(f"mesh: not watertight: edge ({e[0]}, {e[1]}) belongs to {cnt[k]} "
-                         f"faces (a closed tool needs exactly 2)")
-    directed = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    _, dcnt = np.unique(directed, axis=0, return_counts=True)
-    if (dcnt != 1).any():
-        raise ValueError("mesh: faces are not consistently oriented")
-    # about the mean vertex, as `Mesh.volume`, so that a small tool far away keeps its digits
-    mean = V.mean(axis=0)
-    c0 = V - mean
-    a, b, c = c0[F[:, 0]], c0[F[:, 1]], c0[F[:, 2]]
-    six = np.einsum("ij,ij->i", a, np.cross(b, c))
-    vol = six.sum() / 6
-    if not vol > 0:
-        raise ValueError(f"mesh: encloses a non-positive volume ({vol:.4g}); faces must be "
-                         f"oriented outwards")
-    centroid = mean + (six[:, None] * (a + b + c)).sum(axis=0) / (24 * vol)
-    return V, F, centroid
+    _, centroid = _core.mesh_closed_centroid(V, F)
+    return V, F, np.asarray(centroid)
 
 
 @_recorded

@@ -17,3 +17,17 @@ pub fn mesh_volume(
     let f = triangles(&faces)?;
     Ok(py.detach(|| mesh::signed_volume_checked(v, f))?)
 }
+
+/// Volume and centroid of the solid bounded by a closed, outward-wound mesh (errors name
+/// `mesh`: not watertight, inconsistently oriented, non-positive volume).
+#[pyfunction]
+pub fn mesh_closed_centroid(
+    py: Python<'_>,
+    vertices: PyReadonlyArray2<'_, f64>,
+    faces: PyReadonlyArray2<'_, i64>,
+) -> PyResult<(f64, [f64; 3])> {
+    let v = vec3s("mesh", &vertices)?;
+    let f = triangles(&faces)?;
+    let (vol, c) = py.detach(|| mesh::closed_volume_centroid(v, f))?;
+    Ok((vol, c.to_array()))
+}

@@ -58,6 +58,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_volume, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_closed_centroid, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::minimal_rotation, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
