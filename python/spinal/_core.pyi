@@ -271,6 +271,8 @@ def advect(
     h: float,
     steps: int,
     method: str,
+    progress: Callable[[int, int], object] | None = None,
+    every: int = 0,
 ) -> npt.NDArray[np.float64]: ...
 def deform_mesh(
     vertices: npt.NDArray[np.float64],

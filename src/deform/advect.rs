@@ -31,6 +31,17 @@ pub enum Method {
     Split,
 }
 
+/// A run of equal integration steps: step `j < count` goes from `t0 + h·j` to `t0 + h·(j+1)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Run {
+    /// Start time of the run.
+    pub t0: f64,
+    /// Step size (negative when integrating backwards).
+    pub h: f64,
+    /// Number of steps.
+    pub count: usize,
+}
+
 const CHUNK: usize = 256;
 
 /// One path line: `steps` steps of size `h` from time `t0`.
@@ -333,19 +344,19 @@ fn with_locality<R>(field: &Field, points: &mut [DVec3], run: impl FnOnce(&mut [
 /// [`advect_steps`] over `0..steps` in blocks, calling `tick(done, steps)` after each block;
 /// a block is sized to take about [`BLOCK_SECONDS`] (measured on the one before), so a caller
 /// that checks for interrupts in `tick` hears from it several times a second whatever the
-/// input size. Returns `false` when `tick` stopped it (the points are then partly advected).
-/// The bits equal one [`advect_steps`] call.
+/// input size, and ends at every multiple of `every` (0: no such constraint) so that a
+/// progress report can be made there. Returns `false` when `tick` stopped it (the points are
+/// then partly advected). The bits equal one [`advect_steps`] call.
 pub fn advect_ticked(
     field: &Field,
     points: &mut [DVec3],
-    t0: f64,
-    h: f64,
-    steps: usize,
+    run: Run,
     m: Method,
+    every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
     with_locality(field, points, |points| {
-        advect_blocks(field, points, t0, h, steps, m, tick)
+        advect_blocks(field, points, run, m, every, tick)
     })
 }
 
@@ -353,16 +364,22 @@ pub fn advect_ticked(
 fn advect_blocks(
     field: &Field,
     points: &mut [DVec3],
-    t0: f64,
-    h: f64,
-    steps: usize,
+    run: Run,
     m: Method,
+    every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
+    let Run {
+        t0,
+        h,
+        count: steps,
+    } = run;
     let mut done = 0;
     let mut block = 1usize;
     while done < steps {
-        let k = block.min(steps - done);
+        // a block ends at the next multiple of `every` at the latest
+        let next = done.checked_div(every).map_or(steps, |q| (q + 1) * every);
+        let k = block.min(steps - done).min(next - done);
         let clock = std::time::Instant::now();
         advect_steps(field, points, t0, h, done..done + k, m);
         done += k;
@@ -462,10 +479,13 @@ mod tests {
         assert!(advect_ticked(
             &f,
             &mut ticked,
-            0.0,
-            0.01,
-            300,
+            Run {
+                t0: 0.0,
+                h: 0.01,
+                count: 300,
+            },
             Method::Rk4,
+            7,
             &mut |d, n| {
                 calls.push((d, n));
                 true
@@ -474,15 +494,20 @@ mod tests {
         assert_eq!(ticked, once);
         assert_eq!(calls.last(), Some(&(300, 300)));
         assert!(calls.windows(2).all(|w| w[0].0 < w[1].0));
+        // every multiple of 7 is reported
+        assert!((7..300).step_by(7).all(|k| calls.iter().any(|c| c.0 == k)));
         let mut stopped = x0.clone();
         let mut seen = 0;
         assert!(!advect_ticked(
             &f,
             &mut stopped,
-            0.0,
-            0.01,
-            300,
+            Run {
+                t0: 0.0,
+                h: 0.01,
+                count: 300,
+            },
             Method::Rk4,
+            0,
             &mut |d, _| {
                 seen = d;
                 false

@@ -54,16 +54,7 @@ const NONE: usize = usize::MAX;
 /// as torn by the flow (see the module docs).
 const TORN: f64 = 0.25;
 
-/// A run of equal integration steps: step `j < count` goes from `t0 + h·j` to `t0 + h·(j+1)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Run {
-    /// Start time of the run.
-    pub t0: f64,
-    /// Step size (negative when integrating backwards).
-    pub h: f64,
-    /// Number of steps.
-    pub count: usize,
-}
+pub use super::advect::Run;
 
 /// The steps of an integration from `t0` over `duration` in about `steps` equal steps, ended
 /// at the field's breakpoints ([`Field::breakpoints`]: a path tool's velocity is only C⁰ in

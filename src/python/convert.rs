@@ -29,6 +29,8 @@ impl From<InputError> for PyErr {
 /// for [`Ticker::finish`].
 pub struct Ticker {
     progress: Option<Py<PyAny>>,
+    /// Report progress when `done` is a multiple of this (0 or 1: after every tick).
+    every: usize,
     last: std::time::Instant,
     error: Option<PyErr>,
 }
@@ -38,8 +40,14 @@ impl Ticker {
     pub const INTERVAL: std::time::Duration = std::time::Duration::from_millis(50);
 
     pub fn new(progress: Option<Py<PyAny>>) -> Ticker {
+        Ticker::every(progress, 0)
+    }
+
+    /// A ticker that reports progress only at multiples of `every` steps (and at the end).
+    pub fn every(progress: Option<Py<PyAny>>, every: usize) -> Ticker {
         Ticker {
             progress,
+            every,
             last: std::time::Instant::now(),
             error: None,
         }
@@ -47,11 +55,13 @@ impl Ticker {
 
     /// Continue (true) or stop (false) after `done` of `total` steps.
     pub fn tick(&mut self, done: usize, total: usize) -> bool {
-        if self.progress.is_none() && self.last.elapsed() < Self::INTERVAL {
+        let report =
+            self.progress.is_some() && (self.every <= 1 || done % self.every == 0 || done == total);
+        if !report && self.last.elapsed() < Self::INTERVAL {
             return true;
         }
         self.last = std::time::Instant::now();
-        let progress = &self.progress;
+        let progress = if report { &self.progress } else { &None };
         let r = Python::attach(|py| -> PyResult<()> {
             py.check_signals()?;
             if let Some(p) = progress {

@@ -10,8 +10,11 @@ use super::fields::PyField;
 use crate::deform::{self, advect::Method, refine};
 
 /// Advect points: `steps` steps of size `h` from `t0`; a new array. Ctrl-C stops it between
-/// blocks of steps (`KeyboardInterrupt`).
+/// blocks of steps (`KeyboardInterrupt`); `progress(done, steps)` is called at every multiple
+/// of `every` steps and at the end.
 #[pyfunction]
+#[pyo3(signature = (points, field, t0, h, steps, method, progress=None, every=0))]
+#[allow(clippy::too_many_arguments)]
 pub fn advect<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -20,19 +23,26 @@ pub fn advect<'py>(
     h: f64,
     steps: usize,
     method: Method,
+    progress: Option<Py<PyAny>>,
+    every: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let field = &field.field;
     deform::advect::check_method(field, method)?;
     let x = vec3s("vertices", &points)?;
     deform::finite_rows("vertices", x)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
-    let mut ticker = Ticker::new(None);
+    let mut ticker = Ticker::every(progress, every);
     {
         let mut w = out.readwrite();
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
         py.detach(|| {
-            deform::advect::advect_ticked(field, o, t0, h, steps, method, &mut |d, n| {
+            let run = deform::advect::Run {
+                t0,
+                h,
+                count: steps,
+            };
+            deform::advect::advect_ticked(field, o, run, method, every, &mut |d, n| {
                 ticker.tick(d, n)
             })
         });
