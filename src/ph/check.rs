@@ -28,17 +28,16 @@ pub fn finite_cubics(cubics: &[Cubic]) -> Result<()> {
     Ok(())
 }
 
-/// The first non-finite row of `rows` as an error naming `arg`.
+/// The first non-finite row of `rows` as an error naming `arg` (the row only: quaternion
+/// rows arrive reordered, scalar first).
 pub fn finite_rows<const N: usize>(arg: &'static str, rows: &[[f64; N]]) -> Result<()> {
-    for (i, r) in rows.iter().enumerate() {
-        if let Some(k) = r.iter().position(|x| !x.is_finite()) {
-            return Err(InputError::new(
-                arg,
-                format!("contains non-finite values (at index ({i}, {k}))"),
-            ));
-        }
+    match rows.iter().position(|r| !r.iter().all(|x| x.is_finite())) {
+        Some(i) => Err(InputError::new(
+            arg,
+            format!("contains non-finite values (in row {i})"),
+        )),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// [`Cubic::is_ph`] per cubic, after checking the cubics (finite) and `tol` (≥ 0).
