@@ -225,10 +225,7 @@ mod tests {
             &[[1.0, 2.0, 3.0, 4.0], [0.0, f64::INFINITY, 0.0, 0.0]],
         )
         .unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "A0: contains non-finite values (at index (1, 1))"
-        );
+        assert_eq!(e.to_string(), "A0: contains non-finite values (in row 1)");
     }
 
     #[test]
