@@ -728,6 +728,60 @@ def test_fit_bad_input():
         ph.PHSpline(P)
 
 
+def test_fit_segments_bounded():
+    # the bound comes before any allocation (10**7 intervals exhausted the memory)
+    with pytest.raises(ValueError, match="^segments: must be <= 100000, got 10000000"):
+        ph.fit(HELIX, segments=10**7)
+    with pytest.raises(ValueError, match="^segments: must be <= 100000"):
+        ph.fit(HELIX.point(np.linspace(0, 1, 5)), segments=100_001)
+
+
+def test_value_checks_in_the_core_name_the_argument():
+    sp = ph.fit(HELIX, segments=4)
+    P = sp.control_points
+    with pytest.raises(ValueError, match=r"^control_points: contains non-finite values "
+                                         r"\(at index \(0, 2, 1\)\)"):
+        bad = P.copy()
+        bad[0, 2, 1] = np.inf
+        ph.is_ph(bad)
+    with pytest.raises(ValueError, match="^tol: must be non-negative"):
+        ph.is_ph(P, tol=-1.0)
+    with pytest.raises(ValueError, match="^control_points: contains non-finite"):
+        ph.invariants(np.full((4, 3), np.nan))
+    with pytest.raises(ValueError, match="^control_points: cubic 0 has a zero-length leg"):
+        ph.invariants(np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="^A1: contains non-finite"):
+        ph.from_quaternions([1, 0, 0, 0], [np.nan, 0, 0, 1])
+    with pytest.raises(ValueError, match="^start: contains non-finite"):
+        ph.from_quaternions([1, 0, 0, 0], [0, 0, 0, 1], start=[0, np.inf, 0])
+    with pytest.raises(ValueError, match="^control_points: cubic 1: not a PH cubic"):
+        bad = P.copy()
+        bad[1, 1] += 0.01
+        ph.preimage(bad)
+    with pytest.raises(ValueError, match="^knots: must be strictly increasing"):
+        ph.PHSpline(P, knots=[0, 1, 3, 2, 4])
+    with pytest.raises(ValueError, match="^knots: contains non-finite"):
+        ph.PHSpline(P, knots=[0, 1, np.nan, 2, 4])
+    with pytest.raises(ValueError, match="^control_points: no cubics"):
+        ph.PHSpline(np.zeros((0, 4, 3)))
+    with pytest.raises(ValueError, match="^control_points: cubic 2 does not start"):
+        bad = P.copy()
+        bad[2:] += 1.0
+        ph.PHSpline(bad)
+    with pytest.raises(ValueError, match="^omega_start: must be finite"):
+        sp.rmf(omega_start=np.nan)
+    with pytest.raises(ValueError, match="^omega_start: must be finite"):
+        ph.angle_fit(P[0], omega_start=np.inf)
+    with pytest.raises(ValueError, match="^phi: must be finite"):
+        ph.angle_fit(P[0], phi=np.nan)
+    with pytest.raises(ValueError, match="^derivative: must be 0, 1, 2 or 3, got 4"):
+        sp.evaluate(0.5, 4)
+    with pytest.raises(ValueError, match="^derivative: must be >= 0"):
+        sp.evaluate(0.5, -1)
+    with pytest.raises(ValueError, match="^control_points: contains non-finite"):
+        ph.evaluate(np.full((4, 3), np.nan), 0.5)
+
+
 def test_orthogonality_measure_on_the_swept_surface():
     """|O| = |<s_u, s_v>|/(|s_u||s_v|) from finite differences of the surface swept with the
     rational frame (helix, N = 4, circle of radius 0.1): the table's 8.721e-5, computed

@@ -123,7 +123,12 @@ def ph_is_ph(control_points: npt.NDArray[np.float64], tol: float) -> npt.NDArray
 def ph_from_quaternions(
     a0: npt.NDArray[np.float64], a1: npt.NDArray[np.float64], start: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...
-def ph_preimage(control_points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+def ph_preimage(
+    control_points: npt.NDArray[np.float64], tol: float, batch: bool
+) -> npt.NDArray[np.float64]: ...
+def ph_check_spline(
+    control_points: npt.NDArray[np.float64], knots: npt.NDArray[np.float64], single: bool
+) -> None: ...
 def ph_frame_setup(
     control_points: npt.NDArray[np.float64],
     initial: npt.NDArray[np.float64] | None,

@@ -65,6 +65,7 @@ __all__ = [
 
 
 def _finite(a: np.ndarray, name: str) -> np.ndarray:
+    """Finite values, for the inputs of Python-side computations (the core checks its own)."""
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
         raise ValueError(f"{name}: contains non-finite values (at index {tuple(bad.tolist())})")
@@ -75,9 +76,9 @@ def _vectors(x: Any, name: str, width: int = 3) -> tuple[np.ndarray, bool]:
     """``(width,)`` or ``(m, width)`` -> a C-contiguous ``(m, width)`` array and 'was single'."""
     a = as_float_array(x, name)
     if a.shape == (width,):
-        return np.ascontiguousarray(_finite(a, name)[None]), True
+        return np.ascontiguousarray(a[None]), True
     if a.ndim == 2 and a.shape[1] == width:
-        return np.ascontiguousarray(_finite(a, name)), False
+        return np.ascontiguousarray(a), False
     raise ValueError(f"{name}: expected shape ({width},) or (m, {width}), got {a.shape}")
 
 
@@ -85,9 +86,9 @@ def _cubics(x: Any, name: str = "control_points") -> tuple[np.ndarray, bool]:
     """``(4, 3)`` or ``(m, 4, 3)`` control points -> ``(m, 4, 3)`` and 'was single'."""
     a = as_float_array(x, name)
     if a.shape == (4, 3):
-        return np.ascontiguousarray(_finite(a, name)[None]), True
+        return np.ascontiguousarray(a[None]), True
     if a.ndim == 3 and a.shape[1:] == (4, 3):
-        return np.ascontiguousarray(_finite(a, name)), False
+        return np.ascontiguousarray(a), False
     raise ValueError(f"{name}: expected shape (4, 3) or (m, 4, 3), got {a.shape}")
 
 
@@ -167,10 +168,7 @@ def is_ph(control_points, tol: float = 1e-9):
     Returns a bool for ``(4, 3)`` input, a bool array ``(m,)`` for ``(m, 4, 3)``.
     """
     cp, single = _cubics(control_points)
-    tol = float(as_float_array(tol, "tol"))
-    if not (tol >= 0):
-        raise ValueError(f"tol: must be non-negative, got {tol}")
-    out = _core.ph_is_ph(cp, tol)
+    out = _core.ph_is_ph(cp, float(as_float_array(tol, "tol")))
     return bool(out[0]) if single else out
 
 
@@ -216,16 +214,7 @@ def preimage(control_points, *, scalar_first: bool = False, tol: float = 1e-9):
     """
     sf = as_bool(scalar_first, "scalar_first")
     cp, single = _cubics(control_points)
-    rows = _core.ph_preimage(cp)
-    scale = np.linalg.norm(np.diff(cp, axis=1), axis=2).sum(axis=1)
-    bad = np.flatnonzero(~(rows[:, 8] <= tol * scale))
-    if bad.size:
-        i = int(bad[0])
-        where = "" if single else f"cubic {i}: "
-        raise ValueError(
-            f"control_points: {where}not a PH cubic (preimage residual {rows[i, 8]:.3g} for a "
-            f"polygon of length {scale[i]:.3g})"
-        )
+    rows = _core.ph_preimage(cp, float(as_float_array(tol, "tol")), not single)
     q0, q1 = rows[:, 0:4], rows[:, 4:8]
     if not sf:
         q0, q1 = np.roll(q0, -1, axis=1), np.roll(q1, -1, axis=1)
@@ -249,18 +238,7 @@ def invariants(control_points) -> dict:
     with a zero-length leg, or whose invariants are undefined, raises ValueError.
     """
     cp, single = _cubics(control_points)
-    legs = np.linalg.norm(np.diff(cp, axis=1), axis=2)  # (m, 3)
-    scale = np.abs(cp).max(axis=(1, 2))
-    bad = np.flatnonzero(~(legs > 1e-14 * np.maximum(scale, 1e-300)[:, None]).all(axis=1))
-    if bad.size:
-        raise ValueError(f"control_points: cubic {int(bad[0])} has a zero-length leg of its "
-                         "control polygon (a degenerate polygon is not a PH cubic)")
     rows = _core.ph_invariants(cp)
-    if not np.isfinite(rows[:, [i for i, k in enumerate(_INV_KEYS) if k != "kappa_over_tau"]]
-                       ).all():
-        i = int(np.flatnonzero(~np.isfinite(rows).all(axis=1))[0])
-        raise ValueError(f"control_points: the invariants of cubic {i} are undefined (a "
-                         "straight or degenerate polygon)")
     return {k: (float(rows[0, i]) if single else rows[:, i].copy())
             for i, k in enumerate(_INV_KEYS)}
 
@@ -319,12 +297,9 @@ def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = N
     cp, single = _cubics(control_points)
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline.angle_fit")
-    if not _core.ph_is_ph(cp, 1e-7)[0]:
-        raise ValueError("control_points: not a PH cubic (control-polygon test, tolerance 1e-7)")
+    _core.ph_check_spline(cp, np.arange(2.0), True)
     om = float(as_float_array(omega_start, "omega_start"))
     ph = None if phi is None else float(as_float_array(phi, "phi"))
-    if not np.isfinite(om) or (ph is not None and not np.isfinite(ph)):
-        raise ValueError("omega_start, phi: must be finite")
     rows = _core.ph_frame_setup(cp, None, om, ph)
     return _fit_dict(rows, True)
 
@@ -388,38 +363,14 @@ def _erf_col(k: int, p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def _spline_knots(knots, m: int) -> np.ndarray:
-    """The ``(m + 1,)`` joint parameters of a spline of ``m`` cubics (default ``0 … m``)."""
+    """The ``(m + 1,)`` joint parameters of a spline of ``m`` cubics (default ``0 … m``);
+    their values are checked by the core (``ph_check_spline``)."""
     if knots is None:
         return np.arange(m + 1, dtype=float)
-    kn = _finite(as_float_array(knots, "knots"), "knots")
+    kn = as_float_array(knots, "knots")
     if kn.shape != (m + 1,):
         raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
-    if not np.all(np.diff(kn) > 0):
-        raise ValueError("knots: must be strictly increasing")
-    return kn
-
-
-def _check_spline(cp: np.ndarray) -> None:
-    """Cubics ``(m, 4, 3)`` that join end to end (within 1e-9 of the scale), are PH
-    (tolerance 1e-7) and share the tangent direction at every joint (G¹)."""
-    scale = np.abs(cp).max() + 1.0
-    gap = np.linalg.norm(cp[1:, 0] - cp[:-1, 3], axis=1)
-    if gap.size and gap.max() > 1e-9 * scale:
-        i = int(np.argmax(gap))
-        raise ValueError(f"control_points: cubic {i + 1} does not start where cubic "
-                         f"{i} ends (gap {gap[i]:.3g})")
-    ok = _core.ph_is_ph(cp, 1e-7)
-    if not ok.all():
-        i = int(np.flatnonzero(~ok)[0])
-        raise ValueError(f"control_points: cubic {i} is not a PH cubic (control-polygon "
-                         f"test, tolerance 1e-7)")
-    d_in, d_out = cp[:-1, 3] - cp[:-1, 2], cp[1:, 1] - cp[1:, 0]
-    cos = np.einsum("ij,ij->i", d_in, d_out) / (np.linalg.norm(d_in, axis=1)
-                                                * np.linalg.norm(d_out, axis=1))
-    if cos.size and not np.all(cos >= 1 - 1e-12):
-        i = int(np.argmin(cos))
-        raise ValueError(f"control_points: cubics {i} and {i + 1} do not join with a "
-                         f"common tangent (G¹; angle {np.arccos(np.clip(cos[i], -1, 1)):.3g} rad)")
+    return np.ascontiguousarray(kn)
 
 
 def _rational_numerators(fit: dict) -> dict:
@@ -510,11 +461,9 @@ class PHSpline:
 
     def __init__(self, control_points, knots=None):
         cp, _ = _cubics(control_points)
-        m = cp.shape[0]
-        if m == 0:
-            raise ValueError("control_points: no cubics")
-        kn = _spline_knots(knots, m)
-        _check_spline(cp)
+        kn = _spline_knots(knots, cp.shape[0])
+        # no cubics, non-finite values, knots not increasing, gaps, not PH, not G¹
+        _core.ph_check_spline(cp, kn, False)
         self._init(cp, kn)
 
     def _init(self, cp: np.ndarray, kn: np.ndarray) -> None:
@@ -558,16 +507,11 @@ class PHSpline:
         a = as_float_array(s, "s")
         if a.ndim > 1:
             raise ValueError(f"s: expected a scalar or a 1-D array, got shape {a.shape}")
-        a = np.ascontiguousarray(np.atleast_1d(a))
-        if not np.all(np.isfinite(a) & (a >= 0) & (a <= self.segments)):
-            raise ValueError(f"s: values must be finite and within [0, {self.segments}]")
-        return a
+        return np.ascontiguousarray(np.atleast_1d(a))  # values: the core (finite, in [0, m])
 
     def samples(self, n_per_segment: int = 16) -> np.ndarray:
         """``m·n + 1`` uniformly spaced spline parameters ``s`` (the joints included)."""
-        n = as_int(n_per_segment, "n_per_segment")
-        if n < 1:
-            raise ValueError(f"n_per_segment: must be >= 1, got {n}")
+        n = as_int(n_per_segment, "n_per_segment", minimum=1)
         return np.linspace(0.0, self.segments, self.segments * n + 1)
 
     def parameter(self, u) -> np.ndarray:
@@ -580,9 +524,7 @@ class PHSpline:
 
     def evaluate(self, s, derivative: int = 0) -> np.ndarray:
         """Points (or derivatives with respect to the local ``v``) at ``s``, ``(n, 3)``."""
-        d = as_int(derivative, "derivative")
-        if not 0 <= d <= 3:
-            raise ValueError(f"derivative: must be 0, 1, 2 or 3, got {d}")
+        d = as_int(derivative, "derivative", minimum=0)  # <= 3: the core
         return _core.ph_eval(self._cp, self._s(s), d)
 
     def points(self, n_per_segment: int = 16) -> np.ndarray:
@@ -593,15 +535,13 @@ class PHSpline:
     def _initial(self, initial):
         if initial is None:
             return None
-        r = _finite(as_float_array(initial, "initial"), "initial")
+        r = as_float_array(initial, "initial")
         if r.shape != (3,):
             raise ValueError(f"initial: expected shape (3,), got {r.shape}")
         return np.ascontiguousarray(r)
 
     def _frames(self, s, mode, initial, omega_start):
         om = float(as_float_array(omega_start, "omega_start"))
-        if not np.isfinite(om):
-            raise ValueError("omega_start: must be finite")
         return _core.ph_frames(self._cp, self._s(s), mode, self._initial(initial), om, None)
 
     def frenet(self, s) -> np.ndarray:
@@ -743,7 +683,12 @@ def _hermite_batch(p0, t0, p1, t1):
 
 
 def _dev_curve(curve, cp, ta, tb, lo, hi) -> np.ndarray:
-    """Max distance from 41 points of each cubic to the curve arc over [ta, tb] (per row)."""
+    """Max distance from 41 points of each cubic to the curve arc over [ta, tb] (per row),
+    in blocks of 1024 rows (the scan needs 64 kB per row)."""
+    if cp.shape[0] > 1024:
+        return np.concatenate([_dev_curve(curve, cp[i:i + 1024], ta[i:i + 1024],
+                                          tb[i:i + 1024], lo, hi)
+                               for i in range(0, cp.shape[0], 1024)])
     q = cp.shape[0]
     v = np.broadcast_to(np.linspace(0, 1, 41), (q, 41))
     X = _bez(cp, v)
@@ -852,11 +797,18 @@ def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
     return k
 
 
+#: The largest ``segments`` of :func:`fit` (the knots, the Hermite data and the cubics are
+#: held at once; 10**7 intervals exhausted the memory).
+_MAX_FIT_SEGMENTS = 100_000
+
+
 def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
     """The knots of a fit with ``segments`` uniform intervals or explicit ``knots``, and the
     name of the argument that set them."""
     if segments is not None:
         N = as_int(segments, "segments", minimum=1)
+        if N > _MAX_FIT_SEGMENTS:  # the deviation needs (N, 41, 65, 3) temporaries
+            raise ValueError(f"segments: must be <= {_MAX_FIT_SEGMENTS}, got {N}")
         k = np.linspace(lo, hi, N + 1)
         if not analytic:
             k = np.unique(np.round(k))
@@ -901,7 +853,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         given: ``1e-5`` times the bounding-box diagonal.
     segments : int, optional
         ``segments`` uniform intervals (of the parameter, or of the row index), no
-        adaptivity.
+        adaptivity; at most 100,000.
     knots : array_like, optional
         Explicit increasing knots (curve parameters, or integer sample rows); the spline
         covers [knots[0], knots[-1]].

@@ -333,7 +333,16 @@ pub enum Start {
 }
 
 /// Frame data of every segment of a G¹ PH spline.
+/// `omega_start` and `phi`, when given, must be finite.
 pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Segment>> {
+    if let Start::Angle(om) = start {
+        if !om.is_finite() {
+            return Err(InputError::new("omega_start", "must be finite"));
+        }
+    }
+    if phi.is_some_and(|p| !p.is_finite()) {
+        return Err(InputError::new("phi", "must be finite"));
+    }
     let Some(first) = cubics.first() else {
         return Ok(Vec::new());
     };
@@ -523,5 +532,17 @@ mod tests {
         let mut f = vec![[0.0; 9]; 1];
         let e = frames_at(&c, &[-0.5], start, None, Mode::Exact, &mut f, &mut [0.0]).unwrap_err();
         assert_eq!(e.arg, "s");
+    }
+
+    #[test]
+    fn setup_needs_a_finite_start_angle_and_offset() {
+        let c = [r1()];
+        let e = setup(&c, Start::Angle(f64::NAN), None).unwrap_err();
+        assert_eq!(e.to_string(), "omega_start: must be finite");
+        let e = setup(&c, Start::Angle(0.0), Some(f64::INFINITY)).unwrap_err();
+        assert_eq!(e.to_string(), "phi: must be finite");
+        let e = setup(&c, Start::Vector(DVec3::new(f64::NAN, 0.0, 1.0)), None).unwrap_err();
+        assert_eq!(e.arg, "initial");
+        assert!(setup(&c, Start::Angle(0.3), Some(0.1)).is_ok());
     }
 }

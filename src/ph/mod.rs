@@ -16,9 +16,10 @@
 //! * `k = −sgn(Δ)√(L₁L₃ − L₂²)/a` (|k| ≤ 1; 0 for planar cubics), the factor of the exact
 //!   rotation-minimising angle ([`frame`]).
 //!
-//! Submodules: [`hermite`] (G¹ Hermite interpolation with the corrected, signed equation) and
+//! Submodules: [`check`] (value checks of the input), [`hermite`] (G¹ Hermite interpolation with the corrected, signed equation) and
 //! [`frame`] (Frenet frame, exact RMF angle, its rational approximation).
 
+pub mod check;
 pub mod frame;
 pub mod hermite;
 
@@ -359,8 +360,12 @@ pub fn check_params(m: usize, s: &[f64]) -> Result<()> {
 /// of the spline `cubics` at the global parameters `s` (see [`locate`]), in parallel.
 pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVec3>> {
     check_params(cubics.len(), s)?;
+    check::finite_cubics(cubics)?;
     if derivative > 3 {
-        return Err(InputError::new("derivative", "must be 0, 1, 2 or 3"));
+        return Err(InputError::new(
+            "derivative",
+            format!("must be 0, 1, 2 or 3, got {derivative}"),
+        ));
     }
     Ok(s.par_iter()
         .map(|&x| {
@@ -378,14 +383,20 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
             "must have the same number of rows",
         ));
     }
+    check::finite_rows("A0", a0)?;
+    check::finite_rows("A1", a1)?;
+    let st: Vec<[f64; 3]> = start.iter().map(|p| p.to_array()).collect();
+    check::finite_rows("start", &st)?;
     Ok((0..a0.len())
         .map(|i| Cubic::from_quaternions(a0[i], a1[i], start[i]))
         .collect())
 }
 
 /// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a
-/// zero-length leg is an error naming it.
-pub fn preimage_rows(cubics: &[Cubic]) -> Result<Vec<[f64; 9]>> {
+/// zero-length leg, or whose residual exceeds `tol` times the length of its control polygon
+/// (not PH), is an error naming it (`batch`: with its index).
+pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64; 9]>> {
+    check::finite_cubics(cubics)?;
     cubics
         .iter()
         .enumerate()
@@ -396,6 +407,21 @@ pub fn preimage_rows(cubics: &[Cubic]) -> Result<Vec<[f64; 9]>> {
                     format!("cubic {i} has a control-polygon leg of zero length (not a PH cubic)"),
                 )
             })?;
+            let scale: f64 = c.legs().iter().map(|d| d.length()).sum();
+            if !(res <= tol * scale) {
+                let at = if batch {
+                    format!("cubic {i}: ")
+                } else {
+                    String::new()
+                };
+                return Err(InputError::new(
+                    "control_points",
+                    format!(
+                        "{at}not a PH cubic (preimage residual {res:.3e} for a polygon of \
+                         length {scale:.3e})"
+                    ),
+                ));
+            }
             Ok([q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3], res])
         })
         .collect()
@@ -454,7 +480,11 @@ mod tests {
         assert_eq!(e.to_string(), "s: values must be finite and within [0, 2]");
         assert!(eval_at(&c, &[f64::NAN], 0).is_err());
         let e = eval_at(&c, &[0.5], 4).unwrap_err();
-        assert_eq!(e.to_string(), "derivative: must be 0, 1, 2 or 3");
+        assert_eq!(e.to_string(), "derivative: must be 0, 1, 2 or 3, got 4");
+        let mut nan = c.clone();
+        nan[0].b[1].x = f64::NAN;
+        let e = eval_at(&nan, &[0.5], 0).unwrap_err();
+        assert_eq!(e.arg, "control_points");
         let e = eval_at(&[], &[0.0], 0).unwrap_err();
         assert_eq!(e.to_string(), "control_points: no segments");
     }
@@ -462,7 +492,7 @@ mod tests {
     #[test]
     fn quaternion_rows_round_trip() {
         let c = two_segments();
-        let rows = preimage_rows(&c).unwrap();
+        let rows = preimage_rows(&c, 1e-9, true).unwrap();
         let a0: Vec<Quat> = rows.iter().map(|r| [r[0], r[1], r[2], r[3]]).collect();
         let a1: Vec<Quat> = rows.iter().map(|r| [r[4], r[5], r[6], r[7]]).collect();
         assert!(rows.iter().all(|r| r[8] < 1e-12));
@@ -478,10 +508,30 @@ mod tests {
             "A0, A1, start: must have the same number of rows"
         );
         let flat = Cubic::new([DVec3::ZERO, DVec3::ZERO, DVec3::X, DVec3::Y]);
-        let e = preimage_rows(&[c[0], flat]).unwrap_err();
+        let e = preimage_rows(&[c[0], flat], 1e-9, true).unwrap_err();
         assert!(
             e.to_string().starts_with("control_points: cubic 1 has"),
             "{e}"
         );
+        // not PH: the residual names the cubic (batch) or not (one cubic)
+        let mut bent = c[1];
+        bent.b[1] += DVec3::new(0.0, 0.01, 0.0);
+        let e = preimage_rows(&[c[0], bent], 1e-9, true).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("control_points: cubic 1: not a PH cubic"),
+            "{e}"
+        );
+        let e = preimage_rows(&[bent], 1e-9, false).unwrap_err();
+        assert!(
+            e.to_string().starts_with("control_points: not a PH cubic"),
+            "{e}"
+        );
+        let e = from_quaternion_rows(&a0, &a1, &[DVec3::ZERO, DVec3::NAN]).unwrap_err();
+        assert_eq!(e.arg, "start");
+        let mut q = a1.clone();
+        q[0][2] = f64::INFINITY;
+        let e = from_quaternion_rows(&a0, &q, &[DVec3::ZERO; 2]).unwrap_err();
+        assert_eq!(e.arg, "A1");
     }
 }

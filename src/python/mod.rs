@@ -37,6 +37,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ph::ph_is_ph, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_from_quaternions, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_preimage, m)?)?;
+    m.add_function(wrap_pyfunction!(ph::ph_check_spline, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_frame_setup, m)?)?;
     m.add_function(wrap_pyfunction!(ph::ph_frames, m)?)?;
     m.add_class::<fields::PyField>()?;

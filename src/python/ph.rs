@@ -62,9 +62,9 @@ pub fn ph_invariants<'py>(
     control_points: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of(&control_points)?;
-    let mut out = Vec::with_capacity(cubics.len() * 13);
-    for c in &cubics {
-        let v = c.invariants();
+    let rows = ph::check::invariant_rows(&cubics)?;
+    let mut out = Vec::with_capacity(rows.len() * 13);
+    for v in &rows {
         out.extend_from_slice(&[
             v.l[0],
             v.l[1],
@@ -81,7 +81,7 @@ pub fn ph_invariants<'py>(
             v.kappa_max,
         ]);
     }
-    let m = cubics.len();
+    let m = rows.len();
     PyArray1::from_vec(py, out).reshape([m, 13])
 }
 
@@ -93,8 +93,21 @@ pub fn ph_is_ph<'py>(
     tol: f64,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let cubics = cubics_of(&control_points)?;
-    let out: Vec<bool> = cubics.iter().map(|c| c.is_ph(tol)).collect();
+    let out = ph::check::is_ph_rows(&cubics, tol)?;
     Ok(PyArray1::from_vec(py, out))
+}
+
+/// The checks of a G¹ PH spline (`ph::check::check_spline`): raises ValueError or returns
+/// None.
+#[pyfunction]
+pub fn ph_check_spline(
+    control_points: PyReadonlyArray3<'_, f64>,
+    knots: PyReadonlyArray1<'_, f64>,
+    single: bool,
+) -> PyResult<()> {
+    let cubics = cubics_of(&control_points)?;
+    let knots = slice_of("knots", &knots)?;
+    Ok(ph::check::check_spline(&cubics, knots, single)?)
 }
 
 /// Control points `(m, 12)` from quaternion preimages `(m, 4)` (scalar first) and starts.
@@ -118,14 +131,17 @@ pub fn ph_from_quaternions<'py>(
     rows_of(py, out, m)
 }
 
-/// Quaternion preimages `(m, 9)`: `A0` (4, scalar first), `A1` (4), residual.
+/// Quaternion preimages `(m, 9)`: `A0` (4, scalar first), `A1` (4), residual; a residual
+/// above `tol` times the polygon length raises (`batch`: naming the cubic).
 #[pyfunction]
 pub fn ph_preimage<'py>(
     py: Python<'py>,
     control_points: PyReadonlyArray3<'py, f64>,
+    tol: f64,
+    batch: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of(&control_points)?;
-    let rows = ph::preimage_rows(&cubics)?;
+    let rows = ph::preimage_rows(&cubics, tol, batch)?;
     let m = rows.len();
     rows_of(py, rows.concat(), m)
 }
