@@ -64,11 +64,14 @@ def quat_continuous(q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def quat_slerp(
     q0: npt.NDArray[np.float64], q1: npt.NDArray[np.float64], u: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...
+def quat_slerp_frames(
+    frames: npt.NDArray[np.float64], key_u: npt.NDArray[np.float64], new_u: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
 def quat_path_length(q: npt.NDArray[np.float64], closed: bool) -> float: ...
 def quat_transport(
     points: npt.NDArray[np.float64],
-    tangents: npt.NDArray[np.float64],
-    r0: npt.NDArray[np.float64],
+    tangents: npt.NDArray[np.float64] | None,
+    initial: npt.NDArray[np.float64] | None,
     closed: bool,
     turns: int,
     closing_row: bool,

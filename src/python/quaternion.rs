@@ -48,8 +48,8 @@ pub fn quat_continuous<'py>(
     py: Python<'py>,
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let mut v = quats("q", &q)?.to_vec();
-    quaternion::make_continuous(&mut v);
+    let qs = quats("quaternions", &q)?;
+    let v = py.detach(|| quaternion::continuous(qs))?;
     quat_array(py, v)
 }
 
@@ -72,6 +72,25 @@ pub fn quat_slerp<'py>(
     quat_array(py, out)
 }
 
+/// Key frames interpolated by slerp; see `spinal.quaternions.slerp_frames`.
+#[pyfunction]
+pub fn quat_slerp_frames<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArray3<'py, f64>,
+    key_u: PyReadonlyArray1<'py, f64>,
+    new_u: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let fr = frames_of("frames", &frames)?;
+    let (ku, nu) = (slice_of("key_u", &key_u)?, slice_of("new_u", &new_u)?);
+    let out = empty::<f64, numpy::Ix3>(py, &[nu.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        py.detach(|| quaternion::slerp_frames(fr, ku, nu, buf))?;
+    }
+    Ok(out)
+}
+
 /// Length of a quaternion curve on S³.
 #[pyfunction]
 pub fn quat_path_length(
@@ -88,22 +107,22 @@ pub fn quat_path_length(
 pub fn quat_transport<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tangents: PyReadonlyArray2<'py, f64>,
-    r0: PyReadonlyArray1<'py, f64>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
     turns: i64,
     closing_row: bool,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
     let x = vec3s("points", &points)?;
-    let t = vec3s("tangents", &tangents)?;
-    let r = slice_of("initial", &r0)?;
-    if r.len() != 3 || t.len() != x.len() || t.len() < 2 {
-        return Err(value_error(
-            "points and tangents must have the same n >= 2 rows and initial 3 values",
-        ));
-    }
-    let r = glam::DVec3::new(r[0], r[1], r[2]);
-    let rows = t.len() + usize::from(closed && closing_row);
+    let t = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let r = initial
+        .as_ref()
+        .map(|r| vec3_of("initial", r, "expected 3 values"))
+        .transpose()?;
+    let rows = x.len() + usize::from(closed && closing_row);
     let mut out = vec![DQuat::IDENTITY; rows];
     let angle = py.detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))?;
     Ok((quat_array(py, out)?, angle))

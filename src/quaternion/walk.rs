@@ -51,6 +51,9 @@ impl<'a> Walker<'a> {
                 format!("non-finite value at row {i}"),
             ));
         }
+        if faces.is_empty() {
+            return Err(InputError::new("faces", "the mesh has no faces"));
+        }
         let nv = vertices.len();
         let mut f = Vec::with_capacity(faces.len());
         for (i, tri) in faces.iter().enumerate() {
