@@ -404,6 +404,94 @@ mod tests {
         }
     }
 
+    /// Each refused input names the Python argument.
+    fn arg_of<T: std::fmt::Debug>(r: Result<T>) -> &'static str {
+        r.expect_err("an input error").arg
+    }
+
+    #[test]
+    fn continuous_refuses_non_finite_quaternions() {
+        let q = [DQuat::IDENTITY, DQuat::from_xyzw(f64::NAN, 0.0, 0.0, 1.0)];
+        assert_eq!(arg_of(continuous(&q)), "quaternions");
+        let ok = continuous(&[-DQuat::IDENTITY, DQuat::IDENTITY]).expect("finite");
+        assert_eq!(ok, vec![DQuat::IDENTITY; 2]);
+    }
+
+    #[test]
+    fn slerp_frames_checks_keys_and_parameters() {
+        let keys = [rot(DVec3::Z, 0.0), rot(DVec3::Z, 1.0), rot(DVec3::X, 1.0)];
+        let mut out = [[0.0; 9]; 1];
+        let run = |f: &[[f64; 9]], ku: &[f64], nu: &[f64], out: &mut [[f64; 9]]| {
+            slerp_frames(f, ku, nu, out)
+        };
+        assert_eq!(arg_of(run(&keys[..1], &[0.0], &[0.0], &mut out)), "frames");
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 2.0, 1.0], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, f64::NAN], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 1.0], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[f64::NAN], &mut out)),
+            "new_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[2.5], &mut out)),
+            "new_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[-0.1], &mut out)),
+            "new_u"
+        );
+        // inside the range: the keys at the keys, the half turn between the first two
+        let mut out = [[0.0; 9]; 3];
+        run(&keys, &[0.0, 1.0, 2.0], &[0.0, 0.5, 2.0], &mut out).expect("valid keys");
+        let want = [keys[0], rot(DVec3::Z, 0.5), keys[2]];
+        for (a, b) in out.iter().zip(&want) {
+            assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15));
+        }
+    }
+
+    #[test]
+    fn transport_checks_points_tangents_and_initial() {
+        let x: Vec<DVec3> = (0..6)
+            .map(|i| DVec3::new(f64::from(i), (0.5 * f64::from(i)).sin(), 0.0))
+            .collect();
+        let mut out = vec![DQuat::IDENTITY; x.len()];
+        let mut run = |x: &[DVec3], t: Option<&[DVec3]>, r: Option<DVec3>| {
+            transport(x, t, r, false, 0, &mut out[..x.len()])
+        };
+        assert_eq!(arg_of(run(&x[..1], None, None)), "points");
+        assert_eq!(arg_of(run(&x[..1], Some(&x[..1]), None)), "points");
+        let mut t = vec![DVec3::X; x.len()];
+        t[3] = DVec3::ZERO;
+        let e = run(&x, Some(&t), None).expect_err("a zero tangent");
+        assert_eq!(
+            (e.arg, e.msg.as_str()),
+            ("tangents", "zero-length tangent at row 3")
+        );
+        t[3] = DVec3::new(f64::INFINITY, 0.0, 0.0);
+        assert_eq!(arg_of(run(&x, Some(&t), None)), "tangents");
+        assert_eq!(arg_of(run(&x, Some(&t[1..]), None)), "tangents");
+        let t = vec![DVec3::new(2.0, 0.0, 0.0); x.len()];
+        assert_eq!(
+            arg_of(run(&x, Some(&t), Some(DVec3::new(-3.0, 0.0, 0.0)))),
+            "initial"
+        );
+        assert_eq!(arg_of(run(&x, Some(&t), Some(DVec3::ZERO))), "initial");
+        assert_eq!(arg_of(run(&x, Some(&t), Some(DVec3::NAN))), "initial");
+        // a valid call: unit tangents, the frame at row 0 from the projected initial vector
+        run(&x, Some(&t), Some(DVec3::new(1.0, 0.0, 2.0))).expect("valid input");
+        let f0 = to_matrix(out[0]);
+        assert!((f0[2] - 1.0).abs() < 1e-15 && (f0[6] - 1.0).abs() < 1e-15);
+    }
+
     #[test]
     fn slerp_ends_and_short_arc() {
         let a = DQuat::from_axis_angle(DVec3::Z, 0.2);
