@@ -29,8 +29,17 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._frames import estimate_tangents, frames
-from ._validate import as_bool, as_choice, as_float_array, as_frames, as_int, as_points, as_vector
+from ._frames import frames
+from ._validate import (
+    as_bool,
+    as_choice,
+    as_float_array,
+    as_frames,
+    as_int,
+    as_points,
+    as_real,
+    as_vector,
+)
 
 __all__ = [
     "WalkResult",
@@ -275,40 +284,28 @@ def camera_frames(
     closed = as_bool(closed, "closed")
     pts = as_points(points, "points")
     n = len(pts)
-    if n < 2:
-        raise ValueError(f"points: need at least 2 samples, got {n}")
-    if tangents is None:
-        if closed and np.array_equal(pts[0], pts[-1]):
-            tc = estimate_tangents(pts[:-1], closed=True)
-            t = np.vstack([tc, tc[:1]])
-        else:
-            t = estimate_tangents(pts, closed=closed)
-    else:
+    t = None
+    if tangents is not None:
         t = as_float_array(tangents, "tangents")
-        if t.shape != pts.shape or not np.isfinite(t).all():
-            raise ValueError(f"tangents: expected finite values of shape {pts.shape}")
-        ln = np.linalg.norm(t, axis=1)
-        if not np.all(ln > 0):
-            raise ValueError(f"tangents: zero-length tangent at row {int(np.argmin(ln))}")
-        t = t / ln[:, None]
-    u = np.array([0.0, 0.0, 1.0]) if up is None else as_float_array(up, "up")
-    if u.shape != (3,) or not np.isfinite(u).all() or not np.linalg.norm(u) > 0:
-        raise ValueError("up: expected a finite non-zero (3,) vector")
-    u = u / np.linalg.norm(u)
-    if mode == "transport":
-        vertical = np.linalg.norm(np.cross(t[0], u)) <= 1e-3
-        if vertical and up is not None:
-            raise ValueError("up: parallel to the path's first tangent; the start up vector "
-                             "is undefined")
-        init = None if vertical else u
-        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
-    else:
-        f = _level_frames(pts, t, u, float(singular_angle), closed)
+        if t.shape != pts.shape:
+            raise ValueError(f"tangents: expected shape {pts.shape}, got {t.shape}")
+        t = np.ascontiguousarray(t)
+    u = None if up is None else as_vector(up, "up")
+    b = None
     if bank is not None:
         b = as_float_array(bank, "bank")
         b = np.broadcast_to(b, (n,)) if b.ndim == 0 else b
-        if b.shape != (n,) or not np.isfinite(b).all():
-            raise ValueError(f"bank: expected a finite scalar or shape ({n},)")
+        if b.shape != (n,):
+            raise ValueError(f"bank: expected a scalar or shape ({n},), got {b.shape}")
+        b = np.ascontiguousarray(b)
+    t, u, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
+                                                  as_real(singular_angle, "singular_angle"))
+    if mode == "transport":
+        init = None if vertical else u
+        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
+    else:
+        f = _level_frames(pts, t, u, regular, closed)
+    if b is not None:
         c, s = np.cos(b)[:, None], np.sin(b)[:, None]
         r, q = f[:, :, 0].copy(), f[:, :, 1].copy()
         f = f.copy()
@@ -331,14 +328,12 @@ def _angle_about(a, b, t) -> float:
     return float(np.arctan2(np.cross(a, b) @ t, a @ b))
 
 
-def _level_frames(pts, t, u, eps, closed):
+def _level_frames(pts, t, u, regular, closed):
+    """Level-horizon frames; ``regular``: the rows where ``u`` projects onto the normal plane
+    (checked by the core: at least one)."""
     n = len(pts)
     w = u - (t @ u)[:, None] * t
     wn = np.linalg.norm(w, axis=1)
-    regular = wn > np.sin(eps)
-    if not regular.any():
-        raise ValueError("points: the path is parallel to up everywhere; a level horizon is "
-                         "undefined (use mode='transport' or another up)")
     f = np.empty((n, 3, 3))
     r = w[regular] / wn[regular][:, None]
     f[regular] = np.stack([r, np.cross(t[regular], r), t[regular]], axis=2)

@@ -12,7 +12,7 @@ use super::convert::{
     empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles, value_error, vec2s,
     vec3_of, vec3s,
 };
-use crate::quaternion::{self, walk};
+use crate::quaternion::{self, camera, walk};
 
 /// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
 #[pyfunction]
@@ -126,6 +126,52 @@ pub fn quat_transport<'py>(
     let mut out = vec![DQuat::IDENTITY; rows];
     let angle = py.detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))?;
     Ok((quat_array(py, out)?, angle))
+}
+
+/// The checked inputs of a camera path: (unit tangents, unit up, starts vertical, level
+/// rows or None); see `spinal.quaternions.camera_frames`.
+#[pyfunction]
+#[pyo3(signature = (points, tangents, up, bank, closed, level, singular_angle))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn camera_inputs<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    up: Option<PyReadonlyArray1<'py, f64>>,
+    bank: Option<PyReadonlyArray1<'py, f64>>,
+    closed: bool,
+    level: bool,
+    singular_angle: f64,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    bool,
+    Option<Bound<'py, PyArray1<bool>>>,
+)> {
+    let x = vec3s("points", &points)?;
+    let t = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let u = up
+        .as_ref()
+        .map(|u| vec3_of("up", u, "expected 3 values"))
+        .transpose()?;
+    let b = bank.as_ref().map(|b| slice_of("bank", b)).transpose()?;
+    let mode = if level {
+        camera::Mode::Level { singular_angle }
+    } else {
+        camera::Mode::Transport
+    };
+    let c = py.detach(|| camera::inputs(x, t, u, b, closed, mode))?;
+    let n = c.tangents.len();
+    let ts: Vec<f64> = c.tangents.iter().flat_map(|v| v.to_array()).collect();
+    Ok((
+        PyArray1::from_vec(py, ts).reshape([n, 3])?,
+        PyArray1::from_vec(py, c.up.to_array().to_vec()),
+        c.vertical,
+        c.regular.map(|r| PyArray1::from_vec(py, r)),
+    ))
 }
 
 /// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.

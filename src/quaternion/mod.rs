@@ -23,6 +23,7 @@
 //!   quaternion curve on S³, half the total rotation angle of the frames — a measure of
 //!   their total twist and turn (`½∫|ω| ds` in the limit).
 
+pub mod camera;
 pub mod walk;
 
 use glam::{DMat3, DQuat, DVec3};
@@ -247,7 +248,7 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
 /// The unit tangents at the points `x` (`n ≥ 2` rows): the given `t` (finite, non-zero
 /// rows) normalised, or without them the estimate of `spinal.estimate_tangents`
 /// ([`tangent_estimate::estimate_rows`], five-point rule).
-fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> Result<Vec<DVec3>> {
+pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> Result<Vec<DVec3>> {
     if x.len() < 2 {
         return Err(InputError::new(
             "points",
