@@ -64,11 +64,23 @@ def quat_continuous(q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def quat_slerp(
     q0: npt.NDArray[np.float64], q1: npt.NDArray[np.float64], u: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...
+def quat_slerp_frames(
+    frames: npt.NDArray[np.float64], key_u: npt.NDArray[np.float64], new_u: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def camera_inputs(
+    points: npt.NDArray[np.float64],
+    tangents: npt.NDArray[np.float64] | None,
+    up: npt.NDArray[np.float64] | None,
+    bank: npt.NDArray[np.float64] | None,
+    closed: bool,
+    level: bool,
+    singular_angle: float,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], bool, npt.NDArray[np.bool_] | None]: ...
 def quat_path_length(q: npt.NDArray[np.float64], closed: bool) -> float: ...
 def quat_transport(
     points: npt.NDArray[np.float64],
-    tangents: npt.NDArray[np.float64],
-    r0: npt.NDArray[np.float64],
+    tangents: npt.NDArray[np.float64] | None,
+    initial: npt.NDArray[np.float64] | None,
     closed: bool,
     turns: int,
     closing_row: bool,

@@ -29,8 +29,17 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _core
-from ._frames import estimate_tangents, frames
-from ._validate import as_bool, as_choice, as_float_array, as_frames, as_int, as_points, as_vector
+from ._frames import frames
+from ._validate import (
+    as_bool,
+    as_choice,
+    as_float_array,
+    as_frames,
+    as_int,
+    as_points,
+    as_real,
+    as_vector,
+)
 
 __all__ = [
     "WalkResult",
@@ -100,8 +109,6 @@ def make_continuous(quaternions, *, scalar_first: bool = False) -> np.ndarray:
     product (the first made canonical, ``w ≥ 0``). The frames are unchanged."""
     sf = as_bool(scalar_first, "scalar_first")
     q, _ = _quats(quaternions, "quaternions", sf)
-    if not np.isfinite(q).all():
-        raise ValueError("quaternions: contains non-finite values")
     return _from_xyzw(_core.quat_continuous(q), sf)
 
 
@@ -141,39 +148,23 @@ def slerp_frames(frames, new_u, key_u=None) -> np.ndarray:
     """
     f, _ = as_frames(frames)
     n = len(f)
-    if n < 2:
-        raise ValueError(f"frames: need at least 2 key frames, got {n}")
     ku = np.arange(n, dtype=float) if key_u is None else as_float_array(key_u, "key_u")
     if ku.shape != (n,):
         raise ValueError(f"key_u: expected shape ({n},) to match frames, got {ku.shape}")
-    if not (np.isfinite(ku).all() and np.all(np.diff(ku) > 0)):
-        raise ValueError("key_u: must be finite and strictly increasing")
     nu = as_float_array(new_u, "new_u").reshape(-1)
-    if not np.isfinite(nu).all():
-        raise ValueError("new_u: contains non-finite values")
-    if nu.size and (nu.min() < ku[0] or nu.max() > ku[-1]):
-        raise ValueError(f"new_u: values must lie in [{ku[0]}, {ku[-1]}] (the key range)")
-    q = _core.quat_from_frames(f, True)
-    i = np.clip(np.searchsorted(ku, nu, side="right") - 1, 0, n - 2)
-    w = (nu - ku[i]) / (ku[i + 1] - ku[i])
-    return _core.quat_to_frames(_core.quat_slerp(q[i], q[i + 1], np.ascontiguousarray(w)))
+    return _core.quat_slerp_frames(f, np.ascontiguousarray(ku), np.ascontiguousarray(nu))
 
 
-def _initial_r0(pts, t, initial, closed):
-    """Unit reference vector at row 0: the user's (vector or frame), else spinal's default."""
-    t0 = t[0]
+def _initial_r(initial):
+    """The reference vector at row 0 as given: a (3,) vector or a frame's first column."""
     if initial is None:
-        return np.ascontiguousarray(frames(pts, tangents=t, method="rotation", closed=closed)[0][:, 0])
+        return None
     v = as_float_array(initial, "initial")
     if v.shape == (3, 3):
         v = v[:, 0]
-    if v.shape != (3,) or not np.isfinite(v).all():
-        raise ValueError("initial: expected a finite (3,) vector or a (3, 3) frame")
-    p = v - (v @ t0) * t0
-    nrm = np.linalg.norm(p)
-    if not nrm > 1e-8 * np.linalg.norm(v):
-        raise ValueError("initial: the vector is zero or parallel to the first tangent")
-    return np.ascontiguousarray(p / nrm)
+    if v.shape != (3,):
+        raise ValueError("initial: expected a (3,) vector or a (3, 3) frame")
+    return np.ascontiguousarray(v)
 
 
 def quaternion_frames(
@@ -217,25 +208,16 @@ def quaternion_frames(
         f = frames(pts, tangents, method="frenet", closed=closed, initial=initial, turns=turns)
         return _from_xyzw(_core.quat_from_frames(f, True), sf)
     n = len(pts)
-    if n < 2:
-        raise ValueError(f"points: need at least 2 samples, got {n}")
     repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
     core_pts = pts[:-1] if repeat else pts
-    if tangents is None:
-        t = estimate_tangents(core_pts, closed=closed)
-    else:
+    t = None
+    if tangents is not None:
         t = as_float_array(tangents, "tangents")
         if t.shape != pts.shape:
             raise ValueError(f"tangents: expected shape {pts.shape} to match points, got {t.shape}")
-        if not np.isfinite(t).all():
-            raise ValueError("tangents: contains non-finite values")
-        ln = np.linalg.norm(t, axis=1)
-        if not np.all(ln > 0):
-            raise ValueError(f"tangents: zero-length tangent at row {int(np.argmin(ln))}")
-        t = (t / ln[:, None])[: len(core_pts)]
-    t = np.ascontiguousarray(t)
-    r0 = _initial_r0(core_pts, t, initial, closed)
-    q, _ = _core.quat_transport(np.ascontiguousarray(core_pts), t, r0, closed, turns, repeat)
+        t = np.ascontiguousarray(t[: len(core_pts)])
+    q, _ = _core.quat_transport(np.ascontiguousarray(core_pts), t, _initial_r(initial), closed,
+                                turns, repeat)
     return _from_xyzw(q, sf)
 
 
@@ -302,40 +284,28 @@ def camera_frames(
     closed = as_bool(closed, "closed")
     pts = as_points(points, "points")
     n = len(pts)
-    if n < 2:
-        raise ValueError(f"points: need at least 2 samples, got {n}")
-    if tangents is None:
-        if closed and np.array_equal(pts[0], pts[-1]):
-            tc = estimate_tangents(pts[:-1], closed=True)
-            t = np.vstack([tc, tc[:1]])
-        else:
-            t = estimate_tangents(pts, closed=closed)
-    else:
+    t = None
+    if tangents is not None:
         t = as_float_array(tangents, "tangents")
-        if t.shape != pts.shape or not np.isfinite(t).all():
-            raise ValueError(f"tangents: expected finite values of shape {pts.shape}")
-        ln = np.linalg.norm(t, axis=1)
-        if not np.all(ln > 0):
-            raise ValueError(f"tangents: zero-length tangent at row {int(np.argmin(ln))}")
-        t = t / ln[:, None]
-    u = np.array([0.0, 0.0, 1.0]) if up is None else as_float_array(up, "up")
-    if u.shape != (3,) or not np.isfinite(u).all() or not np.linalg.norm(u) > 0:
-        raise ValueError("up: expected a finite non-zero (3,) vector")
-    u = u / np.linalg.norm(u)
-    if mode == "transport":
-        vertical = np.linalg.norm(np.cross(t[0], u)) <= 1e-3
-        if vertical and up is not None:
-            raise ValueError("up: parallel to the path's first tangent; the start up vector "
-                             "is undefined")
-        init = None if vertical else u
-        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
-    else:
-        f = _level_frames(pts, t, u, float(singular_angle), closed)
+        if t.shape != pts.shape:
+            raise ValueError(f"tangents: expected shape {pts.shape}, got {t.shape}")
+        t = np.ascontiguousarray(t)
+    u = None if up is None else as_vector(up, "up")
+    b = None
     if bank is not None:
         b = as_float_array(bank, "bank")
         b = np.broadcast_to(b, (n,)) if b.ndim == 0 else b
-        if b.shape != (n,) or not np.isfinite(b).all():
-            raise ValueError(f"bank: expected a finite scalar or shape ({n},)")
+        if b.shape != (n,):
+            raise ValueError(f"bank: expected a scalar or shape ({n},), got {b.shape}")
+        b = np.ascontiguousarray(b)
+    t, u, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
+                                                  as_real(singular_angle, "singular_angle"))
+    if mode == "transport":
+        init = None if vertical else u
+        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
+    else:
+        f = _level_frames(pts, t, u, regular, closed)
+    if b is not None:
         c, s = np.cos(b)[:, None], np.sin(b)[:, None]
         r, q = f[:, :, 0].copy(), f[:, :, 1].copy()
         f = f.copy()
@@ -358,14 +328,12 @@ def _angle_about(a, b, t) -> float:
     return float(np.arctan2(np.cross(a, b) @ t, a @ b))
 
 
-def _level_frames(pts, t, u, eps, closed):
+def _level_frames(pts, t, u, regular, closed):
+    """Level-horizon frames; ``regular``: the rows where ``u`` projects onto the normal plane
+    (checked by the core: at least one)."""
     n = len(pts)
     w = u - (t @ u)[:, None] * t
     wn = np.linalg.norm(w, axis=1)
-    regular = wn > np.sin(eps)
-    if not regular.any():
-        raise ValueError("points: the path is parallel to up everywhere; a level horizon is "
-                         "undefined (use mode='transport' or another up)")
     f = np.empty((n, 3, 3))
     r = w[regular] / wn[regular][:, None]
     f[regular] = np.stack([r, np.cross(t[regular], r), t[regular]], axis=2)
@@ -430,8 +398,6 @@ def _faces(faces) -> np.ndarray:
     if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
         raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "
                          f"{fa.dtype}")
-    if len(fa) == 0:
-        raise ValueError("faces: the mesh has no faces")
     return np.ascontiguousarray(fa, dtype=np.int64)
 
 

@@ -27,6 +27,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quaternion::quat_to_frames, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_continuous, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_slerp, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_slerp_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::camera_inputs, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_path_length, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_transport, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::walk_mesh, m)?)?;

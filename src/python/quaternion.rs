@@ -12,7 +12,7 @@ use super::convert::{
     empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles, value_error, vec2s,
     vec3_of, vec3s,
 };
-use crate::quaternion::{self, walk};
+use crate::quaternion::{self, camera, walk};
 
 /// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
 #[pyfunction]
@@ -48,8 +48,8 @@ pub fn quat_continuous<'py>(
     py: Python<'py>,
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let mut v = quats("q", &q)?.to_vec();
-    quaternion::make_continuous(&mut v);
+    let qs = quats("quaternions", &q)?;
+    let v = py.detach(|| quaternion::continuous(qs))?;
     quat_array(py, v)
 }
 
@@ -72,6 +72,25 @@ pub fn quat_slerp<'py>(
     quat_array(py, out)
 }
 
+/// Key frames interpolated by slerp; see `spinal.quaternions.slerp_frames`.
+#[pyfunction]
+pub fn quat_slerp_frames<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArray3<'py, f64>,
+    key_u: PyReadonlyArray1<'py, f64>,
+    new_u: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let fr = frames_of("frames", &frames)?;
+    let (ku, nu) = (slice_of("key_u", &key_u)?, slice_of("new_u", &new_u)?);
+    let out = empty::<f64, numpy::Ix3>(py, &[nu.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        py.detach(|| quaternion::slerp_frames(fr, ku, nu, buf))?;
+    }
+    Ok(out)
+}
+
 /// Length of a quaternion curve on S³.
 #[pyfunction]
 pub fn quat_path_length(
@@ -88,25 +107,71 @@ pub fn quat_path_length(
 pub fn quat_transport<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    tangents: PyReadonlyArray2<'py, f64>,
-    r0: PyReadonlyArray1<'py, f64>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    initial: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
     turns: i64,
     closing_row: bool,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
     let x = vec3s("points", &points)?;
-    let t = vec3s("tangents", &tangents)?;
-    let r = slice_of("initial", &r0)?;
-    if r.len() != 3 || t.len() != x.len() || t.len() < 2 {
-        return Err(value_error(
-            "points and tangents must have the same n >= 2 rows and initial 3 values",
-        ));
-    }
-    let r = glam::DVec3::new(r[0], r[1], r[2]);
-    let rows = t.len() + usize::from(closed && closing_row);
+    let t = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let r = initial
+        .as_ref()
+        .map(|r| vec3_of("initial", r, "expected 3 values"))
+        .transpose()?;
+    let rows = x.len() + usize::from(closed && closing_row);
     let mut out = vec![DQuat::IDENTITY; rows];
     let angle = py.detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))?;
     Ok((quat_array(py, out)?, angle))
+}
+
+/// The checked inputs of a camera path: (unit tangents, unit up, starts vertical, level
+/// rows or None); see `spinal.quaternions.camera_frames`.
+#[pyfunction]
+#[pyo3(signature = (points, tangents, up, bank, closed, level, singular_angle))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn camera_inputs<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    up: Option<PyReadonlyArray1<'py, f64>>,
+    bank: Option<PyReadonlyArray1<'py, f64>>,
+    closed: bool,
+    level: bool,
+    singular_angle: f64,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    bool,
+    Option<Bound<'py, PyArray1<bool>>>,
+)> {
+    let x = vec3s("points", &points)?;
+    let t = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let u = up
+        .as_ref()
+        .map(|u| vec3_of("up", u, "expected 3 values"))
+        .transpose()?;
+    let b = bank.as_ref().map(|b| slice_of("bank", b)).transpose()?;
+    let mode = if level {
+        camera::Mode::Level { singular_angle }
+    } else {
+        camera::Mode::Transport
+    };
+    let c = py.detach(|| camera::inputs(x, t, u, b, closed, mode))?;
+    let n = c.tangents.len();
+    let ts: Vec<f64> = c.tangents.iter().flat_map(|v| v.to_array()).collect();
+    Ok((
+        PyArray1::from_vec(py, ts).reshape([n, 3])?,
+        PyArray1::from_vec(py, c.up.to_array().to_vec()),
+        c.vertical,
+        c.regular.map(|r| PyArray1::from_vec(py, r)),
+    ))
 }
 
 /// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.

@@ -23,13 +23,15 @@
 //!   quaternion curve on S³, half the total rotation angle of the frames — a measure of
 //!   their total twist and turn (`½∫|ω| ds` in the limit).
 
+pub mod camera;
 pub mod walk;
 
 use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
 
 use crate::error::{InputError, Result};
-use crate::frames::validate;
+use crate::frames::tangents::{self as tangent_estimate, TangentRule};
+use crate::frames::{self, Method, Orientation, Request, validate};
 use crate::math::rotation;
 
 const GRAIN: usize = 1 << 12;
@@ -69,6 +71,19 @@ pub fn make_continuous(q: &mut [DQuat]) {
             q[i] = -q[i];
         }
     }
+}
+
+/// A sign-continuous copy of quaternions ([`make_continuous`]); non-finite rows are refused.
+pub fn continuous(q: &[DQuat]) -> Result<Vec<DQuat>> {
+    if let Some(i) = validate::first_bad(q, |v| v.is_finite()) {
+        return Err(InputError::new(
+            "quaternions",
+            format!("contains non-finite values (row {i})"),
+        ));
+    }
+    let mut v = q.to_vec();
+    make_continuous(&mut v);
+    Ok(v)
 }
 
 /// Quaternions of frames (row-major `(n, 3, 3)`), sign-continuous if asked.
@@ -141,6 +156,69 @@ pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Res
     Ok(())
 }
 
+/// Key frames interpolated by slerp: `frames` (row-major `(n, 3, 3)`, `n ≥ 2`) at the
+/// finite, strictly increasing `key_u`, evaluated at `new_u` inside `[key_u[0],
+/// key_u[n−1]]`. The quaternions of the keys are made sign-continuous, so each interval
+/// takes the short arc; `u` in `[key_u[i], key_u[i+1])` (the last interval closed) uses
+/// keys `i, i+1` with the weight `(u − key_u[i]) / (key_u[i+1] − key_u[i])`.
+pub fn slerp_frames(
+    frames: &[[f64; 9]],
+    key_u: &[f64],
+    new_u: &[f64],
+    out: &mut [[f64; 9]],
+) -> Result<()> {
+    let n = frames.len();
+    if n < 2 {
+        return Err(InputError::new(
+            "frames",
+            format!("need at least 2 key frames, got {n}"),
+        ));
+    }
+    if key_u.len() != n {
+        return Err(InputError::new(
+            "key_u",
+            format!("expected {n} values to match frames, got {}", key_u.len()),
+        ));
+    }
+    if let Some(i) = (0..n).find(|&i| !key_u[i].is_finite() || (i > 0 && key_u[i] <= key_u[i - 1]))
+    {
+        return Err(InputError::new(
+            "key_u",
+            format!("must be finite and strictly increasing (index {i})"),
+        ));
+    }
+    if let Some(i) = validate::first_bad(new_u, |u| u.is_finite()) {
+        return Err(InputError::new(
+            "new_u",
+            format!("contains non-finite values (index {i})"),
+        ));
+    }
+    let (lo, hi) = (key_u[0], key_u[n - 1]);
+    if let Some(i) = validate::first_bad(new_u, |&u| (lo..=hi).contains(&u)) {
+        return Err(InputError::new(
+            "new_u",
+            format!(
+                "values must lie in [{lo:?}, {hi:?}] (the key range); index {i} is {:?}",
+                new_u[i]
+            ),
+        ));
+    }
+    let q = from_frames(frames, true)?;
+    out.par_iter_mut()
+        .zip(new_u.par_iter())
+        .with_min_len(GRAIN)
+        .for_each(|(o, &u)| {
+            let i = key_u
+                .partition_point(|&k| k <= u)
+                .saturating_sub(1)
+                .min(n - 2);
+            let w = (u - key_u[i]) / (key_u[i + 1] - key_u[i]);
+            let s = slerp(q[i].normalize(), q[i + 1].normalize(), w);
+            *o = to_matrix(s.normalize());
+        });
+    Ok(())
+}
+
 /// Angle between two frames' quaternions: the length of the short arc on S³,
 /// `2 atan2(|b − a|, |b + a|)` after sign alignment (half the relative rotation angle).
 #[inline]
@@ -167,10 +245,65 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
         .sum())
 }
 
+/// The unit tangents at the points `x` (`n ≥ 2` rows): the given `t` (finite, non-zero
+/// rows) normalised, or without them the estimate of `spinal.estimate_tangents`
+/// ([`tangent_estimate::estimate_rows`], five-point rule).
+pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> Result<Vec<DVec3>> {
+    if x.len() < 2 {
+        return Err(InputError::new(
+            "points",
+            format!("need at least 2 samples, got {}", x.len()),
+        ));
+    }
+    let Some(t) = t else {
+        return tangent_estimate::estimate_rows(x, closed, TangentRule::FivePoint);
+    };
+    if t.len() != x.len() {
+        return Err(InputError::new(
+            "tangents",
+            format!("expected {} rows to match points, got {}", x.len(), t.len()),
+        ));
+    }
+    if let Some(i) = validate::first_bad(t, |v| v.is_finite()) {
+        return Err(InputError::new(
+            "tangents",
+            format!("contains non-finite values (row {i})"),
+        ));
+    }
+    if let Some(i) = validate::first_bad(t, |v| v.length() > 0.0) {
+        return Err(InputError::new(
+            "tangents",
+            format!("zero-length tangent at row {i}"),
+        ));
+    }
+    Ok(t.par_iter()
+        .with_min_len(GRAIN)
+        .map(|v| *v / v.length())
+        .collect())
+}
+
+/// The reference vector at row 0 of the rotation-method frames of `x` with unit tangents
+/// `t` ([`frames::compute_into`], spinal's default initial vector).
+fn default_reference(x: &[DVec3], t: &[DVec3], closed: bool) -> Result<DVec3> {
+    let req = Request {
+        points: Some(x),
+        tangents: Some(t),
+        closed,
+        method: Method::Rotation,
+        ..Request::default()
+    };
+    let mut buf = vec![0.0; 9 * x.len()];
+    frames::compute_into(&req, &mut buf)?;
+    Ok(DVec3::new(buf[0], buf[3], buf[6]))
+}
+
 /// Parallel transport as a quaternion curve.
 ///
-/// * `x`: the points (for arc lengths; `n` rows), `t`: unit tangents (`n` rows);
-/// * `r0`: unit reference vector ⟂ `t[0]`;
+/// * `x`: the points (for arc lengths; `n ≥ 2` rows), `t`: tangents (`n` rows, finite and
+///   non-zero; normalised here), default the estimate of `spinal.estimate_tangents`;
+/// * `initial`: reference vector at row 0, projected onto the normal plane of `t[0]` (it
+///   must be finite and not parallel to `t[0]`); `None`: the reference vector of the
+///   rotation-method frames ([`frames::compute_into`]);
 /// * `closed`: the samples form a loop (no repeated end point); the closing angle is then
 ///   spread linearly in arc length (plus `2π·turns`) so the frames close.
 ///
@@ -180,12 +313,17 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
 /// the closing angle (0 for an open curve).
 pub fn transport(
     x: &[DVec3],
-    t: &[DVec3],
-    r0: DVec3,
+    t: Option<&[DVec3]>,
+    initial: Option<DVec3>,
     closed: bool,
     turns: i64,
     out: &mut [DQuat],
 ) -> Result<f64> {
+    let t = &unit_tangents(x, t, closed)?;
+    let r0 = match initial {
+        Some(v) => frames::resolve(&Orientation::Vector(v), t[0], 0, "initial")?,
+        None => default_reference(x, t, closed)?,
+    };
     let n = t.len();
     debug_assert!(out.len() == n || (closed && out.len() == n + 1));
     let q0 = canonical(from_matrix(&{
@@ -265,6 +403,94 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Each refused input names the Python argument.
+    fn arg_of<T: std::fmt::Debug>(r: Result<T>) -> &'static str {
+        r.expect_err("an input error").arg
+    }
+
+    #[test]
+    fn continuous_refuses_non_finite_quaternions() {
+        let q = [DQuat::IDENTITY, DQuat::from_xyzw(f64::NAN, 0.0, 0.0, 1.0)];
+        assert_eq!(arg_of(continuous(&q)), "quaternions");
+        let ok = continuous(&[-DQuat::IDENTITY, DQuat::IDENTITY]).expect("finite");
+        assert_eq!(ok, vec![DQuat::IDENTITY; 2]);
+    }
+
+    #[test]
+    fn slerp_frames_checks_keys_and_parameters() {
+        let keys = [rot(DVec3::Z, 0.0), rot(DVec3::Z, 1.0), rot(DVec3::X, 1.0)];
+        let mut out = [[0.0; 9]; 1];
+        let run = |f: &[[f64; 9]], ku: &[f64], nu: &[f64], out: &mut [[f64; 9]]| {
+            slerp_frames(f, ku, nu, out)
+        };
+        assert_eq!(arg_of(run(&keys[..1], &[0.0], &[0.0], &mut out)), "frames");
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 2.0, 1.0], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, f64::NAN], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 1.0], &[0.5], &mut out)),
+            "key_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[f64::NAN], &mut out)),
+            "new_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[2.5], &mut out)),
+            "new_u"
+        );
+        assert_eq!(
+            arg_of(run(&keys, &[0.0, 1.0, 2.0], &[-0.1], &mut out)),
+            "new_u"
+        );
+        // inside the range: the keys at the keys, the half turn between the first two
+        let mut out = [[0.0; 9]; 3];
+        run(&keys, &[0.0, 1.0, 2.0], &[0.0, 0.5, 2.0], &mut out).expect("valid keys");
+        let want = [keys[0], rot(DVec3::Z, 0.5), keys[2]];
+        for (a, b) in out.iter().zip(&want) {
+            assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-15));
+        }
+    }
+
+    #[test]
+    fn transport_checks_points_tangents_and_initial() {
+        let x: Vec<DVec3> = (0..6)
+            .map(|i| DVec3::new(f64::from(i), (0.5 * f64::from(i)).sin(), 0.0))
+            .collect();
+        let mut out = vec![DQuat::IDENTITY; x.len()];
+        let mut run = |x: &[DVec3], t: Option<&[DVec3]>, r: Option<DVec3>| {
+            transport(x, t, r, false, 0, &mut out[..x.len()])
+        };
+        assert_eq!(arg_of(run(&x[..1], None, None)), "points");
+        assert_eq!(arg_of(run(&x[..1], Some(&x[..1]), None)), "points");
+        let mut t = vec![DVec3::X; x.len()];
+        t[3] = DVec3::ZERO;
+        let e = run(&x, Some(&t), None).expect_err("a zero tangent");
+        assert_eq!(
+            (e.arg, e.msg.as_str()),
+            ("tangents", "zero-length tangent at row 3")
+        );
+        t[3] = DVec3::new(f64::INFINITY, 0.0, 0.0);
+        assert_eq!(arg_of(run(&x, Some(&t), None)), "tangents");
+        assert_eq!(arg_of(run(&x, Some(&t[1..]), None)), "tangents");
+        let t = vec![DVec3::new(2.0, 0.0, 0.0); x.len()];
+        assert_eq!(
+            arg_of(run(&x, Some(&t), Some(DVec3::new(-3.0, 0.0, 0.0)))),
+            "initial"
+        );
+        assert_eq!(arg_of(run(&x, Some(&t), Some(DVec3::ZERO))), "initial");
+        assert_eq!(arg_of(run(&x, Some(&t), Some(DVec3::NAN))), "initial");
+        // a valid call: unit tangents, the frame at row 0 from the projected initial vector
+        run(&x, Some(&t), Some(DVec3::new(1.0, 0.0, 2.0))).expect("valid input");
+        let f0 = to_matrix(out[0]);
+        assert!((f0[2] - 1.0).abs() < 1e-15 && (f0[6] - 1.0).abs() < 1e-15);
     }
 
     #[test]

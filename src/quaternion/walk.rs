@@ -51,6 +51,9 @@ impl<'a> Walker<'a> {
                 format!("non-finite value at row {i}"),
             ));
         }
+        if faces.is_empty() {
+            return Err(InputError::new("faces", "the mesh has no faces"));
+        }
         let nv = vertices.len();
         let mut f = Vec::with_capacity(faces.len());
         for (i, tri) in faces.iter().enumerate() {
@@ -460,6 +463,13 @@ mod tests {
         // a start off the face is an error of the start
         let e = walk_path(&w, 2, DVec3::splat(5.0), None, &moves).unwrap_err();
         assert_eq!(e.arg, "point");
+    }
+
+    #[test]
+    fn a_mesh_without_faces_is_refused() {
+        let (v, _) = cube();
+        let e = Walker::new(&v, &[]).err().expect("no faces");
+        assert_eq!((e.arg, e.msg.as_str()), ("faces", "the mesh has no faces"));
     }
 
     /// A regular tetrahedron around the origin, faces wound outwards.
