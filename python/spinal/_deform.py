@@ -24,7 +24,7 @@ from . import _core
 from ._advect import MAX_STEPS, _progress_bar, advect
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import signed_volume as _volume
-from ._validate import as_bool, as_finite, as_int, as_vector
+from ._validate import as_bool, as_finite, as_int, as_real, as_vector
 from .fields import Field
 
 __all__ = ["DeformReport", "RefinementWarning", "StampReport", "deform", "stamp"]
@@ -173,10 +173,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     if not 1 <= n <= MAX_STEPS:
         raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {n}")
     if refine is not None:
-        refine = as_finite(refine, "refine")
-        if not refine >= 1:
-            raise ValueError(f"refine: must be at least 1 (an edge is split when it grows "
-                             f"beyond refine × its rest length), got {refine}")
+        refine = as_real(refine, "refine")  # the core checks refine ≥ 1
     max_passes = as_int(max_passes, "max_passes")
     if max_passes < 0:
         raise ValueError(f"max_passes: must be ≥ 0, got {max_passes}")

@@ -421,15 +421,19 @@ pub fn deform(
     refinement: Option<Refinement>,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Option<Deformed>> {
-    let topo = Topology::new(faces, rest.len())?;
     if let Some(r) = refinement
         && !(r.ratio >= 1.0 && r.ratio.is_finite())
     {
         return Err(InputError::new(
             "refine",
-            format!("must be a finite number ≥ 1, got {}", r.ratio),
+            format!(
+                "must be at least 1 (an edge is split when it grows beyond refine × its rest \
+                 length) and finite, got {}",
+                r.ratio
+            ),
         ));
     }
+    let topo = Topology::new(faces, rest.len())?;
     let edges = topo.twin.iter().enumerate();
     let (sum, count) =
         edges
