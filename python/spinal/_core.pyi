@@ -51,6 +51,7 @@ def sweep_mesh(
     caps: bool,
     miter_limit: float,
     split_seams: bool,
+    scale_arg: str = "scale",
 ) -> tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],

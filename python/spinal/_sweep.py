@@ -113,6 +113,14 @@ def sweep(
         zero-area profile, non-positive scale, frames that are not rotations, and
         everything :func:`spinal.frames` refuses.
     """
+    return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
+                       miter_limit, split_seams, strict, lengths, offsets, "scale")
+
+
+def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
+                miter_limit, split_seams, strict, lengths, offsets, scale_arg) -> Mesh:
+    """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
+    the public function, which the warnings point at)."""
     pts = as_points(points, "points")
     n = pts.shape[0]
     closed = as_bool(closed, "closed")
@@ -134,7 +142,7 @@ def sweep(
     tw = None if twist is None else as_per_row(twist, "twist", n)
     v, f, nrm, uv, folds = _core.sweep_mesh(
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
-        profile_closed, closed, caps, miter_limit, split_seams,
+        profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
     )
     if folds.size:
         msg = (
@@ -144,7 +152,7 @@ def sweep(
         )
         if strict:
             raise ValueError(f"points: {msg}")
-        warnings.warn(FoldOverWarning(msg, folds), stacklevel=2)
+        warnings.warn(FoldOverWarning(msg, folds), stacklevel=3)
     return Mesh(v, f, nrm, uv, folds)
 
 
@@ -176,14 +184,6 @@ def tube(
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
     pts = as_points(points, "points")
-    rad = as_per_row(radius, "radius", pts.shape[0])
-    # the core checks the scale it is given (and would name `scale`): the radius is checked
-    # here, where its name is known
-    if not np.all(rad > 0):
-        bad = int(np.flatnonzero(~(rad > 0))[0])
-        raise ValueError(f"radius: must be positive and finite, got {rad[bad]} at row {bad}")
-    return sweep(
-        pts, profile, frames=frames, scale=rad, closed=closed, caps=caps,
-        miter_limit=miter_limit, split_seams=split_seams, strict=strict, lengths=lengths,
-        offsets=offsets,
-    )
+    rad = as_per_row(radius, "radius", pts.shape[0])  # the core checks it, naming radius
+    return _sweep_mesh(pts, profile, frames, rad, None, closed, caps, True, miter_limit,
+                       split_seams, strict, lengths, offsets, "radius")

@@ -5,7 +5,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, frames_of, offsets_of, slice_mut, slice_of, vec2s, vec3s};
+use super::convert::{empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s, vec3s};
 use crate::sweep::{self, Options, Profile, Spine};
 
 type MeshArrays<'py> = (
@@ -17,10 +17,11 @@ type MeshArrays<'py> = (
 );
 
 /// Sweep a profile along one or many spines; see `spinal.sweep`. Returns vertices, faces,
-/// normals, uv and the rows where a miter was folded.
+/// normals, uv and the rows where a miter was folded. Errors about the scale name
+/// `scale_arg` (`spinal.tube` passes its radius as the scale).
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
-                    miter_limit, split_seams))]
+                    miter_limit, split_seams, scale_arg="scale"))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -35,6 +36,7 @@ pub fn sweep_mesh<'py>(
     caps: bool,
     miter_limit: f64,
     split_seams: bool,
+    scale_arg: &str,
 ) -> PyResult<MeshArrays<'py>> {
     let pts = vec3s("points", &points)?;
     let fr = frames_of("frames", &frames)?;
@@ -57,11 +59,13 @@ pub fn sweep_mesh<'py>(
         scale: sc,
         twist: tw,
     };
-    let (p, lay) = py.detach(|| {
-        let p = Profile::new(prof, profile_closed)?;
-        let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
-        Ok::<_, crate::InputError>((p, lay))
-    })?;
+    let (p, lay) = py
+        .detach(|| {
+            let p = Profile::new(prof, profile_closed)?;
+            let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
+            Ok::<_, crate::InputError>((p, lay))
+        })
+        .map_err(|e| renamed(e, "scale", scale_arg))?;
     let (nv, nf) = (lay.vertices, lay.faces);
     let v = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
     let n = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
