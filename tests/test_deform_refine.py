@@ -76,28 +76,33 @@ def check_report(M, rep, V, F, tau=1.5):
 
 def test_d14_drag_of_a_small_sphere_is_bounded_and_fast():
     """Before: 49,788 vertices added with max_passes=20 and no warning (the review's 495 s,
-    5.1 GB case at 30 passes). Now the refinement follows the steps: measured 880 added,
-    converged, 0.016 s."""
+    5.1 GB case at 30 passes). Now the refinement follows the steps, bounded: measured a few
+    hundred vertices added in a few ms, with the few edges that cross the tool's slip and
+    that bisection cannot shorten reported (and warned about), not chased."""
     s = trimesh.creation.icosphere(3)
     V, F = icosphere(3)
     clock = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", spinal.RefinementWarning)  # converged: no warning
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         M, rep = spinal.deform(s, DRAG, 1.0, max_passes=20)
     elapsed = time.perf_counter() - clock
     assert elapsed < 5, elapsed
     assert rep.max_vertices == 8 * len(V)
-    assert len(M.vertices) <= rep.max_vertices
+    assert len(M.vertices) <= 4 * len(V)  # far from the bound: nothing grows without limit
     check_report(M, rep, V, F)
-    assert rep.converged and rep.edges_over_threshold == 0
+    assert rep.converged == (rep.edges_over_threshold == 0)
+    warned = [w for w in caught if issubclass(w.category, spinal.RefinementWarning)]
+    assert len(warned) == (0 if rep.converged else 1)
     assert 0 < rep.torn_vertices <= rep.vertices_added  # the tool's surface tears the mesh
     assert rep.steps == DRAG.steps(1.0) == len(rep.step_vertices)
 
 
 def test_d14_drag_of_a_10k_sphere_keeps_the_volume_within_the_vertex_bound():
     """icosphere(5), 10,242 vertices, default steps (9): measured relative volume change
-    −4.03e-4 (unrefined: −4.7e-3), 81,936 = 8× vertices (the default bound, reached at the
-    8th step), 28,798 edges still over the threshold, 0.8 s."""
+    −1.7e-6 (unrefined: −4.7e-3) with 66,327 vertices (6.5×) and 186 edges still over the
+    threshold (edges across the tool's slip that bisection cannot shorten), 0.15 s. The new
+    vertices of torn edges sit on the tool's surface, the slip surface; at plain chord
+    midpoints it was −4.0e-4 at the 8× bound."""
     s = trimesh.creation.icosphere(5)
     V, F = icosphere(5)
     assert len(V) == 10242
@@ -107,8 +112,8 @@ def test_d14_drag_of_a_10k_sphere_keeps_the_volume_within_the_vertex_bound():
         M, rep = spinal.deform(s, DRAG, 1.0)
     # (recorded rather than pytest.warns: the warning is asserted only if it did not converge)
     refinement_warnings = [w for w in caught if issubclass(w.category, spinal.RefinementWarning)]
-    assert abs(rep.relative_change) <= 5e-4, str(rep)
-    assert abs(rep.relative_change) < abs(plain.relative_change) / 5, (rep, plain)
+    assert abs(rep.relative_change) <= 5e-5, str(rep)
+    assert abs(rep.relative_change) < abs(plain.relative_change) / 100, (rep, plain)
     assert len(M.vertices) <= 10 * len(V)
     check_report(M, rep, V, F)
     if rep.converged:
@@ -116,7 +121,7 @@ def test_d14_drag_of_a_10k_sphere_keeps_the_volume_within_the_vertex_bound():
     else:
         assert len(refinement_warnings) == 1 and rep.edges_over_threshold > 0
         assert str(rep.edges_over_threshold) in str(refinement_warnings[0].message)
-        assert len(M.vertices) == rep.max_vertices  # the bound stopped it
+        assert rep.edges_over_threshold < len(M.faces) // 100
 
 
 # ---- refine < 1 is refused; refine = 1 splits nothing that does not move ----------------------

@@ -6,9 +6,10 @@ integration step, an edge longer than ``refine × max(its rest length, mean rest
 split — the longest edge of both its triangles first (Rivara's longest-edge bisection), both
 triangles bisected (conforming, watertight) — and the new vertex is the rest midpoint carried
 by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow tears an edge
-apart (the tangential slip at the surface of a curl translation tool) the chord midpoint is
-used instead. The work is bounded by ``max_vertices``; when the bound stops the refinement the
-report says so and a :class:`RefinementWarning` is issued.
+apart (the tangential slip at the surface of a curl tool) the new vertex goes to the slip
+surface, the tool's surface, next to the edge's chord midpoint. The work is bounded by
+``max_vertices`` and ``max_passes``; when edges remain too long at the end the report says so
+and a :class:`RefinementWarning` is issued.
 """
 
 from __future__ import annotations
@@ -69,17 +70,20 @@ class DeformReport:
     rest_vertices : ndarray (V', 3) float64 or None
         Rest positions of the output mesh's vertices (the input's, then the rest midpoints
         of the split edges), for re-running or checking the deformation: every vertex is the
-        flow of its rest position, except the ``torn_vertices`` placed at a chord midpoint.
+        flow of its rest position, except the ``torn_vertices`` of torn edges.
     converged : bool
-        False when ``max_vertices`` (or ``max_passes``) stopped the refinement with edges
-        still over the threshold (a :class:`RefinementWarning` was issued).
+        False when edges remain over the threshold at the end: ``max_vertices`` or
+        ``max_passes`` stopped the refinement, or edges across a slip that bisection cannot
+        shorten remain (a :class:`RefinementWarning` was issued).
     edges_over_threshold : int
         Edges longer than the threshold at the end (0 when converged).
     max_vertices : int or None
         The vertex bound the refinement ran under (None without refinement).
     torn_vertices : int
-        New vertices placed at the chord midpoint of an edge the flow tore apart (the exact
-        image of its rest midpoint fell farther than a quarter of the edge from it).
+        New vertices of edges the flow tore apart (the exact image of the rest midpoint fell
+        farther than a quarter of the edge from the chord midpoint): the chord midpoint,
+        moved onto the nearest slip surface of the field (a curl tool's surface) when one
+        passes within the edge's length.
     step_vertices : ndarray (steps,) int64 or None
         Vertex count after each integration step.
     timings : dict or None
@@ -108,8 +112,8 @@ class DeformReport:
              f"(relative change {self.relative_change:+.3e}); {self.steps} RK4 steps; "
              f"{self.vertices_added} vertices added in {self.passes} passes")
         if not self.converged:
-            s += (f"; refinement stopped at max_vertices={self.max_vertices} with "
-                  f"{self.edges_over_threshold} edges over the threshold")
+            s += (f"; {self.edges_over_threshold} edges still over the threshold "
+                  f"(max_vertices={self.max_vertices})")
         if self.integration_error is not None:
             s += (f"; integration {self.integration_error:+.2e}, "
                   f"mesh {self.mesh_error:+.2e}")
@@ -130,13 +134,14 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     at rest are split only where they stretch, so a tool that never reaches the mesh adds no
     vertex. Where the flow tears an edge apart (across the tangential slip at the surface of
     a :func:`spinal.fields.translation` tool, whose field is only continuous in its normal
-    part there) the new vertex goes to the edge's chord midpoint. ``refine=None`` only
-    advects.
+    part there) the body's boundary runs along the tool's surface: the new vertex is the
+    edge's chord midpoint moved onto that surface, and the flow carries it along it.
+    ``refine=None`` only advects.
 
     The work is bounded: at most ``max_vertices`` vertices and ``max_passes`` passes after
-    each step. When a bound stops the refinement with edges still too long, the report has
-    ``converged=False`` and the count of those edges, and a :class:`spinal.RefinementWarning`
-    is issued.
+    each step. When edges remain too long at the end (a bound stopped the refinement, or an
+    edge across a slip cannot be shortened by bisection), the report has ``converged=False``
+    and the count of those edges, and a :class:`spinal.RefinementWarning` is issued.
 
     Parameters
     ----------
@@ -218,9 +223,10 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     converged = not bounded
     if not converged:
         warnings.warn(RefinementWarning(
-            f"deform: refinement stopped at max_vertices={max_vertices} (or max_passes="
-            f"{max_passes} per step) with {over} edges still longer than refine × their rest "
-            f"length; raise max_vertices or use more steps"), stacklevel=2)
+            f"deform: {over} edges are still longer than refine × their rest length (the "
+            f"refinement stopped at max_vertices={max_vertices} or max_passes={max_passes} per "
+            f"step, or they cross a slip of the field that bisection cannot shorten); raise "
+            f"max_vertices or use more steps"), stacklevel=2)
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
                           counts, timings)

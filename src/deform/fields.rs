@@ -196,6 +196,16 @@ impl Tool for Translation {
             DVec3::ZERO
         }
     }
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        let c = if self.moving {
+            self.center + self.velocity * t
+        } else {
+            self.center
+        };
+        let y = x - c;
+        let r = y.length();
+        (r > 0.0).then(|| (r - self.radius, y / r))
+    }
 }
 
 /// Sphere tool turning with angular velocity `Ω` about `pivot` (eq. 12.3 corrected).

@@ -66,6 +66,13 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
         DVec3::ZERO
     }
 
+    /// For a tool whose tangential velocity jumps across a surface (the curl tools: across
+    /// their own surface `d = 0`), the signed distance to that surface and its gradient at
+    /// `x`, time `t`; `None` for tools whose velocity is continuous.
+    fn slip_surface(&self, _x: DVec3, _t: f64) -> Option<(f64, DVec3)> {
+        None
+    }
+
     /// Whether an evaluation reads a large table at a place that depends on the point (a
     /// distance grid, a spline's segments): then path lines are integrated in a spatial order
     /// so that neighbouring lanes share cache lines ([`advect::advect_ticked`]).
@@ -246,6 +253,15 @@ impl Field {
         self.tools.iter().fold(DMat3::ZERO, |s, e| {
             s + e.potential_jacobian(x, t).unwrap_or(DMat3::ZERO)
         })
+    }
+
+    /// The nearest slip surface of the tools at `x` ([`Tool::slip_surface`]): the signed
+    /// distance and its gradient of the tool with the smallest `|d|`.
+    pub fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        self.tools
+            .iter()
+            .filter_map(|e| e.slip_surface(x, t))
+            .min_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
     }
 
     /// Sum of the tools' speed bounds.

@@ -21,14 +21,18 @@
 //!   `Φ(rest)` vertex by vertex). Where the flow has *torn* the edge — `Φ(m)` lies farther
 //!   than a quarter of the edge from the chord midpoint, as across the tangential slip at the
 //!   surface of a curl translation tool (thesis §12.1: only the normal velocity is continuous
-//!   there) — no rest point lands between the two sides; the chord midpoint is used instead
-//!   and carried on by the flow, which fills the opened sheet at the target resolution rather
-//!   than splitting one torn edge forever. Splitting a flat pair of triangles at a chord
-//!   midpoint does not change the mesh's volume;
-//!   The strip that a slip opens is re-opened at every step (each chord midpoint travels with
-//!   the side it lands on), so refinement across a slip keeps adding vertices along it: on a
-//!   10k-vertex sphere dragged half a radius by a curl tool centred on its surface the volume
-//!   change is −4e-4, and the default bound of 8× the vertices is reached;
+//!   there) — no rest point lands between the two sides. Across such a slip the body's
+//!   boundary runs along the tool's surface, so the new vertex is the chord midpoint moved
+//!   onto the nearest slip surface of the field ([`super::Tool::slip_surface`], a Newton step
+//!   on the tool's distance, ending a hair on its outer side), and the flow carries it on
+//!   along that surface; where no slip surface passes near, the chord midpoint itself.
+//!   Splitting a flat pair of triangles at a chord midpoint does not change the mesh's
+//!   volume;
+//!   The strip that a slip opens grows at every step, so refinement across a slip keeps
+//!   adding vertices along it: on a 10k-vertex sphere dragged half a radius by a curl tool
+//!   centred on its surface the volume change is −3.5e-6 with 6.4× the vertices (placing the
+//!   strip's vertices at plain chord midpoints gave −4.0e-4 at the 8× bound, and at 40k a
+//!   strip folded over itself);
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
 //!   When a bound stops the refinement the result says so (`converged = false` and the number
 //!   of edges still over the threshold).
@@ -140,7 +144,8 @@ pub struct Deformed {
     pub torn: usize,
     /// Edges still over the threshold at the end (0 when the refinement converged).
     pub over_threshold: usize,
-    /// Whether a bound (`max_vertices`, `max_passes`) stopped the refinement.
+    /// Whether edges remain over the threshold at the end (a bound, `max_vertices` or
+    /// `max_passes`, stopped the refinement, or an edge could not be shortened by splitting).
     pub bounded: bool,
     /// Wall time of the integration of the mesh's vertices, seconds.
     pub time_integrate: f64,
@@ -321,15 +326,21 @@ impl Refiner<'_> {
         t != NONE && self.topo.faces[h / 3][(h + 2) % 3] == self.topo.faces[t / 3][(t + 2) % 3]
     }
 
-    /// Whether `h` is the longest edge of its triangle (ties allowed).
+    /// Whether `h` is the longest of the over-threshold edges of its triangle (ties
+    /// allowed). The longest edge of a triangle is usually over the threshold when any edge
+    /// is; where it is not (a long rest edge, whose threshold is higher), the longest edge
+    /// that is over is split, so the refinement cannot stall.
     fn longest_in_face(&self, w: &[DVec3], h: usize) -> bool {
         let f = h / 3;
         let l = len2(&self.topo, w, h);
-        (0..3).all(|k| len2(&self.topo, w, 3 * f + k) <= l)
+        (0..3).all(|k| {
+            let e = 3 * f + k;
+            len2(&self.topo, w, e) <= l || !self.over(w, e)
+        })
     }
 
-    /// Refinement passes after step `done` (1-based count of the steps taken).
-    fn refine(&mut self, w: &mut Vec<DVec3>, done: usize) {
+    /// Refinement passes after step `done` (1-based count of the steps taken), at time `t`.
+    fn refine(&mut self, w: &mut Vec<DVec3>, done: usize, t: f64) {
         for _ in 0..self.opts.max_passes {
             let over = self.over_edges(w);
             if over.is_empty() {
@@ -370,7 +381,7 @@ impl Refiner<'_> {
             if chosen.is_empty() {
                 return;
             }
-            self.place_and_split(w, &chosen, done);
+            self.place_and_split(w, &chosen, done, t);
             self.passes += 1;
         }
         if !self.over_edges(w).is_empty() {
@@ -378,9 +389,22 @@ impl Refiner<'_> {
         }
     }
 
+    /// A torn edge's new vertex: its chord midpoint `c`, moved onto the nearest slip surface
+    /// of the field when one passes within the edge length `l` of it (a Newton step on the
+    /// surface's distance, ending a hair on its positive side so that the vertex follows the
+    /// material outside the tool).
+    fn on_slip(&self, c: DVec3, l: f64, t: f64) -> DVec3 {
+        match self.field.slip_surface(c, t) {
+            Some((d, g)) if d.abs() < l && g.length_squared() > 0.0 => {
+                c - g * ((d - 1e-9 * l) / g.length_squared())
+            }
+            _ => c,
+        }
+    }
+
     /// New vertices on the chosen half-edges: `Φ(rest midpoint)` through the `done` steps,
     /// or the chord midpoint where the edge is torn; then the splits.
-    fn place_and_split(&mut self, w: &mut Vec<DVec3>, chosen: &[usize], done: usize) {
+    fn place_and_split(&mut self, w: &mut Vec<DVec3>, chosen: &[usize], done: usize, t: f64) {
         let mids: Vec<DVec3> = chosen
             .iter()
             .map(|&h| {
@@ -397,7 +421,7 @@ impl Refiner<'_> {
             // `!(d <= ...)` also catches a NaN placement
             let p = if !(p.distance(chord) <= TORN * l) {
                 self.torn += 1;
-                chord
+                self.on_slip(chord, l, t)
             } else {
                 p
             };
@@ -470,7 +494,7 @@ pub fn deform(
             done += 1;
             if refinement.is_some() {
                 let clock = Instant::now();
-                r.refine(&mut w, done);
+                r.refine(&mut w, done, run.t0 + run.h * (j + 1) as f64);
                 out.time_refine += clock.elapsed().as_secs_f64();
             }
             out.step_vertices.push(w.len());
@@ -482,7 +506,9 @@ pub fn deform(
     if refinement.is_some() {
         out.over_threshold = r.over_edges(&w).len();
     }
-    out.bounded = r.bounded && out.over_threshold > 0;
+    // not converged whenever edges remain over the threshold: a bound stopped the refinement,
+    // or the remaining edges could not be bisected (their split would not shorten them)
+    out.bounded = out.over_threshold > 0;
     out.passes = r.passes;
     out.torn = r.torn;
     out.rest = r.rest;
@@ -693,13 +719,15 @@ mod tests {
         let (_, plain) = run(None);
         assert!(watertight(&d.faces, d.vertices.len()));
         assert!(d.torn > 0, "no torn edge");
-        assert!(!d.bounded, "bounded at {} vertices", d.vertices.len());
+        // measured: 2.9× the vertices, −2.4e-4, a few hundred edges over the threshold that
+        // bisection cannot shorten (chord midpoints off the slip surface gave 4.7×, −7.7e-4)
         assert!(
-            d.vertices.len() < 6 * v.len(),
+            d.vertices.len() < 4 * v.len(),
             "{} vertices",
             d.vertices.len()
         );
-        assert!(change.abs() < 1e-3, "volume change {change}");
+        assert!(d.over_threshold * 33 < d.faces.len() && d.bounded); // 455 of 23,600
+        assert!(change.abs() < 4e-4, "volume change {change}");
         assert!(
             plain.abs() > 10.0 * change.abs(),
             "unrefined {plain}, refined {change}"
