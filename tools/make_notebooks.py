@@ -360,13 +360,13 @@ assert abs(change[1.0]) < abs(change[1.5]) < abs(change[None]) / 3""",
 
 A tool of radius 0.9 centred on the sphere's surface is dragged half a radius sideways. The
 material inside the tool moves with it and the material outside slips past its surface, so
-the flow tears the surface along the tool: no rest point lands in the opened strip, and the
-refinement fills it with new vertices at the chord midpoints of the torn edges
-(`torn_vertices`). The work is bounded by `max_vertices` (default 8× the input): when the
-bound stops the refinement the report says `converged=False` with the number of edges still
-over the threshold, and a `spinal.RefinementWarning` is issued. The volume stays within
-5e-4; the opened strip is the rough band along the tool's surface in the picture (the slip
-folds the chord midpoints it carries, which is where the vertex budget goes).""",
+the flow tears the surface along the tool: no rest point lands in the opened strip, whose
+boundary runs along the tool's surface. The refinement fills it with new vertices placed on
+that surface (`torn_vertices`). The work is bounded by `max_vertices` (default 8× the input)
+and `max_passes`: when edges remain over the threshold (some edges across the slip cannot be
+shortened by bisection) the report says `converged=False` with their number, and a
+`spinal.RefinementWarning` is issued. The volume stays within 5e-4; the opened strip is the
+band along the tool's surface in the picture.""",
     """import time, warnings
 drag = spinal.fields.translation(center=[0, 0, 0.9], radius=0.9, velocity=[0.5, 0, 0])
 _, plain = spinal.deform(sphere, drag, 1.0, refine=None)
