@@ -364,6 +364,10 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
             power: Some(self.power),
         })
     }
+    /// The tool's own surface (its tangential velocity jumps there), within the reach.
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        self.pose(t).distance(&self.shape, x)
+    }
     /// The pose once per batch.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, _tm: f64, out: &mut [DVec3]) {

@@ -246,16 +246,21 @@ impl Rotation {
         bounded("angular_speed", tool)
     }
 
+    /// The tool's centre at time `t` (orbiting the pivot when off it).
     #[inline]
-    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+    pub fn center_at(&self, t: f64) -> DVec3 {
         let w = self.omega.length();
         let arm = self.center - self.pivot;
-        let c = if w > 0.0 && arm != DVec3::ZERO && t != 0.0 {
+        if w > 0.0 && arm != DVec3::ZERO && t != 0.0 {
             self.pivot + rodrigues(arm, self.omega / w, w * t)
         } else {
             self.center
-        };
-        let yc = x - c;
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
+        let yc = x - self.center_at(t);
         let rc2 = yc.length_squared();
         if outside_shell(rc2, self.radius, self.reach) {
             return DVec3::ZERO;
@@ -288,6 +293,11 @@ impl Tool for Rotation {
     #[inline]
     fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
         self.eval(x, t)
+    }
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        let y = x - self.center_at(t);
+        let r = y.length();
+        (r > 0.0).then(|| (r - self.radius, y / r))
     }
     fn max_speed(&self) -> f64 {
         Rotation::max_speed(self)
