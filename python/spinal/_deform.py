@@ -56,7 +56,10 @@ class DeformReport:
     relative_change : float
         ``volume / rest_volume − 1`` (NaN when ``rest_volume`` is 0).
     steps : int
-        RK4 steps taken.
+        The RK4 step count of the call (given or the default rule); with a path tool the
+        steps end at its breakpoints, so more are taken (``step_vertices`` has one entry
+        per step taken), and ``spinal.advect(rest_vertices, field, duration, steps)``
+        reproduces them.
     vertices_added : int
         Vertices added by the refinement, over ``passes`` passes.
     passes : int
