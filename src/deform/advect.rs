@@ -122,6 +122,25 @@ fn eval_lanes(field: &Field, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
     }
 }
 
+/// RK4 on a batch of path lines for a tool whose [`Tool::add_lanes`] does per-batch work
+/// (a pose computed once per batch): the override of [`Tool::rk4_lanes`] for such tools.
+#[inline(always)]
+pub(crate) fn rk4_by_batches<T: super::Tool + ?Sized>(
+    tool: &T,
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+) {
+    rk4_lanes_with(
+        |p, t, tm, out| tool.add_lanes(p, t, tm, out),
+        x,
+        t0,
+        h,
+        steps,
+    );
+}
+
 /// RK4 on `B ≤ LANES` path lines in lock-step with a batch evaluator
 /// `add(points, t, t_mid, out)` that writes the velocities into a zeroed `out`.
 #[inline(always)]

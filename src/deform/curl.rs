@@ -378,13 +378,7 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     }
     #[inline]
     fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
-        super::advect::rk4_lanes_with(
-            |p, t, tm, out| self.add_lanes(p, t, tm, out),
-            x,
-            t0,
-            h,
-            steps,
-        );
+        super::advect::rk4_by_batches(self, x, t0, h, steps);
     }
 }
 

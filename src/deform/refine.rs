@@ -524,24 +524,7 @@ mod tests {
 
     /// An octahedron subdivided `k` times and pushed onto the unit sphere.
     fn sphere(k: usize) -> (Vec<DVec3>, Vec<[usize; 3]>) {
-        let mut v = vec![
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
-        let mut f = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let (mut v, mut f) = crate::math::mesh::fixtures::octahedron();
         for _ in 0..k {
             let mut mid = std::collections::HashMap::new();
             let mut g = Vec::new();

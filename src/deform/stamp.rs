@@ -209,29 +209,7 @@ pub fn stamp(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The unit octahedron, outward wound.
-    fn octahedron() -> (Vec<DVec3>, Vec<[usize; 3]>) {
-        let v = vec![
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
-        let f = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
-        (v, f)
-    }
+    use crate::math::mesh::fixtures::octahedron;
 
     fn go(z1: f64, radius: f64, reach: f64, frames: usize) -> Result<Vec<StampFrame>> {
         let (mut v, f) = octahedron();

@@ -153,6 +153,35 @@ pub fn closed_volume_centroid(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Resu
     Ok((vol, m + moment / (24.0 * vol)))
 }
 
+/// Test meshes shared by the unit tests of several modules.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use glam::DVec3;
+
+    /// The regular octahedron with vertices on the unit axes, faces wound outwards.
+    pub fn octahedron() -> (Vec<DVec3>, Vec<[usize; 3]>) {
+        let v = vec![
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+        ];
+        let f = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        (v, f)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

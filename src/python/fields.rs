@@ -191,69 +191,38 @@ impl PyField {
     }
 }
 
-/// Region function of the cross-product fields.
-#[derive(Clone, Copy)]
-pub struct Blend(bool);
+/// A two-way option string as a `bool` newtype: `$false_name` gives `false`.
+macro_rules! two_way {
+    ($(#[$doc:meta])* $ty:ident, $arg:literal, $false_name:literal, $true_name:literal) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy)]
+        pub struct $ty(bool);
 
-impl FromPyObject<'_, '_> for Blend {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        choice(
-            obj,
-            "blend",
-            "blend",
-            &[("c1", Blend(false)), ("linear", Blend(true))],
-        )
-    }
+        impl FromPyObject<'_, '_> for $ty {
+            type Error = PyErr;
+            fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+                choice(obj, $arg, $arg, &[($false_name, $ty(false)), ($true_name, $ty(true))])
+            }
+        }
+    };
 }
 
-/// Twist and bend: the rate form or the thesis's curl form.
-#[derive(Clone, Copy)]
-pub struct CurlForm(bool);
-
-impl FromPyObject<'_, '_> for CurlForm {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        choice(
-            obj,
-            "form",
-            "form",
-            &[("rate", CurlForm(false)), ("curl", CurlForm(true))],
-        )
-    }
-}
-
-/// A straight strip along its axis or across it.
-#[derive(Clone, Copy)]
-pub struct Across(bool);
-
-impl FromPyObject<'_, '_> for Across {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        choice(
-            obj,
-            "kind",
-            "kind",
-            &[("along", Across(false)), ("across", Across(true))],
-        )
-    }
-}
-
-/// A path tool that pushes (curl tool) or carries (region translation).
-#[derive(Clone, Copy)]
-pub struct Carry(bool);
-
-impl FromPyObject<'_, '_> for Carry {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        choice(
-            obj,
-            "tool",
-            "tool",
-            &[("push", Carry(false)), ("carry", Carry(true))],
-        )
-    }
-}
+two_way!(
+    /// Region function of the cross-product fields: the C¹ blend or the linear one.
+    Blend, "blend", "c1", "linear"
+);
+two_way!(
+    /// Twist and bend: the rate form or the thesis's curl form.
+    CurlForm, "form", "rate", "curl"
+);
+two_way!(
+    /// A straight strip along its axis or across it.
+    Across, "kind", "along", "across"
+);
+two_way!(
+    /// A path tool that pushes (curl tool) or carries (region translation).
+    Carry, "tool", "push", "carry"
+);
 
 impl FromPyObject<'_, '_> for path::PathKind {
     type Error = PyErr;
