@@ -11,7 +11,7 @@ from ._advect import advect
 from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
-from ._frames import closing_angle, estimate_tangents, frames
+from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
 
@@ -33,6 +33,7 @@ __all__ = [
     "flesh",
     "flesh_surface",
     "frames",
+    "frames_in_time",
     "ph",
     "quaternions",
     "stamp",

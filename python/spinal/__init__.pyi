@@ -32,6 +32,7 @@ __all__ = [
     "flesh",
     "flesh_surface",
     "frames",
+    "frames_in_time",
     "ph",
     "quaternions",
     "stamp",
@@ -47,6 +48,7 @@ _I: TypeAlias = npt.NDArray[np.int64]
 _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
 _Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
+_Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
 _SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
@@ -67,6 +69,23 @@ def frames(
     u: int | _Array | None = None,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    constraints: _Constraints | Sequence[_Constraints | None] | None = None,
+    twist_rule: Literal["arc_length", "min_angular_speed"] = "arc_length",
+    guide: _Array | None = None,
+    guide_weight: float = 1.0,
+    guide_tolerance: float = 1e-3,
+    previous: _Array | None = None,
+) -> _F: ...
+def frames_in_time(
+    points_t: _Array | None,
+    tangents_t: _Array | None = None,
+    *,
+    method: _Method = "double_reflection",
+    initial: _Array | None = None,
+    closed: bool = False,
+    turns: int = 0,
+    reflection: _Reflection = "chord",
+    previous: _Array | None = None,
 ) -> _F: ...
 def closing_angle(
     points: _Array | Curve | None,

@@ -39,6 +39,45 @@ def frames_analytic(
 def estimate_tangents(
     points: npt.NDArray[np.float64], closed: bool, rule: str
 ) -> npt.NDArray[np.float64]: ...
+def frames_steered(
+    points: npt.NDArray[np.float64] | None,
+    tangents: npt.NDArray[np.float64] | None,
+    offsets: npt.NDArray[np.int64],
+    u: npt.NDArray[np.float64] | None,
+    d1: npt.NDArray[np.float64] | None,
+    d2: npt.NDArray[np.float64] | None,
+    method: str,
+    tangent_chords: bool,
+    closed: bool,
+    initial_vectors: npt.NDArray[np.float64] | None,
+    initial_frames: npt.NDArray[np.float64] | None,
+    end_vectors: npt.NDArray[np.float64] | None,
+    end_frames: npt.NDArray[np.float64] | None,
+    turns: npt.NDArray[np.int64],
+    con_curves: npt.NDArray[np.int64],
+    con_rows: npt.NDArray[np.int64],
+    con_vectors: npt.NDArray[np.float64],
+    con_frames: npt.NDArray[np.float64],
+    con_is_frame: npt.NDArray[np.bool_],
+    twist_rule: str,
+    guide: npt.NDArray[np.float64] | None,
+    guide_weight: float,
+    guide_tolerance: float,
+    previous: npt.NDArray[np.float64] | None,
+    points_arg: str = "points",
+) -> npt.NDArray[np.float64]: ...
+def frames_in_time(
+    points: npt.NDArray[np.float64] | None,
+    tangents: npt.NDArray[np.float64] | None,
+    steps: int,
+    method: str,
+    tangent_chords: bool,
+    closed: bool,
+    initial_vectors: npt.NDArray[np.float64] | None,
+    initial_frames: npt.NDArray[np.float64] | None,
+    turns: int,
+    previous: npt.NDArray[np.float64] | None,
+) -> npt.NDArray[np.float64]: ...
 def sweep_mesh(
     points: npt.NDArray[np.float64],
     frames: npt.NDArray[np.float64],

@@ -7,10 +7,11 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from ._steer import frames_in_time, steered
 from ._validate import as_bool, as_choice, as_float_array, as_int, as_offsets, as_points
 from .curves import Curve
 
-__all__ = ["closing_angle", "estimate_tangents", "frames"]
+__all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
 METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")
@@ -116,6 +117,12 @@ def frames(
     u=None,
     lengths=None,
     offsets=None,
+    constraints=None,
+    twist_rule: str = "arc_length",
+    guide=None,
+    guide_weight: float = 1.0,
+    guide_tolerance: float = 1e-3,
+    previous=None,
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -189,6 +196,52 @@ def frames(
         each (or ``offsets``, C + 1 start rows ending at n). Curves are computed in parallel;
         ``initial``/``end`` may be given per curve as (C, 3) or (C, 3, 3). Long single curves
         use all cores too (a parallel prefix scan of the per-segment rotations).
+    constraints : mapping or (indices, vectors), optional
+        Prescribed orientations anywhere along the curve: ``{row: vector or (3, 3) frame}``
+        or a pair ``(indices (k,), vectors (k, 3) or frames (k, 3, 3))``; any number, interior
+        rows included, negative rows count from the end. Vectors are projected onto the
+        normal plane (an error if parallel to the tangent); a frame's ``t`` must agree with
+        the tangent within 1e-3 rad. Every frame is the RMF turned about ``t`` by ``α``
+        (``g = cos α r + sin α (t × r)``, Zheng 2008 §7.3); each constraint fixes ``α`` at its
+        row exactly, and between consecutive constraints the twist ``wrap(a_{j+1} − a_j) +
+        2π·turns`` (the least turn, plus ``turns`` whole turns per interval) is spread by
+        ``twist_rule``. Before the first and after the last constraint of an open curve the
+        frames are the RMF turned to meet the nearest constraint. ``initial``/``end`` are
+        constraints at the first/last row; with ``end`` the first row is pinned to the start
+        (``initial`` or the default), so ``end=v`` is ``constraints={0: start, -1: v}``. On a
+        closed curve the intervals run round the seam (where the RMF's closing angle enters).
+        With ``lengths``/``offsets``: a list with one entry per curve (a mapping, a pair or
+        ``None``), rows local to each curve (0 is the curve's first row).
+    twist_rule : {"arc_length", "min_angular_speed"}
+        How the twist between constraints (and of ``end``/``closed``) is spread.
+        ``"arc_length"`` (default): linear in arc length, the least total squared angular
+        speed ``∫|ω|² ds = ∫(κ² + α′²) ds`` (Zheng eq. 7.8; Wang et al. §6.3).
+        ``"min_angular_speed"``: the least total angular speed ``∫|ω| ds = ∫√(κ² + α′²) ds``
+        (Zheng eq. 7.5–7.7, Wang et al. §7): ``α′ = Cκ``, the twist follows the curvature;
+        discretely each segment takes the share ``θ_i / Σθ`` of its interval's twist,
+        ``θ_i`` the angle between consecutive tangents (the exact minimiser of
+        ``Σ √(θ_i² + Δα_i²)``); on an interval that does not turn it falls back to arc length.
+    guide : array_like (n, 3) or (3,), optional
+        Directions for ``r`` to follow (one per sample, or one for all, e.g. "up"): ``r``
+        follows the guide's projection on the normal plane, at angle ``φ_i`` from the RMF,
+        smoothed: ``α`` minimises ``Σ (h̄/h_i)(α_{i+1} − α_i)² + guide_weight · Σ w_i
+        (μ_i/h̄)(α_i − φ_i)²`` (``h_i`` segment lengths, ``h̄`` their mean, ``μ_i`` the
+        half-lengths at sample ``i``, ``w_i = sin²∠(g_i, t_i)``), a symmetric tridiagonal
+        system solved in O(n) after unwrapping ``φ``. Where the guide is within
+        ``guide_tolerance`` of ``±t`` it is ignored and the frame falls back to the RMF's
+        twist rate. ``constraints``/``initial``/``end`` are met exactly on top.
+    guide_weight : float
+        Weight of the guide error against the twist rate, per sample (> 0): the frame follows
+        the guide on features longer than about ``1/√guide_weight`` samples; the bias on a
+        smooth guide is about ``φ″/guide_weight`` (``φ″`` per sample²).
+    guide_tolerance : float
+        Angle in radians (in [0, π/2)) from the tangent below which a guide vector is ignored.
+    previous : array_like (n, 3, 3), optional
+        The frames of the same curve at the previous time step (same sample count): the
+        result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
+        closest to ``previous`` (see :func:`frames_in_time`), so frames of a moving curve do
+        not flicker. Not with ``initial``, ``end``, ``constraints`` or ``guide``, which fix
+        the start themselves.
 
     Returns
     -------
@@ -203,8 +256,9 @@ def frames(
         Wrong shapes, fewer than 2 points (3 for a closed curve), NaN/inf, repeated
         consecutive points (zero-length segments), zero tangents, a cusp or a segment whose
         chord runs against its tangents (``(x_{i+1} − x_i)·(t_i + t_{i+1}) ≤ 0``: a reversal
-        or far too coarse a sampling), an ``initial``/``end`` vector parallel to the tangent.
-        The message names the argument and the row.
+        or far too coarse a sampling), an ``initial``/``end`` vector parallel to the tangent,
+        a constraint row out of range or a constraint parallel to its tangent, a ``guide`` or
+        ``previous`` of the wrong shape. The message names the argument and the row.
 
     Examples
     --------
@@ -214,6 +268,11 @@ def frames(
     >>> F.shape
     (200, 3, 3)
     """
+    if (constraints is not None or guide is not None or previous is not None
+            or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
+        return steered(points, tangents, method, initial, closed, end, turns, reflection, u,
+                       lengths, offsets, constraints, twist_rule, guide, guide_weight,
+                       guide_tolerance, previous)
     out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
                          lengths, offsets)
     return out

@@ -17,15 +17,19 @@
 //! frames into a caller-provided buffer; [`compute_many`] maps it over a bundle of curves in
 //! parallel.
 
+pub mod constraints;
 pub mod double_reflection;
 pub mod frenet;
 pub mod fused;
 pub mod geometry;
+pub mod guide;
 pub mod lanes;
 pub mod projection;
 pub mod rk4;
 pub mod rotation;
+pub mod steer;
 pub mod tangents;
+pub mod time;
 pub mod transport;
 pub mod validate;
 
@@ -621,6 +625,51 @@ impl Ctx<'_> {
         };
         Ok(transport_into(step, t, self.seg, closed, r0, twist, out))
     }
+}
+
+/// What the steering modules ([`steer`]) need besides the frames: the number of distinct
+/// samples, the segment lengths of the twist distribution and the RMF's closing angle.
+pub(crate) struct RmfParts {
+    pub n: usize,
+    pub seg: Vec<f64>,
+    pub closing: f64,
+}
+
+/// The plain rotation-minimising frames of `req` (its `end` and `turns` ignored; a closed
+/// curve's frames are transported once round without the closing twist, so frame `n − 1`
+/// carried across the closing segment differs from frame 0 by the closing angle), written
+/// into `out`, with the [`RmfParts`].
+pub(crate) fn rmf_parts(req: &Request, out: &mut [f64]) -> Result<RmfParts> {
+    let base = Request {
+        end: None,
+        turns: 0,
+        ..*req
+    };
+    let closing = compute_into(&base, out)?;
+    let rows = out.len() / 9;
+    let n = distinct_samples(req, rows)?;
+    let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);
+    let chords = if x.is_empty() {
+        Vec::new()
+    } else {
+        validate::chords(x, req.closed)?
+    };
+    let seg = segment_lengths(req, x, n, chords);
+    if req.closed && closing != 0.0 {
+        // undo the closing twist `closing · s / L` that compute_into spread along the loop
+        let length: f64 = seg.iter().sum();
+        let mut arc = 0.0;
+        for (i, f) in out.chunks_exact_mut(9).take(n).enumerate() {
+            let (sin, cos) = (-closing * arc / length).sin_cos();
+            for row in 0..3 {
+                let (r, s) = (f[3 * row], f[3 * row + 1]);
+                f[3 * row] = cos * r + sin * s;
+                f[3 * row + 1] = cos * s - sin * r;
+            }
+            arc += seg[i];
+        }
+    }
+    Ok(RmfParts { n, seg, closing })
 }
 
 /// Per-curve orientations of a bundle: none, one shared by all curves, or one per curve.

@@ -8,9 +8,9 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    empty, offsets_of, orientations, renamed, slice_mut, slice_of, vec3_array, vec3s,
+    empty, offsets_of, orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
-use crate::frames::{self, Analytic, Method, Request, TangentRule};
+use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
 pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
@@ -128,4 +128,245 @@ pub fn estimate_tangents<'py>(
     let x = vec3s("points", &points)?;
     let t = py.detach(|| frames::tangents::estimate_rows(x, closed, rule))?;
     vec3_array(py, t)
+}
+
+/// Frames of one or many curves steered by constraints, a guide or the previous time step
+/// (`spinal.frames` with `constraints=`, `twist_rule=`, `guide=` or `previous=`). The
+/// constraints of all curves come flattened: curve `con_curves[k]`, local row `con_rows[k]`,
+/// the vector `con_vectors[k]` or, where `con_is_frame[k]`, the frame `con_frames[k]`. An
+/// analytic curve (one) passes `u`, `d1`, `d2` as in [`frames_analytic`].
+#[pyfunction]
+#[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_chords, closed,
+                    initial_vectors, initial_frames, end_vectors, end_frames, turns,
+                    con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
+                    guide, guide_weight, guide_tolerance, previous, points_arg="points"))]
+#[allow(clippy::too_many_arguments)]
+pub fn frames_steered<'py>(
+    py: Python<'py>,
+    points: Option<PyReadonlyArray2<'py, f64>>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    u: Option<PyReadonlyArray1<'py, f64>>,
+    d1: Option<PyReadonlyArray2<'py, f64>>,
+    d2: Option<PyReadonlyArray2<'py, f64>>,
+    method: Method,
+    tangent_chords: bool,
+    closed: bool,
+    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
+    end_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    end_frames: Option<PyReadonlyArray3<'py, f64>>,
+    turns: PyReadonlyArray1<'py, i64>,
+    con_curves: PyReadonlyArray1<'py, i64>,
+    con_rows: PyReadonlyArray1<'py, i64>,
+    con_vectors: PyReadonlyArray2<'py, f64>,
+    con_frames: PyReadonlyArray3<'py, f64>,
+    con_is_frame: PyReadonlyArray1<'py, bool>,
+    twist_rule: &str,
+    guide: Option<PyReadonlyArray2<'py, f64>>,
+    guide_weight: f64,
+    guide_tolerance: f64,
+    previous: Option<PyReadonlyArray3<'py, f64>>,
+    points_arg: &str,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    use crate::frames::constraints::TwistRule;
+    use crate::frames::guide::Guide;
+    use crate::frames::steer::{self, Constraint, Steering};
+    use glam::DMat3;
+
+    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
+    let tgs = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let rows = pts.or(tgs).map(<[_]>::len).unwrap_or(0);
+    let offsets = offsets_of(&offsets)?;
+    let curves = offsets.len().saturating_sub(1);
+    let initial = orientations("initial", initial_vectors, initial_frames)?;
+    let end = orientations("end", end_vectors, end_frames)?;
+    let turns = slice_of("turns", &turns)?;
+    let rule = match twist_rule {
+        "arc_length" => TwistRule::ArcLength,
+        "min_angular_speed" => TwistRule::MinAngularSpeed,
+        other => {
+            return Err(value_error(format!(
+                "twist_rule: unknown rule '{other}'; expected 'arc_length' or \
+                 'min_angular_speed'"
+            )));
+        }
+    };
+    // constraints, grouped by curve
+    let cc = slice_of("constraints", &con_curves)?;
+    let cr = slice_of("constraints", &con_rows)?;
+    let cv = vec3s("constraints", &con_vectors)?;
+    let cf = super::convert::frames_of("constraints", &con_frames)?;
+    let ck = slice_of("constraints", &con_is_frame)?;
+    let k = cc.len();
+    if cr.len() != k || cv.len() != k || cf.len() != k || ck.len() != k {
+        return Err(value_error("constraints: inconsistent constraint arrays"));
+    }
+    let mut per_curve: Vec<Vec<Constraint>> = vec![Vec::new(); curves.max(1)];
+    for j in 0..k {
+        let c = usize::try_from(cc[j])
+            .ok()
+            .filter(|&c| c < curves.max(1))
+            .ok_or_else(|| value_error(format!("constraints: curve {} out of range", cc[j])))?;
+        let row = usize::try_from(cr[j])
+            .map_err(|_| value_error(format!("constraints: row {} is out of range", cr[j])))?;
+        let orientation = if ck[j] {
+            Orientation::Frame(DMat3::from_cols_array(&cf[j]).transpose())
+        } else {
+            Orientation::Vector(cv[j])
+        };
+        if per_curve[c].iter().any(|x| x.row == row) {
+            return Err(value_error(format!(
+                "constraints: row {row} is given twice{}",
+                if curves > 1 {
+                    format!(" (curve {c})")
+                } else {
+                    String::new()
+                }
+            )));
+        }
+        per_curve[c].push(Constraint { row, orientation });
+    }
+    let guide_rows = guide.as_ref().map(|g| vec3s("guide", g)).transpose()?;
+    let prev = previous
+        .as_ref()
+        .map(|p| super::convert::frames_of("previous", p))
+        .transpose()?;
+    if let Some(g) = guide_rows {
+        if g.len() != 1 && g.len() != rows {
+            return Err(value_error(format!(
+                "guide: expected shape (3,) or ({rows}, 3) (one vector per sample), got \
+                 ({}, 3)",
+                g.len()
+            )));
+        }
+    }
+    if let Some(p) = prev {
+        if p.len() != rows {
+            return Err(value_error(format!(
+                "previous: expected shape ({rows}, 3, 3) (the frames of the same curve at the \
+                 previous time step), got ({}, 3, 3)",
+                p.len()
+            )));
+        }
+    }
+    let steering: Vec<Steering> = (0..curves.max(1))
+        .map(|c| {
+            let (a, b) = (offsets[c.min(curves)], offsets[(c + 1).min(curves)]);
+            Steering {
+                constraints: &per_curve[c],
+                rule,
+                turns,
+                guide: guide_rows.map(|g| Guide {
+                    vectors: if g.len() == 1 { g } else { &g[a..b] },
+                    weight: guide_weight,
+                    tolerance: guide_tolerance,
+                }),
+                previous: prev.map(|p| &p[a..b]),
+            }
+        })
+        .collect();
+    let template = Request {
+        points: pts,
+        tangents: tgs,
+        analytic: None,
+        closed,
+        method,
+        tangent_chords,
+        tangent_rule: TangentRule::FivePoint,
+        initial: None,
+        end: None,
+        turns: 0,
+    };
+    let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf = slice_mut(&mut rw)?;
+        if let (Some(u), Some(d1), Some(d2)) = (u.as_ref(), d1.as_ref(), d2.as_ref()) {
+            let req = Request {
+                analytic: Some(Analytic {
+                    u: slice_of("u", u)?,
+                    d1: vec3s("points.d1", d1)?,
+                    d2: vec3s("points.d2", d2)?,
+                }),
+                initial: frames::pick(&initial, 0),
+                end: frames::pick(&end, 0),
+                ..template
+            };
+            let st = steering[0];
+            py.detach(|| steer::compute_steered(&req, &st, buf))?;
+        } else {
+            py.detach(|| {
+                steer::compute_steered_many(&template, &offsets, &initial, &end, &steering, buf)
+            })
+            .map_err(|e| renamed(e, "points", points_arg))?;
+        }
+    }
+    Ok(out)
+}
+
+/// Frames of a curve moving in time, `(T, n, 3)` points (and tangents) flattened to
+/// `(T·n, 3)`: each step's RMF, turned to be closest to the step before.
+#[pyfunction]
+#[pyo3(signature = (points, tangents, steps, method, tangent_chords, closed, initial_vectors,
+                    initial_frames, turns, previous))]
+#[allow(clippy::too_many_arguments)]
+pub fn frames_in_time<'py>(
+    py: Python<'py>,
+    points: Option<PyReadonlyArray2<'py, f64>>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    steps: usize,
+    method: Method,
+    tangent_chords: bool,
+    closed: bool,
+    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
+    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
+    turns: i64,
+    previous: Option<PyReadonlyArray3<'py, f64>>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
+    let tgs = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    let total = pts.or(tgs).map(<[_]>::len).unwrap_or(0);
+    if steps == 0 || total % steps != 0 {
+        return Err(value_error(
+            "points: expected shape (T, n, 3) with T ≥ 1 time steps",
+        ));
+    }
+    let rows = total / steps;
+    let initial = orientations("initial", initial_vectors, initial_frames)?;
+    let prev = previous
+        .as_ref()
+        .map(|p| super::convert::frames_of("previous", p))
+        .transpose()?;
+    let template = Request {
+        points: pts,
+        tangents: tgs,
+        closed,
+        method,
+        tangent_chords,
+        turns,
+        ..Request::default()
+    };
+    let out = empty::<f64, numpy::Ix3>(py, &[total, 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf = slice_mut(&mut rw)?;
+        py.detach(|| {
+            frames::time::frames_in_time(
+                &template,
+                steps,
+                rows,
+                frames::pick(&initial, 0),
+                prev,
+                buf,
+            )
+        })?;
+    }
+    Ok(out)
 }

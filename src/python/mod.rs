@@ -22,6 +22,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames::frames_sampled, m)?)?;
     m.add_function(wrap_pyfunction!(frames::frames_analytic, m)?)?;
     m.add_function(wrap_pyfunction!(frames::estimate_tangents, m)?)?;
+    m.add_function(wrap_pyfunction!(frames::frames_steered, m)?)?;
+    m.add_function(wrap_pyfunction!(frames::frames_in_time, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_from_frames, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_to_frames, m)?)?;

@@ -1,0 +1,273 @@
+//! Steered frames: the RMF of a request turned about its tangents to meet constraints
+//! ([`constraints`](super::constraints)), to follow a guide ([`guide`](super::guide)) or to
+//! stay close to the frames of the previous time step ([`time`](super::time)).
+//!
+//! Pins. `initial` and `end` are constraints at the first and last rows. When `end` is given
+//! the first row is pinned too, to `initial` or to the default start, so that `end` alone
+//! keeps its meaning (the twist spread from the start to the end); a closed curve without any
+//! constraint is pinned at row 0 to its start (the closing twist, spread round the loop). With
+//! these pins and the arc-length rule the result is the plain `end=`/`closed=` result.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::constraints::{self, TwistRule};
+use super::guide::{self, Guide};
+use super::{Method, Orientation, Request, resolve, rmf_parts, time, validate};
+use crate::error::{InputError, Result};
+
+/// A prescribed orientation at a row of the curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constraint {
+    pub row: usize,
+    pub orientation: Orientation,
+}
+
+/// How the frames of one curve are steered.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Steering<'a> {
+    pub constraints: &'a [Constraint],
+    pub rule: TwistRule,
+    /// Extra turns: none (the request's `turns`), one for every interval, or one per interval.
+    pub turns: &'a [i64],
+    pub guide: Option<Guide<'a>>,
+    /// Frames of the same curve at the previous time step (one per row).
+    pub previous: Option<&'a [[f64; 9]]>,
+}
+
+fn col(f: &[f64], k: usize) -> DVec3 {
+    DVec3::new(f[k], f[3 + k], f[6 + k])
+}
+
+/// Frames of one curve, steered; `out` holds `9·rows` values.
+pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<()> {
+    if req.method == Method::Frenet {
+        let arg = if !st.constraints.is_empty() {
+            "constraints"
+        } else if st.guide.is_some() {
+            "guide"
+        } else {
+            "previous"
+        };
+        return Err(InputError::new(
+            arg,
+            "is not used by method='frenet': the Frenet frame is fixed by the curve",
+        ));
+    }
+    if st.previous.is_some() {
+        let other = if !st.constraints.is_empty() {
+            Some("constraints")
+        } else if st.guide.is_some() {
+            Some("guide")
+        } else if req.initial.is_some() {
+            Some("initial")
+        } else if req.end.is_some() {
+            Some("end")
+        } else {
+            None
+        };
+        if let Some(o) = other {
+            return Err(InputError::new(
+                "previous",
+                format!(
+                    "cannot be combined with {o} (they fix the frames that previous would \
+                     choose)"
+                ),
+            ));
+        }
+    }
+    if let Some(g) = &st.guide {
+        guide::check(g)?;
+    }
+    let rows = out.len() / 9;
+    if let Some(p) = st.previous {
+        time::check_previous(p, rows)?;
+    }
+    // constraints: rows in range, distinct
+    for c in st.constraints {
+        if c.row >= rows {
+            return Err(InputError::new(
+                "constraints",
+                format!("row {} is out of range for a curve of {rows} rows", c.row),
+            ));
+        }
+    }
+    let parts = rmf_parts(req, out)?;
+    let n = parts.n;
+    if let Some(g) = &st.guide {
+        if g.vectors.len() != 1 && g.vectors.len() != rows {
+            return Err(InputError::new(
+                "guide",
+                format!(
+                    "expected shape (3,) or ({rows}, 3) (one vector per sample), got ({}, 3)",
+                    g.vectors.len()
+                ),
+            ));
+        }
+    }
+    let t: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 2)).collect();
+    let r: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 0)).collect();
+    let mut pins: Vec<(usize, DVec3)> = Vec::new();
+    for c in st.constraints {
+        if c.row >= n {
+            return Err(InputError::new(
+                "constraints",
+                format!(
+                    "row {} repeats row 0 of the closed curve; constrain row 0 instead",
+                    c.row
+                ),
+            ));
+        }
+        pins.push((
+            c.row,
+            resolve(&c.orientation, t[c.row], c.row, "constraints")?,
+        ));
+    }
+    let mut add = |row: usize, v: DVec3, arg: &'static str| -> Result<()> {
+        if pins.iter().any(|p| p.0 == row) {
+            return Err(InputError::new(
+                arg,
+                format!("row {row} is also given in constraints; give it once"),
+            ));
+        }
+        pins.push((row, v));
+        Ok(())
+    };
+    let constrained = !st.constraints.is_empty() || st.guide.is_some();
+    if let Some(o) = &req.initial {
+        if constrained || req.end.is_some() {
+            add(0, resolve(o, t[0], 0, "initial")?, "initial")?;
+        }
+    }
+    if let Some(o) = &req.end {
+        add(n - 1, resolve(o, t[n - 1], n - 1, "end")?, "end")?;
+        if req.initial.is_none() && !pins.iter().any(|p| p.0 == 0) {
+            pins.push((0, r[0]));
+        }
+    }
+    if req.closed && pins.is_empty() && st.guide.is_none() {
+        pins.push((0, r[0]));
+    }
+    pins.sort_by_key(|p| p.0);
+    let alpha = if let Some(g) = &st.guide {
+        let turns = match st.turns {
+            [] => req.turns,
+            [k] => *k,
+            _ => {
+                return Err(InputError::new(
+                    "turns",
+                    "with guide: one count (the extra turns across a closed curve's seam)",
+                ));
+            }
+        };
+        guide::twist(
+            &r,
+            &t,
+            &parts.seg,
+            req.closed,
+            parts.closing,
+            g,
+            &pins,
+            turns,
+        )?
+    } else {
+        let own = [req.turns];
+        let turns = if st.turns.is_empty() {
+            &own[..]
+        } else {
+            st.turns
+        };
+        constraints::twist(
+            &r,
+            &t,
+            &parts.seg,
+            req.closed,
+            parts.closing,
+            &pins,
+            st.rule,
+            turns,
+        )?
+    };
+    out[..9 * n]
+        .par_chunks_mut(9)
+        .zip(alpha.par_iter())
+        .for_each(|(f, &a)| {
+            if a != 0.0 {
+                let (sin, cos) = a.sin_cos();
+                for row in 0..3 {
+                    let (r, s) = (f[3 * row], f[3 * row + 1]);
+                    f[3 * row] = cos * r + sin * s;
+                    f[3 * row + 1] = cos * s - sin * r;
+                }
+            }
+        });
+    if rows > n {
+        let (head, tail) = out.split_at_mut(9 * n);
+        tail[..9].copy_from_slice(&head[..9]);
+    }
+    if let Some(p) = st.previous {
+        time::align(out, p)?;
+    }
+    Ok(())
+}
+
+/// [`compute_steered`] over a bundle (`offsets` as in [`super::compute_many`]); `steer[c]`
+/// steers curve `c` (one entry: all curves), `initial`/`end` hold 0, 1 or one entry per
+/// curve.
+pub fn compute_steered_many(
+    template: &Request,
+    offsets: &[usize],
+    initial: &[Orientation],
+    end: &[Orientation],
+    steer: &[Steering],
+    out: &mut [f64],
+) -> Result<()> {
+    let curves = offsets.len().saturating_sub(1);
+    for (arg, v) in [("initial", initial.len()), ("end", end.len())] {
+        if v > 1 && v != curves {
+            return Err(InputError::new(
+                arg,
+                format!("expected one entry per curve ({curves}), got {v}"),
+            ));
+        }
+    }
+    let total = template
+        .points
+        .map(<[DVec3]>::len)
+        .or(template.tangents.map(<[DVec3]>::len))
+        .unwrap_or(0);
+    validate::offsets(offsets, total)?;
+    if out.len() != 9 * total || (steer.len() != 1 && steer.len() != curves) {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
+    let mut slices = Vec::with_capacity(curves);
+    let mut rest = out;
+    for w in offsets.windows(2) {
+        let (head, tail) = rest.split_at_mut(9 * (w[1] - w[0]));
+        slices.push(head);
+        rest = tail;
+    }
+    let results: Vec<Result<()>> = slices
+        .into_par_iter()
+        .enumerate()
+        .map(|(c, buf)| {
+            let (a, b) = (offsets[c], offsets[c + 1]);
+            let req = Request {
+                points: template.points.map(|p| &p[a..b]),
+                tangents: template.tangents.map(|t| &t[a..b]),
+                initial: super::pick(initial, c),
+                end: super::pick(end, c),
+                ..*template
+            };
+            let st = steer[if steer.len() == 1 { 0 } else { c }];
+            compute_steered(&req, &st, buf).map_err(|e| {
+                if curves > 1 {
+                    e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
+                } else {
+                    e
+                }
+            })
+        })
+        .collect();
+    results.into_iter().collect()
+}

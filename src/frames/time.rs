@@ -1,0 +1,131 @@
+//! Frames coherent in time: the frames of a moving curve that change no more between time
+//! steps than the curve does.
+//!
+//! All rotation-minimising frames of a curve differ by one constant turn `c` about the
+//! tangents (Zheng 2008, *Studies on Motion and Deformation in Graphics*, Cor. 4.1.3; the
+//! closing twist of a closed curve does not depend on the start either). Of these, the one
+//! closest to the frames `P_i` of the previous time step (Ma 1996, *Curve and Surface Framing
+//! for Scientific Visualization and Domain Dependent Navigation*, §3.5.3: align the frames of
+//! similar curves by one rotation) minimises `Σ_i ‖R_t(c) U_i − P_i‖²_F` (every frame counts
+//! the same). With `U_i = (r, s, t)` and `R_t(c)` turning `(r, s)` by `c`, the sum is least
+//! for `c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)` (`P_r`, `P_s` the first two columns of
+//! `P_i`), in closed form and O(n). A sequence of curves `(T, n)` gets its RMFs in parallel
+//! over `T`; then, in order, each step is turned to its predecessor.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::{Orientation, Request, compute_many, validate};
+use crate::error::{InputError, Result};
+
+/// Column `k` of a row-major frame.
+fn col(f: &[f64], k: usize) -> DVec3 {
+    DVec3::new(f[k], f[3 + k], f[6 + k])
+}
+
+/// Turn every frame of `out` about its tangent by `c` (the columns `r, s`).
+pub fn turn_all(out: &mut [f64], c: f64) {
+    let (sin, cos) = c.sin_cos();
+    out.par_chunks_mut(9 * 1024).for_each(|b| {
+        for f in b.chunks_exact_mut(9) {
+            for row in 0..3 {
+                let (r, s) = (f[3 * row], f[3 * row + 1]);
+                f[3 * row] = cos * r + sin * s;
+                f[3 * row + 1] = cos * s - sin * r;
+            }
+        }
+    });
+}
+
+/// The turn `c` that brings the frames `out` closest to `previous` (both row-major,
+/// `9·rows` values).
+pub fn best_turn(out: &[f64], previous: &[f64]) -> f64 {
+    let (y, x) = out
+        .par_chunks(9 * 1024)
+        .zip(previous.par_chunks(9 * 1024))
+        .map(|(a, b)| {
+            a.chunks_exact(9)
+                .zip(b.chunks_exact(9))
+                .fold((0.0, 0.0), |(y, x), (f, p)| {
+                    let (r, s, pr, ps) = (col(f, 0), col(f, 1), col(p, 0), col(p, 1));
+                    (y + s.dot(pr) - r.dot(ps), x + r.dot(pr) + s.dot(ps))
+                })
+        })
+        .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    y.atan2(x)
+}
+
+/// `previous` must hold one finite rotation per row.
+pub fn check_previous(previous: &[[f64; 9]], rows: usize) -> Result<()> {
+    if previous.len() != rows {
+        return Err(InputError::new(
+            "previous",
+            format!(
+                "expected shape ({rows}, 3, 3) (one frame per sample of the curve), got \
+                 ({}, 3, 3)",
+                previous.len()
+            ),
+        ));
+    }
+    if let Some(i) = validate::first_bad(previous, validate::is_rotation) {
+        return Err(InputError::new(
+            "previous",
+            format!("row {i} is not a rotation matrix (columns r, s, t orthonormal, det +1)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Turn the frames `out` (one curve) to be closest to `previous`.
+pub fn align(out: &mut [f64], previous: &[[f64; 9]]) -> Result<()> {
+    check_previous(previous, out.len() / 9)?;
+    let prev: &[f64] = bytemuck::cast_slice(previous);
+    let c = best_turn(out, prev);
+    turn_all(out, c);
+    Ok(())
+}
+
+/// Frames of `steps` time steps of one curve of `rows` samples stored back to back in the
+/// request's arrays: the RMF of every step (in parallel), then each turned to be closest to
+/// the step before (step 0 to `previous` when given, else it starts from `initial`).
+pub fn frames_in_time(
+    template: &Request,
+    steps: usize,
+    rows: usize,
+    initial: Option<Orientation>,
+    previous: Option<&[[f64; 9]]>,
+    out: &mut [f64],
+) -> Result<()> {
+    if template.end.is_some() {
+        return Err(InputError::new(
+            "end",
+            "cannot be combined with frames in time (each step's start is chosen to match \
+             the step before)",
+        ));
+    }
+    if let Some(p) = previous {
+        if initial.is_some() {
+            return Err(InputError::new(
+                "initial",
+                "cannot be combined with previous (the start is chosen to match previous)",
+            ));
+        }
+        check_previous(p, rows)?;
+    }
+    let offsets: Vec<usize> = (0..=steps).map(|k| k * rows).collect();
+    let init: Vec<Orientation> = initial.into_iter().collect();
+    compute_many(template, &offsets, &init, &[], out).map_err(|e| {
+        let m = e.msg.replacen("curve ", "time step ", 1);
+        InputError::new(e.arg, m)
+    })?;
+    if let Some(p) = previous {
+        let c = best_turn(&out[..9 * rows], bytemuck::cast_slice(p));
+        turn_all(&mut out[..9 * rows], c);
+    }
+    for k in 1..steps {
+        let (before, now) = out[9 * rows * (k - 1)..9 * rows * (k + 1)].split_at_mut(9 * rows);
+        let c = best_turn(now, before);
+        turn_all(now, c);
+    }
+    Ok(())
+}

@@ -1,0 +1,386 @@
+"""Steered frames: interior constraints with the two twist rules, guide vectors, coherence
+over time (``spinal.frames(constraints=, twist_rule=, guide=, previous=)`` and
+``spinal.frames_in_time``).
+
+References are independent of the implementation: the twist of every interval in closed form
+(arc length, or the turning of the tangent), a numerical minimisation (scipy) of the discrete
+total (squared) angular speed, a guide that is an exact RMF turned by a known function, and
+the change of a helix's frames while its pitch changes."""
+
+import itertools
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+import spinal
+
+
+def helix(n=120, b=0.4, span=4 * np.pi, uneven=True):
+    k = np.arange(n)
+    u = span * (k + (0.3 * np.sin(1.7 * k) if uneven else 0.0)) / (n - 1)
+    u = np.sort(u)
+    return np.c_[np.cos(u), np.sin(u), b * u]
+
+
+def wiggle(n=160):
+    u = np.linspace(0, 3.0, n) + 0.004 * np.sin(np.arange(n) * 1.3)
+    return np.c_[3 * np.cos(u), 2 * np.sin(u) + 0.3 * np.sin(4 * u), 0.4 * u + 0.5 * np.sin(3 * u)]
+
+
+def signed(a, b, t):
+    """Angle turning a into b about t (rows)."""
+    return np.arctan2(np.einsum("ij,ij->i", np.cross(a, b), t), np.einsum("ij,ij->i", a, b))
+
+
+def twist_of(F, F0):
+    """The twist of frames F about t from the RMF F0, unwrapped along the rows."""
+    return np.unwrap(signed(F0[:, :, 0], F[:, :, 0], F0[:, :, 2]))
+
+
+def turned(F0, i, beta):
+    r, s = F0[i, :, 0], F0[i, :, 1]
+    return np.cos(beta) * r + np.sin(beta) * s
+
+
+def wrap(a):
+    w = np.mod(a, 2 * np.pi)
+    return np.where(w > np.pi, w - 2 * np.pi, w)
+
+
+def weights(F, x, rule):
+    """Cumulative weights of the rule: chord length, or the turning of the tangent."""
+    if rule == "arc_length":
+        h = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    else:
+        t = F[:, :, 2]
+        h = np.arctan2(np.linalg.norm(np.cross(t[:-1], t[1:]), axis=1),
+                       np.einsum("ij,ij->i", t[:-1], t[1:]))
+    return np.r_[0.0, np.cumsum(h)]
+
+
+@pytest.mark.parametrize("rule", ["arc_length", "min_angular_speed"])
+@pytest.mark.parametrize("rows,betas,turns", [
+    ((20, 85), (0.4, -2.0), 0),
+    ((10, 50, 100), (1.0, -2.5, 2.9), 0),
+    ((10, 50, 100), (1.0, -2.5, 2.9), 1),
+    ((10, 50, 100), (1.0, -2.5, 2.9), [2, -1]),
+])
+def test_interior_constraints_on_a_helix_twist_per_interval_by_the_rule(rule, rows, betas, turns):
+    x = helix()
+    F0 = spinal.frames(x)
+    cons = {k: turned(F0, k, b) for k, b in zip(rows, betas)}
+    F = spinal.frames(x, constraints=cons, twist_rule=rule, turns=turns)
+    for k, g in cons.items():
+        assert np.abs(F[k, :, 0] - g).max() < 1e-12
+    assert np.allclose(F[:, :, 2], F0[:, :, 2], atol=0, rtol=0) or \
+        np.abs(F[:, :, 2] - F0[:, :, 2]).max() < 1e-15
+    # the twist, exactly as the rule says
+    alpha = signed(F0[:, :, 0], F[:, :, 0], F0[:, :, 2])
+    w = weights(F0, x, rule)
+    want = np.empty(len(x))
+    ks = list(rows)
+    tl = [turns] * (len(ks) - 1) if np.isscalar(turns) else list(turns)
+    want[: ks[0] + 1] = betas[0]
+    acc = betas[0]
+    for j in range(len(ks) - 1):
+        a, b = ks[j], ks[j + 1]
+        total = wrap(betas[j + 1] - betas[j]) + 2 * np.pi * tl[j]
+        want[a : b + 1] = acc + total * (w[a : b + 1] - w[a]) / (w[b] - w[a])
+        acc += total
+    want[ks[-1]:] = want[ks[-1]]
+    assert np.abs(wrap(alpha - want)).max() < 1e-12
+    assert np.abs(np.einsum("nij,nik->njk", F, F) - np.eye(3)).max() < 1e-12
+
+
+def test_the_two_rules_differ_where_the_curvature_varies():
+    x = wiggle()
+    F0 = spinal.frames(x)
+    cons = {5: turned(F0, 5, 0.0), 150: turned(F0, 150, 2.5)}
+    a = twist_of(spinal.frames(x, constraints=cons), F0)
+    b = twist_of(spinal.frames(x, constraints=cons, twist_rule="min_angular_speed"), F0)
+    assert np.abs(a - b).max() > 0.05
+
+
+def discrete_speed(dalpha, theta, h, squared):
+    """The discrete total (squared) angular speed of twist increments over one interval."""
+    if squared:
+        return np.sum((theta**2 + dalpha**2) / h)
+    return np.sum(np.sqrt(theta**2 + dalpha**2))
+
+
+@pytest.mark.parametrize("rule,squared", [("min_angular_speed", False), ("arc_length", True)])
+def test_each_rule_minimises_its_discrete_angular_speed(rule, squared):
+    """scipy minimises the discrete ∫|ω| ds (min_angular_speed, Zheng eq. 7.5) or ∫|ω|² ds
+    (arc_length, eq. 7.8) over the twist increments of each interval, the interval's total
+    twist fixed; the library's increments agree to 1e-8."""
+    x = wiggle()
+    F0 = spinal.frames(x)
+    ks = [5, 60, 150]
+    cons = {k: turned(F0, k, b) for k, b in zip(ks, (0.3, 2.9, -1.2))}
+    F = spinal.frames(x, constraints=cons, twist_rule=rule)
+    alpha = twist_of(F, F0)
+    t = F0[:, :, 2]
+    theta = np.arctan2(np.linalg.norm(np.cross(t[:-1], t[1:]), axis=1),
+                       np.einsum("ij,ij->i", t[:-1], t[1:]))
+    h = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    for a, b in itertools.pairwise(ks):
+        got = np.diff(alpha[a : b + 1])
+        total = got.sum()
+        th, hh = theta[a:b], h[a:b]
+
+        def f(y, th=th, hh=hh, total=total):
+            d = np.r_[y, total - y.sum()]
+            return discrete_speed(d, th, hh, squared)
+
+        def grad(y, th=th, hh=hh, total=total):
+            d = np.r_[y, total - y.sum()]
+            g = 2 * d / hh if squared else d / np.sqrt(th**2 + d**2)
+            return g[:-1] - g[-1]
+
+        y0 = np.full(b - a - 1, total / (b - a))
+        res = minimize(f, y0, jac=grad, method="BFGS", options={"gtol": 1e-14, "maxiter": 10000})
+        best = np.r_[res.x, total - res.x.sum()]
+        assert np.abs(best - got).max() < 1e-8, (rule, np.abs(best - got).max())
+        assert f(got[:-1]) <= res.fun + 1e-12
+
+
+def test_end_and_closed_are_special_cases():
+    x = helix(uneven=True)
+    F0 = spinal.frames(x)
+    v = np.array([0.3, -1.0, 0.5])
+    for turns in (0, 2):
+        want = spinal.frames(x, end=v, turns=turns)
+        got = spinal.frames(x, constraints={0: F0[0, :, 0], -1: v}, turns=turns)
+        assert np.abs(got - want).max() < 1e-12
+        got = spinal.frames(x, end=v, turns=turns, constraints={})
+        assert np.abs(got - want).max() < 1e-12
+    u = np.linspace(0, 2 * np.pi, 150, endpoint=False)
+    loop = np.c_[(2 + np.cos(3 * u)) * np.cos(2 * u), (2 + np.cos(3 * u)) * np.sin(2 * u),
+                 np.sin(3 * u)]
+    for turns in (0, -1):
+        want = spinal.frames(loop, closed=True, turns=turns)
+        got = spinal.frames(loop, closed=True, turns=turns, constraints={})
+        assert np.abs(got - want).max() < 1e-12
+        got = spinal.frames(loop, closed=True, turns=turns, constraints={0: want[0]})
+        assert np.abs(got - want).max() < 1e-12
+
+
+@pytest.mark.parametrize("rule", ["arc_length", "min_angular_speed"])
+def test_closed_curve_constraints_run_round_the_seam(rule):
+    u = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    loop = np.c_[(2 + np.cos(3 * u)) * np.cos(2 * u), (2 + np.cos(3 * u)) * np.sin(2 * u),
+                 np.sin(3 * u)]
+    F0 = spinal.frames(loop, closed=True)
+    ks = [30, 90, 170]
+    cons = {k: turned(F0, k, b) for k, b in zip(ks, (0.5, -1.0, 2.0))}
+    F = spinal.frames(loop, closed=True, constraints=cons, twist_rule=rule)
+    for k, g in cons.items():
+        assert np.abs(F[k, :, 0] - g).max() < 1e-12
+    # smooth across the seam: the frame turns little from row 199 to row 0
+    step = np.einsum("ij,ij->", F[-1], F[0])  # trace of F_{n-1}^T F_0
+    assert np.arccos(np.clip((step - 1) / 2, -1, 1)) < 0.2
+    with_repeat = spinal.frames(np.r_[loop, loop[:1]], closed=True, constraints=cons,
+                                twist_rule=rule)
+    assert np.abs(with_repeat[:-1] - F).max() < 1e-12 and np.array_equal(with_repeat[-1], F[0])
+
+
+def test_frame_constraints_and_bundles():
+    x = helix()
+    F0 = spinal.frames(x)
+    frame = F0[40].copy()
+    frame[:, :2] = frame[:, :2] @ np.array([[0.0, -1.0], [1.0, 0.0]])  # turned by 90°
+    F = spinal.frames(x, constraints=(np.array([40, 100]), np.stack([frame, F0[100]])))
+    assert np.abs(F[40] - frame).max() < 1e-12 and np.abs(F[100] - F0[100]).max() < 1e-12
+    y = wiggle()
+    both = np.r_[x, y]
+    spec = [{10: F0[10, :, 1], -5: F0[-5, :, 0]}, None]
+    got = spinal.frames(both, lengths=[len(x), len(y)], constraints=spec)
+    assert np.abs(got[: len(x)] - spinal.frames(x, constraints=spec[0])).max() < 1e-14
+    assert np.abs(got[len(x) :] - spinal.frames(y)).max() < 1e-14
+
+
+def test_analytic_curves_take_constraints():
+    c = spinal.curves.Helix()
+    F0 = spinal.frames(c, u=100)
+    F = spinal.frames(c, u=100, constraints={50: F0[50, :, 1]}, twist_rule="min_angular_speed")
+    assert np.abs(F[50, :, 0] - F0[50, :, 1]).max() < 1e-12
+
+
+# ---- guide ------------------------------------------------------------------------------
+
+
+def test_the_guide_of_an_exact_turned_rmf_is_recovered_to_a_bias_that_shrinks():
+    x = wiggle(400)
+    F0 = spinal.frames(x)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))]
+    s /= s[-1]
+    phi = 1.3 * np.sin(2 * np.pi * s) + 4 * np.pi * s  # two whole turns: needs unwrapping
+    g = np.cos(phi)[:, None] * F0[:, :, 0] + np.sin(phi)[:, None] * F0[:, :, 1]
+    g = 2.0 * g + 0.7 * F0[:, :, 2]  # a length and a tangential part: only the direction counts
+    d2 = np.abs(np.diff(phi, 2)).max()  # φ″ per sample², for the predicted interior bias
+    inner, whole = [], []
+    weights_ = (1.0, 10.0, 100.0, 1000.0)
+    for w in weights_:
+        F = spinal.frames(x, guide=g, guide_weight=w)
+        alpha = twist_of(F, F0)
+        alpha += 2 * np.pi * np.round((phi[0] - alpha[0]) / (2 * np.pi))
+        err = np.abs(alpha - phi)
+        # away from the ends the bias is about φ″/W; at a free end a boundary layer of about
+        # 1/√W samples, where the twist rate relaxes to the RMF's, has a bias ∝ φ′/√W
+        cut = 20
+        inner.append(err[cut:-cut].max())
+        whole.append(err.max())
+        assert inner[-1] < 2 * d2 / w, (w, inner[-1], d2)
+        assert np.abs(np.einsum("nij,nik->njk", F, F) - np.eye(3)).max() < 1e-12
+    inner, whole = np.array(inner), np.array(whole)
+    assert np.all(inner[1:] < inner[:-1] / 5), inner
+    assert np.all(whole[1:] < whole[:-1] / 2.5), whole
+    assert whole[0] < 0.1 and whole[-1] < 1e-3, whole
+
+
+def test_a_guide_along_the_tangent_falls_back_to_the_rmf():
+    x = wiggle()
+    F0 = spinal.frames(x)
+    assert np.abs(spinal.frames(x, guide=F0[:, :, 2]) - F0).max() < 1e-12
+    # a stretch where the guide is the tangent: the twist keeps its rate there (linear)
+    phi = np.full(len(x), 1.0)
+    phi[100:] = 2.0
+    g = np.cos(phi)[:, None] * F0[:, :, 0] + np.sin(phi)[:, None] * F0[:, :, 1]
+    g[60:100] = F0[60:100, :, 2]
+    alpha = twist_of(spinal.frames(x, guide=g, guide_weight=1e6), F0)
+    assert np.abs(alpha[:55] - 1.0).max() < 1e-4 and np.abs(alpha[105:] - 2.0).max() < 1e-4
+    sl = alpha[60:100]
+    h = np.linalg.norm(np.diff(x[59:101], axis=0), axis=1)
+    rate = np.diff(alpha[59:101]) / h
+    assert np.all(np.diff(sl) > 0) and rate.std() < 1e-3 * rate.mean()
+
+
+def test_one_up_vector_levels_the_frames_and_constraints_win():
+    u = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    track = np.c_[3 * np.cos(u), 2 * np.sin(u), 0.3 * np.sin(3 * u)]
+    F = spinal.frames(track, closed=True, guide=[0, 0, 1], guide_weight=100.0)
+    t = F[:, :, 2]
+    level = np.array([0, 0, 1.0]) - t[:, 2:] * t  # "up" in the normal plane
+    level /= np.linalg.norm(level, axis=1)[:, None]
+    assert np.abs(F[:, :, 0] - level).max() < 0.01
+    F0 = spinal.frames(track, closed=True)
+    v = turned(F0, 30, 0.7)
+    F = spinal.frames(track, closed=True, guide=[0, 0, 1], constraints={30: v})
+    assert np.abs(F[30, :, 0] - v).max() < 1e-12
+
+
+# ---- time ---------------------------------------------------------------------------------
+
+
+def moving_helix(steps=100, n=200):
+    u = np.linspace(0, 6 * np.pi, n)
+    b = 0.15 + 0.6 * np.arange(steps) / (steps - 1)
+    return np.stack([np.c_[np.cos(u), np.sin(u), bb * u] for bb in b])
+
+
+def rotation_angle(A, B):
+    """Angle of the rotation between frames A[i] and B[i]."""
+    tr = np.einsum("nij,nij->n", A, B)
+    return np.arccos(np.clip((tr - 1) / 2, -1, 1))
+
+
+def test_frames_in_time_change_no_more_than_the_curve():
+    """A helix of three turns whose pitch b grows over 100 steps. Between steps a frame can
+    change by the turn of its tangent plus the change of the RMF's own twist: the RMF turns
+    against the Frenet frame by ∫τ ds = 6π b/√(1 + b²) over the helix, and the best single
+    turn leaves at most half the change of that total at either end. The frames change by no
+    more than that (about 1.1 times it, from the discrete RMF), so nothing jumps, and they
+    change about 9x less than frames started afresh from a turned start."""
+    P = moving_helix()
+    b = 0.15 + 0.6 * np.arange(len(P)) / (len(P) - 1)
+    holonomy = 6 * np.pi * b / np.sqrt(1 + b**2)
+    F = spinal.frames_in_time(P)
+    assert F.shape == (100, 200, 3, 3)
+    ratios = []
+    for k in range(1, len(P)):
+        dframe = rotation_angle(F[k], F[k - 1]).max()
+        t0, t1 = F[k - 1, :, :, 2], F[k, :, :, 2]
+        dtan = np.arccos(np.clip(np.einsum("ij,ij->i", t0, t1), -1, 1)).max()
+        bound = dtan + 0.5 * abs(holonomy[k] - holonomy[k - 1])
+        ratios.append(dframe / bound)
+        # every step is an RMF of its curve
+        assert np.abs(F[k, :, :, 2] - spinal.frames(P[k])[:, :, 2]).max() < 1e-15
+        assert np.abs(twist_of(F[k], spinal.frames(P[k])).std()) < 1e-12
+    assert max(ratios) < 1.1, max(ratios)
+    # the same as previous= step by step
+    G = [spinal.frames(P[0])]
+    for k in range(1, 5):
+        G.append(spinal.frames(P[k], previous=G[-1]))
+    assert np.abs(np.array(G) - F[:5]).max() < 1e-12
+    # continuing a sequence
+    again = spinal.frames_in_time(P[50:], previous=F[49])
+    assert np.abs(again - F[50:]).max() < 1e-12
+
+
+def test_previous_removes_a_jump_of_the_start():
+    P = moving_helix()[:2]
+    F0 = spinal.frames(P[0])
+    jumped = spinal.frames(P[1], initial=-F0[0, :, 0])  # a start turned by π
+    F1 = spinal.frames(P[1], previous=F0)
+    assert rotation_angle(jumped, F0).max() > 3.0
+    assert rotation_angle(F1, F0).max() < 0.3
+    u = np.linspace(0, 2 * np.pi, 100, endpoint=False)
+    loop = np.c_[np.cos(u), np.sin(u), 0.3 * np.sin(2 * u)]
+    C0 = spinal.frames(loop, closed=True)
+    turned_c = C0.copy()
+    turned_c[:, :, :2] = -turned_c[:, :, :2]
+    assert np.abs(spinal.frames(loop, closed=True, previous=turned_c) - turned_c).max() < 1e-12
+
+
+# ---- bad input ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    ({"constraints": {130: [1, 0, 0]}}, "constraints: row 130 is out of range"),
+    ({"constraints": {-121: [1, 0, 0]}}, "constraints: row -121 is out of range"),
+    ({"constraints": (np.array([3, 400]), np.eye(3)[:2])}, "constraints: row 400 is out of range"),
+    ({"constraints": {3: [1, 2]}}, "constraints: row 3: expected a vector (3,)"),
+    ({"constraints": [1, 2]}, "constraints: expected a mapping"),
+    ({"constraints": {1.5: [1, 0, 0]}}, "constraints: keys must be integer rows"),
+    ({"twist_rule": "curvature"}, "twist_rule: unknown value"),
+    ({"guide": np.ones((7, 3))}, "guide: expected shape (3,) or (120, 3)"),
+    ({"guide": [1, 0]}, "guide: expected shape (3,) or (120, 3)"),
+    ({"guide": [0, 0, 1], "guide_weight": 0.0}, "guide_weight: must be a positive"),
+    ({"guide": [0, 0, 1], "guide_tolerance": 2.0}, "guide_tolerance: must be an angle"),
+    ({"previous": np.ones((5, 3, 3))}, "previous: expected shape (120, 3, 3)"),
+    ({"previous": np.ones((120, 3, 3))}, "previous: row 0 is not a rotation matrix"),
+    ({"previous": np.tile(np.eye(3), (120, 1, 1)), "initial": [1, 0, 0]},
+     "previous: cannot be combined with initial"),
+    ({"constraints": {0: [1, 0, 0]}, "initial": [0, 1, 0]}, "initial: row 0 is also given"),
+    ({"constraints": {3: [0, 0, 1], 9: [0, 1, 0]}, "turns": [1, 2]}, "turns: expected one count"),
+    ({"constraints": {3: [0, 0, 1]}, "method": "frenet"}, "constraints: is not used by method"),
+])
+def test_bad_input_is_named(kwargs, message):
+    x = helix()
+    with pytest.raises((ValueError, TypeError)) as e:
+        spinal.frames(x, **kwargs)
+    assert message in str(e.value)
+
+
+def test_a_constraint_parallel_to_the_tangent_is_named():
+    x = helix()
+    t = spinal.frames(x)[17, :, 2]
+    with pytest.raises(ValueError, match="constraints: the vector is zero or parallel to the "
+                                         "tangent at row 17"):
+        spinal.frames(x, constraints={17: 3 * t})
+    y = wiggle()
+    with pytest.raises(ValueError, match=r"constraints: row 200 is out of range .* \(curve 1\)"):
+        spinal.frames(np.r_[x, y], lengths=[len(x), len(y)], constraints=[None, {200: [1, 0, 0]}])
+
+
+def test_frames_in_time_bad_input_is_named():
+    P = moving_helix(steps=3, n=50)
+    with pytest.raises(ValueError, match=r"points_t: expected shape \(T, n, 3\)"):
+        spinal.frames_in_time(P[0])
+    with pytest.raises(ValueError, match=r"previous: expected shape \(50, 3, 3\)"):
+        spinal.frames_in_time(P, previous=np.ones((3, 3, 3)))
+    bad = P.copy()
+    bad[1, 10] = bad[1, 9]
+    with pytest.raises(ValueError, match="time step 1"):
+        spinal.frames_in_time(bad)
