@@ -583,6 +583,127 @@ BOOKS = {"01_frames": frames, "02_tubes": tubes, "03_knot_tube": knot,
          "04_deformation": deform, "05_fleshing": flesh, "06_quaternion_frames": quat}
 
 
+
+def steering_frames():
+    """Notebook 08: frames steered by a guide (a protein-like ribbon) and frames coherent in
+    time (an animated tube that does not flicker)."""
+    return nb([
+        """md:# Steering frames: guides, constraints and time
+
+The rotation-minimising frame (RMF) fixes the roll of a frame up to one constant turn. `spinal.frames` can
+steer that roll: `constraints=` pins the frame at any rows (the twist in between spread by `twist_rule`),
+`guide=` lets `r` follow a direction field (a chemical bond, "up"), smoothed by `guide_weight`, and
+`previous=` / `spinal.frames_in_time` keep the frames of a moving curve from jumping between time steps.""",
+        SETUP + """
+import matplotlib.pyplot as plt
+from scipy.interpolate import CubicSpline""",
+        """md:## A ribbon that follows the C=O direction
+
+A protein-like Cα trace: a helix of 14 residues, then a pleated strand. Each residue has a "carbonyl"
+direction (outward on the helix, alternating across the strand, with noise). As ribbon programs do,
+alternate guides are flipped so that consecutive ones agree. The ribbon's `r` follows the guide on a
+smooth spline through the trace; the plain RMF does not. `guide_weight` sets the balance: the frame
+follows the guide on features longer than about `1/√guide_weight` samples (here 8 samples per residue).""",
+        """k = np.arange(14)
+helix = np.c_[2.3 * np.cos(np.radians(100) * k), 2.3 * np.sin(np.radians(100) * k), 1.5 * k]
+outward = np.c_[np.cos(np.radians(100) * k), np.sin(np.radians(100) * k), 0 * k]
+j = np.arange(1, 13)
+strand = helix[-1] + np.c_[3.3 * j, 0.9 * (-1.0) ** j, 0.4 * j]
+ca = np.r_[helix, strand]
+rng = np.random.default_rng(1)
+carbonyl = np.r_[outward, np.c_[0 * j, (-1.0) ** j, 0.3 + 0 * j]]
+carbonyl = carbonyl + 0.15 * rng.standard_normal(carbonyl.shape)
+for i in range(1, len(carbonyl)):  # flip alternate guides
+    if carbonyl[i] @ carbonyl[i - 1] < 0:
+        carbonyl[i] = -carbonyl[i]
+
+res = np.arange(len(ca))
+fine = np.linspace(0, len(ca) - 1, 8 * (len(ca) - 1) + 1)
+x = CubicSpline(res, ca)(fine)
+guide = np.stack([np.interp(fine, res, carbonyl[:, d]) for d in range(3)], axis=1)
+F_guide = spinal.frames(x, guide=guide, guide_weight=2.0)
+F_rmf = spinal.frames(x)
+
+def off_guide(F, g):  # angle (degrees) between r and the guide's normal-plane part
+    t = F[:, :, 2]
+    p = g - np.einsum("ij,ij->i", g, t)[:, None] * t
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    return np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", F[:, :, 0], p), -1, 1)))
+
+print("r off the guide: median %.2f°, max %.1f° (RMF: median %.0f°)" % (
+    np.median(off_guide(F_guide, guide)), off_guide(F_guide, guide).max(),
+    np.median(off_guide(F_rmf, guide))))
+assert np.median(off_guide(F_guide, guide)) < 3 and off_guide(F_guide, guide).max() < 20""",
+        """ribbon = np.array([[0.0, -0.9], [0.0, 0.9]])  # across s: the ribbon's face is normal to r
+pl = pv.Plotter(shape=(1, 2), window_size=(900, 380))
+for col, (F, title) in enumerate([(F_rmf, "RMF"), (F_guide, "guide = C=O")]):
+    pl.subplot(0, col)
+    mesh = spinal.sweep(x, ribbon, frames=F, profile_closed=False).to_pyvista()
+    pl.add_mesh(mesh, color="#d08c60" if col else "#8aa0b8", smooth_shading=True)
+    pl.add_arrows(ca, carbonyl / np.linalg.norm(carbonyl, axis=1)[:, None], mag=1.2,
+                  color="#444444")
+    pl.add_text(title, font_size=10)
+    pl.view_vector((1.0, -1.0, 0.6))
+    pl.camera.zoom(1.3)
+pl.show()""",
+        """md:## Interior constraints and the two twist rules
+
+Pin the frame at three rows; between them the extra twist is spread linearly in arc length (least
+∫|ω|² ds, the default) or in proportion to the curvature (least ∫|ω| ds, Zheng eq. 7.5–7.7), which puts
+the twist where the curve bends.""",
+        """pins = {0: F_rmf[0, :, 0], 60: F_rmf[60, :, 1], len(x) - 1: -F_rmf[-1, :, 0]}
+fig, ax = plt.subplots(figsize=(6, 3))
+for rule in ("arc_length", "min_angular_speed"):
+    F = spinal.frames(x, constraints=pins, twist_rule=rule)
+    twist = np.unwrap(np.arctan2(np.einsum("ij,ij->i", F[:, :, 0], F_rmf[:, :, 1]),
+                                 np.einsum("ij,ij->i", F[:, :, 0], F_rmf[:, :, 0])))
+    ax.plot(fine, twist, label=rule)
+    for row, v in pins.items():
+        assert np.abs(F[row, :, 0] - v).max() < 1e-12
+ax.set_xlabel("residue"); ax.set_ylabel("twist from the RMF (rad)"); ax.legend()""",
+        """md:## A tube that does not flicker
+
+A curve waves through a straight position. Started afresh at every time step, its frames depend on the
+principal normal near the start, which turns over when the curve straightens: the tube's stripes jump by
+half a turn. `spinal.frames_in_time` turns each step's RMF by the one angle closest to the step before.""",
+        """T = 8
+xs = np.linspace(0, 6, 120)
+P = np.array([np.c_[xs, a * np.sin(xs), 0.5 * a * np.cos(1.3 * xs) + 0.1 * xs]
+              for a in np.linspace(0.8, -0.8, T)])
+afresh = np.array([spinal.frames(p) for p in P])
+coherent = spinal.frames_in_time(P)
+
+def largest_change(F):  # degrees, per time step, over the samples
+    tr = np.einsum("knij,knij->kn", F[1:], F[:-1])
+    return np.degrees(np.arccos(np.clip((tr - 1) / 2, -1, 1))).max(axis=1)
+
+tangent = np.degrees(np.arccos(np.clip(
+    np.einsum("kni,kni->kn", coherent[1:, :, :, 2], coherent[:-1, :, :, 2]), -1, 1))).max(axis=1)
+print("largest frame change per step, afresh:    ", largest_change(afresh).round(1))
+print("largest frame change per step, coherent:  ", largest_change(coherent).round(1))
+print("largest tangent change per step:          ", tangent.round(1))
+assert largest_change(afresh).max() > 90 and largest_change(coherent).max() < 20""",
+        """stripes = np.array([[np.cos(a), np.sin(a)] for a in np.linspace(0, 2 * np.pi, 12,
+                                                                         endpoint=False)]) * 0.35
+pl = pv.Plotter(shape=(1, 2), window_size=(900, 420))
+for row, (F, title) in enumerate([(afresh, "started afresh"), (coherent, "frames_in_time")]):
+    pl.subplot(0, row)
+    for k in (2, 3, 4, 5):
+        mesh = spinal.sweep(P[k] + [0, 0, 2.0 * k], stripes, frames=F[k], caps=False)
+        mesh = mesh.to_pyvista()  # ring i holds vertices 12 i … 12 i + 11
+        mesh["side"] = np.tile(np.arange(12) < 4, len(xs)).astype(float)
+        pl.add_mesh(mesh, scalars="side", cmap=["#e8e0d0", "#b04a3a"], show_scalar_bar=False,
+                    smooth_shading=True)
+    pl.add_text(title, font_size=10)
+    pl.view_vector((0.35, -1.0, 0.45))
+    pl.camera.zoom(1.3)
+pl.show()""",
+    ])
+
+
+BOOKS["08_steering_frames"] = steering_frames()
+
+
 def write(name: str, book, folder: str = "notebooks") -> str:
     """Write one notebook with stable cell ids (``<topic>-<index>``), so that regenerating
     an unchanged notebook gives an unchanged file."""
