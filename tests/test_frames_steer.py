@@ -384,3 +384,19 @@ def test_frames_in_time_bad_input_is_named():
     bad[1, 10] = bad[1, 9]
     with pytest.raises(ValueError, match="time step 1"):
         spinal.frames_in_time(bad)
+
+
+def test_bundles_take_guides_and_previous_per_curve():
+    x, y = helix(), wiggle()
+    both, lengths = np.r_[x, y], [len(x), len(y)]
+    gx = np.tile([0.0, 0.0, 1.0], (len(x), 1)) + 0.3 * spinal.frames(x)[:, :, 1]
+    gy = np.tile([1.0, 0.0, 0.0], (len(y), 1))
+    got = spinal.frames(both, lengths=lengths, guide=np.r_[gx, gy], guide_weight=5.0)
+    assert np.abs(got[: len(x)] - spinal.frames(x, guide=gx, guide_weight=5.0)).max() < 1e-14
+    assert np.abs(got[len(x) :] - spinal.frames(y, guide=gy, guide_weight=5.0)).max() < 1e-14
+    up = spinal.frames(both, lengths=lengths, guide=[0, 0, 1])
+    assert np.abs(up[len(x) :] - spinal.frames(y, guide=[0, 0, 1])).max() < 1e-14
+    prev = np.r_[spinal.frames(x, initial=[1, 0, 0]), spinal.frames(y, initial=[0, 0, 1])]
+    got = spinal.frames(both, lengths=lengths, previous=prev)
+    assert np.abs(got[: len(x)] - prev[: len(x)]).max() < 1e-12
+    assert np.abs(got[len(x) :] - prev[len(x) :]).max() < 1e-12

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._steer import frames_in_time, steered
+from ._steer import previous_frames, steering
 from ._validate import as_bool, as_choice, as_float_array, as_int, as_offsets, as_points
 from .curves import Curve
 
@@ -215,9 +215,9 @@ def frames(
     twist_rule : {"arc_length", "min_angular_speed"}
         How the twist between constraints (and of ``end``/``closed``) is spread.
         ``"arc_length"`` (default): linear in arc length, the least total squared angular
-        speed ``∫|ω|² ds = ∫(κ² + α′²) ds`` (Zheng eq. 7.8; Wang et al. §6.3).
+        speed ``∫|ω|² ds = ∫(κ² + α′²) ds`` (Zheng eq. 7.8; Wang et al. §6.3 eq. 24).
         ``"min_angular_speed"``: the least total angular speed ``∫|ω| ds = ∫√(κ² + α′²) ds``
-        (Zheng eq. 7.5–7.7, Wang et al. §7): ``α′ = Cκ``, the twist follows the curvature;
+        (Zheng eq. 7.5–7.7; Wang et al. §6.3 eq. 21–23): ``α′ = Cκ``, the twist follows the curvature;
         discretely each segment takes the share ``θ_i / Σθ`` of its interval's twist,
         ``θ_i`` the angle between consecutive tangents (the exact minimiser of
         ``Σ √(θ_i² + Δα_i²)``); on an interval that does not turn it falls back to arc length.
@@ -270,9 +270,9 @@ def frames(
     """
     if (constraints is not None or guide is not None or previous is not None
             or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
-        return steered(points, tangents, method, initial, closed, end, turns, reflection, u,
-                       lengths, offsets, constraints, twist_rule, guide, guide_weight,
-                       guide_tolerance, previous)
+        return _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
+                        lengths, offsets, constraints, twist_rule, guide, guide_weight,
+                        guide_tolerance, previous)
     out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
                          lengths, offsets)
     return out
@@ -336,3 +336,115 @@ def estimate_tangents(points, *, closed: bool = False, method: str = "five_point
     method = as_choice(method, "method", TANGENT_RULES)
     pts = as_points(points, "points")
     return _core.estimate_tangents(pts, as_bool(closed, "closed"), method)
+
+
+def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
+             offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous):
+    """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
+    ``guide``, ``previous`` or per-interval ``turns``)."""
+    method = as_choice(method, "method", METHODS)
+    reflection = as_choice(reflection, "reflection", REFLECTIONS)
+    closed = as_bool(closed, "closed")
+    d1 = d2 = uu = tgs = None
+    if isinstance(points, Curve):
+        if tangents is not None:
+            raise TypeError("tangents: not accepted with an analytic curve (its exact tangents "
+                            "are used)")
+        if lengths is not None or offsets is not None:
+            raise TypeError("lengths, offsets: not accepted with an analytic curve")
+        if reflection != "chord":
+            raise ValueError("reflection: 'tangents' applies to sampled curves only")
+        pts, uu, d1, d2 = _analytic(points, u)
+    else:
+        if u is not None:
+            raise TypeError("u: only used with an analytic curve from spinal.curves")
+        pts = None if points is None else as_points(points, "points")
+        tgs = None if tangents is None else as_points(tangents, "tangents")
+        if pts is None and (tgs is None or reflection != "tangents"):
+            raise TypeError("points: required (only reflection='tangents' works from tangents "
+                            "alone)")
+    rows = (pts if pts is not None else tgs).shape[0]
+    if uu is None:
+        offs, bundle = as_offsets(rows, lengths, offsets)
+    else:
+        offs, bundle = np.array([0, rows], dtype=np.int64), False
+    curves = offs.size - 1
+    iv, if_ = _orientation(initial, "initial", curves, bundle)
+    ev, ef = _orientation(end, "end", curves, bundle)
+    if bundle and (offs[0] != 0 or offs[-1] != rows or np.any(np.diff(offs) < 0)):
+        # the core names the rule that the lengths/offsets break
+        _core.frames_sampled(pts, tgs, offs, method, "five_point", False, closed, None, None,
+                             None, None, 0)
+    steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
+                     previous, offs, bundle, rows)
+    return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, reflection == "tangents",
+                                closed, iv, if_, ev, ef, *steer)
+
+
+def frames_in_time(
+    points_t,
+    tangents_t=None,
+    *,
+    method: str = "double_reflection",
+    initial=None,
+    closed: bool = False,
+    turns: int = 0,
+    reflection: str = "chord",
+    previous=None,
+) -> np.ndarray:
+    r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
+
+    ``points_t`` holds ``T`` time steps of the same curve, ``(T, n, 3)`` (same sample count
+    at every step). Every step gets its rotation-minimising frame (computed in parallel over
+    ``T``), turned about the tangents by the one angle ``c`` that brings it closest to the
+    frames of the step before: ``c`` minimises ``Σ_i ‖R_t(c) U_i − P_i‖²`` (Frobenius; every
+    sample counts the same), in closed form ``c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)``.
+    All RMFs of a curve differ only by such a constant turn (Zheng 2008, Cor. 4.1.3), so the
+    frames stay rotation minimising along the curve and change in time only as much as the
+    curve makes them (Ma 1996, §3.5.3, aligns the frames of similar curves by one rotation).
+    Equivalent to calling :func:`frames` with ``previous=`` step by step.
+
+    Parameters
+    ----------
+    points_t : array_like (T, n, 3)
+        The curve at ``T`` time steps.
+    tangents_t : array_like (T, n, 3), optional
+        Tangents at every step (else estimated as in :func:`frames`).
+    method, closed, turns, reflection
+        As in :func:`frames` (a closed curve keeps its closing twist at every step).
+    initial : array_like (3,) or (3, 3), optional
+        The start of the first step (as in :func:`frames`); not with ``previous``.
+    previous : array_like (n, 3, 3), optional
+        Frames of the step before the first one (to continue a sequence).
+
+    Returns
+    -------
+    ndarray (T, n, 3, 3) float64
+
+    Raises
+    ------
+    ValueError
+        As :func:`frames` (the message names the time step), a ``previous`` of another shape
+        than ``(n, 3, 3)`` or not made of rotations.
+    """
+    method = as_choice(method, "method", METHODS)
+    reflection = as_choice(reflection, "reflection", REFLECTIONS)
+    closed = as_bool(closed, "closed")
+    turns = as_int(turns, "turns")
+    p = None if points_t is None else as_float_array(points_t, "points_t")
+    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
+    ref = p if p is not None else tg
+    if ref is None:
+        raise TypeError("points_t: required")
+    for a, name in ((p, "points_t"), (tg, "tangents_t")):
+        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
+            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
+    if p is not None and tg is not None and p.shape != tg.shape:
+        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
+    steps, n = ref.shape[0], ref.shape[1]
+    iv, if_ = _orientation(initial, "initial", 1, False)
+    prev = previous_frames(previous, n, "the frames of the step before")
+    flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
+    out = _core.frames_in_time(flat(p), flat(tg), steps, method, reflection == "tangents",
+                               closed, iv, if_, turns, prev)
+    return out.reshape(steps, n, 3, 3)

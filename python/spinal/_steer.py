@@ -1,6 +1,6 @@
-"""Steered frames: ``spinal.frames`` with ``constraints=``, ``twist_rule=``, ``guide=`` or
-``previous=``, and :func:`frames_in_time`. The maths is in the Rust core
-(``src/frames/constraints.rs``, ``guide.rs``, ``time.rs``)."""
+"""Argument conversion for steered frames: ``spinal.frames`` with ``constraints=``,
+``twist_rule=``, ``guide=`` or ``previous=``, and ``spinal.frames_in_time``. The maths is in
+the Rust core (``src/frames/constraints.rs``, ``guide.rs``, ``time.rs``)."""
 
 from __future__ import annotations
 
@@ -10,17 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
-from ._validate import (
-    as_bool,
-    as_choice,
-    as_float_array,
-    as_int,
-    as_offsets,
-    as_points,
-    as_real,
-)
-from .curves import Curve
+from ._validate import as_choice, as_float_array, as_int, as_real
 
 TWIST_RULES = ("arc_length", "min_angular_speed")
 
@@ -121,148 +111,35 @@ def _turns(turns: Any) -> np.ndarray:
     return np.array([as_int(turns, "turns")], dtype=np.int64)
 
 
-def _orientation(x: Any, name: str, curves: int, bundle: bool):
-    from ._frames import _orientation as orient
-    return orient(x, name, curves, bundle)
+def guide_rows(guide: Any, rows: int):
+    """``guide`` as a C-contiguous (1, 3) or (rows, 3) array, or None."""
+    if guide is None:
+        return None
+    g = as_float_array(guide, "guide")
+    if g.shape == (3,):
+        g = g[None, :]
+    elif g.shape != (rows, 3):
+        raise ValueError(f"guide: expected shape (3,) or ({rows}, 3) (one vector per "
+                         f"sample), got {g.shape}")
+    return np.ascontiguousarray(g)
 
 
-def steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
-            offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous,
-            points_arg="points"):
-    """The frames of :func:`spinal.frames` with its steering arguments."""
-    from ._frames import METHODS, REFLECTIONS, _analytic
+def previous_frames(previous: Any, rows: int, what: str = "the frames of the same curve at "
+                    "the previous time step"):
+    """``previous`` as a C-contiguous (rows, 3, 3) array, or None."""
+    if previous is None:
+        return None
+    prev = as_float_array(previous, "previous")
+    if prev.shape != (rows, 3, 3):
+        raise ValueError(f"previous: expected shape ({rows}, 3, 3) ({what}), got {prev.shape}")
+    return np.ascontiguousarray(prev)
 
-    method = as_choice(method, "method", METHODS)
-    reflection = as_choice(reflection, "reflection", REFLECTIONS)
+
+def steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance, previous,
+             offs: np.ndarray, bundle: bool, rows: int):
+    """The steering arguments of :func:`spinal.frames` as the core takes them: the turns,
+    the five constraint arrays, the rule, the guide, its weight and tolerance, previous."""
     twist_rule = as_choice(twist_rule, "twist_rule", TWIST_RULES)
-    closed = as_bool(closed, "closed")
-    turn_counts = _turns(turns)
-    weight = as_real(guide_weight, "guide_weight")
-    tolerance = as_real(guide_tolerance, "guide_tolerance")
-    d1 = d2 = uu = None
-    if isinstance(points, Curve):
-        if tangents is not None:
-            raise TypeError("tangents: not accepted with an analytic curve (its exact tangents "
-                            "are used)")
-        if lengths is not None or offsets is not None:
-            raise TypeError("lengths, offsets: not accepted with an analytic curve")
-        if reflection != "chord":
-            raise ValueError("reflection: 'tangents' applies to sampled curves only")
-        pts, uu, d1, d2 = _analytic(points, u)
-        tgs = None
-    else:
-        if u is not None:
-            raise TypeError("u: only used with an analytic curve from spinal.curves")
-        pts = None if points is None else as_points(points, points_arg)
-        tgs = None if tangents is None else as_points(tangents, "tangents")
-        if pts is None and (tgs is None or reflection != "tangents"):
-            raise TypeError("points: required (only reflection='tangents' works from tangents "
-                            "alone)")
-    rows = (pts if pts is not None else tgs).shape[0]
-    offs, bundle = (as_offsets(rows, lengths, offsets) if uu is None
-                    else (np.array([0, rows], dtype=np.int64), False))
-    curves = offs.size - 1
-    iv, if_ = _orientation(initial, "initial", curves, bundle)
-    ev, ef = _orientation(end, "end", curves, bundle)
-    if bundle and (offs[0] != 0 or offs[-1] != rows or np.any(np.diff(offs) < 0)):
-        # let the core name the rule that is broken
-        _core.frames_sampled(pts, tgs, offs, method, "five_point", False, closed, None, None,
-                             None, None, 0, points_arg)
-    cons = _constraints(constraints, offs, bundle)
-    g = None
-    if guide is not None:
-        g = as_float_array(guide, "guide")
-        if g.shape == (3,):
-            g = g[None, :]
-        elif g.shape != (rows, 3):
-            raise ValueError(f"guide: expected shape (3,) or ({rows}, 3) (one vector per "
-                             f"sample), got {g.shape}")
-        g = np.ascontiguousarray(g)
-    prev = None
-    if previous is not None:
-        prev = as_float_array(previous, "previous")
-        if prev.shape != (rows, 3, 3):
-            raise ValueError(f"previous: expected shape ({rows}, 3, 3) (the frames of the same "
-                             f"curve at the previous time step), got {prev.shape}")
-        prev = np.ascontiguousarray(prev)
-    return _core.frames_steered(
-        pts, tgs, offs, uu, d1, d2, method, reflection == "tangents", closed, iv, if_, ev, ef,
-        turn_counts, *cons, twist_rule, g, weight, tolerance, prev, points_arg,
-    )
-
-
-def frames_in_time(
-    points_t,
-    tangents_t=None,
-    *,
-    method: str = "double_reflection",
-    initial=None,
-    closed: bool = False,
-    turns: int = 0,
-    reflection: str = "chord",
-    previous=None,
-) -> np.ndarray:
-    r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
-
-    ``points_t`` holds ``T`` time steps of the same curve, ``(T, n, 3)`` (same sample count
-    at every step). Every step gets its rotation-minimising frame (computed in parallel over
-    ``T``), turned about the tangents by the one angle ``c`` that brings it closest to the
-    frames of the step before: ``c`` minimises ``Σ_i ‖R_t(c) U_i − P_i‖²`` (Frobenius; every
-    sample counts the same), in closed form ``c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)``.
-    All RMFs of a curve differ only by such a constant turn (Zheng 2008, Cor. 4.1.3), so the
-    frames stay rotation minimising along the curve and change in time only as much as the
-    curve makes them (Ma 1996, §3.5.3, aligns the frames of similar curves by one rotation).
-    Equivalent to calling :func:`frames` with ``previous=`` step by step.
-
-    Parameters
-    ----------
-    points_t : array_like (T, n, 3)
-        The curve at ``T`` time steps.
-    tangents_t : array_like (T, n, 3), optional
-        Tangents at every step (else estimated as in :func:`frames`).
-    method, closed, turns, reflection
-        As in :func:`frames` (a closed curve keeps its closing twist at every step).
-    initial : array_like (3,) or (3, 3), optional
-        The start of the first step (as in :func:`frames`); not with ``previous``.
-    previous : array_like (n, 3, 3), optional
-        Frames of the step before the first one (to continue a sequence).
-
-    Returns
-    -------
-    ndarray (T, n, 3, 3) float64
-
-    Raises
-    ------
-    ValueError
-        As :func:`frames` (the message names the time step), a ``previous`` of another shape
-        than ``(n, 3, 3)`` or not made of rotations.
-    """
-    from ._frames import METHODS, REFLECTIONS
-
-    method = as_choice(method, "method", METHODS)
-    reflection = as_choice(reflection, "reflection", REFLECTIONS)
-    closed = as_bool(closed, "closed")
-    turns = as_int(turns, "turns")
-    p = None if points_t is None else as_float_array(points_t, "points_t")
-    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
-    ref = p if p is not None else tg
-    if ref is None:
-        raise TypeError("points_t: required")
-    for a, name in ((p, "points_t"), (tg, "tangents_t")):
-        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
-            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
-    if p is not None and tg is not None and p.shape != tg.shape:
-        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
-    steps, n = ref.shape[0], ref.shape[1]
-    iv, if_ = _orientation(initial, "initial", 1, False)
-    prev = None
-    if previous is not None:
-        prev = as_float_array(previous, "previous")
-        if prev.shape != (n, 3, 3):
-            raise ValueError(f"previous: expected shape ({n}, 3, 3) (the frames of the step "
-                             f"before), got {prev.shape}")
-        prev = np.ascontiguousarray(prev)
-    flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
-    out = _core.frames_in_time(flat(p), flat(tg), steps, method, reflection == "tangents",
-                               closed, iv, if_, turns, prev)
-    return out.reshape(steps, n, 3, 3)
+    return (_turns(turns), *_constraints(constraints, offs, bundle), twist_rule,
+            guide_rows(guide, rows), as_real(guide_weight, "guide_weight"),
+            as_real(guide_tolerance, "guide_tolerance"), previous_frames(previous, rows))

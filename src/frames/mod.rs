@@ -12,7 +12,9 @@
 //! | Frenet | [`frenet`] | exact where κ ≠ 0 | continuous fill at κ ≈ 0 |
 //!
 //! Boundary conditions (closed curves, a prescribed end vector) add a twist linear in arc
-//! length ([`transport`]). The driver [`compute_into`] validates the input, estimates the
+//! length ([`transport`]). [`steer`] turns the RMF about its tangents to meet constraints at
+//! any rows ([`constraints`], twist by arc length or by curvature), to follow a guide
+//! ([`guide`]) or to stay close to the previous time step ([`time`]). The driver [`compute_into`] validates the input, estimates the
 //! tangents when they are not given ([`tangents`]), picks the initial vector and writes the
 //! frames into a caller-provided buffer; [`compute_many`] maps it over a bundle of curves in
 //! parallel.

@@ -15,7 +15,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Orientation, Request, compute_many, validate};
+use super::{Orientation, Request, compute_into, validate};
 use crate::error::{InputError, Result};
 
 /// Column `k` of a row-major frame.
@@ -112,12 +112,34 @@ pub fn frames_in_time(
         }
         check_previous(p, rows)?;
     }
-    let offsets: Vec<usize> = (0..=steps).map(|k| k * rows).collect();
-    let init: Vec<Orientation> = initial.into_iter().collect();
-    compute_many(template, &offsets, &init, &[], out).map_err(|e| {
-        let m = e.msg.replacen("curve ", "time step ", 1);
-        InputError::new(e.arg, m)
-    })?;
+    let total = template
+        .points
+        .map(<[DVec3]>::len)
+        .or(template.tangents.map(<[DVec3]>::len))
+        .unwrap_or(0);
+    if total != steps * rows || out.len() != 9 * total {
+        return Err(InputError::new(
+            "points",
+            format!("expected {steps} time steps of {rows} samples, got {total} rows"),
+        ));
+    }
+    out.par_chunks_mut(9 * rows.max(1))
+        .enumerate()
+        .map(|(k, buf)| {
+            let (a, b) = (k * rows, (k + 1) * rows);
+            let req = Request {
+                points: template.points.map(|p| &p[a..b]),
+                tangents: template.tangents.map(|t| &t[a..b]),
+                analytic: None,
+                initial,
+                end: None,
+                ..*template
+            };
+            compute_into(&req, buf)
+                .map(|_| ())
+                .map_err(|e| e.context(&format!("time step {k}")))
+        })
+        .collect::<Result<()>>()?;
     if let Some(p) = previous {
         let c = best_turn(&out[..9 * rows], bytemuck::cast_slice(p));
         turn_all(&mut out[..9 * rows], c);
