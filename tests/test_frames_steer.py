@@ -382,7 +382,7 @@ def test_frames_in_time_bad_input_is_named():
         spinal.frames_in_time(P, previous=np.ones((3, 3, 3)))
     bad = P.copy()
     bad[1, 10] = bad[1, 9]
-    with pytest.raises(ValueError, match="time step 1"):
+    with pytest.raises(ValueError, match="points_t: time step 1: rows 9 and 10 coincide"):
         spinal.frames_in_time(bad)
 
 

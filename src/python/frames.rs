@@ -366,6 +366,10 @@ pub fn frames_in_time<'py>(
                 prev,
                 buf,
             )
+        })
+        .map_err(|e| match e.arg {
+            "tangents" => renamed(e, "tangents", "tangents_t"),
+            _ => renamed(e, "points", "points_t"),
         })?;
     }
     Ok(out)
