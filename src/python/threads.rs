@@ -20,8 +20,10 @@ pub const MAX_THREADS: usize = 1024;
 /// The setting: a thread count, or 0 for the default.
 static SETTING: AtomicUsize = AtomicUsize::new(0);
 
-/// The pools built so far, by size.
-static POOLS: Mutex<Option<HashMap<usize, Arc<rayon::ThreadPool>>>> = Mutex::new(None);
+/// The pools built so far, by size, and the process that built them: a child made by
+/// `fork` (multiprocessing's default start method on Linux) inherits the map but not the
+/// threads, so it builds its own pools.
+static POOLS: Mutex<Option<(u32, HashMap<usize, Arc<rayon::ThreadPool>>)>> = Mutex::new(None);
 
 /// The default thread count: `RAYON_NUM_THREADS` if it is a positive integer, else the
 /// number of logical CPUs (at most [`MAX_THREADS`]).
@@ -50,7 +52,12 @@ pub fn current_threads() -> usize {
 /// The pool of `n` threads (built on first use).
 fn pool_of(n: usize) -> PyResult<Arc<rayon::ThreadPool>> {
     let mut guard = POOLS.lock().unwrap_or_else(|e| e.into_inner());
-    let pools = guard.get_or_insert_with(HashMap::new);
+    let pid = std::process::id();
+    if guard.as_ref().is_some_and(|(owner, _)| *owner != pid) {
+        // the parent's pools: their workers do not exist here, so never touch them again
+        std::mem::forget(guard.take());
+    }
+    let (_, pools) = guard.get_or_insert_with(|| (pid, HashMap::new()));
     if let Some(p) = pools.get(&n) {
         return Ok(p.clone());
     }
