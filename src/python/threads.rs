@@ -23,7 +23,9 @@ static SETTING: AtomicUsize = AtomicUsize::new(0);
 /// The pools built so far, by size, and the process that built them: a child made by
 /// `fork` (multiprocessing's default start method on Linux) inherits the map but not the
 /// threads, so it builds its own pools.
-static POOLS: Mutex<Option<(u32, HashMap<usize, Arc<rayon::ThreadPool>>)>> = Mutex::new(None);
+static POOLS: Mutex<Option<(u32, Pools)>> = Mutex::new(None);
+
+type Pools = HashMap<usize, Arc<rayon::ThreadPool>>;
 
 /// The default thread count: `RAYON_NUM_THREADS` if it is a positive integer, else the
 /// number of logical CPUs (at most [`MAX_THREADS`]).
