@@ -47,6 +47,7 @@ _I: TypeAlias = npt.NDArray[np.int64]
 _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
 _Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
+_TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
 _SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
@@ -82,7 +83,9 @@ def estimate_tangents(
     points: _Array,
     *,
     closed: bool = False,
-    method: Literal["five_point", "five_point_uniform", "circle"] = "five_point",
+    method: _TangentRule = "five_point_bounded",
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
 ) -> _F: ...
 
 # ---- meshes and sweeps --------------------------------------------------------------------
@@ -137,6 +140,8 @@ def sweep(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 def tube(
     points: _Array,
@@ -151,6 +156,8 @@ def tube(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------

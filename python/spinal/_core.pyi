@@ -37,7 +37,10 @@ def frames_analytic(
     turns: int,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 def estimate_tangents(
-    points: npt.NDArray[np.float64], closed: bool, rule: str
+    points: npt.NDArray[np.float64],
+    closed: bool,
+    rule: str,
+    offsets: npt.NDArray[np.int64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def sweep_mesh(
     points: npt.NDArray[np.float64],
