@@ -230,10 +230,12 @@ def stamp(
 
 class SpineBinding:
     clamped: _I
-    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
+    def __init__(self, vertices: _Array, rest_spine: _Array, *, closed: bool = False) -> None: ...
     def __len__(self) -> int: ...
     @property
     def edge(self) -> _I: ...
+    @property
+    def rest_frames(self) -> _F: ...
     @property
     def param(self) -> _F: ...
     @property
@@ -251,6 +253,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[False] = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F: ...
     @overload
     def deform(
@@ -262,6 +266,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[True],
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> tuple[_F, _I]: ...
     @overload
     def deform(
@@ -273,6 +279,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: bool = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F | tuple[_F, _I]: ...
 
 @overload
@@ -286,6 +294,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[False] = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F: ...
 @overload
 def flesh(
@@ -298,6 +309,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[True],
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> tuple[_F, _I]: ...
 @overload
 def flesh(
@@ -310,6 +324,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F | tuple[_F, _I]: ...
 
 class SurfaceBinding:

@@ -96,10 +96,10 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     return out, angles, bundle
 
 
-def _spine_frames(points, name: str, initial=None) -> np.ndarray:
+def _spine_frames(points, name: str, initial=None, closed: bool = False) -> np.ndarray:
     """The default frames of one curve passed to a spinal function as ``name`` (errors about
     the points name it)."""
-    out, _, _ = _compute(points, None, "double_reflection", initial, False, None, 0, "chord",
+    out, _, _ = _compute(points, None, "double_reflection", initial, closed, None, 0, "chord",
                          None, None, None, points_arg=name)
     return out
 

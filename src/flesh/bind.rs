@@ -30,9 +30,16 @@ pub struct Binding {
 }
 
 /// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
-/// steps, each refined by the Illinois variant of regula falsi to full precision.
+/// steps, each refined by the Illinois variant of regula falsi to full precision. A point
+/// on the section plane of a sample (`f` zero at `a = 0` or `a = 1` up to the round-off of
+/// its evaluation) is a root there, so that it is not lost between two edges whose end
+/// values round to the same sign.
 fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
     let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
+    let on_plane = |a: f64, fa: f64| {
+        let c = sp.c_at(k, a);
+        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * sp.m_at(k, a).length()
+    };
     let mut out = [f64::NAN; 4];
     let mut prev = (0.0, f(0.0));
     for (i, slot) in out.iter_mut().enumerate() {
@@ -40,11 +47,14 @@ fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
         let fb = f(b);
         let (mut a0, mut f0) = prev;
         prev = (b, fb);
-        if f0 == 0.0 {
+        if f0 == 0.0 || (i == 0 && on_plane(0.0, f0)) {
             *slot = a0;
             continue;
         }
         if (f0 > 0.0) == (fb > 0.0) {
+            if i == 3 && on_plane(1.0, fb) {
+                *slot = 1.0;
+            }
             continue;
         }
         let (mut a1, mut f1) = (b, fb);
@@ -87,15 +97,15 @@ fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
 fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
     let n = sp.len();
     let mut best = (f64::INFINITY, 0usize, 0.0f64, 0.0f64);
-    // straight extensions past both ends
+    // straight extensions past both ends (a loop has none)
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
-    if tau < 0.0 {
+    if tau < 0.0 && !sp.closed {
         best = ((w - tau * sp.t[0]).length_squared(), 0, 0.0, tau);
     }
     let w = p - sp.c[n - 1];
     let tau = w.dot(sp.t[n - 1]);
-    if tau > 0.0 {
+    if tau > 0.0 && !sp.closed {
         let d2 = (w - tau * sp.t[n - 1]).length_squared();
         if d2 < best.0 {
             best = (d2, n - 2, 1.0, tau);

@@ -305,7 +305,10 @@ impl FromPyObject<'_, '_> for TangentRule {
 
     fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
         // the default, the five-point rule with bounded ends, is named apart in the message
-        if obj.extract::<&str>().is_ok_and(|s| s == "five_point_bounded") {
+        if obj
+            .extract::<&str>()
+            .is_ok_and(|s| s == "five_point_bounded")
+        {
             return Ok(TangentRule::FivePointBounded);
         }
         choice(
