@@ -12,6 +12,7 @@ use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
 type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
+type Resampled<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// A spine from its points `(n, 3)` and frames `(n, 3, 3)`, both named `arg` (`closed`: a
 /// loop with its first row repeated at the end).
@@ -83,7 +84,7 @@ pub fn flesh_resample<'py>(
     py: Python<'py>,
     posed_points: PyReadonlyArray2<'py, f64>,
     chords: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<Resampled<'py>> {
     let pts = vec3s("posed_spine", &posed_points)?;
     let ch = slice_of("chords", &chords)?;
     let (out, at) = py.detach(|| flesh::spine::compass_walk_located(pts, ch))?;
