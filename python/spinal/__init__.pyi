@@ -51,6 +51,7 @@ _I: TypeAlias = npt.NDArray[np.int64]
 _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
 _Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
+_TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
 _SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
@@ -86,7 +87,9 @@ def estimate_tangents(
     points: _Array,
     *,
     closed: bool = False,
-    method: Literal["five_point", "five_point_uniform", "circle"] = "five_point",
+    method: _TangentRule = "five_point_bounded",
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
 ) -> _F: ...
 
 # ---- meshes and sweeps --------------------------------------------------------------------
@@ -141,6 +144,8 @@ def sweep(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 def tube(
     points: _Array,
@@ -155,6 +160,8 @@ def tube(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------
@@ -227,10 +234,12 @@ def stamp(
 
 class SpineBinding:
     clamped: _I
-    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
+    def __init__(self, vertices: _Array, rest_spine: _Array, *, closed: bool = False) -> None: ...
     def __len__(self) -> int: ...
     @property
     def edge(self) -> _I: ...
+    @property
+    def rest_frames(self) -> _F: ...
     @property
     def param(self) -> _F: ...
     @property
@@ -248,6 +257,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[False] = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F: ...
     @overload
     def deform(
@@ -259,6 +270,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[True],
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> tuple[_F, _I]: ...
     @overload
     def deform(
@@ -270,6 +283,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: bool = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F | tuple[_F, _I]: ...
 
 @overload
@@ -283,6 +298,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[False] = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F: ...
 @overload
 def flesh(
@@ -295,6 +313,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[True],
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> tuple[_F, _I]: ...
 @overload
 def flesh(
@@ -307,6 +328,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F | tuple[_F, _I]: ...
 
 class SurfaceBinding:

@@ -37,7 +37,10 @@ def frames_analytic(
     turns: int,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 def estimate_tangents(
-    points: npt.NDArray[np.float64], closed: bool, rule: str
+    points: npt.NDArray[np.float64],
+    closed: bool,
+    rule: str,
+    offsets: npt.NDArray[np.int64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def sweep_mesh(
     points: npt.NDArray[np.float64],
@@ -321,6 +324,7 @@ def flesh_bind(
     rest_points: npt.NDArray[np.float64],
     rest_frames: npt.NDArray[np.float64],
     vertices: npt.NDArray[np.float64],
+    closed: bool = False,
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
 def flesh_deform(
     posed_points: npt.NDArray[np.float64],
@@ -329,10 +333,11 @@ def flesh_deform(
     coords: npt.NDArray[np.float64],
     solution: str,
     twist: npt.NDArray[np.float64] | None,
+    closed: bool = False,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
-) -> npt.NDArray[np.float64]: ...
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def flesh_surface_bind(
     rest_points: npt.NDArray[np.float64], nu: int, nv: int, vertices: npt.NDArray[np.float64]
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...

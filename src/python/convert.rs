@@ -364,6 +364,13 @@ impl FromPyObject<'_, '_> for TangentRule {
     type Error = PyErr;
 
     fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        // the default, the five-point rule with bounded ends, is named apart in the message
+        if obj
+            .extract::<&str>()
+            .is_ok_and(|s| s == "five_point_bounded")
+        {
+            return Ok(TangentRule::FivePointBounded);
+        }
         choice(
             obj,
             "method",
@@ -374,6 +381,16 @@ impl FromPyObject<'_, '_> for TangentRule {
                 ("circle", TangentRule::Circle),
             ],
         )
+        .map_err(|e| {
+            if e.is_instance_of::<pyo3::exceptions::PyValueError>(obj.py()) {
+                value_error(format!(
+                    "{}, or 'five_point_bounded' (the default: 'five_point' with bounded ends)",
+                    e.value(obj.py())
+                ))
+            } else {
+                e
+            }
+        })
     }
 }
 

@@ -120,15 +120,23 @@ pub fn frames_analytic<'py>(
     Ok((out, angle))
 }
 
-/// Unit tangents estimated from points (one curve).
+/// Unit tangents estimated from points: one curve, or many back to back (`offsets`).
 #[pyfunction]
+#[pyo3(signature = (points, closed, rule, offsets=None))]
 pub fn estimate_tangents<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
     closed: bool,
     rule: TangentRule,
+    offsets: Option<PyReadonlyArray1<'py, i64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let x = vec3s("points", &points)?;
-    let t = detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??;
+    let t = match offsets {
+        None => detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??,
+        Some(o) => {
+            let offs = offsets_of(&o)?;
+            detach_in_pool(py, || frames::tangents::estimate_many(x, &offs, closed, rule))??
+        }
+    };
     vec3_array(py, t)
 }
