@@ -4,6 +4,8 @@ Frames are ``(n, 3, 3)`` rotation matrices whose columns are ``(r, s, t)``: the 
 vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tubes turn
 curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
 :mod:`spinal.quaternions` holds frames as quaternion curves, cameras and a mesh walker.
+The parallel calls use :func:`get_num_threads` worker threads (:func:`set_num_threads`,
+:func:`threads`).
 """
 
 from . import curves, fields, ph, quaternions
@@ -14,6 +16,7 @@ from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
+from ._threads import get_num_threads, set_num_threads, threads
 
 __all__ = [
     "DeformReport",
@@ -34,9 +37,12 @@ __all__ = [
     "flesh_surface",
     "frames",
     "frames_in_time",
+    "get_num_threads",
     "ph",
     "quaternions",
+    "set_num_threads",
     "stamp",
     "sweep",
+    "threads",
     "tube",
 ]

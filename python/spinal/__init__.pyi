@@ -1,6 +1,7 @@
 import os
 import pathlib
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from typing import Any, Literal, TypeAlias, overload
 
@@ -33,10 +34,13 @@ __all__ = [
     "flesh_surface",
     "frames",
     "frames_in_time",
+    "get_num_threads",
     "ph",
     "quaternions",
+    "set_num_threads",
     "stamp",
     "sweep",
+    "threads",
     "tube",
 ]
 
@@ -49,6 +53,7 @@ _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
 _Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
 _Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
+_TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
 _SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
@@ -101,7 +106,9 @@ def estimate_tangents(
     points: _Array,
     *,
     closed: bool = False,
-    method: Literal["five_point", "five_point_uniform", "circle"] = "five_point",
+    method: _TangentRule = "five_point_bounded",
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
 ) -> _F: ...
 
 # ---- meshes and sweeps --------------------------------------------------------------------
@@ -156,6 +163,8 @@ def sweep(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 def tube(
     points: _Array,
@@ -170,6 +179,8 @@ def tube(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    tangents: _Array | None = None,
+    tangent_rule: _TangentRule = "five_point_bounded",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------
@@ -242,10 +253,12 @@ def stamp(
 
 class SpineBinding:
     clamped: _I
-    def __init__(self, vertices: _Array, rest_spine: _Array) -> None: ...
+    def __init__(self, vertices: _Array, rest_spine: _Array, *, closed: bool = False) -> None: ...
     def __len__(self) -> int: ...
     @property
     def edge(self) -> _I: ...
+    @property
+    def rest_frames(self) -> _F: ...
     @property
     def param(self) -> _F: ...
     @property
@@ -263,6 +276,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[False] = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F: ...
     @overload
     def deform(
@@ -274,6 +289,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: Literal[True],
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> tuple[_F, _I]: ...
     @overload
     def deform(
@@ -285,6 +302,8 @@ class SpineBinding:
         twist: float | _Array | None = None,
         strict: bool = False,
         return_clamped: bool = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F | tuple[_F, _I]: ...
 
 @overload
@@ -298,6 +317,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[False] = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F: ...
 @overload
 def flesh(
@@ -310,6 +332,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: Literal[True],
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> tuple[_F, _I]: ...
 @overload
 def flesh(
@@ -322,6 +347,9 @@ def flesh(
     twist: float | _Array | None = None,
     strict: bool = False,
     return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F | tuple[_F, _I]: ...
 
 class SurfaceBinding:
@@ -390,3 +418,9 @@ def flesh_surface(
     strict: bool = False,
     return_clamped: bool = False,
 ) -> _F | tuple[_F, _I]: ...
+
+# ---- worker threads -----------------------------------------------------------------------
+
+def set_num_threads(n: int | None) -> None: ...
+def get_num_threads() -> int: ...
+def threads(n: int | None) -> AbstractContextManager[None]: ...

@@ -37,7 +37,10 @@ def frames_analytic(
     turns: int,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 def estimate_tangents(
-    points: npt.NDArray[np.float64], closed: bool, rule: str
+    points: npt.NDArray[np.float64],
+    closed: bool,
+    rule: str,
+    offsets: npt.NDArray[np.int64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def frames_steered(
     points: npt.NDArray[np.float64] | None,
@@ -47,6 +50,7 @@ def frames_steered(
     d1: npt.NDArray[np.float64] | None,
     d2: npt.NDArray[np.float64] | None,
     method: str,
+    tangent_rule: str,
     tangent_chords: bool,
     closed: bool,
     initial_vectors: npt.NDArray[np.float64] | None,
@@ -71,6 +75,7 @@ def frames_in_time(
     tangents: npt.NDArray[np.float64] | None,
     steps: int,
     method: str,
+    tangent_rule: str,
     tangent_chords: bool,
     closed: bool,
     initial_vectors: npt.NDArray[np.float64] | None,
@@ -360,6 +365,7 @@ def flesh_bind(
     rest_points: npt.NDArray[np.float64],
     rest_frames: npt.NDArray[np.float64],
     vertices: npt.NDArray[np.float64],
+    closed: bool = False,
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
 def flesh_deform(
     posed_points: npt.NDArray[np.float64],
@@ -368,10 +374,11 @@ def flesh_deform(
     coords: npt.NDArray[np.float64],
     solution: str,
     twist: npt.NDArray[np.float64] | None,
+    closed: bool = False,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
-) -> npt.NDArray[np.float64]: ...
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def flesh_surface_bind(
     rest_points: npt.NDArray[np.float64], nu: int, nv: int, vertices: npt.NDArray[np.float64]
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
@@ -393,3 +400,17 @@ def stamp(
     frames: int,
     iterations: int,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+
+# ---- worker threads (spinal._threads) ---------------------------------------------------------
+
+def set_num_threads(n: int | None) -> None:
+    """Set the thread count of the parallel calls (``None``: the default); ``1 <= n <= 1024``."""
+
+def num_threads_setting() -> int | None:
+    """The thread count set, or ``None`` for the default."""
+
+def get_num_threads() -> int:
+    """The thread count the next parallel call will use."""
+
+def pool_threads() -> int:
+    """``rayon::current_num_threads()`` seen from inside a heavy call (for the tests)."""

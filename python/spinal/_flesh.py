@@ -20,7 +20,9 @@ from ._validate import as_bool, as_choice, as_float_array
 SOLUTIONS = ("radial", "normal", "binormal", "none")
 
 
-def _spine(x, name: str) -> tuple[np.ndarray, int]:
+def _spine(x, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
+    """A spine as ``(n, 3)`` rows and its width (2 or 3); a loop (``closed``) loses a repeated
+    first point at its end."""
     arr = as_float_array(x, name)
     if arr.ndim != 2 or arr.shape[1] not in (2, 3):
         raise ValueError(f"{name}: expected an array of shape (n, 3) or (n, 2), got {arr.shape}")
@@ -33,10 +35,35 @@ def _spine(x, name: str) -> tuple[np.ndarray, int]:
     if dim == 2:
         arr = np.c_[arr, np.zeros(len(arr))]
     arr = np.ascontiguousarray(arr)
-    rep = np.flatnonzero(np.linalg.norm(np.diff(arr, axis=0), axis=1) <= 1e-12 * _scale(arr))
+    tol = 1e-12 * _scale(arr)
+    if closed and len(arr) > 1 and np.linalg.norm(arr[-1] - arr[0]) <= tol:
+        arr = arr[:-1]
+    if closed and len(arr) < 3:
+        raise ValueError(f"{name}: a closed spine needs at least 3 distinct points, got "
+                         f"{len(arr)}")
+    rep = np.flatnonzero(np.linalg.norm(np.diff(arr, axis=0), axis=1) <= tol)
     if rep.size:
         raise ValueError(f"{name}: rows {rep[0]} and {rep[0] + 1} repeat the same point")
     return arr, dim
+
+
+def _loop(a: np.ndarray, closed: bool) -> np.ndarray:
+    """Rows of a loop with the first repeated at the end (the core's closing edge)."""
+    return np.ascontiguousarray(np.concatenate([a, a[:1]])) if closed else a
+
+
+def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray):
+    """A closed posed spine resampled at the rest samples' fractions of the loop's length
+    (chord-length parameter): ``(n, 3)`` points and their positions ``k + u`` on the posed
+    loop's edges (edge ``k`` from row ``k`` to row ``k + 1 mod m``). A loop cannot keep every
+    edge length when its length changes, so the stretch ``λ = L1/L0`` is spread uniformly."""
+    ring = np.concatenate([posed, posed[:1]])
+    s = _arc(ring)
+    target = rest_arc[:-1] / rest_arc[-1] * s[-1]
+    k = np.clip(np.searchsorted(s, target, side="right") - 1, 0, len(posed) - 1)
+    u = (target - s[k]) / (s[k + 1] - s[k])
+    pts = ring[k] + u[:, None] * (ring[k + 1] - ring[k])
+    return np.ascontiguousarray(pts), k + u
 
 
 def _scale(a: np.ndarray) -> float:
@@ -47,11 +74,12 @@ def _arc(points: np.ndarray) -> np.ndarray:
     return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
 
 
-def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:
+def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Compass walk (our reading of Zhuo 2014 Ch. IV's "distance between consecutive samples" as
     the chord, not the arc length): points on the posed polyline, from its start, whose
     consecutive distances are the rest spine's chords ``chords``; past its end, along its
-    last edge. Edge lengths are kept exactly, so the discrete stretch is 1 at the samples."""
+    last edge. Edge lengths are kept exactly, so the discrete stretch is 1 at the samples.
+    Also returns each point's position ``k + u`` on the polyline (edge ``k``, fraction ``u``)."""
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
@@ -98,13 +126,119 @@ def _vertices(vertices, dim: int) -> np.ndarray:
     return np.ascontiguousarray(v, dtype=np.float64)
 
 
-def _rest_frames(rest: np.ndarray, dim: int) -> np.ndarray:
+def _rest_frames(rest: np.ndarray, dim: int, closed: bool = False) -> np.ndarray:
     """The RMF of the rest spine; in the plane started with ``r`` in the plane (so the
-    binormal stays out of it)."""
+    binormal stays out of it); on a loop with its closing angle spread in arc length."""
     if dim == 2:
         t0 = rest[1] - rest[0]
-        return _spine_frames(rest, "rest_spine", initial=np.array([-t0[1], t0[0], 0.0]))
-    return _spine_frames(rest, "rest_spine")
+        return _spine_frames(rest, "rest_spine", initial=np.array([-t0[1], t0[0], 0.0]),
+                             closed=closed)
+    return _spine_frames(rest, "rest_spine", closed=closed)
+
+
+def _rotations(f: np.ndarray, name: str) -> None:
+    """Refuse frames that are not proper rotations (columns orthonormal, det +1)."""
+    err = np.abs(np.swapaxes(f, -1, -2) @ f - np.eye(3)).max(axis=(-2, -1))
+    bad = np.flatnonzero(~(err < 1e-6) | ~(np.linalg.det(f) > 0))
+    if bad.size:
+        raise ValueError(f"{name}: row {bad[0]} is not a rotation (expected orthonormal "
+                         f"columns r, s, t with det +1, like spinal.frames)")
+
+
+def _roll_to(frames1: np.ndarray, r0: np.ndarray, name: str) -> np.ndarray:
+    """``frames1`` rolled about their tangents by the constant angle that turns the first
+    reference vector onto ``r0`` projected on the first normal plane (the RMF is linear in
+    its initial vector, so this is the RMF started from ``r0``)."""
+    r, s_, t0 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
+    p = r0 - (r0 @ t0) * t0
+    if not np.linalg.norm(p) > 1e-3 * np.linalg.norm(r0):
+        raise ValueError(f"{name}: its reference vector is parallel to the posed spine's "
+                         f"first tangent")
+    g = np.arctan2(p @ s_, p @ r)
+    c, sn = np.cos(g), np.sin(g)
+    out = frames1.copy()
+    rr, ss = frames1[:, :, 0], frames1[:, :, 1]
+    out[:, :, 0] = c * rr + sn * ss
+    out[:, :, 1] = c * ss - sn * rr
+    return out
+
+
+def _given_roll(frames1, posed_frames, posed_up, at, m: int, closed: bool):
+    """The posed frames with the roll the caller gives: ``frames1`` (the posed spine's frames,
+    whose tangents are kept) with ``r`` the given reference vectors — the ``r`` columns of
+    ``posed_frames`` or the ``posed_up`` vectors at the caller's ``m`` posed rows — blended
+    linearly to the positions ``at`` (``k + u`` on the caller's polyline) of the samples and
+    projected onto their normal planes. One ``(3, 3)`` frame instead sets the first frame:
+    the RMF started from it."""
+    name = "posed_frames" if posed_frames is not None else "posed_up"
+    t = frames1[:, :, 2]
+    if posed_frames is not None:
+        f = as_float_array(posed_frames, name)
+        if f.shape == (3, 3):
+            _rotations(f[None], name)
+            return _roll_to(frames1, f[:, 0], name)
+        if closed and f.shape == (m + 1, 3, 3):  # the caller repeated the first row
+            f = f[:m]
+        if f.shape != (m, 3, 3):
+            raise ValueError(f"{name}: expected shape (3, 3) or ({m}, 3, 3) like posed_spine's "
+                             f"rows, got {f.shape}")
+        _rotations(f, name)
+        vecs, tg = f[:, :, 0], f[:, :, 2]
+    else:
+        u = as_float_array(posed_up, name)
+        if closed and u.shape == (m + 1, 3):
+            u = u[:m]
+        if u.shape == (3,):
+            u = np.broadcast_to(u, (m, 3))
+        if u.shape != (m, 3):
+            raise ValueError(f"{name}: expected shape (3,) or ({m}, 3) like posed_spine's rows, "
+                             f"got {u.shape}")
+        bad = np.flatnonzero(~np.isfinite(u).all(axis=1) | ~(np.linalg.norm(u, axis=1) > 0))
+        if bad.size:
+            raise ValueError(f"{name}: row {bad[0]} is not a finite non-zero vector")
+        vecs, tg = u / np.linalg.norm(u, axis=1, keepdims=True), None
+    # the caller's rows around every sample
+    k = np.floor(at).astype(np.int64)
+    if closed:
+        k %= m
+        nxt = (k + 1) % m
+        w = np.clip(at - np.floor(at), 0.0, 1.0)
+    else:
+        k = np.clip(k, 0, m - 2)
+        nxt = k + 1
+        w = np.clip(at - k, 0.0, 1.0)
+    row = np.where(w < 0.5, k, nxt)
+    if tg is not None:
+        tb = (1 - w)[:, None] * tg[k] + w[:, None] * tg[nxt]
+        cos = np.einsum("ij,ij->i", tb, t) / np.linalg.norm(tb, axis=1)
+        bad = np.flatnonzero(~(cos > 0.5))
+        if bad.size:
+            j = bad[0]
+            raise ValueError(
+                f"{name}: row {row[j]}: its t column is "
+                f"{np.degrees(np.arccos(np.clip(cos[j], -1, 1))):.0f}° from the posed spine's "
+                f"tangent (expected the posed spine's frames, columns r, s, t like spinal.frames)")
+    v = (1 - w)[:, None] * vecs[k] + w[:, None] * vecs[nxt]
+    r = v - np.einsum("ij,ij->i", v, t)[:, None] * t
+    nr = np.linalg.norm(r, axis=1)
+    bad = np.flatnonzero(~(nr > 1e-3))
+    if bad.size:
+        j = bad[0]
+        raise ValueError(f"{name}: row {row[j]}: the reference vector is parallel to the posed "
+                         f"spine's tangent (or turns by a half turn between rows)")
+    r = r / nr[:, None]
+    dots = np.einsum("ij,ij->i", r[:-1], r[1:])
+    if closed:
+        dots = np.r_[dots, r[-1] @ r[0]]
+    bad = np.flatnonzero(~(dots > -0.5))
+    if bad.size:
+        raise ValueError(f"{name}: the roll turns by 120° or more between posed samples "
+                         f"{bad[0]} and {(bad[0] + 1) % len(r)}; give a roll that turns less "
+                         f"between samples")
+    out = frames1.copy()
+    out[:, :, 0] = r
+    out[:, :, 1] = np.cross(t, r)
+    return out
 
 
 class SpineBinding:
@@ -133,6 +267,13 @@ class SpineBinding:
     rest_spine : array_like (n, 3) or (n, 2)
         Rest spine samples, n ≥ 2, no repeated consecutive points, sampled finely enough that
         the tangent turns less than 90° between samples.
+    closed : bool
+        The spine is a loop (rings, tentacle loops; n ≥ 3, a repeated first point at the end
+        is accepted): the closing edge from the last sample to the first carries sections
+        like the others, there are no ends to extend, and the frames are those of
+        ``spinal.frames(rest_spine, closed=True)`` (the RMF with its closing angle spread
+        linearly in arc length, Wang et al. §6.3), so the sections meet across the seam.
+        The posed spines of :meth:`deform` are loops too.
 
     Attributes
     ----------
@@ -148,14 +289,18 @@ class SpineBinding:
         Messages start with the argument's name: wrong shapes, NaN/inf, repeated spine points.
     """
 
-    def __init__(self, vertices, rest_spine):
-        rest, dim = _spine(rest_spine, "rest_spine")
+    def __init__(self, vertices, rest_spine, *, closed: bool = False):
+        closed = as_bool(closed, "closed")
+        rest, dim = _spine(rest_spine, "rest_spine", closed)
         v = _vertices(vertices, dim)
-        self._frames = _rest_frames(rest, dim)
+        self._closed = closed
+        self._frames = _rest_frames(rest, dim, closed)
         self._dim = dim
         self._rest = rest
-        self._lengths = _arc(rest)
-        self._edge, self._coords = _core.flesh_bind(rest, self._frames, v)
+        self._lengths = _arc(_loop(rest, closed))
+        self._edge, self._coords = _core.flesh_bind(
+            _loop(rest, closed), _loop(self._frames, closed), v, closed
+        )
         self.clamped = np.zeros(0, dtype=np.int64)
 
     def __len__(self) -> int:
@@ -164,8 +309,16 @@ class SpineBinding:
     @property
     def edge(self) -> np.ndarray:
         """``(V,)`` int64: the rest spine edge ``k`` (between samples ``k`` and ``k + 1``) that
-        holds each vertex's cross-section; ``0`` or ``n − 2`` for vertices past the ends."""
+        holds each vertex's cross-section; ``0`` or ``n − 2`` for vertices past the ends. On a
+        closed spine edge ``n − 1`` is the closing edge (from sample ``n − 1`` to sample 0)."""
         return self._edge.copy()
+
+    @property
+    def rest_frames(self) -> np.ndarray:
+        """``(n, 3, 3)`` float64: the rest spine's frames (columns ``r, s, t``) in which the
+        offsets are stored. A rigid motion ``x ↦ Rx + c`` of the whole shape is the pose
+        ``deform(rest_spine @ R.T + c, posed_frames=R @ rest_frames)``."""
+        return self._frames.copy()
 
     @property
     def param(self) -> np.ndarray:
@@ -194,17 +347,27 @@ class SpineBinding:
     def posed_spine(self, posed_spine, *, stretchable: bool = False) -> np.ndarray:
         """The posed spine as used by :meth:`deform`: ``(n, 3)`` (resampled when not
         stretchable)."""
-        posed, dim = _spine(posed_spine, "posed_spine")
+        return self._posed(posed_spine, stretchable)[0]
+
+    def _posed(self, posed_spine, stretchable):
+        """The posed spine as used, the caller's row count ``m`` and the positions ``k + u``
+        of the used samples on the caller's polyline (edge ``k``, fraction ``u``)."""
+        posed, dim = _spine(posed_spine, "posed_spine", self._closed)
         if dim != self._dim:
             raise ValueError(f"posed_spine: expected {self._dim} columns like rest_spine")
+        m = len(posed)
         if as_bool(stretchable, "stretchable"):
-            if len(posed) != len(self._rest):
+            if m != len(self._rest):
                 raise ValueError(
                     f"posed_spine: a stretchable spine needs the rest spine's {len(self._rest)} "
-                    f"samples (the sample index is the shared parameter), got {len(posed)}"
+                    f"samples (the sample index is the shared parameter), got {m}"
                 )
-            return posed
-        return _resample(posed, np.diff(self._lengths))
+            return posed, m, np.arange(m, dtype=np.float64)
+        if self._closed:
+            pts, at = _resample_loop(posed, self._lengths)
+            return pts, m, at
+        pts, at = _resample(posed, np.diff(self._lengths))
+        return pts, m, at
 
     def deform(
         self,
@@ -215,6 +378,8 @@ class SpineBinding:
         twist=None,
         strict: bool = False,
         return_clamped: bool = False,
+        posed_frames=None,
+        posed_up=None,
     ):
         r"""The shape posed on ``posed_spine`` with its volume preserved locally.
 
@@ -249,7 +414,11 @@ class SpineBinding:
         nor stretches (a posed spine shorter than the rest spine is extended straight). With
         ``stretchable=True`` the posed spine must have the rest spine's sample count and
         sample ``i`` carries the sections of rest sample ``i``: lengthening a part of it
-        thins that part (λ > 1), compressing thickens it.
+        thins that part (λ > 1), compressing thickens it. A closed spine (``closed=True`` at
+        binding) cannot keep every edge length when the loop's length changes: without
+        ``stretchable`` it is resampled at the rest samples' fractions of its length (chord
+        length along the posed loop), so the stretch ``λ = L1/L0`` is spread evenly and a
+        uniformly scaled ring keeps its volume.
 
         The posed frames are the RMF of the posed spine started from the rest spine's first
         reference vector turned by the minimal rotation of the first tangent and rolled by the
@@ -261,6 +430,17 @@ class SpineBinding:
         spine's N/B (the thesis leaves open whether the stretch comes before or after the
         change of frame; both keep the volume), so they invert exactly only where the stretch
         is 1.
+
+        The roll of the posed spine about its tangent can instead be given
+        (``posed_frames`` or ``posed_up``): this is what a rig drives, and what fixes a rigid
+        motion of a straight spine, whose roll no best fit can recover. The posed frames keep
+        the posed spine's tangents and take the given reference vectors ``r``, blended
+        linearly to where the used samples lie on the caller's polyline and projected onto
+        their normal planes (made unit). So ``posed_frames = R @ binding.rest_frames`` with
+        the spine moved by ``x ↦ Rx + c`` moves the shape rigidly (to round-off) whatever
+        the spine, and rolling those frames by ``θ`` about a straight spine turns the shape by
+        ``θ`` about it. The offsets are carried over in these frames, so the volume is kept
+        as before (the transfer is a rotation about the tangent).
 
         Parameters
         ----------
@@ -275,6 +455,16 @@ class SpineBinding:
             Raise ``ValueError`` instead of warning when vertices are clamped.
         return_clamped : bool
             Also return the indices of the clamped vertices.
+        posed_frames : array_like (m, 3, 3) or (3, 3), optional
+            Frames of the posed spine at its ``m`` rows (columns ``r, s, t`` as
+            :func:`spinal.frames` gives them; proper rotations, their ``t`` within 60° of the
+            posed spine's tangent); only their ``r`` columns are used, as described above.
+            One ``(3, 3)`` frame sets the first frame only: the posed frames are then the RMF
+            started from its ``r``. 3D only (in the plane the frame is fixed).
+        posed_up : array_like (3,) or (m, 3), optional
+            Instead of ``posed_frames``: "up" vectors, one for all rows (a level horizon) or
+            one per row; ``r`` is their projection onto each normal plane (refused where one
+            is within 1e-3 of the tangent's direction).
 
         Returns
         -------
@@ -288,13 +478,27 @@ class SpineBinding:
         """
         solution = as_choice(solution, "solution", SOLUTIONS)
         strict = as_bool(strict, "strict")
-        posed = self.posed_spine(posed_spine, stretchable=stretchable)
+        given = posed_frames is not None or posed_up is not None
+        if posed_frames is not None and posed_up is not None:
+            raise TypeError("posed_frames, posed_up: pass one of them, not both")
+        if given and self._dim == 2:
+            raise TypeError(f"{'posed_frames' if posed_frames is not None else 'posed_up'}: "
+                            f"not used in the plane (the frame is fixed by the plane)")
+        posed, m, at = self._posed(posed_spine, stretchable)
         tw = None if twist is None else _twist(twist, len(self._rest))
-        frames1 = self._posed_frames(posed)
+        if given:
+            frames1 = _spine_frames(posed, "posed_spine", closed=self._closed)
+            frames1 = _given_roll(frames1, posed_frames, posed_up, at, m, self._closed)
+        else:
+            frames1 = self._posed_frames(posed)
         sol = solution
         if self._dim == 2 and sol != "none":
             sol = "normal"
-        out, flags = _core.flesh_deform(posed, frames1, self._edge, self._coords, sol, tw)
+        c = self._closed
+        if tw is not None:
+            tw = _loop(tw, c)
+        out, flags = _core.flesh_deform(_loop(posed, c), _loop(frames1, c), self._edge,
+                                        self._coords, sol, tw, c)
         self.clamped = _report_clamped(flags, strict)
         if self._dim == 2:
             out = np.ascontiguousarray(out[:, :2])
@@ -305,18 +509,13 @@ class SpineBinding:
         :func:`_posed_initial` (in the plane: ``r`` the left normal ``z × t``)."""
         if self._dim == 2:  # r is the left normal z × t all along a planar RMF
             t1 = posed[1] - posed[0]
-            return _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0])
+            return _spine_frames(posed, "posed_spine", initial=[-t1[1], t1[0], 0.0],
+                                 closed=self._closed)
         # the RMF is linear in its initial vector: start from the default one and roll
         # every frame by the constant angle that brings it to the chosen start
-        frames1 = _spine_frames(posed, "posed_spine")
-        r, s_, t1 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
-        init = _posed_initial(self._rest, self._frames[0], posed, t1)
-        g = np.arctan2(init @ s_, init @ r)
-        c, sn = np.cos(g), np.sin(g)
-        rr, ss = frames1[:, :, 0].copy(), frames1[:, :, 1].copy()
-        frames1[:, :, 0] = c * rr + sn * ss
-        frames1[:, :, 1] = c * ss - sn * rr
-        return frames1
+        frames1 = _spine_frames(posed, "posed_spine", closed=self._closed)
+        init = _posed_initial(self._rest, self._frames[0], posed, frames1[0][:, 2])
+        return _roll_to(frames1, init, "posed_spine")
 
 
 def _twist(twist, n: int) -> np.ndarray:
@@ -354,6 +553,9 @@ def flesh(
     twist=None,
     strict: bool = False,
     return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames=None,
+    posed_up=None,
 ):
     r"""Bend a shape with its spine and keep its volume locally (Zhuo 2014): ``(V, 3)``.
 
@@ -361,7 +563,9 @@ def flesh(
     :class:`SpineBinding` for the registration and :meth:`SpineBinding.deform` for the
     solutions (``"radial"``, ``"normal"``, ``"binormal"``, and ``"none"`` the uncorrected
     map), ``stretchable`` (without it the posed spine is resampled to the rest spine's
-    length), ``twist``, fold-over clamping and errors. 2-column input is the planar case.
+    length), ``twist``, ``posed_frames``/``posed_up`` (the roll of the posed spine, e.g.
+    driven by a rig), fold-over clamping and errors; ``closed`` for loops (rings).
+    2-column input is the planar case.
 
     >>> import numpy as np, spinal
     >>> rest = np.c_[np.linspace(-1, 1, 201), np.zeros(201), np.zeros(201)]
@@ -371,13 +575,15 @@ def flesh(
     >>> round(1 - np.linalg.norm(P[0] - [0, 1, 0]), 6)  # radial: r1²(1 − ⅔ r1) = 0.09
     0.341342
     """
-    return SpineBinding(vertices, rest_spine).deform(
+    return SpineBinding(vertices, rest_spine, closed=closed).deform(
         posed_spine,
         solution=solution,
         stretchable=stretchable,
         twist=twist,
         strict=strict,
         return_clamped=return_clamped,
+        posed_frames=posed_frames,
+        posed_up=posed_up,
     )
 
 

@@ -15,7 +15,8 @@ __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
 METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")
-TANGENT_RULES = ("five_point", "five_point_uniform", "circle")
+TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
+DEFAULT_TANGENT_RULE = "five_point_bounded"
 
 
 def _orientation(x: Any, name: str, curves: int, bundle: bool):
@@ -90,16 +91,16 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     # tangents (the core's `tangent_chords` flag)
     chords_from_tangents = reflection == "tangents"
     out, angles = _core.frames_sampled(
-        pts, tgs, offs, method, "five_point", chords_from_tangents, closed,
+        pts, tgs, offs, method, DEFAULT_TANGENT_RULE, chords_from_tangents, closed,
         iv, if_, ev, ef, turns, points_arg,
     )
     return out, angles, bundle
 
 
-def _spine_frames(points, name: str, initial=None) -> np.ndarray:
+def _spine_frames(points, name: str, initial=None, closed: bool = False) -> np.ndarray:
     """The default frames of one curve passed to a spinal function as ``name`` (errors about
     the points name it)."""
-    out, _, _ = _compute(points, None, "double_reflection", initial, False, None, 0, "chord",
+    out, _, _ = _compute(points, None, "double_reflection", initial, closed, None, 0, "chord",
                          None, None, None, points_arg=name)
     return out
 
@@ -139,7 +140,8 @@ def frames(
     tangents : array_like (n, 3), optional
         Tangent directions at the samples (normalised here). Without them the unit tangents
         are estimated from the points by :func:`estimate_tangents` (5-point differences in
-        chord length, one-sided at open ends, periodic when ``closed``), which keeps double
+        chord length, one-sided at open ends with the end tangents bounded by the turn of
+        the last two chords, periodic when ``closed``), which keeps double
         reflection 4th order for any smooth spacing; 3–4 points use the circle through
         neighbours (2nd order), 2 points the chord.
     method : str
@@ -307,10 +309,27 @@ def closing_angle(
     return angles if bundle else float(angles[0])
 
 
-def estimate_tangents(points, *, closed: bool = False, method: str = "five_point") -> np.ndarray:
+def estimate_tangents(
+    points,
+    *,
+    closed: bool = False,
+    method: str = DEFAULT_TANGENT_RULE,
+    lengths=None,
+    offsets=None,
+) -> np.ndarray:
     r"""Unit tangents estimated from sampled points, ``(n, 3)``.
 
-    * ``"five_point"`` (default): the derivative at ``x_i`` of the quartic through the five
+    * ``"five_point_bounded"`` (default): ``"five_point"`` below, with each open end tangent
+      bounded by the turn of the last two chords: with ``ĉ`` the end chord and ``φ`` its
+      angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than ``φ``
+      from ``ĉ`` is turned towards ``ĉ`` onto the cone ``∠(t, ĉ) = φ`` (in the plane of ``ĉ``
+      and ``t``). On smooth samplings the exact end tangent leans ``κh/2 + O(h²)`` from the
+      end chord, inside the cone, so the estimate stays O(h⁴) there; on coarse samplings
+      (e.g. 20-point streamlines) the one-sided quartic extrapolates the last bends and can
+      lean far past the end chord (chisel-shaped tube ends), which the bound removes. The
+      circle rule's end tangent leans exactly by half the circle's turn, inside the same
+      cone. Interior and closed-curve tangents are those of ``"five_point"``.
+    * ``"five_point"``: the derivative at ``x_i`` of the quartic through the five
       samples around it (one-sided at open ends, periodic when ``closed``), parameterised by
       cumulative chord length (Lagrange weights by Fornberg's algorithm). For equal chords
       these are the 5-point formulas of Wang et al. (2008, §6.1),
@@ -329,13 +348,19 @@ def estimate_tangents(points, *, closed: bool = False, method: str = "five_point
       circles for any spacing, O(h²) in general.
 
     With 3–4 points the circle rule is used, with 2 points the chord. A closed curve may
-    repeat its first point at the end (that row gets the first tangent). Raises ValueError
-    for NaN/inf, repeated consecutive points and cusps (the estimate vanishes), naming the
-    row.
+    repeat its first point at the end (that row gets the first tangent). ``lengths`` /
+    ``offsets``: many curves back to back, as in :func:`frames` (each curve estimated on
+    its own, in parallel; ``closed`` applies to every curve). Raises ValueError for NaN/inf,
+    repeated consecutive points and cusps (the estimate vanishes), naming the row (and the
+    curve, in a bundle).
     """
     method = as_choice(method, "method", TANGENT_RULES)
     pts = as_points(points, "points")
-    return _core.estimate_tangents(pts, as_bool(closed, "closed"), method)
+    closed = as_bool(closed, "closed")
+    if lengths is None and offsets is None:
+        return _core.estimate_tangents(pts, closed, method)
+    offs, _ = as_offsets(pts.shape[0], lengths, offsets)
+    return _core.estimate_tangents(pts, closed, method, offs)
 
 
 def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
@@ -373,12 +398,12 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     ev, ef = _orientation(end, "end", curves, bundle)
     if bundle and (offs[0] != 0 or offs[-1] != rows or np.any(np.diff(offs) < 0)):
         # the core names the rule that the lengths/offsets break
-        _core.frames_sampled(pts, tgs, offs, method, "five_point", False, closed, None, None,
-                             None, None, 0)
+        _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE, False, closed, None,
+                             None, None, None, 0)
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
                      previous, offs, bundle, rows)
-    return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, reflection == "tangents",
-                                closed, iv, if_, ev, ef, *steer)
+    return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
+                                reflection == "tangents", closed, iv, if_, ev, ef, *steer)
 
 
 def frames_in_time(
@@ -445,6 +470,6 @@ def frames_in_time(
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
-    out = _core.frames_in_time(flat(p), flat(tg), steps, method, reflection == "tangents",
-                               closed, iv, if_, turns, prev)
+    out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
+                               reflection == "tangents", closed, iv, if_, turns, prev)
     return out.reshape(steps, n, 3, 3)

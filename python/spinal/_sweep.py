@@ -7,10 +7,12 @@ import warnings
 import numpy as np
 
 from . import _core
+from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
 from ._frames import frames as _frames
 from ._mesh import FoldOverWarning, Mesh
 from ._validate import (
     as_bool,
+    as_choice,
     as_float_array,
     as_frames,
     as_int,
@@ -50,6 +52,8 @@ def sweep(
     strict: bool = False,
     lengths=None,
     offsets=None,
+    tangents=None,
+    tangent_rule: str = DEFAULT_TANGENT_RULE,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -97,6 +101,18 @@ def sweep(
     strict : bool
         Raise a ValueError instead of a :class:`FoldOverWarning` where the profile reaches
         past the spine's centre of curvature.
+    lengths, offsets : array_like of int, optional
+        Many spines back to back, as in :func:`spinal.frames`.
+    tangents : array_like (n, 3), optional
+        The spine's tangent directions (normalised here), instead of estimating them: the
+        default frames become ``spinal.frames(points, tangents, closed=closed)`` (double
+        reflection with these tangents, Wang et al. 2008 §4), whose ``t`` column they are.
+    tangent_rule : str
+        How the tangents are estimated when neither ``frames`` nor ``tangents`` is given:
+        a ``method`` of :func:`spinal.estimate_tangents` — ``"five_point_bounded"`` (default:
+        the 4th-order five-point chord-length rule whose end tangents lean from the end chord
+        by at most the turn of the last two chords, so coarse spines get no chisel-shaped
+        ends), ``"five_point"`` (ends unbounded), ``"five_point_uniform"`` or ``"circle"``.
 
     Returns
     -------
@@ -110,15 +126,44 @@ def sweep(
     ------
     ValueError, TypeError
         Bad shapes, non-finite values, repeated consecutive points, a self-intersecting or
-        zero-area profile, non-positive scale, frames that are not rotations, and
-        everything :func:`spinal.frames` refuses.
+        zero-area profile, non-positive scale, frames that are not rotations, tangents of the
+        wrong shape or of zero length, ``tangents``/``tangent_rule`` together with ``frames``
+        (or with each other), and everything :func:`spinal.frames` refuses.
     """
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
-                       miter_limit, split_seams, strict, lengths, offsets, "scale")
+                       miter_limit, split_seams, strict, lengths, offsets, "scale",
+                       tangents, tangent_rule)
+
+
+def _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule):
+    """The sweep's frames: given, or the RMF with the given or estimated tangents."""
+    rule = as_choice(tangent_rule, "tangent_rule", TANGENT_RULES)
+    n = pts.shape[0]
+    if frames is not None:
+        if tangents is not None or rule != DEFAULT_TANGENT_RULE:
+            which = "tangents" if tangents is not None else "tangent_rule"
+            raise TypeError(f"{which}: not used with frames= (the frames' t column is the "
+                            f"tangent)")
+        fr, _ = as_frames(frames, "frames", rows=n)
+        return fr
+    kw = {"offsets": offs} if bundle else {}
+    if tangents is not None:
+        if rule != DEFAULT_TANGENT_RULE:
+            raise TypeError("tangent_rule: not used with tangents= (they replace the estimate)")
+        tg = as_points(tangents, "tangents")
+        if tg.shape[0] != n:
+            raise ValueError(f"tangents: expected shape ({n}, 3) to match points, got "
+                             f"{tg.shape}")
+        return _frames(pts, tg, closed=closed, **kw)
+    if rule != DEFAULT_TANGENT_RULE:
+        tg = estimate_tangents(pts, closed=closed, method=rule, **kw)
+        return _frames(pts, tg, closed=closed, **kw)
+    return _frames(pts, closed=closed, **kw)
 
 
 def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
-                miter_limit, split_seams, strict, lengths, offsets, scale_arg) -> Mesh:
+                miter_limit, split_seams, strict, lengths, offsets, scale_arg,
+                tangents=None, tangent_rule=DEFAULT_TANGENT_RULE) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     pts = as_points(points, "points")
@@ -133,11 +178,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")
     offs, bundle = as_offsets(n, lengths, offsets)
-    if frames is None:
-        kw = {"offsets": offs} if bundle else {}
-        fr = _frames(pts, closed=closed, **kw)
-    else:
-        fr, _ = as_frames(frames, "frames", rows=n)
+    fr = _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule)
     sc = np.ones((n, 2)) if scale is None else as_per_row(scale, "scale", n, pair=True)
     tw = None if twist is None else as_per_row(twist, "twist", n)
     v, f, nrm, uv, folds = _core.sweep_mesh(
@@ -169,6 +210,8 @@ def tube(
     strict: bool = False,
     lengths=None,
     offsets=None,
+    tangents=None,
+    tangent_rule: str = DEFAULT_TANGENT_RULE,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -176,7 +219,8 @@ def tube(
 
     The cross-section is the inscribed polygon, of area ``(sides/2) ρ² sin(2π/sides)``.
     ``radius``: scalar or (n,) positive values (one per spine row); the normals are tilted
-    by the radius slope. Other arguments as in :func:`sweep`.
+    by the radius slope. Other arguments (``tangents``, ``tangent_rule`` included) as in
+    :func:`sweep`.
     """
     sides = as_int(sides, "sides")
     if sides < 3:  # the core sees only the polygon built here
@@ -186,4 +230,4 @@ def tube(
     pts = as_points(points, "points")
     rad = as_per_row(radius, "radius", pts.shape[0])  # the core checks it, naming radius
     return _sweep_mesh(pts, profile, frames, rad, None, closed, caps, True, miter_limit,
-                       split_seams, strict, lengths, offsets, "radius")
+                       split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule)

@@ -516,7 +516,7 @@ pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
     let tangents = crate::frames::tangents::estimate_rows(
         points,
         false,
-        crate::frames::TangentRule::FivePoint,
+        crate::frames::TangentRule::FivePointBounded,
     )?;
     let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1]);
     Ok(points

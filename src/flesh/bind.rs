@@ -30,9 +30,16 @@ pub struct Binding {
 }
 
 /// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
-/// steps, each refined by the Illinois variant of regula falsi to full precision.
+/// steps, each refined by the Illinois variant of regula falsi to full precision. A point
+/// on the section plane of a sample (`f` zero at `a = 0` or `a = 1` up to the round-off of
+/// its evaluation) is a root there, so that it is not lost between two edges whose end
+/// values round to the same sign.
 fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
     let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
+    let on_plane = |a: f64, fa: f64| {
+        let c = sp.c_at(k, a);
+        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * sp.m_at(k, a).length()
+    };
     let mut out = [f64::NAN; 4];
     let mut prev = (0.0, f(0.0));
     for (i, slot) in out.iter_mut().enumerate() {
@@ -40,11 +47,14 @@ fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
         let fb = f(b);
         let (mut a0, mut f0) = prev;
         prev = (b, fb);
-        if f0 == 0.0 {
+        if f0 == 0.0 || (i == 0 && on_plane(0.0, f0)) {
             *slot = a0;
             continue;
         }
         if (f0 > 0.0) == (fb > 0.0) {
+            if i == 3 && on_plane(1.0, fb) {
+                *slot = 1.0;
+            }
             continue;
         }
         let (mut a1, mut f1) = (b, fb);
@@ -87,15 +97,15 @@ fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
 fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
     let n = sp.len();
     let mut best = (f64::INFINITY, 0usize, 0.0f64, 0.0f64);
-    // straight extensions past both ends
+    // straight extensions past both ends (a loop has none)
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
-    if tau < 0.0 {
+    if tau < 0.0 && !sp.closed {
         best = ((w - tau * sp.t[0]).length_squared(), 0, 0.0, tau);
     }
     let w = p - sp.c[n - 1];
     let tau = w.dot(sp.t[n - 1]);
-    if tau > 0.0 {
+    if tau > 0.0 && !sp.closed {
         let d2 = (w - tau * sp.t[n - 1]).length_squared();
         if d2 < best.0 {
             best = (d2, n - 2, 1.0, tau);
@@ -171,4 +181,68 @@ pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
             c.copy_from_slice(&[a, tau, d.dot(l.u), d.dot(l.v), l.sigma, kappa.x, kappa.y]);
         });
     Ok(Binding { edge, coords })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A circle of `n` samples as a loop (first row repeated), with its RMF (`r` the
+    /// binormal z all along, which closes).
+    fn circle(n: usize) -> (Vec<DVec3>, Vec<f64>) {
+        let mut pts = Vec::new();
+        let mut frames = Vec::new();
+        for i in 0..=n {
+            let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+            let (s, c) = a.sin_cos();
+            pts.push(DVec3::new(c, s, 0.0));
+            let (r, t) = (DVec3::Z, DVec3::new(-s, c, 0.0));
+            let q = t.cross(r);
+            // row-major (n, 3, 3), columns r, s, t
+            frames.extend_from_slice(&[r.x, q.x, t.x, r.y, q.y, t.y, r.z, q.z, t.z]);
+        }
+        (pts, frames)
+    }
+
+    #[test]
+    fn loops_bind_on_the_closing_edge_and_on_sample_planes() {
+        let (pts, frames) = circle(12);
+        let sp = SpineModel::new("rest_spine", &pts, &frames, true).unwrap();
+        // the curvature at the seam is that of every other sample, from both sides
+        let inner = sp.eval(6, 0.0).kappa.length();
+        assert!((inner - 1.0).abs() < 0.04);
+        for (k, a) in [(0, 0.0), (11, 1.0)] {
+            let l = sp.eval(k, a);
+            assert!(
+                (l.kappa.length() - inner).abs() < 1e-12,
+                "{k} {a}: {}",
+                l.kappa
+            );
+        }
+        // points in the closing edge's slab, on sample planes (angle π: sample 6), and
+        // outside the ring: never past an end
+        for ang in [-0.2_f64, -0.01, 0.0, std::f64::consts::PI, 1.3] {
+            for rad in [0.7, 1.25] {
+                let p = DVec3::new(rad * ang.cos(), rad * ang.sin(), 0.1);
+                let b = bind(&sp, &[p]).unwrap();
+                let (k, a, tau) = (b.edge[0] as usize, b.coords[0], b.coords[1]);
+                assert_eq!(tau, 0.0);
+                let l = sp.eval(k, a);
+                let d = p - l.q;
+                assert!(
+                    d.dot(l.t).abs() < 1e-12 && d.length() < 0.35,
+                    "{ang} {rad}: {k} {a}"
+                );
+                if ang < 0.0 {
+                    assert_eq!(k, 11);
+                }
+            }
+        }
+        // an open spine's point past its end extends the end instead
+        let open = SpineModel::new("rest_spine", &pts[..7], &frames[..63], false).unwrap();
+        let b = bind(&open, &[DVec3::new(-1.0, -0.2, 0.0)]).unwrap();
+        assert!(b.coords[1] > 0.0);
+        // a loop must repeat its first point
+        assert!(SpineModel::new("rest_spine", &pts[..12], &frames[..108], true).is_err());
+    }
 }

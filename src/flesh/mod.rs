@@ -20,6 +20,18 @@
 //! curvature is continuous across samples, so is the map (up to the O(h³) jump of the speed
 //! ratio); points beyond the end planes use the straight extension of the end (κ = 0).
 //!
+//! **Loops** (`closed`): the spine is given with its first sample and frame repeated at the
+//! end, so the closing edge is an edge like the others; the sample curvature at the seam is
+//! the central difference across it, and there are no ends to extend. The frames are the
+//! RMF with its closing angle spread linearly in arc length (Wang et al. §6.3), so the
+//! sections meet across the seam.
+//!
+//! **The posed frames** are an input: the unbend–transfer–bend map carries the offset's
+//! coordinates from the rest frame to whatever frame the posed spine gets, so the roll of
+//! the posed spine about its tangent (which Zhuo 2014 leaves open; a best fit cannot recover
+//! it for a straight spine) can come from the caller — a rigid motion's frames give a rigid
+//! result, a rig's frames roll the shape — without changing the volume element.
+//!
 //! Registration (bind) is brute force over the edges with pruning, `O(V n)`; deformation is
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
 

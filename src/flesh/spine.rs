@@ -28,13 +28,17 @@ pub struct SpineModel {
     pub p: Vec<Power>,
     /// Per edge: `r_{k+1}` carried back to `t_k` by the minimal rotation.
     pub rb: Vec<DVec3>,
+    /// A loop: the last sample repeats the first (the closing edge is the last edge) and
+    /// there are no ends to extend.
+    pub closed: bool,
 }
 
 /// Sample curvature vectors: central differences of the unit tangents in chord length,
-/// made normal to the tangent (one-sided at the ends).
-fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
+/// made normal to the tangent (one-sided at the ends; across the seam of a loop, whose last
+/// sample repeats the first).
+fn curvatures(c: &[DVec3], t: &[DVec3], closed: bool) -> Vec<DVec3> {
     let n = c.len();
-    (0..n)
+    let mut kv: Vec<DVec3> = (0..n)
         .map(|j| {
             let (a, b) = (j.saturating_sub(1), (j + 1).min(n - 1));
             let mut len = 0.0;
@@ -44,7 +48,15 @@ fn curvatures(c: &[DVec3], t: &[DVec3]) -> Vec<DVec3> {
             let k = (t[b] - t[a]) / len;
             k - t[j] * t[j].dot(k)
         })
-        .collect()
+        .collect();
+    if closed && n >= 3 {
+        // neighbours of the seam sample: n − 2 before it, 1 after it
+        let len = (c[1] - c[0]).length() + (c[n - 1] - c[n - 2]).length();
+        let k = (t[1] - t[n - 2]) / len;
+        kv[0] = k - t[0] * t[0].dot(k);
+        kv[n - 1] = kv[0];
+    }
+    kv
 }
 
 /// The spine evaluated at `(k, a)`.
@@ -66,12 +78,26 @@ pub struct Local {
 
 impl SpineModel {
     /// `frames` is row-major `(n, 3, 3)` with columns `(r, s, t)` (the layout of the crate).
-    pub fn new(arg: &'static str, points: &[DVec3], frames: &[f64]) -> Result<SpineModel> {
+    /// `closed`: the spine is a loop given with its first sample (and frame) repeated at the
+    /// end, so the closing edge is the last one.
+    pub fn new(
+        arg: &'static str,
+        points: &[DVec3],
+        frames: &[f64],
+        closed: bool,
+    ) -> Result<SpineModel> {
         let n = points.len();
-        if n < 2 {
+        let min = if closed { 4 } else { 2 };
+        if n < min {
             return Err(InputError::new(
                 arg,
-                format!("need at least 2 points, got {n}"),
+                format!("need at least {min} points, got {n}"),
+            ));
+        }
+        if closed && points[0] != points[n - 1] {
+            return Err(InputError::new(
+                arg,
+                "a loop must repeat its first point at the end",
             ));
         }
         if frames.len() != 9 * n {
@@ -108,7 +134,7 @@ impl SpineModel {
                 ));
             }
         }
-        let kv = curvatures(points, &t);
+        let kv = curvatures(points, &t, closed);
         let mut m = Vec::with_capacity(n - 1);
         let mut pc = Vec::with_capacity(n - 1);
         for k in 0..n - 1 {
@@ -144,6 +170,7 @@ impl SpineModel {
             m,
             p: pc,
             rb,
+            closed,
         })
     }
 
@@ -238,6 +265,12 @@ impl SpineModel {
 /// needs ≥ 2 distinct consecutive points and the chords must be positive (errors name
 /// `posed_spine` and `rest_spine`, whose chords they are).
 pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec<DVec3>> {
+    check_walk(posed, chords)?;
+    Ok(walk_chords(posed, chords))
+}
+
+/// The input checks of [`compass_walk`].
+fn check_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<()> {
     use crate::error::InputError;
     if posed.len() < 2 {
         return Err(InputError::new(
@@ -251,14 +284,35 @@ pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec
             format!("chord {i} is not positive and finite"),
         ));
     }
-    Ok(walk_chords(posed, chords))
+    Ok(())
+}
+
+/// [`compass_walk`], with the polyline position `k + u` of every point (on edge `k` of
+/// `posed` at the fraction `u`; `u > 1` past the end, along the last edge).
+pub fn compass_walk_located(
+    posed: &[DVec3],
+    chords: &[f64],
+) -> crate::error::Result<(Vec<DVec3>, Vec<f64>)> {
+    check_walk(posed, chords)?;
+    let mut at = Vec::with_capacity(chords.len() + 1);
+    let pts = walk(posed, chords, &mut at);
+    Ok((pts, at))
 }
 
 /// The walk of [`compass_walk`] on checked input.
 fn walk_chords(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
+    walk(posed, chords, &mut Vec::new())
+}
+
+/// The walk; pushes the polyline positions onto `at` when it is given with capacity.
+fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Vec<DVec3> {
+    let record = at.capacity() > 0;
     let mut out = Vec::with_capacity(chords.len() + 1);
     let mut c = posed[0];
     out.push(c);
+    if record {
+        at.push(0.0);
+    }
     let last = posed.len() - 2;
     let mut seg = 0;
     for &h in chords {
@@ -271,6 +325,9 @@ fn walk_chords(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
             let disc = (ec * ec - ee * cc).max(0.0);
             let t = (-ec + disc.sqrt()) / ee;
             if t <= 1.0 || seg == last {
+                if record {
+                    at.push(seg as f64 + t);
+                }
                 break a + t * e;
             }
             seg += 1;

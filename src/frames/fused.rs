@@ -60,7 +60,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
         || req.closed
         || !matches!(req.method, Method::DoubleReflection | Method::Rotation)
         || req.tangent_chords
-        || (given.is_none() && req.tangent_rule != TangentRule::FivePoint)
+        || (given.is_none() && req.tangent_rule != TangentRule::FivePointBounded)
         || n < 5
         || out.len() != 9 * n
     {

@@ -98,7 +98,7 @@ impl Default for Request<'_> {
             closed: false,
             method: Method::DoubleReflection,
             tangent_chords: false,
-            tangent_rule: TangentRule::FivePoint,
+            tangent_rule: TangentRule::FivePointBounded,
             initial: None,
             end: None,
             turns: 0,
@@ -966,7 +966,7 @@ mod tests {
                 })
                 .expect("valid curve");
                 assert_rotations(&out, 1e-12);
-                let est = tangents::estimate_rows(&x, closed, TangentRule::FivePoint)
+                let est = tangents::estimate_rows(&x, closed, TangentRule::FivePointBounded)
                     .expect("regular curve");
                 for (i, e) in est.iter().enumerate() {
                     assert!(

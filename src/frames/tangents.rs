@@ -9,6 +9,16 @@
 //!   where index-based stencils can even point backwards. Guard: where it turns more than
 //!   60° away from the circle estimate below (the quartic overshooting at a kink next to
 //!   very uneven chords), the circle estimate is used instead.
+//! * Bounded ends (the default rule, `FivePointBounded`): the five-point chord-length rule
+//!   with each open end tangent kept inside the cone about the end chord `ĉ` whose
+//!   half-angle is the turn `φ` between the end chord and its neighbour (the discrete
+//!   curvature at the end, `φ ≈ κh`); a tangent leaning further is turned towards `ĉ` onto
+//!   the cone, in the plane of `ĉ` and the tangent. On a smooth curve the exact end tangent
+//!   leans `κh/2 + O(h²)` from the end chord, half the cone, so fine samplings keep the 4th
+//!   order untouched; on coarse samplings (20-point streamlines) the one-sided quartic
+//!   extrapolates the last bends and overshoots, which made chisel-shaped tube ends. (The
+//!   cone is ours: Wang et al. §6.1 give only the one-sided stencils; the circle rule of
+//!   Zheng §7.1 at an end leans exactly by the circle's half-turn, inside the same cone.)
 //! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
 //!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
 //!   samples come from a uniform step of a smooth parameterisation):
@@ -41,6 +51,9 @@ pub enum TangentRule {
     /// Five-point chord-length Lagrange derivative (4th order, any spacing) where there are
     /// at least 5 points, else the circle rule (3–4 points) or the chord (2 points).
     FivePoint,
+    /// [`TangentRule::FivePoint`] with bounded open ends (the default): an end tangent leans
+    /// from the end chord by at most the turn between the last two chords.
+    FivePointBounded,
     /// The uniform five-point stencils of the TOG paper (index as parameter).
     FivePointUniform,
     /// Circle through three consecutive points (2nd order), chord for 2 points.
@@ -237,6 +250,7 @@ pub fn estimate(
         ));
     }
     let five = rule != TangentRule::Circle && n >= 5;
+    let chordal = matches!(rule, TangentRule::FivePoint | TangentRule::FivePointBounded);
     // Estimate and normalise in one pass; a zero (or non-finite) estimate is a cusp. The open
     // ends of the circle rule are zero here and filled below.
     let mut t = Vec::with_capacity(n);
@@ -244,15 +258,20 @@ pub fn estimate(
         .into_par_iter()
         .with_min_len(1 << 12)
         .map(|i| {
-            if five && rule == TangentRule::FivePoint && !closed {
-                return five_point_unit_open(x, i, |j| chords[j]).unwrap_or(DVec3::ZERO);
+            if five && chordal && !closed {
+                let u = if rule == TangentRule::FivePointBounded {
+                    five_point_unit_open(x, i, |j| chords[j])
+                } else {
+                    five_point_unit_unbounded(x, i, |j| chords[j])
+                };
+                return u.unwrap_or(DVec3::ZERO);
             }
             let v = raw_tangent(x, chords, i, closed, rule, five);
             let l = v.length();
             let u = v * (1.0 / l);
             if !(l > 0.0 && u.is_finite()) {
                 DVec3::ZERO
-            } else if five && rule == TangentRule::FivePoint {
+            } else if five && chordal {
                 guard_overshoot(x, i, closed, u)
             } else {
                 u
@@ -272,12 +291,54 @@ pub fn estimate(
     }
 }
 
-/// The unit five-point chord-length tangent at `i` of an open curve with `n ≥ 5` samples,
-/// guarded against overshoot: what [`estimate`] returns there. `h(j)` is the chord length
-/// `|x_{j+1} − x_j|` (callers pass a table or compute it on the fly: the values must be those
-/// of `validate::chords`). `None` where the estimate vanishes (a cusp).
+/// The unit tangent of the default rule ([`TangentRule::FivePointBounded`]) at `i` of an open
+/// curve with `n ≥ 5` samples: the guarded five-point chord-length tangent, its two end
+/// values bounded by the turn of the end chords ([`bound_end`]); what [`estimate`] returns
+/// there. `h(j)` is the chord length `|x_{j+1} − x_j|` (callers pass a table or compute it on
+/// the fly: the values must be those of `validate::chords`). `None` where the estimate
+/// vanishes (a cusp).
 #[inline(always)]
 pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> Option<DVec3> {
+    let u = five_point_unit_unbounded(x, i, h)?;
+    Some(if i == 0 || i + 1 == x.len() {
+        bound_end(x, i, u)
+    } else {
+        u
+    })
+}
+
+/// The end tangent `u` at the open end `i` (0 or n − 1, `n ≥ 3`), turned towards the end
+/// chord `ĉ` onto the cone of half-angle `φ = ∠(ĉ, p̂)` about it (`p̂` the neighbouring chord)
+/// where it leans further than `φ`; unchanged inside the cone.
+#[inline]
+pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
+    let n = x.len();
+    let (c, p) = if i == 0 {
+        (x[1] - x[0], x[2] - x[1])
+    } else {
+        (x[n - 1] - x[n - 2], x[n - 2] - x[n - 3])
+    };
+    let (Some(c), Some(p)) = (c.try_normalize(), p.try_normalize()) else {
+        return u;
+    };
+    let cos_phi = c.dot(p);
+    if u.dot(c) >= cos_phi {
+        return u;
+    }
+    // the direction of the lean in the normal plane of ĉ; for a tangent along −ĉ, the turn
+    // of the chords continued (away from p̂), or any normal on a straight end
+    let side = (u - u.dot(c) * c)
+        .try_normalize()
+        .or_else(|| (c * cos_phi - p).try_normalize())
+        .unwrap_or_else(|| super::geometry::any_perpendicular(c));
+    let sin_phi = c.cross(p).length();
+    (cos_phi * c + sin_phi * side).normalize_or(c)
+}
+
+/// The guarded five-point chord-length tangent of [`TangentRule::FivePoint`] at `i` of an
+/// open curve (`n ≥ 5`), ends unbounded; see [`five_point_unit_open`].
+#[inline(always)]
+pub fn five_point_unit_unbounded(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> Option<DVec3> {
     let n = x.len();
     let v = if i >= 2 && i + 2 < n {
         centred_five_point(
@@ -365,7 +426,7 @@ fn raw_tangent(
     let n = x.len();
     if n == 2 {
         x[1] - x[0]
-    } else if five && rule == TangentRule::FivePoint {
+    } else if five && rule != TangentRule::FivePointUniform {
         if i >= 2 && i + 2 < n {
             centred_five_point(
                 [x[i - 2], x[i - 1], x[i], x[i + 1], x[i + 2]],
@@ -397,6 +458,37 @@ pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec
         t.push(t[0]);
     }
     Ok(t)
+}
+
+/// Unit tangents of many curves stored back to back (`offsets`: C + 1 start rows ending at
+/// `x.len()`), each as [`estimate_rows`] gives it, curves in parallel. Errors name the curve
+/// and its rows when there are several.
+pub fn estimate_many(
+    x: &[DVec3],
+    offsets: &[usize],
+    closed: bool,
+    rule: TangentRule,
+) -> Result<Vec<DVec3>> {
+    crate::frames::validate::offsets(offsets, x.len())?;
+    let curves = offsets.len() - 1;
+    let parts: Vec<Result<Vec<DVec3>>> = (0..curves)
+        .into_par_iter()
+        .map(|c| {
+            let (a, b) = (offsets[c], offsets[c + 1]);
+            estimate_rows(&x[a..b], closed, rule).map_err(|e| {
+                if curves > 1 {
+                    e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
+                } else {
+                    e
+                }
+            })
+        })
+        .collect();
+    let mut out = Vec::with_capacity(x.len());
+    for p in parts {
+        out.extend(p?);
+    }
+    Ok(out)
 }
 
 /// Normalise in place; on a zero or non-finite result returns the first bad index.
@@ -611,6 +703,63 @@ mod tests {
         for k in 0..5 {
             assert!((w[k][1] - d1[k]).abs() < 1e-15 && (w[k][2] - d2[k]).abs() < 1e-14);
         }
+    }
+
+    #[test]
+    fn bounded_ends_stay_in_the_cone_and_keep_the_order() {
+        // a coarse sampling whose one-sided quartic overshoots at the ends
+        let x: Vec<DVec3> = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [2.0, 0.3, 0.1],
+            [3.0, 0.6, 0.1],
+            [4.0, 1.0, 0.3],
+            [4.6, 1.8, 0.7],
+        ]
+        .iter()
+        .map(|&p| DVec3::from_array(p))
+        .collect();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        let n = x.len();
+        let mut acted = 0;
+        for (i, c, p) in [
+            (0, x[1] - x[0], x[2] - x[1]),
+            (n - 1, x[n - 1] - x[n - 2], x[n - 2] - x[n - 3]),
+        ] {
+            let (c, p) = (c.normalize(), p.normalize());
+            let turn = c.angle_between(p);
+            assert!(b[i].angle_between(c) <= turn + 1e-12, "{i}");
+            if a[i].angle_between(c) > turn {
+                acted += 1;
+                // on the cone, leaning to the same side as the unbounded tangent
+                assert!((b[i].angle_between(c) - turn).abs() < 1e-12);
+                assert!(c.cross(a[i]).normalize().dot(c.cross(b[i]).normalize()) > 1.0 - 1e-12);
+            }
+        }
+        assert!(acted > 0);
+        for i in 1..n - 1 {
+            assert_eq!(a[i], b[i]);
+        }
+        // fine samplings: the bound never acts
+        let x: Vec<DVec3> = (0..=200).map(|i| helix(i as f64 * 0.015)).collect();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn many_curves_name_the_curve() {
+        let x: Vec<DVec3> = (0..9).map(|i| helix(i as f64 * 0.3)).collect();
+        let t = estimate_many(&x, &[0, 4, 9], false, TangentRule::FivePointBounded).unwrap();
+        assert_eq!(
+            &t[..4],
+            &estimate_rows(&x[..4], false, TangentRule::FivePointBounded).unwrap()[..]
+        );
+        let mut y = x.clone();
+        y[6] = y[5];
+        let e = estimate_many(&y, &[0, 4, 9], false, TangentRule::FivePointBounded).unwrap_err();
+        assert!(e.to_string().contains("curve 1 (rows 4 to 8)"), "{e}");
     }
 
     #[test]

@@ -7,34 +7,39 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, slice_mut, slice_of, vec3_array, vec3s};
+use super::convert::{detach_in_pool, empty, slice_mut, slice_of, vec3_array, vec3s};
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
 type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
+type Resampled<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// A spine from its points `(n, 3)` and frames `(n, 3, 3)`, both named `arg`.
+/// A spine from its points `(n, 3)` and frames `(n, 3, 3)`, both named `arg` (`closed`: a
+/// loop with its first row repeated at the end).
 fn spine_of<'py>(
     arg: &'static str,
     points: &PyReadonlyArray2<'py, f64>,
     frames: &PyReadonlyArray3<'py, f64>,
+    closed: bool,
 ) -> PyResult<flesh::SpineModel> {
     let pts = vec3s(arg, points)?;
     let fr = slice_of(arg, frames)?;
-    Ok(flesh::SpineModel::new(arg, pts, fr)?)
+    Ok(flesh::SpineModel::new(arg, pts, fr, closed)?)
 }
 
 /// Register vertices on a rest spine; see `spinal.SpineBinding`.
 #[pyfunction]
+#[pyo3(signature = (rest_points, rest_frames, vertices, closed=false))]
 pub fn flesh_bind<'py>(
     py: Python<'py>,
     rest_points: PyReadonlyArray2<'py, f64>,
     rest_frames: PyReadonlyArray3<'py, f64>,
     vertices: PyReadonlyArray2<'py, f64>,
+    closed: bool,
 ) -> PyResult<FleshBinding<'py>> {
-    let rest = spine_of("rest_spine", &rest_points, &rest_frames)?;
+    let rest = spine_of("rest_spine", &rest_points, &rest_frames, closed)?;
     let v = vec3s("vertices", &vertices)?;
-    let b = py.detach(|| flesh::bind(&rest, v))?;
+    let b = detach_in_pool(py, || flesh::bind(&rest, v))??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
     Ok((PyArray1::from_vec(py, b.edge), coords))
@@ -42,7 +47,8 @@ pub fn flesh_bind<'py>(
 
 /// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
 #[pyfunction]
-#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist))]
+#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn flesh_deform<'py>(
     py: Python<'py>,
     posed_points: PyReadonlyArray2<'py, f64>,
@@ -51,8 +57,9 @@ pub fn flesh_deform<'py>(
     coords: PyReadonlyArray2<'py, f64>,
     solution: Solution,
     twist: Option<PyReadonlyArray1<'py, f64>>,
+    closed: bool,
 ) -> PyResult<FleshPose<'py>> {
-    let posed = spine_of("posed_spine", &posed_points, &posed_frames)?;
+    let posed = spine_of("posed_spine", &posed_points, &posed_frames, closed)?;
     let edge = slice_of("edge", &edge)?;
     let coords = slice_of("coords", &coords)?;
     let tw: &[f64] = match &twist {
@@ -65,22 +72,25 @@ pub fn flesh_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        py.detach(|| flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags))?;
+        detach_in_pool(py, || {
+            flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags)
+        })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
 }
 
-/// Compass-walk resampling of a posed spine; see `spinal.SpineBinding.posed_spine`.
+/// Compass-walk resampling of a posed spine; see `spinal.SpineBinding.posed_spine`. Returns
+/// the points and their positions `k + u` on the input polyline.
 #[pyfunction]
 pub fn flesh_resample<'py>(
     py: Python<'py>,
     posed_points: PyReadonlyArray2<'py, f64>,
     chords: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
+) -> PyResult<Resampled<'py>> {
     let pts = vec3s("posed_spine", &posed_points)?;
     let ch = slice_of("chords", &chords)?;
-    let out = py.detach(|| flesh::spine::compass_walk(pts, ch))?;
-    vec3_array(py, out)
+    let (out, at) = detach_in_pool(py, || flesh::spine::compass_walk_located(pts, ch))??;
+    Ok((vec3_array(py, out)?, PyArray1::from_vec(py, at)))
 }
 
 /// The rotation matrix by the smallest angle taking unit `t0` to unit `t1` (a half turn for
@@ -108,10 +118,10 @@ pub fn flesh_surface_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let pts = vec3s("rest_surface", &rest_points)?;
     let v = vec3s("vertices", &vertices)?;
-    let (cell, coords) = py.detach(|| {
+    let (cell, coords) = detach_in_pool(py, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
         surface::bind_surface(&rest, v)
-    })?;
+    })??;
     let n = cell.len();
     let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
     Ok((PyArray1::from_vec(py, cell), coords))
@@ -137,10 +147,10 @@ pub fn flesh_surface_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        py.detach(|| {
+        detach_in_pool(py, || {
             let posed = surface::Surface::new("posed_surface", pts, nu, nv)?;
             surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
-        })?;
+        })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
 }

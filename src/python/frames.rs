@@ -8,7 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    empty, offsets_of, orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
+    detach_in_pool, empty, offsets_of, orientations, renamed, slice_mut, slice_of, value_error,
+    vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
@@ -62,8 +63,10 @@ pub fn frames_sampled<'py>(
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| frames::compute_many(&template, &offsets, &initial, &end, buf))
-            .map_err(|e| renamed(e, "points", points_arg))?
+        detach_in_pool(py, || {
+            frames::compute_many(&template, &offsets, &initial, &end, buf)
+        })?
+        .map_err(|e| renamed(e, "points", points_arg))?
     };
     Ok((out, PyArray1::from_vec(py, angles)))
 }
@@ -112,21 +115,31 @@ pub fn frames_analytic<'py>(
     let angle = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| frames::compute_into(&req, buf))?
+        detach_in_pool(py, || frames::compute_into(&req, buf))??
     };
     Ok((out, angle))
 }
 
-/// Unit tangents estimated from points (one curve).
+/// Unit tangents estimated from points: one curve, or many back to back (`offsets`).
 #[pyfunction]
+#[pyo3(signature = (points, closed, rule, offsets=None))]
 pub fn estimate_tangents<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
     closed: bool,
     rule: TangentRule,
+    offsets: Option<PyReadonlyArray1<'py, i64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let x = vec3s("points", &points)?;
-    let t = py.detach(|| frames::tangents::estimate_rows(x, closed, rule))?;
+    let t = match offsets {
+        None => detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??,
+        Some(o) => {
+            let offs = offsets_of(&o)?;
+            detach_in_pool(py, || {
+                frames::tangents::estimate_many(x, &offs, closed, rule)
+            })??
+        }
+    };
     vec3_array(py, t)
 }
 
@@ -136,7 +149,7 @@ pub fn estimate_tangents<'py>(
 /// the vector `con_vectors[k]` or, where `con_is_frame[k]`, the frame `con_frames[k]`. An
 /// analytic curve (one) passes `u`, `d1`, `d2` as in [`frames_analytic`].
 #[pyfunction]
-#[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_chords, closed,
+#[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
                     con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
                     guide, guide_weight, guide_tolerance, previous, points_arg="points"))]
@@ -150,6 +163,7 @@ pub fn frames_steered<'py>(
     d1: Option<PyReadonlyArray2<'py, f64>>,
     d2: Option<PyReadonlyArray2<'py, f64>>,
     method: Method,
+    tangent_rule: TangentRule,
     tangent_chords: bool,
     closed: bool,
     initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
@@ -276,7 +290,7 @@ pub fn frames_steered<'py>(
         closed,
         method,
         tangent_chords,
-        tangent_rule: TangentRule::FivePoint,
+        tangent_rule,
         initial: None,
         end: None,
         turns: 0,
@@ -297,11 +311,11 @@ pub fn frames_steered<'py>(
                 ..template
             };
             let st = steering[0];
-            py.detach(|| steer::compute_steered(&req, &st, buf))?;
+            detach_in_pool(py, || steer::compute_steered(&req, &st, buf))??;
         } else {
-            py.detach(|| {
+            detach_in_pool(py, || {
                 steer::compute_steered_many(&template, &offsets, &initial, &end, &steering, buf)
-            })
+            })?
             .map_err(|e| renamed(e, "points", points_arg))?;
         }
     }
@@ -311,8 +325,8 @@ pub fn frames_steered<'py>(
 /// Frames of a curve moving in time, `(T, n, 3)` points (and tangents) flattened to
 /// `(T·n, 3)`: each step's RMF, turned to be closest to the step before.
 #[pyfunction]
-#[pyo3(signature = (points, tangents, steps, method, tangent_chords, closed, initial_vectors,
-                    initial_frames, turns, previous))]
+#[pyo3(signature = (points, tangents, steps, method, tangent_rule, tangent_chords, closed,
+                    initial_vectors, initial_frames, turns, previous))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_in_time<'py>(
     py: Python<'py>,
@@ -320,6 +334,7 @@ pub fn frames_in_time<'py>(
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     steps: usize,
     method: Method,
+    tangent_rule: TangentRule,
     tangent_chords: bool,
     closed: bool,
     initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
@@ -350,6 +365,7 @@ pub fn frames_in_time<'py>(
         closed,
         method,
         tangent_chords,
+        tangent_rule,
         turns,
         ..Request::default()
     };
@@ -357,7 +373,7 @@ pub fn frames_in_time<'py>(
     {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| {
+        detach_in_pool(py, || {
             frames::time::frames_in_time(
                 &template,
                 steps,
@@ -366,7 +382,7 @@ pub fn frames_in_time<'py>(
                 prev,
                 buf,
             )
-        })
+        })?
         .map_err(|e| match e.arg {
             "tangents" => renamed(e, "tangents", "tangents_t"),
             _ => renamed(e, "points", "points_t"),

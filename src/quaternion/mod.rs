@@ -256,7 +256,7 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
         ));
     }
     let Some(t) = t else {
-        return tangent_estimate::estimate_rows(x, closed, TangentRule::FivePoint);
+        return tangent_estimate::estimate_rows(x, closed, TangentRule::FivePointBounded);
     };
     if t.len() != x.len() {
         return Err(InputError::new(
