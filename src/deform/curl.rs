@@ -242,8 +242,42 @@ impl Pose {
     /// The distance and its world gradient at `x` for the shape at this pose.
     #[inline(always)]
     pub fn distance<D: Distance>(&self, shape: &D, x: DVec3) -> Option<(f64, DVec3)> {
-        let xb = shape.center() + self.q.transpose() * (x - self.c);
-        shape.distance(xb).map(|(d, g)| (d, self.q * g))
+        self.distance_as::<D, true>(shape, x)
+    }
+
+    /// [`Self::distance`]; with `TURNED` false the orientation is taken as the identity
+    /// (the same values for a pose with `q = I`, without the two matrix products).
+    #[inline(always)]
+    pub fn distance_as<D: Distance, const TURNED: bool>(
+        &self,
+        shape: &D,
+        x: DVec3,
+    ) -> Option<(f64, DVec3)> {
+        if TURNED {
+            let xb = shape.center() + self.q.transpose() * (x - self.c);
+            shape.distance(xb).map(|(d, g)| (d, self.q * g))
+        } else {
+            shape.distance(shape.center() + (x - self.c))
+        }
+    }
+
+    /// `out[j] += f(p[j])` with `f = eval::<TURNED>`, `TURNED` false when the orientation is
+    /// the identity (checked once per batch).
+    #[inline(always)]
+    pub fn add_lanes<F, G>(&self, p: &[DVec3], out: &mut [DVec3], turned: F, plain: G)
+    where
+        F: Fn(DVec3) -> DVec3,
+        G: Fn(DVec3) -> DVec3,
+    {
+        if self.q == DMat3::IDENTITY {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += plain(*x);
+            }
+        } else {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += turned(*x);
+            }
+        }
     }
 }
 
@@ -310,7 +344,13 @@ impl<D: Distance + Clone + Into<Shape>> CurlTool<D> {
     /// The velocity at `x` with the shape at `pose`.
     #[inline(always)]
     pub fn eval_at(&self, x: DVec3, pose: &Pose) -> DVec3 {
-        let Some((d, g)) = pose.distance(&self.shape, x) else {
+        self.eval_as::<true>(x, pose)
+    }
+
+    /// [`Self::eval_at`], the pose's orientation taken as the identity unless `TURNED`.
+    #[inline(always)]
+    fn eval_as<const TURNED: bool>(&self, x: DVec3, pose: &Pose) -> DVec3 {
+        let Some((d, g)) = pose.distance_as::<D, TURNED>(&self.shape, x) else {
             return DVec3::ZERO;
         };
         let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
@@ -372,9 +412,12 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, _tm: f64, out: &mut [DVec3]) {
         let pose = self.pose(t);
-        for (o, x) in out.iter_mut().zip(p) {
-            *o += self.eval_at(*x, &pose);
-        }
+        pose.add_lanes(
+            p,
+            out,
+            |x| self.eval_as::<true>(x, &pose),
+            |x| self.eval_as::<false>(x, &pose),
+        );
     }
     #[inline]
     fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {

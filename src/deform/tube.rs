@@ -287,6 +287,14 @@ impl Axis {
     /// segment or an end cap), if any.
     #[inline]
     pub fn closest(&self, x: DVec3, outer: f64) -> Option<Foot> {
+        self.closest_point(x, outer).map(|(f, _)| f)
+    }
+
+    /// [`Self::closest`] with the foot's point. `F_k = (X − x_k)·m_k` is evaluated once per
+    /// sample; a segment is a candidate only where `F` changes sign from `≥ 0` to `< 0` across
+    /// it (then the bounding-sphere cull, then Newton), an end cap only beyond its plane.
+    #[inline]
+    pub fn closest_point(&self, x: DVec3, outer: f64) -> Option<(Foot, DVec3)> {
         let o2 = outer * outer;
         let n = self.samples.len();
         let lim = self.bound + outer;
@@ -295,35 +303,36 @@ impl Axis {
         }
         let mut best = o2;
         let mut hit = None;
-        for (k, seg) in self.segs.iter().enumerate() {
-            let lim = seg.radius + outer;
-            if (x - seg.centre).length_squared() >= lim * lim {
-                continue;
+        let p0 = &self.samples[0];
+        let mut f0 = (x - p0.x).dot(p0.m);
+        if f0 < 0.0 {
+            let r2 = (x - p0.x).length_squared();
+            if r2 < best {
+                best = r2;
+                hit = Some((Foot::Cap(0), p0.x));
             }
-            let (p0, p1) = (&self.samples[k], &self.samples[k + 1]);
-            let f0 = (x - p0.x).dot(p0.m);
+        }
+        for (k, (seg, p1)) in self.segs.iter().zip(&self.samples[1..]).enumerate() {
             let f1 = (x - p1.x).dot(p1.m);
-            if k == 0 && f0 < 0.0 {
-                let r2 = (x - p0.x).length_squared();
-                if r2 < best {
-                    best = r2;
-                    hit = Some(Foot::Cap(0));
-                }
-            }
-            if k == n - 2 && f1 >= 0.0 {
-                let r2 = (x - p1.x).length_squared();
-                if r2 < best {
-                    best = r2;
-                    hit = Some(Foot::Cap(n - 1));
-                }
-            }
             if f0 >= 0.0 && f1 < 0.0 {
-                let l = Self::foot(seg, x, f0, f1);
-                let r2 = (x - seg.at(l).0).length_squared();
-                if r2 < best {
-                    best = r2;
-                    hit = Some(Foot::Segment(k, l));
+                let lim = seg.radius + outer;
+                if (x - seg.centre).length_squared() < lim * lim {
+                    let l = Self::foot(seg, x, f0, f1);
+                    let g = seg.curve.value(l);
+                    let r2 = (x - g).length_squared();
+                    if r2 < best {
+                        best = r2;
+                        hit = Some((Foot::Segment(k, l), g));
+                    }
                 }
+            }
+            f0 = f1;
+        }
+        let pn = &self.samples[n - 1];
+        if f0 >= 0.0 {
+            let r2 = (x - pn.x).length_squared();
+            if r2 < best {
+                hit = Some((Foot::Cap(n - 1), pn.x));
             }
         }
         hit
