@@ -334,6 +334,13 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
             power: Some(self.power),
         })
     }
+    /// The shape's own surface at its pose at `t` (its tangential velocity jumps there; the
+    /// pose of the first or last key outside the keys, where the tool rests).
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        let ts = &self.keys.times;
+        let t = t.clamp(ts[0], ts[ts.len() - 1]);
+        self.keys.pose_in(t, t)?.pose.distance(&self.shape, x)
+    }
     /// The pose once per batch, then the frozen-pose field at every point.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
