@@ -75,8 +75,8 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         per step). Tools moving with one common velocity are integrated co-moving (steady
         potential ``A + ½ Z × u``). Only for :func:`spinal.fields.translation` and the curl
         tools of any shape (:func:`~spinal.fields.sdf_curl`, :func:`~spinal.fields.mesh_curl`,
-        :func:`~spinal.fields.rod`; sums of them); about 4–6× the cost of an RK4 step. It does not lower the *mesh* volume
-        error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
+        :func:`~spinal.fields.rod`; sums of them); about 4–6× the cost of an RK4 step. It does
+        not lower the *mesh* volume error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
         pointwise, for very long runs where RK4's drift (∝ T h⁴) would grow.
     t0 : float
         Start time (tools that move are at ``center + velocity·t``).
