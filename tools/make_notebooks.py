@@ -539,8 +539,9 @@ The curl fields work with the signed distance `d` of any shape (and its exact gr
 `fields.rod` (a tube about a spline axis), `fields.sdf_curl` (a sampled distance) and
 `fields.mesh_curl` (a closed mesh) push the material like the sphere above, exactly
 divergence-free. `fields.keyframed` moves a tool's shape rigidly through keys `(t, c, Q)`
-(Hermite positions, slerped orientations). Left: a bent rod pressed into the sphere; right:
-a capsule following a curved key path across the surface while turning.""",
+(Hermite positions, slerped orientations). Left: a bent rod pressed into the sphere;
+middle: a box given as a triangle mesh (`mesh_curl`, its distance sampled on a 64³ grid)
+pressed in; right: a capsule following a curved key path across the surface while turning.""",
         """from scipy.spatial.transform import Rotation
 th = np.linspace(-0.5, 0.5, 7)
 axis = np.c_[np.sin(th), 0.2 * np.sin(2 * th), np.cos(th)] * 1.3
@@ -553,17 +554,26 @@ turns = Rotation.from_rotvec(np.outer(times, [0, 0, 2.0])).as_matrix()
 cap = spinal.fields.rod([[-0.2, 0, 0], [0.2, 0, 0]], 0.12, velocity=[1, 0, 0], reach=0.25)
 keyed = spinal.fields.keyframed(cap, times, path, turns)
 swept = spinal.advect(V0, keyed, 1.0)
-for name, W in (("rod", pressed), ("keyframed capsule", swept)):
+box = trimesh.creation.box([0.6, 0.6, 0.3])
+box.apply_translation([0, 0, 1.2])
+boxed = spinal.fields.mesh_curl((box.vertices, box.faces), velocity=[0, 0, -1])
+stamped = spinal.advect(V0, boxed, 0.25)
+box.apply_translation([0, 0, -0.25])   # the box at t = 0.25
+for name, W in (("rod", pressed), ("mesh_curl box", stamped), ("keyframed capsule", swept)):
     tv = trimesh.Trimesh(W, F, process=False).volume
     print(f"{name}: max displacement {np.linalg.norm(W - V0, axis=1).max():.3f}, "
           f"relative volume change {tv / vol0 - 1:+.2e}")
     assert abs(tv / vol0 - 1) < 1e-3
-pl = pv.Plotter(shape=(1, 2), window_size=(900, 420))
+pl = pv.Plotter(shape=(1, 3), window_size=(1300, 420))
 pl.subplot(0, 0)
 pl.add_mesh(pv.wrap(trimesh.Trimesh(pressed, F, process=False)), color="#c8a27a",
             smooth_shading=True)
 pl.add_mesh(pv.Spline(rod_now, 100).tube(radius=0.15), color="#3060a0", opacity=0.6)
 pl.subplot(0, 1)
+pl.add_mesh(pv.wrap(trimesh.Trimesh(stamped, F, process=False)), color="#c8a27a",
+            smooth_shading=True)
+pl.add_mesh(pv.wrap(box), color="#3060a0", opacity=0.6)
+pl.subplot(0, 2)
 pl.add_mesh(pv.wrap(trimesh.Trimesh(swept, F, process=False)), color="#c8a27a",
             smooth_shading=True)
 pl.add_mesh(pv.Spline(path, 100), color="#a03030", line_width=3)

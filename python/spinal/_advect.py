@@ -73,9 +73,10 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         (``curl A = v``), each by the implicit midpoint rule, in a Strang composition —
         2nd order, with ``det(∂X_{n+1}/∂X_n) = 1`` to round-off at every point (RK4: O(h⁵)
         per step). Tools moving with one common velocity are integrated co-moving (steady
-        potential ``A + ½ Z × u``). Only for :func:`spinal.fields.translation` tools (sums
-        of them); about 4–6× the cost of an RK4 step. It does not lower the *mesh* volume
-        error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
+        potential ``A + ½ Z × u``). Only for :func:`spinal.fields.translation` and the curl
+        tools of any shape (:func:`~spinal.fields.sdf_curl`, :func:`~spinal.fields.mesh_curl`,
+        :func:`~spinal.fields.rod`; sums of them); about 4–6× the cost of an RK4 step. It does
+        not lower the *mesh* volume error (the O(edge²) floor dominates); it makes the map exactly volume-preserving
         pointwise, for very long runs where RK4's drift (∝ T h⁴) would grow.
     t0 : float
         Start time (tools that move are at ``center + velocity·t``).

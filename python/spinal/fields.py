@@ -377,6 +377,13 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     A sphere's sampled distance reproduces :func:`sphere` with a 3rd-order error in the grid
     spacing (measured in ``tests/test_deform_tools.py``).
 
+    RK4 is only about 3rd order on this field: ``v`` uses ``∇d``, which is C¹ (the cubic
+    B-spline's second derivatives jump across cell faces), so ``v``'s second derivatives jump
+    there and each step across a face has an O(h³) local error; a path line crosses a fixed
+    number of faces, so the global error falls about 8× per halving of the step where it
+    crosses faces and 16× where it does not (measured for :func:`sdf_curl`: ratios 4.6–18,
+    mean order 3.3, ``tests/test_deform_curl.py``).
+
     Parameters
     ----------
     grid : (nx, ny, nz) signed distances (negative inside the tool, length units) at the
@@ -599,7 +606,8 @@ def sdf_curl(grid, origin, spacing, *, velocity=None, angular_velocity=None, piv
     ``d`` the C² tricubic B-spline interpolating the samples and ``g`` its exact gradient,
     as for :func:`sdf_tool` (whose arguments ``grid``, ``origin``, ``spacing``, ``center``
     and ``reach`` these are; the support ``|d| < reach``, inside the tool too, must stay
-    inside the grid)."""
+    inside the grid). RK4 is about 3rd order on it where path lines cross cell faces (see
+    :func:`sdf_tool`)."""
     a, o, h = _sdf_samples(grid, origin, spacing)
     return _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
                       moving, "sdf_curl")

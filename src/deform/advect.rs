@@ -302,7 +302,8 @@ pub fn check_method(field: &Field, m: Method) -> crate::error::Result<()> {
     if m == Method::Split && !field.has_potential() {
         return Err(crate::error::InputError::new(
             "method",
-            "'split' needs curl potentials; only fields.translation tools have one",
+            "'split' needs curl potentials; only fields.translation and the curl tools of any shape \
+             (sdf_curl, mesh_curl, rod) have one",
         ));
     }
     Ok(())

@@ -162,6 +162,29 @@ impl Falloff {
         self.k * (self.e * u + (0.5 * self.ps) * (y * g.dot(u) - u * g.dot(y)))
     }
 
+    /// Jacobian (columns `∂A/∂x_j`) of the translation's potential
+    /// `A = −(1/(2R^p)) φ (Y × u)`: `(k/2)[p sgn(d) g_j (Y × u) − e (e_j × u)]`.
+    #[inline]
+    pub fn translate_potential_jacobian(&self, g: DVec3, y: DVec3, u: DVec3) -> DMat3 {
+        let yu = y.cross(u);
+        let col =
+            |j: usize, ej: DVec3| (0.5 * self.k) * (yu * (self.ps * g[j]) - ej.cross(u) * self.e);
+        DMat3::from_cols(col(0, DVec3::X), col(1, DVec3::Y), col(2, DVec3::Z))
+    }
+
+    /// Jacobian of the rotation's potential `A = −(1/(3R^p)) φ B`:
+    /// `(k/3)[p sgn(d) g_j B − e ∂_j B]`, `∂_j B = 2Y_j Ω − Ω_j Y − (Ω·Y) e_j`.
+    #[inline]
+    pub fn rotate_potential_jacobian(&self, g: DVec3, y: DVec3, omega: DVec3) -> DMat3 {
+        let b = omega * y.length_squared() - y * omega.dot(y);
+        let oy = omega.dot(y);
+        let col = |j: usize, ej: DVec3| {
+            let db = omega * (2.0 * y[j]) - y * omega[j] - ej * oy;
+            (self.k / 3.0) * (b * (self.ps * g[j]) - db * self.e)
+        };
+        DMat3::from_cols(col(0, DVec3::X), col(1, DVec3::Y), col(2, DVec3::Z))
+    }
+
     /// The curl rotation `(e^{p−1}/(3R^p))[p sgn(d) g × B + 3e Ω × Y]`, `B = |Y|²Ω − (Ω·Y)Y`.
     #[inline(always)]
     pub fn rotate(&self, g: DVec3, y: DVec3, omega: DVec3) -> DVec3 {
@@ -242,8 +265,42 @@ impl Pose {
     /// The distance and its world gradient at `x` for the shape at this pose.
     #[inline(always)]
     pub fn distance<D: Distance>(&self, shape: &D, x: DVec3) -> Option<(f64, DVec3)> {
-        let xb = shape.center() + self.q.transpose() * (x - self.c);
-        shape.distance(xb).map(|(d, g)| (d, self.q * g))
+        self.distance_as::<D, true>(shape, x)
+    }
+
+    /// [`Self::distance`]; with `TURNED` false the orientation is taken as the identity
+    /// (the same values for a pose with `q = I`, without the two matrix products).
+    #[inline(always)]
+    pub fn distance_as<D: Distance, const TURNED: bool>(
+        &self,
+        shape: &D,
+        x: DVec3,
+    ) -> Option<(f64, DVec3)> {
+        if TURNED {
+            let xb = shape.center() + self.q.transpose() * (x - self.c);
+            shape.distance(xb).map(|(d, g)| (d, self.q * g))
+        } else {
+            shape.distance(shape.center() + (x - self.c))
+        }
+    }
+
+    /// `out[j] += f(p[j])` with `f = eval::<TURNED>`, `TURNED` false when the orientation is
+    /// the identity (checked once per batch).
+    #[inline(always)]
+    pub fn add_lanes<F, G>(&self, p: &[DVec3], out: &mut [DVec3], turned: F, plain: G)
+    where
+        F: Fn(DVec3) -> DVec3,
+        G: Fn(DVec3) -> DVec3,
+    {
+        if self.q == DMat3::IDENTITY {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += plain(*x);
+            }
+        } else {
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += turned(*x);
+            }
+        }
     }
 }
 
@@ -310,7 +367,13 @@ impl<D: Distance + Clone + Into<Shape>> CurlTool<D> {
     /// The velocity at `x` with the shape at `pose`.
     #[inline(always)]
     pub fn eval_at(&self, x: DVec3, pose: &Pose) -> DVec3 {
-        let Some((d, g)) = pose.distance(&self.shape, x) else {
+        self.eval_as::<true>(x, pose)
+    }
+
+    /// [`Self::eval_at`], the pose's orientation taken as the identity unless `TURNED`.
+    #[inline(always)]
+    fn eval_as<const TURNED: bool>(&self, x: DVec3, pose: &Pose) -> DVec3 {
+        let Some((d, g)) = pose.distance_as::<D, TURNED>(&self.shape, x) else {
             return DVec3::ZERO;
         };
         let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
@@ -326,6 +389,21 @@ impl<D: Distance + Clone + Into<Shape>> CurlTool<D> {
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
         self.eval_at(x, &self.pose(t))
+    }
+
+    /// Jacobian of the curl potential at `x`, time `t` (zero outside the support).
+    pub fn potential_jacobian(&self, x: DVec3, t: f64) -> DMat3 {
+        let pose = self.pose(t);
+        let Some((d, g)) = pose.distance(&self.shape, x) else {
+            return DMat3::ZERO;
+        };
+        let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
+            return DMat3::ZERO;
+        };
+        match self.motion {
+            Motion::Translate(u) => f.translate_potential_jacobian(g, x - pose.c, u),
+            Motion::Rotate { omega, pivot } => f.rotate_potential_jacobian(g, x - pivot, omega),
+        }
     }
 
     pub fn max_speed(&self) -> f64 {
@@ -352,6 +430,9 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     fn length_scale(&self) -> f64 {
         self.shape.reach()
     }
+    fn potential_jacobian(&self, x: DVec3, t: f64) -> Option<DMat3> {
+        Some(CurlTool::potential_jacobian(self, x, t))
+    }
     fn rigid_velocity(&self) -> DVec3 {
         match self.motion {
             Motion::Translate(u) if self.moving => u,
@@ -372,9 +453,12 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, _tm: f64, out: &mut [DVec3]) {
         let pose = self.pose(t);
-        for (o, x) in out.iter_mut().zip(p) {
-            *o += self.eval_at(*x, &pose);
-        }
+        pose.add_lanes(
+            p,
+            out,
+            |x| self.eval_as::<true>(x, &pose),
+            |x| self.eval_as::<false>(x, &pose),
+        );
     }
     #[inline]
     fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
@@ -418,6 +502,7 @@ pub struct ToolShape {
 
 #[cfg(test)]
 mod tests {
+    use super::super::Field;
     use super::super::fields::{Rotation, Translation};
     use super::*;
 
@@ -461,6 +546,64 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `curl A` from the potential's Jacobian (columns `∂A/∂x_j`).
+    fn curl_of(j: DMat3) -> DVec3 {
+        DVec3::new(
+            j.col(1).z - j.col(2).y,
+            j.col(2).x - j.col(0).z,
+            j.col(0).y - j.col(1).x,
+        )
+    }
+
+    #[test]
+    fn the_potential_jacobian_has_the_velocity_as_curl_and_matches_differences() {
+        let axis: Vec<DVec3> = (0..7)
+            .map(|i| {
+                let a = i as f64 * 0.15 - 0.45;
+                DVec3::new(a.sin(), 0.2 * (2.0 * a).sin(), a.cos())
+            })
+            .collect();
+        let rod = Arc::new(Rod::from_points(&axis, 0.15, Some(0.3), None).unwrap());
+        let om = DVec3::new(0.3, -1.0, 0.5);
+        for (motion, p) in [
+            (Motion::Translate(DVec3::new(0.2, 0.1, -1.0)), 2),
+            (Motion::Translate(DVec3::new(0.2, 0.1, -1.0)), 4),
+            (
+                Motion::Rotate {
+                    omega: om,
+                    pivot: DVec3::new(0.1, 0.0, 0.8),
+                },
+                3,
+            ),
+        ] {
+            let tool = CurlTool::new(rod.clone(), motion, p, true).unwrap();
+            let mut inside = 0;
+            for i in 0..300 {
+                let a = i as f64 * 0.77;
+                let x = DVec3::new(
+                    a.sin() * 0.8,
+                    (1.3 * a).cos() * 0.4,
+                    0.9 + 0.3 * (0.7 * a).sin(),
+                );
+                let t = 0.1;
+                let jac = tool.potential_jacobian(x, t);
+                let v = tool.eval(x, t);
+                assert!(
+                    (curl_of(jac) - v).length() <= 1e-12 * (1.0 + v.length()),
+                    "{x}"
+                );
+                if v.length() > 0.0 {
+                    inside += 1;
+                }
+            }
+            assert!(inside > 30, "{inside}");
+        }
+        assert!(
+            Field::single(CurlTool::new(rod, Motion::Translate(DVec3::Z), 2, true).unwrap())
+                .has_potential()
+        );
     }
 
     #[test]

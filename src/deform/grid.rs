@@ -46,6 +46,11 @@ pub struct GridTool {
     pub reach: f64,
     pub linear: bool,
     pub moving: bool,
+    /// `1 / spacing`, the largest node index `n − 1` (as a float) and the largest cell index
+    /// `n − 2` per axis.
+    inv_spacing: f64,
+    top: [f64; 3],
+    last: [i64; 3],
     /// `y_max[b]`: largest `|X − C|` over the cells whose smallest coefficient is below
     /// `(b + 1) R_f / BUCKETS` (a point at distance `d` lies in a cell with minimum `≤ d`).
     y_max: [f64; BUCKETS],
@@ -56,15 +61,16 @@ const BUCKETS: usize = 64;
 /// Cubic B-spline weights and their derivatives at fraction `f ∈ [0, 1]`.
 #[inline(always)]
 fn weights(f: f64) -> ([f64; 4], [f64; 4]) {
+    const SIXTH: f64 = 1.0 / 6.0;
     let g = 1.0 - f;
     let f2 = f * f;
     let f3 = f2 * f;
     (
         [
-            g * g * g / 6.0,
-            (3.0 * f3 - 6.0 * f2 + 4.0) / 6.0,
-            (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) / 6.0,
-            f3 / 6.0,
+            g * g * g * SIXTH,
+            (3.0 * f3 - 6.0 * f2 + 4.0) * SIXTH,
+            (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) * SIXTH,
+            f3 * SIXTH,
         ],
         [
             -0.5 * g * g,
@@ -170,6 +176,9 @@ impl GridTool {
             n,
             coef,
             cell_min,
+            inv_spacing: 1.0 / spacing,
+            top: n.map(|k| (k - 1) as f64),
+            last: n.map(|k| k as i64 - 2),
             velocity,
             center,
             reach,
@@ -183,57 +192,62 @@ impl GridTool {
     /// `d ≥ R_f` is certain (outside the grid, or a cell whose coefficients are all `≥ R_f`).
     #[inline]
     pub fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        let g = (x - self.origin) * (1.0 / self.spacing);
+        let g = (x - self.origin) * self.inv_spacing;
         let n = self.n;
         let mut idx = [0usize; 3];
         let mut fr = [0.0; 3];
         for a in 0..3 {
-            let top = (n[a] - 1) as f64;
-            if !(g[a] >= 0.0 && g[a] <= top) {
+            if !(g[a] >= 0.0 && g[a] <= self.top[a]) {
                 return None;
             }
-            // g ≥ 0 here, so truncation is the floor (no libm call on the baseline target)
-            let i = (g[a] as usize).min(n[a] - 2);
-            idx[a] = i;
+            // 0 ≤ g ≤ n − 1 here, so truncation is the floor (no libm call on the baseline
+            // target); through i64, whose conversions are single instructions
+            let i = (g[a] as i64).min(self.last[a]);
+            idx[a] = i as usize;
             fr[a] = g[a] - i as f64;
         }
         let c = [n[0] - 1, n[1] - 1, n[2] - 1];
         if self.cell_min[(idx[0] * c[1] + idx[1]) * c[2] + idx[2]] >= self.reach {
             return None;
         }
+        self.spline(idx, fr)
+    }
+
+    /// The B-spline and its gradient in cell `idx` at fractions `fr` (kept out of line, so
+    /// that the cull of [`Self::distance`], taken by most points, stays short).
+    #[inline(never)]
+    fn spline(&self, idx: [usize; 3], fr: [f64; 3]) -> Option<(f64, DVec3)> {
+        let n = self.n;
         let (wx, dx) = weights(fr[0]);
         let (wy, dy) = weights(fr[1]);
         let (wz, dz) = weights(fr[2]);
-        // the 16 (y, z) weight products of the value and of the y- and z-derivatives
-        let mut w0 = [0.0; 16];
-        let mut wdy = [0.0; 16];
-        let mut wdz = [0.0; 16];
-        for b in 0..4 {
-            for c in 0..4 {
-                w0[4 * b + c] = wy[b] * wz[c];
-                wdy[4 * b + c] = dy[b] * wz[c];
-                wdz[4 * b + c] = wy[b] * dz[c];
-            }
-        }
+        // separable contraction, the z direction kept as a 4-vector to the end: for each x
+        // layer `a`, `s0 = Σ_b wy_b c_ab·` and `sy = Σ_b dy_b c_ab·` (rows of 4 along z), then
+        // `e0 = Σ_a wx_a s0`, `ex = Σ_a dx_a s0`, `ey = Σ_a wx_a sy`; finally the z weights:
+        // `d = e0·wz`, `∂ξ d = ex·wz`, `∂η d = ey·wz`, `∂ζ d = e0·dz`
         let (py, pz) = (n[1] + 2, n[2] + 2);
-        let (mut d, mut gx, mut gy, mut gz) = (0.0, 0.0, 0.0, 0.0);
+        let (mut e0, mut ex, mut ey) = ([0.0; 4], [0.0; 4], [0.0; 4]);
         for a in 0..4 {
-            let (mut s0, mut sy, mut sz) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+            let (mut s0, mut sy) = ([0.0; 4], [0.0; 4]);
             for b in 0..4 {
                 let base = ((idx[0] + a) * py + idx[1] + b) * pz + idx[2];
-                let cs = &self.coef[base..base + 4];
+                let Some(cs) = self.coef.get(base..base + 4) else {
+                    return None;
+                };
                 for c in 0..4 {
-                    s0[c] += w0[4 * b + c] * cs[c];
-                    sy[c] += wdy[4 * b + c] * cs[c];
-                    sz[c] += wdz[4 * b + c] * cs[c];
+                    s0[c] += wy[b] * cs[c];
+                    sy[c] += dy[b] * cs[c];
                 }
             }
-            let t = (s0[0] + s0[1]) + (s0[2] + s0[3]);
-            d += wx[a] * t;
-            gx += dx[a] * t;
-            gy += wx[a] * ((sy[0] + sy[1]) + (sy[2] + sy[3]));
-            gz += wx[a] * ((sz[0] + sz[1]) + (sz[2] + sz[3]));
+            for c in 0..4 {
+                e0[c] += wx[a] * s0[c];
+                ex[c] += dx[a] * s0[c];
+                ey[c] += wx[a] * sy[c];
+            }
         }
+        let dot =
+            |u: &[f64; 4], w: &[f64; 4]| (u[0] * w[0] + u[1] * w[1]) + (u[2] * w[2] + u[3] * w[3]);
+        let (d, gx, gy, gz) = (dot(&e0, &wz), dot(&ex, &wz), dot(&ey, &wz), dot(&e0, &dz));
         Some((d, DVec3::new(gx, gy, gz) * (1.0 / self.spacing)))
     }
 

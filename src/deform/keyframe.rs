@@ -263,7 +263,13 @@ impl<D: Distance> Keyframed<D> {
     /// The velocity at `x` for the tool at pose `p`.
     #[inline(always)]
     pub fn eval_at(&self, x: DVec3, p: &KeyPose) -> DVec3 {
-        let Some((d, g)) = p.pose.distance(&self.shape, x) else {
+        self.eval_as::<true>(x, p)
+    }
+
+    /// [`Self::eval_at`], the pose's orientation taken as the identity unless `TURNED`.
+    #[inline(always)]
+    fn eval_as<const TURNED: bool>(&self, x: DVec3, p: &KeyPose) -> DVec3 {
+        let Some((d, g)) = p.pose.distance_as::<D, TURNED>(&self.shape, x) else {
             return DVec3::ZERO;
         };
         let Some(f) = Falloff::at(d, self.shape.reach(), self.power) else {
@@ -328,13 +334,23 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
             power: Some(self.power),
         })
     }
+    /// The shape's own surface at its pose at `t` (its tangential velocity jumps there; the
+    /// pose of the first or last key outside the keys, where the tool rests).
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        let ts = &self.keys.times;
+        let t = t.clamp(ts[0], ts[ts.len() - 1]);
+        self.keys.pose_in(t, t)?.pose.distance(&self.shape, x)
+    }
     /// The pose once per batch, then the frozen-pose field at every point.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
         if let Some(pose) = self.keys.pose_in(t, tm) {
-            for (o, x) in out.iter_mut().zip(p) {
-                *o += self.eval_at(*x, &pose);
-            }
+            pose.pose.add_lanes(
+                p,
+                out,
+                |x| self.eval_as::<true>(x, &pose),
+                |x| self.eval_as::<false>(x, &pose),
+            );
         }
     }
     #[inline]

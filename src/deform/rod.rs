@@ -93,8 +93,8 @@ impl Rod {
     #[inline]
     pub fn closest(&self, x: DVec3) -> Option<DVec3> {
         self.axis
-            .closest(x, self.radius + self.reach)
-            .map(|f| self.axis.point(f))
+            .closest_point(x, self.radius + self.reach)
+            .map(|(_, p)| p)
     }
 }
 

@@ -87,7 +87,13 @@ pub struct Axis {
     /// A sphere (`centre`, `bound`) containing every segment's hull.
     centre: DVec3,
     bound: f64,
+    /// `m_k·x`, `m_k·y`, `m_k·z` and `x_k·m_k` of the samples (four arrays, each followed
+    /// by [`BLOCK`] zeros), for [`Axis::closest_point`]'s scan by blocks.
+    planes: [Vec<f64>; 4],
 }
+
+/// Samples per block of the scan of [`Axis::closest_point`].
+const BLOCK: usize = 16;
 
 /// The nearest point of an [`Axis`] to a query point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -239,11 +245,22 @@ impl Axis {
             .iter()
             .map(|g| (g.centre - centre).length() + g.radius)
             .fold(0.0, f64::max);
+        // the normal planes `F_k = X·m_k − x_k·m_k` by component, padded to whole blocks
+        let mut planes = [0, 1, 2, 3].map(|_| Vec::with_capacity(samples.len() + BLOCK));
+        for p in &samples {
+            for (a, v) in [p.m.x, p.m.y, p.m.z, p.x.dot(p.m)].into_iter().enumerate() {
+                planes[a].push(v);
+            }
+        }
+        for pl in planes.iter_mut() {
+            pl.resize(samples.len() + BLOCK, 0.0);
+        }
         Ok(Axis {
             samples,
             segs,
             centre,
             bound,
+            planes,
         })
     }
 
@@ -287,6 +304,15 @@ impl Axis {
     /// segment or an end cap), if any.
     #[inline]
     pub fn closest(&self, x: DVec3, outer: f64) -> Option<Foot> {
+        self.closest_point(x, outer).map(|(f, _)| f)
+    }
+
+    /// [`Self::closest`] with the foot's point. `F_k = (X − x_k)·m_k` is evaluated at the
+    /// samples in blocks of [`BLOCK`] (a vectorisable loop); a segment is a candidate only
+    /// where `F` changes sign from `≥ 0` to `< 0` across it (then the bounding-sphere cull,
+    /// then Newton), an end cap only beyond its plane.
+    #[inline]
+    pub fn closest_point(&self, x: DVec3, outer: f64) -> Option<(Foot, DVec3)> {
         let o2 = outer * outer;
         let n = self.samples.len();
         let lim = self.bound + outer;
@@ -295,36 +321,57 @@ impl Axis {
         }
         let mut best = o2;
         let mut hit = None;
-        for (k, seg) in self.segs.iter().enumerate() {
-            let lim = seg.radius + outer;
-            if (x - seg.centre).length_squared() >= lim * lim {
-                continue;
+        let [mx, my, mz, mc] = &self.planes;
+        let mut f = [0.0; BLOCK + 1];
+        let mut start = 0;
+        while start + 1 < n {
+            // samples start..start + BLOCK + 1 (zeros past the end), segments start..
+            let (bx, by, bz, bc) = (
+                &mx[start..start + BLOCK + 1],
+                &my[start..start + BLOCK + 1],
+                &mz[start..start + BLOCK + 1],
+                &mc[start..start + BLOCK + 1],
+            );
+            for j in 0..BLOCK + 1 {
+                f[j] = (x.x * bx[j] + x.y * by[j]) + (x.z * bz[j] - bc[j]);
             }
-            let (p0, p1) = (&self.samples[k], &self.samples[k + 1]);
-            let f0 = (x - p0.x).dot(p0.m);
-            let f1 = (x - p1.x).dot(p1.m);
-            if k == 0 && f0 < 0.0 {
-                let r2 = (x - p0.x).length_squared();
+            if start == 0 && f[0] < 0.0 {
+                let p0 = self.samples[0].x;
+                let r2 = (x - p0).length_squared();
                 if r2 < best {
                     best = r2;
-                    hit = Some(Foot::Cap(0));
+                    hit = Some((Foot::Cap(0), p0));
                 }
             }
-            if k == n - 2 && f1 >= 0.0 {
-                let r2 = (x - p1.x).length_squared();
-                if r2 < best {
-                    best = r2;
-                    hit = Some(Foot::Cap(n - 1));
+            let mut pos = 0u32;
+            for (j, fj) in f.iter().enumerate() {
+                pos |= ((*fj >= 0.0) as u32) << j;
+            }
+            let segs = (n - 1 - start).min(BLOCK);
+            let mut cand = pos & !(pos >> 1) & ((1u32 << segs) - 1);
+            while cand != 0 {
+                let j = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                let k = start + j;
+                let seg = &self.segs[k];
+                let lim = seg.radius + outer;
+                if (x - seg.centre).length_squared() < lim * lim {
+                    let l = Self::foot(seg, x, f[j], f[j + 1]);
+                    let g = seg.curve.value(l);
+                    let r2 = (x - g).length_squared();
+                    if r2 < best {
+                        best = r2;
+                        hit = Some((Foot::Segment(k, l), g));
+                    }
                 }
             }
-            if f0 >= 0.0 && f1 < 0.0 {
-                let l = Self::foot(seg, x, f0, f1);
-                let r2 = (x - seg.at(l).0).length_squared();
-                if r2 < best {
-                    best = r2;
-                    hit = Some(Foot::Segment(k, l));
+            if start + BLOCK >= n - 1 && f[n - 1 - start] >= 0.0 {
+                let pn = self.samples[n - 1].x;
+                if (x - pn).length_squared() < best {
+                    hit = Some((Foot::Cap(n - 1), pn));
                 }
             }
+            start += BLOCK;
         }
         hit
     }
