@@ -137,6 +137,9 @@ def sweep(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    dtype: npt.DTypeLike = "float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh: ...
 def tube(
     points: _Array,
@@ -151,6 +154,9 @@ def tube(
     strict: bool = False,
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    dtype: npt.DTypeLike = "float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------
