@@ -197,69 +197,100 @@ fn strictly_convex(p: &[DVec2]) -> bool {
     (turning.abs() - std::f64::consts::TAU).abs() < 1.0
 }
 
-/// A uniform grid of square cells over the bounding box of `p`, about `k` cells in all.
-struct Grid {
+/// Square cells of side `side` (the median edge length) holding items (edges or vertices),
+/// sorted by cell: memory and time follow the items, not the bounding box.
+struct Cells {
     lo: DVec2,
     inv: f64,
-    nx: usize,
-    ny: usize,
+    /// `(cell key, item)`, sorted.
+    items: Vec<(u64, usize)>,
 }
 
-impl Grid {
-    fn new(p: &[DVec2], k: usize) -> Grid {
-        let lo = p.iter().fold(DVec2::INFINITY, |a, &q| a.min(q));
-        let hi = p.iter().fold(DVec2::NEG_INFINITY, |a, &q| a.max(q));
-        let side = (hi - lo).max_element() / (k.max(1) as f64).sqrt().ceil();
-        let inv = if side > 0.0 { 1.0 / side } else { 0.0 };
-        let cells = |w: f64| ((w * inv) as usize).saturating_add(1).min(1 << 16);
-        Grid {
+impl Cells {
+    fn new(p: &[DVec2], closed: bool) -> Cells {
+        let m = p.len();
+        let edges = if closed { m } else { m - 1 };
+        let mut len: Vec<f64> = (0..edges)
+            .map(|j| (p[(j + 1) % m] - p[j]).length())
+            .collect();
+        let mid = len.len() / 2;
+        let side = *len.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let lo = p.iter().fold(DVec2::INFINITY, |a, &q| a.min(q)) - DVec2::splat(side);
+        Cells {
             lo,
-            inv,
-            nx: cells(hi.x - lo.x),
-            ny: cells(hi.y - lo.y),
+            inv: if side > 0.0 { 1.0 / side } else { 0.0 },
+            items: Vec::new(),
         }
     }
 
-    /// Cell ranges `(x0..=x1, y0..=y1)` covered by the box of `a` and `b`.
-    fn span(&self, a: DVec2, b: DVec2) -> (usize, usize, usize, usize) {
-        let c = |v: f64, n: usize| (((v * self.inv).max(0.0)) as usize).min(n - 1);
-        let (l, h) = (a.min(b) - self.lo, a.max(b) - self.lo);
-        (
-            c(l.x, self.nx),
-            c(h.x, self.nx),
-            c(l.y, self.ny),
-            c(h.y, self.ny),
-        )
+    /// Cell coordinates of `q` (clamped: far cells merge, which only costs tests).
+    fn xy(&self, q: DVec2) -> (u64, u64) {
+        let c = ((q - self.lo) * self.inv)
+            .max(DVec2::ZERO)
+            .min(DVec2::splat(1e9));
+        (c.x as u64, c.y as u64)
     }
 
-    fn cell(&self, q: DVec2) -> usize {
-        let (x, _, y, _) = self.span(q, q);
-        y * self.nx + x
+    fn key(x: u64, y: u64) -> u64 {
+        (y << 32) | x
+    }
+
+    /// Add `item` to every cell the segment `a b` passes through (and some neighbours):
+    /// samples every half cell, each with its 3 × 3 block of cells.
+    fn add_segment(&mut self, a: DVec2, b: DVec2, item: usize) {
+        let steps = ((b - a).length() * self.inv * 2.0).ceil().min(4e9) as usize;
+        let mut last = None;
+        for k in 0..=steps {
+            let (x, y) = self.xy(a.lerp(b, k as f64 / steps.max(1) as f64));
+            if last == Some((x, y)) {
+                continue;
+            }
+            last = Some((x, y));
+            for dy in 0..3 {
+                for dx in 0..3 {
+                    let (cx, cy) = ((x + dx).saturating_sub(1), (y + dy).saturating_sub(1));
+                    self.items.push((Self::key(cx, cy), item));
+                }
+            }
+        }
+    }
+
+    fn add_point(&mut self, q: DVec2, item: usize) {
+        let (x, y) = self.xy(q);
+        self.items.push((Self::key(x, y), item));
+    }
+
+    fn sort(&mut self) {
+        self.items.sort_unstable();
+        self.items.dedup();
+    }
+
+    /// Items of the cell `(x, y)`.
+    fn at(&self, x: u64, y: u64) -> &[(u64, usize)] {
+        let k = Self::key(x, y);
+        let i = self.items.partition_point(|e| e.0 < k);
+        let j = i + self.items[i..].partition_point(|e| e.0 == k);
+        &self.items[i..j]
     }
 }
 
 /// The first pair of non-adjacent edges `(a, b)`, `a < b`, that meet, or `None` for a simple
-/// polyline/polygon. Edges are binned on a grid; only edges sharing a cell are compared.
+/// polyline/polygon. Edges are binned in cells; only edges sharing a cell are compared.
 fn first_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
     let m = p.len();
     let edges = if closed { m } else { m - 1 };
-    let grid = Grid::new(p, edges);
-    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); grid.nx * grid.ny];
+    let mut cells = Cells::new(p, closed);
     for e in 0..edges {
-        let (x0, x1, y0, y1) = grid.span(p[e], p[(e + 1) % m]);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                cells[y * grid.nx + x].push(e);
-            }
-        }
+        cells.add_segment(p[e], p[(e + 1) % m], e);
     }
+    cells.sort();
     let mut best: Option<(usize, usize)> = None;
-    for list in &cells {
-        for (k, &a) in list.iter().enumerate() {
-            for &b in &list[k + 1..] {
+    for group in cells.items.chunk_by(|x, y| x.0 == y.0) {
+        for (k, &(_, a)) in group.iter().enumerate() {
+            for &(_, b) in &group[k + 1..] {
                 let (a, b) = (a.min(b), a.max(b));
-                if b == a + 1 || (closed && a == 0 && b == m - 1) {
-                    continue; // adjacent edges share a vertex
+                if b <= a + 1 || (closed && a == 0 && b == m - 1) {
+                    continue; // the same or adjacent edges (sharing a vertex)
                 }
                 if best.is_some_and(|q| q <= (a, b)) {
                     continue;
@@ -286,15 +317,15 @@ fn ear_clip(p: &[DVec2], ccw: &[usize]) -> Vec<[usize; 3]> {
         let (a, b, c) = (q[prev[k]], q[k], q[next[k]]);
         cross(b - a, c - b)
     };
-    let grid = Grid::new(&q, m);
-    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); grid.nx * grid.ny];
+    let mut cells = Cells::new(&q, true);
     let mut reflex = Vec::new();
     for k in 0..m {
         if turn(&prev, &next, k) <= 0.0 {
-            cells[grid.cell(q[k])].push(k);
+            cells.add_point(q[k], k);
             reflex.push(k);
         }
     }
+    cells.sort();
     let inside = |a: DVec2, b: DVec2, c: DVec2, v: DVec2| {
         cross(b - a, v - a) >= 0.0 && cross(c - b, v - b) >= 0.0 && cross(a - c, v - c) >= 0.0
     };
@@ -314,12 +345,12 @@ fn ear_clip(p: &[DVec2], ccw: &[usize]) -> Vec<[usize; 3]> {
                     && turn(&prev, &next, v) <= 0.0
                     && inside(a, b, c, q[v])
             };
-            let (x0, x1, y0, y1) = grid.span(a.min(b).min(c), a.max(b).max(c));
-            ear = if (x1 - x0 + 1) * (y1 - y0 + 1) > reflex.len() {
+            let ((x0, y0), (x1, y1)) = (cells.xy(a.min(b).min(c)), cells.xy(a.max(b).max(c)));
+            ear = if (x1 - x0 + 1).saturating_mul(y1 - y0 + 1) > reflex.len() as u64 {
                 !reflex.iter().any(|&v| blocks(v))
             } else {
                 !(y0..=y1)
-                    .any(|y| (x0..=x1).any(|x| cells[y * grid.nx + x].iter().any(|&v| blocks(v))))
+                    .any(|y| (x0..=x1).any(|x| cells.at(x, y).iter().any(|&(_, v)| blocks(v))))
             };
         }
         if !ear {
