@@ -42,8 +42,8 @@ def test_float32_is_the_float64_mesh_rounded(closed):
     assert m32.to_pyvista().n_points == len(m32.vertices)
     # a sweep with twist, scale and an open profile, as a string dtype
     prof = [(-0.1, 0.0), (0.0, 0.05), (0.1, 0.0)]
-    kw = dict(twist=np.linspace(0, 3, len(x)), scale=np.c_[r, 2 * r], closed=closed,
-              profile_closed=False)
+    kw = {"twist": np.linspace(0, 3, len(x)), "scale": np.c_[r, 2 * r], "closed": closed,
+          "profile_closed": False}
     a, b = spinal.sweep(x, prof, **kw), spinal.sweep(x, prof, dtype="float32", **kw)
     np.testing.assert_array_equal(b.faces, a.faces)
     np.testing.assert_array_equal(b.vertices, a.vertices.astype(np.float32))

@@ -208,12 +208,14 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             format!("non-finite value at row {i}"),
         ));
     }
-    let mut arc = Vec::with_capacity(chords.len() + 1);
+    // the arc lengths in the chords' buffer (no second array of the spine's length)
+    let mut arc = chords;
+    arc.reserve_exact(1);
+    arc.insert(0, 0.0);
     let mut acc = 0.0;
-    arc.push(acc);
-    for c in chords {
-        acc += c;
-        arc.push(acc);
+    for a in arc.iter_mut() {
+        acc += *a;
+        *a = acc;
     }
     Ok(Plan {
         rings,
