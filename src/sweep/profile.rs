@@ -319,9 +319,9 @@ fn ear_clip(p: &[DVec2], ccw: &[usize]) -> Vec<[usize; 3]> {
     };
     let mut cells = Cells::new(&q, true);
     let mut reflex = Vec::new();
-    for k in 0..m {
+    for (k, &v) in q.iter().enumerate() {
         if turn(&prev, &next, k) <= 0.0 {
-            cells.add_point(q[k], k);
+            cells.add_point(v, k);
             reflex.push(k);
         }
     }
@@ -425,6 +425,44 @@ mod tests {
                 assert!((area_of(&p, &tris) - prof.area.abs()).abs() < 1e-12);
             }
         }
+    }
+
+    /// A regular 1000-gon is convex (a fan); a gear of 400 teeth is not (ear clipping);
+    /// both cover their area with counter-clockwise triangles, in either orientation.
+    #[test]
+    fn convex_and_many_vertex_profiles_are_covered() {
+        let ngon: Vec<DVec2> = (0..1000)
+            .map(|k| DVec2::from_angle(std::f64::consts::TAU * k as f64 / 1000.0))
+            .collect();
+        let gear: Vec<DVec2> = (0..1600)
+            .map(|k| {
+                let r = if (k / 2) % 2 == 0 { 1.0 } else { 0.9 };
+                r * DVec2::from_angle(std::f64::consts::TAU * k as f64 / 1600.0)
+            })
+            .collect();
+        for (poly, convex) in [(ngon, true), (gear, false)] {
+            for rev in [false, true] {
+                let mut p = poly.clone();
+                if rev {
+                    p.reverse();
+                }
+                let prof = Profile::new(&p, true).unwrap();
+                assert_eq!(prof.convex, convex);
+                let tris = prof.triangulate();
+                assert_eq!(tris.len(), p.len() - 2);
+                for t in &tris {
+                    assert!(cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]) > 0.0);
+                }
+                let a = area_of(&p, &tris);
+                assert!((a - prof.area.abs()).abs() < 1e-12 * a);
+            }
+        }
+        // a dent through the middle of the gear makes it self-intersecting
+        let mut bad: Vec<DVec2> = (0..1600)
+            .map(|k| DVec2::from_angle(std::f64::consts::TAU * k as f64 / 1600.0))
+            .collect();
+        bad[800] = DVec2::new(1.5, 0.0);
+        assert!(Profile::new(&bad, true).is_err());
     }
 
     #[test]
