@@ -4,23 +4,32 @@ Same spine (a helix), same number of sides, one run. For every size it times
 
 * ``spinal.tube(points, r, sides)`` — frames (double reflection) + mesh with normals and uv,
   float64 triangles, watertight with caps;
-* VTK via PyVista on one polyline, ``PolyData.tube`` — float32 triangle strips (less output:
-  no uv, strips instead of triangles); and ``+ .triangulate()`` for a triangle mesh like ours;
-* VTK on ``pyvista.lines_from_points(points)`` — the call most examples show (one line per
-  segment: a separate ring pair for every segment, 4× the vertices);
+* ``spinal.tube(..., dtype=np.float32)`` — the same mesh stored in float32, int32 faces;
+* VTK via PyVista on one polyline, ``PolyData.tube`` — vtkTubeFilter, float32 triangle strips
+  (less output: no uv, strips instead of triangles); and ``+ .triangulate()``
+  (vtkTriangleFilter) for a triangle mesh like ours;
+* VTK on ``pyvista.lines_from_points(points)`` — one line cell per segment, so a separate
+  capped ring pair for every segment (4× the vertices; not the same surface);
 * ``trimesh.creation.sweep_polygon`` when shapely is installed (skipped otherwise);
-* the NumPy floor: allocating and writing arrays of the size of spinal's output once.
+* the NumPy floor: allocating and writing arrays of the size of spinal's float64 output once.
 
-and prints a table with the ratios. ``--bundle`` adds 1 000 curves of 1 000 points (spinal in
-one call with ``lengths``; VTK one PolyData with 1 000 polylines).
+and prints a float64 table with the ratios, then the float32 table against VTK. The default
+run adds 1 000 curves of 1 000 points (spinal in one call with ``lengths``; VTK one PolyData
+with 1 000 polylines; ``--no-bundle`` leaves it out). ``--bundle`` adds the big bundle:
+100 000 streamlines of ~96 points (≈ 9.6 M points, 8 sides), time and peak memory of every
+call measured in a fresh process (spinal float32 and float64, VTK strips and triangles).
 
     python benchmarks/bench_sweep.py              # 10^3 … 10^6 spine points
     python benchmarks/bench_sweep.py --max 2e5
+    python benchmarks/bench_sweep.py --bundle     # + the 100k-streamline bundle (~10 GB)
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -87,6 +96,8 @@ def run(sizes, repeat, bundle):
         del mesh
         res = {"case": label}
         res["spinal"] = best(lambda: spinal.tube(x, RADIUS, SIDES, **kw), rep)  # noqa: B023
+        res["spinal float32"] = best(
+            lambda: spinal.tube(x, RADIUS, SIDES, dtype=np.float32, **kw), rep)  # noqa: B023
         res["floor"] = best(lambda: floor(nv, nf), rep)  # noqa: B023
         if "pv" in p:
             pv = p["pv"]
@@ -120,31 +131,120 @@ def run(sizes, repeat, bundle):
     return rows
 
 
+BUNDLE_CHILD = r"""
+import json, sys, time
+import numpy as np
+what, curves, per, sides = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+rng = np.random.default_rng(0)
+# smooth random streamlines: cumulative sums of slowly turning unit steps
+n = curves * per
+d = rng.normal(size=(curves, 3))[:, None, :] + 0.3 * np.cumsum(
+    rng.normal(size=(curves, per, 3)) * 0.2, axis=1)
+d /= np.linalg.norm(d, axis=2, keepdims=True)
+x = np.ascontiguousarray((np.cumsum(d, axis=1) + rng.uniform(-50, 50, (curves, 1, 3)))
+                         .reshape(n, 3))
+del d
+lengths = np.full(curves, per)
+r = 0.2
+def status(key):
+    with open("/proc/self/status") as f:
+        return next(int(l.split()[1]) for l in f if l.startswith(key)) * 1024
+if what.startswith("spinal"):
+    import spinal
+    spinal.tube(x[:per], r, sides)  # warm-up
+    kw = {"dtype": np.float32} if what == "spinal float32" else {}
+    run = lambda: spinal.tube(x, r, sides, lengths=lengths, **kw)
+    size = lambda m: sum(a.nbytes for a in (m.vertices, m.faces, m.normals, m.uv))
+else:
+    import pyvista as pv
+    cells = np.empty((curves, per + 1), dtype=np.int64)
+    cells[:, 0] = per
+    cells[:, 1:] = np.arange(n).reshape(curves, per)
+    poly = pv.PolyData(x, lines=cells.ravel())
+    del cells
+    poly.tube(radius=r, n_sides=sides, capping=True)  # warm-up is the whole call: skip
+    if what == "vtk strips":
+        run = lambda: poly.tube(radius=r, n_sides=sides, capping=True)
+    else:
+        run = lambda: poly.tube(radius=r, n_sides=sides, capping=True).triangulate()
+    size = lambda m: m.actual_memory_size * 1024
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")
+before = status("VmRSS:")
+t0 = time.perf_counter()
+out = run()
+t = time.perf_counter() - t0
+print(json.dumps({"s": t, "peak": status("VmHWM:") - before, "output": size(out),
+                  "points": n}))
+"""
+
+
+def bundle_rows(curves=100_000, per=96, sides=8):
+    """Time and peak memory of each call on the big bundle, each in a fresh process (so the
+    peaks do not mix); a call that fails (memory) is reported as such."""
+    rows = []
+    whats = ["spinal float32", "spinal float64"]
+    if "pv" in peers():
+        whats += ["vtk strips", "vtk triangles"]
+    for what in whats:
+        r = subprocess.run([sys.executable, "-c", BUNDLE_CHILD, what, str(curves), str(per),
+                            str(sides)], capture_output=True, text=True, check=False)
+        if r.returncode:
+            rows.append((what, None, r.stderr.strip().splitlines()[-1:] or ["failed"]))
+        else:
+            rows.append((what, json.loads(r.stdout), None))
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e6)
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--no-bundle", action="store_true")
+    ap.add_argument("--no-bundle", action="store_true",
+                    help="leave out the 1,000-curve bundle row")
+    ap.add_argument("--bundle", action="store_true",
+                    help="add the 100,000-streamline bundle (~9.6 M points, 8 sides; ~10 GB)")
     args = ap.parse_args()
     sizes = [n for n in (1_000, 10_000, 100_000, 200_000, 1_000_000) if n <= args.max]
     rows = run(sizes, args.repeat, not args.no_bundle)
     peers_cols = ["vtk strips", "vtk triangles", "vtk lines_from_points", "trimesh sweep_polygon"]
-    print(f"tubes with {SIDES} sides; times in ms (best of runs); ratio = peer time / spinal time\n")
-    print("| case | spinal | NumPy write floor | " + " | ".join(peers_cols) + " |")
-    print("|---" * (3 + len(peers_cols)) + "|")
+    print("Columns: spinal = spinal.tube(points, r, sides) (float64, normals, uv, int64 faces); "
+          "vtk strips = pyvista.PolyData(points, lines=[n, 0, …, n−1]).tube(radius=r, "
+          "n_sides=sides, capping=True), i.e. vtkTubeFilter on one polyline per curve, "
+          "float32 triangle strips; vtk triangles = the same + .triangulate() "
+          "(vtkTriangleFilter); vtk lines_from_points = pyvista.lines_from_points(points)"
+          ".tube(...) (one line cell per segment: a capped ring pair per segment); "
+          "NumPy write floor = np.full of arrays of spinal's float64 output size.\n")
+    print(f"tubes with {SIDES} sides; times in ms (best of runs); ratio = peer time / spinal "
+          "(float64) time; NumPy write floor: ratio = spinal / floor (target ≤ 1.4× at 1M "
+          "points); spinal float32 = spinal.tube(..., dtype=np.float32) (vertices, normals, uv "
+          "float32, int32 faces), its last column = VTK time / float32 time (targets: ≥ 3× VTK "
+          "strips at 1M points, > 1× VTK triangles everywhere)\n")
+    f32_col = "spinal float32: VTK strips, triangles ×"
+    print("| case | spinal | spinal float32 | NumPy write floor | " + " | ".join(peers_cols)
+          + f" | {f32_col} |")
+    print("|---" * (5 + len(peers_cols)) + "|")
     for r in rows:
-        cells = [r["case"], f"{1e3 * r['spinal']:.1f}",
-                 f"{1e3 * r['floor']:.1f} ({r['spinal'] / r['floor']:.1f}×)"]
+        f32 = r["spinal float32"]
+        cells = [r["case"], f"{1e3 * r['spinal']:.1f}", f"{1e3 * f32:.1f}",
+                 f"{1e3 * r['floor']:.1f} ({r['spinal'] / r['floor']:.2f}×)"]
         for c in peers_cols:
             cells.append(f"{1e3 * r[c]:.1f} ({r[c] / r['spinal']:.1f}×)" if c in r else "–")
+        cells.append(" / ".join(f"{r[c] / f32:.1f}" for c in ("vtk strips", "vtk triangles")
+                                if c in r) or "–")
         print("| " + " | ".join(cells) + " |")
-    big = [r for r in rows if r["case"] == "200,000 points"]
-    if big and "vtk lines_from_points" in big[0]:
-        r = big[0]
-        print(f"\n200k points × {SIDES} sides: spinal {r['vtk lines_from_points'] / r['spinal']:.1f}× "
-              f"faster than VTK on lines_from_points, {r['vtk triangles'] / r['spinal']:.1f}× than "
-              f"VTK strips + triangulate, {r['vtk strips'] / r['spinal']:.1f}× than VTK strips "
-              f"(target ≥ 20× VTK)")
+    if args.bundle:
+        print("\n100,000 streamlines × 96 points (9.6 M points), 8 sides, one call each in a fresh "
+              "process; peak = VmHWM growth of the call (reset before it)\n")
+        print("| call | time s | peak GB | output GB | peak / output | bytes per point |")
+        print("|---|---|---|---|---|---|")
+        for what, res, err in bundle_rows():
+            if res is None:
+                print(f"| {what} | failed: {err[0][:80]} | | | | |")
+                continue
+            print(f"| {what} | {res['s']:.2f} | {res['peak'] / 1e9:.2f} | "
+                  f"{res['output'] / 1e9:.2f} | {res['peak'] / res['output']:.2f} | "
+                  f"{res['peak'] / res['points']:.0f} |")
 
 
 if __name__ == "__main__":

@@ -140,7 +140,7 @@ def sweep_rows(text):
         ms = num(r["spinal"])
         peers = []
         for col, cell in r.items():
-            if col in ("case", "spinal") or cell in ("–", "-", ""):
+            if col in ("case", "spinal") or col.startswith("spinal ") or cell in ("–", "-", ""):
                 continue
             ratio = paren_ratio(cell)
             if col == "NumPy write floor":  # that column prints spinal / floor

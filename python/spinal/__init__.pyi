@@ -165,6 +165,9 @@ def sweep(
     offsets: _Ints | None = None,
     tangents: _Array | None = None,
     tangent_rule: _TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh: ...
 def tube(
     points: _Array,
@@ -181,6 +184,9 @@ def tube(
     offsets: _Ints | None = None,
     tangents: _Array | None = None,
     tangent_rule: _TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------

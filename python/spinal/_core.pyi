@@ -96,11 +96,15 @@ def sweep_mesh(
     miter_limit: float,
     split_seams: bool,
     scale_arg: str = "scale",
+    single: bool = False,
+    index32: bool = False,
+    normals: bool = True,
+    uv: bool = True,
 ) -> tuple[
-    npt.NDArray[np.float64],
-    npt.NDArray[np.int64],
-    npt.NDArray[np.float64],
-    npt.NDArray[np.float64],
+    npt.NDArray[np.floating],
+    npt.NDArray[np.signedinteger],
+    npt.NDArray[np.floating] | None,
+    npt.NDArray[np.floating] | None,
     npt.NDArray[np.int64],
 ]: ...
 def quat_from_frames(frames: npt.NDArray[np.float64], continuous: bool) -> npt.NDArray[np.float64]: ...

@@ -65,13 +65,13 @@ class Mesh:
 
     Attributes
     ----------
-    vertices : ndarray (V, 3) float64
-    faces : ndarray (F, 3) int64
+    vertices : ndarray (V, 3) float64 (or float32)
+    faces : ndarray (F, 3) int64 (or int32)
         Vertex indices, counter-clockwise seen from outside (the right-hand normal points
         outwards on closed and capped sweeps).
-    normals : ndarray (V, 3) float64
+    normals : ndarray (V, 3) float64 (or float32), or None
         Unit normals of the smooth swept surface at the vertices (not averaged face normals).
-    uv : ndarray (V, 2) float64
+    uv : ndarray (V, 2) float64 (or float32), or None
         Texture coordinates: ``u`` = arc length of the spine at the vertex's ring (in the
         units of the points), ``v`` = arc length around the profile / its perimeter.
     fold_over : ndarray (k,) int64
@@ -80,10 +80,10 @@ class Mesh:
     """
 
     def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None):
-        self.vertices = np.asarray(vertices, dtype=np.float64)
-        self.faces = np.asarray(faces, dtype=np.int64)
-        self.normals = None if normals is None else np.asarray(normals, dtype=np.float64)
-        self.uv = None if uv is None else np.asarray(uv, dtype=np.float64)
+        self.vertices = _floats(vertices)
+        self.faces = _ints(faces)
+        self.normals = None if normals is None else _floats(normals)
+        self.uv = None if uv is None else _floats(uv)
         self.fold_over = (
             np.zeros(0, dtype=np.int64) if fold_over is None else np.asarray(fold_over, np.int64)
         )
@@ -108,7 +108,7 @@ class Mesh:
     def is_watertight(self) -> bool:
         """Every edge is shared by exactly two faces that traverse it in opposite directions
         (closed, consistently oriented, by vertex index)."""
-        f = self.faces
+        f = self.faces.astype(np.int64, copy=False)
         e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
         key = e[:, 0] * (len(self.vertices) + 1) + e[:, 1]
         rev = e[:, 1] * (len(self.vertices) + 1) + e[:, 0]
@@ -226,6 +226,16 @@ class Mesh:
             return img
         pl.show()
         return None
+
+
+def _floats(a) -> np.ndarray:
+    """float32 arrays as they are (the sweeps' ``dtype=numpy.float32``), others as float64."""
+    return a if isinstance(a, np.ndarray) and a.dtype == np.float32 else np.asarray(a, np.float64)
+
+
+def _ints(a) -> np.ndarray:
+    """int32 arrays as they are, others as int64."""
+    return a if isinstance(a, np.ndarray) and a.dtype == np.int32 else np.asarray(a, np.int64)
 
 
 def _has_display() -> bool:

@@ -23,6 +23,31 @@ from ._validate import (
 
 __all__ = ["sweep", "tube"]
 
+#: Most sides of a :func:`tube` (a 2**20-gon is round to 5e-12 of its radius).
+MAX_SIDES = 2**20
+
+
+def _dtype(dtype) -> bool:
+    """True for float32 output, False for float64; anything else is refused by name."""
+    try:
+        dt = np.dtype(dtype)
+    except TypeError:
+        dt = None
+    if dt is None or dt not in (np.dtype(np.float64), np.dtype(np.float32)):
+        raise ValueError(f"dtype: expected numpy.float64 or numpy.float32, got {dtype!r}")
+    return dt == np.float32
+
+
+def _scale_rows(scale, name: str, n: int) -> np.ndarray:
+    """The scale as ``(n, 2)`` rows, or one ``(1, 2)`` row when it is the same everywhere
+    (the core broadcasts it; no per-row copy)."""
+    if scale is None:
+        return np.ones((1, 2))
+    a = as_float_array(scale, name)
+    if a.ndim == 0:
+        return np.full((1, 2), float(a))
+    return as_per_row(a, name, n, pair=True)
+
 
 def _ranges(rows: np.ndarray) -> str:
     """'3–7, 12, 20–21' for sorted integer rows."""
@@ -54,6 +79,9 @@ def sweep(
     offsets=None,
     tangents=None,
     tangent_rule: str = DEFAULT_TANGENT_RULE,
+    dtype="float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -113,6 +141,14 @@ def sweep(
         the 4th-order five-point chord-length rule whose end tangents lean from the end chord
         by at most the turn of the last two chords, so coarse spines get no chisel-shaped
         ends), ``"five_point"`` (ends unbounded), ``"five_point_uniform"`` or ``"circle"``.
+    dtype : "float64" or "float32" (or numpy.float64, numpy.float32)
+        Precision of ``vertices``, ``normals`` and ``uv``. With ``float32`` everything is
+        still computed in double precision and stored rounded (the same topology, vertices
+        within float32 rounding of the float64 ones), and the faces are int32 when the
+        vertex count fits: 56 bytes per vertex instead of 112.
+    normals, uv : bool
+        Compute the normals / texture coordinates (``False``: ``None`` in the mesh, less
+        memory and time).
 
     Returns
     -------
@@ -120,19 +156,22 @@ def sweep(
         ``vertices`` (V, 3), ``faces`` (F, 3), ``normals`` (V, 3) — normals of the smooth
         swept surface, tilted by a varying radius —, ``uv`` (V, 2) (u = spine arc length,
         v = profile arc length / perimeter) and ``fold_over`` (spine rows). Vertex
-        ``k * m + j`` (per spine) is profile vertex ``j`` on ring ``k``.
+        ``k * m + j`` (per spine) is profile vertex ``j`` on ring ``k``. The quads between
+        rings are split along alternating diagonals (a checkerboard), so the volume of
+        twisted sweeps converges at second order.
 
     Raises
     ------
     ValueError, TypeError
         Bad shapes, non-finite values, repeated consecutive points, a self-intersecting or
-        zero-area profile, non-positive scale, frames that are not rotations, tangents of the
+        zero-area profile, non-positive scale, frames that are not rotations or whose
+        tangent runs against the spine (frames of the reversed curve), tangents of the
         wrong shape or of zero length, ``tangents``/``tangent_rule`` together with ``frames``
         (or with each other), and everything :func:`spinal.frames` refuses.
     """
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
-                       tangents, tangent_rule)
+                       tangents, tangent_rule, dtype, normals, uv)
 
 
 def _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule):
@@ -163,7 +202,8 @@ def _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule):
 
 def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
-                tangents=None, tangent_rule=DEFAULT_TANGENT_RULE) -> Mesh:
+                tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
+                normals=True, uv=True) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     pts = as_points(points, "points")
@@ -173,17 +213,21 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     profile_closed = as_bool(profile_closed, "profile_closed")
     split_seams = as_bool(split_seams, "split_seams")
     strict = as_bool(strict, "strict")
+    single = _dtype(dtype)
+    want_normals = as_bool(normals, "normals")
+    want_uv = as_bool(uv, "uv")
     miter_limit = float(as_float_array(miter_limit, "miter_limit"))
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")
     offs, bundle = as_offsets(n, lengths, offsets)
     fr = _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule)
-    sc = np.ones((n, 2)) if scale is None else as_per_row(scale, "scale", n, pair=True)
+    sc = _scale_rows(scale, scale_arg, n)
     tw = None if twist is None else as_per_row(twist, "twist", n)
     v, f, nrm, uv, folds = _core.sweep_mesh(
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
+        single, single, want_normals, want_uv,
     )
     if folds.size:
         msg = (
@@ -212,6 +256,9 @@ def tube(
     offsets=None,
     tangents=None,
     tangent_rule: str = DEFAULT_TANGENT_RULE,
+    dtype="float64",
+    normals: bool = True,
+    uv: bool = True,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -219,15 +266,20 @@ def tube(
 
     The cross-section is the inscribed polygon, of area ``(sides/2) ρ² sin(2π/sides)``.
     ``radius``: scalar or (n,) positive values (one per spine row); the normals are tilted
-    by the radius slope. Other arguments (``tangents``, ``tangent_rule`` included) as in
-    :func:`sweep`.
+    by the radius slope. ``sides``: 3 to 2**20. Other arguments (``tangents``,
+    ``tangent_rule``, ``dtype=numpy.float32``, ``normals``, ``uv``) as in :func:`sweep`.
     """
     sides = as_int(sides, "sides")
     if sides < 3:  # the core sees only the polygon built here
         raise ValueError(f"sides: a tube needs at least 3 sides, got {sides}")
+    if sides > MAX_SIDES:
+        raise ValueError(f"sides: at most {MAX_SIDES:,} (2**20) sides, got {sides:,}")
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
     pts = as_points(points, "points")
-    rad = as_per_row(radius, "radius", pts.shape[0])  # the core checks it, naming radius
+    rad = as_float_array(radius, "radius")  # the core checks the values, naming radius
+    if rad.ndim:
+        rad = as_per_row(rad, "radius", pts.shape[0])
     return _sweep_mesh(pts, profile, frames, rad, None, closed, caps, True, miter_limit,
-                       split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule)
+                       split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
+                       dtype, normals, uv)

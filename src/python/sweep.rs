@@ -1,8 +1,6 @@
 //! Sweeps and tubes (`spinal.sweep`); the algorithm is in [`crate::sweep`].
 
-use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
-};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 
 use super::convert::{
@@ -11,19 +9,23 @@ use super::convert::{
 use crate::sweep::{self, Options, Profile, Spine};
 
 type MeshArrays<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<i64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Option<Bound<'py, PyAny>>,
+    Option<Bound<'py, PyAny>>,
     Bound<'py, PyArray1<i64>>,
 );
 
 /// Sweep a profile along one or many spines; see `spinal.sweep`. Returns vertices, faces,
-/// normals, uv and the rows where a miter was folded. Errors about the scale name
-/// `scale_arg` (`spinal.tube` passes its radius as the scale).
+/// normals (or None), uv (or None) and the rows where a miter was folded. Coordinates are
+/// float32 with `single` (computed in float64, stored rounded), faces int32 with `index32`
+/// when the vertex count fits (int64 otherwise). Errors about the scale name `scale_arg`
+/// (`spinal.tube` passes its radius as the scale). `scale` may have a single row (the same
+/// scale at every sample).
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
-                    miter_limit, split_seams, scale_arg="scale"))]
+                    miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
+                    normals=true, uv=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -39,6 +41,10 @@ pub fn sweep_mesh<'py>(
     miter_limit: f64,
     split_seams: bool,
     scale_arg: &str,
+    single: bool,
+    index32: bool,
+    normals: bool,
+    uv: bool,
 ) -> PyResult<MeshArrays<'py>> {
     let pts = vec3s("points", &points)?;
     let fr = frames_of("frames", &frames)?;
@@ -67,24 +73,80 @@ pub fn sweep_mesh<'py>(
         Ok::<_, crate::InputError>((p, lay))
     })?
     .map_err(|e| renamed(e, "scale", scale_arg))?;
-    let (nv, nf) = (lay.vertices, lay.faces);
-    let v = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
-    let n = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
-    let uv = empty::<f64, numpy::Ix2>(py, &[nv, 2])?;
-    let f = empty::<i64, numpy::Ix2>(py, &[nf, 3])?;
-    let folds = {
-        let (mut wv, mut wn, mut wu, mut wf) =
-            (v.readwrite(), n.readwrite(), uv.readwrite(), f.readwrite());
-        let out = sweep::MeshMut {
-            vertices: bytemuck::cast_slice_mut(slice_mut(&mut wv)?),
-            faces: bytemuck::cast_slice_mut(slice_mut(&mut wf)?),
-            normals: bytemuck::cast_slice_mut(slice_mut(&mut wn)?),
-            uv: bytemuck::cast_slice_mut(slice_mut(&mut wu)?),
-        };
-        detach_in_pool(py, || {
-            sweep::sweep_into(&spine, &offsets, &p, &opts, &lay, out)
-        })?
+    // int32 faces only where every index fits
+    let index32 = index32 && lay.vertices <= i32::MAX as usize;
+    let job = Job {
+        spine: &spine,
+        offsets: &offsets,
+        p: &p,
+        opts: &opts,
+        lay: &lay,
+        normals,
+        uv,
     };
-    let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
-    Ok((v, f, n, uv, PyArray1::from_vec(py, folds)))
+    match (single, index32) {
+        (false, false) => job.run::<f64, i64>(py),
+        (false, true) => job.run::<f64, i32>(py),
+        (true, false) => job.run::<f32, i64>(py),
+        (true, true) => job.run::<f32, i32>(py),
+    }
+}
+
+/// A checked sweep, to be written into arrays of a chosen precision.
+struct Job<'a> {
+    spine: &'a Spine<'a>,
+    offsets: &'a [usize],
+    p: &'a Profile,
+    opts: &'a Options,
+    lay: &'a sweep::Layout,
+    normals: bool,
+    uv: bool,
+}
+
+impl Job<'_> {
+    fn run<'py, R, I>(&self, py: Python<'py>) -> PyResult<MeshArrays<'py>>
+    where
+        R: sweep::Real + numpy::Element + bytemuck::Pod,
+        I: sweep::Index + numpy::Element + bytemuck::Pod,
+    {
+        let (nv, nf) = (self.lay.vertices, self.lay.faces);
+        let v = empty::<R, numpy::Ix2>(py, &[nv, 3])?;
+        let f = empty::<I, numpy::Ix2>(py, &[nf, 3])?;
+        let n = match self.normals {
+            true => Some(empty::<R, numpy::Ix2>(py, &[nv, 3])?),
+            false => None,
+        };
+        let uv = match self.uv {
+            true => Some(empty::<R, numpy::Ix2>(py, &[nv, 2])?),
+            false => None,
+        };
+        let folds = {
+            let (mut wv, mut wf) = (v.readwrite(), f.readwrite());
+            let mut wn = n.as_ref().map(|a| a.readwrite());
+            let mut wu = uv.as_ref().map(|a| a.readwrite());
+            let out = sweep::MeshMut::<R, I> {
+                vertices: bytemuck::cast_slice_mut(slice_mut(&mut wv)?),
+                faces: bytemuck::cast_slice_mut(slice_mut(&mut wf)?),
+                normals: match wn.as_mut() {
+                    Some(w) => Some(bytemuck::cast_slice_mut(slice_mut(w)?)),
+                    None => None,
+                },
+                uv: match wu.as_mut() {
+                    Some(w) => Some(bytemuck::cast_slice_mut(slice_mut(w)?)),
+                    None => None,
+                },
+            };
+            detach_in_pool(py, || {
+                sweep::sweep_into(self.spine, self.offsets, self.p, self.opts, self.lay, out)
+            })?
+        };
+        let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
+        Ok((
+            v.into_any(),
+            f.into_any(),
+            n.map(Bound::into_any),
+            uv.map(Bound::into_any),
+            PyArray1::from_vec(py, folds),
+        ))
+    }
 }

@@ -24,6 +24,25 @@
 //! last rings. Every vertex is shared by all its faces, so closed sweeps and capped open
 //! sweeps are watertight by construction.
 //!
+//! **Alternating diagonals.** A twisted quad `a b c d` (`a b` on ring `i`, `d c` on ring
+//! `i + 1`) is not planar; its two splits enclose volumes that differ by the tetrahedron on
+//! its corners, `τ/6` with `τ = det(b − a, d − a, c − a)`, one above and one below the
+//! bilinear patch through the corners (whose volume is their mean). One diagonal everywhere
+//! makes that error add up to first order in the ring spacing `h`, with the sign of the
+//! twist. Segments whose quads are not planar (some `|τ| > 10⁻⁹ |b − a| |d − a| |c − d|`:
+//! twist, torsion of the spine, a closing twist spread along a loop) are split along `a c`
+//! on even `i` and along `b d` on odd `i`, so the errors of neighbouring segments cancel and
+//! the volume converges at second order, like the bilinear surface (the same cancellation as
+//! the alternating rows of the "4-8"/checkerboard splits, with every vertex of valence 6).
+//! Segments of planar quads (straight and circular spines without twist) keep `a c`
+//! everywhere: the split does not change their volume, and the regular triangulation is the
+//! one discrete curvature operators converge on. The test is done in `f64` on the geometry,
+//! so `f32` output has the same faces.
+//!
+//! **Output precision.** Everything is computed in `f64`; the buffers are `f64` or `f32`
+//! ([`Real`]) and the face indices `i64` or `i32` ([`Index`]), written directly (no
+//! conversion pass). Normals and uv are optional.
+//!
 //! **Normals** are those of the smooth swept surface `S(u, v)`: `n ∝ S_v × S_u` from
 //! differences of the ring vertices — around the profile (central) and along the spine (the
 //! three-point derivative in arc length, one-sided at open ends). They therefore include the
@@ -53,7 +72,8 @@ pub struct Spine<'a> {
     pub points: &'a [DVec3],
     /// Row-major `(n, 3, 3)` frames, columns `(r, s, t)`.
     pub frames: &'a [[f64; 9]],
-    /// Scale along the profile's `(a, b)` axes.
+    /// Scale along the profile's `(a, b)` axes: one row per sample, or a single row for
+    /// all of them.
     pub scale: &'a [DVec2],
     /// Twist about the tangent, radians (empty: none).
     pub twist: &'a [f64],
@@ -124,7 +144,7 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             format!("has {} rows but points has {n}", s.frames.len()),
         ));
     }
-    if s.scale.len() != n {
+    if s.scale.len() != n && s.scale.len() != 1 {
         return Err(InputError::new(
             "scale",
             format!("has {} rows but points has {n}", s.scale.len()),
@@ -161,6 +181,17 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             ),
         ));
     }
+    if let Some(i) = against_spine(&s.points[..rings], s.frames, opts.closed) {
+        let j = if i + 1 == rings { 0 } else { i + 1 };
+        return Err(InputError::new(
+            "frames",
+            format!(
+                "the tangent column t of rows {i} and {j} points against the spine (from \
+                 point {i} to point {j}): the sweep would be inside out; frames must be \
+                 computed for the points in their order (spinal.frames(points))"
+            ),
+        ));
+    }
     if let Some(i) = validate::first_bad(s.scale, |v| v.x > 0.0 && v.y > 0.0 && v.is_finite()) {
         return Err(InputError::new(
             "scale",
@@ -177,12 +208,14 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             format!("non-finite value at row {i}"),
         ));
     }
-    let mut arc = Vec::with_capacity(chords.len() + 1);
+    // the arc lengths in the chords' buffer (no second array of the spine's length)
+    let mut arc = chords;
+    arc.reserve_exact(1);
+    arc.insert(0, 0.0);
     let mut acc = 0.0;
-    arc.push(acc);
-    for c in chords {
-        acc += c;
-        arc.push(acc);
+    for a in arc.iter_mut() {
+        acc += *a;
+        *a = acc;
     }
     Ok(Plan {
         rings,
@@ -192,6 +225,23 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
         cols: p.len() + usize::from(p.closed && opts.split_seams),
         arc,
     })
+}
+
+/// The first segment `i` (from sample `i` to the next) that runs against the tangents of
+/// both its ends, `(x_{i+1} − x_i)·t_i < 0` and `(x_{i+1} − x_i)·t_{i+1} < 0`: frames of the
+/// reversed curve, which would turn the mesh inside out.
+fn against_spine(x: &[DVec3], frames: &[[f64; 9]], closed: bool) -> Option<usize> {
+    let n = x.len();
+    let segments = if closed { n } else { n - 1 };
+    let t = |k: usize| columns(&frames[k]).2;
+    (0..segments)
+        .into_par_iter()
+        .with_min_len(1 << 14)
+        .find_first(|&i| {
+            let j = if i + 1 == n { 0 } else { i + 1 };
+            let chord = x[j] - x[i];
+            chord.dot(t(i)) < 0.0 && chord.dot(t(j)) < 0.0
+        })
 }
 
 /// Mitre stretch at ring `i`: `(factor − 1, unit direction)`, or zero where the spine is
@@ -265,14 +315,58 @@ fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3]
     }
 }
 
+/// Storage of the output coordinates: `f64`, or `f32` rounded from the `f64` results.
+pub trait Real: Copy + Send + Sync + 'static {
+    fn of(x: f64) -> Self;
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn of(x: f64) -> f64 {
+        x
+    }
+}
+
+impl Real for f32 {
+    #[inline(always)]
+    fn of(x: f64) -> f32 {
+        x as f32
+    }
+}
+
+/// Storage of the face indices: `i64`, or `i32` (the caller checks that they fit).
+pub trait Index: Copy + Send + Sync + 'static {
+    fn of(i: usize) -> Self;
+}
+
+impl Index for i64 {
+    #[inline(always)]
+    fn of(i: usize) -> i64 {
+        i as i64
+    }
+}
+
+impl Index for i32 {
+    #[inline(always)]
+    fn of(i: usize) -> i32 {
+        i as i32
+    }
+}
+
+#[inline(always)]
+fn put3<R: Real>(v: DVec3) -> [R; 3] {
+    [R::of(v.x), R::of(v.y), R::of(v.z)]
+}
+
 /// Output buffers of a sweep, sized by [`Layout`]; every element is written.
 #[derive(Debug)]
-pub struct MeshMut<'a> {
-    pub vertices: &'a mut [DVec3],
-    pub faces: &'a mut [[i64; 3]],
-    pub normals: &'a mut [DVec3],
-    /// Texture coordinates `(u, v)`, as in [`Mesh::uv`].
-    pub uv: &'a mut [DVec2],
+pub struct MeshMut<'a, R, I> {
+    pub vertices: &'a mut [[R; 3]],
+    pub faces: &'a mut [[I; 3]],
+    /// Unit normals (`None`: not computed).
+    pub normals: Option<&'a mut [[R; 3]]>,
+    /// Texture coordinates `(u, v)`, as in [`Mesh::uv`] (`None`: not computed).
+    pub uv: Option<&'a mut [[R; 2]]>,
 }
 
 /// The checked input of a sweep and the size of its mesh, from [`layout`].
@@ -285,14 +379,16 @@ pub struct Layout {
 
 /// Sweep one spine into its share of the output buffers; returns the rows (global) that
 /// start a folded-over segment.
-fn sweep_one(
+#[allow(clippy::too_many_arguments)]
+fn sweep_one<R: Real, I: Index>(
     s: &Spine,
     plan: &Plan,
     p: &Profile,
+    tris: &[[usize; 3]],
     opts: &Options,
     vbase: usize,
     rowbase: usize,
-    out: MeshMut,
+    out: MeshMut<R, I>,
 ) -> Vec<usize> {
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
     let grain = (4096 / plan.cols).max(1);
@@ -309,12 +405,13 @@ fn sweep_one(
         sign,
         rowbase,
     };
-    let folds = rings.write(out.vertices, out.normals, out.uv, grain);
+    let mut twisted = vec![false; plan.segments];
+    let folds = rings.write(out.vertices, out.normals, out.uv, &mut twisted, grain);
     let edges = if p.closed { p.len() } else { p.len() - 1 };
     let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
-    write_side_faces(side, plan, edges, vbase, sign, grain);
+    write_side_faces(side, plan, edges, vbase, sign, &twisted, grain);
     if plan.caps {
-        write_caps(caps, plan, p, vbase);
+        write_caps(caps, plan, tris, vbase);
     }
     folds
 }
@@ -405,7 +502,7 @@ impl Rings<'_> {
     fn base(&self, k: usize) -> (DVec3, DVec3, DVec3) {
         let s = self.s;
         let (r, q, _) = columns(&s.frames[k]);
-        let sc = s.scale[k];
+        let sc = s.scale[if s.scale.len() == 1 { 0 } else { k }];
         let (sn, cs) = if s.twist.is_empty() {
             (0.0, 1.0)
         } else {
@@ -432,59 +529,83 @@ impl Rings<'_> {
     }
 
     /// All stored rings, `grain` rings per parallel task; returns the fold-over rows.
-    fn write(
+    /// `twisted[i]`: the quads of segment `i` are not planar (see [`Rings::twisted`]).
+    fn write<R: Real>(
         &self,
-        vertices: &mut [DVec3],
-        normals: &mut [DVec3],
-        uv: &mut [DVec2],
+        vertices: &mut [[R; 3]],
+        normals: Option<&mut [[R; 3]]>,
+        uv: Option<&mut [[R; 2]]>,
+        twisted: &mut [bool],
         grain: usize,
     ) -> Vec<usize> {
         let (r_n, cols) = (self.plan.rings, self.plan.cols);
         let block = grain * cols;
         let (column, arc, sign) = (&self.column[..], &self.plan.arc[..], self.sign);
-        vertices
-            .par_chunks_mut(block)
-            .zip(normals.par_chunks_mut(block))
-            .zip(uv.par_chunks_mut(block))
+        let blocks = vertices.len().div_ceil(block);
+        let mut nb: Vec<Option<&mut [[R; 3]]>> = match normals {
+            Some(a) => a.chunks_mut(block).map(Some).collect(),
+            None => Vec::new(),
+        };
+        nb.resize_with(blocks, || None);
+        let mut ub: Vec<Option<&mut [[R; 2]]>> = match uv {
+            Some(a) => a.chunks_mut(block).map(Some).collect(),
+            None => Vec::new(),
+        };
+        ub.resize_with(blocks, || None);
+        let mut tb: Vec<&mut [bool]> = twisted.chunks_mut(grain).collect();
+        tb.resize_with(blocks, || &mut []);
+        let jobs: Vec<_> = vertices.chunks_mut(block).zip(nb).zip(ub).zip(tb).collect();
+        jobs.into_par_iter()
             .enumerate()
-            .flat_map_iter(|(bi, ((bv, bn), bu))| {
+            .flat_map_iter(|(bi, (((bv, mut bn), mut bu), tw))| {
                 let i0 = bi * grain;
                 let mut folds = Vec::new();
                 let mut prev = self.geo((i0 + r_n - 1) % r_n);
                 let mut cur = self.geo(i0 % r_n);
-                let rings = bv
-                    .chunks_mut(cols)
-                    .zip(bn.chunks_mut(cols))
-                    .zip(bu.chunks_mut(cols));
-                for (di, ((rv, rn), ruv)) in rings.enumerate() {
+                for (di, rv) in bv.chunks_mut(cols).enumerate() {
                     let i = i0 + di;
                     let next = self.geo((i + 1) % r_n);
                     let b = cur.b;
-                    let cr = self.normal_crosses([&prev, &cur, &next]);
-                    // The column loop stays here: as a function of its own (with `&mut`
-                    // slice arguments) the compiler vectorises it across columns, with many
-                    // spilled broadcasts, and the sweep got 15–20 % slower (200 000 rings of
-                    // 16 vertices, one thread).
-                    for (c, ((v, nv), w)) in
-                        column.iter().zip(rv.iter_mut().zip(rn.iter_mut()).zip(ruv))
-                    {
-                        let cw = &c.w;
-                        let nn = cw[0] * cr[0]
-                            + cw[1] * cr[1]
-                            + cw[2] * cr[2]
-                            + cw[3] * cr[3]
-                            + cw[4] * cr[4]
-                            + cw[5] * cr[5];
-                        *nv = nn.try_normalize().unwrap_or_else(|| {
-                            // degenerate spine derivative: the normal of the ring plane
-                            let e = cw[0] * b.1 + cw[1] * b.2;
-                            (sign * e.cross(cur.t)).try_normalize().unwrap_or(cur.t)
-                        });
-                        *v = b.0 + c.p.x * cur.ma + c.p.y * cur.mb;
-                        *w = DVec2::new(arc[i], c.v);
+                    let ring = di * cols..(di + 1) * cols;
+                    if let Some(bn) = bn.as_deref_mut() {
+                        let cr = self.normal_crosses([&prev, &cur, &next]);
+                        // The column loop stays here: as a function of its own (with `&mut`
+                        // slice arguments) the compiler vectorises it across columns, with
+                        // many spilled broadcasts, and the sweep got 15–20 % slower (200 000
+                        // rings of 16 vertices, one thread).
+                        for (c, (v, nv)) in
+                            column.iter().zip(rv.iter_mut().zip(&mut bn[ring.clone()]))
+                        {
+                            let cw = &c.w;
+                            let nn = cw[0] * cr[0]
+                                + cw[1] * cr[1]
+                                + cw[2] * cr[2]
+                                + cw[3] * cr[3]
+                                + cw[4] * cr[4]
+                                + cw[5] * cr[5];
+                            *nv = put3(nn.try_normalize().unwrap_or_else(|| {
+                                // degenerate spine derivative: the normal of the ring plane
+                                let e = cw[0] * b.1 + cw[1] * b.2;
+                                (sign * e.cross(cur.t)).try_normalize().unwrap_or(cur.t)
+                            }));
+                            *v = put3(b.0 + c.p.x * cur.ma + c.p.y * cur.mb);
+                        }
+                    } else {
+                        for (c, v) in column.iter().zip(rv.iter_mut()) {
+                            *v = put3(b.0 + c.p.x * cur.ma + c.p.y * cur.mb);
+                        }
                     }
-                    if i < self.plan.segments && self.folds_over(&cur, &next) {
-                        folds.push(self.rowbase + i);
+                    if let Some(bu) = bu.as_deref_mut() {
+                        let u = R::of(arc[i]);
+                        for (c, w) in column.iter().zip(&mut bu[ring]) {
+                            *w = [u, R::of(c.v)];
+                        }
+                    }
+                    if i < self.plan.segments {
+                        if self.folds_over(&cur, &next) {
+                            folds.push(self.rowbase + i);
+                        }
+                        tw[di] = self.twisted(&cur, &next);
                     }
                     prev = cur;
                     cur = next;
@@ -532,6 +653,25 @@ impl Rings<'_> {
         ]
     }
 
+    /// Are the quads of the segment from `cur` to `next` twisted (not planar)? The quad of
+    /// profile edge `p → p + e` has `b − a = A e`, `c − d = A′ e` and
+    /// `d − a = Δx + (A′ − A) p`, with `A = (ma, mb)`; `τ = det(b − a, d − a, c − d)`.
+    #[inline(always)]
+    fn twisted(&self, cur: &Geo, next: &Geo) -> bool {
+        let (dx, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
+        let pts = &self.p.points;
+        let m = pts.len();
+        let edges = if self.p.closed { m } else { m - 1 };
+        (0..edges).any(|j| {
+            let (p, e) = (pts[j], pts[(j + 1) % m] - pts[j]);
+            let u = e.x * cur.ma + e.y * cur.mb;
+            let w = e.x * next.ma + e.y * next.mb;
+            let v = dx + p.x * dma + p.y * dmb;
+            let tau = u.cross(v).dot(w);
+            tau.abs() > 1e-9 * (u.length() * v.length() * w.length())
+        })
+    }
+
     /// Fold-over of the segment from `cur` to `next`: rail edges must advance along both
     /// tangents. The rail edge of profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb),
     /// so its components along t and t′ are affine in p.
@@ -548,13 +688,15 @@ impl Rings<'_> {
 }
 
 /// Side faces: two triangles per quad between ring `i` and `i + 1`, `edges` quads per ring
-/// (vertex ids from `vbase`). Without split seams the last column/ring wraps to the first.
-fn write_side_faces(
-    side: &mut [[i64; 3]],
+/// (vertex ids from `vbase`), split along `b d` instead of `a c` on the odd twisted
+/// segments. Without split seams the last column/ring wraps to the first.
+fn write_side_faces<I: Index>(
+    side: &mut [[I; 3]],
     plan: &Plan,
     edges: usize,
     vbase: usize,
     sign: f64,
+    twisted: &[bool],
     grain: usize,
 ) {
     let cols = plan.cols;
@@ -564,30 +706,35 @@ fn write_side_faces(
         .with_min_len(grain)
         .enumerate()
         .for_each(|(i, quads)| {
-            let id = |ii: usize, jj: usize| (vbase + row(ii) * cols + col(jj)) as i64;
-            for j in 0..edges {
+            let id = |ii: usize, jj: usize| I::of(vbase + row(ii) * cols + col(jj));
+            for (j, pair) in quads.chunks_exact_mut(2).enumerate() {
                 let (a, b, c, d) = (id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j));
-                if sign > 0.0 {
-                    quads[2 * j] = [a, b, c];
-                    quads[2 * j + 1] = [a, c, d];
+                let (t1, t2) = if i % 2 == 0 || !twisted[i] {
+                    ([a, b, c], [a, c, d])
                 } else {
-                    quads[2 * j] = [a, c, b];
-                    quads[2 * j + 1] = [a, d, c];
+                    ([a, b, d], [b, c, d])
+                };
+                if sign > 0.0 {
+                    pair[0] = t1;
+                    pair[1] = t2;
+                } else {
+                    pair[0] = [t1[0], t1[2], t1[1]];
+                    pair[1] = [t2[0], t2[2], t2[1]];
                 }
             }
         });
 }
 
-/// Caps: the profile's triangulation on the first ring (facing −t) and the last (+t).
-fn write_caps(caps: &mut [[i64; 3]], plan: &Plan, p: &Profile, vbase: usize) {
-    let tris = p.triangulate();
-    let last = (vbase + (plan.rings - 1) * plan.cols) as i64;
-    let first = vbase as i64;
+/// Caps: the profile's triangulation `tris` on the first ring (facing −t) and the last (+t).
+fn write_caps<I: Index>(caps: &mut [[I; 3]], plan: &Plan, tris: &[[usize; 3]], vbase: usize) {
+    let last = vbase + (plan.rings - 1) * plan.cols;
+    let first = vbase;
     let k = tris.len();
-    for (c, tr) in tris.iter().enumerate() {
-        let [a, b, d] = tr.map(|v| v as i64);
-        caps[c] = [first + a, first + d, first + b]; // faces −t
-        caps[k + c] = [last + a, last + b, last + d]; // faces +t
+    let (lo, hi) = caps.split_at_mut(k);
+    for ((tr, c0), c1) in tris.iter().zip(lo).zip(hi) {
+        let [a, b, d] = *tr;
+        *c0 = [I::of(first + a), I::of(first + d), I::of(first + b)]; // faces −t
+        *c1 = [I::of(last + a), I::of(last + b), I::of(last + d)]; // faces +t
     }
 }
 
@@ -596,7 +743,11 @@ fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
     Spine {
         points: &all.points[a..b],
         frames: &all.frames[a..b],
-        scale: &all.scale[a..b],
+        scale: if all.scale.len() == 1 {
+            all.scale
+        } else {
+            &all.scale[a..b]
+        },
         twist: if all.twist.is_empty() {
             &[]
         } else {
@@ -645,22 +796,27 @@ pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options)
 
 /// Sweep `profile` along every spine of a checked bundle into buffers of the sizes in
 /// `layout` (spines in parallel). Returns the rows starting a folded-over segment.
-pub fn sweep_into(
+pub fn sweep_into<R: Real, I: Index>(
     all: &Spine,
     offsets: &[usize],
     profile: &Profile,
     opts: &Options,
     layout: &Layout,
-    out: MeshMut,
+    out: MeshMut<R, I>,
 ) -> Vec<usize> {
     let (nv, nf) = (layout.vertices, layout.faces);
     assert!(
         out.vertices.len() == nv
-            && out.normals.len() == nv
-            && out.uv.len() == nv
+            && out.normals.as_ref().is_none_or(|a| a.len() == nv)
+            && out.uv.as_ref().is_none_or(|a| a.len() == nv)
             && out.faces.len() == nf,
         "sweep_into: buffers must have the sizes of the layout"
     );
+    let tris = if layout.plans.iter().any(|p| p.caps) {
+        profile.triangulate()
+    } else {
+        Vec::new()
+    };
     // Split the buffers per spine.
     let mut jobs = Vec::with_capacity(layout.plans.len());
     let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, out.faces);
@@ -668,8 +824,20 @@ pub fn sweep_into(
     for (c, plan) in layout.plans.iter().enumerate() {
         let (k, kf) = (plan.vertices(), plan.faces(profile));
         let (v1, v2) = v.split_at_mut(k);
-        let (n1, n2) = nr.split_at_mut(k);
-        let (u1, u2) = u.split_at_mut(k);
+        let (n1, n2) = match nr {
+            Some(a) => {
+                let (x, y) = a.split_at_mut(k);
+                (Some(x), Some(y))
+            }
+            None => (None, None),
+        };
+        let (u1, u2) = match u {
+            Some(a) => {
+                let (x, y) = a.split_at_mut(k);
+                (Some(x), Some(y))
+            }
+            None => (None, None),
+        };
         let (f1, f2) = f.split_at_mut(kf);
         let mine = MeshMut {
             vertices: v1,
@@ -688,6 +856,7 @@ pub fn sweep_into(
                 &part(all, offsets, c),
                 &layout.plans[c],
                 profile,
+                &tris,
                 opts,
                 vbase,
                 offsets[c],
@@ -719,11 +888,11 @@ pub fn sweep_many(
         profile,
         opts,
         &lay,
-        MeshMut {
-            vertices: &mut mesh.vertices,
+        MeshMut::<f64, i64> {
+            vertices: bytemuck::cast_slice_mut(&mut mesh.vertices),
             faces: &mut mesh.faces,
-            normals: &mut mesh.normals,
-            uv: &mut mesh.uv,
+            normals: Some(bytemuck::cast_slice_mut(&mut mesh.normals)),
+            uv: Some(bytemuck::cast_slice_mut(&mut mesh.uv)),
         },
     );
     Ok(mesh)
