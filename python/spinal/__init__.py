@@ -12,7 +12,7 @@ from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames
-from ._mesh import FoldOverWarning, Mesh
+from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
 from ._sweep import sweep, tube
 
 __all__ = [
@@ -20,6 +20,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "RefinementWarning",
+    "SkippedCurvesWarning",
     "SpineBinding",
     "StampReport",
     "SurfaceBinding",
