@@ -11,8 +11,9 @@
 //!   each bucket (of the size of the vertex degree) is then sorted on its own. An edge `{v, w}`
 //!   of a closed 2-manifold has exactly two slots, traversed in opposite directions when the
 //!   faces are consistently oriented ("winding"); one slot is a boundary edge, more a
-//!   non-manifold edge. The vertex range is split into one part per thread; each part scans
-//!   the faces for its own slots, so every bucket is written by one thread, without locks.
+//!   non-manifold edge. The sort runs in two parallel distributions (blocks of vertices, then
+//!   vertices within a block), each face chunk writing its own part of every block, so no
+//!   two threads write the same place and no lock is needed.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -69,39 +70,58 @@ fn corners<I: Index>(t: &[I; 3]) -> [usize; 3] {
 
 /// Refuse faces with an index outside `0..n` (the first such face; errors name `faces`).
 pub fn check_faces<I: Index>(f: &[[I; 3]], n: usize) -> Result<()> {
-    match f
-        .par_iter()
-        .position_first(|t| !t.iter().all(|&i| ok_i64(i.get(), n)))
-    {
+    let bad = f
+        .par_chunks(BLOCK)
+        .position_first(|b| !b.iter().all(|t| valid(t, n)));
+    match bad {
         None => Ok(()),
-        Some(i) => {
-            let x = f[i]
-                .iter()
-                .map(|i| i.get())
-                .find(|&x| !ok_i64(x, n))
-                .unwrap_or(-1);
-            Err(InputError::new(
-                "faces",
-                format!(
-                    "face {i} refers to vertex {x}, but there are {n} vertices (indices must \
-                     lie in 0..{n})"
-                ),
-            ))
-        }
+        Some(c) => Err(out_of_range(f, c * BLOCK, n)),
     }
 }
 
-fn ok_i64(x: i64, n: usize) -> bool {
-    usize::try_from(x).is_ok_and(|x| x < n)
+#[inline(always)]
+fn valid<I: Index>(t: &[I; 3], n: usize) -> bool {
+    t.iter()
+        .all(|i| usize::try_from(i.get()).is_ok_and(|x| x < n))
 }
 
-/// The compensated sum of `term(face)` over all faces, in fixed blocks.
-fn face_sum<I: Index>(f: &[[I; 3]], term: impl Fn([usize; 3]) -> f64 + Sync) -> f64 {
-    let blocks: Vec<f64> = f
+/// The error about the first face from `from` on with an index outside `0..n`.
+fn out_of_range<I: Index>(f: &[[I; 3]], from: usize, n: usize) -> InputError {
+    let i = from + f[from..].iter().position(|t| !valid(t, n)).unwrap_or(0);
+    let x = f[i]
+        .iter()
+        .map(|i| i.get())
+        .find(|&x| !usize::try_from(x).is_ok_and(|x| x < n))
+        .unwrap_or(-1);
+    InputError::new(
+        "faces",
+        format!(
+            "face {i} refers to vertex {x}, but there are {n} vertices (indices must lie in \
+             0..{n})"
+        ),
+    )
+}
+
+/// The compensated sum of `term(face)` over all faces, in fixed blocks, checking the
+/// indices on the way (errors name `faces`).
+fn face_sum<I: Index>(
+    f: &[[I; 3]],
+    n: usize,
+    term: impl Fn([usize; 3]) -> f64 + Sync,
+) -> Result<f64> {
+    let blocks: Vec<Option<f64>> = f
         .par_chunks(BLOCK)
-        .map(|b| compensated_sum(b.iter().map(|t| term(corners(t)))))
+        .map(|b| {
+            if !b.iter().all(|t| valid(t, n)) {
+                return None;
+            }
+            Some(compensated_sum(b.iter().map(|t| term(corners(t)))))
+        })
         .collect();
-    compensated_sum(blocks.into_iter())
+    if let Some(c) = blocks.iter().position(Option::is_none) {
+        return Err(out_of_range(f, c * BLOCK, n));
+    }
+    Ok(compensated_sum(blocks.into_iter().flatten()))
 }
 
 /// The mean of the vertices (zero for none), summed in fixed blocks.
@@ -119,22 +139,20 @@ fn mean<P: Point>(v: &[P]) -> DVec3 {
 /// Signed volume of the mesh `(v, f)` about its mean vertex (faces checked, errors name
 /// `faces`); positive for a closed mesh wound counter-clockwise seen from outside.
 pub fn volume<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    check_faces(f, v.len())?;
     let m = mean(v);
-    let s = face_sum(f, |[a, b, c]| {
+    let s = face_sum(f, v.len(), |[a, b, c]| {
         let (a, b, c) = (v[a].dvec3() - m, v[b].dvec3() - m, v[c].dvec3() - m);
         a.dot(b.cross(c))
-    });
+    })?;
     Ok(s / 6.0)
 }
 
 /// Total area of the triangles (faces checked, errors name `faces`).
 pub fn area<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    check_faces(f, v.len())?;
-    let s = face_sum(f, |[a, b, c]| {
+    let s = face_sum(f, v.len(), |[a, b, c]| {
         let a = v[a].dvec3();
         (v[b].dvec3() - a).cross(v[c].dvec3() - a).length()
-    });
+    })?;
     Ok(0.5 * s)
 }
 
@@ -291,7 +309,7 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
             };
             for win in start.windows(2) {
                 let bucket = &mut keys[win[0]..win[1]];
-                bucket.sort_unstable();
+                sort_small(bucket);
                 let mut i = 0;
                 while i < bucket.len() {
                     let w = bucket[i].get() >> 1;
@@ -315,6 +333,25 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
             st
         })
         .reduce(EdgeStats::default, EdgeStats::add)
+}
+
+/// Sort a bucket: insertion sort for the few entries of a typical vertex (a library sort's
+/// set-up costs more there), the library's otherwise.
+#[inline]
+fn sort_small<K: Key>(b: &mut [K]) {
+    if b.len() > 24 {
+        b.sort_unstable();
+        return;
+    }
+    for i in 1..b.len() {
+        let x = b[i];
+        let mut j = i;
+        while j > 0 && b[j - 1] > x {
+            b[j] = b[j - 1];
+            j -= 1;
+        }
+        b[j] = x;
+    }
 }
 
 #[cfg(test)]
