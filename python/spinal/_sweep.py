@@ -174,6 +174,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     pdata = _point_data(point_data, n, curves if bundle else None)
     # curves too short to sweep: refused by the core (on_short="raise") or left out here
     row0, curve_ids, skipped = offs[:-1], np.arange(curves), np.zeros(0, dtype=np.int64)
+    keep_rows = None
     if on_short == "skip" and lens is not None:
         short = lens < (3 if closed else 2)
         if short.any():
@@ -202,8 +203,8 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
     )
-    kept_rows = np.concatenate([np.arange(a, a + b) for a, b in zip(row0, np.diff(offs))])
-    folds = kept_rows[folds] if folds.size else folds
+    if folds.size and keep_rows is not None:  # back to the rows as given
+        folds = np.flatnonzero(keep_rows)[folds]
     rings, vstart = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
     if folds.size:
         where = f"spine rows {_ranges(folds)}"
