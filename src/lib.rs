@@ -28,6 +28,7 @@ pub mod error;
 pub mod flesh;
 pub mod frames;
 pub mod math;
+pub mod mesh;
 pub mod ph;
 mod python;
 pub mod quaternion;

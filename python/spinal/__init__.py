@@ -14,7 +14,7 @@ from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
-from ._mesh import FoldOverWarning, Mesh
+from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
 from ._sweep import sweep, tube
 from ._threads import get_num_threads, set_num_threads, threads
 
@@ -23,6 +23,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "RefinementWarning",
+    "SkippedCurvesWarning",
     "SpineBinding",
     "StampReport",
     "SurfaceBinding",

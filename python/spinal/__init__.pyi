@@ -20,6 +20,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "RefinementWarning",
+    "SkippedCurvesWarning",
     "SpineBinding",
     "StampReport",
     "SurfaceBinding",
@@ -50,6 +51,9 @@ _Array: TypeAlias = npt.ArrayLike
 _F: TypeAlias = npt.NDArray[np.float64]
 _I: TypeAlias = npt.NDArray[np.int64]
 _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
+# a bundle as users hold it: a list (any sequence, e.g. nibabel's ArraySequence) of (n_i, 3)
+_Curves: TypeAlias = Sequence[_Array] | Any
+_PointData: TypeAlias = dict[str, _Array]
 _Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
 _Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
@@ -62,8 +66,8 @@ _SurfaceSolution: TypeAlias = Literal["offset", "none"]
 # ---- frames -------------------------------------------------------------------------------
 
 def frames(
-    points: _Array | Curve | None,
-    tangents: _Array | None = None,
+    points: _Array | Curve | _Curves | None,
+    tangents: _Array | _Curves | None = None,
     *,
     method: _Method = "double_reflection",
     initial: _Array | None = None,
@@ -93,8 +97,8 @@ def frames_in_time(
     previous: _Array | None = None,
 ) -> _F: ...
 def closing_angle(
-    points: _Array | Curve | None,
-    tangents: _Array | None = None,
+    points: _Array | Curve | _Curves | None,
+    tangents: _Array | _Curves | None = None,
     *,
     method: _Method = "double_reflection",
     reflection: _Reflection = "chord",
@@ -115,14 +119,25 @@ def estimate_tangents(
 
 class FoldOverWarning(UserWarning):
     indices: _I
-    def __init__(self, message: str, indices: _I) -> None: ...
+    curves: _I | None
+    rows: _I | None
+    def __init__(
+        self, message: str, indices: _I, curves: _I | None = None, rows: _I | None = None
+    ) -> None: ...
+
+class SkippedCurvesWarning(UserWarning):
+    curves: _I
+    def __init__(self, message: str, curves: _I) -> None: ...
 
 class Mesh:
-    vertices: _F
-    faces: _I
+    vertices: npt.NDArray[np.float64] | npt.NDArray[np.float32]
+    faces: _I | npt.NDArray[np.int32]
     normals: _F | None
     uv: _F | None
     fold_over: _I
+    point_data: dict[str, npt.NDArray[Any]]
+    cell_data: dict[str, npt.NDArray[Any]]
+    skipped_curves: _I
     def __init__(
         self,
         vertices: _Array,
@@ -130,13 +145,30 @@ class Mesh:
         normals: _Array | None = None,
         uv: _Array | None = None,
         fold_over: _Array | None = None,
+        *,
+        point_data: _PointData | None = None,
+        cell_data: _PointData | None = None,
+        sample_of: _Array | None = None,
+        curve_of: _Array | None = None,
+        skipped_curves: _Array | None = None,
     ) -> None: ...
+    @property
+    def sample_of(self) -> _I | None: ...
+    @property
+    def curve_of(self) -> _I | None: ...
     @property
     def volume(self) -> float: ...
     @property
     def area(self) -> float: ...
+    def edge_stats(self) -> dict[str, int]: ...
     @property
     def is_watertight(self) -> bool: ...
+    @property
+    def is_closed(self) -> bool: ...
+    @property
+    def is_winding_consistent(self) -> bool: ...
+    @staticmethod
+    def concatenate(meshes: Sequence[Mesh]) -> Mesh: ...
     def to_trimesh(self) -> Any: ...
     def to_pyvista(self) -> Any: ...
     def save(self, path: str | os.PathLike[str]) -> pathlib.Path: ...
@@ -149,7 +181,7 @@ class Mesh:
     ) -> npt.NDArray[np.uint8] | None: ...
 
 def sweep(
-    points: _Array,
+    points: _Array | _Curves,
     profile: _Array,
     *,
     frames: _Array | None = None,
@@ -168,9 +200,11 @@ def sweep(
     dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
+    point_data: _PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
 ) -> Mesh: ...
 def tube(
-    points: _Array,
+    points: _Array | _Curves,
     radius: float | _Array = 1.0,
     sides: int = 16,
     *,
@@ -187,6 +221,8 @@ def tube(
     dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
+    point_data: _PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------

@@ -8,7 +8,16 @@ import numpy as np
 
 from . import _core
 from ._steer import previous_frames, steering
-from ._validate import as_bool, as_choice, as_float_array, as_int, as_offsets, as_points
+from ._validate import (
+    as_bool,
+    as_choice,
+    as_curves,
+    as_float_array,
+    as_int,
+    as_offsets,
+    as_points,
+    is_curve_list,
+)
 from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
@@ -78,12 +87,25 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         return out, np.array([angle]), False
     if u is not None:
         raise TypeError("u: only used with an analytic curve from spinal.curves")
-    pts = None if points is None else as_points(points, points_arg)
-    tgs = None if tangents is None else as_points(tangents, "tangents")
+    if is_curve_list(points) or (points is None and is_curve_list(tangents)):
+        # a sequence of curves: the rows back to back, the lengths from the sequence
+        pts, offs, bundle = (None, None, True) if points is None else as_curves(
+            points, lengths, offsets, points_arg)
+        tgs = None
+        if tangents is not None:
+            tgs, toffs, _ = as_curves(tangents, None, None, "tangents")
+            if offs is not None and not np.array_equal(toffs, offs):
+                raise ValueError("tangents: the curves must have the lengths of points'")
+            offs = toffs if offs is None else offs
+    else:
+        pts = None if points is None else as_points(points, points_arg)
+        tgs = None if tangents is None else as_points(tangents, "tangents")
+        offs = None
     if pts is None and (tgs is None or reflection != "tangents"):
         raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
     rows = (pts if pts is not None else tgs).shape[0]
-    offs, bundle = as_offsets(rows, lengths, offsets)
+    if offs is None:
+        offs, bundle = as_offsets(rows, lengths, offsets)
     curves = offs.size - 1
     iv, if_ = _orientation(initial, "initial", curves, bundle)
     ev, ef = _orientation(end, "end", curves, bundle)
@@ -197,7 +219,10 @@ def frames(
         Many curves in one call: ``points`` holds all curves back to back, ``lengths[c]`` rows
         each (or ``offsets``, C + 1 start rows ending at n). Curves are computed in parallel;
         ``initial``/``end`` may be given per curve as (C, 3) or (C, 3, 3). Long single curves
-        use all cores too (a parallel prefix scan of the per-segment rotations).
+        use all cores too (a parallel prefix scan of the per-segment rotations). A bundle may
+        also be given as users hold it: ``points`` a list (any sequence) of ``(n_i, 3)``
+        arrays of any real dtype, e.g. nibabel's ``ArraySequence`` (``tangents`` likewise);
+        the frames of all curves then come back to back in one array.
     constraints : mapping or (indices, vectors), optional
         Prescribed orientations anywhere along the curve: ``{row: vector or (3, 3) frame}``
         or a pair ``(indices (k,), vectors (k, 3) or frames (k, 3, 3))``; any number, interior

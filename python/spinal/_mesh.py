@@ -11,22 +11,40 @@ import numpy as np
 from . import _core
 from ._validate import as_float_array
 
-__all__ = ["FoldOverWarning", "Mesh", "mesh_arrays"]
+__all__ = ["FoldOverWarning", "Mesh", "SkippedCurvesWarning", "mesh_arrays"]
 
 
 class FoldOverWarning(UserWarning):
     """The swept profile reaches past the spine's centre of curvature, so the surface folds
-    over itself there. ``indices`` holds the spine rows that start the folded segments."""
+    over itself there. ``indices`` holds the spine rows that start the folded segments (rows
+    of all curves back to back); for a bundle ``curves`` holds the curve of each and
+    ``rows`` the row within that curve (None for a single spine)."""
 
-    def __init__(self, message: str, indices: np.ndarray):
+    def __init__(self, message: str, indices: np.ndarray, curves: np.ndarray | None = None,
+                 rows: np.ndarray | None = None):
         super().__init__(message)
         self.indices = indices
+        self.curves = curves
+        self.rows = rows
 
     def __reduce__(self):
         # the default (cls, args, state) would call cls(message) without indices; pickling
         # matters for process pools, which send exceptions (and recorded warnings) back
         message = self.args[0] if self.args else ""
-        return type(self), (message, self.indices), self.__dict__
+        return type(self), (message, self.indices, self.curves, self.rows), self.__dict__
+
+
+class SkippedCurvesWarning(UserWarning):
+    """A sweep with ``on_short="skip"`` left out curves too short to sweep; ``curves`` holds
+    their ids (also in ``Mesh.skipped_curves``)."""
+
+    def __init__(self, message: str, curves: np.ndarray):
+        super().__init__(message)
+        self.curves = curves
+
+    def __reduce__(self):
+        message = self.args[0] if self.args else ""
+        return type(self), (message, self.curves), self.__dict__
 
 
 def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
@@ -60,8 +78,93 @@ def mesh_arrays(mesh):
     return V, F
 
 
+def _as_faces(faces, n: int) -> np.ndarray:
+    """``faces`` as an ``(F, 3)`` int64 (or int32) array with every index in ``0..n``."""
+    if isinstance(faces, (str, bytes)):
+        raise TypeError(f"faces: expected an (F, 3) array of integers, got {type(faces).__name__}")
+    try:
+        F = np.asarray(faces)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"faces: cannot be read as an array ({exc})") from None
+    if F.size == 0:
+        F = F.reshape(0, 3)
+    if F.dtype.kind not in "iu":
+        raise TypeError(f"faces: expected integer vertex indices, got dtype {F.dtype}")
+    if F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"faces: expected an array of shape (F, 3), got shape {F.shape}")
+    if F.dtype not in (np.int32, np.int64):
+        if F.dtype.kind == "u" and F.size and F.max() > np.iinfo(np.int64).max:
+            raise ValueError(f"faces: vertex index {F.max()} out of range (there are {n} "
+                             f"vertices)")
+        F = F.astype(np.int64)
+    _core.mesh_check_faces(np.ascontiguousarray(F), n)
+    return F
+
+
+def _rows_or_none(x, name: str, n: int, width: int):
+    if x is None:
+        return None
+    single = isinstance(x, np.ndarray) and x.dtype == np.float32
+    a = x if single else as_float_array(x, name)
+    if a.shape != (n, width):
+        raise ValueError(f"{name}: expected shape ({n}, {width}) (one row per vertex), got "
+                         f"{a.shape}")
+    return a
+
+
+def _index_array(x, name: str, n: int | None = None, none: bool = False):
+    if x is None:
+        return None if none else np.zeros(0, dtype=np.int64)
+    a = np.asarray(x)
+    if a.size == 0:
+        a = a.reshape(0)
+    if a.dtype.kind not in "iu" or a.ndim != 1:
+        raise TypeError(f"{name}: expected a 1-D array of integers, got {a.dtype} {a.shape}")
+    if n is not None and len(a) != n:
+        raise ValueError(f"{name}: expected one entry per vertex ({n}), got {len(a)}")
+    return a.astype(np.int64, copy=False)
+
+
+def _attributes(data, name: str, n: int) -> dict:
+    """A dict of ``(n,)`` / ``(n, k)`` numeric arrays (``name`` in errors)."""
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise TypeError(f"{name}: expected a dict of arrays, got {type(data).__name__}")
+    out = {}
+    for k, v in data.items():
+        if not isinstance(k, str):
+            raise TypeError(f"{name}: keys must be strings, got {k!r}")
+        a = np.asarray(v)
+        if a.dtype.kind not in "biuf" or a.ndim not in (1, 2) or len(a) != n:
+            raise ValueError(f"{name}[{k!r}]: expected a numeric ({n},) or ({n}, k) array, "
+                             f"got {a.dtype} {a.shape}")
+        out[k] = a
+    return out
+
+
+def _rows_of(m: Mesh) -> int:
+    """Spine rows a mesh stands for (for offsetting ``sample_of`` when joining)."""
+    n = getattr(m, "_n_rows", None)
+    if n is not None:
+        return n
+    s = m.sample_of
+    return int(s.max()) + 1 if s is not None and len(s) else 0
+
+
+def _curves_of(m: Mesh) -> int:
+    n = getattr(m, "_n_curves", None)
+    if n is not None:
+        return n
+    c = m.curve_of
+    return int(c.max()) + 1 if c is not None and len(c) else 0
+
+
 class Mesh:
     """A triangle mesh: what :func:`spinal.sweep` and :func:`spinal.tube` return.
+
+    ``Mesh(vertices, faces, ...)`` checks its arrays (shapes, integer faces with indices in
+    ``0..V``); errors name the argument.
 
     Attributes
     ----------
@@ -77,16 +180,75 @@ class Mesh:
     fold_over : ndarray (k,) int64
         Spine rows starting a segment where the surface folds over itself (empty when
         none); see :class:`FoldOverWarning`.
+    point_data : dict of str to ndarray (V,) or (V, k)
+        Per-vertex attributes: the ``point_data=`` of the sweep, each sample's (or curve's)
+        value on every vertex of its ring (caps included).
+    cell_data : dict of str to ndarray (F,) or (F, k)
+        Per-face attributes; sweeps of a bundle put the curve of every face in
+        ``"curve_id"``.
+    sample_of, curve_of : ndarray (V,) int64 or None
+        The spine row (as given: rows of all curves back to back) and the curve of every
+        vertex of a sweep (None for meshes made otherwise). Computed when first read.
+    skipped_curves : ndarray (k,) int64
+        Curves of a bundle left out by ``on_short="skip"`` (empty when none).
     """
 
-    def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None):
-        self.vertices = _floats(vertices)
-        self.faces = _ints(faces)
-        self.normals = None if normals is None else _floats(normals)
-        self.uv = None if uv is None else _floats(uv)
-        self.fold_over = (
-            np.zeros(0, dtype=np.int64) if fold_over is None else np.asarray(fold_over, np.int64)
-        )
+    def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None, *,
+                 point_data=None, cell_data=None, sample_of=None, curve_of=None,
+                 skipped_curves=None):
+        single = isinstance(vertices, np.ndarray) and vertices.dtype == np.float32
+        V = vertices if single else as_float_array(vertices, "vertices")
+        if V.ndim != 2 or V.shape[1] != 3:
+            raise ValueError(f"vertices: expected an array of shape (V, 3), got shape {V.shape}")
+        n = len(V)
+        F = _as_faces(faces, n)
+        self.vertices, self.faces = V, F
+        self.normals = _rows_or_none(normals, "normals", n, 3)
+        self.uv = _rows_or_none(uv, "uv", n, 2)
+        self.fold_over = _index_array(fold_over, "fold_over")
+        self.point_data = _attributes(point_data, "point_data", n)
+        self.cell_data = _attributes(cell_data, "cell_data", len(F))
+        self._sample_of = _index_array(sample_of, "sample_of", n, none=True)
+        self._curve_of = _index_array(curve_of, "curve_of", n, none=True)
+        self._rings = self._n_rows = self._n_curves = None
+        self.skipped_curves = _index_array(skipped_curves, "skipped_curves")
+
+    @classmethod
+    def _of_sweep(cls, vertices, faces, normals, uv, fold_over, rings, rows, curves) -> Mesh:
+        """A sweep's mesh without the checks (the core built it); ``rings`` is the compact
+        vertex layout ``(ring_sample (R,), ring_curve (R,), cols)``: stored ring ``r`` holds
+        vertices ``r*cols .. (r+1)*cols`` of spine row ``ring_sample[r]``, curve
+        ``ring_curve[r]``; the sweep had ``rows`` spine rows in ``curves`` curves."""
+        mesh = cls.__new__(cls)
+        mesh.vertices, mesh.faces, mesh.normals, mesh.uv = vertices, faces, normals, uv
+        mesh.fold_over = np.asarray(fold_over, dtype=np.int64)
+        mesh.point_data, mesh.cell_data = {}, {}
+        mesh._sample_of = mesh._curve_of = None
+        mesh._rings, mesh._n_rows, mesh._n_curves = rings, rows, curves
+        mesh.skipped_curves = np.zeros(0, dtype=np.int64)
+        return mesh
+
+    @property
+    def sample_of(self) -> np.ndarray | None:
+        """The spine row of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
+        if self._sample_of is None and self._rings is not None:
+            self._sample_of = np.repeat(self._rings[0], self._rings[2])
+        return self._sample_of
+
+    @sample_of.setter
+    def sample_of(self, value) -> None:
+        self._sample_of = _index_array(value, "sample_of", len(self.vertices), none=True)
+
+    @property
+    def curve_of(self) -> np.ndarray | None:
+        """The curve of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
+        if self._curve_of is None and self._rings is not None:
+            self._curve_of = np.repeat(self._rings[1], self._rings[2])
+        return self._curve_of
+
+    @curve_of.setter
+    def curve_of(self, value) -> None:
+        self._curve_of = _index_array(value, "curve_of", len(self.vertices), none=True)
 
     def __repr__(self) -> str:
         return f"spinal.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
@@ -95,30 +257,114 @@ class Mesh:
     def volume(self) -> float:
         """Signed enclosed volume, ``Σ (a · (b × c)) / 6`` over the faces (divergence
         theorem); positive for a closed, outward-facing mesh. Summed about the mean vertex,
-        so a small mesh far from the origin keeps its digits."""
-        return signed_volume(self.vertices, self.faces)
+        so a small mesh far from the origin keeps its digits (compensated sums, in parallel,
+        linear in the faces)."""
+        return _core.mesh_measure(*self._arrays(), "volume")
 
     @property
     def area(self) -> float:
-        """Total surface area."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
+        """Total surface area (compensated sums, in parallel, linear in the faces)."""
+        return _core.mesh_measure(*self._arrays(), "area")
+
+    def edge_stats(self) -> dict[str, int]:
+        """Counts of the undirected edges (by vertex index): ``edges``, ``boundary`` (in one
+        face), ``non_manifold`` (in more than two), ``inconsistent`` (in two faces that
+        traverse it the same way) and ``degenerate`` (face corners joining a vertex to
+        itself). A counting sort of the face slots on their smaller vertex: linear time,
+        ``O(F)`` integers of memory, in parallel."""
+        V, F = self._arrays()
+        keys = ("edges", "boundary", "non_manifold", "inconsistent", "degenerate")
+        return dict(zip(keys, _core.mesh_edges(F, len(V))))
 
     @property
     def is_watertight(self) -> bool:
         """Every edge is shared by exactly two faces that traverse it in opposite directions
         (closed, consistently oriented, by vertex index)."""
-        f = self.faces.astype(np.int64, copy=False)
-        e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
-        key = e[:, 0] * (len(self.vertices) + 1) + e[:, 1]
-        rev = e[:, 1] * (len(self.vertices) + 1) + e[:, 0]
-        if np.unique(key).size != key.size:  # a directed edge used twice
-            return False
-        return bool(np.isin(rev, key).all())
+        e = self.edge_stats()
+        return e["boundary"] == e["non_manifold"] == e["inconsistent"] == e["degenerate"] == 0
+
+    @property
+    def is_closed(self) -> bool:
+        """Every edge is shared by exactly two faces, whatever their orientation
+        (``trimesh.Trimesh.is_watertight``)."""
+        e = self.edge_stats()
+        return e["boundary"] == e["non_manifold"] == e["degenerate"] == 0
+
+    @property
+    def is_winding_consistent(self) -> bool:
+        """Every edge shared by two faces is traversed by them in opposite directions
+        (``trimesh.Trimesh.is_winding_consistent``)."""
+        return self.edge_stats()["inconsistent"] == 0
+
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Vertices and faces as the core reads them (C-contiguous, float32/64, int32/64)."""
+        V, F = self.vertices, self.faces
+        if V.dtype not in (np.float32, np.float64):
+            V = np.asarray(V, dtype=np.float64)
+        if F.dtype not in (np.int32, np.int64):
+            F = np.asarray(F, dtype=np.int64)
+        return np.ascontiguousarray(V), np.ascontiguousarray(F).reshape(-1, 3)
+
+    @staticmethod
+    def concatenate(meshes) -> Mesh:
+        """One mesh of all ``meshes`` (a sequence of :class:`Mesh`), for chunked pipelines:
+        vertices stacked, faces offset by the vertices before them. ``normals``/``uv`` are kept
+        when every mesh has them; ``point_data``/``cell_data`` keys present in every mesh are
+        kept. ``sample_of``, ``fold_over`` (spine rows) are offset by the rows of the meshes
+        before (their largest row + 1, or the rows the sweep was given), ``curve_of``,
+        ``skipped_curves`` and ``cell_data["curve_id"]`` by their curves, so chunks of a
+        bundle swept one by one give the mesh of the whole bundle."""
+        meshes = list(meshes)
+        if not meshes or not all(isinstance(m, Mesh) for m in meshes):
+            raise TypeError("meshes: expected a non-empty sequence of spinal.Mesh")
+        V = np.concatenate([m.vertices for m in meshes])
+        nv = np.cumsum([0] + [len(m.vertices) for m in meshes])
+        big = nv[-1] > np.iinfo(np.int32).max
+        ftype = np.int64 if big or any(m.faces.dtype == np.int64 for m in meshes) else np.int32
+        F = np.concatenate([m.faces.astype(ftype, copy=False) + ftype(o)
+                            for m, o in zip(meshes, nv[:-1])])
+
+        def joined(attr):
+            parts = [getattr(m, attr) for m in meshes]
+            return None if any(p is None for p in parts) else np.concatenate(parts)
+
+        rows = np.cumsum([0] + [_rows_of(m) for m in meshes])
+        curves = np.cumsum([0] + [_curves_of(m) for m in meshes])
+
+        def shifted(attr, shift):
+            parts = [getattr(m, attr) for m in meshes]
+            if any(p is None for p in parts):
+                return None
+            return np.concatenate([p + s for p, s in zip(parts, shift)])
+
+        def common(attr, shift_curve):
+            keys = [k for k in getattr(meshes[0], attr)
+                    if all(k in getattr(m, attr) for m in meshes)]
+            out = {}
+            for k in keys:
+                parts = [getattr(m, attr)[k] for m in meshes]
+                if shift_curve and k == "curve_id":
+                    parts = [p + s for p, s in zip(parts, curves)]
+                out[k] = np.concatenate(parts)
+            return out
+
+        mesh = Mesh.__new__(Mesh)
+        mesh.vertices, mesh.faces = V, F
+        mesh.normals, mesh.uv = joined("normals"), joined("uv")
+        mesh.fold_over = np.concatenate([m.fold_over + s for m, s in zip(meshes, rows)])
+        mesh.point_data = common("point_data", False)
+        mesh.cell_data = common("cell_data", True)
+        mesh._sample_of, mesh._curve_of, mesh._rings = (
+            shifted("sample_of", rows), shifted("curve_of", curves), None)
+        mesh._n_rows, mesh._n_curves = int(rows[-1]), int(curves[-1])
+        mesh.skipped_curves = np.concatenate(
+            [m.skipped_curves + s for m, s in zip(meshes, curves)]).astype(np.int64)
+        return mesh
 
     def to_trimesh(self):
         """A ``trimesh.Trimesh`` with the same vertices, faces and normals (no merging or
-        reordering; ``uv`` goes to a ``TextureVisuals`` when present)."""
+        reordering; ``uv`` goes to a ``TextureVisuals`` when present; ``point_data`` and
+        ``cell_data`` to ``vertex_attributes`` and ``face_attributes``)."""
         import trimesh
 
         visual = None
@@ -130,11 +376,13 @@ class Mesh:
             vertex_normals=self.normals,
             visual=visual,
             process=False,
+            vertex_attributes=dict(self.point_data),
+            face_attributes=dict(self.cell_data),
         )
 
     def to_pyvista(self):
-        """A ``pyvista.PolyData`` with point data ``Normals`` (active normals) and the
-        texture coordinates ``uv``."""
+        """A ``pyvista.PolyData`` with point data ``Normals`` (active normals), the texture
+        coordinates ``uv`` and every array of ``point_data``; cell data from ``cell_data``."""
         import pyvista as pv
 
         cells = np.hstack([np.full((len(self.faces), 1), 3, dtype=np.int64), self.faces])
@@ -145,40 +393,38 @@ class Mesh:
         if self.uv is not None:
             poly.point_data["uv"] = self.uv
             poly.point_data.active_texture_coordinates_name = "uv"
+        for k, v in self.point_data.items():
+            poly.point_data[k] = v
+        for k, v in self.cell_data.items():
+            poly.cell_data[k] = v
         return poly
 
     def save(self, path: str | os.PathLike) -> pathlib.Path:
-        """Write the mesh to ``path``: binary little-endian PLY (``.ply``: positions, normals
-        ``nx ny nz`` and texture coordinates ``s t`` as doubles, faces as int32 vertex lists)
-        or Wavefront OBJ (``.obj``: ``v``, ``vn``, ``vt`` and ``f v/vt/vn`` lines, 17
-        significant digits). No third-party package is needed. Returns the path."""
+        """Write the mesh to ``path``; no third-party package is needed. Returns the path.
+
+        * ``.ply``: binary little-endian PLY: positions, normals ``nx ny nz`` and texture
+          coordinates ``s t``, then every ``point_data`` array as vertex properties (``name``,
+          or ``name_0 … name_{k-1}`` for ``(V, k)``), faces as int32 vertex lists followed by
+          the ``cell_data`` arrays as face properties.
+        * ``.vtp``: VTK XML PolyData (appended raw binary, 64-bit headers): points, triangles,
+          point data ``Normals`` and ``uv`` (texture coordinates) and ``point_data``; cell
+          data from ``cell_data``. Read by VTK/pyvista and ParaView.
+        * ``.obj``: Wavefront OBJ (``v``, ``vn``, ``vt`` and ``f v/vt/vn`` lines, 17
+          significant digits); attributes are not written.
+        """
+        if not isinstance(path, (str, os.PathLike)):
+            raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
         path = pathlib.Path(path)
         suffix = path.suffix.lower()
-        if suffix not in (".ply", ".obj"):
-            raise ValueError(f"path: unknown format {suffix!r}; use .ply or .obj")
+        if suffix not in (".ply", ".obj", ".vtp"):
+            raise ValueError(f"path: unknown format {suffix!r}; use .ply, .vtp or .obj")
+        if suffix == ".vtp":
+            _write_vtp(self, path)
+            return path
         if len(self.vertices) >= 2**31:
             raise ValueError("path: PLY/OBJ indices here are 32-bit; the mesh is too large")
-        cols = [self.vertices]
-        names = ["x", "y", "z"]
-        if self.normals is not None:
-            cols.append(self.normals)
-            names += ["nx", "ny", "nz"]
-        if self.uv is not None:
-            cols.append(self.uv)
-            names += ["s", "t"]
         if suffix == ".ply":
-            vert = np.ascontiguousarray(np.hstack(cols), dtype="<f8")
-            face = np.empty(len(self.faces), dtype=[("n", "u1"), ("v", "<i4", (3,))])
-            face["n"] = 3
-            face["v"] = self.faces
-            header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(vert)}"]
-            header += [f"property double {n}" for n in names]
-            header += [f"element face {len(face)}", "property list uchar int vertex_indices",
-                       "end_header"]
-            with open(path, "wb") as f:
-                f.write(("\n".join(header) + "\n").encode("ascii"))
-                f.write(vert.tobytes())
-                f.write(face.tobytes())
+            _write_ply(self, path)
             return path
         with open(path, "w") as f:
             f.write("# spinal mesh\n")
@@ -228,14 +474,131 @@ class Mesh:
         return None
 
 
-def _floats(a) -> np.ndarray:
-    """float32 arrays as they are (the sweeps' ``dtype=numpy.float32``), others as float64."""
-    return a if isinstance(a, np.ndarray) and a.dtype == np.float32 else np.asarray(a, np.float64)
+
+# PLY property types by NumPy dtype (int64 is written as int when it fits, else double)
+_PLY_TYPES = {"f8": "double", "f4": "float", "i1": "char", "u1": "uchar", "i2": "short",
+              "u2": "ushort", "i4": "int", "u4": "uint"}
+# VTK XML type names by NumPy dtype
+_VTK_TYPES = {"f8": "Float64", "f4": "Float32", "i1": "Int8", "u1": "UInt8", "i2": "Int16",
+              "u2": "UInt16", "i4": "Int32", "u4": "UInt32", "i8": "Int64", "u8": "UInt64"}
 
 
-def _ints(a) -> np.ndarray:
-    """int32 arrays as they are, others as int64."""
-    return a if isinstance(a, np.ndarray) and a.dtype == np.int32 else np.asarray(a, np.int64)
+def _plain(a: np.ndarray, kinds: dict) -> np.ndarray:
+    """``a`` in a little-endian dtype of ``kinds`` (bools as uint8; int64 as int32 where the
+    format has no 64-bit integers and the values fit, else float64)."""
+    a = np.asarray(a)
+    if a.dtype.kind == "b":
+        a = a.astype(np.uint8)
+    code = f"{a.dtype.kind}{a.dtype.itemsize}"
+    if code not in kinds:
+        fits = a.dtype.kind in "iu" and (a.size == 0 or (
+            a.min() >= np.iinfo(np.int32).min and a.max() <= np.iinfo(np.int32).max))
+        a = a.astype(np.int32 if fits else np.float64)
+        code = f"{a.dtype.kind}{a.dtype.itemsize}"
+    return a.astype(a.dtype.newbyteorder("<"), copy=False)
+
+
+def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
+    """``(property name, 1-D little-endian array)`` of every column of the attribute
+    arrays (``name`` or ``name_0 … name_{k-1}``)."""
+    cols = []
+    for k, a in data.items():
+        a = _plain(a, kinds)
+        key = "_".join(k.split()) or "_"
+        names = [key] if a.ndim == 1 else [f"{key}_{j}" for j in range(a.shape[1])]
+        for j, nm in enumerate(names):
+            if nm in taken:
+                raise ValueError(f"{what}: the name {nm!r} is taken in the PLY file")
+            taken.add(nm)
+            cols.append((nm, a if a.ndim == 1 else a[:, j]))
+    return cols
+
+
+def _write_ply(mesh: Mesh, path: pathlib.Path) -> None:
+    V, F = mesh.vertices, mesh.faces
+    cols = [(n, V[:, j]) for j, n in enumerate("xyz")]
+    if mesh.normals is not None:
+        cols += [(n, mesh.normals[:, j]) for j, n in enumerate(("nx", "ny", "nz"))]
+    if mesh.uv is not None:
+        cols += [(n, mesh.uv[:, j]) for j, n in enumerate("st")]
+    cols = [(n, _plain(c, _PLY_TYPES)) for n, c in cols]
+    cols += _columns(mesh.point_data, _PLY_TYPES, {n for n, _ in cols}, "point_data")
+    fcols = _columns(mesh.cell_data, _PLY_TYPES, {"vertex_indices"}, "cell_data")
+    vert = np.empty(len(V), dtype=[(n, c.dtype) for n, c in cols])
+    for n, c in cols:
+        vert[n] = c
+    face = np.empty(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))]
+                    + [(n, c.dtype) for n, c in fcols])
+    face["n"] = 3
+    face["v"] = F
+    for n, c in fcols:
+        face[n] = c
+    def decl(c):
+        return _PLY_TYPES[f"{c.dtype.kind}{c.dtype.itemsize}"]
+
+    header = ["ply", "format binary_little_endian 1.0", "comment written by spinal",
+              f"element vertex {len(vert)}"]
+    header += [f"property {decl(c)} {n}" for n, c in cols]
+    header += [f"element face {len(face)}", "property list uchar int vertex_indices"]
+    header += [f"property {decl(c)} {n}" for n, c in fcols]
+    header += ["end_header"]
+    with open(path, "wb") as f:
+        f.write(("\n".join(header) + "\n").encode("ascii"))
+        f.write(vert.tobytes())
+        f.write(face.tobytes())
+
+
+def _write_vtp(mesh: Mesh, path: pathlib.Path) -> None:
+    """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
+    by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
+    Formats", Kitware)."""
+    from xml.sax.saxutils import quoteattr
+
+    blocks, offset = [], 0
+
+    def array(a, name, extra=""):
+        nonlocal offset
+        a = np.ascontiguousarray(_plain(a, _VTK_TYPES))
+        comps = 1 if a.ndim == 1 else a.shape[1]
+        tag = (f'<DataArray type="{_VTK_TYPES[f"{a.dtype.kind}{a.dtype.itemsize}"]}" '
+               f'Name={quoteattr(name)} NumberOfComponents="{comps}"{extra} '
+               f'format="appended" offset="{offset}"/>')
+        raw = a.tobytes()
+        blocks.append(np.uint64(len(raw)).astype("<u8").tobytes() + raw)
+        offset += 8 + len(raw)
+        return tag
+
+    nv, nf = len(mesh.vertices), len(mesh.faces)
+    points = array(mesh.vertices, "Points")
+    conn = array(mesh.faces.reshape(-1).astype(np.int64), "connectivity")
+    offs = array(3 * np.arange(1, nf + 1, dtype=np.int64), "offsets")
+    pdata, active = [], []
+    if mesh.normals is not None:
+        pdata.append(array(mesh.normals, "Normals"))
+        active.append('Normals="Normals"')
+    if mesh.uv is not None:
+        pdata.append(array(mesh.uv, "uv"))
+        active.append('TCoords="uv"')
+    pdata += [array(v, k) for k, v in mesh.point_data.items()]
+    cdata = [array(v, k) for k, v in mesh.cell_data.items()]
+    xml = [
+        '<?xml version="1.0"?>',
+        ('<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+         'header_type="UInt64">'),
+        "<PolyData>",
+        (f'<Piece NumberOfPoints="{nv}" NumberOfVerts="0" NumberOfLines="0" '
+         f'NumberOfStrips="0" NumberOfPolys="{nf}">'),
+        f"<PointData {' '.join(active)}>", *pdata, "</PointData>",
+        "<CellData>", *cdata, "</CellData>",
+        "<Points>", points, "</Points>",
+        "<Polys>", conn, offs, "</Polys>",
+        "</Piece>", "</PolyData>",
+        '<AppendedData encoding="raw">',
+    ]
+    with open(path, "wb") as f:
+        f.write(("\n".join(xml) + "\n_").encode("utf-8"))
+        f.writelines(blocks)
+        f.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 
 def _has_display() -> bool:

@@ -9,14 +9,14 @@ import numpy as np
 from . import _core
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
 from ._frames import frames as _frames
-from ._mesh import FoldOverWarning, Mesh
+from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
 from ._validate import (
     as_bool,
     as_choice,
+    as_curves,
     as_float_array,
     as_frames,
     as_int,
-    as_offsets,
     as_per_row,
     as_points,
 )
@@ -38,15 +38,18 @@ def _dtype(dtype) -> bool:
     return dt == np.float32
 
 
-def _scale_rows(scale, name: str, n: int) -> np.ndarray:
+def _scale_rows(scale, name: str, n: int, lens) -> np.ndarray:
     """The scale as ``(n, 2)`` rows, or one ``(1, 2)`` row when it is the same everywhere
-    (the core broadcasts it; no per-row copy)."""
+    (the core broadcasts it; no per-row copy). ``lens``: the curves' row counts of a bundle,
+    for a value per curve; a tube's ``radius`` is one value per row (or curve)."""
     if scale is None:
         return np.ones((1, 2))
     a = as_float_array(scale, name)
     if a.ndim == 0:
         return np.full((1, 2), float(a))
-    return as_per_row(a, name, n, pair=True)
+    pair = name == "scale"
+    a = _per_row_or_curve(a, name, n, lens, pair=pair)
+    return np.ascontiguousarray(a if pair else np.stack([a, a], axis=1))
 
 
 def _ranges(rows: np.ndarray) -> str:
@@ -82,6 +85,8 @@ def sweep(
     dtype="float64",
     normals: bool = True,
     uv: bool = True,
+    point_data=None,
+    on_short: str = "raise",
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -97,8 +102,11 @@ def sweep(
 
     Parameters
     ----------
-    points : array_like (n, 3)
-        Spine samples (several spines back to back with ``lengths``/``offsets``).
+    points : array_like (n, 3), or a sequence of (n_i, 3) arrays
+        Spine samples: one spine, several spines back to back with ``lengths``/``offsets``,
+        or a bundle as users hold it: a list (any sequence) of ``(n_i, 3)`` arrays of any
+        real dtype, e.g. nibabel's ``ArraySequence`` of streamlines (then curve ``c`` is
+        ``points[c]`` and the rows of all curves are numbered back to back).
     profile : array_like (m, 2)
         Polygon in the normal plane, coordinates along ``(r, s)``. Closed by default (a
         repeated first vertex at the end is accepted; either orientation: faces are wound
@@ -130,7 +138,9 @@ def sweep(
         Raise a ValueError instead of a :class:`FoldOverWarning` where the profile reaches
         past the spine's centre of curvature.
     lengths, offsets : array_like of int, optional
-        Many spines back to back, as in :func:`spinal.frames`.
+        Several spines in ``points``, back to back: ``lengths[c]`` rows each, or curve ``c``
+        in rows ``offsets[c]:offsets[c+1]``. ``scale`` (and ``radius`` of :func:`tube`)
+        may then also be given per curve, ``(C,)`` (or ``(C, 2)``).
     tangents : array_like (n, 3), optional
         The spine's tangent directions (normalised here), instead of estimating them: the
         default frames become ``spinal.frames(points, tangents, closed=closed)`` (double
@@ -149,16 +159,27 @@ def sweep(
     normals, uv : bool
         Compute the normals / texture coordinates (``False``: ``None`` in the mesh, less
         memory and time).
+    point_data : dict of str to array_like, optional
+        Attributes carried onto the mesh: ``(n,)`` or ``(n, k)`` arrays, one value per spine
+        row (of all curves), or for a bundle ``(C,)`` / ``(C, k)`` per curve. Every vertex of
+        a ring (caps included) gets its sample's (curve's) value, in ``Mesh.point_data``
+        with the dtype given.
+    on_short : {"raise", "skip"}
+        What to do with curves of a bundle that have too few rows to sweep (0 or 1; 2 on a
+        closed spine): refuse them (ValueError) or leave them out, with a
+        :class:`SkippedCurvesWarning` naming them and ``Mesh.skipped_curves``.
 
     Returns
     -------
     Mesh
         ``vertices`` (V, 3), ``faces`` (F, 3), ``normals`` (V, 3) — normals of the smooth
         swept surface, tilted by a varying radius —, ``uv`` (V, 2) (u = spine arc length,
-        v = profile arc length / perimeter) and ``fold_over`` (spine rows). Vertex
-        ``k * m + j`` (per spine) is profile vertex ``j`` on ring ``k``. The quads between
-        rings are split along alternating diagonals (a checkerboard), so the volume of
-        twisted sweeps converges at second order.
+        v = profile arc length / perimeter), ``fold_over`` (spine rows), ``point_data``,
+        ``cell_data`` (``"curve_id"`` per face for a bundle), and ``sample_of`` /
+        ``curve_of``: the spine row and the curve of every vertex. Vertex ``k * m + j``
+        (per spine) is profile vertex ``j`` on ring ``k``. The quads between rings are
+        split along alternating diagonals (a checkerboard), so the volume of twisted sweeps
+        converges at second order.
 
     Raises
     ------
@@ -168,31 +189,33 @@ def sweep(
         tangent runs against the spine (frames of the reversed curve), tangents of the
         wrong shape or of zero length, ``tangents``/``tangent_rule`` together with ``frames``
         (or with each other), and everything :func:`spinal.frames` refuses.
+
+    Warns
+    -----
+    FoldOverWarning
+        The surface folds over itself (spine rows; for a bundle also curve ids and the
+        rows within each curve).
+    SkippedCurvesWarning
+        ``on_short="skip"`` left curves out.
     """
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
-                       tangents, tangent_rule, dtype, normals, uv)
+                       tangents, tangent_rule, dtype, normals, uv, point_data, on_short)
 
 
-def _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule):
-    """The sweep's frames: given, or the RMF with the given or estimated tangents."""
-    rule = as_choice(tangent_rule, "tangent_rule", TANGENT_RULES)
-    n = pts.shape[0]
-    if frames is not None:
-        if tangents is not None or rule != DEFAULT_TANGENT_RULE:
-            which = "tangents" if tangents is not None else "tangent_rule"
+def _sweep_frames(pts, fr, closed, offs, bundle, tg, rule):
+    """The sweep's frames: ``fr`` (checked frames) when given, or the RMF with the given
+    (checked) tangents ``tg`` or tangents estimated by ``rule``."""
+    if fr is not None:
+        if tg is not None or rule != DEFAULT_TANGENT_RULE:
+            which = "tangents" if tg is not None else "tangent_rule"
             raise TypeError(f"{which}: not used with frames= (the frames' t column is the "
                             f"tangent)")
-        fr, _ = as_frames(frames, "frames", rows=n)
         return fr
     kw = {"offsets": offs} if bundle else {}
-    if tangents is not None:
+    if tg is not None:
         if rule != DEFAULT_TANGENT_RULE:
             raise TypeError("tangent_rule: not used with tangents= (they replace the estimate)")
-        tg = as_points(tangents, "tangents")
-        if tg.shape[0] != n:
-            raise ValueError(f"tangents: expected shape ({n}, 3) to match points, got "
-                             f"{tg.shape}")
         return _frames(pts, tg, closed=closed, **kw)
     if rule != DEFAULT_TANGENT_RULE:
         tg = estimate_tangents(pts, closed=closed, method=rule, **kw)
@@ -203,10 +226,10 @@ def _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule):
 def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
-                normals=True, uv=True) -> Mesh:
+                normals=True, uv=True, point_data=None, on_short="raise") -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
-    pts = as_points(points, "points")
+    pts, offs, bundle = as_curves(points, lengths, offsets)
     n = pts.shape[0]
     closed = as_bool(closed, "closed")
     caps = as_bool(caps, "caps")
@@ -216,29 +239,158 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     single = _dtype(dtype)
     want_normals = as_bool(normals, "normals")
     want_uv = as_bool(uv, "uv")
+    on_short = as_choice(on_short, "on_short", ("raise", "skip"))
     miter_limit = float(as_float_array(miter_limit, "miter_limit"))
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")
-    offs, bundle = as_offsets(n, lengths, offsets)
-    fr = _sweep_frames(pts, frames, closed, offs, bundle, tangents, tangent_rule)
-    sc = _scale_rows(scale, scale_arg, n)
+    lens = np.diff(offs) if bundle and (np.diff(offs) >= 0).all() else None
+    curves = offs.size - 1
+    rule = as_choice(tangent_rule, "tangent_rule", TANGENT_RULES)
+    fr = None if frames is None else as_frames(frames, "frames", rows=n)[0]
+    tg = None
+    if tangents is not None:
+        tg = as_points(tangents, "tangents")
+        if tg.shape[0] != n:
+            raise ValueError(f"tangents: expected shape ({n}, 3) to match points, got "
+                             f"{tg.shape}")
+    sc = _scale_rows(scale, scale_arg, n, lens)
     tw = None if twist is None else as_per_row(twist, "twist", n)
+    pdata = _point_data(point_data, n, curves if bundle else None)
+    # curves too short to sweep: refused by the core (on_short="raise") or left out here
+    row0, curve_ids, skipped = offs[:-1], np.arange(curves), np.zeros(0, dtype=np.int64)
+    keep_rows = None
+    if on_short == "skip" and lens is not None:
+        short = lens < (3 if closed else 2)
+        if short.any():
+            skipped = np.flatnonzero(short).astype(np.int64)
+            keep_rows = np.repeat(~short, lens)
+            pts = np.ascontiguousarray(pts[keep_rows])
+            fr = None if fr is None else np.ascontiguousarray(fr[keep_rows])
+            tg = None if tg is None else np.ascontiguousarray(tg[keep_rows])
+            if sc.shape[0] > 1:
+                sc = np.ascontiguousarray(sc[keep_rows])
+            tw = None if tw is None else np.ascontiguousarray(tw[keep_rows])
+            row0, curve_ids = row0[~short], curve_ids[~short]
+            offs = np.concatenate([[0], np.cumsum(lens[~short])]).astype(np.int64)
+            warnings.warn(SkippedCurvesWarning(
+                f"points: left out {len(skipped)} curve(s) with fewer than "
+                f"{3 if closed else 2} points (on_short='skip'): {_ranges(skipped)}; see "
+                f"Mesh.skipped_curves", skipped), stacklevel=3)
+    if offs.size == 1:  # every curve left out
+        mesh = Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)),
+                    np.zeros((0, 2)), skipped_curves=skipped)
+        mesh.point_data = {k: a[:0] for k, (a, _) in pdata.items()}
+        mesh._n_rows, mesh._n_curves = n, curves
+        return mesh
+    fr = _sweep_frames(pts, fr, closed, offs, bundle, tg, rule)
     v, f, nrm, uv, folds = _core.sweep_mesh(
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
         single, single, want_normals, want_uv,
     )
+    if folds.size and keep_rows is not None:  # back to the rows as given
+        folds = np.flatnonzero(keep_rows)[folds]
+    rings, vstart = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
     if folds.size:
+        where = f"spine rows {_ranges(folds)}"
+        fold_curves = None
+        if bundle:
+            starts = _orig_offsets(lens, n)
+            fold_curves = np.searchsorted(starts, folds, side="right") - 1
+            where += " (" + _by_curve(fold_curves, folds - starts[fold_curves]) + ")"
         msg = (
             f"the profile reaches past the spine's centre of curvature (the surface folds "
-            f"over itself) on the segments starting at spine rows {_ranges(folds)}; sample "
+            f"over itself) on the segments starting at {where}; sample "
             f"the spine more densely there, reduce the profile, or smooth the spine"
         )
         if strict:
             raise ValueError(f"points: {msg}")
-        warnings.warn(FoldOverWarning(msg, folds), stacklevel=3)
-    return Mesh(v, f, nrm, uv, folds)
+        local = None if fold_curves is None else folds - _orig_offsets(lens, n)[fold_curves]
+        warnings.warn(FoldOverWarning(msg, folds, fold_curves, local), stacklevel=3)
+    mesh = Mesh._of_sweep(v, f, nrm, uv, folds, rings, n, curves)
+    mesh.skipped_curves = skipped
+    for k, (a, per_curve) in pdata.items():
+        mesh.point_data[k] = np.repeat(a[rings[1] if per_curve else rings[0]], rings[2], axis=0)
+    if bundle:
+        fc = np.searchsorted(vstart, f[:, 0], side="right") - 1
+        small = curves <= np.iinfo(np.int32).max
+        mesh.cell_data["curve_id"] = curve_ids.astype(np.int32 if small else np.int64)[fc]
+    return mesh
+
+
+def _orig_offsets(lens, n: int) -> np.ndarray:
+    return np.concatenate([[0], np.cumsum(lens)]) if lens is not None else np.array([0, n])
+
+
+def _by_curve(curves: np.ndarray, rows: np.ndarray, most: int = 8) -> str:
+    """'curve 3 rows 5–7; curve 9 row 0 …' (local rows), the first ``most`` curves."""
+    ids = np.unique(curves)
+    parts = []
+    for c in ids[:most]:
+        r = rows[curves == c]
+        parts.append(f"curve {c} row{'s' if len(r) > 1 else ''} {_ranges(r)}")
+    more = f"; and {len(ids) - most} more curves" if len(ids) > most else ""
+    return "; ".join(parts) + more
+
+
+def _per_row_or_curve(x, name: str, n: int, lens, *, pair: bool) -> np.ndarray:
+    """:func:`as_per_row`, also accepting one value per curve of a bundle, ``(C,)`` (or
+    ``(C, 2)`` with ``pair``), repeated over the curve's rows."""
+    a = as_float_array(x, name)
+    if lens is not None and a.ndim >= 1 and len(a) == len(lens) != n and (
+            a.shape == (len(lens),) or (pair and a.shape == (len(lens), 2))):
+        a = np.repeat(a, lens, axis=0)
+    return as_per_row(a, name, n, pair=pair)
+
+
+def _point_data(data, n: int, curves: int | None) -> dict:
+    """``{name: (array, per_curve)}``: ``(n,)``/``(n, k)`` arrays per spine row, or for a
+    bundle ``(C,)``/``(C, k)`` per curve."""
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise TypeError(f"point_data: expected a dict of arrays, got {type(data).__name__}")
+    out = {}
+    for k, v in data.items():
+        if not isinstance(k, str):
+            raise TypeError(f"point_data: keys must be strings, got {k!r}")
+        if isinstance(v, (str, bytes)):
+            raise TypeError(f"point_data[{k!r}]: expected a numeric array, got "
+                            f"{type(v).__name__}")
+        a = np.asarray(v)
+        if a.dtype.kind not in "biuf":
+            raise TypeError(f"point_data[{k!r}]: expected a numeric array, got dtype {a.dtype}")
+        per = f"({n},) or ({n}, k) per spine row" + (
+            f", or ({curves},) or ({curves}, k) per curve" if curves is not None else "")
+        if a.ndim not in (1, 2) or len(a) not in (n, curves):
+            raise ValueError(f"point_data[{k!r}]: expected {per}, got shape {a.shape}")
+        out[k] = (a, len(a) != n)
+    return out
+
+
+def _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, nv):
+    """The stored rings of a sweep, as the core lays them out: per curve, one ring per
+    distinct sample (a closed curve's repeated first point has none; split seams on a
+    closed curve repeat its first ring at the end). Returns ``(ring_sample, ring_curve,
+    cols)`` (given rows and curves) and the first vertex of every curve ``(C + 1,)``."""
+    lens = np.diff(offs)
+    rings = lens.copy()
+    if closed:
+        a, b = pts[offs[:-1]], pts[offs[1:] - 1]
+        d = np.abs(b - a).max(axis=1)
+        scale = np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1))
+        rings -= ((lens >= 2) & (d <= 8 * np.finfo(float).eps * scale)).astype(rings.dtype)
+    stored = rings + int(closed and split_seams)
+    total = int(stored.sum())
+    cols = nv // total
+    if cols * total != nv:
+        raise RuntimeError("spinal: the sweep's vertex layout is not one ring per sample")
+    starts = np.concatenate([[0], np.cumsum(stored)])
+    local = np.arange(total) - np.repeat(starts[:-1], stored)
+    sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
+    return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64),
+            cols), starts * cols
 
 
 def tube(
@@ -259,15 +411,19 @@ def tube(
     dtype="float64",
     normals: bool = True,
     uv: bool = True,
+    point_data=None,
+    on_short: str = "raise",
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
     towards s), scaled by ``radius``.
 
     The cross-section is the inscribed polygon, of area ``(sides/2) ρ² sin(2π/sides)``.
-    ``radius``: scalar or (n,) positive values (one per spine row); the normals are tilted
-    by the radius slope. ``sides``: 3 to 2**20. Other arguments (``tangents``,
-    ``tangent_rule``, ``dtype=numpy.float32``, ``normals``, ``uv``) as in :func:`sweep`.
+    ``radius``: scalar or (n,) positive values (one per spine row), or for a bundle (C,)
+    (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
+    Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
+    ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``) as in
+    :func:`sweep`.
     """
     sides = as_int(sides, "sides")
     if sides < 3:  # the core sees only the polygon built here
@@ -276,10 +432,7 @@ def tube(
         raise ValueError(f"sides: at most {MAX_SIDES:,} (2**20) sides, got {sides:,}")
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
-    pts = as_points(points, "points")
-    rad = as_float_array(radius, "radius")  # the core checks the values, naming radius
-    if rad.ndim:
-        rad = as_per_row(rad, "radius", pts.shape[0])
-    return _sweep_mesh(pts, profile, frames, rad, None, closed, caps, True, miter_limit,
+    # the core checks the radius' values, naming radius
+    return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
-                       dtype, normals, uv)
+                       dtype, normals, uv, point_data, on_short)

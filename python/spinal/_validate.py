@@ -104,6 +104,52 @@ def as_offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]
     return np.ascontiguousarray(arr), True
 
 
+def is_curve_list(x: Any) -> bool:
+    """Whether ``x`` is a sequence of curves (a list or tuple of ``(n_i, 3)`` arrays, nibabel's
+    ``ArraySequence``, ...) rather than one ``(n, 3)`` array-like: not an ndarray, and its
+    first item is two-dimensional (nibabel's ArraySequence, even empty)."""
+    if isinstance(x, (np.ndarray, str, bytes)) or not hasattr(x, "__len__"):
+        return False
+    if not hasattr(x, "__iter__") and not hasattr(x, "__getitem__"):
+        return False
+    if type(x).__name__ == "ArraySequence":
+        return True
+    try:
+        first = next(iter(x))
+        return np.ndim(first) == 2
+    except (StopIteration, TypeError, ValueError):
+        return False
+
+
+def as_curves(x: Any, lengths: Any = None, offsets: Any = None,
+              name: str = "points") -> tuple[np.ndarray, np.ndarray, bool]:
+    """The rows ``(N, 3)`` float64 (C-contiguous), the CSR offsets ``(C + 1,)`` int64 and
+    whether the call is a bundle, from either one ``(n, 3)`` array-like with optional
+    ``lengths``/``offsets`` (see :func:`as_offsets`) or a sequence of ``(n_i, 3)`` arrays of
+    any real dtype (a list, a tuple, nibabel's ``ArraySequence``, ...): curve ``c`` is
+    ``x[c]``, empty and one-row curves included."""
+    if not is_curve_list(x):
+        pts = as_points(x, name)
+        offs, bundle = as_offsets(pts.shape[0], lengths, offsets)
+        return pts, offs, bundle
+    if lengths is not None or offsets is not None:
+        raise TypeError(f"lengths, offsets: not accepted with a sequence of curves as {name} "
+                        f"(the curves' lengths come from the sequence)")
+    parts = []
+    for c, item in enumerate(x):
+        a = as_float_array(item, f"{name}[{c}]")
+        if a.size == 0:
+            a = a.reshape(0, 3)
+        if a.ndim != 2 or a.shape[1] != 3:
+            raise ValueError(f"{name}[{c}]: expected an array of shape (n, 3), got shape "
+                             f"{a.shape}")
+        parts.append(a)
+    lens = np.array([len(a) for a in parts], dtype=np.int64)
+    pts = np.concatenate(parts) if parts else np.zeros((0, 3))
+    offs = np.concatenate([[0], np.cumsum(lens)]).astype(np.int64)
+    return np.ascontiguousarray(pts, dtype=np.float64), offs, True
+
+
 def as_real(x: Any, name: str) -> float:
     """A Python float from a real number (not a bool): the type only, any value."""
     if isinstance(x, bool) or not isinstance(x, numbers.Real):

@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 
 use super::convert::{detach_in_pool, triangles, vec3s};
 use crate::math::mesh;
+use crate::mesh::measure;
 
 /// Signed volume of a closed triangle mesh, summed about the mean vertex.
 #[pyfunction]
@@ -30,4 +31,143 @@ pub fn mesh_closed_centroid(
     let f = triangles(&faces)?;
     let (vol, c) = detach_in_pool(py, || mesh::closed_volume_centroid(v, f))??;
     Ok((vol, c.to_array()))
+}
+
+/// The `(k, 3)` rows of a C-contiguous array (errors name `arg`).
+fn rows<'a, T: numpy::Element + bytemuck::Pod>(
+    arg: &str,
+    a: &'a PyReadonlyArray2<'_, T>,
+) -> PyResult<&'a [[T; 3]]> {
+    use numpy::PyUntypedArrayMethods;
+    if a.shape()[1] != 3 {
+        return Err(super::convert::value_error(format!(
+            "{arg}: expected shape (n, 3), got {:?}",
+            a.shape()
+        )));
+    }
+    Ok(bytemuck::cast_slice(super::convert::slice_of(arg, a)?))
+}
+
+/// Vertices as NumPy holds them: `float64` or `float32`.
+enum Vertices<'py> {
+    F64(PyReadonlyArray2<'py, f64>),
+    F32(PyReadonlyArray2<'py, f32>),
+}
+
+/// Faces as NumPy holds them: `int64` or `int32`.
+enum Faces<'py> {
+    I64(PyReadonlyArray2<'py, i64>),
+    I32(PyReadonlyArray2<'py, i32>),
+}
+
+fn vertices_of<'py>(a: &Bound<'py, PyAny>) -> PyResult<Vertices<'py>> {
+    if let Ok(v) = a.extract::<PyReadonlyArray2<'py, f64>>() {
+        return Ok(Vertices::F64(v));
+    }
+    a.extract::<PyReadonlyArray2<'py, f32>>()
+        .map(Vertices::F32)
+        .map_err(|_| {
+            super::convert::value_error("vertices: expected a float64 or float32 (n, 3) array")
+        })
+}
+
+fn faces_of<'py>(a: &Bound<'py, PyAny>) -> PyResult<Faces<'py>> {
+    if let Ok(f) = a.extract::<PyReadonlyArray2<'py, i64>>() {
+        return Ok(Faces::I64(f));
+    }
+    a.extract::<PyReadonlyArray2<'py, i32>>()
+        .map(Faces::I32)
+        .map_err(|_| super::convert::value_error("faces: expected an int64 or int32 (F, 3) array"))
+}
+
+/// `$body` with `$v` / `$f` bound to the row slices of every dtype combination.
+macro_rules! with_mesh {
+    ($vs:expr, $fs:expr, |$v:ident, $f:ident| $body:expr) => {
+        match ($vs, $fs) {
+            (Vertices::F64(a), Faces::I64(b)) => {
+                let ($v, $f) = (rows::<f64>("vertices", a)?, rows::<i64>("faces", b)?);
+                $body
+            }
+            (Vertices::F64(a), Faces::I32(b)) => {
+                let ($v, $f) = (rows::<f64>("vertices", a)?, rows::<i32>("faces", b)?);
+                $body
+            }
+            (Vertices::F32(a), Faces::I64(b)) => {
+                let ($v, $f) = (rows::<f32>("vertices", a)?, rows::<i64>("faces", b)?);
+                $body
+            }
+            (Vertices::F32(a), Faces::I32(b)) => {
+                let ($v, $f) = (rows::<f32>("vertices", a)?, rows::<i32>("faces", b)?);
+                $body
+            }
+        }
+    };
+}
+
+/// `"volume"` (signed, about the mean vertex) or `"area"` of a triangle mesh with `float64`
+/// or `float32` vertices and `int64` or `int32` faces (indices checked, errors name `faces`).
+#[pyfunction]
+pub fn mesh_measure(
+    py: Python<'_>,
+    vertices: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<f64> {
+    let (vs, fs) = (vertices_of(vertices)?, faces_of(faces)?);
+    let area = match what {
+        "volume" => false,
+        "area" => true,
+        _ => {
+            return Err(super::convert::value_error(format!(
+                "what: unknown measure {what:?}"
+            )));
+        }
+    };
+    with_mesh!(&vs, &fs, |v, f| Ok(py.detach(|| if area {
+        measure::area(v, f)
+    } else {
+        measure::volume(v, f)
+    })?))
+}
+
+/// Edge statistics of the faces over `n` vertices: `(edges, boundary, non_manifold,
+/// inconsistent, degenerate)` (see `crate::mesh::measure::EdgeStats`).
+#[pyfunction]
+pub fn mesh_edges(
+    py: Python<'_>,
+    faces: &Bound<'_, PyAny>,
+    n: usize,
+) -> PyResult<(usize, usize, usize, usize, usize)> {
+    let e = match faces_of(faces)? {
+        Faces::I64(a) => {
+            let f = rows::<i64>("faces", &a)?;
+            py.detach(|| measure::edges(f, n))?
+        }
+        Faces::I32(a) => {
+            let f = rows::<i32>("faces", &a)?;
+            py.detach(|| measure::edges(f, n))?
+        }
+    };
+    Ok((
+        e.edges,
+        e.boundary,
+        e.non_manifold,
+        e.inconsistent,
+        e.degenerate,
+    ))
+}
+
+/// Refuse face indices outside `0..n` (errors name `faces`).
+#[pyfunction]
+pub fn mesh_check_faces(py: Python<'_>, faces: &Bound<'_, PyAny>, n: usize) -> PyResult<()> {
+    match faces_of(faces)? {
+        Faces::I64(a) => {
+            let f = rows::<i64>("faces", &a)?;
+            Ok(py.detach(|| measure::check_faces(f, n))?)
+        }
+        Faces::I32(a) => {
+            let f = rows::<i32>("faces", &a)?;
+            Ok(py.detach(|| measure::check_faces(f, n))?)
+        }
+    }
 }

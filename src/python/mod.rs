@@ -65,6 +65,9 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_volume, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_closed_centroid, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_measure, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_edges, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_check_faces, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::minimal_rotation, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;

@@ -1,0 +1,4 @@
+//! Triangle meshes as they leave the sweeps: measures of any size ([`measure`]: volume,
+//! area, edge manifoldness and winding) in time linear in the faces.
+
+pub mod measure;
