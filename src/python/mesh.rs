@@ -123,11 +123,11 @@ pub fn mesh_measure(
             )));
         }
     };
-    with_mesh!(&vs, &fs, |v, f| Ok(py.detach(|| if area {
+    with_mesh!(&vs, &fs, |v, f| Ok(detach_in_pool(py, || if area {
         measure::area(v, f)
     } else {
         measure::volume(v, f)
-    })?))
+    })??))
 }
 
 /// Edge statistics of the faces over `n` vertices: `(edges, boundary, non_manifold,
@@ -141,11 +141,11 @@ pub fn mesh_edges(
     let e = match faces_of(faces)? {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
-            py.detach(|| measure::edges(f, n))?
+            detach_in_pool(py, || measure::edges(f, n))??
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
-            py.detach(|| measure::edges(f, n))?
+            detach_in_pool(py, || measure::edges(f, n))??
         }
     };
     Ok((
@@ -163,11 +163,11 @@ pub fn mesh_check_faces(py: Python<'_>, faces: &Bound<'_, PyAny>, n: usize) -> P
     match faces_of(faces)? {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
-            Ok(py.detach(|| measure::check_faces(f, n))?)
+            Ok(detach_in_pool(py, || measure::check_faces(f, n))??)
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
-            Ok(py.detach(|| measure::check_faces(f, n))?)
+            Ok(detach_in_pool(py, || measure::check_faces(f, n))??)
         }
     }
 }
