@@ -238,12 +238,14 @@ def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) ->
 def spin(a, b) -> np.ndarray | float:
     """Signed angle (radians, in (−π, π]) that turns frame ``a``'s reference vector ``r``
     into frame ``b``'s about ``a``'s tangent — the twist between two frames with the same
-    tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``.
+    tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``
+    (one of them may be a single frame). Both must be finite rotation matrices whose
+    tangents (third columns) agree within 1e-3 rad; otherwise ``ValueError`` names the
+    argument and the frame.
     """
     fa, sa = as_frames(a, "a")
     fb, sb = as_frames(b, "b")
-    ra, sa_, rb = fa[:, :, 0], fa[:, :, 1], fb[:, :, 0]
-    ang = np.arctan2(np.einsum("ij,ij->i", rb, sa_), np.einsum("ij,ij->i", rb, ra))
+    ang = _core.quat_spin(fa, fb)
     return float(ang[0]) if (sa and sb) else ang
 
 

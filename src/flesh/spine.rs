@@ -251,7 +251,20 @@ pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec
             format!("chord {i} is not positive and finite"),
         ));
     }
-    Ok(walk_chords(posed, chords))
+    // the walk squares chords twice (|e·(a − c)|²): divide a spine far from unit size by its
+    // power-of-two scale first (exact), and multiply back
+    let (lo, hi) = crate::frames::geometry::bounds(posed);
+    match crate::math::scale::curve_exponent(lo, hi) {
+        None => Ok(walk_chords(posed, chords)),
+        Some(k) => {
+            let p = crate::math::scale::scaled(posed, k);
+            let h: Vec<f64> = chords
+                .iter()
+                .map(|&c| crate::math::scale::ldexp(c, k))
+                .collect();
+            Ok(crate::math::scale::scaled(&walk_chords(&p, &h), -k))
+        }
+    }
 }
 
 /// The walk of [`compass_walk`] on checked input.
