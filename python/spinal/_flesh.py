@@ -288,6 +288,7 @@ class SpineBinding:
         """
         solution = as_choice(solution, "solution", SOLUTIONS)
         strict = as_bool(strict, "strict")
+        return_clamped = as_bool(return_clamped, "return_clamped")
         posed = self.posed_spine(posed_spine, stretchable=stretchable)
         tw = None if twist is None else _twist(twist, len(self._rest))
         frames1 = self._posed_frames(posed)
@@ -449,6 +450,7 @@ class SurfaceBinding:
         """
         solution = as_choice(solution, "solution", ("offset", "none"))
         strict = as_bool(strict, "strict")
+        return_clamped = as_bool(return_clamped, "return_clamped")
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:
             raise ValueError(f"posed_surface: expected the rest grid's shape "

@@ -17,6 +17,7 @@ from ._validate import (
     as_offsets,
     as_per_row,
     as_points,
+    as_real,
 )
 
 __all__ = ["sweep", "tube"]
@@ -128,7 +129,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     profile_closed = as_bool(profile_closed, "profile_closed")
     split_seams = as_bool(split_seams, "split_seams")
     strict = as_bool(strict, "strict")
-    miter_limit = float(as_float_array(miter_limit, "miter_limit"))
+    miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")

@@ -254,17 +254,32 @@ pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec
     // the walk squares chords twice (|e·(a − c)|²): divide a spine far from unit size by its
     // power-of-two scale first (exact), and multiply back
     let (lo, hi) = crate::frames::geometry::bounds(posed);
-    match crate::math::scale::curve_exponent(lo, hi) {
-        None => Ok(walk_chords(posed, chords)),
+    let out = match crate::math::scale::curve_exponent(lo, hi) {
+        None => walk_chords(posed, chords),
         Some(k) => {
             let p = crate::math::scale::scaled(posed, k);
             let h: Vec<f64> = chords
                 .iter()
                 .map(|&c| crate::math::scale::ldexp(c, k))
                 .collect();
-            Ok(crate::math::scale::scaled(&walk_chords(&p, &h), -k))
+            crate::math::scale::scaled(&walk_chords(&p, &h), -k)
         }
+    };
+    if let Some(i) = out.windows(2).position(|w| w[0] == w[1]) {
+        return Err(InputError::new(
+            "posed_spine",
+            format!(
+                "resampled to the rest spine's chords ({:e} at chord {i}), samples {i} and {} \
+                 fall on the same float64 point at coordinates of size {:e}: the rest spine's \
+                 chords are out of the representable range at the posed spine's size; pose a \
+                 spine of the rest spine's size, or pass stretchable=True",
+                chords[i],
+                i + 1,
+                crate::math::scale::max_abs(out[i])
+            ),
+        ));
     }
+    Ok(out)
 }
 
 /// The walk of [`compass_walk`] on checked input.

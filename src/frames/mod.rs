@@ -219,6 +219,13 @@ fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
 /// A curve whose size is far from 1 is first divided by a power of two (exact; see
 /// [`crate::math::scale`]), so the frames and the angle do not depend on its units.
 pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
+    if req.turns != 0 && !req.closed && req.end.is_none() && req.method != Method::Frenet {
+        return Err(InputError::new(
+            "turns",
+            "applies to a closed curve (closed=True) or with a prescribed end; an open curve \
+             without end has no twist to add turns to",
+        ));
+    }
     let owned = normalised(req);
     let req = match &owned {
         Some(o) => &o.request(req),
