@@ -203,8 +203,9 @@ fn mitre(x: &[DVec3], t: DVec3, i: usize, closed: bool, limit: f64) -> (f64, DVe
     }
     let prev = x[(i + n - 1) % n];
     let next = x[(i + 1) % n];
-    let din = (x[i] - prev).normalize();
-    let dout = (next - x[i]).normalize();
+    // scaled by the largest component before squaring: any finite spine size
+    let unit = |v: DVec3| crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO);
+    let (din, dout) = (unit(x[i] - prev), unit(next - x[i]));
     let half_cos = 0.5 * (1.0 + din.dot(dout)); // cos²(φ/2)
     let k = din - dout;
     let k = k - k.dot(t) * t;
