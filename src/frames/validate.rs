@@ -100,7 +100,12 @@ pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
             for (k, l) in ls.iter_mut().enumerate() {
                 let i = a0 + k;
                 let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
-                *l = (b - a).length();
+                let d = b - a;
+                *l = d.length();
+                if !(*l > 1e-150 && *l < 1e150) {
+                    // the square under- or overflowed: the length scaled first
+                    *l = crate::math::scale::length(d);
+                }
                 if bad.is_none() && repeated(a, b, floor) {
                     bad = Some(i);
                 }

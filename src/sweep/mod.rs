@@ -699,6 +699,21 @@ pub fn sweep_into(
     folds.concat()
 }
 
+/// Refuse swept vertices beyond the f64 range (`x_i + M_i·(scale_i ⊙ profile_j)`
+/// overflowing for huge finite input); named by the profile's `scale`.
+pub fn check_finite(vertices: &[DVec3]) -> Result<()> {
+    match validate::first_bad(vertices, |v| v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            "scale",
+            format!(
+                "the swept vertex {i} (spine point + frame · scale · profile) is out of the \
+                 representable range of float64; reduce the profile, its scale or the spine"
+            ),
+        )),
+    }
+}
+
 /// [`layout`] and [`sweep_into`] with freshly allocated buffers.
 pub fn sweep_many(
     all: &Spine,
@@ -727,6 +742,7 @@ pub fn sweep_many(
             uv: &mut mesh.uv,
         },
     );
+    check_finite(&mesh.vertices)?;
     Ok(mesh)
 }
 
