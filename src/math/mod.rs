@@ -19,3 +19,6 @@ pub mod cubic;
 pub mod mesh;
 pub mod rotation;
 pub mod scale;
+
+#[cfg(test)]
+mod proptests;
