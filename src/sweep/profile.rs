@@ -137,6 +137,8 @@ impl Profile {
                 "the closed polygon has zero area (its vertices are collinear)",
             ));
         }
+        // the area in the units of the input (it fits where the polygon does)
+        let area = crate::math::scale::ldexp(area, -2 * k);
         let p = p_all;
         let mut v = Vec::with_capacity(m);
         let mut acc = 0.0;
