@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 
 from . import _core
-from ._validate import as_choice, as_finite, as_int, as_points
+from ._validate import as_bool, as_choice, as_finite, as_int, as_points
 from .fields import Field
 
 __all__ = ["advect"]
@@ -94,6 +94,8 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
     duration = as_finite(duration, "duration")
     t0 = as_finite(t0, "t0")
     method = as_choice(method, "method", ("rk4", "euler", "split"))
+    if not callable(progress):
+        progress = as_bool(progress, "progress")
     if steps is None:
         steps = field.steps(duration)
     else:

@@ -478,6 +478,7 @@ class SpineBinding:
         """
         solution = as_choice(solution, "solution", SOLUTIONS)
         strict = as_bool(strict, "strict")
+        return_clamped = as_bool(return_clamped, "return_clamped")
         given = posed_frames is not None or posed_up is not None
         if posed_frames is not None and posed_up is not None:
             raise TypeError("posed_frames, posed_up: pass one of them, not both")
@@ -655,6 +656,7 @@ class SurfaceBinding:
         """
         solution = as_choice(solution, "solution", ("offset", "none"))
         strict = as_bool(strict, "strict")
+        return_clamped = as_bool(return_clamped, "return_clamped")
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:
             raise ValueError(f"posed_surface: expected the rest grid's shape "

@@ -50,7 +50,11 @@ def _analytic(curve: Curve, u: Any):
     if u is None:
         raise TypeError("u: required with an analytic curve (parameter values or a sample count)")
     if isinstance(u, (int, np.integer)) and not isinstance(u, bool):
-        uu = curve.parameters(int(u))
+        count = as_int(u, "u", minimum=2)
+        try:
+            uu = curve.parameters(count)
+        except MemoryError:
+            raise MemoryError(f"u: {count} samples do not fit in memory") from None
     else:
         uu = as_float_array(u, "u")
         if uu.ndim != 1 or uu.size < 2:  # the midpoints below need two values

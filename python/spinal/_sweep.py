@@ -19,6 +19,7 @@ from ._validate import (
     as_int,
     as_per_row,
     as_points,
+    as_real,
 )
 
 __all__ = ["sweep", "tube"]
@@ -240,7 +241,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     want_normals = as_bool(normals, "normals")
     want_uv = as_bool(uv, "uv")
     on_short = as_choice(on_short, "on_short", ("raise", "skip"))
-    miter_limit = float(as_float_array(miter_limit, "miter_limit"))
+    miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")

@@ -1,9 +1,11 @@
 """Argument conversion shared by the public functions: one helper per kind of argument.
 
-These only coerce types and shapes (dtype, number of dimensions, shape, Python types,
-choices of a string): array-likes become C-contiguous float64 arrays of the shape the core
-expects. Values (NaN/inf, lengths, repeated points, rotation matrices, …) are checked once,
-by the Rust core, whose messages name the Python argument as well.
+These coerce types and shapes (dtype, number of dimensions, shape, Python types, choices of
+a string): array-likes become C-contiguous float64 arrays of the shape the core expects;
+booleans must be ``bool``; integers must fit a 64-bit integer (counts within their bounds);
+scalars that no core check sees must be finite and within their range. Values of arrays
+(NaN/inf, lengths, repeated points, rotation matrices, …) are checked once, by the Rust
+core, whose messages name the Python argument as well.
 
 Every check raises ``TypeError`` (not numbers at all) or ``ValueError`` (numbers of the
 wrong shape) with a message that starts with the argument's name.
@@ -160,21 +162,46 @@ def as_real(x: Any, name: str) -> float:
     return float(x)
 
 
-def as_finite(x: Any, name: str) -> float:
-    """A finite Python float (for values that no core check sees)."""
+def as_finite(x: Any, name: str, minimum: float | None = None,
+              maximum: float | None = None) -> float:
+    """A finite Python float (for values that no core check sees), within
+    ``[minimum, maximum]`` when given."""
     x = as_real(x, name)
     if not np.isfinite(x):
         raise ValueError(f"{name}: must be finite, got {x}")
+    if minimum is not None and x < minimum:
+        raise ValueError(f"{name}: must be >= {minimum}, got {x}")
+    if maximum is not None and x > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {x}")
     return x
 
 
-def as_int(x: Any, name: str, minimum: int | None = None) -> int:
-    """A Python int (not a bool), at least ``minimum`` when given."""
+def as_positive(x: Any, name: str) -> float:
+    """A finite Python float > 0."""
+    x = as_finite(x, name)
+    if not x > 0:
+        raise ValueError(f"{name}: must be positive, got {x}")
+    return x
+
+
+#: Integers reach the core as 64-bit values.
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
+
+
+def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None) -> int:
+    """A Python int (not a bool) that fits a 64-bit integer, within ``[minimum, maximum]``
+    when given."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
+    x = int(x)
+    if not INT64_MIN <= x <= INT64_MAX:
+        raise ValueError(f"{name}: {x} is out of the representable range of a 64-bit "
+                         f"integer [-2**63, 2**63 - 1]")
     if minimum is not None and x < minimum:
-        raise ValueError(f"{name}: must be >= {minimum}, got {int(x)}")
-    return int(x)
+        raise ValueError(f"{name}: must be >= {minimum}, got {x}")
+    if maximum is not None and x > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {x}")
+    return x
 
 
 def as_bool(x: Any, name: str) -> bool:

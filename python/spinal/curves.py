@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from ._validate import as_float_array
+from ._validate import as_finite, as_float_array, as_int, as_positive
 
 __all__ = ["Bezier", "Curve", "Helix", "Polynomial", "TorusKnot", "Viviani"]
 
@@ -67,7 +67,7 @@ class Curve:
         """``n`` uniformly spaced parameters over :attr:`domain` (both ends included)."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
             raise ValueError(f"u: a sample count must be an integer >= 2, got {n!r}")
-        return np.linspace(self.domain[0], self.domain[1], int(n))
+        return np.linspace(self.domain[0], self.domain[1], as_int(n, "u"))
 
     def sample(self, n: int) -> np.ndarray:
         """``n`` points at uniformly spaced parameters over :attr:`domain`."""
@@ -114,10 +114,11 @@ class Helix(Curve):
     """
 
     def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0):
-        if not (a > 0 and math.isfinite(a) and math.isfinite(b)):
+        a = as_finite(a, "a")
+        if not a > 0:
             raise ValueError(f"a: the helix radius must be positive and finite, got {a!r}")
-        self.a, self.b = float(a), float(b)
-        self.domain = (0.0, 2 * math.pi * float(turns))
+        self.a, self.b = a, as_finite(b, "b")
+        self.domain = (0.0, 2 * math.pi * as_positive(turns, "turns"))
 
     def _eval(self, u, k):
         a, b = self.a, self.b
@@ -156,9 +157,11 @@ class TorusKnot(Curve):
     closed = True
 
     def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3):
+        as_finite(p, "p"), as_finite(q, "q")  # real numbers (integers for a closed knot)
+        R, r = as_finite(R, "R"), as_finite(r, "r")
         if not (R > 0 and r > 0):
             raise ValueError("R, r: radii must be positive")
-        self.p, self.q, self.R, self.r = p, q, float(R), float(r)
+        self.p, self.q, self.R, self.r = p, q, R, r
         self.domain = (0.0, 2 * math.pi)
 
     def _eval(self, u, k):
@@ -191,9 +194,7 @@ class Viviani(Curve):
     closed = True
 
     def __init__(self, a: float = 1.0):
-        if not a > 0:
-            raise ValueError(f"a: must be positive, got {a!r}")
-        self.a = float(a)
+        self.a = as_positive(a, "a")
         self.domain = (0.0, 4 * math.pi)
 
     def _eval(self, u, k):
@@ -219,7 +220,10 @@ class Polynomial(Curve):
         if not np.all(np.isfinite(c)):
             raise ValueError("coefficients: contains non-finite values")
         self.coefficients = c.copy()
-        self.domain = (float(domain[0]), float(domain[1]))
+        d = as_float_array(domain, "domain")
+        if d.shape != (2,) or not np.all(np.isfinite(d)) or not d[1] > d[0]:
+            raise ValueError(f"domain: expected two finite values lo < hi, got {domain!r}")
+        self.domain = (float(d[0]), float(d[1]))
 
     def _eval(self, u, k):
         c = self.coefficients
@@ -238,6 +242,9 @@ class Bezier(Polynomial):
         p = as_float_array(control_points, "control_points")
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2:
             raise ValueError(f"control_points: expected shape (d+1, 3), d >= 1, got {p.shape}")
+        if not np.all(np.isfinite(p)):
+            bad = int(np.flatnonzero(~np.isfinite(p).all(axis=1))[0])
+            raise ValueError(f"control_points: non-finite value at row {bad}")
         d = p.shape[0] - 1
         # power-basis coefficients: c_j = C(d, j) Σ_i (-1)^(j-i) C(j, i) P_i
         coeffs = np.array(

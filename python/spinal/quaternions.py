@@ -33,11 +33,11 @@ from ._frames import frames
 from ._validate import (
     as_bool,
     as_choice,
+    as_finite,
     as_float_array,
     as_frames,
     as_int,
     as_points,
-    as_real,
     as_vector,
 )
 
@@ -232,18 +232,21 @@ def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) ->
         a = _core.quat_from_frames(as_frames(a, "q")[0], True)
     else:
         a, _ = _quats(a, "q", as_bool(scalar_first, "scalar_first"))
-    return float(_core.quat_path_length(a, as_bool(closed, "closed")))
+    # + 0.0: an empty sum is -0.0
+    return float(_core.quat_path_length(a, as_bool(closed, "closed"))) + 0.0
 
 
 def spin(a, b) -> np.ndarray | float:
     """Signed angle (radians, in (−π, π]) that turns frame ``a``'s reference vector ``r``
     into frame ``b``'s about ``a``'s tangent — the twist between two frames with the same
-    tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``.
+    tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``
+    (one of them may be a single frame). Both must be finite rotation matrices whose
+    tangents (third columns) agree within 1e-3 rad; otherwise ``ValueError`` names the
+    argument and the frame.
     """
     fa, sa = as_frames(a, "a")
     fb, sb = as_frames(b, "b")
-    ra, sa_, rb = fa[:, :, 0], fa[:, :, 1], fb[:, :, 0]
-    ang = np.arctan2(np.einsum("ij,ij->i", rb, sa_), np.einsum("ij,ij->i", rb, ra))
+    ang = _core.quat_spin(fa, fb)
     return float(ang[0]) if (sa and sb) else ang
 
 
@@ -299,7 +302,8 @@ def camera_frames(
             raise ValueError(f"bank: expected a scalar or shape ({n},), got {b.shape}")
         b = np.ascontiguousarray(b)
     t, u, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
-                                                  as_real(singular_angle, "singular_angle"))
+                                                  as_finite(singular_angle, "singular_angle",
+                                                            0.0, np.pi / 2))
     if mode == "transport":
         init = None if vertical else u
         f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))

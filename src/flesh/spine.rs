@@ -266,7 +266,7 @@ impl SpineModel {
 /// `posed_spine` and `rest_spine`, whose chords they are).
 pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec<DVec3>> {
     check_walk(posed, chords)?;
-    Ok(walk_chords(posed, chords))
+    scaled_walk(posed, chords, &mut Vec::new())
 }
 
 /// The input checks of [`compass_walk`].
@@ -295,13 +295,46 @@ pub fn compass_walk_located(
 ) -> crate::error::Result<(Vec<DVec3>, Vec<f64>)> {
     check_walk(posed, chords)?;
     let mut at = Vec::with_capacity(chords.len() + 1);
-    let pts = walk(posed, chords, &mut at);
+    let pts = scaled_walk(posed, chords, &mut at)?;
     Ok((pts, at))
 }
 
-/// The walk of [`compass_walk`] on checked input.
-fn walk_chords(posed: &[DVec3], chords: &[f64]) -> Vec<DVec3> {
-    walk(posed, chords, &mut Vec::new())
+/// The walk on checked input, on a spine far from unit size divided by its power-of-two
+/// scale first (exact; the walk squares chords twice, |e·(a − c)|²) and multiplied back;
+/// pushes the polyline positions onto `at` when it is given with capacity.
+fn scaled_walk(
+    posed: &[DVec3],
+    chords: &[f64],
+    at: &mut Vec<f64>,
+) -> crate::error::Result<Vec<DVec3>> {
+    use crate::error::InputError;
+    let (lo, hi) = crate::frames::geometry::bounds(posed);
+    let out = match crate::math::scale::curve_exponent(lo, hi) {
+        None => walk(posed, chords, at),
+        Some(k) => {
+            let p = crate::math::scale::scaled(posed, k);
+            let h: Vec<f64> = chords
+                .iter()
+                .map(|&c| crate::math::scale::ldexp(c, k))
+                .collect();
+            crate::math::scale::scaled(&walk(&p, &h, at), -k)
+        }
+    };
+    if let Some(i) = out.windows(2).position(|w| w[0] == w[1]) {
+        return Err(InputError::new(
+            "posed_spine",
+            format!(
+                "resampled to the rest spine's chords ({:e} at chord {i}), samples {i} and {} \
+                 fall on the same float64 point at coordinates of size {:e}: the rest spine's \
+                 chords are out of the representable range at the posed spine's size; pose a \
+                 spine of the rest spine's size, or pass stretchable=True",
+                chords[i],
+                i + 1,
+                crate::math::scale::max_abs(out[i])
+            ),
+        ));
+    }
+    Ok(out)
 }
 
 /// The walk; pushes the polyline positions onto `at` when it is given with capacity.

@@ -20,12 +20,12 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::double_reflection::dr_step;
-use super::geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
+use super::geometry::{any_perpendicular, bounds, rotate_about, signed_angle};
 use super::lanes::{Arith, F4, L, V4};
 use super::rotation::rotation_step;
 use super::tangents::{OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open};
 use super::transport::{ChunkEnds, Scan, Twist, plan, write_frame};
-use super::validate::{COINCIDE_EPS, MIN_ALIGNMENT, coincide};
+use super::validate::{MIN_ALIGNMENT, REPEAT_REL, repeated};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};
 use crate::math::rotation::minimal_rotate_with;
 
@@ -83,15 +83,16 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
 
     // The default initial vector: the principal normal at the first sample where the curve
     // bends, carried back to sample 0 (as `Ctx::run`).
-    let (scale, diag) = scale_and_diagonal(x);
+    let (lo, hi) = bounds(x);
+    let (scale, diag) = (lo.abs().max(hi.abs()).max_element(), (hi - lo).length());
     if !(scale.is_finite() && diag.is_finite()) {
         return None;
     }
     let noise = 64.0 * f64::EPSILON * scale;
-    // chords longer than this are not repeated points: `coincide` needs
-    // |b − a|_∞ ≤ 8ε·max(|a|_∞, |b|_∞) ≤ 8ε·scale, and |b − a|_∞ ≥ |b − a|/√3 (with a margin
-    // for the rounding of the computed length)
-    let apart = 2.0 * COINCIDE_EPS * scale;
+    // chords longer than this are not repeated points: `repeated` needs
+    // |b − a|_∞ ≤ floor, and |b − a|_∞ ≥ |b − a|/√3 (with a margin for the rounding of the
+    // computed length)
+    let apart = 4.0 * crate::math::scale::half_extent(lo, hi) * REPEAT_REL;
     let normal = |i: usize, ti: DVec3| {
         circle_normal(x, ti, i, false, noise)
             .and_then(|(nrm, kappa)| (kappa * diag > STRAIGHT_TOL).then_some(nrm))
@@ -174,8 +175,7 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
 /// A given tangent made unit, as `tangents::normalize_all` does; `None` where it cannot be.
 #[inline(always)]
 fn unit(v: DVec3) -> Option<DVec3> {
-    let l = v.length();
-    (l > 0.0 && l.is_finite() && (v / l).is_finite()).then(|| v / l)
+    crate::math::scale::normalize(v)
 }
 
 /// The given tangents `s … te − 1` made unit into `t` (four at a time), or `None` where one
@@ -465,7 +465,7 @@ fn block_chords(w: &mut Scratch, blk: &Block) {
     }
 }
 
-/// Does the block hold a repeated point (`validate::coincide`)?
+/// Does the block hold a repeated point (`validate::repeated`, floor `apart / 2`)?
 ///
 /// `|b − a|_∞ ≥ h/√3`, so a chord longer than `apart` cannot coincide (the exact test runs
 /// only on the rare short ones). Non-finite samples need no test of their own: ±inf anywhere
@@ -479,7 +479,8 @@ fn repeated_point(w: &Scratch, x: &[DVec3], blk: &Block, apart: f64) -> bool {
     w.h[j0..j1]
         .iter()
         .fold(false, |acc, &hj| acc | (hj <= apart))
-        && (s..blk.e.min(n - 1)).any(|j| w.h[j - lo] <= apart && coincide(x[j], x[j + 1]))
+        && (s..blk.e.min(n - 1))
+            .any(|j| w.h[j - lo] <= apart && repeated(x[j], x[j + 1], 0.5 * apart))
 }
 
 /// The five-point tangents of the block (`five_point_unit_open`): the interior ones

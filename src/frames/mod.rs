@@ -117,9 +117,11 @@ pub(crate) fn resolve(o: &Orientation, t: DVec3, row: usize, arg: &'static str) 
             if !v.is_finite() {
                 return Err(InputError::new(arg, "contains a non-finite value"));
             }
+            // a unit vector first, so that huge or tiny vectors neither overflow nor vanish
+            let v = crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO);
             let p = v - v.dot(t) * t;
             let l = p.length();
-            if l == 0.0 || l <= 1e-8 * v.length() {
+            if l == 0.0 || l <= 1e-8 {
                 return Err(InputError::new(
                     arg,
                     format!(
@@ -219,10 +221,59 @@ fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
 /// Returns the raw end angle of the boundary condition (the closing angle for a closed
 /// curve, the angle from the transported frame to `end` otherwise; 0 without a condition),
 /// before `2π·turns` is added.
+///
+/// A curve whose size is far from 1 is first divided by a power of two (exact; see
+/// [`crate::math::scale`]), so the frames and the angle do not depend on its units.
 pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
+    if req.turns != 0 && !req.closed && req.end.is_none() && req.method != Method::Frenet {
+        return Err(InputError::new(
+            "turns",
+            "applies to a closed curve (closed=True) or with a prescribed end; an open curve \
+             without end has no twist to add turns to",
+        ));
+    }
+    let owned = normalised(req);
+    let req = match &owned {
+        Some(o) => &o.request(req),
+        None => req,
+    };
     match fused::try_open_points(req, out) {
         Some(angle) => Ok(angle),
         None => compute_general(req, out),
+    }
+}
+
+/// The points (and exact derivatives) of a request divided by the curve's power-of-two
+/// scale, or `None` when its size needs no normalisation.
+struct Normalised {
+    points: Vec<DVec3>,
+    d1: Vec<DVec3>,
+    d2: Vec<DVec3>,
+}
+
+fn normalised(req: &Request) -> Option<Normalised> {
+    let p = req.points?;
+    let (lo, hi) = geometry::bounds(p);
+    let k = crate::math::scale::curve_exponent(lo, hi)?;
+    let scaled = |v: &[DVec3]| crate::math::scale::scaled(v, k);
+    Some(Normalised {
+        points: scaled(p),
+        d1: req.analytic.map_or_else(Vec::new, |a| scaled(a.d1)),
+        d2: req.analytic.map_or_else(Vec::new, |a| scaled(a.d2)),
+    })
+}
+
+impl Normalised {
+    fn request<'a>(&'a self, req: &Request<'a>) -> Request<'a> {
+        Request {
+            points: Some(&self.points),
+            analytic: req.analytic.map(|a| Analytic {
+                u: a.u,
+                d1: &self.d1,
+                d2: &self.d2,
+            }),
+            ..*req
+        }
     }
 }
 

@@ -446,8 +446,15 @@ fn raw_tangent(
 
 /// Unit tangents for one curve as the user gave it: validates the points, accepts a closed
 /// curve that repeats its first point at the end (that row gets the first tangent).
+///
+/// A curve whose size is far from 1 is divided by a power of two first (exact; see
+/// [`crate::math::scale`]): unit tangents do not depend on the units.
 pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec3>> {
     crate::frames::validate::finite("points", x)?;
+    let (lo, hi) = crate::frames::geometry::bounds(x);
+    let owned =
+        crate::math::scale::curve_exponent(lo, hi).map(|k| crate::math::scale::scaled(x, k));
+    let x = owned.as_deref().unwrap_or(x);
     let mut n = x.len();
     if closed && n >= 2 && crate::frames::validate::coincide(x[n - 1], x[0]) {
         n -= 1;
@@ -491,7 +498,8 @@ pub fn estimate_many(
     Ok(out)
 }
 
-/// Normalise in place; on a zero or non-finite result returns the first bad index.
+/// Normalise in place (scaled by the largest component first, so any finite non-zero vector
+/// works); on a zero or non-finite vector returns the first bad index.
 pub fn normalize_all(t: &mut [DVec3]) -> std::result::Result<(), usize> {
     let bad = t
         .par_chunks_mut(1 << 12)
@@ -499,9 +507,8 @@ pub fn normalize_all(t: &mut [DVec3]) -> std::result::Result<(), usize> {
         .filter_map(|(c, block)| {
             let mut bad = None;
             for (k, v) in block.iter_mut().enumerate() {
-                let l = v.length();
-                if l > 0.0 && l.is_finite() && (*v / l).is_finite() {
-                    *v /= l;
+                if let Some(u) = crate::math::scale::normalize(*v) {
+                    *v = u;
                 } else if bad.is_none() {
                     bad = Some((c << 12) + k);
                 }

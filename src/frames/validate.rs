@@ -2,8 +2,8 @@
 //! first offending row, naming the argument.
 //!
 //! * Non-finite values (NaN, ±inf) are refused.
-//! * Consecutive samples that coincide to round-off (`|x_{i+1} − x_i|_∞ ≤ 8ε·max|x|_∞`)
-//!   make a zero-length segment: refused (the reflection `R₁` is undefined and no tangent
+//! * Consecutive samples closer than `2⁻⁶⁰` times the curve's size
+//!   (`|x_{i+1} − x_i|_∞ ≤ 2⁻⁶⁰·extent`) make a zero-length segment: refused (the reflection `R₁` is undefined and no tangent
 //!   can be estimated there).
 //! * A segment whose chord runs against its tangents, `v̂₁·(t_i + t_{i+1}) ≤ 10⁻⁶`, is a
 //!   reversal (cusp) or far too coarse a sampling: refused. This is exactly the condition
@@ -58,16 +58,37 @@ fn describe(p: DVec3) -> String {
     format!("[{}, {}, {}]", p.x, p.y, p.z)
 }
 
+/// The same point up to the round-off of its coordinates (`|b − a|_∞ ≤ 8ε·max|·|_∞`): the
+/// test for a closed curve's repeated first sample at the end.
 #[inline]
 pub fn coincide(a: DVec3, b: DVec3) -> bool {
     let d = (b - a).abs().max_element();
     d <= COINCIDE_EPS * a.abs().max_element().max(b.abs().max_element())
 }
 
+/// Consecutive samples closer than this fraction of the curve's size (the largest side of
+/// its bounding box) make a zero-length segment. Relative to the size, not to the
+/// coordinates: samples a few ulps apart far from the origin are distinct points (1e-3 apart
+/// at 1e12), and every chord that passes keeps its fifth power in the normal range.
+pub const REPEAT_REL: f64 = 1.0 / (1u64 << 60) as f64;
+
+/// The largest `|x_{i+1} − x_i|_∞` that counts as a repeated point on the curve `x`.
+pub fn repeat_floor(x: &[DVec3]) -> f64 {
+    let (lo, hi) = crate::frames::geometry::bounds(x);
+    2.0 * crate::math::scale::half_extent(lo, hi) * REPEAT_REL
+}
+
+/// A zero-length segment: `|b − a|_∞ ≤ floor` (see [`repeat_floor`]).
+#[inline]
+pub fn repeated(a: DVec3, b: DVec3, floor: f64) -> bool {
+    (b - a).abs().max_element() <= floor
+}
+
 /// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
-/// consecutive points.
+/// consecutive points ([`repeated`]).
 pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
     let n = x.len();
+    let floor = repeat_floor(x);
     let m = if closed { n } else { n.saturating_sub(1) };
     let mut seg = vec![0.0; m];
     let bad = seg
@@ -79,8 +100,13 @@ pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
             for (k, l) in ls.iter_mut().enumerate() {
                 let i = a0 + k;
                 let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
-                *l = (b - a).length();
-                if bad.is_none() && coincide(a, b) {
+                let d = b - a;
+                *l = d.length();
+                if !(*l > 1e-150 && *l < 1e150) {
+                    // the square under- or overflowed: the length scaled first
+                    *l = crate::math::scale::length(d);
+                }
+                if bad.is_none() && repeated(a, b, floor) {
                     bad = Some(i);
                 }
             }

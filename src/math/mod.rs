@@ -10,9 +10,15 @@
 //!   quaternion forms), Rodrigues' rotation about an axis, the signed angle about an axis,
 //!   3×3 rotation matrix ↔ unit quaternion (Shepperd's method), and the test whether a
 //!   matrix is a rotation.
+//! * [`scale`]: normalisation by a power of two (curves) or the largest component
+//!   (vectors, quaternions) before squaring, so results do not depend on the units.
 //! * [`mesh`]: signed volume of a closed triangle mesh and its undirected edges (for
 //!   manifold checks and adjacency).
 
 pub mod cubic;
 pub mod mesh;
 pub mod rotation;
+pub mod scale;
+
+#[cfg(test)]
+mod proptests;

@@ -238,11 +238,28 @@ impl Cubic {
 
     /// Control points from a quaternion preimage `A₀, A₁` and the start point (the quaternion
     /// form of spatial PH curves; MJ characterise PH cubics by their control polygon, (17)).
+    ///
+    /// The legs are quadratic in `A`: both quaternions are divided by the power of two `2^k`
+    /// nearest their largest component first and the legs multiplied by `2^{2k}` after, so
+    /// the intermediate products cannot overflow where the legs themselves fit in f64 (a leg
+    /// beyond the f64 range is ±inf: callers check).
     pub fn from_quaternions(a0: Quat, a1: Quat, start: DVec3) -> Self {
+        use crate::math::scale::{exponent, ldexp};
+        let m = a0
+            .iter()
+            .chain(a1.iter())
+            .fold(0.0_f64, |m, c| m.max(c.abs()));
+        let k = if m > 0.0 && m.is_finite() {
+            exponent(m)
+        } else {
+            0
+        };
+        let (a0, a1) = (a0.map(|c| ldexp(c, -k)), a1.map(|c| ldexp(c, -k)));
+        let back = |v: DVec3| DVec3::new(ldexp(v.x, 2 * k), ldexp(v.y, 2 * k), ldexp(v.z, 2 * k));
         let b0 = start;
-        let b1 = b0 + aib(a0, a0) / 3.0;
-        let b2 = b1 + (aib(a0, a1) + aib(a1, a0)) / 6.0;
-        let b3 = b2 + aib(a1, a1) / 3.0;
+        let b1 = b0 + back(aib(a0, a0) / 3.0);
+        let b2 = b1 + back((aib(a0, a1) + aib(a1, a0)) / 6.0);
+        let b3 = b2 + back(aib(a1, a1) / 3.0);
         Cubic::new([b0, b1, b2, b3])
     }
 
@@ -387,9 +404,22 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
     check::finite_rows("A1", a1)?;
     let st: Vec<[f64; 3]> = start.iter().map(|p| p.to_array()).collect();
     check::finite_rows("start", &st)?;
-    Ok((0..a0.len())
-        .map(|i| Cubic::from_quaternions(a0[i], a1[i], start[i]))
-        .collect())
+    (0..a0.len())
+        .map(|i| {
+            let c = Cubic::from_quaternions(a0[i], a1[i], start[i]);
+            if c.b.iter().all(|p| p.is_finite()) {
+                Ok(c)
+            } else {
+                Err(InputError::new(
+                    "A0, A1",
+                    format!(
+                        "row {i}: the control points (of size |A|² plus start) are out of \
+                         the representable range of float64"
+                    ),
+                ))
+            }
+        })
+        .collect()
 }
 
 /// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a

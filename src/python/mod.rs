@@ -27,6 +27,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frames::frames_in_time, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_from_frames, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::quat_spin, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_to_frames, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_continuous, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_slerp, m)?)?;

@@ -26,6 +26,19 @@ pub fn quat_from_frames<'py>(
     quat_array(py, q)
 }
 
+/// The twist angle between frames `a` and `b` about their common tangent; see
+/// `spinal.quaternions.spin`.
+#[pyfunction]
+pub fn quat_spin<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray3<'py, f64>,
+    b: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (fa, fb) = (frames_of("a", &a)?, frames_of("b", &b)?);
+    let out = py.detach(|| quaternion::spin::spin(fa, fb))?;
+    Ok(PyArray1::from_vec(py, out))
+}
+
 /// Frames of quaternions `(x, y, z, w)`.
 #[pyfunction]
 pub fn quat_to_frames<'py>(

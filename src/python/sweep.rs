@@ -54,6 +54,11 @@ pub fn sweep_mesh<'py>(
         None => &[],
     };
     let prof = vec2s("profile", "(m, 2)", &profile)?;
+    let scaled = sweep::scaled_input(pts, prof, sc);
+    let (pts, prof, sc) = match &scaled {
+        Some(s) => (&s.points[..], &s.profile[..], &s.scale[..]),
+        None => (pts, prof, sc),
+    };
     let offsets = offsets_of(&offsets)?;
     let opts = Options {
         closed,
@@ -83,6 +88,8 @@ pub fn sweep_mesh<'py>(
         lay: &lay,
         normals,
         uv,
+        k: scaled.as_ref().map(|s| s.k),
+        scale_arg,
     };
     match (single, index32) {
         (false, false) => job.run::<f64, i64>(py),
@@ -101,6 +108,9 @@ struct Job<'a> {
     lay: &'a sweep::Layout,
     normals: bool,
     uv: bool,
+    /// The power of two the input was scaled by ([`sweep::scaled_input`]).
+    k: Option<i32>,
+    scale_arg: &'a str,
 }
 
 impl Job<'_> {
@@ -136,9 +146,23 @@ impl Job<'_> {
                     None => None,
                 },
             };
-            detach_in_pool(py, || {
+            let folds = detach_in_pool(py, || {
                 sweep::sweep_into(self.spine, self.offsets, self.p, self.opts, self.lay, out)
+            })?;
+            let verts: &mut [[R; 3]] = bytemuck::cast_slice_mut(slice_mut(&mut wv)?);
+            let uvs: Option<&mut [[R; 2]]> = match wu.as_mut() {
+                Some(w) => Some(bytemuck::cast_slice_mut(slice_mut(w)?)),
+                None => None,
+            };
+            let k = self.k;
+            detach_in_pool(py, || {
+                if let Some(k) = k {
+                    sweep::unscale(verts, uvs, k);
+                }
+                sweep::check_finite_out(verts)
             })?
+            .map_err(|e| renamed(e, "scale", self.scale_arg))?;
+            folds
         };
         let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
         Ok((

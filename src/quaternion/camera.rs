@@ -58,13 +58,12 @@ pub fn inputs(
 ) -> Result<Inputs> {
     let t = unit_tangents(x, tangents, closed)?;
     let u = up.unwrap_or(DVec3::Z);
-    if !(u.is_finite() && u.length() > 0.0) {
+    let Some(u) = crate::math::scale::normalize(u) else {
         return Err(InputError::new(
             "up",
             "expected a finite non-zero (3,) vector",
         ));
-    }
-    let u = u / u.length();
+    };
     let vertical = t[0].cross(u).length() <= VERTICAL_SIN;
     if let Some(b) = bank {
         validate::finite_scalars("bank", b)?;

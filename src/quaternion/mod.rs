@@ -24,6 +24,7 @@
 //!   their total twist and turn (`½∫|ω| ds` in the limit).
 
 pub mod camera;
+pub mod spin;
 pub mod walk;
 
 use glam::{DMat3, DQuat, DVec3};
@@ -109,9 +110,28 @@ pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> 
     Ok(q)
 }
 
+/// `q / |q|`, divided by its largest component first so that any finite non-zero quaternion
+/// (|q| from 1e-320 to 1e308) gives its rotation; `None` for zero or non-finite `q`.
+#[inline]
+pub fn unit(q: DQuat) -> Option<DQuat> {
+    crate::math::scale::normalize4(q.to_array())
+}
+
+/// Can `q` be normalised ([`unit`])?
+#[inline]
+fn normalisable(q: &DQuat) -> bool {
+    unit(*q).is_some()
+}
+
+/// [`unit`] of a quaternion already checked by [`normalisable`].
+#[inline]
+fn unit_checked(q: DQuat) -> DQuat {
+    unit(q).unwrap_or(DQuat::IDENTITY)
+}
+
 /// Frames of quaternions (normalised first; a zero or non-finite quaternion is refused).
 pub fn to_frames(q: &[DQuat], out: &mut [[f64; 9]]) -> Result<()> {
-    if let Some(i) = validate::first_bad(q, |v| v.is_finite() && v.length_squared() > 1e-200) {
+    if let Some(i) = validate::first_bad(q, normalisable) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite and cannot be normalised"),
@@ -120,7 +140,7 @@ pub fn to_frames(q: &[DQuat], out: &mut [[f64; 9]]) -> Result<()> {
     out.par_iter_mut()
         .zip(q.par_iter())
         .with_min_len(GRAIN)
-        .for_each(|(o, v)| *o = to_matrix(v.normalize()));
+        .for_each(|(o, v)| *o = to_matrix(unit_checked(*v)));
     Ok(())
 }
 
@@ -141,7 +161,7 @@ pub fn slerp(a: DQuat, b: DQuat, u: f64) -> DQuat {
 /// Slerp row by row (all three slices have the same length).
 pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Result<()> {
     for (arg, v) in [("q0", a), ("q1", b)] {
-        if let Some(i) = validate::first_bad(v, |v| v.is_finite() && v.length_squared() > 1e-200) {
+        if let Some(i) = validate::first_bad(v, normalisable) {
             return Err(InputError::new(
                 arg,
                 format!("row {i} is zero or not finite"),
@@ -152,7 +172,7 @@ pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Res
     out.par_iter_mut()
         .enumerate()
         .with_min_len(GRAIN)
-        .for_each(|(i, o)| *o = slerp(a[i].normalize(), b[i].normalize(), u[i]));
+        .for_each(|(i, o)| *o = slerp(unit_checked(a[i]), unit_checked(b[i]), u[i]));
     Ok(())
 }
 
@@ -230,7 +250,7 @@ fn arc(a: DQuat, b: DQuat) -> f64 {
 /// Length of the quaternion curve (unit quaternions, any signs), `closed` adding the arc
 /// from the last to the first.
 pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
-    if let Some(i) = validate::first_bad(q, |v| v.is_finite() && v.length_squared() > 1e-200) {
+    if let Some(i) = validate::first_bad(q, normalisable) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite"),
@@ -241,7 +261,7 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
     Ok((0..m)
         .into_par_iter()
         .with_min_len(GRAIN)
-        .map(|i| arc(q[i].normalize(), q[(i + 1) % n].normalize()))
+        .map(|i| arc(unit_checked(q[i]), unit_checked(q[(i + 1) % n])))
         .sum())
 }
 
@@ -270,7 +290,7 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
             format!("contains non-finite values (row {i})"),
         ));
     }
-    if let Some(i) = validate::first_bad(t, |v| v.length() > 0.0) {
+    if let Some(i) = validate::first_bad(t, |v| crate::math::scale::normalize(*v).is_some()) {
         return Err(InputError::new(
             "tangents",
             format!("zero-length tangent at row {i}"),
@@ -278,7 +298,7 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
     }
     Ok(t.par_iter()
         .with_min_len(GRAIN)
-        .map(|v| *v / v.length())
+        .map(|v| crate::math::scale::normalize(*v).unwrap_or(DVec3::Z))
         .collect())
 }
 
@@ -359,7 +379,7 @@ pub fn transport(
     let mut acc = 0.0;
     arc.push(0.0);
     for i in 0..n {
-        acc += (x[(i + 1) % n] - x[i]).length();
+        acc += crate::math::scale::length(x[(i + 1) % n] - x[i]);
         arc.push(acc);
     }
     let len = arc[n];

@@ -253,8 +253,9 @@ fn mitre(x: &[DVec3], t: DVec3, i: usize, closed: bool, limit: f64) -> (f64, DVe
     }
     let prev = x[(i + n - 1) % n];
     let next = x[(i + 1) % n];
-    let din = (x[i] - prev).normalize();
-    let dout = (next - x[i]).normalize();
+    // scaled by the largest component before squaring: any finite spine size
+    let unit = |v: DVec3| crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO);
+    let (din, dout) = (unit(x[i] - prev), unit(next - x[i]));
     let half_cos = 0.5 * (1.0 + din.dot(dout)); // cos²(φ/2)
     let k = din - dout;
     let k = k - k.dot(t) * t;
@@ -318,6 +319,7 @@ fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3]
 /// Storage of the output coordinates: `f64`, or `f32` rounded from the `f64` results.
 pub trait Real: Copy + Send + Sync + 'static {
     fn of(x: f64) -> Self;
+    fn to_f64(self) -> f64;
 }
 
 impl Real for f64 {
@@ -325,12 +327,95 @@ impl Real for f64 {
     fn of(x: f64) -> f64 {
         x
     }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
 }
 
 impl Real for f32 {
     #[inline(always)]
     fn of(x: f64) -> f32 {
         x as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+/// A spine, profile and scale far from unit size brought near it by powers of two (exact):
+/// spine points times `2^k` (`k` from the spine's size), the profile divided by `2^j` (its
+/// largest coordinate) and the scale multiplied by `2^(k + j)`, so `x + M (scale ⊙ profile)`
+/// is the swept surface times `2^k`. The normals and fold tests multiply lengths, which would overflow or
+/// underflow otherwise; [`unscale`] multiplies the vertices and arc lengths back.
+pub struct Scaled {
+    pub k: i32,
+    pub points: Vec<DVec3>,
+    pub profile: Vec<DVec2>,
+    pub scale: Vec<DVec2>,
+}
+
+/// The [`Scaled`] input, or `None` when the input is near unit size (or not finite: the
+/// checks then report it as given).
+pub fn scaled_input(points: &[DVec3], profile: &[DVec2], scale: &[DVec2]) -> Option<Scaled> {
+    use crate::math::scale as s;
+    let finite = points.iter().all(|p| p.is_finite())
+        && profile.iter().all(|p| p.is_finite())
+        && scale.iter().all(|v| v.x > 0.0 && v.y > 0.0 && v.is_finite());
+    if !finite {
+        return None;
+    }
+    let (lo, hi) = crate::frames::geometry::bounds(points);
+    let k = s::curve_exponent(lo, hi);
+    let pmax = profile
+        .iter()
+        .fold(0.0_f64, |m, v| m.max(v.abs().max_element()));
+    let j = match pmax > 0.0 {
+        true => Some(s::exponent(pmax)).filter(|e| e.abs() > s::SAFE_EXP),
+        false => None,
+    };
+    if k.is_none() && j.is_none() {
+        return None;
+    }
+    let (k, j) = (k.unwrap_or(0), j.unwrap_or(0));
+    let mul2 = |v: &DVec2, e: i32| DVec2::new(s::ldexp(v.x, e), s::ldexp(v.y, e));
+    Some(Scaled {
+        k,
+        points: s::scaled(points, k),
+        profile: profile.iter().map(|v| mul2(v, -j)).collect(),
+        scale: scale.iter().map(|v| mul2(v, k + j)).collect(),
+    })
+}
+
+/// Divide the vertices and the arc-length coordinate `u` of a mesh swept from
+/// [`scaled_input`] by `2^k` again.
+pub fn unscale<R: Real>(vertices: &mut [[R; 3]], uv: Option<&mut [[R; 2]]>, k: i32) {
+    use crate::math::scale::ldexp;
+    let back = |x: &mut R| *x = R::of(ldexp(x.to_f64(), -k));
+    vertices.par_iter_mut().for_each(|v| v.iter_mut().for_each(back));
+    if let Some(uv) = uv {
+        uv.par_iter_mut().for_each(|t| back(&mut t[0]));
+    }
+}
+
+/// Refuse swept vertices beyond the range of the output type (float64, or float32 with
+/// `dtype=float32`); named by the profile's `scale`.
+pub fn check_finite_out<R: Real>(vertices: &[[R; 3]]) -> Result<()> {
+    let bad = vertices
+        .par_iter()
+        .position_first(|v| !v.iter().all(|x| x.to_f64().is_finite()));
+    match bad {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            "scale",
+            format!(
+                "the swept vertex {i} (spine point + frame · scale · profile) is out of the \
+                 representable range of the output dtype (float{}); reduce the profile, its \
+                 scale or the spine",
+                8 * std::mem::size_of::<R>()
+            ),
+        )),
     }
 }
 
@@ -867,6 +952,21 @@ pub fn sweep_into<R: Real, I: Index>(
     folds.concat()
 }
 
+/// Refuse swept vertices beyond the f64 range (`x_i + M_i·(scale_i ⊙ profile_j)`
+/// overflowing for huge finite input); named by the profile's `scale`.
+pub fn check_finite(vertices: &[DVec3]) -> Result<()> {
+    match validate::first_bad(vertices, |v| v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            "scale",
+            format!(
+                "the swept vertex {i} (spine point + frame · scale · profile) is out of the \
+                 representable range of float64; reduce the profile, its scale or the spine"
+            ),
+        )),
+    }
+}
+
 /// [`layout`] and [`sweep_into`] with freshly allocated buffers.
 pub fn sweep_many(
     all: &Spine,
@@ -895,6 +995,7 @@ pub fn sweep_many(
             uv: Some(bytemuck::cast_slice_mut(&mut mesh.uv)),
         },
     );
+    check_finite(&mesh.vertices)?;
     Ok(mesh)
 }
 

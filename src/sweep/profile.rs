@@ -103,6 +103,24 @@ impl Profile {
             ));
         }
         let edges = if closed { m } else { m - 1 };
+        // the area and intersection tests multiply coordinates: run them on the polygon
+        // divided by the power of two of its largest coordinate (exact), so that any finite
+        // size works
+        let k = if scale > 0.0 {
+            -crate::math::scale::exponent(scale)
+        } else {
+            0
+        };
+        let unit = |v: &DVec2| {
+            DVec2::new(
+                crate::math::scale::ldexp(v.x, k),
+                crate::math::scale::ldexp(v.y, k),
+            )
+        };
+        let q: Vec<DVec2> = p.iter().map(unit).collect();
+        let (p_all, p) = (p, q);
+        let scale = crate::math::scale::ldexp(scale, k);
+        let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
         if let Some(j) = (0..edges).find(|&j| same(p[j], p[(j + 1) % m])) {
             return Err(InputError::new(
                 ARG,
@@ -133,12 +151,15 @@ impl Profile {
                 "the closed polygon has zero area (its vertices are collinear)",
             ));
         }
+        // the area in the units of the input (it fits where the polygon does)
+        let area = crate::math::scale::ldexp(area, -2 * k);
+        let p = p_all;
         let mut v = Vec::with_capacity(m);
         let mut acc = 0.0;
         for j in 0..m {
             v.push(acc);
             if j + 1 < m || closed {
-                acc += (p[(j + 1) % m] - p[j]).length();
+                acc += crate::math::scale::length((p[(j + 1) % m] - p[j]).extend(0.0));
             }
         }
         for x in v.iter_mut() {

@@ -1,0 +1,165 @@
+"""Property tests over scales 1e-150 … 1e150: a valid input scaled by 10^k gives the answer
+of the unscaled input (scaled back where the answer has units) and never a NaN; quaternions
+of any size give their rotation. Kept to about a minute in all (``max_examples``)."""
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import spinal
+from spinal import fields as fl
+from spinal import quaternions as Q
+
+SETTINGS = settings(max_examples=200, deadline=None,
+                    suppress_health_check=[HealthCheck.too_slow])
+EXPONENTS = st.integers(-150, 150)
+SEEDS = st.integers(0, 2**32 - 1)
+
+
+def walk(seed: int, n: int, closed: bool = False) -> np.ndarray:
+    """A smooth random curve: a random walk with small turns and step ratios up to 20 (a
+    closed one: a random closed Fourier curve)."""
+    rng = np.random.default_rng(seed)
+    if closed:
+        u = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        c = rng.normal(size=(3, 3, 2)) / np.arange(1, 4)[None, :, None]
+        x = sum(np.outer(np.cos((k + 1) * u), c[:, k, 0]) + np.outer(np.sin((k + 1) * u), c[:, k, 1])
+                for k in range(3))
+        return x + np.outer(np.cos(u), [3.0, 0, 0]) + np.outer(np.sin(u), [0, 3.0, 0])
+    d = rng.normal(size=3)
+    d /= np.linalg.norm(d)
+    pts = [rng.normal(size=3)]
+    for _ in range(n - 1):
+        d = d + rng.normal(size=3) * 0.1
+        d /= np.linalg.norm(d)
+        pts.append(pts[-1] + d * rng.uniform(0.1, 2.0))
+    return np.array(pts)
+
+
+def same_or_named_error(call_scaled, call_ref, back=1.0, atol=1e-9):
+    """The scaled call gives the reference (times ``back``) or both raise the same named
+    ValueError; never a NaN."""
+    try:
+        ref = call_ref()
+    except ValueError as e:
+        with pytest.raises(ValueError) as got:
+            call_scaled()
+        assert str(got.value).split(":")[0] == str(e).split(":")[0]
+        return
+    out = call_scaled()
+    assert np.isfinite(out).all()
+    np.testing.assert_allclose(np.asarray(out) / back, ref, rtol=1e-9, atol=atol)
+
+
+@SETTINGS
+@given(SEEDS, st.integers(2, 40), EXPONENTS,
+       st.sampled_from(["double_reflection", "rotation", "projection", "frenet"]),
+       st.booleans())
+def test_frames_are_scale_invariant(seed, n, k, method, with_tangents):
+    x = walk(seed, n)
+    s = 10.0**k
+    t = spinal.estimate_tangents(x) if with_tangents else None
+    same_or_named_error(lambda: spinal.frames(x * s, t, method=method),
+                        lambda: spinal.frames(x, t, method=method))
+    same_or_named_error(lambda: spinal.estimate_tangents(x * s),
+                        lambda: spinal.estimate_tangents(x))
+
+
+@SETTINGS
+@given(SEEDS, st.integers(6, 40), EXPONENTS, st.integers(-2, 2))
+def test_closed_frames_and_closing_angle_are_scale_invariant(seed, n, k, turns):
+    x = walk(seed, n, closed=True)
+    s = 10.0**k
+    same_or_named_error(lambda: spinal.frames(x * s, closed=True, turns=turns),
+                        lambda: spinal.frames(x, closed=True, turns=turns))
+    same_or_named_error(lambda: np.array(spinal.closing_angle(x * s)),
+                        lambda: np.array(spinal.closing_angle(x)))
+    same_or_named_error(lambda: Q.quaternion_frames(x * s, closed=True),
+                        lambda: Q.quaternion_frames(x, closed=True))
+
+
+@SETTINGS
+@given(SEEDS, st.integers(2, 30), st.integers(-300, 300), st.booleans())
+def test_sweeps_and_tubes_scale(seed, n, k, caps):
+    x = walk(seed, n)
+    s = 10.0**k
+    prof = 0.05 * np.array([[1, 0], [0, 1], [-1, 0.2], [0, -1.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # fold-over warnings: the same at every scale
+        same_or_named_error(lambda: spinal.sweep(x * s, prof * s, caps=caps).vertices,
+                            lambda: spinal.sweep(x, prof, caps=caps).vertices, back=s)
+        same_or_named_error(lambda: spinal.tube(x * s, 0.05 * s, 6, caps=caps).vertices,
+                            lambda: spinal.tube(x, 0.05, 6, caps=caps).vertices, back=s)
+        same_or_named_error(lambda: spinal.tube(x * s, 0.05 * s, 6, caps=caps).normals,
+                            lambda: spinal.tube(x, 0.05, 6, caps=caps).normals)
+
+
+@SETTINGS
+@given(SEEDS, st.integers(3, 30), EXPONENTS, st.sampled_from(["transport", "up"]))
+def test_camera_and_quaternion_frames_are_scale_invariant(seed, n, k, mode):
+    x = walk(seed, n)
+    s = 10.0**k
+    same_or_named_error(lambda: Q.camera_frames(x * s, mode=mode),
+                        lambda: Q.camera_frames(x, mode=mode))
+    same_or_named_error(lambda: Q.quaternion_frames(x * s), lambda: Q.quaternion_frames(x))
+
+
+@SETTINGS
+@given(SEEDS, EXPONENTS, st.sampled_from(["radial", "normal", "binormal", "none"]),
+       st.booleans())
+def test_flesh_scales(seed, k, solution, stretchable):
+    rng = np.random.default_rng(seed)
+    s = 10.0**k
+    m = 31
+    rest = np.c_[np.linspace(-1, 1, m), np.zeros(m), np.zeros(m)]
+    bend = rng.uniform(0.2, 1.2)
+    v = np.linspace(-1, 1, m) * bend
+    posed = np.c_[np.sin(v), 1 - np.cos(v), 0.1 * rng.normal() * v**2] / bend
+    verts = rng.uniform(-0.2, 0.2, size=(5, 3)) * [4, 1, 1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        same_or_named_error(
+            lambda: spinal.flesh(verts * s, rest * s, posed * s, solution=solution,
+                                 stretchable=stretchable),
+            lambda: spinal.flesh(verts, rest, posed, solution=solution, stretchable=stretchable),
+            back=s)
+
+
+UNIT_BOX = st.lists(st.floats(-1, 1, allow_subnormal=False), min_size=4, max_size=4)
+
+
+@SETTINGS
+@given(UNIT_BOX, UNIT_BOX, st.integers(-300, 300), st.integers(-300, 300))
+def test_quaternions_of_any_size(q, q2, k0, k1):
+    q, q2 = np.array(q), np.array(q2)
+    if np.linalg.norm(q) < 1e-3:
+        q = q + np.array([0, 0, 0, 1.0])
+    if np.linalg.norm(q2) < 1e-3:
+        q2 = q2 + np.array([1.0, 0, 0, 0])
+    ref = Q.from_quaternions(q)
+    assert np.abs(Q.from_quaternions(q * 10.0**k0) - ref).max() < 1e-13
+    length = Q.quaternion_length(np.stack([q, q2]))
+    got = Q.quaternion_length(np.stack([q * 10.0**k0, q2 * 10.0**k1]))
+    assert got == pytest.approx(length, abs=1e-12)
+    if abs(q @ q2) > 1e-6 * np.linalg.norm(q) * np.linalg.norm(q2):  # the short arc is defined
+        mid = Q.slerp(q * 10.0**k0, q2 * 10.0**k1, 0.3)
+        np.testing.assert_allclose(np.abs(mid @ Q.slerp(q, q2, 0.3)), 1.0, atol=1e-12)
+
+
+@SETTINGS
+@given(SEEDS, st.integers(-150, 150))
+def test_fields_scale(seed, k):
+    """A translation tool and its points scaled alike: the velocity scales with them (the
+    falloff is a function of the ratios), finite everywhere."""
+    rng = np.random.default_rng(seed)
+    s = 10.0**k
+    center, vel = rng.normal(size=3), rng.normal(size=3)
+    pts = center + rng.normal(size=(20, 3)) * 0.5
+    f, fs = fl.translation(center, 0.3, vel), fl.translation(center * s, 0.3 * s, vel * s)
+    ref = f(pts)
+    got = fs(pts * s)
+    assert np.isfinite(got).all()
+    np.testing.assert_allclose(got / s, ref, rtol=1e-9, atol=1e-12)

@@ -1,0 +1,197 @@
+"""The reproducers of the robustness review (numerics and arguments rows), each asserting the
+fixed behaviour: scale-invariant frames, quaternions of any size, named errors for every
+argument."""
+
+import warnings
+
+import numpy as np
+import pytest
+import trimesh
+
+import spinal
+from spinal import fields as fl
+from spinal import ph
+from spinal import quaternions as Q
+
+u = np.linspace(0, 4 * np.pi, 60)
+H = np.c_[np.cos(u), np.sin(u), 0.2 * u]
+K = spinal.curves.TorusKnot().sample(80)
+SQ = 0.1 * np.array([[1, 1], [-1, 1], [-1, -1], [1, -1.0]])
+REST = np.c_[np.linspace(-1, 1, 41), np.zeros(41), np.zeros(41)]
+_v = np.linspace(-1, 1, 41)
+POSED = np.c_[np.sin(_v), 1 - np.cos(_v), np.zeros(41)]
+
+
+def test_D01_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
+    t = spinal.estimate_tangents(H)
+    for method in ("double_reflection", "frenet", "rotation", "projection"):
+        f = spinal.frames(H * 1e-160, t, method=method)
+        assert not np.isnan(f).any(), method
+        np.testing.assert_allclose(f, spinal.frames(H, t, method=method), atol=1e-12)
+    tk = spinal.estimate_tangents(K, closed=True)
+    for s in (1e-153, 1e-160):
+        a = spinal.closing_angle(K * s, tk)
+        assert a == pytest.approx(spinal.closing_angle(K, tk), abs=1e-12)
+
+
+def test_D02_huge_and_tiny_curves_are_not_cusps():
+    ref = spinal.frames(H)
+    for s in (1e80, 1e-80, 1e-100, 1e150, 1e-150):
+        np.testing.assert_allclose(spinal.frames(H * s), ref, atol=1e-12)
+        np.testing.assert_allclose(spinal.estimate_tangents(H * s), spinal.estimate_tangents(H),
+                                   atol=1e-12)
+    t = spinal.estimate_tangents(H)
+    np.testing.assert_allclose(spinal.frames(H * 1e160, t), spinal.frames(H, t), atol=1e-12)
+    for s in (1e80, 1e-100):
+        v = spinal.tube(H * s, 0.1 * s).vertices / s
+        np.testing.assert_allclose(v, spinal.tube(H, 0.1).vertices, atol=1e-12)
+        np.testing.assert_allclose(Q.camera_frames(H * s), Q.camera_frames(H), atol=1e-12)
+        np.testing.assert_allclose(Q.quaternion_frames(H * s), Q.quaternion_frames(H), atol=1e-12)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            got = spinal.flesh(np.array([[0, 0.3, 0]]) * s, REST * s, POSED * s) / s
+            want = spinal.flesh([[0, 0.3, 0]], REST, POSED)
+        np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+def test_D03_default_reference_vector_is_scale_invariant():
+    assert np.abs(spinal.frames(H * 1e70) - spinal.frames(H)).max() < 1e-12
+    t = spinal.estimate_tangents(H)
+    for s in (1e100, 1e-100):
+        assert np.abs(spinal.frames(H * s, t) - spinal.frames(H, t)).max() < 1e-12
+    # a small helix far from the origin against the same (rounded) curve at the origin
+    x = 0.01 * H + 1e9
+    spin = Q.spin(spinal.frames(x), spinal.frames(x - 1e9))
+    assert np.abs(spin).max() < 1e-4  # the rounding of x at 1e9, not a half turn
+
+
+def test_D04_from_quaternions_normalises_any_size():
+    q = np.array([0.1, 0.2, 0.3, 0.9])
+    want = Q.from_quaternions(q)
+    assert not np.allclose(want, np.eye(3))
+    for s in (1e155, 1e300, 1e-150, 1e-300, 1e-320):
+        np.testing.assert_allclose(Q.from_quaternions(q / np.linalg.norm(q) * s), want,
+                                   atol=1e-14 if s > 1e-310 else 1e-3)
+    with pytest.raises(ValueError, match="quaternions: row 0 is zero"):
+        Q.from_quaternions([0.0, 0, 0, 0])
+
+
+def test_D05_quaternion_length_of_scaled_quaternions():
+    q = np.array([[0.1, 0.2, 0.3, 0.9], [0, 0, 0, 1.0]])
+    want = Q.quaternion_length(q)
+    assert want == pytest.approx(0.394, abs=1e-3)
+    for s in (1e300, 1e-300, 2.0):
+        assert Q.quaternion_length(q * s) == pytest.approx(want, rel=1e-14)
+
+
+def test_D06_spin_checks_its_frames():
+    f = spinal.frames(H)
+    with pytest.raises(ValueError, match="^a: non-finite value in frame 0"):
+        Q.spin(np.full((3, 3), np.nan), np.eye(3))
+    for bad in (np.full((3, 3), np.inf), np.zeros((3, 3)), 2 * np.eye(3), np.diag([1, 1, -1.0])):
+        with pytest.raises(ValueError, match="^b: "):
+            Q.spin(np.eye(3), bad)
+    with pytest.raises(ValueError, match="^b: has 4 frames but a has 3"):
+        Q.spin(f[:3], f[:4])
+    with pytest.raises(ValueError, match="^b: the tangent of frame 0"):
+        Q.spin(f[0], f[10])
+    # valid input: unchanged results
+    assert abs(Q.spin(f[0], f[0])) < 1e-15
+    assert Q.spin(f, f).shape == (60,)
+
+
+def test_D07_ph_from_quaternions_overflow_is_a_named_error():
+    with pytest.raises(ValueError, match="out of the representable range"):
+        ph.from_quaternions([0, 0, 0, 1e300], [0, 0, 1e300, 0])
+    # large but representable: the same curve scaled by |A|²
+    b = ph.from_quaternions([0.1, 0.2, 0.3, 0.9], [0.4, -0.2, 0.1, 0.8])
+    big = ph.from_quaternions(np.array([0.1, 0.2, 0.3, 0.9]) * 1e150,
+                              np.array([0.4, -0.2, 0.1, 0.8]) * 1e150)
+    assert np.isfinite(big).all()
+    np.testing.assert_allclose(big / 1e300, b, rtol=1e-12, atol=1e-300)
+
+
+def test_D09_huge_integers_name_the_argument():
+    b = trimesh.creation.box()
+    tool = fl.translation([0, 0, 1], 0.3, [1, 0, 0])
+    calls = {
+        "turns": lambda: spinal.frames(K, closed=True, turns=2**70),
+        "steps": lambda: spinal.advect(np.zeros((3, 3)), tool, 0.1, 2**64),
+        "frames": lambda: spinal.stamp(trimesh.creation.icosphere(1), [0, 0, 1.32],
+                                       [0, 0, 1.1], 0.3, frames=2**64),
+        "face": lambda: Q.walk_mesh(b.vertices, b.faces, 2**63, b.vertices[b.faces[0]].mean(0),
+                                    [[0.1, 0.1]]),
+    }
+    calls["turns "] = lambda: Q.quaternion_frames(K, closed=True, turns=2**70)
+    for name, call in calls.items():
+        with pytest.raises(ValueError, match=f"^{name.strip()}: .*out of the representable range"):
+            call()
+
+
+def test_D19_distinct_points_a_few_ulps_apart_far_from_the_origin():
+    f = spinal.frames(spinal.curves.Helix(), u=[1e15, 1e15 + 1, 1e15 + 2])
+    assert f.shape == (3, 3, 3) and np.isfinite(f).all()
+    x = np.c_[1e12 + np.arange(5) * 1e-3, np.zeros(5), np.zeros(5)]
+    f = spinal.frames(x)
+    np.testing.assert_allclose(f[:, :, 2], np.tile([1.0, 0, 0], (5, 1)), atol=1e-12)
+    # exact repeats are still refused
+    x[3] = x[2]
+    with pytest.raises(ValueError, match="points: rows 2 and 3 coincide"):
+        spinal.frames(x)
+
+
+def test_D20_huge_finite_vectors_do_not_overflow():
+    ref = spinal.frames(H, initial=[1, 1, 0])
+    np.testing.assert_allclose(spinal.frames(H, initial=[1e300, 1e300, 0]), ref, atol=1e-14)
+    t = spinal.estimate_tangents(H)
+    np.testing.assert_allclose(spinal.frames(H, t * 1e300), spinal.frames(H, t), atol=1e-14)
+    np.testing.assert_allclose(spinal.frames(H, t * 1e-300), spinal.frames(H, t), atol=1e-14)
+    np.testing.assert_allclose(Q.camera_frames(H, up=[0, 0, 1e300]), Q.camera_frames(H),
+                               atol=1e-14)
+    m = spinal.sweep(H * 1e300, SQ * 1e300, caps=False)
+    assert np.isfinite(m.vertices).all()
+    np.testing.assert_allclose(m.vertices / 1e300, spinal.sweep(H, SQ, caps=False).vertices,
+                               atol=1e-12)
+    with pytest.raises(ValueError, match="^posed_spine: .*out of the representable range"):
+        spinal.flesh([[0, 0.3, 0]], REST, POSED * 1e300)
+    with pytest.raises(ValueError, match="^radius: must be positive and finite"):
+        spinal.tube(H, np.inf)
+
+
+def test_D21_loose_arguments_are_refused():
+    with pytest.raises(ValueError, match="^singular_angle: must be >= 0"):
+        Q.camera_frames(H, mode="up", singular_angle=-1)
+    with pytest.raises(ValueError, match="^singular_angle: must be finite"):
+        Q.camera_frames(H, mode="up", singular_angle=np.nan)
+    with pytest.raises(TypeError, match="^singular_angle: "):
+        Q.camera_frames(H, mode="up", singular_angle="x")
+    tool = fl.translation([0, 0, 1], 0.3, [1, 0, 0])
+    with pytest.raises(ValueError, match="^max_passes: "):
+        spinal.deform(trimesh.creation.icosphere(1), tool, 0.1, max_passes=-1)
+    with pytest.raises(TypeError, match="^estimate: "):
+        spinal.deform(trimesh.creation.icosphere(1), tool, 0.1, estimate=1)
+    with pytest.raises(TypeError, match="^return_clamped: "):
+        spinal.flesh([[0, 0.3, 0]], REST, POSED, return_clamped="yes")
+    with pytest.raises(TypeError, match="^progress: "):
+        spinal.advect(np.zeros((3, 3)), tool, 0.1, progress="yes")
+    with pytest.raises(ValueError, match="^turns: must be positive"):
+        spinal.curves.Helix(turns=0)
+    with pytest.raises(ValueError, match="^turns: applies to a closed curve"):
+        spinal.frames(H, turns=3)
+    assert spinal.frames(H, turns=3, end=[1, 0, 0]).shape == (60, 3, 3)
+    length = Q.quaternion_length(np.array([[0, 0, 0, 1.0]]))
+    assert length == 0.0 and np.copysign(1.0, length) == 1.0
+
+
+def test_D25_messages_name_the_argument():
+    with pytest.raises(TypeError, match="^miter_limit: "):
+        spinal.sweep(H, SQ, miter_limit=[4, 4])
+    f = spinal.frames(H)
+    with pytest.raises(ValueError, match="^b: "):
+        Q.spin(f[:3], f[:4])
+    with pytest.raises(TypeError, match="^a: "):
+        spinal.curves.Helix(a="1")
+    with pytest.raises(ValueError, match="^control_points: non-finite value at row 1"):
+        spinal.curves.Bezier([[0, 0, 0], [np.nan, 0, 0]])
+    with pytest.raises(MemoryError, match="^u: "):
+        spinal.frames(spinal.curves.Helix(), u=2**40)
