@@ -1,9 +1,27 @@
-"""Write the six gallery notebooks (the source of truth for their cells); run from the repo
-root: ``python tools/make_notebooks.py``. The notebooks are written without outputs; the test
-suite executes them (nbmake). ``SPINAL_WRITE_IMAGES=1`` while executing them refreshes the
-README's pictures in docs/images/."""
+"""Write the gallery notebooks (this file is the source of truth for their cells) and execute
+them, storing their outputs, so that they show their pictures without being run (on the web
+view and in the API reference). Run from the repository root:
+
+    python tools/make_notebooks.py                  # write and execute every notebook
+    python tools/make_notebooks.py 01_frames 06     # only these (by name or number)
+    python tools/make_notebooks.py --no-execute     # cells only, no outputs
+
+Execution uses nbclient (``pip install -e '.[test]'``) with pyvista off-screen. The stored
+outputs are tidied: no stderr streams (progress lines, warnings), no timing metadata, and
+pictures re-encoded as small palette PNGs. ``tests/test_notebooks.py`` checks that the
+committed notebooks' cells equal the ones written here and that they hold outputs; the test
+suite also executes them (nbmake). ``SPINAL_WRITE_IMAGES=1`` while executing them refreshes
+the README's pictures in docs/images/.
+"""
 
 from __future__ import annotations
+
+import argparse
+import base64
+import io
+import os
+import pathlib
+import sys
 
 import nbformat as nbf
 
@@ -52,7 +70,7 @@ rmf = spinal.frames(x)
 def turning(F):  # angle between consecutive reference vectors (rad)
     return np.arccos(np.clip(np.einsum("ij,ij->i", F[1:, :, 0], F[:-1, :, 0]), -1, 1))
 
-fig, ax = plt.subplots(figsize=(6, 3))
+fig, ax = plt.subplots(figsize=(6, 3.2), layout="constrained")
 ax.plot(u[1:], turning(frenet), label="Frenet")
 ax.plot(u[1:], turning(rmf), label="RMF (double reflection)")
 ax.set_xlabel("u"); ax.set_ylabel("turn of r per step (rad)"); ax.legend()
@@ -73,11 +91,12 @@ for n in ns:
         F = (spinal.frames(helix, u=u, method=m) if m == "rk4"
              else spinal.frames(helix.point(u), helix.d1(u), method=m, initial=exact[0]))
         errors[m].append(np.linalg.norm(F[:, :, 0] - exact, axis=1).max())
-fig, ax = plt.subplots(figsize=(5, 4))
+fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
 for m, e in errors.items():
     order = np.log2(e[-2] / e[-1])
     ax.loglog(20 / ns, e, "o-", label=f"{m} (order {order:.2f})")
-ax.set_xlabel("step h"); ax.set_ylabel("max |r - r_exact|"); ax.legend()
+ax.xaxis.set_minor_formatter(plt.NullFormatter())   # decade labels only: no overlap
+ax.set_xlabel("step h"); ax.set_ylabel("max |r - r_exact|"); ax.legend(fontsize=8)
 assert abs(np.log2(errors["double_reflection"][-2] / errors["double_reflection"][-1]) - 4) < 0.05""",
     """md:## A ribbon along the RMF, rendered off-screen with PyVista""",
     """import os
@@ -233,10 +252,13 @@ cam = Q.camera_frames(knot, closed=True)
 tube = spinal.tube(knot, 0.15, 24, closed=True).to_pyvista()
 pl = pv.Plotter(window_size=(480, 360))
 pl.add_mesh(tube, color="#7aa6c2", smooth_shading=True)
-i = 120
-pl.camera.position = knot[i] + 0.05 * cam[i][:, 1]
-pl.camera.focal_point = knot[i] - cam[i][:, 2]
-pl.camera.up = cam[i][:, 1]
+i = 120                                  # the camera's pose at sample i: behind it and above
+right, up, back = cam[i].T
+pl.add_mesh(pv.Sphere(radius=0.2, center=knot[i]), color="crimson")  # where the viewer is
+pl.add_arrows(knot[i][None], -back[None], mag=0.8, color="crimson")   # and where it looks
+pl.camera.position = knot[i] + 4.0 * back + 2.5 * up
+pl.camera.focal_point = knot[i] - 1.0 * back
+pl.camera.up = up
 pl.show()""",
     """md:## Pythagorean-hodograph cubics: rational frames
 
@@ -254,8 +276,9 @@ print("angle between the PH spline's RMF and the helix's RMF at the joints: max 
       np.abs(Q.spin(F_true, F_ph)).max())
 mesh = spline.sweep(0.15 * np.array([[1, 0], [0, 1], [-1, 0], [0, -1.0]]))
 print(mesh, "watertight:", mesh.is_watertight)
-mesh.plot(screenshot=os.path.join(IMAGES, "ph_sweep.png") if IMAGES else None,
-          window_size=(480, 360))""",
+from PIL import Image                   # off-screen, Mesh.plot returns the picture as an array
+Image.fromarray(mesh.plot(screenshot=os.path.join(IMAGES, "ph_sweep.png") if IMAGES else None,
+                          window_size=(480, 360)))""",
     """md:## Walking on a torus
 
 The walker's frame is rotated across every edge by the dihedral angle, so its path is straight
@@ -498,7 +521,7 @@ if path is not None:
     rest, posed = arc(201, 11.0, 8.0)
     rest += [0.75, 0.8, 0]
     posed += [0.75, 0.8, 0]
-    print("cow.obj from", path)
+    print("cow.obj from", Path(*path.parts[-4:]))   # shared/data/meshes/cow.obj
 else:
     name, mesh = "bunny-like", bunny_like()
     # the spine runs along the back, the body below it: bent with the belly outside
@@ -594,6 +617,70 @@ def write(name: str, book, folder: str = "notebooks") -> str:
     return path
 
 
+def small_png(data: str, colors: int = 256) -> str:
+    """A base64 PNG re-encoded with an adaptive palette (a few times smaller for renders and
+    plots, no visible change), or the input when that is not smaller."""
+    from PIL import Image
+
+    image = Image.open(io.BytesIO(base64.b64decode(data)))
+    buf = io.BytesIO()
+    image.convert("RGB").quantize(colors, method=Image.Quantize.MEDIANCUT).save(
+        buf, format="PNG", optimize=True)
+    small = base64.b64encode(buf.getvalue()).decode("ascii")
+    return small if len(small) < len(data) else data
+
+
+def tidy(book) -> None:
+    """Outputs as stored: no stderr streams (progress lines, warnings), pictures as small
+    palette PNGs, no execution timing metadata."""
+    for cell in book.cells:
+        if cell.cell_type != "code":
+            continue
+        cell.metadata.pop("execution", None)
+        kept = []
+        for out in cell.outputs:
+            if out.output_type == "stream" and out.name == "stderr":
+                continue
+            data = out.get("data", {})
+            if "image/png" in data:
+                data["image/png"] = small_png(data["image/png"])
+            kept.append(out)
+        cell.outputs = kept
+
+
+def execute(path: str, timeout: int = 1800) -> None:
+    """Run the notebook at ``path`` in a fresh kernel (in its folder, pyvista off-screen) and
+    store its tidied outputs."""
+    import nbclient
+
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    os.environ["MPLBACKEND"] = "module://matplotlib_inline.backend_inline"  # figures inline
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                 or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    book = nbf.read(path, as_version=4)
+    client = nbclient.NotebookClient(book, timeout=timeout, kernel_name="python3",
+                                     record_timing=False,
+                                     resources={"metadata": {"path": str(pathlib.Path(path).parent)}})
+    client.execute()
+    tidy(book)
+    nbf.write(book, path)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("names", nargs="*", help="notebooks to write (name or number; default all)")
+    ap.add_argument("--no-execute", action="store_true", help="write cells without outputs")
+    a = ap.parse_args(argv)
+    chosen = [n for n in BOOKS if not a.names or any(n == k or n.split("_")[0] == k.zfill(2)
+                                                     for k in a.names)]
+    for name in chosen:
+        path = write(name, BOOKS[name])
+        if not a.no_execute:
+            execute(path)
+        print("wrote", path, "" if a.no_execute else "(executed)")
+    return 0
+
+
 if __name__ == "__main__":
-    for name, book in BOOKS.items():
-        print("wrote", write(name, book))
+    sys.exit(main())
