@@ -14,10 +14,10 @@ ROOT = pathlib.Path(__file__).parents[1]
 
 
 def generator():
-    spec = importlib.util.spec_from_file_location("make_notebooks",
-                                                  ROOT / "tools" / "make_notebooks.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    found = importlib.util.spec_from_file_location("make_notebooks",
+                                                   ROOT / "tools" / "make_notebooks.py")
+    module = importlib.util.module_from_spec(found)
+    found.loader.exec_module(module)
     return module
 
 

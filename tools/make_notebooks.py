@@ -388,7 +388,7 @@ boundary runs along the tool's surface. The refinement fills it with new vertice
 that surface (`torn_vertices`). The work is bounded by `max_vertices` (default 8× the input)
 and `max_passes`: when edges remain over the threshold (some edges across the slip cannot be
 shortened by bisection) the report says `converged=False` with their number, and a
-`spinal.RefinementWarning` is issued. The volume stays within 5e-4; the opened strip is the
+`spinal.RefinementWarning` is emitted. The volume stays within 5e-4; the opened strip is the
 band along the tool's surface in the picture.""",
     """import time, warnings
 drag = spinal.fields.translation(center=[0, 0, 0.9], radius=0.9, velocity=[0.5, 0, 0])
