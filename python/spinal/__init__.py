@@ -21,6 +21,10 @@ Quaternion frames and PH cubics
     :mod:`spinal.quaternions` (conversions, slerp, transport, cameras, mesh walkers);
     :mod:`spinal.ph` (Pythagorean-hodograph cubics, G¹ PH splines, rational frames).
 
+Threads
+    The parallel calls use :func:`get_num_threads` worker threads (:func:`set_num_threads`,
+    :func:`threads` for a block of code).
+
 ``python -m spinal demo`` runs a tour that writes its results to a folder.
 """
 
@@ -32,6 +36,7 @@ from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames
 from ._mesh import FoldOverWarning, Mesh
 from ._sweep import sweep, tube
+from ._threads import get_num_threads, set_num_threads, threads
 
 __all__ = [
     "DeformReport",
@@ -51,9 +56,12 @@ __all__ = [
     "flesh",
     "flesh_surface",
     "frames",
+    "get_num_threads",
     "ph",
     "quaternions",
+    "set_num_threads",
     "stamp",
     "sweep",
+    "threads",
     "tube",
 ]

@@ -1,6 +1,7 @@
 import os
 import pathlib
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from typing import Any, Literal, TypeAlias, overload
 
@@ -32,10 +33,13 @@ __all__ = [
     "flesh",
     "flesh_surface",
     "frames",
+    "get_num_threads",
     "ph",
     "quaternions",
+    "set_num_threads",
     "stamp",
     "sweep",
+    "threads",
     "tube",
 ]
 
@@ -371,3 +375,9 @@ def flesh_surface(
     strict: bool = False,
     return_clamped: bool = False,
 ) -> _F | tuple[_F, _I]: ...
+
+# ---- worker threads -----------------------------------------------------------------------
+
+def set_num_threads(n: int | None) -> None: ...
+def get_num_threads() -> int: ...
+def threads(n: int | None) -> AbstractContextManager[None]: ...

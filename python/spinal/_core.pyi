@@ -354,3 +354,17 @@ def stamp(
     frames: int,
     iterations: int,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+
+# ---- worker threads (spinal._threads) ---------------------------------------------------------
+
+def set_num_threads(n: int | None) -> None:
+    """Set the thread count of the parallel calls (``None``: the default); ``1 <= n <= 1024``."""
+
+def num_threads_setting() -> int | None:
+    """The thread count set, or ``None`` for the default."""
+
+def get_num_threads() -> int:
+    """The thread count the next parallel call will use."""
+
+def pool_threads() -> int:
+    """``rayon::current_num_threads()`` seen from inside a heavy call (for the tests)."""

@@ -22,6 +22,12 @@ class FoldOverWarning(UserWarning):
         super().__init__(message)
         self.indices = indices
 
+    def __reduce__(self):
+        # the default (cls, args, state) would call cls(message) without indices; pickling
+        # matters for process pools, which send exceptions (and recorded warnings) back
+        message = self.args[0] if self.args else ""
+        return type(self), (message, self.indices), self.__dict__
+
 
 def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
     """Signed volume ``Σ (a · (b × c)) / 6`` of the triangles ``F`` over vertices ``V``

@@ -8,9 +8,14 @@ use numpy::{
     Element, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray, PyReadonlyArray1,
     PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray, PyUntypedArrayMethods,
 };
-use pyo3::exceptions::PyValueError;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError};
+use std::time::Duration;
+
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
+use super::threads;
 use crate::error::InputError;
 use crate::frames::{Method, Orientation, TangentRule};
 use crate::{deform, flesh, ph};
@@ -22,54 +27,109 @@ impl From<InputError> for PyErr {
     }
 }
 
+/// A request to stop a heavy call, set by the calling thread when a signal handler raised
+/// (Ctrl-C) and polled by the work between its blocks (the worker threads never see
+/// signals: Python runs its handlers on the main thread only).
+#[derive(Default)]
+pub struct Stop(AtomicBool);
+
+impl Stop {
+    /// Whether the work should stop now.
+    pub fn requested(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// How often the calling thread checks for signals while a heavy call runs.
+pub const SIGNAL_INTERVAL: Duration = Duration::from_millis(20);
+
+/// Run heavy work with the GIL released inside the rayon pool of the current thread setting
+/// ([`super::threads`]); a `KeyboardInterrupt` (or another error of a signal handler) raised
+/// while it runs is returned once the work has finished, so no worker outlives the call.
+pub fn detach_in_pool<T: Send>(py: Python<'_>, op: impl FnOnce() -> T + Send) -> PyResult<T> {
+    detach_stoppable(py, &Stop::default(), op)
+}
+
+/// [`detach_in_pool`] for work that polls `stop` between its blocks: the calling thread
+/// checks for signals every [`SIGNAL_INTERVAL`] and, when a handler raises, sets `stop`,
+/// waits for the work to return and returns the handler's error (its result is dropped).
+pub fn detach_stoppable<T: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    op: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    let pool = threads::current_pool()?;
+    if pool.current_thread_index().is_some() {
+        // a call from inside the pool (a progress callback): blocking this worker to wait
+        // for another could deadlock a pool of one thread, so run here
+        return Ok(py.detach(op));
+    }
+    py.detach(|| {
+        let (tx, rx) = mpsc::channel();
+        pool.in_place_scope(|scope| {
+            scope.spawn(move |_| {
+                // the receiver outlives the scope, so this send cannot fail
+                let _ = tx.send(op());
+            });
+            loop {
+                match rx.recv_timeout(SIGNAL_INTERVAL) {
+                    Ok(v) => return Ok(v),
+                    Err(RecvTimeoutError::Timeout) => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            stop.0.store(true, Ordering::Relaxed);
+                            let _ = rx.recv();
+                            return Err(e);
+                        }
+                    }
+                    // the work panicked; the scope raises the panic again when it ends
+                    Err(RecvTimeoutError::Disconnected) => {
+                        return Err(PyRuntimeError::new_err("worker thread failed"));
+                    }
+                }
+            }
+        })
+    })
+}
+
 /// Calls back into Python between the steps of a long computation, for the core's
-/// `tick(done, total) -> bool`: checks for signals (Ctrl-C raises `KeyboardInterrupt` there)
-/// at least every [`Ticker::INTERVAL`] and calls `progress(done, total)` after every step
-/// when given. A Python error stops the computation (the tick returns `false`) and is kept
-/// for [`Ticker::finish`].
-pub struct Ticker {
+/// `tick(done, total) -> bool`: stops (returns `false`) when the calling thread asked to
+/// ([`Stop`], Ctrl-C) and calls `progress(done, total)` after every step when given. A
+/// Python error stops the computation and is kept for [`Ticker::finish`].
+pub struct Ticker<'a> {
     progress: Option<Py<PyAny>>,
     /// Report progress when `done` is a multiple of this (0 or 1: after every tick).
     every: usize,
-    last: std::time::Instant,
+    stop: &'a Stop,
     error: Option<PyErr>,
 }
 
-impl Ticker {
-    /// How often the signals are checked without a progress callback.
-    pub const INTERVAL: std::time::Duration = std::time::Duration::from_millis(50);
-
-    pub fn new(progress: Option<Py<PyAny>>) -> Ticker {
-        Ticker::every(progress, 0)
+impl<'a> Ticker<'a> {
+    pub fn new(progress: Option<Py<PyAny>>, stop: &'a Stop) -> Ticker<'a> {
+        Ticker::every(progress, 0, stop)
     }
 
     /// A ticker that reports progress only at multiples of `every` steps (and at the end).
-    pub fn every(progress: Option<Py<PyAny>>, every: usize) -> Ticker {
+    pub fn every(progress: Option<Py<PyAny>>, every: usize, stop: &'a Stop) -> Ticker<'a> {
         Ticker {
             progress,
             every,
-            last: std::time::Instant::now(),
+            stop,
             error: None,
         }
     }
 
     /// Continue (true) or stop (false) after `done` of `total` steps.
     pub fn tick(&mut self, done: usize, total: usize) -> bool {
-        let report =
-            self.progress.is_some() && (self.every <= 1 || done % self.every == 0 || done == total);
-        if !report && self.last.elapsed() < Self::INTERVAL {
+        if self.stop.requested() {
+            return false;
+        }
+        let Some(p) = &self.progress else {
+            return true;
+        };
+        if !(self.every <= 1 || done % self.every == 0 || done == total) {
             return true;
         }
-        self.last = std::time::Instant::now();
-        let progress = if report { &self.progress } else { &None };
-        let r = Python::attach(|py| -> PyResult<()> {
-            py.check_signals()?;
-            if let Some(p) = progress {
-                p.bind(py).call1((done, total))?;
-            }
-            Ok(())
-        });
-        match r {
+        match Python::attach(|py| p.bind(py).call1((done, total)).map(drop)) {
             Ok(()) => true,
             Err(e) => {
                 self.error = Some(e);

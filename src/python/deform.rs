@@ -5,7 +5,9 @@ use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::convert::{Ticker, empty, slice_mut, triangles, value_error, vec3_array, vec3s};
+use super::convert::{
+    Stop, Ticker, detach_stoppable, empty, slice_mut, triangles, value_error, vec3_array, vec3s,
+};
 use super::fields::PyField;
 use crate::deform::{self, advect::Method, refine};
 
@@ -31,12 +33,13 @@ pub fn advect<'py>(
     let x = vec3s("vertices", &points)?;
     deform::finite_rows("vertices", x)?;
     let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
-    let mut ticker = Ticker::every(progress, every);
+    let stop = Stop::default();
+    let mut ticker = Ticker::every(progress, every, &stop);
     {
         let mut w = out.readwrite();
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
-        py.detach(|| {
+        detach_stoppable(py, &stop, || {
             let run = deform::advect::Run {
                 t0,
                 h,
@@ -45,7 +48,7 @@ pub fn advect<'py>(
             deform::advect::advect_ticked(field, o, run, method, every, &mut |d, n| {
                 ticker.tick(d, n)
             })
-        });
+        })?;
     }
     ticker.finish()?;
     Ok(out)
@@ -93,11 +96,12 @@ pub fn deform_mesh<'py>(
         max_vertices,
         max_passes,
     });
-    let mut ticker = Ticker::new(progress);
-    let out = py.detach(|| {
+    let stop = Stop::default();
+    let mut ticker = Ticker::new(progress, &stop);
+    let out = detach_stoppable(py, &stop, || {
         let runs = refine::schedule(field, t0, duration, steps);
         refine::deform(field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
-    })?;
+    })??;
     ticker.finish()?;
     let d = out.ok_or_else(|| value_error("deform: stopped"))?;
     let faces: Vec<i64> = d.faces.iter().flatten().map(|&i| i as i64).collect();
@@ -143,8 +147,9 @@ pub fn stamp<'py>(
         .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
         .collect();
     let mut v = x.to_vec();
-    let mut ticker = Ticker::new(None);
-    let rep = py.detach(|| {
+    let stop = Stop::default();
+    let mut ticker = Ticker::new(None, &stop);
+    let rep = detach_stoppable(py, &stop, || {
         deform::stamp::stamp(
             &mut v,
             &f,
@@ -156,7 +161,7 @@ pub fn stamp<'py>(
             iterations,
             &mut |d, n| ticker.tick(d, n),
         )
-    })?;
+    })??;
     ticker.finish()?;
     if rep.len() < frames {
         return Err(value_error("stamp: stopped"));

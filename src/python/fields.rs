@@ -11,7 +11,7 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use super::convert::{choice, empty, slice_mut, slice_of, value_error, vec3s};
+use super::convert::{choice, detach_in_pool, empty, slice_mut, slice_of, value_error, vec3s};
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
     keyframe, path, rod, tube,
@@ -83,7 +83,7 @@ impl PyField {
             let mut w = out.readwrite();
             let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
             let field = &self.field;
-            py.detach(|| deform::advect::eval_into(field, x, t, o));
+            detach_in_pool(py, || deform::advect::eval_into(field, x, t, o))?;
         }
         Ok(out)
     }
@@ -421,7 +421,7 @@ pub fn field_strip_curve(
     blend: Blend,
 ) -> PyResult<PyField> {
     let x = vec3s("points", &points)?;
-    let tool = py.detach(|| tube::strip_curve(x, radius, speed, reach, blend.0))?;
+    let tool = detach_in_pool(py, || tube::strip_curve(x, radius, speed, reach, blend.0))??;
     Ok(PyField::new(Field::single(tool), "strip_curve"))
 }
 
@@ -595,7 +595,9 @@ pub fn field_rod(
     moving: bool,
 ) -> PyResult<PyField> {
     let x = vec3s("points", &points)?;
-    let rod = py.detach(|| rod::Rod::from_points(x, radius, reach, center.map(DVec3::from)))?;
+    let rod = detach_in_pool(py, || {
+        rod::Rod::from_points(x, radius, reach, center.map(DVec3::from))
+    })??;
     let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
     let tool = curl::CurlTool::new(std::sync::Arc::new(rod), mo, falloff_power, moving)?;
     Ok(PyField::new(Field::single(tool), "rod"))

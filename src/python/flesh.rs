@@ -7,7 +7,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, slice_mut, slice_of, vec3_array, vec3s};
+use super::convert::{detach_in_pool, empty, slice_mut, slice_of, vec3_array, vec3s};
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
@@ -34,7 +34,7 @@ pub fn flesh_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let rest = spine_of("rest_spine", &rest_points, &rest_frames)?;
     let v = vec3s("vertices", &vertices)?;
-    let b = py.detach(|| flesh::bind(&rest, v))?;
+    let b = detach_in_pool(py, || flesh::bind(&rest, v))??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
     Ok((PyArray1::from_vec(py, b.edge), coords))
@@ -65,7 +65,9 @@ pub fn flesh_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        py.detach(|| flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags))?;
+        detach_in_pool(py, || {
+            flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags)
+        })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
 }
@@ -79,7 +81,7 @@ pub fn flesh_resample<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let pts = vec3s("posed_spine", &posed_points)?;
     let ch = slice_of("chords", &chords)?;
-    let out = py.detach(|| flesh::spine::compass_walk(pts, ch))?;
+    let out = detach_in_pool(py, || flesh::spine::compass_walk(pts, ch))??;
     vec3_array(py, out)
 }
 
@@ -108,10 +110,10 @@ pub fn flesh_surface_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let pts = vec3s("rest_surface", &rest_points)?;
     let v = vec3s("vertices", &vertices)?;
-    let (cell, coords) = py.detach(|| {
+    let (cell, coords) = detach_in_pool(py, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
         surface::bind_surface(&rest, v)
-    })?;
+    })??;
     let n = cell.len();
     let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
     Ok((PyArray1::from_vec(py, cell), coords))
@@ -137,10 +139,10 @@ pub fn flesh_surface_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        py.detach(|| {
+        detach_in_pool(py, || {
             let posed = surface::Surface::new("posed_surface", pts, nu, nv)?;
             surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
-        })?;
+        })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
 }

@@ -8,7 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    empty, offsets_of, orientations, renamed, slice_mut, slice_of, vec3_array, vec3s,
+    detach_in_pool, empty, offsets_of, orientations, renamed, slice_mut, slice_of, vec3_array,
+    vec3s,
 };
 use crate::frames::{self, Analytic, Method, Request, TangentRule};
 
@@ -62,8 +63,10 @@ pub fn frames_sampled<'py>(
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| frames::compute_many(&template, &offsets, &initial, &end, buf))
-            .map_err(|e| renamed(e, "points", points_arg))?
+        detach_in_pool(py, || {
+            frames::compute_many(&template, &offsets, &initial, &end, buf)
+        })?
+        .map_err(|e| renamed(e, "points", points_arg))?
     };
     Ok((out, PyArray1::from_vec(py, angles)))
 }
@@ -112,7 +115,7 @@ pub fn frames_analytic<'py>(
     let angle = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        py.detach(|| frames::compute_into(&req, buf))?
+        detach_in_pool(py, || frames::compute_into(&req, buf))??
     };
     Ok((out, angle))
 }
@@ -126,6 +129,6 @@ pub fn estimate_tangents<'py>(
     rule: TangentRule,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let x = vec3s("points", &points)?;
-    let t = py.detach(|| frames::tangents::estimate_rows(x, closed, rule))?;
+    let t = detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??;
     vec3_array(py, t)
 }

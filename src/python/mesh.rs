@@ -3,7 +3,7 @@
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
 
-use super::convert::{triangles, vec3s};
+use super::convert::{detach_in_pool, triangles, vec3s};
 use crate::math::mesh;
 
 /// Signed volume of a closed triangle mesh, summed about the mean vertex.
@@ -15,7 +15,7 @@ pub fn mesh_volume(
 ) -> PyResult<f64> {
     let v = vec3s("vertices", &vertices)?;
     let f = triangles(&faces)?;
-    Ok(py.detach(|| mesh::signed_volume_checked(v, f))?)
+    Ok(detach_in_pool(py, || mesh::signed_volume_checked(v, f))??)
 }
 
 /// Volume and centroid of the solid bounded by a closed, outward-wound mesh (errors name
@@ -28,6 +28,6 @@ pub fn mesh_closed_centroid(
 ) -> PyResult<(f64, [f64; 3])> {
     let v = vec3s("mesh", &vertices)?;
     let f = triangles(&faces)?;
-    let (vol, c) = py.detach(|| mesh::closed_volume_centroid(v, f))?;
+    let (vol, c) = detach_in_pool(py, || mesh::closed_volume_centroid(v, f))??;
     Ok((vol, c.to_array()))
 }

@@ -1,9 +1,9 @@
 //! The Python binding layer (`spinal._core`), one thin file per concept: it converts NumPy
-//! arrays to slices ([`convert`]), releases the GIL around the heavy calls and maps
-//! [`InputError`](crate::InputError) to `ValueError`. It holds no algorithms; the Python
-//! package (`python/spinal`) normalises arguments (dtype, layout, shapes) before calling in
-//! here, so these functions expect C-contiguous arrays of the right dtype. The core modules
-//! never name pyo3 (checked by a test below).
+//! arrays to slices ([`convert`]), runs the heavy calls with the GIL released in the rayon
+//! pool of [`threads`] and maps [`InputError`](crate::InputError) to `ValueError`. It holds
+//! no algorithms; the Python package (`python/spinal`) normalises arguments (dtype, layout,
+//! shapes) before calling in here, so these functions expect C-contiguous arrays of the
+//! right dtype. The core modules never name pyo3 (checked by a test below).
 
 mod convert;
 mod deform;
@@ -14,6 +14,7 @@ mod mesh;
 mod ph;
 mod quaternion;
 mod sweep;
+mod threads;
 
 use pyo3::prelude::*;
 
@@ -68,6 +69,10 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(flesh::flesh_resample, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_surface_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_surface_deform, m)?)?;
+    m.add_function(wrap_pyfunction!(threads::set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(threads::num_threads_setting, m)?)?;
+    m.add_function(wrap_pyfunction!(threads::get_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(threads::pool_threads, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

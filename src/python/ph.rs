@@ -7,7 +7,9 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{cubics_of, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s};
+use super::convert::{
+    cubics_of, detach_in_pool, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s,
+};
 use super::frames::FramesAndAngles;
 use crate::ph::{self, frame::Mode};
 
@@ -32,7 +34,7 @@ pub fn ph_hermite<'py>(
 ) -> PyResult<HermiteArrays<'py>> {
     let (p0, t0) = (vec3s("p0", &p0)?, vec3s("t0", &t0)?);
     let (p1, t1) = (vec3s("p1", &p1)?, vec3s("t1", &t1)?);
-    let rows = py.detach(|| ph::hermite::hermite_rows(p0, t0, p1, t1, all, batch))?;
+    let rows = detach_in_pool(py, || ph::hermite::hermite_rows(p0, t0, p1, t1, all, batch))??;
     Ok((
         rows_of(py, rows.candidates, p0.len())?,
         PyArray1::from_vec(py, rows.counts),
@@ -51,7 +53,7 @@ pub fn ph_eval<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of(&control_points)?;
     let s = slice_of("s", &s)?;
-    let out = py.detach(|| ph::eval_at(&cubics, s, derivative))?;
+    let out = detach_in_pool(py, || ph::eval_at(&cubics, s, derivative))??;
     rows_of(py, bytemuck::allocation::cast_vec(out), s.len())
 }
 
@@ -169,7 +171,7 @@ pub fn ph_frame_setup<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of(&control_points)?;
     let start = start_of(initial, omega_start)?;
-    let segs = py.detach(|| ph::frame::setup(&cubics, start, phi))?;
+    let segs = detach_in_pool(py, || ph::frame::setup(&cubics, start, phi))??;
     let out: Vec<f64> = segs.iter().flat_map(|s| s.to_row()).collect();
     rows_of(py, out, segs.len())
 }
@@ -198,7 +200,9 @@ pub fn ph_frames<'py>(
         let frames: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let mut ra = angles.readwrite();
         let a = slice_mut(&mut ra)?;
-        py.detach(|| ph::frame::frames_at(&cubics, s, start, phi, mode, frames, a))?;
+        detach_in_pool(py, || {
+            ph::frame::frames_at(&cubics, s, start, phi, mode, frames, a)
+        })??;
     }
     Ok((out, angles))
 }

@@ -9,8 +9,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles, value_error, vec2s,
-    vec3_of, vec3s,
+    detach_in_pool, empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles,
+    value_error, vec2s, vec3_of, vec3s,
 };
 use crate::quaternion::{self, camera, walk};
 
@@ -22,7 +22,7 @@ pub fn quat_from_frames<'py>(
     continuous: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let fr = frames_of("frames", &frames)?;
-    let q = py.detach(|| quaternion::from_frames(fr, continuous))?;
+    let q = detach_in_pool(py, || quaternion::from_frames(fr, continuous))??;
     quat_array(py, q)
 }
 
@@ -37,7 +37,7 @@ pub fn quat_to_frames<'py>(
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
-        py.detach(|| quaternion::to_frames(qs, buf))?;
+        detach_in_pool(py, || quaternion::to_frames(qs, buf))??;
     }
     Ok(out)
 }
@@ -49,7 +49,7 @@ pub fn quat_continuous<'py>(
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let qs = quats("quaternions", &q)?;
-    let v = py.detach(|| quaternion::continuous(qs))?;
+    let v = detach_in_pool(py, || quaternion::continuous(qs))??;
     quat_array(py, v)
 }
 
@@ -68,7 +68,7 @@ pub fn quat_slerp<'py>(
         ));
     }
     let mut out = vec![DQuat::IDENTITY; a.len()];
-    py.detach(|| quaternion::slerp_many(a, b, us, &mut out))?;
+    detach_in_pool(py, || quaternion::slerp_many(a, b, us, &mut out))??;
     quat_array(py, out)
 }
 
@@ -86,7 +86,7 @@ pub fn quat_slerp_frames<'py>(
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
-        py.detach(|| quaternion::slerp_frames(fr, ku, nu, buf))?;
+        detach_in_pool(py, || quaternion::slerp_frames(fr, ku, nu, buf))??;
     }
     Ok(out)
 }
@@ -99,7 +99,7 @@ pub fn quat_path_length(
     closed: bool,
 ) -> PyResult<f64> {
     let qs = quats("quaternions", &q)?;
-    Ok(py.detach(|| quaternion::path_length(qs, closed))?)
+    Ok(detach_in_pool(py, || quaternion::path_length(qs, closed))??)
 }
 
 /// Parallel transport as a quaternion recurrence; returns (quaternions, closing angle).
@@ -124,7 +124,9 @@ pub fn quat_transport<'py>(
         .transpose()?;
     let rows = x.len() + usize::from(closed && closing_row);
     let mut out = vec![DQuat::IDENTITY; rows];
-    let angle = py.detach(|| quaternion::transport(x, t, r, closed, turns, &mut out))?;
+    let angle = detach_in_pool(py, || {
+        quaternion::transport(x, t, r, closed, turns, &mut out)
+    })??;
     Ok((quat_array(py, out)?, angle))
 }
 
@@ -163,7 +165,7 @@ pub fn camera_inputs<'py>(
     } else {
         camera::Mode::Transport
     };
-    let c = py.detach(|| camera::inputs(x, t, u, b, closed, mode))?;
+    let c = detach_in_pool(py, || camera::inputs(x, t, u, b, closed, mode))??;
     let n = c.tangents.len();
     let ts: Vec<f64> = c.tangents.iter().flat_map(|v| v.to_array()).collect();
     Ok((
@@ -221,10 +223,10 @@ pub fn walk_mesh<'py>(
         Some(_) => return Err(value_error("direction: expected 3 values")),
         None => None,
     };
-    let walk = py.detach(|| {
+    let walk = detach_in_pool(py, || {
         let w = walk::Walker::new(v, f)?;
         walk::walk_path(&w, face, p, d, mv)
-    })?;
+    })??;
     let (states, path) = (&walk.states, &walk.path);
     let k = states.len();
     let (pts, fcs, frs) = walker_states(states);
@@ -282,10 +284,10 @@ pub fn walk_mesh_many<'py>(
     let starts: Vec<walk::Start> = (0..fc.len())
         .map(|i| (fc[i], p[i], d.map(|d| d[i])))
         .collect();
-    let states = py.detach(|| {
+    let states = detach_in_pool(py, || {
         let w = walk::Walker::new(v, f)?;
         walk::walk_many(&w, &starts, mv, k)
-    })?;
+    })??;
     let nw = starts.len();
     let (pts, fcs, frs) = walker_states(&states);
     let stopped: Vec<bool> = states

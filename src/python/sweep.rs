@@ -5,7 +5,9 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s, vec3s};
+use super::convert::{
+    detach_in_pool, empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s, vec3s,
+};
 use crate::sweep::{self, Options, Profile, Spine};
 
 type MeshArrays<'py> = (
@@ -59,13 +61,12 @@ pub fn sweep_mesh<'py>(
         scale: sc,
         twist: tw,
     };
-    let (p, lay) = py
-        .detach(|| {
-            let p = Profile::new(prof, profile_closed)?;
-            let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
-            Ok::<_, crate::InputError>((p, lay))
-        })
-        .map_err(|e| renamed(e, "scale", scale_arg))?;
+    let (p, lay) = detach_in_pool(py, || {
+        let p = Profile::new(prof, profile_closed)?;
+        let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
+        Ok::<_, crate::InputError>((p, lay))
+    })?
+    .map_err(|e| renamed(e, "scale", scale_arg))?;
     let (nv, nf) = (lay.vertices, lay.faces);
     let v = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
     let n = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
@@ -80,7 +81,9 @@ pub fn sweep_mesh<'py>(
             normals: bytemuck::cast_slice_mut(slice_mut(&mut wn)?),
             uv: bytemuck::cast_slice_mut(slice_mut(&mut wu)?),
         };
-        py.detach(|| sweep::sweep_into(&spine, &offsets, &p, &opts, &lay, out))
+        detach_in_pool(py, || {
+            sweep::sweep_into(&spine, &offsets, &p, &opts, &lay, out)
+        })?
     };
     let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
     Ok((v, f, n, uv, PyArray1::from_vec(py, folds)))
