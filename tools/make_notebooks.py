@@ -602,8 +602,168 @@ pl.show()""",
 
 deform.cells += nb(curl_tools_section()).cells
 
+scale = nb([
+    """md:# Scale-out: many chunks on many processes with Dask
+
+spinal's calls use all cores of one machine. Beyond that, a large job splits into
+independent chunks that [Dask](https://docs.dask.org/) maps over worker processes, here a
+`distributed.LocalCluster` on this machine, on a cluster the same code with another cluster
+object (see `docs/scale-out.md`). Each task runs inside `spinal.threads(1)`, so a worker
+process uses one core and the workers do not oversubscribe the machine.
+
+Two jobs: a bundle of streamline tubes (100,000 in the full run; 8,000 here) and a
+deformation animation (1,000 frames in the full run; 60 here). Each chunk is computed from
+a few numbers (a seed, a slice), so only small messages travel, and each result is shown to
+equal the single call bit for bit. Install with `pip install 'spinal[dask]'`.""",
+    """import hashlib, time
+import numpy as np
+import dask, dask.bag as db
+from distributed import Client, LocalCluster
+import spinal
+
+# the full run: N_CURVES = 100_000, N_FRAMES = 1_000 (see docs/scale-out.md)
+N_CURVES, CHUNKS = 8_000, 4
+N_FRAMES = 60
+cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                       dashboard_address=None, silence_logs=50)
+client = Client(cluster)
+print(f"{len(client.scheduler_info()['workers'])} worker processes, 1 thread each")""",
+    """md:## A bundle of streamline tubes
+
+A synthetic bundle: helical streamlines of a vortex (radius 0.2–2, turning faster near the
+axis), 48 points each, made from a seed inside the task. `spinal.tube` turns a chunk of
+curves into one mesh (`lengths=`); the task returns a digest of the mesh, its size and
+volume and its own compute time. (At scale a task would write its mesh to storage.)""",
+    """def bundle(seed, n_curves, n_points=48):
+    \"\"\"n_curves helical streamlines from a seed: flat points and lengths.\"\"\"
+    rng = np.random.default_rng(seed)
+    r = rng.uniform(0.2, 2.0, (n_curves, 1))
+    phase = rng.uniform(0, 2 * np.pi, (n_curves, 1))
+    z0 = rng.uniform(-1, 1, (n_curves, 1))
+    s = np.linspace(0, 1, n_points)
+    angle = phase + 2.0 * s / np.sqrt(r)
+    points = np.stack([r * np.cos(angle), r * np.sin(angle), z0 + 0.8 * s + 0 * r], axis=-1)
+    return points.reshape(-1, 3), np.full(n_curves, n_points)
+
+def digest(*arrays):
+    h = hashlib.sha256()
+    for a in arrays:
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
+
+def tube_chunk(seeds, n_curves):
+    \"\"\"One task: the tubes of the curves made from `seeds`, on one thread.\"\"\"
+    with spinal.threads(1):
+        clock = time.perf_counter()
+        points, lengths = zip(*(bundle(s, n_curves) for s in seeds))
+        mesh = spinal.tube(np.concatenate(points), 0.004, sides=6, lengths=np.concatenate(lengths))
+        seconds = time.perf_counter() - clock
+    return {"curves": n_curves * len(seeds), "vertices": len(mesh.vertices),
+            "faces": len(mesh.faces), "volume": mesh.volume,
+            "digest": digest(mesh.vertices, mesh.faces), "seconds": seconds}
+
+per_seed = 500                                          # curves made from one seed
+seeds = np.arange(N_CURVES // per_seed)
+chunks = np.array_split(seeds, CHUNKS)
+clock = time.perf_counter()
+results = db.from_sequence([(c.tolist(), per_seed) for c in chunks], npartitions=CHUNKS) \\
+            .starmap(tube_chunk).compute()
+wall = time.perf_counter() - clock
+for k, r in enumerate(results):
+    print(f"chunk {k}: {r['curves']:,} curves, {r['vertices']:,} vertices, "
+          f"{r['curves'] / r['seconds']:,.0f} curves/s on one thread, digest {r['digest']}")
+print(f"{N_CURVES:,} curves in {wall:.1f} s wall on {len(client.scheduler_info()['workers'])} workers")""",
+    """md:### The same as one call
+
+The whole bundle in one call of `spinal.tube` (all threads of this process): every chunk's
+slice of the big mesh has the chunk's digest, so the chunks are exactly the single call.""",
+    """points, lengths = zip(*(bundle(s, per_seed) for s in seeds))
+clock = time.perf_counter()
+mesh = spinal.tube(np.concatenate(points), 0.004, sides=6, lengths=np.concatenate(lengths))
+single = time.perf_counter() - clock
+v0 = f0 = 0
+for r in results:
+    nv, nf = r["vertices"], r["faces"]
+    assert digest(mesh.vertices[v0:v0 + nv], mesh.faces[f0:f0 + nf] - v0) == r["digest"]
+    v0, f0 = v0 + nv, f0 + nf
+assert v0 == len(mesh.vertices) and f0 == len(mesh.faces)
+assert np.isclose(sum(r["volume"] for r in results), mesh.volume, rtol=1e-12)
+print(f"single call: {single:.2f} s with {spinal.get_num_threads()} threads; every chunk equal")""",
+    """md:## A deformation animation
+
+A tool pushes into a ring-shaped tube; the animation is `N_FRAMES` frames, each advancing the
+previous one by `dt` (4 RK4 steps). Advection moves every vertex on its own, so the
+vertices split into chunks: a task runs the whole animation on its slice (the field travels
+pickled) and returns a digest of its frames and the last frame. Concatenated, the chunks
+equal the single call on the whole mesh, frame by frame.""",
+    """t = 2 * np.pi * np.arange(256) / 256
+ring = spinal.tube(np.c_[np.cos(t), np.sin(t), 0 * t], 0.25, sides=64, closed=True)
+tool = spinal.fields.translation([1.6, 0, 0], 0.3, [-0.5, 0, 0])   # a dent 0.15 deep
+dt = 0.4 / N_FRAMES
+
+def animate(V, n_frames, chunks=None):
+    \"\"\"Frame by frame; a digest of every chunk's rows over all frames, and the last frame.\"\"\"
+    hashes = [hashlib.sha256() for _ in (chunks or [slice(None)])]
+    for k in range(n_frames):
+        V = spinal.advect(V, tool, dt, steps=4, t0=k * dt)
+        for h, part in zip(hashes, chunks or [slice(None)]):
+            h.update(V[part].tobytes())
+    return [h.hexdigest()[:16] for h in hashes], V
+
+@dask.delayed
+def animate_chunk(V):
+    with spinal.threads(1):
+        clock = time.perf_counter()
+        (h,), last = animate(V, N_FRAMES)
+        return h, last, time.perf_counter() - clock
+
+parts = np.array_split(np.arange(len(ring.vertices)), CHUNKS)
+clock = time.perf_counter()
+out = dask.compute(*[animate_chunk(ring.vertices[p]) for p in parts])
+wall = time.perf_counter() - clock
+for p, (h, last, seconds) in zip(parts, out):
+    print(f"{len(p):,} vertices x {N_FRAMES} frames: {len(p) * N_FRAMES * 4 / seconds / 1e6:.1f} "
+          f"M vertex-steps/s on one thread, digest {h}")
+print(f"{N_FRAMES} frames of {len(ring.vertices):,} vertices in {wall:.1f} s wall")""",
+    """clock = time.perf_counter()
+hashes, last = animate(ring.vertices, N_FRAMES, chunks=[slice(p[0], p[-1] + 1) for p in parts])
+single = time.perf_counter() - clock
+assert hashes == [h for h, _, _ in out]
+assert np.array_equal(last, np.concatenate([l for _, l, _ in out]))
+change = spinal.Mesh(last, ring.faces).volume / ring.volume - 1
+print(f"single call: {single:.1f} s with {spinal.get_num_threads()} threads; every frame equal; "
+      f"volume change after the last frame {change:+.1e}")""",
+    """pv_ok = True
+try:
+    import pyvista as pv
+    pv.OFF_SCREEN = True
+    pv.set_jupyter_backend("static")
+except ImportError:                      # pictures need spinal[viz]
+    pv_ok = False
+if pv_ok:
+    pl = pv.Plotter(window_size=(560, 360))
+    pl.add_mesh(spinal.Mesh(last, ring.faces).to_pyvista(), color="#d9a066", smooth_shading=True)
+    pl.add_mesh(pv.Sphere(radius=0.3, center=(1.6 - 0.4 * 0.5, 0, 0)), color="#4060a0", opacity=0.3)
+    pl.camera_position = [(3.0, -2.4, 2.2), (0.5, 0, 0), (0, 0, 1)]
+    pl.show()""",
+    """client.close()
+cluster.close()""",
+    """md:## Scaling up and out
+
+* Larger jobs: set `N_CURVES = 100_000` and `N_FRAMES = 1_000` (and more `CHUNKS`, a few per
+  worker). The measured full runs are in `docs/scale-out.md`.
+* More machines: replace the `LocalCluster` with a cluster object of
+  [dask-jobqueue](https://jobqueue.dask.org/) (`SLURMCluster`, `PBSCluster`, …) or
+  [dask-kubernetes](https://kubernetes.dask.org/) and call `cluster.scale(...)`; the task
+  functions and the `compute` calls stay the same. Every worker needs spinal installed (the
+  same environment or container image).
+* At scale, let a task write its mesh or frames to shared storage and return only a small
+  summary, as here.""",
+])
+
 BOOKS = {"01_frames": frames, "02_tubes": tubes, "03_knot_tube": knot,
-         "04_deformation": deform, "05_fleshing": flesh, "06_quaternion_frames": quat}
+         "04_deformation": deform, "05_fleshing": flesh, "06_quaternion_frames": quat,
+         "07_scale_out": scale}
 
 
 def write(name: str, book, folder: str = "notebooks") -> str:
