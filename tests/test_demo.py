@@ -2,7 +2,6 @@
 empty, the meshes load in trimesh with the volumes it prints (and the knot tube's with an
 independent one), and the volume errors it prints are small and behave as theory says."""
 
-import importlib.util
 import re
 import sys
 
@@ -29,6 +28,13 @@ def number(pattern, text):
     return float(m.group(1))
 
 
+try:  # the demo makes its pictures only with pyvista
+    import pyvista  # noqa: F401
+
+    HAS_PYVISTA = True
+except ImportError:
+    HAS_PYVISTA = False
+
 FLOAT = r"([-+]?\d+\.\d+(?:e[-+]\d+)?)"
 
 
@@ -40,7 +46,13 @@ def test_demo_writes_results(tmp_path, capsys):
     assert {"torus_knot_frames.npy", "torus_knot_ribbon.ply", "helix_convergence.csv",
             "torus_knot_tube.ply", "torus_knot_tube.obj", "dented_ring.ply",
             "bent_bar_none.ply", "bent_bar_radial.ply"} <= set(files)
-    assert "meshes written by trimesh" in out
+    # meshes keep float64 positions, normals and texture coordinates (spinal's writer)
+    assert "meshes written by spinal's built-in writer (PLY float64" in out
+    for name, props in (("torus_knot_tube.ply", ("x", "nx", "s", "t")),
+                        ("bent_bar_radial.ply", ("x", "s", "t"))):
+        header = (tmp_path / name).read_bytes().split(b"end_header")[0].decode()
+        for prop in props:
+            assert f"property double {prop}\n" in header, (name, header)
 
     F = np.load(tmp_path / "torus_knot_frames.npy")
     assert F.shape == (2049, 3, 3) and np.array_equal(F[0], F[-1])
@@ -90,7 +102,7 @@ def test_demo_writes_results(tmp_path, capsys):
         assert m.volume == pytest.approx(bar * (1 + change), rel=1e-6)
 
     # The picture, when pyvista can render.
-    if importlib.util.find_spec("pyvista") is not None:
+    if HAS_PYVISTA:
         assert "torus_knot_tube.png" in files, out
         png = tmp_path / "torus_knot_tube.png"
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -98,6 +110,11 @@ def test_demo_writes_results(tmp_path, capsys):
 
         image = np.asarray(Image.open(png).convert("RGB"))
         assert image.shape == (480, 640, 3) and len(np.unique(image.reshape(-1, 3), axis=0)) > 10
+        # one labelled picture per part
+        for name, shape in (("frames_ribbon.png", (480, 640)), ("dented_ring.png", (480, 640)),
+                            ("bent_bar.png", (420, 960))):
+            image = np.asarray(Image.open(tmp_path / name).convert("RGB"))
+            assert image.shape[:2] == shape and len(np.unique(image.reshape(-1, 3), axis=0)) > 10
 
 
 def test_demo_without_trimesh_uses_the_builtin_writer(tmp_path, capsys, monkeypatch):
@@ -107,6 +124,8 @@ def test_demo_without_trimesh_uses_the_builtin_writer(tmp_path, capsys, monkeypa
     monkeypatch.undo()
     assert "meshes written by spinal's built-in writer" in out
     assert "picture: skipped" in out and "torus_knot_tube.png" not in files
+    assert "pip install 'spinal[viz]'" in out
+    assert not any(name.endswith(".png") for name in files)
     for name in files:
         assert (tmp_path / name).stat().st_size > 0, name
     vol = number(r"closed knot tube: .* volume " + FLOAT, out)
@@ -114,3 +133,32 @@ def test_demo_without_trimesh_uses_the_builtin_writer(tmp_path, capsys, monkeypa
         tube = trimesh.load(tmp_path / f"torus_knot_tube.{ext}", process=False)
         assert tube.is_watertight and tube.volume == pytest.approx(vol, rel=1e-6)
     assert "\nvt " in (tmp_path / "torus_knot_tube.obj").read_text()  # uv kept
+
+
+def test_cli_help_and_version(capsys):
+    import spinal
+
+    assert main([]) == 0
+    text = capsys.readouterr().out
+    assert "usage: python -m spinal" in text and "demo" in text
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0
+    assert capsys.readouterr().out.strip() == f"spinal {spinal.__version__}"
+
+
+def test_demo_prints_no_warning(tmp_path):
+    """The demo renders off-screen without a word on stderr (no VTK/pyvista warnings)."""
+    import os
+    import subprocess
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY",
+                                                            "PYVISTA_OFF_SCREEN",
+                                                            "VTK_DEFAULT_OPENGL_WINDOW")}
+    run = subprocess.run([sys.executable, "-m", "spinal", "demo", "--out", str(tmp_path)],
+                         check=False, capture_output=True, text=True, env=env,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == ""
+    if HAS_PYVISTA:
+        assert "bent_bar.png" in run.stdout

@@ -105,14 +105,14 @@ def test_helix_closed_form_rmf():
     c = np.hypot(a, b)
     helix = Helix(a, b)
     expected = {64: 1.0861e-5, 256: 4.2388e-8, 1024: 1.6557e-10}
-    for n, e_spec in expected.items():
+    for n, e_paper in expected.items():
         u = np.linspace(0, S / c, n + 1)
         exact = helix.rmf(u)
         F = spinal.frames(helix.point(u), helix.d1(u), initial=exact[0][:, 0])
         err = np.linalg.norm(F[:, :, 0] - exact[:, :, 0], axis=1).max()
         kappa, tau, h = a / c**2, b / c**2, S / n
         predicted = S * kappa**2 * tau**3 * h**4 / 720
-        assert abs(err - e_spec) / e_spec < 0.01, (n, err)
+        assert abs(err - e_paper) / e_paper < 0.01, (n, err)
         assert abs(err / predicted - 1) < 0.02, (n, err, predicted)
         # RK4 on the analytic helix converges to the same closed form
         G = spinal.frames(helix, u=u, method="rk4")

@@ -1,11 +1,31 @@
 """spinal: moving frames, sweeps and volume-preserving deformations along 3D curves.
 
-Frames are ``(n, 3, 3)`` rotation matrices whose columns are ``(r, s, t)``: the reference
-vector, ``s = t × r`` and the unit tangent. See :func:`frames`. Sweeps and tubes turn
-curves into watertight triangle meshes: :func:`sweep`, :func:`tube`, :class:`Mesh`.
-:mod:`spinal.quaternions` holds frames as quaternion curves, cameras and a mesh walker.
-The parallel calls use :func:`get_num_threads` worker threads (:func:`set_num_threads`,
-:func:`threads`).
+NumPy arrays in, NumPy arrays out (float64; inputs never modified); the work is done by a
+Rust core on all cores. Bad input raises ``ValueError``/``TypeError`` naming the argument.
+
+Frames
+    :func:`frames` (rotation-minimising by double reflection, rotation, projection, Frenet,
+    RK4; closed curves, end conditions, bundles), :func:`closing_angle`,
+    :func:`estimate_tangents`; analytic curves in :mod:`spinal.curves`.
+Sweeps
+    :func:`tube`, :func:`sweep` return a watertight :class:`Mesh` with normals and texture
+    coordinates (``.save``, ``.to_trimesh``, ``.to_pyvista``, ``.plot``).
+Deformation
+    Divergence-free velocity fields in :mod:`spinal.fields`; :func:`advect` (RK4, splitting),
+    :func:`deform` (advection with refinement and a volume report, :class:`DeformReport`),
+    :func:`stamp` (contact stamper, :class:`StampReport`).
+Fleshing
+    :func:`flesh`, :class:`SpineBinding` (bending along a spine with local volume
+    correction), :func:`flesh_surface`, :class:`SurfaceBinding` (spine surfaces).
+Quaternion frames and PH cubics
+    :mod:`spinal.quaternions` (conversions, slerp, transport, cameras, mesh walkers);
+    :mod:`spinal.ph` (Pythagorean-hodograph cubics, G¹ PH splines, rational frames).
+
+Threads
+    The parallel calls use :func:`get_num_threads` worker threads (:func:`set_num_threads`,
+    :func:`threads` for a block of code).
+
+``python -m spinal demo`` runs a tour that writes its results to a folder.
 """
 
 from . import curves, fields, ph, quaternions

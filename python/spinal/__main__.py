@@ -1,14 +1,16 @@
-"""``python -m spinal demo [--out DIR]``: a small end-to-end run on built-in curves.
+"""Command line: ``python -m spinal`` (help), ``python -m spinal --version`` and
+``python -m spinal demo [--out DIR]``, a small end-to-end run on built-in curves.
 
-Computes rotation-minimising frames on the torus knot of Wang et al. (2008) and on a helix,
-measures their accuracy against an independent closed form (the helix RMF) and the published
-closing angle; sweeps a closed tube around the knot and tubes around a circle, measuring
-their volumes against Pappus' theorem; pushes a dent into a tube with a divergence-free
-field and reports the volume change; bends a bar that sits off its spine with and without
-Zhuo's volume correction and compares the uncorrected change with its closed form. Writes
-the frames, a convergence table, the meshes (PLY and OBJ, through trimesh when it is
-installed, else spinal's own writer) and, when pyvista is installed, a picture to DIR, and
-prints every path and volume error. Needs only NumPy; takes a few seconds.
+The demo computes rotation-minimising frames on the torus knot of Wang et al. (2008) and on a
+helix, measures their accuracy against an independent closed form (the helix RMF) and the
+published closing angle; sweeps a closed tube around the knot and tubes around a circle,
+measuring their volumes against Pappus' theorem; pushes a dent into a tube with a
+divergence-free field and reports the volume change; bends a bar that sits off its spine with
+and without Zhuo's volume correction and compares the uncorrected change with its closed form.
+It writes the frames, a convergence table and the meshes (PLY with float64 positions, normals
+and texture coordinates, and OBJ with 17 digits, by :meth:`spinal.Mesh.save`) to DIR and, when
+pyvista is installed (``pip install 'spinal[viz]'``), one labelled picture per part; it prints
+every path and volume error. Needs only NumPy; takes a few seconds.
 """
 
 from __future__ import annotations
@@ -24,28 +26,15 @@ from spinal.curves import Helix, TorusKnot
 
 
 def save_mesh(mesh: spinal.Mesh, path: pathlib.Path) -> pathlib.Path:
-    """Write ``mesh`` as PLY or OBJ (by the suffix): with trimesh when it is installed
-    (positions, faces and normals; binary PLY with float32 coordinates, OBJ with 12
-    decimals), otherwise with :meth:`spinal.Mesh.save` (float64 PLY, 17-digit OBJ, and the
-    texture coordinates)."""
-    try:
-        import trimesh
-    except ImportError:
-        return mesh.save(path)
-    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, vertex_normals=mesh.normals, process=False)
-    if path.suffix == ".obj":
-        tm.export(path, digits=12)
-    else:
-        tm.export(path)
-    return path
+    """Write ``mesh`` as PLY or OBJ (by the suffix) with :meth:`spinal.Mesh.save`: float64
+    positions, the normals and the texture coordinates are kept (trimesh's PLY writer would
+    store float32 and drop the texture coordinates)."""
+    return mesh.save(path)
 
 
 def mesh_writer() -> str:
-    try:
-        import trimesh
-    except ImportError:
-        return "spinal's built-in writer (trimesh not installed; PLY float64, OBJ 17 digits)"
-    return f"trimesh {trimesh.__version__} (PLY float32, OBJ 12 decimals)"
+    return ("spinal's built-in writer (PLY float64 with normals and uv, OBJ 17 digits with "
+            "vn and vt)")
 
 
 def ribbon(x: np.ndarray, F: np.ndarray, width: float) -> spinal.Mesh:
@@ -111,6 +100,7 @@ def demo(out: pathlib.Path) -> int:
     ring = spinal.tube(np.c_[R * np.cos(t), R * np.sin(t), 0 * t], r, sides, closed=True)
     tool = spinal.fields.translation([R + r + 0.25, 0, 0], 0.2, [-0.5, 0, 0])
     dented, report = spinal.deform(ring, tool, 0.4, estimate=True)
+    tool_end = np.array([R + r + 0.25 - 0.5 * 0.4, 0, 0])  # the tool's centre at the end
     written.append(save_mesh(dented, out / "dented_ring.ply"))
 
     # Fleshing: a bar beside its spine (cross-section [0.15, 0.35] × [-0.1, 0.1], centroid
@@ -126,27 +116,24 @@ def demo(out: pathlib.Path) -> int:
     arc = np.linspace(-1.5, 1.5, 301)  # arc length along the spine
     rest_spine = np.c_[arc, 0 * arc, 0 * arc]
     posed_spine = np.c_[Rb * np.sin(arc / Rb), Rb * (1 - np.cos(arc / Rb)), 0 * arc]
-    bar_change = {}
+    bar_change, bent_bars = {}, {}
     for solution in ("none", "radial"):
         V = spinal.flesh(bar.vertices, rest_spine, posed_spine, solution=solution)
-        bent = spinal.Mesh(V, bar.faces)
+        bent = spinal.Mesh(V, bar.faces, uv=bar.uv)  # texture coordinates ride along
+        bent_bars[solution] = bent
         bar_change[solution] = bent.volume / bar.volume - 1
         written.append(save_mesh(bent, out / f"bent_bar_{solution}.ply"))
 
-    picture = None
     try:
-        import os
-
-        os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
-        if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
-                                                     or os.environ.get("WAYLAND_DISPLAY")):
-            # headless: render through EGL rather than trying (and warning about) X first
-            os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-        tube.plot(screenshot=out / "torus_knot_tube.png", window_size=(640, 480))
-        picture = out / "torus_knot_tube.png"
-        written.append(picture)
-    except Exception as e:  # noqa: BLE001 - pyvista missing or no OpenGL: skip the picture
-        picture = f"skipped ({type(e).__name__}: {e})"
+        pictures = render_pictures(out, x, F, alpha, tube, ring, dented, report, tool_end,
+                                   bar, bent_bars, bar_change, posed_spine)
+        written += pictures
+        picture = None
+    except ImportError as e:  # pyvista missing: the demo runs without pictures
+        picture = (f"skipped ({e}; pip install 'spinal[viz]' for the pictures: frames ribbon, "
+                   "knot tube, dent, bent bar)")
+    except Exception as e:  # noqa: BLE001 - no OpenGL: say so and go on
+        picture = f"skipped (could not render off-screen: {type(e).__name__}: {e})"
 
     print(f"spinal {spinal.__version__} demo")
     print(f"  torus knot, 2048 segments, closed: RMF closing angle {alpha:+.9f} rad "
@@ -174,7 +161,7 @@ def demo(out: pathlib.Path) -> int:
           f"{bar_change['none'] + ybar / Rb:+.1e}")
     print(f"    corrected (solution='radial') {bar_change['radial']:+.1e}")
     print(f"  meshes written by {mesh_writer()}")
-    if isinstance(picture, str):
+    if picture is not None:
         print(f"  picture: {picture}")
     print("wrote:")
     for p in written:
@@ -182,15 +169,105 @@ def demo(out: pathlib.Path) -> int:
     return 0
 
 
+def _pyvista():
+    """pyvista set up to render off-screen without a window and without warnings: on a Linux
+    machine with no display VTK renders through EGL instead of trying X first."""
+    import os
+
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                 or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    return pv
+
+
+def render_pictures(out, x, F, alpha, tube, ring, dented, report, tool_end, bar, bent_bars,
+                    bar_change, posed_spine) -> list[pathlib.Path]:
+    """One labelled PNG per part of the demo (needs pyvista): the frames as a ribbon, the
+    closed knot tube, the dent with its volume report and the bar bent without and with the
+    volume correction, side by side."""
+    pv = _pyvista()
+    written = []
+
+    def finish(pl, name):
+        path = out / name
+        pl.screenshot(str(path))
+        pl.close()
+        written.append(path)
+
+    # 1. frames: a ribbon x ± w·r along the closed RMF, coloured by arc length
+    w = 0.05
+    pts = np.empty((2 * len(x), 3))
+    pts[0::2], pts[1::2] = x - w * F[:, :, 0], x + w * F[:, :, 0]
+    a = 2 * np.arange(len(x) - 1)
+    faces = np.concatenate([np.c_[a, a + 1, a + 3], np.c_[a, a + 3, a + 2]])
+    poly = spinal.Mesh(pts, faces).to_pyvista()
+    poly["arc length"] = np.repeat(np.r_[0, np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))], 2)
+    pl = pv.Plotter(off_screen=True, window_size=(640, 480))
+    pl.add_mesh(poly, scalars="arc length", cmap="viridis", show_scalar_bar=False,
+                smooth_shading=True)
+    pl.add_text(f"Rotation-minimising frames on a torus knot ({len(x) - 1} segments)\n"
+                f"ribbon along r; closing angle {alpha:+.6f} rad spread over the loop",
+                position="upper_left", font_size=10)
+    pl.view_isometric()
+    finish(pl, "frames_ribbon.png")
+
+    # 2. the closed knot tube
+    pl = pv.Plotter(off_screen=True, window_size=(640, 480))
+    pl.add_mesh(tube.to_pyvista(), color="#c9a227", smooth_shading=True)
+    pl.add_text(f"Closed torus-knot tube: {len(tube.vertices):,} vertices,\n"
+                f"watertight {tube.is_watertight}, volume {tube.volume:.6f}",
+                position="upper_left", font_size=10)
+    pl.view_isometric()
+    finish(pl, "torus_knot_tube.png")
+
+    # 3. the dent, with the tool where it stopped and the volume report
+    pl = pv.Plotter(off_screen=True, window_size=(640, 480))
+    pl.add_mesh(dented.to_pyvista(), color="#d9a066", smooth_shading=True)
+    pl.add_mesh(pv.Sphere(radius=0.2, center=tool_end), color="#4060a0", opacity=0.35)
+    pl.add_text(f"A divergence-free tool pushes a dent into a tube\n"
+                f"volume change {report.relative_change:+.1e} (integration "
+                f"{report.integration_error:+.0e}, mesh {report.mesh_error:+.0e})\n"
+                f"{report.steps} RK4 steps, +{report.vertices_added} vertices by refinement",
+                position="upper_left", font_size=10)
+    pl.camera_position = [(3.2, -2.2, 1.9), (0.6, 0.0, 0.0), (0, 0, 1)]
+    finish(pl, "dented_ring.png")
+
+    # 4. the bar bent with its spine: uncorrected and radial correction, side by side
+    pl = pv.Plotter(off_screen=True, shape=(1, 2), window_size=(960, 420))
+    near = np.abs(posed_spine[:, 0]) < 0.75
+    for k, (solution, label) in enumerate((("none", "no correction (solution='none')"),
+                                           ("radial", "volume correction ('radial')"))):
+        pl.subplot(0, k)
+        pl.add_mesh(bar.to_pyvista(), color="grey", opacity=0.25)
+        pl.add_mesh(bent_bars[solution].to_pyvista(), color="#c8a27a", smooth_shading=True)
+        pl.add_mesh(pv.lines_from_points(posed_spine[near]), color="#3060a0", line_width=3)
+        pl.add_text(f"{label}\nvolume change {bar_change[solution]:+.4%}",
+                    position="upper_left", font_size=10)
+        pl.camera_position = "xy"
+    pl.link_views()
+    finish(pl, "bent_bar.png")
+    return written
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m spinal")
-    sub = ap.add_subparsers(dest="command", required=True)
+    ap = argparse.ArgumentParser(
+        prog="python -m spinal",
+        description="spinal: moving frames, sweeps and volume-preserving deformations along "
+                    "3D curves. Run `python -m spinal demo` for a tour that writes its results "
+                    "(and, with spinal[viz], pictures) to a folder.")
+    ap.add_argument("--version", action="version", version=f"spinal {spinal.__version__}")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND")
     d = sub.add_parser("demo", help="run the built-in example and write results to a folder")
     d.add_argument("--out", default="spinal-demo", help="output folder (default: spinal-demo)")
     a = ap.parse_args(argv)
     if a.command == "demo":
         return demo(pathlib.Path(a.out))
-    return 2
+    ap.print_help()
+    return 0
 
 
 if __name__ == "__main__":

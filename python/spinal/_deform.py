@@ -9,7 +9,7 @@ by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow 
 apart (the tangential slip at the surface of a curl tool) the new vertex goes to the slip
 surface, the tool's surface, next to the edge's chord midpoint. The work is bounded by
 ``max_vertices`` and ``max_passes``; when edges remain too long at the end the report says so
-and a :class:`RefinementWarning` is issued.
+and a :class:`RefinementWarning` is emitted.
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ class DeformReport:
     converged : bool
         False when edges remain over the threshold at the end: ``max_vertices`` or
         ``max_passes`` stopped the refinement, or edges across a slip that bisection cannot
-        shorten remain (a :class:`RefinementWarning` was issued).
+        shorten remain (a :class:`RefinementWarning` was emitted).
     edges_over_threshold : int
         Edges longer than the threshold at the end (0 when converged).
     max_vertices : int or None
@@ -144,7 +144,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     The work is bounded: at most ``max_vertices`` vertices and ``max_passes`` passes after
     each step. When edges remain too long at the end (a bound stopped the refinement, or an
     edge across a slip cannot be shortened by bisection), the report has ``converged=False``
-    and the count of those edges, and a :class:`spinal.RefinementWarning` is issued.
+    and the count of those edges, and a :class:`spinal.RefinementWarning` is emitted.
 
     Parameters
     ----------

@@ -73,6 +73,8 @@ def mesh_arrays(mesh):
     if F.ndim != 2 or F.shape[1] != 3 or F.dtype.kind not in "iu":
         raise ValueError(f"mesh: faces must be an (m, 3) integer array, got {F.shape} {F.dtype}")
     F = np.ascontiguousarray(F, dtype=np.int64)
+    if not F.flags.aligned:  # e.g. from a pickle protocol 5 buffer
+        F = F.copy()
     if len(F) and (F.min() < 0 or F.max() >= len(V)):
         raise ValueError("mesh: face indices out of range")
     return V, F

@@ -28,7 +28,10 @@ def as_float_array(x: Any, name: str) -> np.ndarray:
     except (ValueError, TypeError) as exc:  # ragged nested lists
         raise ValueError(f"{name}: cannot be read as an array ({exc})") from None
     if arr.dtype.kind in "iuf":
-        return arr.astype(np.float64, copy=False)
+        arr = arr.astype(np.float64, copy=False)
+        # an unaligned buffer (pickle protocol 5 out-of-band data, as Dask and multiprocessing
+        # deliver arrays) is copied: the core reads aligned float64 only
+        return arr if arr.flags.aligned else arr.copy()
     if arr.dtype.kind == "O":
         try:
             return arr.astype(np.float64)

@@ -56,12 +56,12 @@ pub struct PathTool {
     /// Per segment: body axis-angle `Θ_k` and `F_k Θ_k / ΔS_k` (world ω per unit speed).
     theta: Vec<DVec3>,
     omega: Vec<DVec3>,
-    pub spec: PathToolSpec,
+    pub params: PathToolParams,
 }
 
 /// The parameters of a [`PathTool`] besides its spine samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PathToolSpec {
+pub struct PathToolParams {
     /// Start time of the motion.
     pub t0: f64,
     /// Duration `T` of the motion (> 0).
@@ -97,8 +97,8 @@ pub struct Pose {
 impl PathTool {
     /// Build from samples (positions and orthonormal right-handed frames, strictly increasing
     /// arc length `s`, at least 2) and the parameters.
-    pub fn new(samples: Vec<Sample>, spec: PathToolSpec) -> Result<PathTool> {
-        let duration = spec.duration;
+    pub fn new(samples: Vec<Sample>, params: PathToolParams) -> Result<PathTool> {
+        let duration = params.duration;
         let bad = |m: String| InputError::new("field", m);
         if samples.len() < 2 {
             return Err(bad("a path needs at least 2 samples".into()));
@@ -137,7 +137,7 @@ impl PathTool {
             samples,
             theta,
             omega,
-            spec,
+            params,
         })
     }
 
@@ -163,15 +163,15 @@ impl PathTool {
     /// ends at a sample time (or at `t0`, `t0 + T`) all see the same smooth piece (the pose
     /// polynomials are evaluated at `t`, slightly outside the segment if `t` is its end).
     pub fn pose_in(&self, t: f64, tm: f64) -> Option<Pose> {
-        let taum = (tm - self.spec.t0) / self.spec.duration;
+        let taum = (tm - self.params.t0) / self.params.duration;
         if !(0.0..=1.0).contains(&taum) {
             return None;
         }
         let s0 = self.samples[0].s;
         let l = self.length();
-        let sigma = s0 + (t - self.spec.t0) / self.spec.duration * l;
+        let sigma = s0 + (t - self.params.t0) / self.params.duration * l;
         let sigma_m = s0 + taum * l;
-        let u = l / self.spec.duration;
+        let u = l / self.params.duration;
         let n = self.samples.len();
         let k = self
             .samples
@@ -213,17 +213,17 @@ impl PathTool {
     /// time, so batches compute it once).
     #[inline]
     pub fn eval_at(&self, x: DVec3, p: &Pose) -> DVec3 {
-        let outer = self.spec.radius + self.spec.reach;
+        let outer = self.params.radius + self.params.reach;
         if (x - p.o).length_squared() >= outer * outer {
             return DVec3::ZERO;
         }
-        let mut v = if self.spec.carry {
+        let mut v = if self.params.carry {
             Sphere {
                 center: p.o,
                 velocity: p.v,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                linear: self.spec.linear,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                linear: self.params.linear,
                 moving: false,
             }
             .eval(x, 0.0)
@@ -231,28 +231,28 @@ impl PathTool {
             Translation {
                 center: p.o,
                 velocity: p.v,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                power: self.spec.power,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                power: self.params.power,
                 moving: false,
             }
             .eval(x, 0.0)
         };
-        if self.spec.rotate {
+        if self.params.rotate {
             v += Rotation {
                 center: p.o,
                 pivot: p.o,
                 omega: p.omega,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                power: self.spec.power,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                power: self.params.power,
             }
             .eval(x, 0.0);
         }
-        if self.spec.twist != 0.0 {
+        if self.params.twist != 0.0 {
             v += self.swirl(p, SwirlKind::Twist).eval(x);
         }
-        if self.spec.bend != 0.0 {
+        if self.params.bend != 0.0 {
             v += self.swirl(p, SwirlKind::Bend).eval(x);
         }
         v
@@ -260,14 +260,14 @@ impl PathTool {
 
     fn swirl(&self, p: &Pose, kind: SwirlKind) -> Swirl {
         let (axis, rate) = match kind {
-            SwirlKind::Twist => (p.frame.z_axis, self.spec.twist),
-            SwirlKind::Bend => (p.frame.x_axis, self.spec.bend),
+            SwirlKind::Twist => (p.frame.z_axis, self.params.twist),
+            SwirlKind::Bend => (p.frame.x_axis, self.params.bend),
         };
         Swirl {
             pivot: p.o,
             axis,
             rate,
-            reach: self.spec.radius + self.spec.reach,
+            reach: self.params.radius + self.params.reach,
             kind,
             curl_form: false,
         }
@@ -276,7 +276,7 @@ impl PathTool {
     /// A bound of `|v|`: the parts' bounds at the largest tool speed and turning rate
     /// (sampled at 17 points per segment, ×1.05).
     pub fn max_speed(&self) -> f64 {
-        let u = self.length() / self.spec.duration;
+        let u = self.length() / self.params.duration;
         let mut vmax: f64 = 0.0;
         for w in self.samples.windows(2) {
             let ds = w[1].s - w[0].s;
@@ -287,13 +287,13 @@ impl PathTool {
             }
         }
         let vel = DVec3::X * (u * vmax * 1.05);
-        let mut m = if self.spec.carry {
+        let mut m = if self.params.carry {
             Sphere {
                 center: DVec3::ZERO,
                 velocity: vel,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                linear: self.spec.linear,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                linear: self.params.linear,
                 moving: false,
             }
             .max_speed()
@@ -301,22 +301,22 @@ impl PathTool {
             Translation {
                 center: DVec3::ZERO,
                 velocity: vel,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                power: self.spec.power,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                power: self.params.power,
                 moving: false,
             }
             .max_speed()
         };
-        if self.spec.rotate {
+        if self.params.rotate {
             let w = self.omega.iter().map(|w| w.length()).fold(0.0, f64::max) * u;
             m += Rotation {
                 center: DVec3::ZERO,
                 pivot: DVec3::ZERO,
                 omega: DVec3::X * w,
-                radius: self.spec.radius,
-                reach: self.spec.reach,
-                power: self.spec.power,
+                radius: self.params.radius,
+                reach: self.params.reach,
+                power: self.params.power,
             }
             .max_speed();
         }
@@ -326,10 +326,10 @@ impl PathTool {
             omega: DVec3::ZERO,
             frame: DMat3::IDENTITY,
         };
-        if self.spec.twist != 0.0 {
+        if self.params.twist != 0.0 {
             m += self.swirl(&pose, SwirlKind::Twist).max_speed();
         }
-        if self.spec.bend != 0.0 {
+        if self.params.bend != 0.0 {
             m += self.swirl(&pose, SwirlKind::Bend).max_speed();
         }
         m
@@ -340,7 +340,7 @@ impl PathTool {
         let (s0, l) = (self.samples[0].s, self.length());
         self.samples
             .iter()
-            .map(move |p| self.spec.t0 + self.spec.duration * (p.s - s0) / l)
+            .map(move |p| self.params.t0 + self.params.duration * (p.s - s0) / l)
     }
 }
 
@@ -437,7 +437,7 @@ impl PathTool {
             });
         }
         let radius = positive("radius", a.radius)?;
-        let spec = PathToolSpec {
+        let params = PathToolParams {
             t0: finite("t0", a.t0)?,
             duration: positive("duration", a.duration)?,
             radius,
@@ -457,7 +457,7 @@ impl PathTool {
                 0.0
             },
         };
-        let tool = PathTool::new(samples, spec)?;
+        let tool = PathTool::new(samples, params)?;
         let speed = tool.max_speed();
         if !speed.is_finite() {
             return Err(InputError::new(
@@ -478,7 +478,7 @@ impl Tool for PathTool {
         PathTool::max_speed(self)
     }
     fn length_scale(&self) -> f64 {
-        self.spec.reach
+        self.params.reach
     }
     fn breakpoints(&self) -> Vec<f64> {
         PathTool::breakpoints(self).collect()
@@ -519,7 +519,7 @@ mod tests {
                 }
             })
             .collect();
-        let spec = PathToolSpec {
+        let params = PathToolParams {
             t0: 0.5,
             duration: 2.0,
             radius: 0.1,
@@ -531,7 +531,7 @@ mod tests {
             twist: 0.0,
             bend: 0.0,
         };
-        let tool = PathTool::new(samples.clone(), spec).unwrap();
+        let tool = PathTool::new(samples.clone(), params).unwrap();
         for (i, s) in samples.iter().enumerate() {
             let t = 0.5 + 2.0 * s.s / tool.length();
             let p = tool.pose(t).unwrap();
