@@ -17,6 +17,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::spine::SpineModel;
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 /// Numbers stored per vertex besides the edge index.
@@ -157,8 +158,12 @@ pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
         ));
     }
     let nv = vertices.len();
-    let mut edge = vec![0i64; nv];
-    let mut coords = vec![0.0; COORDS * nv];
+    let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
+    let mut coords = alloc::filled(
+        "SpineBinding",
+        alloc::product("SpineBinding", COORDS, nv, 8)?,
+        0.0,
+    )?;
     edge.par_iter_mut()
         .zip(coords.par_chunks_mut(COORDS))
         .zip(vertices.par_iter())

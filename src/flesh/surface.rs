@@ -23,6 +23,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::solve::CLAMPED_BEND;
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::cubic::basis;
 
@@ -284,8 +285,12 @@ pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec
         ));
     }
     let nv = vertices.len();
-    let mut cell = vec![0i64; nv];
-    let mut coords = vec![0.0; SURFACE_COORDS * nv];
+    let mut cell = alloc::filled("SurfaceBinding", nv, 0i64)?;
+    let mut coords = alloc::filled(
+        "SurfaceBinding",
+        alloc::product("SurfaceBinding", SURFACE_COORDS, nv, 8)?,
+        0.0,
+    )?;
     let (nu_, nv_) = (rest.nu, rest.nv);
     cell.par_iter_mut()
         .zip(coords.par_chunks_mut(SURFACE_COORDS))

@@ -8,6 +8,7 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{detach_in_pool, empty, slice_mut, slice_of, vec3_array, vec3s};
+use crate::alloc;
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
@@ -61,7 +62,7 @@ pub fn flesh_deform<'py>(
     };
     let nv = edge.len();
     let out = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
-    let mut flags = vec![0u8; nv];
+    let mut flags = alloc::filled("flesh", nv, 0u8)?;
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
@@ -135,7 +136,7 @@ pub fn flesh_surface_deform<'py>(
     let coords = slice_of("coords", &coords)?;
     let n = cell.len();
     let out = empty::<f64, numpy::Ix2>(py, &[n, 3])?;
-    let mut flags = vec![0u8; n];
+    let mut flags = alloc::filled("flesh_surface", n, 0u8)?;
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);

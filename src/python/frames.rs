@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, offsets_of, orientations, renamed, slice_mut, slice_of, vec3_array,
-    vec3s,
+    detach_in_pool, empty, ensure_memory, offsets_of, orientations, renamed, slice_mut, slice_of,
+    vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Request, TangentRule};
 
@@ -129,6 +129,8 @@ pub fn estimate_tangents<'py>(
     rule: TangentRule,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let x = vec3s("points", &points)?;
+    // chord lengths, the estimate and its copy into the array
+    ensure_memory("estimate_tangents", x.len(), 8 + 24 + 24)?;
     let t = detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??;
     vec3_array(py, t)
 }
