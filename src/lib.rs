@@ -24,6 +24,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod alloc;
+pub mod cancel;
 pub mod deform;
 pub mod error;
 pub mod flesh;

@@ -160,7 +160,7 @@ sys.exit(3)
 """
 
 
-def late_after_sigint(setup: str, call: str, after: float = 1.0) -> float:
+def late_after_sigint(setup: str, call: str, after: float = 0.5) -> float:
     code = SIGINT_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after)
     r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
                        text=True, timeout=600)
@@ -179,6 +179,14 @@ D17_CASES = {
     "deform": (
         "s = trimesh.creation.icosphere(6); f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n",
         "spinal.deform(s, f, 1.0, 20000)"),
+    "frames_bundle": (
+        ("s = np.linspace(0, 40, 5000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "X = np.concatenate([C + i for i in range(2000)])\n"),
+        "spinal.frames(X, lengths=[5000] * 2000)"),
+    "flesh": (
+        ("u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]\n"
+         "V = np.random.default_rng(0).normal(size=(3_000_000, 3))\n"),
+        "spinal.flesh(V, H, H * 1.1)"),
     "stamp": (
         "s = trimesh.creation.icosphere(5)\n",
         "spinal.stamp(s, [0, 0, 1.32], [0, 0, 0.2], .5, frames=100_000)"),

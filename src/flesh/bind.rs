@@ -18,6 +18,7 @@ use rayon::prelude::*;
 
 use super::spine::SpineModel;
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// Numbers stored per vertex besides the edge index.
@@ -151,6 +152,15 @@ fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
 
 /// Register `vertices` on the rest spine.
 pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
+    bind_cancellable(rest, vertices, &cancel::never)
+}
+
+/// [`bind`] that polls `cancel` before each vertex (see [`crate::cancel`]).
+pub fn bind_cancellable(
+    rest: &SpineModel,
+    vertices: &[DVec3],
+    cancel: Cancel<'_>,
+) -> Result<Binding> {
     if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "vertices",
@@ -168,6 +178,9 @@ pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
         .zip(coords.par_chunks_mut(COORDS))
         .zip(vertices.par_iter())
         .for_each(|((e, c), &p)| {
+            if cancel() {
+                return;
+            }
             let (k, a, tau) = locate(rest, p);
             let l = rest.eval(k, a);
             let d = p - l.q - tau * l.t;

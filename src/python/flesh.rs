@@ -7,7 +7,9 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{detach_in_pool, empty, slice_mut, slice_of, vec3_array, vec3s};
+use super::convert::{
+    Stop, detach_in_pool, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s,
+};
 use crate::alloc;
 use crate::flesh::{self, Solution, surface};
 
@@ -35,7 +37,10 @@ pub fn flesh_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let rest = spine_of("rest_spine", &rest_points, &rest_frames)?;
     let v = vec3s("vertices", &vertices)?;
-    let b = detach_in_pool(py, || flesh::bind(&rest, v))??;
+    let stop = Stop::default();
+    let b = detach_stoppable(py, &stop, || {
+        flesh::bind_cancellable(&rest, v, &|| stop.requested())
+    })??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
     Ok((PyArray1::from_vec(py, b.edge), coords))
@@ -66,8 +71,10 @@ pub fn flesh_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        detach_in_pool(py, || {
-            flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            flesh::deform_cancellable(&posed, edge, coords, solution, tw, buf, &mut flags, &cancel)
         })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))

@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, ensure_memory, offsets_of, orientations, renamed, slice_mut, slice_of,
-    vec3_array, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, ensure_memory, offsets_of, orientations,
+    renamed, slice_mut, slice_of, vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Request, TangentRule};
 
@@ -63,8 +63,10 @@ pub fn frames_sampled<'py>(
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        detach_in_pool(py, || {
-            frames::compute_many(&template, &offsets, &initial, &end, buf)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            frames::compute_many_cancellable(&template, &offsets, &initial, &end, buf, &cancel)
         })?
         .map_err(|e| renamed(e, "points", points_arg))?
     };

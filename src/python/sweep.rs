@@ -6,7 +6,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut,
+    slice_of, vec2s, vec3s,
 };
 use crate::sweep::{self, Options, Profile, Spine};
 
@@ -81,8 +82,10 @@ pub fn sweep_mesh<'py>(
             normals: bytemuck::cast_slice_mut(slice_mut(&mut wn)?),
             uv: bytemuck::cast_slice_mut(slice_mut(&mut wu)?),
         };
-        detach_in_pool(py, || {
-            sweep::sweep_into(&spine, &offsets, &p, &opts, &lay, out)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            sweep::sweep_into_cancellable(&spine, &offsets, &p, &opts, &lay, out, &cancel)
         })?
     };
     let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();

@@ -43,6 +43,7 @@ pub mod profile;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::validate;
 pub use profile::Profile;
@@ -285,6 +286,7 @@ pub struct Layout {
 
 /// Sweep one spine into its share of the output buffers; returns the rows (global) that
 /// start a folded-over segment.
+#[allow(clippy::too_many_arguments)]
 fn sweep_one(
     s: &Spine,
     plan: &Plan,
@@ -293,6 +295,7 @@ fn sweep_one(
     vbase: usize,
     rowbase: usize,
     out: MeshMut,
+    cancel: Cancel<'_>,
 ) -> Vec<usize> {
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
     let grain = (4096 / plan.cols).max(1);
@@ -309,7 +312,7 @@ fn sweep_one(
         sign,
         rowbase,
     };
-    let folds = rings.write(out.vertices, out.normals, out.uv, grain);
+    let folds = rings.write(out.vertices, out.normals, out.uv, grain, cancel);
     let edges = if p.closed { p.len() } else { p.len() - 1 };
     let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
     write_side_faces(side, plan, edges, vbase, sign, grain);
@@ -438,6 +441,7 @@ impl Rings<'_> {
         normals: &mut [DVec3],
         uv: &mut [DVec2],
         grain: usize,
+        cancel: Cancel<'_>,
     ) -> Vec<usize> {
         let (r_n, cols) = (self.plan.rings, self.plan.cols);
         let block = grain * cols;
@@ -450,6 +454,9 @@ impl Rings<'_> {
             .flat_map_iter(|(bi, ((bv, bn), bu))| {
                 let i0 = bi * grain;
                 let mut folds = Vec::new();
+                if cancel() {
+                    return folds;
+                }
                 let mut prev = self.geo((i0 + r_n - 1) % r_n);
                 let mut cur = self.geo(i0 % r_n);
                 let rings = bv
@@ -653,6 +660,19 @@ pub fn sweep_into(
     layout: &Layout,
     out: MeshMut,
 ) -> Vec<usize> {
+    sweep_into_cancellable(all, offsets, profile, opts, layout, out, &cancel::never)
+}
+
+/// [`sweep_into`] that polls `cancel` before each block of rings (see [`crate::cancel`]).
+pub fn sweep_into_cancellable(
+    all: &Spine,
+    offsets: &[usize],
+    profile: &Profile,
+    opts: &Options,
+    layout: &Layout,
+    out: MeshMut,
+    cancel: Cancel<'_>,
+) -> Vec<usize> {
     let (nv, nf) = (layout.vertices, layout.faces);
     assert!(
         out.vertices.len() == nv
@@ -692,6 +712,7 @@ pub fn sweep_into(
                 vbase,
                 offsets[c],
                 mine,
+                cancel,
             )
         })
         .collect();
