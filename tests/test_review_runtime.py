@@ -187,6 +187,16 @@ D17_CASES = {
         ("u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]\n"
          "V = np.random.default_rng(0).normal(size=(3_000_000, 3))\n"),
         "spinal.flesh(V, H, H * 1.1)"),
+    "walk_mesh_many": (
+        ("b = trimesh.creation.icosphere(4); w, k = 1000, 2000\n"
+         "P = b.vertices[b.faces[:w]].mean(1); M = np.tile([[2.0, .1]], (w, k, 1))\n"),
+        "Q.walk_mesh_many(b.vertices, b.faces, np.arange(w), P, M)"),
+    "SurfaceBinding": (
+        ("g = np.stack(np.meshgrid(np.linspace(0, 1, 40), np.linspace(0, 1, 40),\n"
+         "                         indexing='ij'), -1)\n"
+         "S = np.concatenate([g, np.zeros(g.shape[:2] + (1,))], -1)\n"
+         "V = np.random.default_rng(0).uniform(size=(2_000_000, 3))\n"),
+        "spinal.SurfaceBinding(V, S)"),
     "stamp": (
         "s = trimesh.creation.icosphere(5)\n",
         "spinal.stamp(s, [0, 0, 1.32], [0, 0, 0.2], .5, frames=100_000)"),

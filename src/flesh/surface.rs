@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use super::solve::CLAMPED_BEND;
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::basis;
 
@@ -278,6 +279,15 @@ fn try_cell(sf: &Surface, i: usize, j: usize, p: DVec3, best: &mut Option<Foot>)
 
 /// Register `vertices` on the rest surface: `SURFACE_COORDS` numbers and the cell per vertex.
 pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec<f64>)> {
+    bind_surface_cancellable(rest, vertices, &cancel::never)
+}
+
+/// [`bind_surface`] that polls `cancel` before each vertex (see [`crate::cancel`]).
+pub fn bind_surface_cancellable(
+    rest: &Surface,
+    vertices: &[DVec3],
+    cancel: Cancel<'_>,
+) -> Result<(Vec<i64>, Vec<f64>)> {
     if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "vertices",
@@ -296,6 +306,9 @@ pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec
         .zip(coords.par_chunks_mut(SURFACE_COORDS))
         .zip(vertices.par_iter())
         .for_each(|((c, out), &p)| {
+            if cancel() {
+                return;
+            }
             // nearest sample, then the cells around it (then all cells if needed)
             let near = rest
                 .s

@@ -118,9 +118,10 @@ pub fn flesh_surface_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let pts = vec3s("rest_surface", &rest_points)?;
     let v = vec3s("vertices", &vertices)?;
-    let (cell, coords) = detach_in_pool(py, || {
+    let stop = Stop::default();
+    let (cell, coords) = detach_stoppable(py, &stop, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
-        surface::bind_surface(&rest, v)
+        surface::bind_surface_cancellable(&rest, v, &|| stop.requested())
     })??;
     let n = cell.len();
     let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;

@@ -9,8 +9,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles,
-    value_error, vec2s, vec3_of, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, frames_of, quat_array, quats, slice_mut,
+    slice_of, triangles, value_error, vec2s, vec3_of, vec3s,
 };
 use crate::alloc;
 use crate::quaternion::{self, camera, walk};
@@ -293,9 +293,10 @@ pub fn walk_mesh_many<'py>(
     let starts: Vec<walk::Start> = (0..fc.len())
         .map(|i| (fc[i], p[i], d.map(|d| d[i])))
         .collect();
-    let states = detach_in_pool(py, || {
+    let stop = Stop::default();
+    let states = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
-        walk::walk_many(&w, &starts, mv, k)
+        walk::walk_many_cancellable(&w, &starts, mv, k, &|| stop.requested())
     })??;
     let nw = starts.len();
     let (pts, fcs, frs) = walker_states("walk_mesh_many", &states)?;

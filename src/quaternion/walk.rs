@@ -16,6 +16,7 @@
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh;
 
@@ -372,6 +373,17 @@ pub type Start = (i64, DVec3, Option<DVec3>);
 /// walker (the adjacency is built once, by the caller's [`Walker::new`]). The first error
 /// (in walker order) is reported with the walker's index.
 pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Result<Vec<State>> {
+    walk_many_cancellable(w, starts, moves, k, &cancel::never)
+}
+
+/// [`walk_many`] that polls `cancel` before each move (see [`crate::cancel`]).
+pub fn walk_many_cancellable(
+    w: &Walker,
+    starts: &[Start],
+    moves: &[DVec2],
+    k: usize,
+    cancel: Cancel<'_>,
+) -> Result<Vec<State>> {
     use rayon::prelude::*;
     if moves.len() != starts.len() * k {
         return Err(InputError::new(
@@ -404,6 +416,9 @@ pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Res
                 out[0] = s;
                 let mut crossings = Vec::new();
                 for (j, m) in moves[i * k..(i + 1) * k].iter().enumerate() {
+                    if cancel() {
+                        return Ok(());
+                    }
                     crossings.clear();
                     s = w.step(s, *m, &mut crossings).map_err(ctx)?;
                     out[j + 1] = s;
