@@ -6,10 +6,23 @@ use std::fmt;
 /// An input that cannot be processed, with the name of the offending argument.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InputError {
-    /// Name of the argument as the user sees it (`"points"`, `"tangents"`, `"initial"`, …).
+    /// Name of the argument as the user sees it (`"points"`, `"tangents"`, `"initial"`, …),
+    /// or of the call for [`ErrorKind::OutOfMemory`].
     pub arg: &'static str,
     /// What is wrong, in words, including the row index where one applies.
     pub msg: String,
+    /// Bad input, or input too large for the memory.
+    pub kind: ErrorKind,
+}
+
+/// The kind of an [`InputError`] (the binding raises `ValueError` or `MemoryError`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ErrorKind {
+    /// A value, shape or combination of arguments that cannot be processed.
+    #[default]
+    Invalid,
+    /// A buffer sized by the input could not be allocated.
+    OutOfMemory,
 }
 
 impl InputError {
@@ -17,6 +30,26 @@ impl InputError {
         InputError {
             arg,
             msg: msg.into(),
+            kind: ErrorKind::Invalid,
+        }
+    }
+
+    /// `what` (a call, e.g. `"walk_mesh"`) needs `count` more elements of `size` bytes than
+    /// the allocator gives (or than the address space holds, when the product overflows).
+    pub fn out_of_memory(what: &'static str, count: usize, size: usize) -> Self {
+        let msg = match count.checked_mul(size) {
+            Some(b) => format!(
+                "out of memory: cannot allocate {:.3} GB ({count} elements of {size} bytes)",
+                b as f64 / 1e9
+            ),
+            None => {
+                format!("out of memory: {count} elements of {size} bytes exceed the address space")
+            }
+        };
+        InputError {
+            arg: what,
+            msg,
+            kind: ErrorKind::OutOfMemory,
         }
     }
 
@@ -25,6 +58,7 @@ impl InputError {
         InputError {
             arg: self.arg,
             msg: format!("{prefix}: {}", self.msg),
+            kind: self.kind,
         }
     }
 }

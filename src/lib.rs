@@ -23,6 +23,8 @@
 // `!(a > b)` is used on purpose: it is also true when a value is NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod alloc;
+pub mod cancel;
 pub mod deform;
 pub mod error;
 pub mod flesh;

@@ -35,6 +35,7 @@ use glam::DVec3;
 use super::Field;
 use super::advect::{Method, integrate};
 use super::fields::Translation;
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::mesh::signed_volume as volume;
 
@@ -91,8 +92,8 @@ pub fn stamp(
     }
     let u = travel / len;
     let mut out = Vec::with_capacity(frames);
-    let mut contact = vec![false; v.len()];
-    let mut movable = vec![false; v.len()];
+    let mut contact = alloc::filled("stamp", v.len(), false)?;
+    let mut movable = alloc::filled("stamp", v.len(), false)?;
     for k in 1..=frames {
         let c = start + travel * (k as f64 / frames as f64);
         let before = volume(v, f);

@@ -17,6 +17,8 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::spine::SpineModel;
+use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// Numbers stored per vertex besides the edge index.
@@ -160,6 +162,15 @@ fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
 
 /// Register `vertices` on the rest spine.
 pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
+    bind_cancellable(rest, vertices, &cancel::never)
+}
+
+/// [`bind`] that polls `cancel` before each vertex (see [`crate::cancel`]).
+pub fn bind_cancellable(
+    rest: &SpineModel,
+    vertices: &[DVec3],
+    cancel: Cancel<'_>,
+) -> Result<Binding> {
     if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "vertices",
@@ -167,12 +178,19 @@ pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
         ));
     }
     let nv = vertices.len();
-    let mut edge = vec![0i64; nv];
-    let mut coords = vec![0.0; COORDS * nv];
+    let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
+    let mut coords = alloc::filled(
+        "SpineBinding",
+        alloc::product("SpineBinding", COORDS, nv, 8)?,
+        0.0,
+    )?;
     edge.par_iter_mut()
         .zip(coords.par_chunks_mut(COORDS))
         .zip(vertices.par_iter())
         .for_each(|((e, c), &p)| {
+            if cancel() {
+                return;
+            }
             let (k, a, tau) = locate(rest, p);
             let l = rest.eval(k, a);
             let d = p - l.q - tau * l.t;

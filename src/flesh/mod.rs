@@ -41,7 +41,7 @@ pub mod solve;
 pub mod spine;
 pub mod surface;
 
-pub use bind::{Binding, COORDS, bind};
-pub use pose::deform;
+pub use bind::{Binding, COORDS, bind, bind_cancellable};
+pub use pose::{deform, deform_cancellable};
 pub use solve::Solution;
 pub use spine::SpineModel;

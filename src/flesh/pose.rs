@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use super::bind::COORDS;
 use super::solve::{Solution, bend, unbend};
 use super::spine::SpineModel;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// Deform a registered shape. `twist` is empty or one angle (rad) per spine sample.
@@ -29,6 +30,21 @@ pub fn deform(
     twist: &[f64],
     out: &mut [DVec3],
     flags: &mut [u8],
+) -> Result<()> {
+    deform_cancellable(posed, edge, coords, sol, twist, out, flags, &cancel::never)
+}
+
+/// [`deform`] that polls `cancel` before each block of vertices (see [`crate::cancel`]).
+#[allow(clippy::too_many_arguments)]
+pub fn deform_cancellable(
+    posed: &SpineModel,
+    edge: &[i64],
+    coords: &[f64],
+    sol: Solution,
+    twist: &[f64],
+    out: &mut [DVec3],
+    flags: &mut [u8],
+    cancel: Cancel<'_>,
 ) -> Result<()> {
     let n = posed.len();
     let nv = edge.len();
@@ -65,7 +81,11 @@ pub fn deform(
     out.par_chunks_mut(TASK)
         .zip(flags.par_chunks_mut(TASK))
         .zip(edge.par_chunks(TASK).zip(coords.par_chunks(COORDS * TASK)))
-        .for_each(|((o, f), (e, c))| run(posed, twist, e, c, o, f));
+        .for_each(|((o, f), (e, c))| {
+            if !cancel() {
+                run(posed, twist, e, c, o, f)
+            }
+        });
     Ok(())
 }
 

@@ -23,6 +23,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::solve::CLAMPED_BEND;
+use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::basis;
 
@@ -277,6 +279,15 @@ fn try_cell(sf: &Surface, i: usize, j: usize, p: DVec3, best: &mut Option<Foot>)
 
 /// Register `vertices` on the rest surface: `SURFACE_COORDS` numbers and the cell per vertex.
 pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec<f64>)> {
+    bind_surface_cancellable(rest, vertices, &cancel::never)
+}
+
+/// [`bind_surface`] that polls `cancel` before each vertex (see [`crate::cancel`]).
+pub fn bind_surface_cancellable(
+    rest: &Surface,
+    vertices: &[DVec3],
+    cancel: Cancel<'_>,
+) -> Result<(Vec<i64>, Vec<f64>)> {
     if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "vertices",
@@ -284,13 +295,20 @@ pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec
         ));
     }
     let nv = vertices.len();
-    let mut cell = vec![0i64; nv];
-    let mut coords = vec![0.0; SURFACE_COORDS * nv];
+    let mut cell = alloc::filled("SurfaceBinding", nv, 0i64)?;
+    let mut coords = alloc::filled(
+        "SurfaceBinding",
+        alloc::product("SurfaceBinding", SURFACE_COORDS, nv, 8)?,
+        0.0,
+    )?;
     let (nu_, nv_) = (rest.nu, rest.nv);
     cell.par_iter_mut()
         .zip(coords.par_chunks_mut(SURFACE_COORDS))
         .zip(vertices.par_iter())
         .for_each(|((c, out), &p)| {
+            if cancel() {
+                return;
+            }
             // nearest sample, then the cells around it (then all cells if needed)
             let near = rest
                 .s

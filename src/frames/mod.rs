@@ -744,6 +744,18 @@ pub fn compute_many(
     end: &[Orientation],
     out: &mut [f64],
 ) -> Result<Vec<f64>> {
+    compute_many_cancellable(template, offsets, initial, end, out, &crate::cancel::never)
+}
+
+/// [`compute_many`] that polls `cancel` before each curve (see [`crate::cancel`]).
+pub fn compute_many_cancellable(
+    template: &Request,
+    offsets: &[usize],
+    initial: &[Orientation],
+    end: &[Orientation],
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<f64>> {
     let curves = offsets.len().saturating_sub(1);
     for (arg, v) in [("initial", initial.len()), ("end", end.len())] {
         if v > 1 && v != curves {
@@ -776,6 +788,9 @@ pub fn compute_many(
         .into_par_iter()
         .enumerate()
         .map(|(c, buf)| {
+            if cancel() {
+                return Ok(0.0);
+            }
             let (a, b) = (offsets[c], offsets[c + 1]);
             let req = Request {
                 points: template.points.map(|p| &p[a..b]),

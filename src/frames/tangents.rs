@@ -43,6 +43,7 @@ use super::lanes::Arith;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 /// How tangents are estimated from points.
@@ -253,7 +254,7 @@ pub fn estimate(
     let chordal = matches!(rule, TangentRule::FivePoint | TangentRule::FivePointBounded);
     // Estimate and normalise in one pass; a zero (or non-finite) estimate is a cusp. The open
     // ends of the circle rule are zero here and filled below.
-    let mut t = Vec::with_capacity(n);
+    let mut t = alloc::with_capacity("estimate_tangents", n)?;
     (0..n)
         .into_par_iter()
         .with_min_len(1 << 12)
@@ -462,7 +463,8 @@ pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec
     let chords = crate::frames::validate::chords(&x[..n], closed)?;
     let mut t = estimate(&x[..n], &chords, closed, rule)?;
     if n < x.len() {
-        t.push(t[0]);
+        let first = t[0];
+        alloc::push("estimate_tangents", &mut t, first)?;
     }
     Ok(t)
 }

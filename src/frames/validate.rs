@@ -13,6 +13,7 @@
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::rotation;
 
@@ -90,7 +91,7 @@ pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
     let n = x.len();
     let floor = repeat_floor(x);
     let m = if closed { n } else { n.saturating_sub(1) };
-    let mut seg = vec![0.0; m];
+    let mut seg = alloc::filled("chord lengths", m, 0.0)?;
     let bad = seg
         .par_chunks_mut(CHECK_CHUNK)
         .enumerate()

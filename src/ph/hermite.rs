@@ -35,6 +35,7 @@
 use glam::DVec3;
 
 use super::Cubic;
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::frames::geometry::any_perpendicular;
 
@@ -228,9 +229,13 @@ pub fn hermite_rows(
         ));
     }
     let mut out = Rows {
-        candidates: vec![0.0; m * CANDIDATE_ROW],
-        counts: vec![0; m],
-        codes: vec![0; m],
+        candidates: alloc::filled(
+            "ph.hermite",
+            alloc::product("ph.hermite", m, CANDIDATE_ROW, 8)?,
+            0.0,
+        )?,
+        counts: alloc::filled("ph.hermite", m, 0)?,
+        codes: alloc::filled("ph.hermite", m, 0)?,
     };
     for i in 0..m {
         let at = |arg: &'static str, msg: &str| {

@@ -26,6 +26,7 @@ pub mod hermite;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 use crate::math::cubic::Bezier;
@@ -384,12 +385,14 @@ pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVe
             format!("must be 0, 1, 2 or 3, got {derivative}"),
         ));
     }
-    Ok(s.par_iter()
+    let mut out = alloc::with_capacity("PHSpline.evaluate", s.len())?;
+    s.par_iter()
         .map(|&x| {
             let (i, v) = locate(cubics.len(), x);
             cubics[i].derivative(derivative, v)
         })
-        .collect())
+        .collect_into_vec(&mut out);
+    Ok(out)
 }
 
 /// [`Cubic::from_quaternions`] row by row (preimages scalar first).

@@ -12,19 +12,35 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 use super::threads;
-use crate::error::InputError;
+use crate::alloc;
+use crate::error::{ErrorKind, InputError};
 use crate::frames::{Method, Orientation, TangentRule};
 use crate::{deform, flesh, ph};
 
-/// `ValueError("arg: message")`, so `?` works on core results.
+/// `ValueError("arg: message")` (`MemoryError("call: out of memory …")` when a buffer sized
+/// by the input could not be allocated), so `?` works on core results.
 impl From<InputError> for PyErr {
     fn from(e: InputError) -> PyErr {
-        PyValueError::new_err(e.to_string())
+        match e.kind {
+            ErrorKind::Invalid => PyValueError::new_err(e.to_string()),
+            ErrorKind::OutOfMemory => PyMemoryError::new_err(e.to_string()),
+        }
     }
+}
+
+/// Fails with `MemoryError` naming `call` unless `bytes` more bytes can be allocated now:
+/// a heavy call checks its working memory (estimated from the input sizes) before it starts,
+/// so that a refusal of one of its many internal buffers cannot abort the process. The
+/// probe is freed at once (large blocks go back to the system).
+pub fn ensure_memory(call: &'static str, count: usize, size: usize) -> PyResult<()> {
+    let bytes = alloc::product(call, count, size, 1)?;
+    alloc::with_capacity::<u8>(call, bytes)
+        .map_err(|_| InputError::out_of_memory(call, count, size))?;
+    Ok(())
 }
 
 /// A request to stop a heavy call, set by the calling thread when a signal handler raised
@@ -147,7 +163,7 @@ impl<'a> Ticker<'a> {
 /// The error as a `ValueError` naming `to` where the core named its argument `from` (a
 /// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
 pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {
-    if e.arg == from {
+    if e.arg == from && e.kind == ErrorKind::Invalid {
         PyValueError::new_err(format!("{to}: {}", e.msg))
     } else {
         e.into()

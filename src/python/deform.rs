@@ -9,6 +9,7 @@ use super::convert::{
     Stop, Ticker, detach_stoppable, empty, slice_mut, triangles, value_error, vec3_array, vec3s,
 };
 use super::fields::PyField;
+use crate::alloc;
 use crate::deform::{self, advect::Method, refine};
 
 /// Advect points: `steps` steps of size `h` from `t0`; a new array. Ctrl-C stops it between
@@ -146,7 +147,7 @@ pub fn stamp<'py>(
         .iter()
         .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
         .collect();
-    let mut v = x.to_vec();
+    let mut v = alloc::copied("stamp", x)?;
     let stop = Stop::default();
     let mut ticker = Ticker::new(None, &stop);
     let rep = detach_stoppable(py, &stop, || {

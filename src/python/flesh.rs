@@ -7,7 +7,10 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{detach_in_pool, empty, slice_mut, slice_of, vec3_array, vec3s};
+use super::convert::{
+    Stop, detach_in_pool, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s,
+};
+use crate::alloc;
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
@@ -39,7 +42,10 @@ pub fn flesh_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let rest = spine_of("rest_spine", &rest_points, &rest_frames, closed)?;
     let v = vec3s("vertices", &vertices)?;
-    let b = detach_in_pool(py, || flesh::bind(&rest, v))??;
+    let stop = Stop::default();
+    let b = detach_stoppable(py, &stop, || {
+        flesh::bind_cancellable(&rest, v, &|| stop.requested())
+    })??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
     Ok((PyArray1::from_vec(py, b.edge), coords))
@@ -68,12 +74,14 @@ pub fn flesh_deform<'py>(
     };
     let nv = edge.len();
     let out = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
-    let mut flags = vec![0u8; nv];
+    let mut flags = alloc::filled("flesh", nv, 0u8)?;
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        detach_in_pool(py, || {
-            flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            flesh::deform_cancellable(&posed, edge, coords, solution, tw, buf, &mut flags, &cancel)
         })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
@@ -118,9 +126,10 @@ pub fn flesh_surface_bind<'py>(
 ) -> PyResult<FleshBinding<'py>> {
     let pts = vec3s("rest_surface", &rest_points)?;
     let v = vec3s("vertices", &vertices)?;
-    let (cell, coords) = detach_in_pool(py, || {
+    let stop = Stop::default();
+    let (cell, coords) = detach_stoppable(py, &stop, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
-        surface::bind_surface(&rest, v)
+        surface::bind_surface_cancellable(&rest, v, &|| stop.requested())
     })??;
     let n = cell.len();
     let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
@@ -143,7 +152,7 @@ pub fn flesh_surface_deform<'py>(
     let coords = slice_of("coords", &coords)?;
     let n = cell.len();
     let out = empty::<f64, numpy::Ix2>(py, &[n, 3])?;
-    let mut flags = vec![0u8; n];
+    let mut flags = alloc::filled("flesh_surface", n, 0u8)?;
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);

@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, offsets_of, orientations, renamed, slice_mut, slice_of, value_error,
-    vec3_array, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, ensure_memory, offsets_of, orientations,
+    renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
@@ -63,8 +63,10 @@ pub fn frames_sampled<'py>(
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        detach_in_pool(py, || {
-            frames::compute_many(&template, &offsets, &initial, &end, buf)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            frames::compute_many_cancellable(&template, &offsets, &initial, &end, buf, &cancel)
         })?
         .map_err(|e| renamed(e, "points", points_arg))?
     };
@@ -131,6 +133,8 @@ pub fn estimate_tangents<'py>(
     offsets: Option<PyReadonlyArray1<'py, i64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let x = vec3s("points", &points)?;
+    // chord lengths, the estimate and its copy into the array
+    ensure_memory("estimate_tangents", x.len(), 8 + 24 + 24)?;
     let t = match offsets {
         None => detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??,
         Some(o) => {

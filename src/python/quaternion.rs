@@ -9,9 +9,10 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles,
-    value_error, vec2s, vec3_of, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, frames_of, quat_array, quats, slice_mut,
+    slice_of, triangles, value_error, vec2s, vec3_of, vec3s,
 };
+use crate::alloc;
 use crate::quaternion::{self, camera, walk};
 
 /// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
@@ -136,7 +137,7 @@ pub fn quat_transport<'py>(
         .map(|r| vec3_of("initial", r, "expected 3 values"))
         .transpose()?;
     let rows = x.len() + usize::from(closed && closing_row);
-    let mut out = vec![DQuat::IDENTITY; rows];
+    let mut out = alloc::filled("quaternion_frames", rows, DQuat::IDENTITY)?;
     let angle = detach_in_pool(py, || {
         quaternion::transport(x, t, r, closed, turns, &mut out)
     })??;
@@ -190,14 +191,21 @@ pub fn camera_inputs<'py>(
 }
 
 /// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.
-fn walker_states(states: &[walk::State]) -> (Vec<f64>, Vec<i64>, Vec<f64>) {
-    let pts = states.iter().flat_map(|s| s.point.to_array()).collect();
-    let fcs = states.iter().map(|s| s.face as i64).collect();
-    let frs = states
-        .iter()
-        .flat_map(|s| s.frame.transpose().to_cols_array())
-        .collect();
-    (pts, fcs, frs)
+/// `call` names the Python function in `MemoryError`.
+fn walker_states(
+    call: &'static str,
+    states: &[walk::State],
+) -> PyResult<(Vec<f64>, Vec<i64>, Vec<f64>)> {
+    let mut pts = alloc::with_capacity(call, alloc::product(call, states.len(), 3, 8)?)?;
+    pts.extend(states.iter().flat_map(|s| s.point.to_array()));
+    let fcs = alloc::collect(call, states.iter().map(|s| s.face as i64))?;
+    let mut frs = alloc::with_capacity(call, alloc::product(call, states.len(), 9, 8)?)?;
+    frs.extend(
+        states
+            .iter()
+            .flat_map(|s| s.frame.transpose().to_cols_array()),
+    );
+    Ok((pts, fcs, frs))
 }
 
 type WalkArrays<'py> = (
@@ -242,12 +250,13 @@ pub fn walk_mesh<'py>(
     })??;
     let (states, path) = (&walk.states, &walk.path);
     let k = states.len();
-    let (pts, fcs, frs) = walker_states(states);
-    let stopped: Vec<bool> = states[1..].iter().map(|s| s.stopped).collect();
+    let (pts, fcs, frs) = walker_states("walk_mesh", states)?;
+    let stopped = alloc::collect("walk_mesh", states[1..].iter().map(|s| s.stopped))?;
     let m = path.len();
-    let pp: Vec<f64> = path.iter().flat_map(|p| p.point.to_array()).collect();
-    let pf: Vec<i64> = path.iter().map(|p| p.face as i64).collect();
-    let pm: Vec<i64> = path.iter().map(|p| p.step as i64).collect();
+    let mut pp = alloc::with_capacity("walk_mesh", alloc::product("walk_mesh", m, 3, 8)?)?;
+    pp.extend(path.iter().flat_map(|p| p.point.to_array()));
+    let pf = alloc::collect("walk_mesh", path.iter().map(|p| p.face as i64))?;
+    let pm = alloc::collect("walk_mesh", path.iter().map(|p| p.step as i64))?;
     Ok((
         PyArray1::from_vec(py, pts).reshape([k, 3])?,
         PyArray1::from_vec(py, fcs),
@@ -297,16 +306,19 @@ pub fn walk_mesh_many<'py>(
     let starts: Vec<walk::Start> = (0..fc.len())
         .map(|i| (fc[i], p[i], d.map(|d| d[i])))
         .collect();
-    let states = detach_in_pool(py, || {
+    let stop = Stop::default();
+    let states = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
-        walk::walk_many(&w, &starts, mv, k)
+        walk::walk_many_cancellable(&w, &starts, mv, k, &|| stop.requested())
     })??;
     let nw = starts.len();
-    let (pts, fcs, frs) = walker_states(&states);
-    let stopped: Vec<bool> = states
-        .chunks(k + 1)
-        .flat_map(|w| w[1..].iter().map(|s| s.stopped))
-        .collect();
+    let (pts, fcs, frs) = walker_states("walk_mesh_many", &states)?;
+    let mut stopped = alloc::with_capacity("walk_mesh_many", nw * k)?;
+    stopped.extend(
+        states
+            .chunks(k + 1)
+            .flat_map(|w| w[1..].iter().map(|s| s.stopped)),
+    );
     Ok((
         PyArray1::from_vec(py, pts).reshape([nw, k + 1, 3])?,
         PyArray1::from_vec(py, fcs).reshape([nw, k + 1])?,

@@ -4,7 +4,8 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyRead
 use pyo3::prelude::*;
 
 use super::convert::{
-    detach_in_pool, empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s, vec3s,
+    Stop, detach_in_pool, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut,
+    slice_of, vec2s, vec3s,
 };
 use crate::sweep::{self, Options, Profile, Spine};
 
@@ -146,8 +147,11 @@ impl Job<'_> {
                     None => None,
                 },
             };
-            let folds = detach_in_pool(py, || {
-                sweep::sweep_into(self.spine, self.offsets, self.p, self.opts, self.lay, out)
+            let stop = Stop::default();
+            let folds = detach_stoppable(py, &stop, || {
+                let cancel = || stop.requested();
+                let (s, o, p, lay) = (self.spine, self.offsets, self.p, self.opts);
+                sweep::sweep_into_cancellable(s, o, p, lay, self.lay, out, &cancel)
             })?;
             let verts: &mut [[R; 3]] = bytemuck::cast_slice_mut(slice_mut(&mut wv)?);
             let uvs: Option<&mut [[R; 2]]> = match wu.as_mut() {

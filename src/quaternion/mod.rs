@@ -30,6 +30,7 @@ pub mod walk;
 use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::frames::tangents::{self as tangent_estimate, TangentRule};
 use crate::frames::{self, Method, Orientation, Request, validate};
@@ -82,7 +83,7 @@ pub fn continuous(q: &[DQuat]) -> Result<Vec<DQuat>> {
             format!("contains non-finite values (row {i})"),
         ));
     }
-    let mut v = q.to_vec();
+    let mut v = alloc::copied("quaternions", q)?;
     make_continuous(&mut v);
     Ok(v)
 }
@@ -98,7 +99,7 @@ pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> 
             ),
         ));
     }
-    let mut q: Vec<DQuat> = Vec::with_capacity(frames.len());
+    let mut q: Vec<DQuat> = alloc::with_capacity("to_quaternions", frames.len())?;
     frames
         .par_iter()
         .with_min_len(GRAIN)
@@ -296,10 +297,12 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
             format!("zero-length tangent at row {i}"),
         ));
     }
-    Ok(t.par_iter()
+    let mut out = alloc::with_capacity("quaternion_frames", t.len())?;
+    t.par_iter()
         .with_min_len(GRAIN)
         .map(|v| crate::math::scale::normalize(*v).unwrap_or(DVec3::Z))
-        .collect())
+        .collect_into_vec(&mut out);
+    Ok(out)
 }
 
 /// The reference vector at row 0 of the rotation-method frames of `x` with unit tangents
@@ -312,7 +315,11 @@ fn default_reference(x: &[DVec3], t: &[DVec3], closed: bool) -> Result<DVec3> {
         method: Method::Rotation,
         ..Request::default()
     };
-    let mut buf = vec![0.0; 9 * x.len()];
+    let mut buf = alloc::filled(
+        "quaternion_frames",
+        alloc::product("quaternion_frames", 9, x.len(), 8)?,
+        0.0,
+    )?;
     frames::compute_into(&req, &mut buf)?;
     Ok(DVec3::new(buf[0], buf[3], buf[6]))
 }
@@ -375,7 +382,7 @@ pub fn transport(
     let r_end = q_end * DVec3::X;
     let alpha = rotation::signed_angle(r_end, r0, t[0]);
     let total = alpha + std::f64::consts::TAU * turns as f64;
-    let mut arc = Vec::with_capacity(n + 1);
+    let mut arc = alloc::with_capacity("quaternion_frames", n + 1)?;
     let mut acc = 0.0;
     arc.push(0.0);
     for i in 0..n {

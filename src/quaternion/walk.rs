@@ -15,6 +15,8 @@
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
+use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh;
 
@@ -292,7 +294,7 @@ impl<'a> Walker<'a> {
             st.face = g;
             st.point = pe;
             entered = Some(kg);
-            path.push((pe, g));
+            alloc::push("walk_mesh", path, (pe, g))?;
         }
         Err(InputError::new(
             "moves",
@@ -329,17 +331,25 @@ pub fn walk_path(
     moves: &[DVec2],
 ) -> Result<Walk> {
     let mut s = w.start(face, point, direction)?;
-    let mut states = Vec::with_capacity(moves.len() + 1);
+    let mut states = alloc::with_capacity("walk_mesh", moves.len() + 1)?;
     states.push(s);
-    let mut path = vec![PathPoint {
+    let mut path = alloc::with_capacity("walk_mesh", moves.len() + 1)?;
+    path.push(PathPoint {
         point: s.point,
         face: s.face,
         step: 0,
-    }];
+    });
     let mut crossings = Vec::new();
     for (k, m) in moves.iter().enumerate() {
         crossings.clear();
         s = w.step(s, *m, &mut crossings)?;
+        path.try_reserve(crossings.len() + 1).map_err(|_| {
+            InputError::out_of_memory(
+                "walk_mesh",
+                path.len() + crossings.len() + 1,
+                size_of::<PathPoint>(),
+            )
+        })?;
         path.extend(crossings.iter().map(|&(point, face)| PathPoint {
             point,
             face,
@@ -363,6 +373,17 @@ pub type Start = (i64, DVec3, Option<DVec3>);
 /// walker (the adjacency is built once, by the caller's [`Walker::new`]). The first error
 /// (in walker order) is reported with the walker's index.
 pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Result<Vec<State>> {
+    walk_many_cancellable(w, starts, moves, k, &cancel::never)
+}
+
+/// [`walk_many`] that polls `cancel` before each move (see [`crate::cancel`]).
+pub fn walk_many_cancellable(
+    w: &Walker,
+    starts: &[Start],
+    moves: &[DVec2],
+    k: usize,
+    cancel: Cancel<'_>,
+) -> Result<Vec<State>> {
     use rayon::prelude::*;
     if moves.len() != starts.len() * k {
         return Err(InputError::new(
@@ -374,26 +395,41 @@ pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Res
             ),
         ));
     }
-    let walks: Vec<Result<Vec<State>>> = starts
-        .par_iter()
+    // every state in one buffer, allocated before any walker runs (the walkers write their
+    // rows in place), so running out of memory is an error here rather than an abort later
+    let total = alloc::product("walk_mesh_many", starts.len(), k + 1, size_of::<State>())?;
+    let blank = State {
+        point: DVec3::ZERO,
+        face: 0,
+        frame: DMat3::IDENTITY,
+        stopped: false,
+    };
+    let mut all = alloc::filled("walk_mesh_many", total, blank)?;
+    let first_error = all
+        .par_chunks_mut(k + 1)
+        .zip(starts.par_iter())
         .enumerate()
-        .map(|(i, &(face, point, dir))| {
+        .filter_map(|(i, (out, &(face, point, dir)))| {
             let ctx = |e: InputError| e.context(&format!("walker {i}"));
-            let mut s = w.start(face, point, dir).map_err(ctx)?;
-            let mut out = Vec::with_capacity(k + 1);
-            out.push(s);
-            let mut crossings = Vec::new();
-            for m in &moves[i * k..(i + 1) * k] {
-                crossings.clear();
-                s = w.step(s, *m, &mut crossings).map_err(ctx)?;
-                out.push(s);
-            }
-            Ok(out)
+            let mut run = || -> Result<()> {
+                let mut s = w.start(face, point, dir).map_err(ctx)?;
+                out[0] = s;
+                let mut crossings = Vec::new();
+                for (j, m) in moves[i * k..(i + 1) * k].iter().enumerate() {
+                    if cancel() {
+                        return Ok(());
+                    }
+                    crossings.clear();
+                    s = w.step(s, *m, &mut crossings).map_err(ctx)?;
+                    out[j + 1] = s;
+                }
+                Ok(())
+            };
+            run().err().map(|e| (i, e))
         })
-        .collect();
-    let mut all = Vec::with_capacity(starts.len() * (k + 1));
-    for r in walks {
-        all.extend(r?);
+        .min_by_key(|(i, _)| *i);
+    if let Some((_, e)) = first_error {
+        return Err(e);
     }
     Ok(all)
 }

@@ -62,6 +62,7 @@ pub mod profile;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::validate;
 pub use profile::Profile;
@@ -362,7 +363,9 @@ pub fn scaled_input(points: &[DVec3], profile: &[DVec2], scale: &[DVec2]) -> Opt
     use crate::math::scale as s;
     let finite = points.iter().all(|p| p.is_finite())
         && profile.iter().all(|p| p.is_finite())
-        && scale.iter().all(|v| v.x > 0.0 && v.y > 0.0 && v.is_finite());
+        && scale
+            .iter()
+            .all(|v| v.x > 0.0 && v.y > 0.0 && v.is_finite());
     if !finite {
         return None;
     }
@@ -393,7 +396,9 @@ pub fn scaled_input(points: &[DVec3], profile: &[DVec2], scale: &[DVec2]) -> Opt
 pub fn unscale<R: Real>(vertices: &mut [[R; 3]], uv: Option<&mut [[R; 2]]>, k: i32) {
     use crate::math::scale::ldexp;
     let back = |x: &mut R| *x = R::of(ldexp(x.to_f64(), -k));
-    vertices.par_iter_mut().for_each(|v| v.iter_mut().for_each(back));
+    vertices
+        .par_iter_mut()
+        .for_each(|v| v.iter_mut().for_each(back));
     if let Some(uv) = uv {
         uv.par_iter_mut().for_each(|t| back(&mut t[0]));
     }
@@ -474,6 +479,7 @@ fn sweep_one<R: Real, I: Index>(
     vbase: usize,
     rowbase: usize,
     out: MeshMut<R, I>,
+    cancel: Cancel<'_>,
 ) -> Vec<usize> {
     // Rings per parallel task: enough work (~4k vertices) to pay for the task.
     let grain = (4096 / plan.cols).max(1);
@@ -491,7 +497,14 @@ fn sweep_one<R: Real, I: Index>(
         rowbase,
     };
     let mut twisted = vec![false; plan.segments];
-    let folds = rings.write(out.vertices, out.normals, out.uv, &mut twisted, grain);
+    let folds = rings.write(
+        out.vertices,
+        out.normals,
+        out.uv,
+        &mut twisted,
+        grain,
+        cancel,
+    );
     let edges = if p.closed { p.len() } else { p.len() - 1 };
     let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
     write_side_faces(side, plan, edges, vbase, sign, &twisted, grain);
@@ -622,6 +635,7 @@ impl Rings<'_> {
         uv: Option<&mut [[R; 2]]>,
         twisted: &mut [bool],
         grain: usize,
+        cancel: Cancel<'_>,
     ) -> Vec<usize> {
         let (r_n, cols) = (self.plan.rings, self.plan.cols);
         let block = grain * cols;
@@ -645,6 +659,9 @@ impl Rings<'_> {
             .flat_map_iter(|(bi, (((bv, mut bn), mut bu), tw))| {
                 let i0 = bi * grain;
                 let mut folds = Vec::new();
+                if cancel() {
+                    return folds;
+                }
                 let mut prev = self.geo((i0 + r_n - 1) % r_n);
                 let mut cur = self.geo(i0 % r_n);
                 for (di, rv) in bv.chunks_mut(cols).enumerate() {
@@ -889,6 +906,19 @@ pub fn sweep_into<R: Real, I: Index>(
     layout: &Layout,
     out: MeshMut<R, I>,
 ) -> Vec<usize> {
+    sweep_into_cancellable(all, offsets, profile, opts, layout, out, &cancel::never)
+}
+
+/// [`sweep_into`] that polls `cancel` before each block of rings (see [`crate::cancel`]).
+pub fn sweep_into_cancellable<R: Real, I: Index>(
+    all: &Spine,
+    offsets: &[usize],
+    profile: &Profile,
+    opts: &Options,
+    layout: &Layout,
+    out: MeshMut<R, I>,
+    cancel: Cancel<'_>,
+) -> Vec<usize> {
     let (nv, nf) = (layout.vertices, layout.faces);
     assert!(
         out.vertices.len() == nv
@@ -946,6 +976,7 @@ pub fn sweep_into<R: Real, I: Index>(
                 vbase,
                 offsets[c],
                 mine,
+                cancel,
             )
         })
         .collect();

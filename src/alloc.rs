@@ -1,0 +1,80 @@
+//! Fallible allocation of buffers whose size comes from the input. Rust's infallible
+//! allocation aborts the process when the allocator refuses (under `ulimit -v`, a container
+//! limit, or a request larger than the address space); these helpers ask with
+//! `try_reserve_exact` and checked multiplication instead, and return
+//! [`InputError::out_of_memory`] naming the call, which the Python binding raises as
+//! `MemoryError`.
+
+use crate::error::{InputError, Result};
+
+/// An empty vector with room for exactly `n` elements.
+pub fn with_capacity<T>(what: &'static str, n: usize) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| InputError::out_of_memory(what, n, size_of::<T>()))?;
+    Ok(v)
+}
+
+/// `n` copies of `value`.
+pub fn filled<T: Clone>(what: &'static str, n: usize, value: T) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, n)?;
+    v.resize(n, value);
+    Ok(v)
+}
+
+/// A copy of `x`.
+pub fn copied<T: Copy>(what: &'static str, x: &[T]) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, x.len())?;
+    v.extend_from_slice(x);
+    Ok(v)
+}
+
+/// The items of an iterator of known length.
+pub fn collect<T>(what: &'static str, it: impl ExactSizeIterator<Item = T>) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, it.len())?;
+    v.extend(it);
+    Ok(v)
+}
+
+/// Push onto a growing vector (amortised doubling, as `Vec::push`), failing instead of
+/// aborting when the next block cannot be had.
+pub fn push<T>(what: &'static str, v: &mut Vec<T>, x: T) -> Result<()> {
+    if v.len() == v.capacity() {
+        v.try_reserve(1).map_err(|_| {
+            InputError::out_of_memory(what, v.len().saturating_mul(2), size_of::<T>())
+        })?;
+    }
+    v.push(x);
+    Ok(())
+}
+
+/// `a · b` elements, or the out-of-memory error when the product overflows `usize`.
+pub fn product(what: &'static str, a: usize, b: usize, size: usize) -> Result<usize> {
+    a.checked_mul(b)
+        .filter(|n| {
+            n.checked_mul(size)
+                .is_some_and(|b| b <= isize::MAX as usize)
+        })
+        .ok_or_else(|| InputError::out_of_memory(what, a.saturating_mul(b), size))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::ErrorKind;
+
+    #[test]
+    fn refusals_are_errors_not_aborts() {
+        let e = with_capacity::<[f64; 3]>("frames", usize::MAX / 8).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::OutOfMemory);
+        assert!(e.to_string().starts_with("frames: out of memory"), "{e}");
+        assert!(filled("x", usize::MAX / 2, 0u64).is_err());
+        assert!(product("x", usize::MAX / 2, 3, 1).is_err());
+        assert!(product("x", 1 << 40, 1 << 20, 8).is_err());
+        assert_eq!(product("x", 3, 4, 8), Ok(12));
+        let mut v = Vec::new();
+        push("x", &mut v, 1u8).unwrap();
+        assert_eq!(copied("x", &v).unwrap(), vec![1]);
+        assert_eq!(collect("x", [1, 2].into_iter()).unwrap(), vec![1, 2]);
+    }
+}

@@ -1,0 +1,221 @@
+"""Runtime rows of the robustness review (shared/reviews/robustness-defects.md): running out
+of memory raises ``MemoryError`` instead of aborting the interpreter (D16), Ctrl-C stops a
+long call promptly (D17), ``ph.fit`` bounds ``segments`` (D22).
+
+The memory tests run each reproducer in a child process whose address space is limited
+(``RLIMIT_AS``) to what it already holds plus a small headroom, with inputs whose outputs
+or working buffers need several times that headroom: the child must catch ``MemoryError``
+and exit normally (before the fix several of them died of SIGABRT, 'memory allocation of N
+bytes failed'). The Ctrl-C tests send SIGINT from a timer thread inside the child and
+measure, in the child, the time from the signal to the ``KeyboardInterrupt``.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+import spinal
+from spinal import ph
+
+pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and SIGINT: Linux")
+
+# address space the child may still map after building its inputs
+HEADROOM = 100 << 20
+
+PRELUDE = """
+import resource, sys, numpy as np, trimesh, spinal
+from spinal import ph, quaternions as Q
+spinal.set_num_threads(2)
+u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]
+spinal.frames(H); spinal.tube(H, .1, 8)  # the worker pool and its arenas exist
+"""
+
+LIMIT = """
+def vm_size():
+    for line in open('/proc/self/status'):
+        if line.startswith('VmSize:'):
+            return int(line.split()[1]) * 1024
+lim = vm_size() + {headroom}
+resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
+try:
+    {call}
+except MemoryError as e:
+    print('MemoryError:', e)
+    sys.exit(0)
+print('no MemoryError')
+sys.exit(3)
+"""
+
+
+def run_limited(setup: str, call: str) -> subprocess.CompletedProcess:
+    code = PRELUDE + textwrap.dedent(setup) + LIMIT.format(headroom=HEADROOM, call=call)
+    return subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                          text=True, timeout=300)
+
+
+# name: (inputs built before the limit, the call, the words of the MemoryError)
+D16_CASES = {
+    "estimate_tangents": (
+        ("n = 10_000_000; s = np.linspace(0, 2000, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.estimate_tangents(X)", "estimate_tangents: out of memory"),
+    "to_quaternions": (
+        "F = np.ascontiguousarray(np.broadcast_to(np.eye(3), (4_000_000, 3, 3)))\n",
+        "Q.to_quaternions(F)", ""),
+    "quaternion_frames": (
+        ("n = 4_000_000; s = np.linspace(0, 800, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "Q.quaternion_frames(X)", ""),
+    "walk_mesh": (
+        "b = trimesh.creation.box()\n",
+        "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), [[3e7, .1234]])",
+        "walk_mesh: out of memory"),
+    "walk_mesh_many": (
+        ("b = trimesh.creation.box(); w, k = 100_000, 60\n"
+        "P = np.repeat(b.vertices[b.faces[0]].mean(0)[None], w, 0)\n"
+        "M = np.tile([[.01, .1]], (w, k, 1))\n"),
+        "Q.walk_mesh_many(b.vertices, b.faces, np.zeros(w, int), P, M)",
+        "walk_mesh_many: out of memory"),
+    "stamp": (
+        ("s = trimesh.creation.icosphere(2)\n"
+        "V = np.vstack([s.vertices, np.random.default_rng(0).normal(size=(6_000_000, 3))])\n"),
+        "spinal.stamp((V, s.faces), [0, 0, 1.32], [0, 0, 1.1], .3)", "stamp: out of memory"),
+    "SpineBinding": (
+        "V = np.random.default_rng(0).normal(size=(5_000_000, 3))\n",
+        "spinal.SpineBinding(V, H)", "SpineBinding: out of memory"),
+    "flesh": (
+        "V = np.random.default_rng(0).normal(size=(5_000_000, 3))\n",
+        "spinal.flesh(V, H, H * 1.1)", "out of memory"),
+    "SurfaceBinding": (
+        ("g = np.stack(np.meshgrid(np.linspace(0, 1, 8), np.linspace(0, 1, 9), indexing='ij'), -1)\n"
+        "S = np.concatenate([g, np.zeros(g.shape[:2] + (1,))], -1)\n"
+        "V = np.random.default_rng(0).uniform(size=(5_000_000, 3))\n"),
+        "spinal.SurfaceBinding(V, S)", "SurfaceBinding: out of memory"),
+    "ph.hermite": (
+        "m = 1_000_000; P0 = np.zeros((m, 3)); P1 = np.ones((m, 3)); T = np.ones((m, 3))\n",
+        "ph.hermite(P0, T, P1, T)", ""),
+    "PHSpline.evaluate": (
+        ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
+        "s = np.linspace(0, 1, 10_000_000)\n"),
+        "sp.evaluate(s)", ""),
+}
+
+
+@pytest.mark.parametrize("name", list(D16_CASES))
+def test_D16_out_of_memory_raises_memory_error(name):
+    setup, call, words = D16_CASES[name]
+    r = run_limited(setup, call)
+    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
+    assert "MemoryError:" in r.stdout, r.stdout
+    assert words in r.stdout, r.stdout
+
+
+def test_D16_memory_error_comes_from_the_core_not_an_abort():
+    """The review's reproducer: a 3e7-long move asks for a 2.4 GB crossing path; the walk
+    grows its path fallibly and says which call ran out."""
+    r = run_limited("b = trimesh.creation.box()\n",
+                    "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), "
+                    "[[3e7, .1234]])")
+    assert r.returncode == 0 and "walk_mesh: out of memory" in r.stdout, (r.stdout, r.stderr)
+
+
+def test_D16_small_calls_unchanged_under_a_limit():
+    r = run_limited("", "print(spinal.estimate_tangents(H).shape); raise MemoryError('fine')")
+    assert r.returncode == 0 and "(60, 3)" in r.stdout, (r.stdout, r.stderr)
+
+
+def test_D22_fit_segments_is_bounded():
+    with pytest.raises(ValueError, match=r"^segments: must be <= 100000"):
+        ph.fit(spinal.curves.Helix(), segments=10**7)
+    assert ph.fit(spinal.curves.Helix(), segments=4).segments == 4
+
+
+# ------------------------------------------------------------------------------ Ctrl-C
+
+SIGINT_CHILD = """
+import os, signal, sys, threading, time
+import numpy as np, trimesh, spinal
+from spinal import fields as fl, quaternions as Q, ph
+spinal.set_num_threads(2)
+{setup}
+sent = []
+def fire():
+    sent.append(time.perf_counter())
+    os.kill(os.getpid(), signal.SIGINT)
+threading.Timer({after}, fire).start()
+start = time.perf_counter()
+try:
+    {call}
+except KeyboardInterrupt:
+    late = time.perf_counter() - sent[0]
+    print(f'interrupted {{late:.3f}} s after the signal')
+    sys.exit(0)
+print(f'finished after {{time.perf_counter() - start:.1f}} s, no KeyboardInterrupt')
+sys.exit(3)
+"""
+
+
+def late_after_sigint(setup: str, call: str, after: float = 0.5) -> float:
+    code = SIGINT_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after)
+    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                       text=True, timeout=600)
+    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
+    return float(r.stdout.split()[1])
+
+
+D17_CASES = {
+    "advect": (
+        ("P = np.random.default_rng(0).normal(size=(2_000_000, 3))\n"
+        "f = fl.translation([0, 0, 1.32], .3, [0, 0, -1])\n"),
+        "spinal.advect(P, f, .3, 200)"),
+    "advect_many_steps": (
+        "f = fl.translation([0, 0, 1.32], .3, [0, 0, -1])\n",
+        "spinal.advect(np.zeros((10, 3)), f, .3, 10**8)"),
+    "deform": (
+        "s = trimesh.creation.icosphere(6); f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n",
+        "spinal.deform(s, f, 1.0, 20000)"),
+    "frames_bundle": (
+        ("s = np.linspace(0, 40, 5000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "X = np.concatenate([C + i for i in range(2000)])\n"),
+        "spinal.frames(X, lengths=[5000] * 2000)"),
+    "flesh": (
+        ("u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]\n"
+         "V = np.random.default_rng(0).normal(size=(3_000_000, 3))\n"),
+        "spinal.flesh(V, H, H * 1.1)"),
+    "walk_mesh_many": (
+        ("b = trimesh.creation.icosphere(4); w, k = 1000, 2000\n"
+         "P = b.vertices[b.faces[:w]].mean(1); M = np.tile([[2.0, .1]], (w, k, 1))\n"),
+        "Q.walk_mesh_many(b.vertices, b.faces, np.arange(w), P, M)"),
+    "SurfaceBinding": (
+        ("g = np.stack(np.meshgrid(np.linspace(0, 1, 40), np.linspace(0, 1, 40),\n"
+         "                         indexing='ij'), -1)\n"
+         "S = np.concatenate([g, np.zeros(g.shape[:2] + (1,))], -1)\n"
+         "V = np.random.default_rng(0).uniform(size=(2_000_000, 3))\n"),
+        "spinal.SurfaceBinding(V, S)"),
+    "stamp": (
+        "s = trimesh.creation.icosphere(5)\n",
+        "spinal.stamp(s, [0, 0, 1.32], [0, 0, 0.2], .5, frames=100_000)"),
+}
+
+
+@pytest.mark.parametrize("name", list(D17_CASES))
+def test_D17_ctrl_c_within_half_a_second(name):
+    setup, call = D17_CASES[name]
+    assert late_after_sigint(setup, call) < 0.5
+
+
+def test_D17_threads_setting_keeps_results():
+    """The calls stay bit-identical with the signal-watching pool (review: threads
+    bit-identical)."""
+    u = np.linspace(0, 4 * np.pi, 60)
+    h = np.c_[np.cos(u), np.sin(u), 0.2 * u]
+    with spinal.threads(1):
+        a = spinal.frames(h)
+    with spinal.threads(2):
+        b = spinal.frames(h)
+    np.testing.assert_array_equal(a, b)
