@@ -231,9 +231,7 @@ impl GridTool {
             let (mut s0, mut sy) = ([0.0; 4], [0.0; 4]);
             for b in 0..4 {
                 let base = ((idx[0] + a) * py + idx[1] + b) * pz + idx[2];
-                let Some(cs) = self.coef.get(base..base + 4) else {
-                    return None;
-                };
+                let cs = self.coef.get(base..base + 4)?;
                 for c in 0..4 {
                     s0[c] += wy[b] * cs[c];
                     sy[c] += dy[b] * cs[c];
