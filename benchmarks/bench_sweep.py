@@ -16,8 +16,9 @@ Same spine (a helix), same number of sides, one run. For every size it times
 and prints a float64 table with the ratios, then the float32 table against VTK. The default
 run adds 1 000 curves of 1 000 points (spinal in one call with ``lengths``; VTK one PolyData
 with 1 000 polylines; ``--no-bundle`` leaves it out). ``--bundle`` adds the big bundle:
-100 000 streamlines of ~96 points (≈ 9.6 M points, 8 sides), time and peak memory of every
-call measured in a fresh process (spinal float32 and float64, VTK strips and triangles).
+100 000 streamlines of 96 points (9.6 M points, 8 sides), time and peak memory of every
+call measured in a fresh process (spinal float32 and VTK strips; ``--bundle-all`` adds
+spinal float64 and VTK strips + triangulate).
 
     python benchmarks/bench_sweep.py              # 10^3 … 10^6 spine points
     python benchmarks/bench_sweep.py --max 2e5
@@ -179,13 +180,15 @@ print(json.dumps({"s": t, "peak": status("VmHWM:") - before, "output": size(out)
 """
 
 
-def bundle_rows(curves=100_000, per=96, sides=8):
+def bundle_rows(curves=100_000, per=96, sides=8, everything=False):
     """Time and peak memory of each call on the big bundle, each in a fresh process (so the
-    peaks do not mix); a call that fails (memory) is reported as such."""
+    peaks do not mix); a call that fails (memory) is reported as such. ``everything`` adds
+    spinal float64 (~9.3 GB) and VTK strips + triangulate (~8 GB)."""
     rows = []
-    whats = ["spinal float32", "spinal float64"]
-    if "pv" in peers():
-        whats += ["vtk strips", "vtk triangles"]
+    has_vtk = "pv" in peers()
+    whats = ["spinal float32"] + (["vtk strips"] if has_vtk else [])
+    if everything:
+        whats += ["spinal float64"] + (["vtk triangles"] if has_vtk else [])
     for what in whats:
         r = subprocess.run([sys.executable, "-c", BUNDLE_CHILD, what, str(curves), str(per),
                             str(sides)], capture_output=True, text=True, check=False)
@@ -203,7 +206,11 @@ def main():
     ap.add_argument("--no-bundle", action="store_true",
                     help="leave out the 1,000-curve bundle row")
     ap.add_argument("--bundle", action="store_true",
-                    help="add the 100,000-streamline bundle (~9.6 M points, 8 sides; ~10 GB)")
+                    help="add the 100,000-streamline bundle (~9.6 M points, 8 sides): spinal "
+                         "float32 and VTK strips (~5 GB each)")
+    ap.add_argument("--bundle-all", action="store_true",
+                    help="with --bundle: also spinal float64 and VTK strips + triangulate "
+                         "(~9 GB each)")
     args = ap.parse_args()
     sizes = [n for n in (1_000, 10_000, 100_000, 200_000, 1_000_000) if n <= args.max]
     rows = run(sizes, args.repeat, not args.no_bundle)
@@ -238,7 +245,7 @@ def main():
               "process; peak = VmHWM growth of the call (reset before it)\n")
         print("| call | time s | peak GB | output GB | peak / output | bytes per point |")
         print("|---|---|---|---|---|---|")
-        for what, res, err in bundle_rows():
+        for what, res, err in bundle_rows(everything=args.bundle_all):
             if res is None:
                 print(f"| {what} | failed: {err[0][:80]} | | | | |")
                 continue
