@@ -14,7 +14,7 @@ def test_D10_mesh_validates_its_arrays():
     an out-of-range one raised IndexError from .volume, float faces were truncated and
     (V, 2) vertices gave an einsum error."""
     with pytest.raises(ValueError, match="faces: face 0 refers to vertex -1, but there are 3"):
-        spinal.Mesh(np.eye(3), [[0, 1, -1]]).volume  # the review's reproducer
+        _ = spinal.Mesh(np.eye(3), [[0, 1, -1]]).volume  # the review's reproducer
     with pytest.raises(ValueError, match="faces: face 0 refers to vertex 7"):
         spinal.Mesh(np.eye(3), [[0, 1, 7]])
     with pytest.raises(TypeError, match="faces: expected integer vertex indices, got dtype float"):

@@ -240,9 +240,9 @@ def test_fold_over_warning_names_curves_and_local_rows():
     np.testing.assert_array_equal(mesh.fold_over, local + 121)
     assert alone.fold_over.size == local.size
     # rows and curves as given, also past a skipped curve
-    with pytest.warns(spinal.FoldOverWarning, match=r"\(curve 2 rows ") as rec:
-        with pytest.warns(spinal.SkippedCurvesWarning):
-            mesh = spinal.tube([straight, bend[:1], bend], 0.15, 8, on_short="skip")
+    with (pytest.warns(spinal.FoldOverWarning, match=r"\(curve 2 rows ") as rec,
+          pytest.warns(spinal.SkippedCurvesWarning)):
+        mesh = spinal.tube([straight, bend[:1], bend], 0.15, 8, on_short="skip")
     np.testing.assert_array_equal(rec[0].message.indices, local + 122)
     np.testing.assert_array_equal(mesh.fold_over, local + 122)
     np.testing.assert_array_equal(rec[0].message.rows, local)
