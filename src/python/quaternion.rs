@@ -36,7 +36,7 @@ pub fn quat_spin<'py>(
     b: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (fa, fb) = (frames_of("a", &a)?, frames_of("b", &b)?);
-    let out = py.detach(|| quaternion::spin::spin(fa, fb))?;
+    let out = detach_in_pool(py, || quaternion::spin::spin(fa, fb))??;
     Ok(PyArray1::from_vec(py, out))
 }
 
