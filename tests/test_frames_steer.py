@@ -400,3 +400,11 @@ def test_bundles_take_guides_and_previous_per_curve():
     got = spinal.frames(both, lengths=lengths, previous=prev)
     assert np.abs(got[: len(x)] - prev[: len(x)]).max() < 1e-12
     assert np.abs(got[len(x) :] - prev[len(x) :]).max() < 1e-12
+
+
+def test_steered_frames_refuse_tangents_of_another_length():
+    """Found by the randomized harness: per-interval ``turns`` with tangents of the wrong
+    length reached the steered path unchecked."""
+    x = np.c_[np.cos(np.linspace(0, 1, 5)), np.sin(np.linspace(0, 1, 5)), np.zeros(5)]
+    with pytest.raises(ValueError, match="^tangents"):
+        spinal.frames(x, np.zeros((0, 3)), turns=[1, 1])

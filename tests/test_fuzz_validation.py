@@ -68,7 +68,8 @@ def rand_scalar(rng, kind):
 ARGS = {"points", "tangents", "method", "initial", "closed", "end", "turns", "reflection", "u",
         "lengths", "offsets", "profile", "frames", "scale", "twist", "caps", "profile_closed",
         "miter_limit", "split_seams", "strict", "radius", "sides"}
-NAMED = re.compile(r"^([a-z_]+)(, [a-z_]+)*:")
+# an argument, or an element of one ("points[3]: ..." for a curve of a list)
+NAMED = re.compile(r"^([a-z_]+)(\[\d+\])?(, [a-z_]+)*:")
 
 
 def check(call, expect_shape):
@@ -79,7 +80,8 @@ def check(call, expect_shape):
             out = call()
     except (ValueError, TypeError) as e:
         m = NAMED.match(str(e))
-        if not m or not set(m.group(0).rstrip(":").split(", ")) <= ARGS:
+        names = re.sub(r"\[\d+\]", "", m.group(0)).rstrip(":").split(", ") if m else []
+        if not m or not set(names) <= ARGS:
             return f"{type(e).__name__} not naming an argument: {e}"
         return None
     except Exception as e:  # noqa: BLE001 - any other type is the failure we look for

@@ -37,7 +37,10 @@ def exception_classes():
 def instance(cls):
     """An instance with every ``__init__`` argument set to something recognisable."""
     if cls is spinal.FoldOverWarning:
-        return cls("spine rows 3–5 fold over", np.array([3, 4, 5]))
+        return cls("spine rows 3–5 fold over", np.array([3, 4, 5]), np.array([0, 0, 1]),
+                   np.array([3, 4, 0]))
+    if cls is spinal.SkippedCurvesWarning:
+        return cls("curves 2, 7 left out", np.array([2, 7]))
     return cls(f"a {cls.__name__}")
 
 

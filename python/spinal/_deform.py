@@ -316,12 +316,10 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     a, b = as_vector(start, "start"), as_vector(end, "end")
     rho = _positive(radius, "radius")
     reach = rho if reach is None else _positive(reach, "reach")
-    frames = as_int(frames, "frames")
-    if not 1 <= frames <= MAX_FRAMES:
-        raise ValueError(f"frames: must be at least 1 and at most {MAX_FRAMES:,}, got {frames}")
-    iterations = as_int(iterations, "iterations")
-    if not 0 <= iterations <= MAX_ITERATIONS:
-        raise ValueError(f"iterations: must be ≥ 0 and at most {MAX_ITERATIONS}, got {iterations}")
+    frames = as_int(frames, "frames", 1, MAX_FRAMES, out_of_bounds=lambda x: (
+        f"must be at least 1 and at most {MAX_FRAMES:,}, got {x}"))
+    iterations = as_int(iterations, "iterations", 0, MAX_ITERATIONS, out_of_bounds=lambda x: (
+        f"must be ≥ 0 and at most {MAX_ITERATIONS}, got {x}"))
     W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations)
     rest, vol = _volume(V, F), _volume(W, F)
     change = vol / rest - 1 if rest != 0 else float("nan")

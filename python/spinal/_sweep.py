@@ -426,11 +426,10 @@ def tube(
     ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``) as in
     :func:`sweep`.
     """
-    sides = as_int(sides, "sides")
-    if sides < 3:  # the core sees only the polygon built here
-        raise ValueError(f"sides: a tube needs at least 3 sides, got {sides}")
-    if sides > MAX_SIDES:
-        raise ValueError(f"sides: at most {MAX_SIDES:,} (2**20) sides, got {sides:,}")
+    # the core sees only the polygon built here
+    sides = as_int(sides, "sides", 3, MAX_SIDES, out_of_bounds=lambda x: (
+        f"a tube needs at least 3 sides, got {x}" if x < 3
+        else f"at most {MAX_SIDES:,} (2**20) sides, got {x:,}"))
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
     # the core checks the radius' values, naming radius

@@ -191,12 +191,19 @@ def as_positive(x: Any, name: str) -> float:
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
 
-def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None) -> int:
+def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None, *,
+           out_of_bounds=None) -> int:
     """A Python int (not a bool) that fits a 64-bit integer, within ``[minimum, maximum]``
-    when given."""
+    when given. ``out_of_bounds(x)``, when given, words the error for a value outside the
+    bounds (checked first, so a huge value gets the argument's own limits)."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
     x = int(x)
+    if out_of_bounds is not None and (
+            (minimum is not None and x < minimum) or (maximum is not None and x > maximum)):
+        huge = "" if INT64_MIN <= x <= INT64_MAX else (
+            " (out of the representable range of a 64-bit integer, too)")
+        raise ValueError(f"{name}: {out_of_bounds(x)}{huge}")
     if not INT64_MIN <= x <= INT64_MAX:
         raise ValueError(f"{name}: {x} is out of the representable range of a 64-bit "
                          f"integer [-2**63, 2**63 - 1]")

@@ -236,6 +236,9 @@ pub fn compute_steered_many(
         .map(<[DVec3]>::len)
         .or(template.tangents.map(<[DVec3]>::len))
         .unwrap_or(0);
+    if let (Some(p), Some(t)) = (template.points, template.tangents) {
+        super::rows_match(p, t)?;
+    }
     validate::offsets(offsets, total)?;
     if out.len() != 9 * total || (steer.len() != 1 && steer.len() != curves) {
         return Err(InputError::new("out", "output buffer has the wrong size"));
