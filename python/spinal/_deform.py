@@ -316,10 +316,10 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     a, b = as_vector(start, "start"), as_vector(end, "end")
     rho = _positive(radius, "radius")
     reach = rho if reach is None else _positive(reach, "reach")
-    frames = as_int(frames, "frames")
+    frames = as_int(frames, "frames", any_size=True)  # bounded here
     if not 1 <= frames <= MAX_FRAMES:
         raise ValueError(f"frames: must be at least 1 and at most {MAX_FRAMES:,}, got {frames}")
-    iterations = as_int(iterations, "iterations")
+    iterations = as_int(iterations, "iterations", any_size=True)  # bounded here
     if not 0 <= iterations <= MAX_ITERATIONS:
         raise ValueError(f"iterations: must be ≥ 0 and at most {MAX_ITERATIONS}, got {iterations}")
     W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations)

@@ -33,7 +33,7 @@ def _spine(x, name: str) -> tuple[np.ndarray, int]:
     if dim == 2:
         arr = np.c_[arr, np.zeros(len(arr))]
     arr = np.ascontiguousarray(arr)
-    rep = np.flatnonzero(np.linalg.norm(np.diff(arr, axis=0), axis=1) <= 1e-12 * _scale(arr))
+    rep = np.flatnonzero(_norms(np.diff(arr, axis=0)) <= 1e-12 * _scale(arr))
     if rep.size:
         raise ValueError(f"{name}: rows {rep[0]} and {rep[0] + 1} repeat the same point")
     return arr, dim
@@ -43,8 +43,13 @@ def _scale(a: np.ndarray) -> float:
     return max(float(np.abs(a).max(initial=0.0)), 1e-300)
 
 
+def _norms(d: np.ndarray) -> np.ndarray:
+    """Row lengths without overflow or underflow in the squares (hypot)."""
+    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+
+
 def _arc(points: np.ndarray) -> np.ndarray:
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    return np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
 
 
 def _resample(posed: np.ndarray, chords: np.ndarray) -> np.ndarray:

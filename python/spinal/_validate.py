@@ -142,13 +142,15 @@ def as_positive(x: Any, name: str) -> float:
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
 
-def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None) -> int:
+def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None, *,
+           any_size: bool = False) -> int:
     """A Python int (not a bool) that fits a 64-bit integer, within ``[minimum, maximum]``
-    when given."""
+    when given. ``any_size``: skip the 64-bit check (for a caller that bounds the value
+    itself, with its own message, before it reaches the core)."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
     x = int(x)
-    if not INT64_MIN <= x <= INT64_MAX:
+    if not any_size and not INT64_MIN <= x <= INT64_MAX:
         raise ValueError(f"{name}: {x} is out of the representable range of a 64-bit "
                          f"integer [-2**63, 2**63 - 1]")
     if minimum is not None and x < minimum:
