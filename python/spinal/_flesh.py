@@ -36,12 +36,12 @@ def _spine(x, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
         arr = np.c_[arr, np.zeros(len(arr))]
     arr = np.ascontiguousarray(arr)
     tol = 1e-12 * _scale(arr)
-    if closed and len(arr) > 1 and np.linalg.norm(arr[-1] - arr[0]) <= tol:
+    if closed and len(arr) > 1 and float(_norms((arr[-1] - arr[0])[None])[0]) <= tol:
         arr = arr[:-1]
     if closed and len(arr) < 3:
         raise ValueError(f"{name}: a closed spine needs at least 3 distinct points, got "
                          f"{len(arr)}")
-    rep = np.flatnonzero(np.linalg.norm(np.diff(arr, axis=0), axis=1) <= tol)
+    rep = np.flatnonzero(_norms(np.diff(arr, axis=0)) <= tol)
     if rep.size:
         raise ValueError(f"{name}: rows {rep[0]} and {rep[0] + 1} repeat the same point")
     return arr, dim
@@ -70,8 +70,13 @@ def _scale(a: np.ndarray) -> float:
     return max(float(np.abs(a).max(initial=0.0)), 1e-300)
 
 
+def _norms(d: np.ndarray) -> np.ndarray:
+    """Row lengths without overflow or underflow in the squares (hypot)."""
+    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+
+
 def _arc(points: np.ndarray) -> np.ndarray:
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    return np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
 
 
 def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
