@@ -220,7 +220,8 @@ class Mesh:
         """A sweep's mesh without the checks (the core built it); ``rings`` is the compact
         vertex layout ``(ring_sample (R,), ring_curve (R,), cols)``: stored ring ``r`` holds
         vertices ``r*cols .. (r+1)*cols`` of spine row ``ring_sample[r]``, curve
-        ``ring_curve[r]``; the sweep had ``rows`` spine rows in ``curves`` curves."""
+        ``ring_curve[r]`` (or a function returning it, called when first needed); the sweep
+        had ``rows`` spine rows in ``curves`` curves."""
         mesh = cls.__new__(cls)
         mesh.vertices, mesh.faces, mesh.normals, mesh.uv = vertices, faces, normals, uv
         mesh.fold_over = np.asarray(fold_over, dtype=np.int64)
@@ -230,11 +231,18 @@ class Mesh:
         mesh.skipped_curves = np.zeros(0, dtype=np.int64)
         return mesh
 
+    def _ring_arrays(self):
+        """The sweep's ring layout ``(ring_sample, ring_curve, cols)``, built on first use."""
+        if callable(self._rings):
+            self._rings = self._rings()
+        return self._rings
+
     @property
     def sample_of(self) -> np.ndarray | None:
         """The spine row of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._sample_of is None and self._rings is not None:
-            self._sample_of = np.repeat(self._rings[0], self._rings[2])
+            rings = self._ring_arrays()
+            self._sample_of = np.repeat(rings[0], rings[2])
         return self._sample_of
 
     @sample_of.setter
@@ -245,7 +253,8 @@ class Mesh:
     def curve_of(self) -> np.ndarray | None:
         """The curve of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._curve_of is None and self._rings is not None:
-            self._curve_of = np.repeat(self._rings[1], self._rings[2])
+            rings = self._ring_arrays()
+            self._curve_of = np.repeat(rings[1], rings[2])
         return self._curve_of
 
     @curve_of.setter

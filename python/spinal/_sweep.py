@@ -311,8 +311,11 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         warnings.warn(FoldOverWarning(msg, folds, fold_curves, local), stacklevel=3)
     mesh = Mesh._of_sweep(v, f, nrm, uv, folds, rings, n, curves)
     mesh.skipped_curves = skipped
-    for k, (a, per_curve) in pdata.items():
-        mesh.point_data[k] = np.repeat(a[rings[1] if per_curve else rings[0]], rings[2], axis=0)
+    if pdata:
+        rings = mesh._ring_arrays()
+        for k, (a, per_curve) in pdata.items():
+            mesh.point_data[k] = np.repeat(a[rings[1] if per_curve else rings[0]], rings[2],
+                                           axis=0)
     if bundle:
         fc = np.searchsorted(vstart, f[:, 0], side="right") - 1
         small = curves <= np.iinfo(np.int32).max
@@ -373,8 +376,9 @@ def _point_data(data, n: int, curves: int | None) -> dict:
 def _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, nv):
     """The stored rings of a sweep, as the core lays them out: per curve, one ring per
     distinct sample (a closed curve's repeated first point has none; split seams on a
-    closed curve repeat its first ring at the end). Returns ``(ring_sample, ring_curve,
-    cols)`` (given rows and curves) and the first vertex of every curve ``(C + 1,)``."""
+    closed curve repeat its first ring at the end). Returns a function giving ``(ring_sample,
+    ring_curve, cols)`` (given rows and curves; O(rings) memory, so only built when asked
+    for) and the first vertex of every curve ``(C + 1,)``."""
     lens = np.diff(offs)
     rings = lens.copy()
     if closed:
@@ -388,10 +392,14 @@ def _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, nv):
     if cols * total != nv:
         raise RuntimeError("spinal: the sweep's vertex layout is not one ring per sample")
     starts = np.concatenate([[0], np.cumsum(stored)])
-    local = np.arange(total) - np.repeat(starts[:-1], stored)
-    sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
-    return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64),
-            cols), starts * cols
+
+    def per_ring():
+        local = np.arange(total) - np.repeat(starts[:-1], stored)
+        sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
+        return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64),
+                cols)
+
+    return per_ring, starts * cols
 
 
 def tube(
