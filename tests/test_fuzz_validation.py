@@ -67,7 +67,9 @@ def rand_scalar(rng, kind):
 
 ARGS = {"points", "tangents", "method", "initial", "closed", "end", "turns", "reflection", "u",
         "lengths", "offsets", "profile", "frames", "scale", "twist", "caps", "profile_closed",
-        "miter_limit", "split_seams", "strict", "radius", "sides"}
+        "miter_limit", "split_seams", "strict", "radius", "sides", "constraints", "twist_rule",
+        "guide", "guide_weight", "guide_tolerance", "previous", "tangent_rule", "dtype",
+        "normals", "uv", "point_data", "on_short"}
 # an argument, or an element of one ("points[3]: ..." for a curve of a list)
 NAMED = re.compile(r"^([a-z_]+)(\[\d+\])?(, [a-z_]+)*:")
 

@@ -218,8 +218,9 @@ fn strictly_convex(p: &[DVec2]) -> bool {
     (turning.abs() - std::f64::consts::TAU).abs() < 1.0
 }
 
-/// Square cells of side `side` (the median edge length) holding items (edges or vertices),
-/// sorted by cell: memory and time follow the items, not the bounding box.
+/// Square cells of side `side` (the median edge length, but at least a quarter of the mean, so
+/// that a few edges far longer than the rest cross O(m) cells in all) holding items (edges or
+/// vertices), sorted by cell: memory and time follow the items, not the bounding box.
 struct Cells {
     lo: DVec2,
     inv: f64,
@@ -234,8 +235,11 @@ impl Cells {
         let mut len: Vec<f64> = (0..edges)
             .map(|j| (p[(j + 1) % m] - p[j]).length())
             .collect();
+        let total: f64 = len.iter().sum();
         let mid = len.len() / 2;
-        let side = *len.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let median = *len.select_nth_unstable_by(mid, f64::total_cmp).1;
+        // Σ (2 len / side + 1) ≤ 8 edges + edges samples of 9 cells each
+        let side = median.max(total / (4.0 * edges as f64));
         let lo = p.iter().fold(DVec2::INFINITY, |a, &q| a.min(q)) - DVec2::splat(side);
         Cells {
             lo,
@@ -417,6 +421,28 @@ mod tests {
         tris.iter()
             .map(|t| 0.5 * cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]))
             .sum()
+    }
+
+    /// One edge 3e9 times longer than the others: the binning stays O(m) (it asked for
+    /// 8 GiB once, aborting the process).
+    #[test]
+    fn one_long_edge_bins_into_few_cells() {
+        let t = 2.99865106e-10;
+        let p = [
+            DVec2::new(t, 0.0),
+            DVec2::new(0.0, t),
+            DVec2::new(-t, 0.0),
+            DVec2::new(-1.0, -t),
+        ];
+        for closed in [false, true] {
+            let mut cells = Cells::new(&p, closed);
+            let edges = if closed { p.len() } else { p.len() - 1 };
+            for e in 0..edges {
+                cells.add_segment(p[e], p[(e + 1) % p.len()], e);
+            }
+            assert!(cells.items.len() <= 9 * 10 * edges, "{}", cells.items.len());
+        }
+        assert!(Profile::new(&p, false).is_ok());
     }
 
     #[test]
