@@ -402,6 +402,8 @@ class SurfaceBinding:
     def uv(self) -> _F: ...
     @property
     def offset(self) -> _F: ...
+    @property
+    def rest_frames(self) -> _F: ...
     @overload
     def deform(
         self,
@@ -410,6 +412,8 @@ class SurfaceBinding:
         solution: _SurfaceSolution = "offset",
         strict: bool = False,
         return_clamped: Literal[False] = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F: ...
     @overload
     def deform(
@@ -419,6 +423,8 @@ class SurfaceBinding:
         solution: _SurfaceSolution = "offset",
         strict: bool = False,
         return_clamped: Literal[True],
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> tuple[_F, _I]: ...
     @overload
     def deform(
@@ -428,6 +434,8 @@ class SurfaceBinding:
         solution: _SurfaceSolution = "offset",
         strict: bool = False,
         return_clamped: bool = False,
+        posed_frames: _Array | None = None,
+        posed_up: _Array | None = None,
     ) -> _F | tuple[_F, _I]: ...
 
 @overload
@@ -439,6 +447,8 @@ def flesh_surface(
     solution: _SurfaceSolution = "offset",
     strict: bool = False,
     return_clamped: Literal[False] = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F: ...
 @overload
 def flesh_surface(
@@ -449,6 +459,8 @@ def flesh_surface(
     solution: _SurfaceSolution = "offset",
     strict: bool = False,
     return_clamped: Literal[True],
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> tuple[_F, _I]: ...
 @overload
 def flesh_surface(
@@ -459,6 +471,8 @@ def flesh_surface(
     solution: _SurfaceSolution = "offset",
     strict: bool = False,
     return_clamped: bool = False,
+    posed_frames: _Array | None = None,
+    posed_up: _Array | None = None,
 ) -> _F | tuple[_F, _I]: ...
 
 # ---- worker threads -----------------------------------------------------------------------

@@ -403,6 +403,7 @@ def flesh_surface_deform(
     cell: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
     corrected: bool,
+    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def stamp(
     vertices: npt.NDArray[np.float64],

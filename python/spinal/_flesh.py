@@ -601,6 +601,53 @@ def _grid(x, name: str) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
+def _surface_frames(g: np.ndarray) -> np.ndarray:
+    """``(nu, nv, 3, 3)`` frames at the grid samples, columns ``(e1, e2, N)``: ``N`` the unit
+    ``S_u × S_v`` and ``e1`` the unit ``S_u`` projected on its normal plane, both by the
+    central differences of the core (one-sided at the border), ``e2 = N × e1``."""
+    nu, nv = g.shape[:2]
+    iu = np.arange(nu)
+    iv = np.arange(nv)
+    i0, i1 = np.maximum(iu - 1, 0), np.minimum(iu + 1, nu - 1)
+    j0, j1 = np.maximum(iv - 1, 0), np.minimum(iv + 1, nv - 1)
+    du = g[i1] - g[i0]
+    dv = g[:, j1] - g[:, j0]
+    n = np.cross(du, dv)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    e1 = du - np.sum(du * n, axis=-1, keepdims=True) * n
+    e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
+    return np.stack([e1, np.cross(n, e1), n], axis=-1)
+
+
+def _surface_directions(posed_frames, posed_up, shape):
+    """The ``(name, (nu·nv, 3) directions)`` the core lays the offsets along, or ``None``."""
+    if posed_frames is None and posed_up is None:
+        return None
+    if posed_frames is not None and posed_up is not None:
+        raise TypeError("posed_frames, posed_up: pass one of them, not both")
+    nu, nv = shape
+    if posed_frames is not None:
+        f = as_float_array(posed_frames, "posed_frames")
+        if f.shape != (nu, nv, 3, 3):
+            raise ValueError(f"posed_frames: expected shape ({nu}, {nv}, 3, 3) like "
+                             f"posed_surface's grid, got {f.shape}")
+        err = np.abs(np.swapaxes(f, -1, -2) @ f - np.eye(3)).max(axis=(-2, -1))
+        bad = np.argwhere(~(err < 1e-6) | ~(np.linalg.det(f) > 0))
+        if bad.size:
+            i, j = bad[0]
+            raise ValueError(f"posed_frames: grid point ({i}, {j}) is not a rotation (expected "
+                             f"orthonormal columns (S_u direction, in-surface perpendicular, "
+                             f"normal) with det +1, like SurfaceBinding.rest_frames)")
+        return "posed_frames", np.ascontiguousarray(f[..., 2].reshape(-1, 3))
+    u = as_float_array(posed_up, "posed_up")
+    if u.shape == (3,):
+        u = np.broadcast_to(u, (nu, nv, 3))
+    if u.shape != (nu, nv, 3):
+        raise ValueError(f"posed_up: expected shape (3,) or ({nu}, {nv}, 3) like "
+                         f"posed_surface's grid, got {u.shape}")
+    return "posed_up", np.ascontiguousarray(u.reshape(-1, 3))
+
+
 class SurfaceBinding:
     r"""A shape registered on a rest spine surface (Zhuo 2014 Ch. VI), to be posed many times.
 
@@ -632,6 +679,7 @@ class SurfaceBinding:
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
         self._shape = g.shape[:2]
+        self._rest_frames = _surface_frames(g)
         self._cell, self._coords = _core.flesh_surface_bind(
             g.reshape(-1, 3), g.shape[0], g.shape[1], np.ascontiguousarray(v, dtype=np.float64)
         )
@@ -651,13 +699,46 @@ class SurfaceBinding:
         """``(V,)`` signed offsets ``h`` along the rest normal."""
         return self._coords[:, 2].copy()
 
+    @property
+    def rest_frames(self) -> np.ndarray:
+        """``(nu, nv, 3, 3)`` frames of the rest surface at its samples, columns ``(e1, e2,
+        N)``: ``e1`` the direction of ``S_u``, ``e2 = N × e1`` in the surface, ``N`` the
+        normal (all by the central differences the binding uses). ``R @ rest_frames`` are
+        the ``posed_frames`` of the surface moved by ``x ↦ Rx + c``."""
+        return self._rest_frames.copy()
+
     def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
-               return_clamped: bool = False):
+               return_clamped: bool = False, posed_frames=None, posed_up=None):
         """The shape on ``posed_surface`` (same grid shape): ``(V, 3)``.
 
         ``solution="offset"`` (default) corrects the offset (volume preserving);
         ``"none"`` keeps ``h1 = h0`` (the uncorrected map). Clamped vertices (no fold-free
         offset, or foot outside the grid) are reported as in :meth:`SpineBinding.deform`.
+
+        By default every normal segment is laid along the posed surface's normal. It can
+        instead be laid along directions the caller gives at the posed samples, interpolated
+        over the cells exactly as the sample normals are (bicubic Hermite with
+        central-difference derivatives, made unit: C¹): ``P = S(u, v) + h1 D(u, v)``. The
+        volume element ``det[S_u + h D_u, S_v + h D_v, D]`` holds for any unit field ``D``
+        across the surface, so ``"offset"`` still keeps the volume (Jacobian determinant 1);
+        with a constant ``D`` it is ``(S_u × S_v)·D`` and ``h1 = h0 A0/A1``.
+
+        Parameters
+        ----------
+        posed_frames : array_like (nu, nv, 3, 3), optional
+            Frames at the posed samples, columns ``(S_u direction, in-surface perpendicular,
+            normal)`` like :attr:`rest_frames`; proper rotations (so the first two columns
+            are orthogonal to the third). Only the normal column is used: it carries the
+            normal segment there. ``R @ binding.rest_frames`` with the surface moved by
+            ``x ↦ Rx + c`` moves the shape rigidly; a rig can tilt the segments.
+        posed_up : array_like (3,) or (nu, nv, 3), optional
+            Instead of ``posed_frames``: directions (one for all samples, or one per sample;
+            made unit) along which the offset is laid instead of the normal, e.g. a constant
+            "up" keeps a skin's thickness vertical on a sheared surface.
+
+        Both must lie on the normal's side of the surface and not in it (refused where the
+        cosine with the sample normal is 1e-3 or less, or where the interpolated direction
+        reaches the surface's plane inside a cell).
         """
         solution = as_choice(solution, "solution", ("offset", "none"))
         strict = as_bool(strict, "strict")
@@ -666,8 +747,10 @@ class SurfaceBinding:
         if g.shape[:2] != self._shape:
             raise ValueError(f"posed_surface: expected the rest grid's shape "
                              f"{self._shape}, got {g.shape[:2]}")
+        dirs = _surface_directions(posed_frames, posed_up, self._shape)
         out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
-                                                self._cell, self._coords, solution == "offset")
+                                                self._cell, self._coords, solution == "offset",
+                                                dirs)
         clamped = np.flatnonzero(flags).astype(np.int64)
         self.clamped = clamped
         if clamped.size:
@@ -680,10 +763,13 @@ class SurfaceBinding:
 
 
 def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "offset",
-                  strict: bool = False, return_clamped: bool = False):
+                  strict: bool = False, return_clamped: bool = False, posed_frames=None,
+                  posed_up=None):
     """Bend a shape with a spine surface and keep its volume locally (Zhuo 2014 Ch. VI).
 
-    One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``.
+    One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``
+    (``posed_frames``/``posed_up``: the directions the offsets are laid along).
     """
     return SurfaceBinding(vertices, rest_surface).deform(
-        posed_surface, solution=solution, strict=strict, return_clamped=return_clamped)
+        posed_surface, solution=solution, strict=strict, return_clamped=return_clamped,
+        posed_frames=posed_frames, posed_up=posed_up)

@@ -18,6 +18,10 @@
 //! test `F(h_c) ≥ h_t` directly, which is equivalent to the corrected inequality.
 //! Points whose foot lies outside the grid are attached to the border with their residual
 //! carried rigidly in the local frame (not volume preserving; reported).
+//! The posed offset direction may be given per sample instead of the normal
+//! ([`Surface::with_directions`]: a rig's frames, a constant "up"): the same interpolation
+//! gives a unit field `D`, and `P = S + hD` has the volume element `det[S_u + hD_u, S_v + hD_v, D]`
+//! of the same form, so the same correction keeps the volume.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -132,27 +136,12 @@ impl Surface {
                 n.push(c / l);
             }
         }
-        let mut d = Vec::with_capacity(nu * nv);
-        for i in 0..nu {
-            for j in 0..nv {
-                let (su, sv) = grid_diff(points, nu, nv, i, j);
-                let (mu, mv) = grid_diff(&n, nu, nv, i, j);
-                d.push([su, sv, mu, mv]);
-            }
-        }
-        for i in 0..nu - 1 {
-            for j in 0..nv - 1 {
-                for (a, b) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
-                    let l = eval_raw(points, &n, &d, nv, i, j, a, b);
-                    let (aa, _, _) = l.abc();
-                    if !(aa > 0.0) {
-                        return Err(InputError::new(
-                            arg,
-                            format!("cell ({i}, {j}) folds over; sample the surface more finely"),
-                        ));
-                    }
-                }
-            }
+        let d = derivatives(points, &n, nu, nv);
+        if let Some((i, j)) = folded(points, &n, &d, nu, nv) {
+            return Err(InputError::new(
+                arg,
+                format!("cell ({i}, {j}) folds over; sample the surface more finely"),
+            ));
         }
         Ok(Surface {
             nu,
@@ -163,10 +152,110 @@ impl Surface {
         })
     }
 
+    /// The surface with the offset laid along the given directions `dirs` (one per sample,
+    /// named `dir_arg`, made unit) instead of the sample normals, interpolated over the cells
+    /// exactly as the normals are (bicubic Hermite of the samples with central-difference
+    /// derivatives, then made unit: C¹). The volume element `det[S_u + hD_u, S_v + hD_v, D]`
+    /// and so the offset correction hold for any unit direction field `D` transverse to the
+    /// surface; a direction within the surface (or on its other side) is refused.
+    pub fn with_directions(
+        arg: &'static str,
+        points: &[DVec3],
+        nu: usize,
+        nv: usize,
+        dir_arg: &'static str,
+        dirs: &[DVec3],
+    ) -> Result<Surface> {
+        let mut sf = Surface::new(arg, points, nu, nv)?;
+        if dirs.len() != nu * nv {
+            return Err(InputError::new(
+                dir_arg,
+                format!(
+                    "expected {} directions like the grid, got {}",
+                    nu * nv,
+                    dirs.len()
+                ),
+            ));
+        }
+        let mut n = Vec::with_capacity(nu * nv);
+        for (k, (&g, &normal)) in dirs.iter().zip(&sf.n).enumerate() {
+            let (i, j) = (k / nv, k % nv);
+            let l = g.length();
+            if !g.is_finite() || !(l > 1e-300) {
+                return Err(InputError::new(
+                    dir_arg,
+                    format!("grid point ({i}, {j}): not a finite non-zero vector"),
+                ));
+            }
+            let g = g / l;
+            let c = g.dot(normal);
+            if !(c > 1e-3) {
+                return Err(InputError::new(
+                    dir_arg,
+                    format!(
+                        "grid point ({i}, {j}): the direction is {:.1}° from the surface normal: \
+                         parallel to the surface or on its other side",
+                        c.clamp(-1.0, 1.0).acos().to_degrees()
+                    ),
+                ));
+            }
+            n.push(g);
+        }
+        let d = derivatives(points, &n, nu, nv);
+        if let Some((i, j)) = folded(points, &n, &d, nu, nv) {
+            return Err(InputError::new(
+                dir_arg,
+                format!(
+                    "cell ({i}, {j}): the interpolated direction reaches the surface's plane; \
+                     give directions that turn less between samples"
+                ),
+            ));
+        }
+        sf.n = n;
+        sf.d = d;
+        Ok(sf)
+    }
+
     #[inline]
     pub fn eval(&self, i: usize, j: usize, u: f64, v: f64) -> SurfLocal {
         eval_raw(&self.s, &self.n, &self.d, self.nv, i, j, u, v)
     }
+}
+
+/// Per sample: `[∂S/∂i, ∂S/∂j, ∂n/∂i, ∂n/∂j]` by central differences.
+fn derivatives(points: &[DVec3], n: &[DVec3], nu: usize, nv: usize) -> Vec<[DVec3; 4]> {
+    let mut d = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            let (su, sv) = grid_diff(points, nu, nv, i, j);
+            let (mu, mv) = grid_diff(n, nu, nv, i, j);
+            d.push([su, sv, mu, mv]);
+        }
+    }
+    d
+}
+
+/// The first cell whose volume element `A = (S_u × S_v)·N` is not positive at its corners
+/// or centre.
+fn folded(
+    points: &[DVec3],
+    n: &[DVec3],
+    d: &[[DVec3; 4]],
+    nu: usize,
+    nv: usize,
+) -> Option<(usize, usize)> {
+    for i in 0..nu - 1 {
+        for j in 0..nv - 1 {
+            for (a, b) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
+                let l = eval_raw(points, n, d, nv, i, j, a, b);
+                let (aa, _, _) = l.abc();
+                if !(aa > 0.0) {
+                    return Some((i, j));
+                }
+            }
+        }
+    }
+    None
 }
 
 /// Bicubic Hermite patch (zero twist) of corner values `p` and per-step derivatives `du`,

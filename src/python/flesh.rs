@@ -137,7 +137,11 @@ pub fn flesh_surface_bind<'py>(
 }
 
 /// Deform vertices registered on a spine surface; see `spinal.SurfaceBinding.deform`.
+/// `directions` (one per sample, row-major, with the name of the argument they came from)
+/// replace the sample normals as the offset directions.
 #[pyfunction]
+#[pyo3(signature = (posed_points, nu, nv, cell, coords, corrected, directions=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn flesh_surface_deform<'py>(
     py: Python<'py>,
     posed_points: PyReadonlyArray2<'py, f64>,
@@ -146,8 +150,20 @@ pub fn flesh_surface_deform<'py>(
     cell: PyReadonlyArray1<'py, i64>,
     coords: PyReadonlyArray2<'py, f64>,
     corrected: bool,
+    directions: Option<(String, PyReadonlyArray2<'py, f64>)>,
 ) -> PyResult<FleshPose<'py>> {
     let pts = vec3s("posed_surface", &posed_points)?;
+    let dirs = match &directions {
+        Some((name, d)) => {
+            let arg: &'static str = if name == "posed_up" {
+                "posed_up"
+            } else {
+                "posed_frames"
+            };
+            Some((arg, vec3s(arg, d)?))
+        }
+        None => None,
+    };
     let cell = slice_of("cell", &cell)?;
     let coords = slice_of("coords", &coords)?;
     let n = cell.len();
@@ -157,7 +173,12 @@ pub fn flesh_surface_deform<'py>(
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         detach_in_pool(py, || {
-            let posed = surface::Surface::new("posed_surface", pts, nu, nv)?;
+            let posed = match dirs {
+                Some((arg, d)) => {
+                    surface::Surface::with_directions("posed_surface", pts, nu, nv, arg, d)?
+                }
+                None => surface::Surface::new("posed_surface", pts, nu, nv)?,
+            };
             surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
         })??;
     }
