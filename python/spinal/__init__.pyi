@@ -84,6 +84,7 @@ def frames(
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
     previous: _Array | None = None,
+    previous_twist: bool = False,
 ) -> _F: ...
 def frames_in_time(
     points_t: _Array | None,

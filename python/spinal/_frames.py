@@ -150,6 +150,7 @@ def frames(
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
     previous=None,
+    previous_twist: bool = False,
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -273,6 +274,14 @@ def frames(
         closest to ``previous`` (see :func:`frames_in_time`), so frames of a moving curve do
         not flicker. Not with ``initial``, ``end``, ``constraints`` or ``guide``, which fix
         the start themselves.
+    previous_twist : bool
+        With ``previous``: follow its twist profile too, not only its start: the frames are
+        those of ``guide=previous[:, :, 0]`` (the previous ``r`` columns, projected on the new
+        normal planes and smoothed by ``guide_weight`` as for ``guide``; ``guide_tolerance``
+        applies), so a twist the previous frames carried along the curve is kept. On a curve
+        that does not move, the previous frames come back up to the guide's smoothing bias
+        (about ``φ″/guide_weight``, ``φ″`` the previous twist's second difference per
+        sample). Default ``False``: the RMF turned by one angle.
 
     Returns
     -------
@@ -299,11 +308,14 @@ def frames(
     >>> F.shape
     (200, 3, 3)
     """
+    previous_twist = as_bool(previous_twist, "previous_twist")
+    if previous_twist and previous is None:
+        raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
     if (constraints is not None or guide is not None or previous is not None
             or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
         return _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
                         lengths, offsets, constraints, twist_rule, guide, guide_weight,
-                        guide_tolerance, previous)
+                        guide_tolerance, previous, previous_twist)
     out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
                          lengths, offsets)
     return out
@@ -393,10 +405,20 @@ def estimate_tangents(
 
 
 def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
-             offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous):
+             offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous,
+             previous_twist=False):
     """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
     ``guide``, ``previous`` or per-interval ``turns``)."""
     method = as_choice(method, "method", METHODS)
+    if previous_twist:
+        if method == "frenet":
+            raise ValueError("previous: is not used by method='frenet': the Frenet frame is "
+                             "fixed by the curve")
+        for other, val in (("constraints", constraints), ("guide", guide),
+                           ("initial", initial), ("end", end)):
+            if val is not None:
+                raise ValueError(f"previous: cannot be combined with {other} (they fix the "
+                                 f"frames that previous would choose)")
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
     d1 = d2 = uu = tgs = None
@@ -429,10 +451,24 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         # the core names the rule that the lengths/offsets break
         _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE, False, closed, None,
                              None, None, None, 0)
+    if previous_twist:
+        guide, previous = _previous_twist_guide(previous, rows), None
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
                      previous, offs, bundle, rows)
     return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
                                 reflection == "tangents", closed, iv, if_, ev, ef, *steer)
+
+
+def _previous_twist_guide(previous, rows: int) -> np.ndarray:
+    """The ``r`` columns of ``previous`` (checked: one rotation per row) as a guide."""
+    prev = previous_frames(previous, rows)
+    m = prev
+    err = np.abs(np.swapaxes(m, -1, -2) @ m - np.eye(3)).max(axis=(-2, -1))
+    bad = np.flatnonzero(~(err < 1e-6) | ~(np.linalg.det(m) > 0))
+    if bad.size:
+        raise ValueError(f"previous: row {bad[0]} is not a rotation matrix (columns r, s, t "
+                         f"orthonormal, det +1)")
+    return np.ascontiguousarray(prev[:, :, 0])
 
 
 def frames_in_time(
