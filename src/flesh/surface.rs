@@ -574,4 +574,24 @@ mod tests {
         let (h, ok) = surface_offset(0.0, 0.0, 0.3);
         assert!(ok && (h - 0.3).abs() < 1e-15);
     }
+
+    #[test]
+    fn given_directions() {
+        // a plane z = 0.5 x: the normals given back reproduce it; "up" = z lays the
+        // offset vertically with A = (S_u × S_v)·z; a direction in the plane is refused
+        let pts: Vec<DVec3> = (0..4)
+            .flat_map(|i| (0..3).map(move |j| DVec3::new(i as f64, j as f64, 0.5 * i as f64)))
+            .collect();
+        let sf = Surface::new("s", &pts, 4, 3).unwrap();
+        let same = Surface::with_directions("s", &pts, 4, 3, "d", &sf.n).unwrap();
+        let (a, b) = (sf.eval(1, 0, 0.3, 0.6), same.eval(1, 0, 0.3, 0.6));
+        assert!((a.n - b.n).length() < 1e-15 && a.abc() == b.abc());
+        let up = Surface::with_directions("s", &pts, 4, 3, "d", &[DVec3::Z * 2.0; 12]).unwrap();
+        let l = up.eval(2, 1, 0.5, 0.5);
+        assert!((l.n - DVec3::Z).length() < 1e-15);
+        let (a, b, c) = l.abc();
+        assert!((a - 1.0).abs() < 1e-14 && b.abs() < 1e-14 && c.abs() < 1e-14);
+        let err = Surface::with_directions("s", &pts, 4, 3, "d", &[DVec3::Y; 12]).unwrap_err();
+        assert!(err.to_string().starts_with("d: grid point (0, 0)"), "{err}");
+    }
 }
