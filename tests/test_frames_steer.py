@@ -194,9 +194,9 @@ def test_frame_constraints_and_bundles():
     assert np.abs(F[40] - frame).max() < 1e-12 and np.abs(F[100] - F0[100]).max() < 1e-12
     y = wiggle()
     both = np.r_[x, y]
-    spec = [{10: F0[10, :, 1], -5: F0[-5, :, 0]}, None]
-    got = spinal.frames(both, lengths=[len(x), len(y)], constraints=spec)
-    assert np.abs(got[: len(x)] - spinal.frames(x, constraints=spec[0])).max() < 1e-14
+    given = [{10: F0[10, :, 1], -5: F0[-5, :, 0]}, None]
+    got = spinal.frames(both, lengths=[len(x), len(y)], constraints=given)
+    assert np.abs(got[: len(x)] - spinal.frames(x, constraints=given[0])).max() < 1e-14
     assert np.abs(got[len(x) :] - spinal.frames(y)).max() < 1e-14
 
 

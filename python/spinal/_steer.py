@@ -25,15 +25,15 @@ def _orientation_rows(vals: np.ndarray, name: str):
     raise ValueError(f"{name}: expected vectors (k, 3) or frames (k, 3, 3), got shape {vals.shape}")
 
 
-def _one_curve(spec: Any, rows: int, where: str):
+def _one_curve(given: Any, rows: int, where: str):
     """The constraints of one curve: (local rows, vectors, frames, is_frame)."""
     name = "constraints"
-    if spec is None:
+    if given is None:
         return (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3, 3)),
                 np.zeros(0, dtype=bool))
-    if isinstance(spec, Mapping):
+    if isinstance(given, Mapping):
         keys, vecs, frames, kinds = [], [], [], []
-        for key, val in spec.items():
+        for key, val in given.items():
             if isinstance(key, bool) or not isinstance(key, numbers.Integral):
                 raise TypeError(f"{name}: keys must be integer rows, got {key!r}{where}")
             a = as_float_array(val, name)
@@ -53,42 +53,42 @@ def _one_curve(spec: Any, rows: int, where: str):
         vec = np.array(vecs, dtype=float).reshape(-1, 3)
         frm = np.array(frames, dtype=float).reshape(-1, 3, 3)
         kind = np.array(kinds, dtype=bool)
-    elif isinstance(spec, tuple) and len(spec) == 2:
-        idx = np.asarray(spec[0])
+    elif isinstance(given, tuple) and len(given) == 2:
+        idx = np.asarray(given[0])
         if idx.ndim != 1 or (idx.size and idx.dtype.kind not in "iu"):
             raise TypeError(f"{name}: the indices of (indices, vectors) must be a 1-D array of "
                             f"integers{where}")
         idx = idx.astype(np.int64)
-        vals = as_float_array(spec[1], name)
+        vals = as_float_array(given[1], name)
         if vals.shape[:1] != idx.shape:
             raise ValueError(f"{name}: {idx.size} indices but vectors of shape {vals.shape}"
                              f"{where}")
         vec, frm, kind = _orientation_rows(vals, name)
     else:
         raise TypeError(f"{name}: expected a mapping {{row: vector or frame}} or a pair "
-                        f"(indices, vectors){where}, got {type(spec).__name__}")
+                        f"(indices, vectors){where}, got {type(given).__name__}")
     idx = np.where(idx < 0, idx + rows, idx)
     bad = (idx < 0) | (idx >= rows)
     if bad.any():
-        row = int(np.asarray(spec[0] if isinstance(spec, tuple) else list(spec))[bad][0])
+        row = int(np.asarray(given[0] if isinstance(given, tuple) else list(given))[bad][0])
         raise ValueError(f"{name}: row {row} is out of range for a curve of {rows} rows{where}")
     return idx, vec, frm, kind
 
 
-def _constraints(spec: Any, offs: np.ndarray, bundle: bool):
+def _constraints(given: Any, offs: np.ndarray, bundle: bool):
     """Flattened constraints of all curves: (curves, rows, vectors, frames, is_frame)."""
     curves = offs.size - 1
-    if spec is None:
+    if given is None:
         parts = [(c, _one_curve(None, 0, "")) for c in range(0)]
     elif bundle:
-        if isinstance(spec, (Mapping, np.ndarray)) or not hasattr(spec, "__len__") \
-                or len(spec) != curves:
+        if isinstance(given, (Mapping, np.ndarray)) or not hasattr(given, "__len__") \
+                or len(given) != curves:
             raise ValueError(f"constraints: with lengths/offsets, expected a list of {curves} "
                              "entries (one mapping, (indices, vectors) pair or None per curve)")
         parts = [(c, _one_curve(s, int(offs[c + 1] - offs[c]), f" (curve {c})"))
-                 for c, s in enumerate(spec)]
+                 for c, s in enumerate(given)]
     else:
-        parts = [(0, _one_curve(spec, int(offs[1]), ""))]
+        parts = [(0, _one_curve(given, int(offs[1]), ""))]
     cc = [np.full(p[0].size, c, np.int64) for c, p in parts]
     cat = (lambda xs, shape: np.ascontiguousarray(np.concatenate(xs))
            if xs else np.zeros(shape))

@@ -452,7 +452,7 @@ pub fn deform(
             "refine",
             format!(
                 "must be at least 1 (an edge is split when it grows beyond refine × its rest \
-                 length) and finite, got {}",
+                 length) and finite, got {:?}",
                 r.ratio
             ),
         ));

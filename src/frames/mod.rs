@@ -216,6 +216,46 @@ fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
     ))
 }
 
+/// The checks of a bundle request (per-curve `initial`/`end` counts, points against tangents,
+/// the offsets, the output size) and the output cut into one `9 × rows` slice per curve.
+pub(crate) fn bundle_slices<'o>(
+    template: &Request,
+    offsets: &[usize],
+    initial: &[Orientation],
+    end: &[Orientation],
+    out: &'o mut [f64],
+) -> Result<Vec<&'o mut [f64]>> {
+    let curves = offsets.len().saturating_sub(1);
+    for (arg, v) in [("initial", initial.len()), ("end", end.len())] {
+        if v > 1 && v != curves {
+            return Err(InputError::new(
+                arg,
+                format!("expected one entry per curve ({curves}), got {v}"),
+            ));
+        }
+    }
+    let total = template
+        .points
+        .map(<[DVec3]>::len)
+        .or(template.tangents.map(<[DVec3]>::len))
+        .unwrap_or(0);
+    if let (Some(p), Some(t)) = (template.points, template.tangents) {
+        rows_match(p, t)?;
+    }
+    validate::offsets(offsets, total)?;
+    if out.len() != 9 * total {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
+    let mut slices = Vec::with_capacity(curves);
+    let mut rest = out;
+    for w in offsets.windows(2) {
+        let (head, tail) = rest.split_at_mut(9 * (w[1] - w[0]));
+        slices.push(head);
+        rest = tail;
+    }
+    Ok(slices)
+}
+
 /// Compute the frames of one curve into `out` (`9 × rows` values, row-major `(rows, 3, 3)`).
 ///
 /// Returns the raw end angle of the boundary condition (the closing angle for a closed
@@ -757,33 +797,7 @@ pub fn compute_many_cancellable(
     cancel: crate::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     let curves = offsets.len().saturating_sub(1);
-    for (arg, v) in [("initial", initial.len()), ("end", end.len())] {
-        if v > 1 && v != curves {
-            return Err(InputError::new(
-                arg,
-                format!("expected one entry per curve ({curves}), got {v}"),
-            ));
-        }
-    }
-    let total = template
-        .points
-        .map(<[DVec3]>::len)
-        .or(template.tangents.map(<[DVec3]>::len))
-        .unwrap_or(0);
-    if let (Some(p), Some(t)) = (template.points, template.tangents) {
-        rows_match(p, t)?;
-    }
-    validate::offsets(offsets, total)?;
-    if out.len() != 9 * total {
-        return Err(InputError::new("out", "output buffer has the wrong size"));
-    }
-    let mut slices = Vec::with_capacity(curves);
-    let mut rest = out;
-    for w in offsets.windows(2) {
-        let (head, tail) = rest.split_at_mut(9 * (w[1] - w[0]));
-        slices.push(head);
-        rest = tail;
-    }
+    let slices = bundle_slices(template, offsets, initial, end, out)?;
     let results: Vec<Result<f64>> = slices
         .into_par_iter()
         .enumerate()

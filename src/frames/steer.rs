@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::constraints::{self, TwistRule};
 use super::guide::{self, Guide};
-use super::{Method, Orientation, Request, resolve, rmf_parts, time, validate};
+use super::{Method, Orientation, Request, resolve, rmf_parts, time};
 use crate::error::{InputError, Result};
 
 /// A prescribed orientation at a row of the curve.
@@ -223,33 +223,10 @@ pub fn compute_steered_many(
     out: &mut [f64],
 ) -> Result<()> {
     let curves = offsets.len().saturating_sub(1);
-    for (arg, v) in [("initial", initial.len()), ("end", end.len())] {
-        if v > 1 && v != curves {
-            return Err(InputError::new(
-                arg,
-                format!("expected one entry per curve ({curves}), got {v}"),
-            ));
-        }
+    if steer.len() != 1 && steer.len() != curves {
+        return Err(InputError::new("out", "one steering per curve expected"));
     }
-    let total = template
-        .points
-        .map(<[DVec3]>::len)
-        .or(template.tangents.map(<[DVec3]>::len))
-        .unwrap_or(0);
-    if let (Some(p), Some(t)) = (template.points, template.tangents) {
-        super::rows_match(p, t)?;
-    }
-    validate::offsets(offsets, total)?;
-    if out.len() != 9 * total || (steer.len() != 1 && steer.len() != curves) {
-        return Err(InputError::new("out", "output buffer has the wrong size"));
-    }
-    let mut slices = Vec::with_capacity(curves);
-    let mut rest = out;
-    for w in offsets.windows(2) {
-        let (head, tail) = rest.split_at_mut(9 * (w[1] - w[0]));
-        slices.push(head);
-        rest = tail;
-    }
+    let slices = super::bundle_slices(template, offsets, initial, end, out)?;
     let results: Vec<Result<()>> = slices
         .into_par_iter()
         .enumerate()
@@ -273,4 +250,54 @@ pub fn compute_steered_many(
         })
         .collect();
     results.into_iter().collect()
+}
+
+/// The constraints of all curves of a bundle, given flat (curve `curve[j]`, local row
+/// `row[j]`, `orientation[j]`), grouped by curve; a curve or row out of range and a row
+/// given twice are refused (named `constraints`).
+pub fn constraints_by_curve(
+    curves: usize,
+    curve: &[i64],
+    row: &[i64],
+    orientation: Vec<Orientation>,
+) -> Result<Vec<Vec<Constraint>>> {
+    let bad = |msg: String| InputError::new("constraints", msg);
+    let mut per_curve: Vec<Vec<Constraint>> = vec![Vec::new(); curves.max(1)];
+    for ((&cj, &rj), orientation) in curve.iter().zip(row).zip(orientation) {
+        let c = usize::try_from(cj)
+            .ok()
+            .filter(|&c| c < curves.max(1))
+            .ok_or_else(|| bad(format!("curve {cj} out of range")))?;
+        let row = usize::try_from(rj).map_err(|_| bad(format!("row {rj} is out of range")))?;
+        if per_curve[c].iter().any(|x| x.row == row) {
+            let which = if curves > 1 {
+                format!(" (curve {c})")
+            } else {
+                String::new()
+            };
+            return Err(bad(format!("row {row} is given twice{which}")));
+        }
+        per_curve[c].push(Constraint { row, orientation });
+    }
+    Ok(per_curve)
+}
+
+/// The guide holds one vector or one per sample, `previous` one frame per sample.
+pub fn check_lengths(rows: usize, guide: Option<usize>, previous: Option<usize>) -> Result<()> {
+    if let Some(g) = guide.filter(|&g| g != 1 && g != rows) {
+        return Err(InputError::new(
+            "guide",
+            format!("expected shape (3,) or ({rows}, 3) (one vector per sample), got ({g}, 3)"),
+        ));
+    }
+    if let Some(p) = previous.filter(|&p| p != rows) {
+        return Err(InputError::new(
+            "previous",
+            format!(
+                "expected shape ({rows}, 3, 3) (the frames of the same curve at the previous \
+                 time step), got ({p}, 3, 3)"
+            ),
+        ));
+    }
+    Ok(())
 }

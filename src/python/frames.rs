@@ -189,7 +189,7 @@ pub fn frames_steered<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     use crate::frames::constraints::TwistRule;
     use crate::frames::guide::Guide;
-    use crate::frames::steer::{self, Constraint, Steering};
+    use crate::frames::steer::{self, Steering};
     use glam::DMat3;
 
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
@@ -223,54 +223,19 @@ pub fn frames_steered<'py>(
     if cr.len() != k || cv.len() != k || cf.len() != k || ck.len() != k {
         return Err(value_error("constraints: inconsistent constraint arrays"));
     }
-    let mut per_curve: Vec<Vec<Constraint>> = vec![Vec::new(); curves.max(1)];
-    for j in 0..k {
-        let c = usize::try_from(cc[j])
-            .ok()
-            .filter(|&c| c < curves.max(1))
-            .ok_or_else(|| value_error(format!("constraints: curve {} out of range", cc[j])))?;
-        let row = usize::try_from(cr[j])
-            .map_err(|_| value_error(format!("constraints: row {} is out of range", cr[j])))?;
-        let orientation = if ck[j] {
-            Orientation::Frame(DMat3::from_cols_array(&cf[j]).transpose())
-        } else {
-            Orientation::Vector(cv[j])
-        };
-        if per_curve[c].iter().any(|x| x.row == row) {
-            return Err(value_error(format!(
-                "constraints: row {row} is given twice{}",
-                if curves > 1 {
-                    format!(" (curve {c})")
-                } else {
-                    String::new()
-                }
-            )));
-        }
-        per_curve[c].push(Constraint { row, orientation });
-    }
+    let orientations: Vec<Orientation> = (0..k)
+        .map(|j| match ck[j] {
+            true => Orientation::Frame(DMat3::from_cols_array(&cf[j]).transpose()),
+            false => Orientation::Vector(cv[j]),
+        })
+        .collect();
+    let per_curve = steer::constraints_by_curve(curves, cc, cr, orientations)?;
     let guide_rows = guide.as_ref().map(|g| vec3s("guide", g)).transpose()?;
     let prev = previous
         .as_ref()
         .map(|p| super::convert::frames_of("previous", p))
         .transpose()?;
-    if let Some(g) = guide_rows {
-        if g.len() != 1 && g.len() != rows {
-            return Err(value_error(format!(
-                "guide: expected shape (3,) or ({rows}, 3) (one vector per sample), got \
-                 ({}, 3)",
-                g.len()
-            )));
-        }
-    }
-    if let Some(p) = prev {
-        if p.len() != rows {
-            return Err(value_error(format!(
-                "previous: expected shape ({rows}, 3, 3) (the frames of the same curve at the \
-                 previous time step), got ({}, 3, 3)",
-                p.len()
-            )));
-        }
-    }
+    steer::check_lengths(rows, guide_rows.map(<[_]>::len), prev.map(<[_]>::len))?;
     let steering: Vec<Steering> = (0..curves.max(1))
         .map(|c| {
             let (a, b) = (offsets[c.min(curves)], offsets[(c + 1).min(curves)]);
