@@ -69,7 +69,7 @@ ARGS = {"points", "tangents", "method", "initial", "closed", "end", "turns", "re
         "lengths", "offsets", "profile", "frames", "scale", "twist", "caps", "profile_closed",
         "miter_limit", "split_seams", "strict", "radius", "sides", "constraints", "twist_rule",
         "guide", "guide_weight", "guide_tolerance", "previous", "tangent_rule", "dtype",
-        "normals", "uv", "point_data", "on_short"}
+        "normals", "uv", "point_data", "on_short", "previous_twist"}
 # an argument, or an element of one ("points[3]: ..." for a curve of a list)
 NAMED = re.compile(r"^([a-z_]+)(\[\d+\])?(, [a-z_]+)*:")
 
