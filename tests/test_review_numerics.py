@@ -196,3 +196,11 @@ def test_D25_messages_name_the_argument():
         spinal.curves.Bezier([[0, 0, 0], [np.nan, 0, 0]])
     with pytest.raises(MemoryError, match="^u: "):
         spinal.frames(spinal.curves.Helix(), u=2**40)
+    with pytest.raises(TypeError, match="^vertices: "):
+        spinal.Mesh("abc", [[0, 1, 2]])
+    with pytest.raises(ValueError, match="^vertices: "):
+        spinal.Mesh([[0, 0], [1, 0], [0, 1]], [[0, 1, 2]])
+    with pytest.raises(TypeError, match="^path: "):
+        spinal.Mesh(np.eye(3), [[0, 1, 2]]).save(5)
+    with pytest.raises(ValueError, match="^path: "):
+        spinal.Mesh(np.eye(3), [[0, 1, 2]]).save("mesh.stl")

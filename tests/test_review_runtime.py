@@ -200,6 +200,20 @@ D17_CASES = {
     "stamp": (
         "s = trimesh.creation.icosphere(5)\n",
         "spinal.stamp(s, [0, 0, 1.32], [0, 0, 0.2], .5, frames=100_000)"),
+    "frames_one_curve": (
+        ("n = 20_000_000; s = np.linspace(0, 4000, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.frames(X)"),
+    "estimate_tangents": (
+        ("n = 20_000_000; s = np.linspace(0, 4000, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.estimate_tangents(X)"),
+    "to_quaternions": (
+        "F = np.ascontiguousarray(np.broadcast_to(np.eye(3), (20_000_000, 3, 3)))\n",
+        "Q.to_quaternions(F)"),
+    "from_quaternions": (
+        "q = np.tile([.1, .2, .3, .9], (10_000_000, 1))\n",
+        "Q.from_quaternions(q)"),
 }
 
 

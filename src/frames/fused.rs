@@ -51,7 +51,11 @@ fn aligned_with(v: DVec3, vv: f64, ti: DVec3, tj: DVec3) -> bool {
 /// Frames of an open curve given by points, with or without tangents (double reflection or
 /// the rotation method; five-point tangents when none are given; `n ≥ 5`), or `None` when
 /// the request is of another kind or any check fails.
-pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
+pub(super) fn try_open_points(
+    req: &Request,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Option<f64> {
     let x = req.points?;
     let n = x.len();
     let given = req.tangents;
@@ -111,9 +115,15 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
                 }
             }
             if found.is_none() && lim < n {
-                found = (lim..n)
-                    .into_par_iter()
-                    .find_map_first(|i| tan(i).and_then(|ti| normal(i, ti)).map(|v| (i, v)));
+                found = (lim..n).into_par_iter().find_map_first(|i| {
+                    if cancel() {
+                        return Some((0, p));
+                    }
+                    tan(i).and_then(|ti| normal(i, ti)).map(|v| (i, v))
+                });
+            }
+            if cancel() {
+                return None;
             }
             match found {
                 None => p,
@@ -141,6 +151,9 @@ pub(super) fn try_open_points(req: &Request, out: &mut [f64]) -> Option<f64> {
     // the segments inside it; the one that leads into it is checked here.
     let (_, cs) = plan(n, true);
     let work = |c: usize, start: Option<DVec3>, buf: &mut [f64]| {
+        if cancel() {
+            return None;
+        }
         let a = c * cs;
         if a > 0 && !aligned(x[a] - x[a - 1], tan(a - 1)?, tan(a)?) {
             return None;
@@ -643,7 +656,7 @@ mod tests {
     fn both(req: &Request) -> (Vec<f64>, Vec<f64>, f64, f64) {
         let n = req.points.map_or(0, <[DVec3]>::len);
         let (mut a, mut b) = (vec![0.0; 9 * n], vec![0.0; 9 * n]);
-        let fa = try_open_points(req, &mut a).expect("fast path taken");
+        let fa = try_open_points(req, &mut a, &crate::cancel::never).expect("fast path taken");
         let fb = compute_general(req, &mut b).expect("valid input");
         (a, b, fa, fb)
     }
@@ -746,7 +759,7 @@ mod tests {
                 .build()
                 .unwrap();
             let mut out = vec![0.0; 9 * n];
-            let got = pool.install(|| try_open_points(req, &mut out));
+            let got = pool.install(|| try_open_points(req, &mut out, &crate::cancel::never));
             (got, out)
         };
         let (serial, one) = run(1, &req);
@@ -825,7 +838,10 @@ mod tests {
                         tangents: Some(&u),
                         ..Default::default()
                     };
-                    assert!(try_open_points(&req, &mut out).is_none(), "{bad} at {row}");
+                    assert!(
+                        try_open_points(&req, &mut out, &crate::cancel::never).is_none(),
+                        "{bad} at {row}"
+                    );
                     assert!(compute_general(&req, &mut out).is_err(), "{bad} at {row}");
                 }
                 // a NaN point with good tangents: only the chords next to it see it
@@ -838,7 +854,7 @@ mod tests {
                         ..Default::default()
                     };
                     assert!(
-                        try_open_points(&req, &mut out).is_none(),
+                        try_open_points(&req, &mut out, &crate::cancel::never).is_none(),
                         "NaN point at {row}"
                     );
                     assert!(
@@ -936,36 +952,36 @@ mod tests {
                 ..Default::default()
             }
         }
-        assert!(try_open_points(&req(&x), &mut out).is_some());
+        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_some());
         x[1500] = x[1499]; // a repeated point
-        assert!(try_open_points(&req(&x), &mut out).is_none());
+        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_none());
         x[1500] = DVec3::new(f64::NAN, 0.0, 0.0);
-        assert!(try_open_points(&req(&x), &mut out).is_none());
+        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_none());
         for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
             for row in [0, 1, 2, 1500, 2997, 2998, 2999] {
                 let mut y = curve(3000, 0);
                 y[row].y = bad;
                 assert!(
-                    try_open_points(&req(&y), &mut out).is_none(),
+                    try_open_points(&req(&y), &mut out, &crate::cancel::never).is_none(),
                     "{bad} at {row}"
                 );
             }
         }
         x[1500] = x[1498]; // a reversal: a cusp or a segment against its tangents
-        assert!(try_open_points(&req(&x), &mut out).is_none());
+        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_none());
         let x = curve(3000, 0);
         let bad = Request {
             points: Some(&x),
             initial: Some(Orientation::Vector(DVec3::ZERO)), // no normal-plane component
             ..Default::default()
         };
-        assert!(try_open_points(&bad, &mut out).is_none());
+        assert!(try_open_points(&bad, &mut out, &crate::cancel::never).is_none());
         assert!(super::super::compute_into(&bad, &mut out).is_err());
         let closed = Request {
             points: Some(&x),
             closed: true,
             ..Default::default()
         };
-        assert!(try_open_points(&closed, &mut out).is_none());
+        assert!(try_open_points(&closed, &mut out, &crate::cancel::never).is_none());
     }
 }

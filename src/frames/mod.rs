@@ -265,6 +265,16 @@ pub(crate) fn bundle_slices<'o>(
 /// A curve whose size is far from 1 is first divided by a power of two (exact; see
 /// [`crate::math::scale`]), so the frames and the angle do not depend on its units.
 pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
+    compute_into_cancellable(req, out, &crate::cancel::never)
+}
+
+/// [`compute_into`] that polls `cancel` before every chunk of the fused scan and returns at
+/// once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+pub fn compute_into_cancellable(
+    req: &Request,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<f64> {
     if req.turns != 0 && !req.closed && req.end.is_none() && req.method != Method::Frenet {
         return Err(InputError::new(
             "turns",
@@ -277,8 +287,12 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
         Some(o) => &o.request(req),
         None => req,
     };
-    match fused::try_open_points(req, out) {
+    if cancel() {
+        return Ok(0.0);
+    }
+    match fused::try_open_points(req, out, cancel) {
         Some(angle) => Ok(angle),
+        None if cancel() => Ok(0.0),
         None => compute_general(req, out),
     }
 }
@@ -814,7 +828,7 @@ pub fn compute_many_cancellable(
                 end: pick(end, c),
                 ..*template
             };
-            compute_into(&req, buf).map_err(|e| {
+            compute_into_cancellable(&req, buf, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {

@@ -239,6 +239,21 @@ pub fn estimate(
     closed: bool,
     rule: TangentRule,
 ) -> Result<Vec<DVec3>> {
+    estimate_cancellable(x, chords, closed, rule, &crate::cancel::never)
+}
+
+/// Rows per segment of a cancellable estimate ([`estimate_cancellable`]).
+const CANCEL_SEGMENT: usize = 1 << 20;
+
+/// [`estimate`] that polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and
+/// returns the rows done so far once it says stop (see [`crate::cancel`]).
+pub fn estimate_cancellable(
+    x: &[DVec3],
+    chords: &[f64],
+    closed: bool,
+    rule: TangentRule,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     let n = x.len();
     let min = if closed { 3 } else { 2 };
     if n < min {
@@ -255,30 +270,38 @@ pub fn estimate(
     // Estimate and normalise in one pass; a zero (or non-finite) estimate is a cusp. The open
     // ends of the circle rule are zero here and filled below.
     let mut t = alloc::with_capacity("estimate_tangents", n)?;
-    (0..n)
-        .into_par_iter()
-        .with_min_len(1 << 12)
-        .map(|i| {
-            if five && chordal && !closed {
-                let u = if rule == TangentRule::FivePointBounded {
-                    five_point_unit_open(x, i, |j| chords[j])
-                } else {
-                    five_point_unit_unbounded(x, i, |j| chords[j])
-                };
-                return u.unwrap_or(DVec3::ZERO);
-            }
-            let v = raw_tangent(x, chords, i, closed, rule, five);
-            let l = v.length();
-            let u = v * (1.0 / l);
-            if !(l > 0.0 && u.is_finite()) {
-                DVec3::ZERO
-            } else if five && chordal {
-                guard_overshoot(x, i, closed, u)
-            } else {
-                u
-            }
-        })
-        .collect_into_vec(&mut t);
+    // in segments, each written in parallel into the reserved room, so that a cancelled
+    // call neither computes nor touches the pages of the rows it skips
+    for start in (0..n).step_by(CANCEL_SEGMENT) {
+        if cancel() {
+            return Ok(t);
+        }
+        t.par_extend(
+            (start..(start + CANCEL_SEGMENT).min(n))
+                .into_par_iter()
+                .with_min_len(1 << 12)
+                .map(|i| {
+                    if five && chordal && !closed {
+                        let u = if rule == TangentRule::FivePointBounded {
+                            five_point_unit_open(x, i, |j| chords[j])
+                        } else {
+                            five_point_unit_unbounded(x, i, |j| chords[j])
+                        };
+                        return u.unwrap_or(DVec3::ZERO);
+                    }
+                    let v = raw_tangent(x, chords, i, closed, rule, five);
+                    let l = v.length();
+                    let u = v * (1.0 / l);
+                    if !(l > 0.0 && u.is_finite()) {
+                        DVec3::ZERO
+                    } else if five && chordal {
+                        guard_overshoot(x, i, closed, u)
+                    } else {
+                        u
+                    }
+                }),
+        );
+    }
     if !five && !closed && n >= 3 {
         for (end, inner, chord) in [(0, 1, x[1] - x[0]), (n - 1, n - 2, x[n - 1] - x[n - 2])] {
             let ti = t[inner];
@@ -451,7 +474,21 @@ fn raw_tangent(
 /// A curve whose size is far from 1 is divided by a power of two first (exact; see
 /// [`crate::math::scale`]): unit tangents do not depend on the units.
 pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec3>> {
+    estimate_rows_cancellable(x, closed, rule, &crate::cancel::never)
+}
+
+/// [`estimate_rows`] that polls `cancel` between its passes and for every row of the
+/// estimate (see [`crate::cancel`]); a cancelled call returns an incomplete result.
+pub fn estimate_rows_cancellable(
+    x: &[DVec3],
+    closed: bool,
+    rule: TangentRule,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     crate::frames::validate::finite("points", x)?;
+    if cancel() {
+        return Ok(Vec::new());
+    }
     let (lo, hi) = crate::frames::geometry::bounds(x);
     let owned =
         crate::math::scale::curve_exponent(lo, hi).map(|k| crate::math::scale::scaled(x, k));
@@ -460,8 +497,17 @@ pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec
     if closed && n >= 2 && crate::frames::validate::coincide(x[n - 1], x[0]) {
         n -= 1;
     }
+    if cancel() {
+        return Ok(Vec::new());
+    }
     let chords = crate::frames::validate::chords(&x[..n], closed)?;
-    let mut t = estimate(&x[..n], &chords, closed, rule)?;
+    if cancel() {
+        return Ok(Vec::new());
+    }
+    let mut t = estimate_cancellable(&x[..n], &chords, closed, rule, cancel)?;
+    if cancel() {
+        return Ok(t);
+    }
     if n < x.len() {
         let first = t[0];
         alloc::push("estimate_tangents", &mut t, first)?;

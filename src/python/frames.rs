@@ -136,7 +136,13 @@ pub fn estimate_tangents<'py>(
     // chord lengths, the estimate and its copy into the array
     ensure_memory("estimate_tangents", x.len(), 8 + 24 + 24)?;
     let t = match offsets {
-        None => detach_in_pool(py, || frames::tangents::estimate_rows(x, closed, rule))??,
+        None => {
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                let cancel = || stop.requested();
+                frames::tangents::estimate_rows_cancellable(x, closed, rule, &cancel)
+            })??
+        }
         Some(o) => {
             let offs = offsets_of(&o)?;
             detach_in_pool(py, || {

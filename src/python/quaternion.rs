@@ -23,7 +23,10 @@ pub fn quat_from_frames<'py>(
     continuous: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let fr = frames_of("frames", &frames)?;
-    let q = detach_in_pool(py, || quaternion::from_frames(fr, continuous))??;
+    let stop = Stop::default();
+    let q = detach_stoppable(py, &stop, || {
+        quaternion::from_frames_cancellable(fr, continuous, &|| stop.requested())
+    })??;
     quat_array(py, q)
 }
 
@@ -51,7 +54,10 @@ pub fn quat_to_frames<'py>(
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
-        detach_in_pool(py, || quaternion::to_frames(qs, buf))??;
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            quaternion::to_frames_cancellable(qs, buf, &|| stop.requested())
+        })??;
     }
     Ok(out)
 }

@@ -38,6 +38,9 @@ use crate::math::rotation;
 
 const GRAIN: usize = 1 << 12;
 
+/// Rows per segment of a cancellable conversion ([`from_frames_cancellable`]).
+const CANCEL_SEGMENT: usize = 1 << 20;
+
 /// The unit quaternion of a row-major rotation matrix (columns `r, s, t`), Shepperd's
 /// method ([`rotation::quat_from_mat3`]). The result is normalised; its sign is not canonical.
 pub fn from_matrix(f: &[f64; 9]) -> DQuat {
@@ -90,7 +93,18 @@ pub fn continuous(q: &[DQuat]) -> Result<Vec<DQuat>> {
 
 /// Quaternions of frames (row-major `(n, 3, 3)`), sign-continuous if asked.
 pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> {
-    if let Some(i) = validate::first_bad(frames, validate::is_rotation) {
+    from_frames_cancellable(frames, continuous, &crate::cancel::never)
+}
+
+/// [`from_frames`] that polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and
+/// returns the rows done so far once it says stop (see [`crate::cancel`]).
+pub fn from_frames_cancellable(
+    frames: &[[f64; 9]],
+    continuous: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DQuat>> {
+    // a cancelled check passes every row (the result is discarded)
+    if let Some(i) = validate::first_bad(frames, |f| cancel() || validate::is_rotation(f)) {
         return Err(InputError::new(
             "frames",
             format!(
@@ -100,12 +114,19 @@ pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> 
         ));
     }
     let mut q: Vec<DQuat> = alloc::with_capacity("to_quaternions", frames.len())?;
-    frames
-        .par_iter()
-        .with_min_len(GRAIN)
-        .map(|f| canonical(from_matrix(f)))
-        .collect_into_vec(&mut q);
-    if continuous {
+    // in segments written into the reserved room: a cancelled call neither computes nor
+    // touches the pages of the rows it skips
+    for seg in frames.chunks(CANCEL_SEGMENT) {
+        if cancel() {
+            return Ok(q);
+        }
+        q.par_extend(
+            seg.par_iter()
+                .with_min_len(GRAIN)
+                .map(|f| canonical(from_matrix(f))),
+        );
+    }
+    if continuous && !cancel() {
         make_continuous(&mut q);
     }
     Ok(q)
@@ -132,16 +153,37 @@ fn unit_checked(q: DQuat) -> DQuat {
 
 /// Frames of quaternions (normalised first; a zero or non-finite quaternion is refused).
 pub fn to_frames(q: &[DQuat], out: &mut [[f64; 9]]) -> Result<()> {
-    if let Some(i) = validate::first_bad(q, normalisable) {
+    to_frames_cancellable(q, out, &crate::cancel::never)
+}
+
+/// [`to_frames`] that polls `cancel` before every block of rows and skips the remaining
+/// blocks once it returns `true` (`out` is then incomplete; see [`crate::cancel`]). Blocks,
+/// not rows: the first write to a fresh output page costs a page fault, so the loop
+/// also stops between the faults.
+pub fn to_frames_cancellable(
+    q: &[DQuat],
+    out: &mut [[f64; 9]],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
+    if let Some(i) = validate::first_bad(q, |v| cancel() || normalisable(v)) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite and cannot be normalised"),
         ));
     }
-    out.par_iter_mut()
-        .zip(q.par_iter())
-        .with_min_len(GRAIN)
-        .for_each(|(o, v)| *o = to_matrix(unit_checked(*v)));
+    if out.len() != q.len() {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
+    out.par_chunks_mut(GRAIN)
+        .zip(q.par_chunks(GRAIN))
+        .for_each(|(o, v)| {
+            if cancel() {
+                return;
+            }
+            for (o, v) in o.iter_mut().zip(v) {
+                *o = to_matrix(unit_checked(*v));
+            }
+        });
     Ok(())
 }
 
