@@ -99,6 +99,14 @@ D16_CASES = {
     "ph.hermite": (
         "m = 1_000_000; P0 = np.zeros((m, 3)); P1 = np.ones((m, 3)); T = np.ones((m, 3))\n",
         "ph.hermite(P0, T, P1, T)", ""),
+    "frames guided": (
+        ("n = 10_000_000; s = np.linspace(0, 2000, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.frames(X, guide=[0, 0, 1])", "frames: out of memory"),
+    "Mesh.is_watertight": (
+        ("m = 30_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
+        "mesh = spinal.Mesh(np.zeros((1000, 3)), F)\n"),
+        "mesh.is_watertight", "mesh edges: out of memory"),
     "PHSpline.evaluate": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
         "s = np.linspace(0, 1, 10_000_000)\n"),

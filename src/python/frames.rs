@@ -270,6 +270,9 @@ pub fn frames_steered<'py>(
         end: None,
         turns: 0,
     };
+    // the output (72 bytes a row), the rotation-minimising frames, the tangents and the
+    // twist solve
+    ensure_memory("frames", rows, 256)?;
     let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
     {
         let mut rw = out.readwrite();
@@ -344,6 +347,9 @@ pub fn frames_in_time<'py>(
         turns,
         ..Request::default()
     };
+    // the output (72 bytes a row), the rotation-minimising frames, the tangents and the
+    // twist solve
+    ensure_memory("frames", total, 256)?;
     let out = empty::<f64, numpy::Ix3>(py, &[total, 3, 3])?;
     {
         let mut rw = out.readwrite();

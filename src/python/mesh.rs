@@ -1,9 +1,9 @@
 //! Mesh measures (`spinal.Mesh`); the algorithms are in [`crate::math::mesh`].
 
-use numpy::PyReadonlyArray2;
+use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use super::convert::{detach_in_pool, triangles, vec3s};
+use super::convert::{detach_in_pool, ensure_memory, triangles, vec3s};
 use crate::math::mesh;
 use crate::mesh::measure;
 
@@ -138,7 +138,14 @@ pub fn mesh_edges(
     faces: &Bound<'_, PyAny>,
     n: usize,
 ) -> PyResult<(usize, usize, usize, usize, usize)> {
-    let e = match faces_of(faces)? {
+    let faces = faces_of(faces)?;
+    // a slot count per vertex and a key per face corner (sorted in place)
+    let slots = match &faces {
+        Faces::I64(a) => 3 * a.shape()[0],
+        Faces::I32(a) => 3 * a.shape()[0],
+    };
+    ensure_memory("mesh edges", slots.saturating_add(n), 16)?;
+    let e = match faces {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
             detach_in_pool(py, || measure::edges(f, n))??
