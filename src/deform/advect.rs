@@ -466,7 +466,16 @@ mod tests {
             })
             .collect();
         let strip = super::super::tube::strip_curve(&axis, 0.1, 1.0, Some(0.15), false).unwrap();
-        let f = Field::single(strip);
+        // and so does a rod curl tool (its axis is a table of segments too)
+        let rod = super::super::rod::Rod::from_points(&axis, 0.1, Some(0.15), None).unwrap();
+        let rod = super::super::curl::CurlTool::new(
+            std::sync::Arc::new(rod),
+            super::super::curl::Motion::Translate(DVec3::new(0.0, 0.0, -1.0)),
+            2,
+            true,
+        )
+        .unwrap();
+        assert!(super::super::Tool::wants_locality(&rod));
         let x0: Vec<DVec3> = (0..6000)
             .map(|i| {
                 let a = i as f64;
@@ -476,12 +485,14 @@ mod tests {
         let mut order = spatial_order(&x0);
         order.sort_unstable();
         assert!(order.iter().enumerate().all(|(i, &j)| i as u32 == j));
-        let mut sorted = x0.clone();
-        advect_in_place(&f, &mut sorted, 0.0, 0.02, 8, Method::Rk4);
-        let mut plain = x0.clone();
-        advect_steps(&f, &mut plain, 0.0, 0.02, 0..8, Method::Rk4);
-        assert_eq!(sorted, plain);
-        assert_ne!(plain, x0);
+        for f in [Field::single(strip), Field::single(rod)] {
+            let mut sorted = x0.clone();
+            advect_in_place(&f, &mut sorted, 0.0, 0.02, 8, Method::Rk4);
+            let mut plain = x0.clone();
+            advect_steps(&f, &mut plain, 0.0, 0.02, 0..8, Method::Rk4);
+            assert_eq!(sorted, plain);
+            assert_ne!(plain, x0);
+        }
     }
 
     #[test]
