@@ -162,8 +162,9 @@ def time_spinal(n, repeat):
 
 
 def progress_cost(repeat):
-    """``advect(progress=callable)`` against the same call without: a progress report splits
-    the steps into 100 blocks, each a call of the compiled field (built once)."""
+    """``advect(progress=callable)`` against the same call without: one core call either way,
+    in blocks of about 20 ms; with a callable, each block reports the multiples of 1/100 of
+    the steps that it passed."""
     V = points(40962)
     name, f = next((k, v) for k, v in tool_cases().items() if k.startswith("distance-grid"))
     plain = best(lambda: spinal.advect(V, f, T, 100), repeat)

@@ -364,9 +364,12 @@ fn with_locality<R>(field: &Field, points: &mut [DVec3], run: impl FnOnce(&mut [
 /// [`advect_steps`] over `0..steps` in blocks, calling `tick(done, steps)` after each block;
 /// a block is sized to take about [`BLOCK_SECONDS`] (measured on the one before), so a caller
 /// that checks for interrupts in `tick` hears from it several times a second whatever the
-/// input size, and ends at every multiple of `every` (0: no such constraint) so that a
-/// progress report can be made there. Returns `false` when `tick` stopped it (the points are
-/// then partly advected). The bits equal one [`advect_steps`] call.
+/// input size. After a block, `tick` is also called, in order and before the call for the
+/// block's end, at every multiple of `every` (0: none) that the block passed, so a progress
+/// report can be made there; the blocks need not end there (each block ends in a join of the
+/// pool's threads, which on a short block costs more than the report). Returns `false` when
+/// `tick` stopped it (the points are then partly advected). The bits equal one
+/// [`advect_steps`] call.
 pub fn advect_ticked(
     field: &Field,
     points: &mut [DVec3],
@@ -397,16 +400,21 @@ fn advect_blocks(
     let mut done = 0;
     let mut block = 1usize;
     while done < steps {
-        // a block ends at the next multiple of `every` at the latest
-        let next = done.checked_div(every).map_or(steps, |q| (q + 1) * every);
-        let k = block.min(steps - done).min(next - done);
+        let k = block.min(steps - done);
         let clock = std::time::Instant::now();
         advect_steps(field, points, t0, h, done..done + k, m);
-        done += k;
-        if !tick(done, steps) {
-            return false;
-        }
         let dt = clock.elapsed().as_secs_f64();
+        // the multiples of `every` passed inside the block, then its end
+        let first = done
+            .checked_div(every)
+            .map_or(done + k, |q| (q + 1) * every);
+        let passed = (first..done + k).step_by(every.max(1)).chain([done + k]);
+        for j in passed {
+            if !tick(j, steps) {
+                return false;
+            }
+        }
+        done += k;
         block = if dt > 0.0 {
             (k as f64 * BLOCK_SECONDS / dt).clamp(1.0, 1e9) as usize
         } else {
@@ -466,7 +474,16 @@ mod tests {
             })
             .collect();
         let strip = super::super::tube::strip_curve(&axis, 0.1, 1.0, Some(0.15), false).unwrap();
-        let f = Field::single(strip);
+        // and so does a rod curl tool (its axis is a table of segments too)
+        let rod = super::super::rod::Rod::from_points(&axis, 0.1, Some(0.15), None).unwrap();
+        let rod = super::super::curl::CurlTool::new(
+            std::sync::Arc::new(rod),
+            super::super::curl::Motion::Translate(DVec3::new(0.0, 0.0, -1.0)),
+            2,
+            true,
+        )
+        .unwrap();
+        assert!(super::super::Tool::wants_locality(&rod));
         let x0: Vec<DVec3> = (0..6000)
             .map(|i| {
                 let a = i as f64;
@@ -476,12 +493,14 @@ mod tests {
         let mut order = spatial_order(&x0);
         order.sort_unstable();
         assert!(order.iter().enumerate().all(|(i, &j)| i as u32 == j));
-        let mut sorted = x0.clone();
-        advect_in_place(&f, &mut sorted, 0.0, 0.02, 8, Method::Rk4);
-        let mut plain = x0.clone();
-        advect_steps(&f, &mut plain, 0.0, 0.02, 0..8, Method::Rk4);
-        assert_eq!(sorted, plain);
-        assert_ne!(plain, x0);
+        for f in [Field::single(strip), Field::single(rod)] {
+            let mut sorted = x0.clone();
+            advect_in_place(&f, &mut sorted, 0.0, 0.02, 8, Method::Rk4);
+            let mut plain = x0.clone();
+            advect_steps(&f, &mut plain, 0.0, 0.02, 0..8, Method::Rk4);
+            assert_eq!(sorted, plain);
+            assert_ne!(plain, x0);
+        }
     }
 
     #[test]

@@ -55,6 +55,11 @@ pub trait Distance: Send + Sync + std::fmt::Debug {
     fn gradient_bound(&self) -> f64 {
         1.0
     }
+    /// Whether an evaluation reads a table at a place that depends on the point (a grid's
+    /// coefficients, an axis's segments): see [`Tool::wants_locality`].
+    fn wants_locality(&self) -> bool {
+        false
+    }
 }
 
 impl<D: Distance + ?Sized> Distance for Arc<D> {
@@ -73,6 +78,9 @@ impl<D: Distance + ?Sized> Distance for Arc<D> {
     }
     fn gradient_bound(&self) -> f64 {
         (**self).gradient_bound()
+    }
+    fn wants_locality(&self) -> bool {
+        (**self).wants_locality()
     }
 }
 
@@ -124,6 +132,9 @@ impl Distance for GridTool {
     }
     fn gradient_bound(&self) -> f64 {
         self.slope_bound()
+    }
+    fn wants_locality(&self) -> bool {
+        true
     }
 }
 
@@ -420,6 +431,9 @@ impl<D: Distance + Clone + Into<Shape>> CurlTool<D> {
 }
 
 impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
+    fn wants_locality(&self) -> bool {
+        self.shape.wants_locality()
+    }
     #[inline]
     fn velocity(&self, x: DVec3, t: f64, _tm: f64) -> DVec3 {
         self.eval(x, t)

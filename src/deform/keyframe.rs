@@ -315,6 +315,9 @@ pub fn keyframed(shape: ToolShape, keys: Keys, power: Option<i64>) -> Result<sup
 }
 
 impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
+    fn wants_locality(&self) -> bool {
+        self.shape.wants_locality()
+    }
     #[inline]
     fn velocity(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
         self.eval(x, t, tm)

@@ -116,6 +116,9 @@ impl Distance for Rod {
     fn extent(&self) -> f64 {
         self.bound + self.radius + self.reach
     }
+    fn wants_locality(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]
