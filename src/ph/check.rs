@@ -76,22 +76,11 @@ pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
                 ));
             }
             let v = c.invariants();
-            let defined = [
-                v.l[0],
-                v.l[1],
-                v.l[2],
-                v.ctheta,
-                v.stheta,
-                v.delta,
-                v.a,
-                v.b,
-                v.c,
-                v.k,
-                v.sigma_min,
-                v.kappa_max,
-            ]
-            .iter()
-            .all(|x| x.is_finite());
+            let defined = v
+                .row()
+                .iter()
+                .enumerate()
+                .all(|(j, x)| j == Invariants::KAPPA_OVER_TAU || x.is_finite());
             if !defined {
                 return Err(InputError::new(
                     "control_points",

@@ -91,6 +91,32 @@ pub struct Invariants {
     pub kappa_max: f64,
 }
 
+impl Invariants {
+    /// Index of `κ/τ` in [`Invariants::row`] (infinite for a planar cubic; every other entry
+    /// is finite for a PH cubic that is not straight).
+    pub const KAPPA_OVER_TAU: usize = 10;
+
+    /// `[L1, L2, L3, cθ, sθ, Δ, a, b, c, k, κ/τ, σ_min, κ_max]`, the order of
+    /// `spinal.ph.invariants`.
+    pub fn row(&self) -> [f64; 13] {
+        [
+            self.l[0],
+            self.l[1],
+            self.l[2],
+            self.ctheta,
+            self.stheta,
+            self.delta,
+            self.a,
+            self.b,
+            self.c,
+            self.k,
+            self.kappa_over_tau,
+            self.sigma_min,
+            self.kappa_max,
+        ]
+    }
+}
+
 /// Relative size of `sθ` below which a cubic counts as a straight segment.
 pub const STRAIGHT_EPS: f64 = 1e-12;
 

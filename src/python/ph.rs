@@ -67,21 +67,7 @@ pub fn ph_invariants<'py>(
     let rows = ph::check::invariant_rows(&cubics)?;
     let mut out = Vec::with_capacity(rows.len() * 13);
     for v in &rows {
-        out.extend_from_slice(&[
-            v.l[0],
-            v.l[1],
-            v.l[2],
-            v.ctheta,
-            v.stheta,
-            v.delta,
-            v.a,
-            v.b,
-            v.c,
-            v.k,
-            v.kappa_over_tau,
-            v.sigma_min,
-            v.kappa_max,
-        ]);
+        out.extend_from_slice(&v.row());
     }
     let m = rows.len();
     PyArray1::from_vec(py, out).reshape([m, 13])
