@@ -347,8 +347,15 @@ def test_sweep_bad_input(kwargs, exc, match):
 
 def test_tube_bad_input_and_inputs_untouched():
     x = Helix(1, 0.3, turns=1).sample(30)
-    with pytest.raises(ValueError, match="radius: must be positive"):
+    # the radius is named with the value the user gave, not the internal (x, y) scale pair
+    with pytest.raises(ValueError, match=r"radius: must be positive and finite, got -1 at row 0"):
         spinal.tube(x, -1.0)
+    r = np.full(len(x), 0.1)
+    r[7] = np.nan
+    with pytest.raises(ValueError, match=r"radius: .*got NaN at row 7"):
+        spinal.tube(x, r)
+    with pytest.raises(ValueError, match=r"scale: .*got \[0\.1, -0\.2\] at row 0"):
+        spinal.sweep(x, [(0.1, 0), (0, 0.1), (-0.1, 0)], scale=np.tile([0.1, -0.2], (30, 1)))
     with pytest.raises(ValueError, match="sides: a tube needs at least 3"):
         spinal.tube(x, 0.1, 2)
     bad = x.copy()

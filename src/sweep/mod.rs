@@ -197,9 +197,9 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
         return Err(InputError::new(
             "scale",
             format!(
-                "must be positive and finite, got {:?} at row {i} (for a pointed end use a \
+                "must be positive and finite, got {} at row {i} (for a pointed end use a \
                  small positive value)",
-                s.scale[i].to_array()
+                shown(s.scale[i])
             ),
         ));
     }
@@ -231,6 +231,16 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
 /// The first segment `i` (from sample `i` to the next) that runs against the tangents of
 /// both its ends, `(x_{i+1} − x_i)·t_i < 0` and `(x_{i+1} − x_i)·t_{i+1} < 0`: frames of the
 /// reversed curve, which would turn the mesh inside out.
+/// A row of the scale as the user gave it: one number for a radius (both factors equal),
+/// the pair otherwise.
+fn shown(v: DVec2) -> String {
+    if v.x == v.y || (v.x.is_nan() && v.y.is_nan()) {
+        format!("{}", v.x)
+    } else {
+        format!("{:?}", v.to_array())
+    }
+}
+
 fn against_spine(x: &[DVec3], frames: &[[f64; 9]], closed: bool) -> Option<usize> {
     let n = x.len();
     let segments = if closed { n } else { n - 1 };
