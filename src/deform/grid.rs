@@ -284,14 +284,16 @@ impl GridTool {
 /// Cells per reach below which a grid is too coarse for the blend region.
 pub const MIN_CELLS_PER_REACH: f64 = 4.0;
 
-/// The tool of `spinal.fields.sdf_tool` from its B-spline coefficients, validated: finite
-/// vectors, positive spacing and reach, at least [`MIN_CELLS_PER_REACH`] cells per reach,
-/// and a support that stays inside the grid ([`GridTool::new`]).
+/// The tool of `spinal.fields.sdf_tool` from its B-spline coefficients, an array of shape
+/// `shape = (nx + 2, ny + 2, nz + 2)` for a distance sampled on `(nx, ny, nz)` nodes,
+/// validated: at least 4 nodes per axis, finite vectors, positive spacing and reach, at
+/// least [`MIN_CELLS_PER_REACH`] cells per reach, and a support that stays inside the grid
+/// ([`GridTool::new`]).
 #[allow(clippy::too_many_arguments)]
 pub fn grid_tool(
     origin: DVec3,
     spacing: f64,
-    n: [usize; 3],
+    shape: [usize; 3],
     coef: Vec<f64>,
     velocity: DVec3,
     center: DVec3,
@@ -299,6 +301,13 @@ pub fn grid_tool(
     linear: bool,
     moving: bool,
 ) -> Result<GridTool> {
+    if shape.iter().any(|&k| k < 6) || coef.len() != shape.iter().product::<usize>() {
+        return Err(InputError::new(
+            "grid",
+            format!("expected at least 4 nodes per axis, got shape {shape:?}"),
+        ));
+    }
+    let n = shape.map(|k| k - 2);
     let origin = super::finite3("origin", origin)?;
     let velocity = super::finite3("velocity", velocity)?;
     let center = super::finite3("center", center)?;

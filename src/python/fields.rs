@@ -440,18 +440,11 @@ pub fn field_grid(
     moving: bool,
     name: &str,
 ) -> PyResult<PyField> {
-    let sh = coefficients.shape();
-    if sh.iter().any(|&k| k < 6) {
-        return Err(value_error(format!(
-            "grid: expected at least 4 nodes per axis, got shape {sh:?}"
-        )));
-    }
-    let n = [sh[0] - 2, sh[1] - 2, sh[2] - 2];
-    let coef = slice_of("grid", &coefficients)?.to_vec();
+    let (shape, coef) = coefficients_of(&coefficients)?;
     let tool = grid::grid_tool(
         origin.into(),
         spacing,
-        n,
+        shape,
         coef,
         velocity.into(),
         center.into(),
@@ -523,6 +516,28 @@ pub fn field_zero() -> PyField {
     }
 }
 
+/// A grid's B-spline coefficients and their array shape (checked by the core).
+fn coefficients_of(c: &PyReadonlyArray3<'_, f64>) -> PyResult<([usize; 3], Vec<f64>)> {
+    let sh = c.shape();
+    Ok(([sh[0], sh[1], sh[2]], slice_of("grid", c)?.to_vec()))
+}
+
+/// A field of one curl tool of `shape` (shared by the tool's copies).
+fn curl_field<D>(
+    shape: D,
+    m: curl::Motion,
+    power: i64,
+    moving: bool,
+    name: &str,
+) -> PyResult<PyField>
+where
+    std::sync::Arc<D>: curl::Distance + Clone + Into<curl::Shape>,
+    curl::CurlTool<std::sync::Arc<D>>: crate::deform::Tool + 'static,
+{
+    let tool = curl::CurlTool::new(std::sync::Arc::new(shape), m, power, moving)?;
+    Ok(PyField::new(Field::single(tool), name))
+}
+
 /// The motion of a curl tool from its optional arguments.
 fn motion(
     velocity: Option<[f64; 3]>,
@@ -555,18 +570,11 @@ pub fn field_grid_curl(
     moving: bool,
     name: &str,
 ) -> PyResult<PyField> {
-    let sh = coefficients.shape();
-    if sh.iter().any(|&k| k < 6) {
-        return Err(value_error(format!(
-            "grid: expected at least 4 nodes per axis, got shape {sh:?}"
-        )));
-    }
-    let n = [sh[0] - 2, sh[1] - 2, sh[2] - 2];
-    let coef = slice_of("grid", &coefficients)?.to_vec();
+    let (shape, coef) = coefficients_of(&coefficients)?;
     let shape = grid::grid_tool(
         origin.into(),
         spacing,
-        n,
+        shape,
         coef,
         DVec3::ZERO,
         center.into(),
@@ -574,9 +582,9 @@ pub fn field_grid_curl(
         false,
         false,
     )?;
-    let m = motion(velocity, angular_velocity, pivot, shape.center)?;
-    let tool = curl::CurlTool::new(std::sync::Arc::new(shape), m, falloff_power, moving)?;
-    Ok(PyField::new(Field::single(tool), name))
+    let center = shape.center;
+    let m = motion(velocity, angular_velocity, pivot, center)?;
+    curl_field(shape, m, falloff_power, moving, name)
 }
 
 /// `spinal.fields.rod`: a curl tool shaped as the tube about the axis through `points`.
@@ -599,8 +607,7 @@ pub fn field_rod(
         rod::Rod::from_points(x, radius, reach, center.map(DVec3::from))
     })??;
     let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
-    let tool = curl::CurlTool::new(std::sync::Arc::new(rod), mo, falloff_power, moving)?;
-    Ok(PyField::new(Field::single(tool), "rod"))
+    curl_field(rod, mo, falloff_power, moving, "rod")
 }
 
 /// `spinal.fields.keyframed`: the shape of `tool` (a field of one tool) following keys;
