@@ -317,13 +317,30 @@ pub fn transport_into<S: Step>(
     twist: Twist,
     out: &mut [f64],
 ) -> f64 {
+    let ext = if closed { t.len() } else { t.len() - 1 } + 1;
+    let (_, cs) = plan(ext, step.is_rotation());
+    transport_chunked(step, t, seg, closed, r0, twist, out, cs)
+}
+
+/// [`transport_into`] with chunks of `cs` extended frames (the scan's result does not
+/// depend on `cs` beyond rounding).
+#[allow(clippy::too_many_arguments)]
+fn transport_chunked<S: Step>(
+    step: &S,
+    t: &[DVec3],
+    seg: &[f64],
+    closed: bool,
+    r0: DVec3,
+    twist: Twist,
+    out: &mut [f64],
+    cs: usize,
+) -> f64 {
     let n = t.len();
     let m = if closed { n } else { n - 1 }; // segments; extended frames 0..=m
     let ext = m + 1;
     let rows = out.len() / 9;
     debug_assert!(rows == n || (closed && rows == n + 1));
     let tt = |i: usize| t[if i == n { 0 } else { i }];
-    let (_, cs) = plan(ext, step.is_rotation());
     let work = |c: usize, start: Option<DVec3>, buf: &mut [f64]| {
         let (a, b) = (c * cs, ((c + 1) * cs).min(ext));
         let s0 = start.unwrap_or_else(|| any_perpendicular(tt(a)));
@@ -504,8 +521,6 @@ mod tests {
                 };
                 let m = if closed { n } else { n - 1 };
                 let seg: Vec<f64> = (0..m).map(|i| (x[(i + 1) % n] - x[i]).length()).collect();
-                let ext = m + 1;
-                let tt = |i: usize| t[if i == n { 0 } else { i }];
                 let r0 = any_perpendicular(t[0]);
                 let target = any_perpendicular(t[n - 1]).cross(t[n - 1]);
                 let twists = if closed {
@@ -521,39 +536,14 @@ mod tests {
                     for rows in [n, n + usize::from(closed)] {
                         let (want, want_raw) = serial(&dr, &t, &seg, closed, r0, twist, rows);
                         for cs in [1, 2, 3, 5] {
-                            let scan = Scan {
-                                boundary_step: |i: usize, r: DVec3| dr.step(i, r),
-                                tangent: tt,
-                                seg: |i: usize| seg[i.min(seg.len() - 1)],
-                                n,
-                                closed,
-                                r0,
-                                twist,
-                                cs,
-                                ext,
-                            };
-                            // the chunk work of `transport_into`, with chunks of `cs` frames
-                            let work = |c: usize, start: Option<DVec3>, buf: &mut [f64]| {
-                                let (a, b) = (c * cs, ((c + 1) * cs).min(ext));
-                                let s0 = start.unwrap_or_else(|| any_perpendicular(tt(a)));
-                                let mut rows = buf.chunks_exact_mut(9);
-                                let mut r = s0;
-                                for i in a..b {
-                                    if let Some(f) = rows.next() {
-                                        write_frame(f, r, tt(i));
-                                    }
-                                    if i + 1 < b {
-                                        r = dr.step(i, r);
-                                    }
-                                }
-                                Some((s0, r, seg[a.min(m)..b.min(m)].iter().sum::<f64>()))
-                            };
                             let mut three: Option<Vec<f64>> = None;
                             for threads in [1, 2, 3, 3] {
                                 let mut out = vec![0.0; 9 * rows];
-                                let raw = pool(threads)
-                                    .install(|| scan.scan(work, &mut out))
-                                    .expect("no check fails");
+                                let raw = pool(threads).install(|| {
+                                    transport_chunked(
+                                        &dr, &t, &seg, closed, r0, twist, &mut out, cs,
+                                    )
+                                });
                                 let what = format!(
                                     "n {n}, closed {closed}, {twist:?}, rows {rows}, chunk {cs}, {threads} threads"
                                 );
