@@ -23,9 +23,9 @@ import json
 import os
 import subprocess
 import sys
-import time
 
 import numpy as np
+from _timing import best
 
 import spinal
 from spinal import fields
@@ -141,14 +141,6 @@ def points(n):
     d = rng.normal(size=(n, 3))
     return d / np.linalg.norm(d, axis=1)[:, None] * rng.random(n)[:, None] ** (1 / 3)
 
-
-def best(f, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
 
 
 def time_spinal(n, repeat):

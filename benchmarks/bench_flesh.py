@@ -19,22 +19,14 @@ import json
 import os
 import subprocess
 import sys
-import time
 
 import numpy as np
+from _timing import best
 
 import spinal
 
 SAMPLES = 100
 
-
-def best(f, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
 
 
 def spines():

@@ -23,19 +23,12 @@ import sys
 import time
 
 import numpy as np
+from _timing import best
 
 import spinal
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]
 
-
-def best(f, repeat, *args, **kwargs):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f(*args, **kwargs)
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
 
 
 def helix(n):

@@ -10,27 +10,14 @@ built the mesh, and next to trimesh's ``volume`` / ``is_watertight`` on the same
 from __future__ import annotations
 
 import argparse
-import time
 
-import numpy as np
+from _timing import best, helix
 
 import spinal
 
 SIDES = 16
 
 
-def best(f, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
-
-
-def helix(n, turns=100):
-    u = np.linspace(0, 2 * np.pi * turns, n)
-    return np.c_[np.cos(u), np.sin(u), 0.05 * u]
 
 
 def main() -> None:

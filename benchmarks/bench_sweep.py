@@ -31,9 +31,9 @@ import argparse
 import json
 import subprocess
 import sys
-import time
 
 import numpy as np
+from _timing import best, helix
 
 import spinal
 
@@ -41,18 +41,6 @@ SIDES = 16
 RADIUS = 0.05
 
 
-def best(f, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        f()
-        ts.append(time.perf_counter() - t0)
-    return min(ts)
-
-
-def helix(n, turns=100):
-    u = np.linspace(0, 2 * np.pi * turns, n)
-    return np.c_[np.cos(u), np.sin(u), 0.05 * u]
 
 
 def floor(nv, nf):
