@@ -270,6 +270,11 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
 
 /// [`compute_into`] that polls `cancel` before every chunk of the fused scan and returns at
 /// once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+///
+/// Memory: the per-row working vectors of this module (tangents, chords, segment lengths,
+/// normals, ω) take well under the 256 bytes per row that the binding's `ensure_memory`
+/// probe checks before the call, so they are allocated infallibly; the normalised copy of
+/// the input is allocated fallibly.
 pub fn compute_into_cancellable(
     req: &Request,
     out: &mut [f64],
