@@ -36,6 +36,17 @@ pub fn collect<T>(what: &'static str, it: impl ExactSizeIterator<Item = T>) -> R
     Ok(v)
 }
 
+/// The items of an indexed parallel iterator, in order, into a vector reserved fallibly
+/// first (rayon's `collect_into_vec` then uses the reserved room).
+pub fn par_collect<T: Send>(
+    what: &'static str,
+    it: impl rayon::iter::IndexedParallelIterator<Item = T>,
+) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, it.len())?;
+    it.collect_into_vec(&mut v);
+    Ok(v)
+}
+
 /// Push onto a growing vector (amortised doubling, as `Vec::push`), failing instead of
 /// aborting when the next block cannot be had.
 pub fn push<T>(what: &'static str, v: &mut Vec<T>, x: T) -> Result<()> {
@@ -76,5 +87,8 @@ mod tests {
         push("x", &mut v, 1u8).unwrap();
         assert_eq!(copied("x", &v).unwrap(), vec![1]);
         assert_eq!(collect("x", [1, 2].into_iter()).unwrap(), vec![1, 2]);
+        use rayon::prelude::*;
+        let v = par_collect("x", (0..10_000u32).into_par_iter().map(|i| 2 * i)).unwrap();
+        assert!(v.iter().enumerate().all(|(i, &x)| x == 2 * i as u32));
     }
 }

@@ -1,4 +1,4 @@
-"""Property tests over scales 1e-150 … 1e150: a valid input scaled by 10^k gives the answer
+"""Property tests over scales 1e-150 … 1e150 (flesh: 1e-300 … 1e300): a valid input scaled by 10^k gives the answer
 of the unscaled input (scaled back where the answer has units) and never a NaN; quaternions
 of any size give their rotation. Kept to about a minute in all (``max_examples``)."""
 
@@ -108,7 +108,7 @@ def test_camera_and_quaternion_frames_are_scale_invariant(seed, n, k, mode):
 
 
 @SETTINGS
-@given(SEEDS, EXPONENTS, st.sampled_from(["radial", "normal", "binormal", "none"]),
+@given(SEEDS, st.integers(-300, 300), st.sampled_from(["radial", "normal", "binormal", "none"]),
        st.booleans())
 def test_flesh_scales(seed, k, solution, stretchable):
     rng = np.random.default_rng(seed)

@@ -204,3 +204,66 @@ def test_D25_messages_name_the_argument():
         spinal.Mesh(np.eye(3), [[0, 1, 2]]).save(5)
     with pytest.raises(ValueError, match="^path: "):
         spinal.Mesh(np.eye(3), [[0, 1, 2]]).save("mesh.stl")
+
+
+# ------------------------------------------------------------- flesh beyond 1e±150
+
+FLESH_SCALES = (1e-200, 1e-160, 1e160, 1e200)
+_ring_u = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+RING = np.c_[np.cos(_ring_u), np.sin(_ring_u), 0 * _ring_u]
+RING_POSED = np.c_[1.2 * np.cos(_ring_u), np.sin(_ring_u), 0.1 * np.sin(2 * _ring_u)]
+POSED_3D = np.c_[np.sin(_v), 1 - np.cos(_v), 0.1 * _v**2]
+FLESH_V = np.array([[0, 0.3, 0], [0.5, -0.1, 0.2], [1.3, 0.1, 0.0], [-1.2, 0, 0.1]])
+_g = np.stack(np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 6), indexing="ij"), -1)
+SURF_REST = np.concatenate([_g, 0.1 * _g[..., :1] ** 2], -1)
+SURF_POSED = np.concatenate([_g, 0.3 * (_g[..., :1] ** 2 + _g[..., 1:] ** 2)], -1)
+SURF_V = np.array([[0.3, 0.4, 0.1], [0.7, 0.2, -0.05], [2, 2, 0.3]])  # the last outside
+
+FLESH_CALLS = {
+    **{f"{sol} stretchable={st}": (
+        lambda s, sol=sol, st=st: spinal.flesh(FLESH_V * s, REST * s, POSED_3D * s,
+                                               solution=sol, stretchable=st))
+       for sol in ("radial", "normal", "binormal", "none") for st in (False, True)},
+    "closed": lambda s: spinal.flesh((FLESH_V[:2] + [1, 0, 0]) * s, RING * s, RING_POSED * s,
+                                     closed=True),
+    "posed_up": lambda s: spinal.flesh(FLESH_V * s, REST * s, POSED_3D * s, posed_up=[0, 0.3, 1]),
+    "planar": lambda s: spinal.flesh(FLESH_V[:, :2] * s, REST[:, :2] * s, POSED[:, :2] * s),
+    "offset": lambda s: spinal.SpineBinding(FLESH_V * s, REST * s).offset,
+    "arc_length": lambda s: spinal.SpineBinding(FLESH_V * s, REST * s).arc_length,
+    "surface": lambda s: spinal.flesh_surface(SURF_V * s, SURF_REST * s, SURF_POSED * s),
+    "surface none": lambda s: spinal.flesh_surface(SURF_V * s, SURF_REST * s, SURF_POSED * s,
+                                                   solution="none"),
+    "surface posed_up": lambda s: spinal.flesh_surface(SURF_V * s, SURF_REST * s,
+                                                       SURF_POSED * s, posed_up=[0.1, 0, 1]),
+    "surface offset": lambda s: spinal.SurfaceBinding(SURF_V * s, SURF_REST * s).offset,
+    "surface rest_frames": lambda s: spinal.SurfaceBinding(SURF_V * s, SURF_REST * s)
+    .rest_frames * s,
+}
+
+
+@pytest.mark.parametrize("name", list(FLESH_CALLS))
+def test_flesh_at_any_scale_is_the_unit_result_scaled(name):
+    """The spine and surface models are built on the input divided by its power-of-two
+    scale, so bending at 1e±200 is bending at 1 (before: off by 3.5e-4 at 1e-160, a
+    misleading 'turns too fast' error from 1e160 up)."""
+    call = FLESH_CALLS[name]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        want = call(1.0)
+        for s in FLESH_SCALES:
+            got = call(s)
+            assert np.isfinite(got).all(), (name, s)
+            np.testing.assert_allclose(got / s, want, rtol=1e-9, atol=1e-9 * np.abs(want).max(),
+                                       err_msg=f"{name} at {s:g}")
+
+
+def test_flesh_sizes_out_of_range_are_named():
+    """A pose whose result is past float64 (a stretch of 1e600 between rest and pose) says
+    so and names the argument, instead of returning inf or NaN."""
+    with pytest.raises(ValueError, match="^posed_spine: vertex 0: .*out of range"):
+        spinal.flesh(FLESH_V * 1e-300, REST * 1e-300, POSED_3D * 1e300, stretchable=True)
+    with pytest.raises(ValueError, match="^posed_surface: vertex 1: .*out of range"):
+        spinal.flesh_surface(SURF_V, SURF_REST, SURF_POSED * 1e-200)
+    # very different but representable sizes are fine
+    out = spinal.flesh(FLESH_V, REST, POSED_3D * 1e200, stretchable=True)
+    assert np.isfinite(out).all() and np.abs(out).max() > 1e199

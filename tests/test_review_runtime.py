@@ -107,6 +107,21 @@ D16_CASES = {
         ("m = 30_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
         "mesh = spinal.Mesh(np.zeros((1000, 3)), F)\n"),
         "mesh.is_watertight", "mesh edges: out of memory"),
+    "mesh_closed_centroid": (
+        ("m = 5_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
+        "V = np.random.default_rng(0).normal(size=(1000, 3))\n"),
+        "spinal._core.mesh_closed_centroid(V, F)", "closed tool: out of memory"),
+    "walk_mesh big mesh": (
+        ("m = 5_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
+        "V = np.random.default_rng(0).normal(size=(1000, 3))\n"),
+        "Q.walk_mesh(V, F, 0, V[F[0]].mean(0), [[.01, .1]])", "walk_mesh: out of memory"),
+    "strip_curve": (
+        ("n = 2_000_000; s = np.linspace(0, 2000, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.fields.strip_curve(X, .1, 1.0)", "out of memory"),
+    "SpineBinding at 1e200": (
+        "V = np.random.default_rng(0).normal(size=(5_000_000, 3)) * 1e200\n",
+        "spinal.SpineBinding(V, H * 1e200)", "SpineBinding: out of memory"),
     "PHSpline.evaluate": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
         "s = np.linspace(0, 1, 10_000_000)\n"),

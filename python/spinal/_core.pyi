@@ -395,13 +395,14 @@ def flesh_resample(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def flesh_surface_bind(
     rest_points: npt.NDArray[np.float64], nu: int, nv: int, vertices: npt.NDArray[np.float64]
-) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], int]: ...
 def flesh_surface_deform(
     posed_points: npt.NDArray[np.float64],
     nu: int,
     nv: int,
     cell: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
+    rest_exp: int,
     corrected: bool,
     directions: tuple[str, npt.NDArray[np.float64]] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...

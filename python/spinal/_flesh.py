@@ -66,6 +66,13 @@ def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray):
     return np.ascontiguousarray(pts), k + u
 
 
+def _unit_sized(a: np.ndarray) -> np.ndarray:
+    """``a`` times the power of two that brings its largest absolute entry into [0.5, 1)
+    (exact; ``a`` itself when it is zero)."""
+    m = float(np.abs(a).max(initial=0.0))
+    return np.ldexp(a, -np.frexp(m)[1]) if m > 0 and np.isfinite(m) else a
+
+
 def _scale(a: np.ndarray) -> float:
     return max(float(np.abs(a).max(initial=0.0)), 1e-300)
 
@@ -99,8 +106,10 @@ def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.n
     inverse roll."""
     r0, t0 = f0[:, 0], f0[:, 2]
     q = _core.minimal_rotation(t0, t1)
-    a = rest - rest.mean(0)
-    b = posed - posed.mean(0)
+    # each spine divided by a power of two near its size first (exact; the rotation does not
+    # depend on it): the products of coordinates below leave float64's range beyond 1e±150
+    a = _unit_sized(rest - rest.mean(0))
+    b = _unit_sized(posed - posed.mean(0))
     u, sv, vt = np.linalg.svd(a.T @ b)
     sa = np.linalg.svd(a, compute_uv=False)
     sb = np.linalg.svd(b, compute_uv=False)
@@ -605,6 +614,7 @@ def _surface_frames(g: np.ndarray) -> np.ndarray:
     """``(nu, nv, 3, 3)`` frames at the grid samples, columns ``(e1, e2, N)``: ``N`` the unit
     ``S_u × S_v`` and ``e1`` the unit ``S_u`` projected on its normal plane, both by the
     central differences of the core (one-sided at the border), ``e2 = N × e1``."""
+    g = _unit_sized(g)  # the cross products of differences leave float64's range far from 1
     nu, nv = g.shape[:2]
     iu = np.arange(nu)
     iv = np.arange(nv)
@@ -680,7 +690,7 @@ class SurfaceBinding:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
         self._shape = g.shape[:2]
         self._rest_frames = _surface_frames(g)
-        self._cell, self._coords = _core.flesh_surface_bind(
+        self._cell, self._coords, self._exp = _core.flesh_surface_bind(
             g.reshape(-1, 3), g.shape[0], g.shape[1], np.ascontiguousarray(v, dtype=np.float64)
         )
         self.clamped = np.zeros(0, dtype=np.int64)
@@ -749,8 +759,8 @@ class SurfaceBinding:
                              f"{self._shape}, got {g.shape[:2]}")
         dirs = _surface_directions(posed_frames, posed_up, self._shape)
         out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
-                                                self._cell, self._coords, solution == "offset",
-                                                dirs)
+                                                self._cell, self._coords, self._exp,
+                                                solution == "offset", dirs)
         clamped = np.flatnonzero(flags).astype(np.int64)
         self.clamped = clamped
         if clamped.size:

@@ -29,6 +29,7 @@
 use glam::DVec3;
 
 use super::cross::{speed_factor, translate};
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 /// A tool given by a signed-distance grid (see the module docs).
@@ -100,11 +101,13 @@ impl GridTool {
                 "sdf grid needs at least 4 nodes per axis, got {n:?}"
             )));
         }
-        let p = [n[0] + 2, n[1] + 2, n[2] + 2];
-        if coef.len() != p[0] * p[1] * p[2] {
+        // user numbers: sums and product checked (a wrapped one could match `coef`)
+        let p = n.map(|k| k.saturating_add(2));
+        let nodes = p[0].checked_mul(p[1]).and_then(|a| a.checked_mul(p[2]));
+        if nodes != Some(coef.len()) {
             return Err(bad(format!(
                 "sdf grid of {n:?} nodes needs {} coefficients, got {}",
-                p[0] * p[1] * p[2],
+                nodes.map_or_else(|| "more than usize".to_string(), |c| c.to_string()),
                 coef.len()
             )));
         }
@@ -112,13 +115,14 @@ impl GridTool {
         let c = [n[0] - 1, n[1] - 1, n[2] - 1];
         let win =
             |v: &[f64], i: usize, s: usize| v[i].min(v[i + s]).min(v[i + 2 * s]).min(v[i + 3 * s]);
-        let mut mz = vec![0.0; p[0] * p[1] * c[2]];
+        // each smaller than `coef` (checked above), allocated fallibly
+        let mut mz = alloc::filled("sdf grid", p[0] * p[1] * c[2], 0.0)?;
         for i in 0..p[0] * p[1] {
             for k in 0..c[2] {
                 mz[i * c[2] + k] = win(&coef, i * p[2] + k, 1);
             }
         }
-        let mut my = vec![0.0; p[0] * c[1] * c[2]];
+        let mut my = alloc::filled("sdf grid", p[0] * c[1] * c[2], 0.0)?;
         for i in 0..p[0] {
             for j in 0..c[1] {
                 for k in 0..c[2] {
@@ -126,7 +130,7 @@ impl GridTool {
                 }
             }
         }
-        let mut cell_min = vec![0.0; c[0] * c[1] * c[2]];
+        let mut cell_min = alloc::filled("sdf grid", c[0] * c[1] * c[2], 0.0)?;
         for i in 0..c[0] {
             for j in 0..c[1] {
                 for k in 0..c[2] {

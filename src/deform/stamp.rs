@@ -91,7 +91,8 @@ pub fn stamp(
         return Err(InputError::new("frames", "must be at least 1"));
     }
     let u = travel / len;
-    let mut out = Vec::with_capacity(frames);
+    // `frames` is a user number: the list grows with the frames done, not reserved from it
+    let mut out = alloc::with_capacity("stamp", frames.min(1024))?;
     let mut contact = alloc::filled("stamp", v.len(), false)?;
     let mut movable = alloc::filled("stamp", v.len(), false)?;
     for k in 1..=frames {
@@ -169,19 +170,25 @@ pub fn stamp(
             ));
         }
         if !(dent > 0.0) {
-            out.push(StampFrame {
-                dent: dent.max(0.0),
-                time: 0.0,
-                residual: snapped - before,
-                contact: nc,
-            });
+            alloc::push(
+                "stamp",
+                &mut out,
+                StampFrame {
+                    dent: dent.max(0.0),
+                    time: 0.0,
+                    residual: snapped - before,
+                    contact: nc,
+                },
+            )?;
             if !tick(k, frames) {
                 break;
             }
             continue;
         }
-        let idx: Vec<usize> = (0..v.len()).filter(|&i| movable[i]).collect();
-        let rest: Vec<DVec3> = idx.iter().map(|&i| v[i]).collect();
+        let moving = movable.iter().filter(|&&m| m).count();
+        let mut idx = alloc::with_capacity("stamp", moving)?;
+        idx.extend((0..v.len()).filter(|&i| movable[i]));
+        let rest = alloc::collect("stamp", idx.iter().map(|&i| v[i]))?;
         let mut time = dent / rate;
         let mut after = snapped;
         for it in 0..=iterations {
@@ -194,12 +201,16 @@ pub fn stamp(
                 time *= dent / gained;
             }
         }
-        out.push(StampFrame {
-            dent,
-            time,
-            residual: after - before,
-            contact: nc,
-        });
+        alloc::push(
+            "stamp",
+            &mut out,
+            StampFrame {
+                dent,
+                time,
+                residual: after - before,
+                contact: nc,
+            },
+        )?;
         if !tick(k, frames) {
             break;
         }

@@ -46,6 +46,7 @@
 use glam::DVec3;
 
 use super::cross::{blend, translate};
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
 
@@ -157,11 +158,13 @@ impl Axis {
                 return Err(bad(format!("strip axis derivative {i} is zero")));
             }
         }
-        let mut segs = Vec::with_capacity(samples.len() - 1);
+        const CALL: &str = "strip_curve/rod axis";
+        let mut segs = alloc::with_capacity(CALL, samples.len() - 1)?;
         // the axis at `PER` parameters per segment (and the last sample), with their
         // chord-length parameters, for the self-approach check
-        let mut dense = Vec::with_capacity(PER * (samples.len() - 1) + 1);
-        let mut param = Vec::with_capacity(dense.capacity());
+        let rows = alloc::product(CALL, PER, samples.len() - 1, size_of::<DVec3>())? + 1;
+        let mut dense = alloc::with_capacity(CALL, rows)?;
+        let mut param = alloc::with_capacity(CALL, rows)?;
         // (segment, curvature × (radius + reach + arc), curvature) of the worst bend
         let mut worst: (usize, f64, f64) = (0, 0.0, 0.0);
         for (k, w) in samples.windows(2).enumerate() {
@@ -246,7 +249,12 @@ impl Axis {
             .map(|g| (g.centre - centre).length() + g.radius)
             .fold(0.0, f64::max);
         // the normal planes `F_k = X·m_k − x_k·m_k` by component, padded to whole blocks
-        let mut planes = [0, 1, 2, 3].map(|_| Vec::with_capacity(samples.len() + BLOCK));
+        let mut planes = [
+            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
+            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
+            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
+            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
+        ];
         for p in &samples {
             for (a, v) in [p.m.x, p.m.y, p.m.z, p.x.dot(p.m)].into_iter().enumerate() {
                 planes[a].push(v);
@@ -497,20 +505,21 @@ impl super::Tool for StripAlong {
 /// `δ_k = (x_{k+1} − x_k)/h_k`):
 /// `h_k m_{k−1} + 2(h_{k−1} + h_k) m_k + h_{k−1} m_{k+1} = 3(h_k δ_{k−1} + h_{k−1} δ_k)`.
 /// `x` and `s` have the same length ≥ 2.
-pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Vec<DVec3> {
+pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Result<Vec<DVec3>> {
+    const CALL: &str = "strip_curve/rod axis";
     let n = x.len();
-    let mut m = vec![DVec3::ZERO; n];
+    let mut m = alloc::filled(CALL, n, DVec3::ZERO)?;
     m[0] = m0;
     m[n - 1] = m1;
     if n <= 2 {
-        return m;
+        return Ok(m);
     }
-    let h: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
+    let h = alloc::collect(CALL, s.windows(2).map(|w| w[1] - w[0]))?;
     let delta = |k: usize| (x[k + 1] - x[k]) / h[k];
     // interior row i is knot k = i + 1: lower h_{i+1}, diagonal 2(h_i + h_{i+1}), upper h_i
     let k = n - 2;
-    let mut c = vec![0.0; k];
-    let mut d = vec![DVec3::ZERO; k];
+    let mut c = alloc::filled(CALL, k, 0.0)?;
+    let mut d = alloc::filled(CALL, k, DVec3::ZERO)?;
     let rhs = |i: usize| {
         let mut r = 3.0 * (h[i + 1] * delta(i) + h[i] * delta(i + 1));
         if i == 0 {
@@ -533,7 +542,7 @@ pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Ve
         d[i] = d[i] - c[i] * d[i + 1];
     }
     m[1..n - 1].copy_from_slice(&d);
-    m
+    Ok(m)
 }
 
 /// The axis samples of a tube about `points`: at least 2 finite samples with no repeated
@@ -548,7 +557,7 @@ pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
         ));
     }
     super::finite_rows("points", points)?;
-    let mut s = Vec::with_capacity(points.len());
+    let mut s = alloc::with_capacity("strip_curve/rod axis", points.len())?;
     s.push(0.0);
     for (i, w) in points.windows(2).enumerate() {
         let chord = w[0].distance(w[1]);
@@ -565,13 +574,15 @@ pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
         false,
         crate::frames::TangentRule::FivePointBounded,
     )?;
-    let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1]);
-    Ok(points
-        .iter()
-        .zip(&m)
-        .zip(&s)
-        .map(|((&x, &m), &s)| AxisSample { x, m, s })
-        .collect())
+    let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1])?;
+    alloc::collect(
+        "strip_curve/rod axis",
+        points
+            .iter()
+            .zip(&m)
+            .zip(&s)
+            .map(|((&x, &m), &s)| AxisSample { x, m, s }),
+    )
 }
 
 /// The strip of `spinal.fields.strip_curve` about `points` ([`axis_samples`], then
@@ -625,6 +636,8 @@ fn self_approach(p: &[DVec3], t: &[f64], outer: f64) -> Option<(usize, usize, f6
     }
     let two = 2.0 * outer;
     let near = std::f64::consts::PI * outer;
+    // `len` and the cells' runs are at most the size of `p`, the strip's dense axis, which
+    // was allocated fallibly just before (this check has no error path of its own)
     let mut len = Vec::with_capacity(n);
     let mut acc = 0.0;
     len.push(acc);
@@ -824,13 +837,13 @@ mod tests {
         let dg = |t: f64| DVec3::new(1.0, 2.0 * t - 1.0, 0.75 * t * t);
         let s = [0.0, 0.3, 0.5, 1.1, 1.2, 2.0, 2.7];
         let x: Vec<DVec3> = s.iter().map(|&t| g(t)).collect();
-        let m = clamped_spline_slopes(&x, &s, dg(0.0), dg(2.7));
+        let m = clamped_spline_slopes(&x, &s, dg(0.0), dg(2.7)).unwrap();
         for (mk, &t) in m.iter().zip(&s) {
             assert!((*mk - dg(t)).length() < 1e-13, "{mk} {}", dg(t));
         }
-        let two = clamped_spline_slopes(&x[..2], &s[..2], DVec3::X, DVec3::Y);
+        let two = clamped_spline_slopes(&x[..2], &s[..2], DVec3::X, DVec3::Y).unwrap();
         assert_eq!(two, vec![DVec3::X, DVec3::Y]);
-        let three = clamped_spline_slopes(&x[..3], &s[..3], dg(0.0), dg(0.5));
+        let three = clamped_spline_slopes(&x[..3], &s[..3], dg(0.0), dg(0.5)).unwrap();
         assert!((three[1] - dg(0.3)).length() < 1e-13);
     }
 

@@ -9,9 +9,12 @@
 //! sample, so no vertex snaps to a sample (§7.1's "slicing") and the offset is exactly
 //! normal to the interpolated tangent.
 //!
-//! Stored per vertex: `k` and [`COORDS`] numbers `[a, τ, α, β, σ0, κα0, κβ0]`: the edge
+//! Stored per vertex: `k` and [`COORDS`] numbers `[a, τ, α, β, σ0, σ0κα0, σ0κβ0]`: the edge
 //! parameter, the tangential coordinate past an end (0 inside), the offset in the RMF
-//! `(α, β)`, and the rest spine's speed and curvature vector (RMF coordinates) at `(k, a)`.
+//! `(α, β)`, the rest spine's speed `σ0` and its curvature vector (RMF coordinates) at
+//! `(k, a)` times `σ0`. Lengths are in the units of the input and the last two numbers have
+//! none, so a binding does not depend on the normalisation of the rest spine's model (see
+//! [`SpineModel`]) and any posed spine's model can read it.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -177,6 +180,22 @@ pub fn bind_cancellable(
             format!("row {i} is not finite"),
         ));
     }
+    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
+    if rest.scale.exp() > 0 {
+        // a spine far smaller than 1: a vertex far from it may leave the range once scaled
+        if let Some(i) = vertices
+            .par_iter()
+            .position_first(|v| !to_model.of3(*v).is_finite())
+        {
+            return Err(InputError::new(
+                "vertices",
+                format!(
+                    "row {i} is out of range: its distance from the rest spine, in units of \
+                     the spine's size, exceeds float64"
+                ),
+            ));
+        }
+    }
     let nv = vertices.len();
     let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
     let mut coords = alloc::filled(
@@ -191,12 +210,26 @@ pub fn bind_cancellable(
             if cancel() {
                 return;
             }
+            let p = to_model.of3(p);
             let (k, a, tau) = locate(rest, p);
             let l = rest.eval(k, a);
             let d = p - l.q - tau * l.t;
-            let kappa = if tau != 0.0 { DVec2::ZERO } else { l.kappa };
+            let sk = if tau != 0.0 {
+                DVec2::ZERO
+            } else {
+                l.kappa * l.sigma
+            };
+            let len = |x: f64| to_input.of(x);
             *e = k as i64;
-            c.copy_from_slice(&[a, tau, d.dot(l.u), d.dot(l.v), l.sigma, kappa.x, kappa.y]);
+            c.copy_from_slice(&[
+                a,
+                len(tau),
+                len(d.dot(l.u)),
+                len(d.dot(l.v)),
+                len(l.sigma),
+                sk.x,
+                sk.y,
+            ]);
         });
     Ok(Binding { edge, coords })
 }

@@ -19,6 +19,7 @@ use super::solve::{Solution, bend, unbend};
 use super::spine::SpineModel;
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::math::scale;
 
 /// Deform a registered shape. `twist` is empty or one angle (rad) per spine sample.
 /// Writes the vertices to `out` and the per-vertex flags (see [`super::solve`]) to `flags`.
@@ -86,6 +87,23 @@ pub fn deform_cancellable(
                 run(posed, twist, e, c, o, f)
             }
         });
+    if posed.scale.exp() != 0 {
+        // a binding and a pose whose sizes differ by more than the range of f64 between
+        // them (a stretch λ past it), or a result past the largest float
+        if let Some(i) = out.par_iter().position_first(|p| !p.is_finite()) {
+            if !cancel() {
+                return Err(InputError::new(
+                    "posed_spine",
+                    format!(
+                        "vertex {i}: the posed position is out of range of float64 (the \
+                         stretch between the rest spine and the posed spine at size {:e} is \
+                         out of range)",
+                        scale::ldexp(1.0, -posed.scale.exp())
+                    ),
+                ));
+            }
+        }
+    }
     Ok(())
 }
 
@@ -148,6 +166,8 @@ fn lanes<const S: u8, const L: usize>(
     flags: &mut [u8],
 ) {
     let sol = solution(S);
+    // lengths of the binding (input units) to the posed model's units and back
+    let (to_model, to_input) = (posed.scale, posed.scale.inverse());
     let k: [usize; L] = std::array::from_fn(|l| edge[l] as usize);
     let a: [f64; L] = std::array::from_fn(|l| coords[COORDS * l]);
     let loc = posed.eval_lanes(&k, &a);
@@ -160,14 +180,16 @@ fn lanes<const S: u8, const L: usize>(
     for l in 0..L {
         let c = &coords[COORDS * l..COORDS * (l + 1)];
         let (k, a, tau) = (k[l], c[0], c[1]);
-        lam[l] = loc[l].sigma / c[4];
+        let s0 = to_model.of(c[4]);
+        lam[l] = loc[l].sigma / s0;
         let k0 = if tau != 0.0 {
             DVec2::ZERO
         } else {
             k1[l] = loc[l].kappa;
-            DVec2::new(c[5], c[6])
+            DVec2::new(c[5], c[6]) * (1.0 / s0)
         };
-        let mut dl = unbend(sol, DVec2::new(c[2], c[3]), k0, &mut fl[l]);
+        let d0 = DVec2::new(to_model.of(c[2]), to_model.of(c[3]));
+        let mut dl = unbend(sol, d0, k0, &mut fl[l]);
         if !twist.is_empty() {
             let phi = twist[k] + a * (twist[k + 1] - twist[k]);
             let (s, cs) = phi.sin_cos();
@@ -179,14 +201,14 @@ fn lanes<const S: u8, const L: usize>(
         d[l] = bend(sol, d[l], k1[l], lam[l], &mut fl[l]);
     }
     for l in 0..L {
-        let tau = coords[COORDS * l + 1];
+        let tau = to_model.of(coords[COORDS * l + 1]);
         let (loc, d, lam) = (&loc[l], d[l], lam[l]);
         let along = if sol == Solution::None {
             tau
         } else {
             lam * tau
         };
-        out[l] = loc.q + along * loc.t + d.x * loc.u + d.y * loc.v;
+        out[l] = to_input.of3(loc.q + along * loc.t + d.x * loc.u + d.y * loc.v);
         flags[l] = fl[l];
     }
 }

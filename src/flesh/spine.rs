@@ -9,14 +9,23 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
 use crate::math::rotation::minimal_rotate;
+use crate::math::scale::{self, Pow2};
 
 /// A sampled spine with its frames (`t` and `r` columns of `spinal.frames`).
+///
+/// The model is built on the samples divided by their power-of-two scale
+/// ([`scale::curve_exponent`]; "model units", exact): lengths enter its arithmetic squared
+/// (chords, distances) and as products with curvatures, which leave the range of f64 for
+/// spines far from unit size although the input is fine.
 #[derive(Clone, Debug)]
 pub struct SpineModel {
-    /// Sample points `C_j` (input units).
+    /// Input units to model units (`2^k`, 1 for spines of moderate size).
+    pub scale: Pow2,
+    /// Sample points `C_j` (model units).
     pub c: Vec<DVec3>,
     /// Unit tangents `t_j` at the samples (the `t` columns of the frames).
     pub t: Vec<DVec3>,
@@ -36,10 +45,11 @@ pub struct SpineModel {
 /// Sample curvature vectors: central differences of the unit tangents in chord length,
 /// made normal to the tangent (one-sided at the ends; across the seam of a loop, whose last
 /// sample repeats the first).
-fn curvatures(c: &[DVec3], t: &[DVec3], closed: bool) -> Vec<DVec3> {
+fn curvatures(call: &'static str, c: &[DVec3], t: &[DVec3], closed: bool) -> Result<Vec<DVec3>> {
     let n = c.len();
-    let mut kv: Vec<DVec3> = (0..n)
-        .map(|j| {
+    let mut kv = alloc::collect(
+        call,
+        (0..n).map(|j| {
             let (a, b) = (j.saturating_sub(1), (j + 1).min(n - 1));
             let mut len = 0.0;
             for i in a..b {
@@ -47,8 +57,8 @@ fn curvatures(c: &[DVec3], t: &[DVec3], closed: bool) -> Vec<DVec3> {
             }
             let k = (t[b] - t[a]) / len;
             k - t[j] * t[j].dot(k)
-        })
-        .collect();
+        }),
+    )?;
     if closed && n >= 3 {
         // neighbours of the seam sample: n − 2 before it, 1 after it
         let len = (c[1] - c[0]).length() + (c[n - 1] - c[n - 2]).length();
@@ -56,13 +66,13 @@ fn curvatures(c: &[DVec3], t: &[DVec3], closed: bool) -> Vec<DVec3> {
         kv[0] = k - t[0] * t[0].dot(k);
         kv[n - 1] = kv[0];
     }
-    kv
+    Ok(kv)
 }
 
 /// The spine evaluated at `(k, a)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Local {
-    /// Position `C(a)` (input units).
+    /// Position `C(a)` (model units).
     pub q: DVec3,
     /// Unit tangent `t(a)`.
     pub t: DVec3,
@@ -72,7 +82,7 @@ pub struct Local {
     pub v: DVec3,
     /// `C'(a) · t(a)`: the speed of the sections along the spine.
     pub sigma: f64,
-    /// Curvature vector (1/length) in the `(u, v)` coordinates.
+    /// Curvature vector (1/length, model units) in the `(u, v)` coordinates.
     pub kappa: DVec2,
 }
 
@@ -103,8 +113,23 @@ impl SpineModel {
         if frames.len() != 9 * n {
             return Err(InputError::new(arg, "frames do not match the points"));
         }
-        let mut t = Vec::with_capacity(n);
-        let mut r = Vec::with_capacity(n);
+        // the call, for out-of-memory errors
+        let call = if arg == "rest_spine" {
+            "SpineBinding"
+        } else {
+            "SpineBinding.deform"
+        };
+        let (lo, hi) = crate::frames::geometry::bounds(points);
+        let k = scale::curve_exponent(lo, hi).unwrap_or(0);
+        let to_model = Pow2::new(k);
+        let pts = if k == 0 {
+            alloc::copied(call, points)?
+        } else {
+            scale::try_scaled(call, points, k)?
+        };
+        let points = &pts[..];
+        let mut t = alloc::with_capacity(call, n)?;
+        let mut r = alloc::with_capacity(call, n)?;
         for (i, f) in frames.chunks_exact(9).enumerate() {
             let ri = DVec3::new(f[0], f[3], f[6]);
             let ti = DVec3::new(f[2], f[5], f[8]);
@@ -134,9 +159,9 @@ impl SpineModel {
                 ));
             }
         }
-        let kv = curvatures(points, &t, closed);
-        let mut m = Vec::with_capacity(n - 1);
-        let mut pc = Vec::with_capacity(n - 1);
+        let kv = curvatures(call, points, &t, closed)?;
+        let mut m = alloc::with_capacity(call, n - 1)?;
+        let mut pc = alloc::with_capacity(call, n - 1)?;
         for k in 0..n - 1 {
             let e = points[k + 1] - points[k];
             let h = e.length();
@@ -160,11 +185,13 @@ impl SpineModel {
             m.push(coef);
             pc.push(pos);
         }
-        let rb = (0..n - 1)
-            .map(|k| minimal_rotate(t[k + 1], t[k], r[k + 1]))
-            .collect();
+        let rb = alloc::collect(
+            call,
+            (0..n - 1).map(|k| minimal_rotate(t[k + 1], t[k], r[k + 1])),
+        )?;
         Ok(SpineModel {
-            c: points.to_vec(),
+            scale: to_model,
+            c: pts,
             t,
             r,
             m,
@@ -294,7 +321,7 @@ pub fn compass_walk_located(
     chords: &[f64],
 ) -> crate::error::Result<(Vec<DVec3>, Vec<f64>)> {
     check_walk(posed, chords)?;
-    let mut at = Vec::with_capacity(chords.len() + 1);
+    let mut at = alloc::with_capacity("SpineBinding.deform", chords.len() + 1)?;
     let pts = scaled_walk(posed, chords, &mut at)?;
     Ok((pts, at))
 }
@@ -310,14 +337,14 @@ fn scaled_walk(
     use crate::error::InputError;
     let (lo, hi) = crate::frames::geometry::bounds(posed);
     let out = match crate::math::scale::curve_exponent(lo, hi) {
-        None => walk(posed, chords, at),
+        None => walk(posed, chords, at)?,
         Some(k) => {
-            let p = crate::math::scale::scaled(posed, k);
-            let h: Vec<f64> = chords
-                .iter()
-                .map(|&c| crate::math::scale::ldexp(c, k))
-                .collect();
-            crate::math::scale::scaled(&walk(&p, &h, at), -k)
+            let p = scale::try_scaled("SpineBinding.deform", posed, k)?;
+            let h = alloc::collect(
+                "SpineBinding.deform",
+                chords.iter().map(|&c| scale::ldexp(c, k)),
+            )?;
+            scale::try_scaled("SpineBinding.deform", &walk(&p, &h, at)?, -k)?
         }
     };
     if let Some(i) = out.windows(2).position(|w| w[0] == w[1]) {
@@ -338,9 +365,9 @@ fn scaled_walk(
 }
 
 /// The walk; pushes the polyline positions onto `at` when it is given with capacity.
-fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Vec<DVec3> {
+fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Result<Vec<DVec3>> {
     let record = at.capacity() > 0;
-    let mut out = Vec::with_capacity(chords.len() + 1);
+    let mut out = alloc::with_capacity("SpineBinding.deform", chords.len() + 1)?;
     let mut c = posed[0];
     out.push(c);
     if record {
@@ -368,5 +395,5 @@ fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Vec<DVec3> {
         out.push(next);
         c = next;
     }
-    out
+    Ok(out)
 }

@@ -31,20 +31,31 @@ use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::basis;
+use crate::math::scale::{self, Pow2};
 
 /// Flag: the vertex's foot is outside the surface (attached to the border, uncorrected).
 pub const OUTSIDE: u8 = 4;
 /// Numbers stored per vertex: `[u, v, h0, A0, B0, C0, r1, r2, r3]` (r: border residual).
+/// `h0` and `r` are in the units of the input; `A0` (an area per cell) and `B0` (a length)
+/// in the units of the rest surface's model ([`Surface::scale`], whose exponent the binding
+/// keeps with the coordinates).
 pub const SURFACE_COORDS: usize = 9;
 
 /// A sampled spine surface.
+///
+/// The model is built on the samples divided by their power-of-two scale
+/// ([`scale::curve_exponent`]; "model units", exact): its normals are cross products of
+/// differences and its volume element a cubic in the offset, which leave the range of f64
+/// for surfaces far from unit size although the input is fine.
 #[derive(Clone, Debug)]
 pub struct Surface {
+    /// Input units to model units (`2^k`, 1 for surfaces of moderate size).
+    pub scale: Pow2,
     /// Grid rows (first index `i`).
     pub nu: usize,
     /// Grid columns (second index `j`); sample `(i, j)` is row `i·nv + j`.
     pub nv: usize,
-    /// Surface samples `S_ij`, row-major (input units).
+    /// Surface samples `S_ij`, row-major (model units).
     pub s: Vec<DVec3>,
     /// Unit normals at the samples, `S_i × S_j` by central differences.
     pub n: Vec<DVec3>,
@@ -65,7 +76,7 @@ fn grid_diff(x: &[DVec3], nu: usize, nv: usize, i: usize, j: usize) -> (DVec3, D
 /// The surface at one point of a cell.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfLocal {
-    /// The point `S(u, v)` (input units).
+    /// The point `S(u, v)` (model units).
     pub s: DVec3,
     /// `∂S/∂u` (per grid step).
     pub su: DVec3,
@@ -98,12 +109,26 @@ impl SurfLocal {
 
 impl Surface {
     pub fn new(arg: &'static str, points: &[DVec3], nu: usize, nv: usize) -> Result<Surface> {
-        if nu < 2 || nv < 2 || points.len() != nu * nv {
+        if nu < 2 || nv < 2 || nu.checked_mul(nv) != Some(points.len()) {
             return Err(InputError::new(arg, "need a grid of at least 2 × 2 points"));
         }
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(InputError::new(arg, format!("point {i} is not finite")));
         }
+        // the call, for out-of-memory errors
+        let call = if arg == "rest_surface" {
+            "SurfaceBinding"
+        } else {
+            "SurfaceBinding.deform"
+        };
+        let (lo, hi) = crate::frames::geometry::bounds(points);
+        let k = scale::curve_exponent(lo, hi).unwrap_or(0);
+        let pts = if k == 0 {
+            alloc::copied(call, points)?
+        } else {
+            scale::try_scaled(call, points, k)?
+        };
+        let points = &pts[..];
         let at = |i: usize, j: usize| points[i * nv + j];
         let scale = points
             .iter()
@@ -120,7 +145,7 @@ impl Surface {
                 }
             }
         }
-        let mut n = Vec::with_capacity(nu * nv);
+        let mut n = alloc::with_capacity(call, nu * nv)?;
         for i in 0..nu {
             for j in 0..nv {
                 let du = at((i + 1).min(nu - 1), j) - at(i.saturating_sub(1), j);
@@ -136,7 +161,7 @@ impl Surface {
                 n.push(c / l);
             }
         }
-        let d = derivatives(points, &n, nu, nv);
+        let d = derivatives(call, points, &n, nu, nv)?;
         if let Some((i, j)) = folded(points, &n, &d, nu, nv) {
             return Err(InputError::new(
                 arg,
@@ -144,9 +169,10 @@ impl Surface {
             ));
         }
         Ok(Surface {
+            scale: Pow2::new(k),
             nu,
             nv,
-            s: points.to_vec(),
+            s: pts,
             n,
             d,
         })
@@ -177,17 +203,16 @@ impl Surface {
                 ),
             ));
         }
-        let mut n = Vec::with_capacity(nu * nv);
+        let mut n = alloc::with_capacity("SurfaceBinding.deform", nu * nv)?;
         for (k, (&g, &normal)) in dirs.iter().zip(&sf.n).enumerate() {
             let (i, j) = (k / nv, k % nv);
-            let l = g.length();
-            if !g.is_finite() || !(l > 1e-300) {
+            // directions of any finite size (scaled by their largest component first)
+            let Some(g) = scale::normalize(g) else {
                 return Err(InputError::new(
                     dir_arg,
                     format!("grid point ({i}, {j}): not a finite non-zero vector"),
                 ));
-            }
-            let g = g / l;
+            };
             let c = g.dot(normal);
             if !(c > 1e-3) {
                 return Err(InputError::new(
@@ -201,8 +226,8 @@ impl Surface {
             }
             n.push(g);
         }
-        let d = derivatives(points, &n, nu, nv);
-        if let Some((i, j)) = folded(points, &n, &d, nu, nv) {
+        let d = derivatives("SurfaceBinding.deform", &sf.s, &n, nu, nv)?;
+        if let Some((i, j)) = folded(&sf.s, &n, &d, nu, nv) {
             return Err(InputError::new(
                 dir_arg,
                 format!(
@@ -223,8 +248,14 @@ impl Surface {
 }
 
 /// Per sample: `[∂S/∂i, ∂S/∂j, ∂n/∂i, ∂n/∂j]` by central differences.
-fn derivatives(points: &[DVec3], n: &[DVec3], nu: usize, nv: usize) -> Vec<[DVec3; 4]> {
-    let mut d = Vec::with_capacity(nu * nv);
+fn derivatives(
+    call: &'static str,
+    points: &[DVec3],
+    n: &[DVec3],
+    nu: usize,
+    nv: usize,
+) -> Result<Vec<[DVec3; 4]>> {
+    let mut d = alloc::with_capacity(call, nu * nv)?;
     for i in 0..nu {
         for j in 0..nv {
             let (su, sv) = grid_diff(points, nu, nv, i, j);
@@ -232,7 +263,7 @@ fn derivatives(points: &[DVec3], n: &[DVec3], nu: usize, nv: usize) -> Vec<[DVec
             d.push([su, sv, mu, mv]);
         }
     }
-    d
+    Ok(d)
 }
 
 /// The first cell whose volume element `A = (S_u × S_v)·N` is not positive at its corners
@@ -383,6 +414,22 @@ pub fn bind_surface_cancellable(
             format!("row {i} is not finite"),
         ));
     }
+    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
+    if rest.scale.exp() > 0 {
+        // a surface far smaller than 1: a vertex far from it may leave the range once scaled
+        if let Some(i) = vertices
+            .par_iter()
+            .position_first(|v| !to_model.of3(*v).is_finite())
+        {
+            return Err(InputError::new(
+                "vertices",
+                format!(
+                    "row {i} is out of range: its distance from the rest surface, in units \
+                     of the surface's size, exceeds float64"
+                ),
+            ));
+        }
+    }
     let nv = vertices.len();
     let mut cell = alloc::filled("SurfaceBinding", nv, 0i64)?;
     let mut coords = alloc::filled(
@@ -398,6 +445,7 @@ pub fn bind_surface_cancellable(
             if cancel() {
                 return;
             }
+            let p = to_model.of3(p);
             // nearest sample, then the cells around it (then all cells if needed)
             let near = rest
                 .s
@@ -444,6 +492,7 @@ pub fn bind_surface_cancellable(
             };
             let l = rest.eval(i, j, u, v);
             let (a, b, cc) = l.abc();
+            let (h, resid) = (to_input.of(h), to_input.of3(resid));
             *c = (i * nv_ + j) as i64;
             out.copy_from_slice(&[u, v, h, a, b, cc, resid.x, resid.y, resid.z]);
         });
@@ -504,9 +553,11 @@ pub fn surface_offset(m: f64, g: f64, t: f64) -> (f64, bool) {
     (sign * h, true)
 }
 
-/// Deform registered vertices onto the posed surface (same grid shape).
+/// Deform registered vertices onto the posed surface (same grid shape); `rest_exp` is the
+/// exponent of the rest surface's [`Surface::scale`] (the units of `A0`, `B0`).
 pub fn deform_surface(
     posed: &Surface,
+    rest_exp: i32,
     cell: &[i64],
     coords: &[f64],
     corrected: bool,
@@ -527,6 +578,17 @@ pub fn deform_surface(
             format!("vertex {i} is bound to a cell the posed grid does not have"),
         ));
     }
+    // lengths of the binding to the posed model's units, and its output back to the input's
+    let (to_model, to_input) = (posed.scale, posed.scale.inverse());
+    let q = posed.scale.exp();
+    let (Some(d), Some(d2)) = (
+        q.checked_sub(rest_exp),
+        q.checked_sub(rest_exp).and_then(|d| d.checked_mul(2)),
+    ) else {
+        return Err(InputError::new("coords", "inconsistent scale exponent"));
+    };
+    // rest model lengths (B0) and areas (A0) in the posed model's units
+    let (len1, area1) = (Pow2::new(d), Pow2::new(d2));
     out.par_iter_mut()
         .zip(flags.par_iter_mut())
         .zip(cell.par_iter().zip(coords.par_chunks(SURFACE_COORDS)))
@@ -535,23 +597,40 @@ pub fn deform_surface(
             let l = posed.eval(i, j, x[0], x[1]);
             let resid = DVec3::new(x[6], x[7], x[8]);
             if resid != DVec3::ZERO {
+                let resid = to_model.of3(resid);
                 let (e1, e2) = l.frame();
-                *o = l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n;
+                *o = to_input.of3(l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n);
                 *f = OUTSIDE;
                 return;
             }
-            let h0 = x[2];
+            let h0 = to_model.of(x[2]);
             if !corrected {
-                *o = l.s + h0 * l.n;
+                *o = to_input.of3(l.s + h0 * l.n);
                 *f = 0;
                 return;
             }
             let (a1, b1, c1) = l.abc();
-            let rhs = h0 * (x[3] + h0 * (0.5 * x[4] + h0 * x[5] / 3.0));
+            let (a0, b0) = (area1.of(x[3]), len1.of(x[4]));
+            let rhs = h0 * (a0 + h0 * (0.5 * b0 + h0 * x[5] / 3.0));
             let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
-            *o = l.s + h1 * l.n;
+            *o = to_input.of3(l.s + h1 * l.n);
             *f = if ok { 0 } else { CLAMPED_BEND };
         });
+    if q != 0 || rest_exp != 0 {
+        // a binding and a pose whose sizes differ by more than the range of f64 between
+        // them, or a result past the largest float
+        if let Some(i) = out.par_iter().position_first(|p| !p.is_finite()) {
+            return Err(InputError::new(
+                "posed_surface",
+                format!(
+                    "vertex {i}: the posed position is out of range of float64 (the change \
+                     of area between the rest surface and the posed surface at size {:e} is \
+                     out of range)",
+                    scale::ldexp(1.0, -q)
+                ),
+            ));
+        }
+    }
     Ok(())
 }
 

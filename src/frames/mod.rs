@@ -270,6 +270,11 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
 
 /// [`compute_into`] that polls `cancel` before every chunk of the fused scan and returns at
 /// once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+///
+/// Memory: the per-row working vectors of this module (tangents, chords, segment lengths,
+/// normals, ω) take well under the 256 bytes per row that the binding's `ensure_memory`
+/// probe checks before the call, so they are allocated infallibly; the normalised copy of
+/// the input is allocated fallibly.
 pub fn compute_into_cancellable(
     req: &Request,
     out: &mut [f64],
@@ -282,7 +287,7 @@ pub fn compute_into_cancellable(
              without end has no twist to add turns to",
         ));
     }
-    let owned = normalised(req);
+    let owned = normalised(req)?;
     let req = match &owned {
         Some(o) => &o.request(req),
         None => req,
@@ -305,16 +310,20 @@ struct Normalised {
     d2: Vec<DVec3>,
 }
 
-fn normalised(req: &Request) -> Option<Normalised> {
-    let p = req.points?;
+fn normalised(req: &Request) -> Result<Option<Normalised>> {
+    let Some(p) = req.points else {
+        return Ok(None);
+    };
     let (lo, hi) = geometry::bounds(p);
-    let k = crate::math::scale::curve_exponent(lo, hi)?;
-    let scaled = |v: &[DVec3]| crate::math::scale::scaled(v, k);
-    Some(Normalised {
-        points: scaled(p),
-        d1: req.analytic.map_or_else(Vec::new, |a| scaled(a.d1)),
-        d2: req.analytic.map_or_else(Vec::new, |a| scaled(a.d2)),
-    })
+    let Some(k) = crate::math::scale::curve_exponent(lo, hi) else {
+        return Ok(None);
+    };
+    let scaled = |v: &[DVec3]| crate::math::scale::try_scaled("frames", v, k);
+    Ok(Some(Normalised {
+        points: scaled(p)?,
+        d1: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d1))?,
+        d2: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d2))?,
+    }))
 }
 
 impl Normalised {

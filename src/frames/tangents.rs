@@ -490,8 +490,9 @@ pub fn estimate_rows_cancellable(
         return Ok(Vec::new());
     }
     let (lo, hi) = crate::frames::geometry::bounds(x);
-    let owned =
-        crate::math::scale::curve_exponent(lo, hi).map(|k| crate::math::scale::scaled(x, k));
+    let owned = crate::math::scale::curve_exponent(lo, hi)
+        .map(|k| crate::math::scale::try_scaled("estimate_tangents", x, k))
+        .transpose()?;
     let x = owned.as_deref().unwrap_or(x);
     let mut n = x.len();
     if closed && n >= 2 && crate::frames::validate::coincide(x[n - 1], x[0]) {
@@ -539,7 +540,7 @@ pub fn estimate_many(
             })
         })
         .collect();
-    let mut out = Vec::with_capacity(x.len());
+    let mut out = alloc::with_capacity("estimate_tangents", x.len())?;
     for p in parts {
         out.extend(p?);
     }

@@ -46,7 +46,7 @@ pub fn compensated_sum(terms: impl Iterator<Item = f64>) -> f64 {
 /// checked to lie in `0..v.len()` (errors name `faces`).
 pub fn signed_volume_checked(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Result<f64> {
     let n = v.len();
-    let mut faces = Vec::with_capacity(f.len());
+    let mut faces = crate::alloc::with_capacity("signed_volume", f.len())?;
     for (i, t) in f.iter().enumerate() {
         let mut c = [0usize; 3];
         for (k, &x) in t.iter().enumerate() {
@@ -62,10 +62,15 @@ pub fn signed_volume_checked(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Resul
     Ok(signed_volume(v, &faces))
 }
 
+/// The sorted undirected edges of a mesh and the edge id of every face slot.
+pub type EdgeList = (Vec<[usize; 2]>, Vec<[usize; 3]>);
+
 /// The undirected edges of the faces `f`, sorted (`[i, j]` with `i < j`), and the edge id
 /// of every face slot (slot `k` of a face is its edge from corner `k` to corner `k + 1`).
-pub fn edges(f: &[[usize; 3]]) -> (Vec<[usize; 2]>, Vec<[usize; 3]>) {
-    let mut keyed: Vec<([usize; 2], usize)> = Vec::with_capacity(3 * f.len());
+/// Buffers are allocated fallibly; the out-of-memory error names `what`.
+pub fn edges(what: &'static str, f: &[[usize; 3]]) -> crate::error::Result<EdgeList> {
+    let slots = crate::alloc::product(what, 3, f.len(), size_of::<([usize; 2], usize)>())?;
+    let mut keyed: Vec<([usize; 2], usize)> = crate::alloc::with_capacity(what, slots)?;
     for (i, c) in f.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
@@ -74,23 +79,27 @@ pub fn edges(f: &[[usize; 3]]) -> (Vec<[usize; 2]>, Vec<[usize; 3]>) {
     }
     keyed.sort_unstable();
     let mut list: Vec<[usize; 2]> = Vec::new();
-    let mut slot = vec![[0usize; 3]; f.len()];
+    let mut slot = crate::alloc::filled(what, f.len(), [0usize; 3])?;
     for (e, s) in keyed {
         if list.last() != Some(&e) {
-            list.push(e);
+            crate::alloc::push(what, &mut list, e)?;
         }
         slot[s / 3][s % 3] = list.len() - 1;
     }
-    (list, slot)
+    Ok((list, slot))
 }
 
 /// How many face slots use each of the `n` edges (`slot` as returned by [`edges`]).
-pub fn edge_counts(slot: &[[usize; 3]], n: usize) -> Vec<usize> {
-    let mut count = vec![0usize; n];
+pub fn edge_counts(
+    what: &'static str,
+    slot: &[[usize; 3]],
+    n: usize,
+) -> crate::error::Result<Vec<usize>> {
+    let mut count = crate::alloc::filled(what, n, 0usize)?;
     for s in slot.iter().flatten() {
         count[*s] += 1;
     }
-    count
+    Ok(count)
 }
 
 /// The signed volume and the centroid of the solid bounded by a closed, consistently
@@ -104,7 +113,8 @@ pub fn closed_volume_centroid(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Resu
         return Err(bad("has no faces".into()));
     }
     let n = v.len();
-    let mut faces = Vec::with_capacity(f.len());
+    const CALL: &str = "closed tool";
+    let mut faces = crate::alloc::with_capacity(CALL, f.len())?;
     for (i, t) in f.iter().enumerate() {
         let mut c = [0usize; 3];
         for (k, &x) in t.iter().enumerate() {
@@ -116,8 +126,8 @@ pub fn closed_volume_centroid(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Resu
         }
         faces.push(c);
     }
-    let (list, slot) = edges(&faces);
-    let count = edge_counts(&slot, list.len());
+    let (list, slot) = edges(CALL, &faces)?;
+    let count = edge_counts(CALL, &slot, list.len())?;
     // the first bad edge in the order of the slots 0→1 of all faces, then 1→2, then 2→0
     for k in 0..3 {
         if let Some(s) = slot.iter().find(|s| count[s[k]] != 2) {
@@ -128,19 +138,23 @@ pub fn closed_volume_centroid(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Resu
             )));
         }
     }
-    let mut directed: Vec<(usize, usize)> = faces
-        .iter()
-        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-        .collect();
+    let mut directed: Vec<(usize, usize)> = crate::alloc::with_capacity(CALL, 3 * faces.len())?;
+    directed.extend(
+        faces
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]),
+    );
     directed.sort_unstable();
     if directed.windows(2).any(|w| w[0] == w[1]) {
         return Err(bad("faces are not consistently oriented".into()));
     }
     let m = v.iter().sum::<DVec3>() / n as f64;
-    let six: Vec<f64> = faces
-        .iter()
-        .map(|t| (v[t[0]] - m).dot((v[t[1]] - m).cross(v[t[2]] - m)))
-        .collect();
+    let six = crate::alloc::collect(
+        CALL,
+        faces
+            .iter()
+            .map(|t| (v[t[0]] - m).dot((v[t[1]] - m).cross(v[t[2]] - m))),
+    )?;
     let vol = compensated_sum(six.iter().copied()) / 6.0;
     if !(vol > 0.0) {
         return Err(bad(format!(
@@ -249,11 +263,16 @@ mod tests {
     #[test]
     fn cube_edges_are_manifold() {
         let (_, f) = cube();
-        let (list, slot) = edges(&f);
+        let (list, slot) = edges("x", &f).unwrap();
         // 12 cube edges and 6 face diagonals, each shared by two triangles
         assert_eq!(list.len(), 18);
         assert!(list.windows(2).all(|w| w[0] < w[1]));
-        assert!(edge_counts(&slot, list.len()).iter().all(|&c| c == 2));
+        assert!(
+            edge_counts("x", &slot, list.len())
+                .unwrap()
+                .iter()
+                .all(|&c| c == 2)
+        );
         for (t, s) in f.iter().zip(&slot) {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -261,7 +280,7 @@ mod tests {
             }
         }
         // one triangle alone: three boundary edges
-        let (list, slot) = edges(&f[..1]);
-        assert_eq!(edge_counts(&slot, list.len()), vec![1, 1, 1]);
+        let (list, slot) = edges("x", &f[..1]).unwrap();
+        assert_eq!(edge_counts("x", &slot, list.len()).unwrap(), vec![1, 1, 1]);
     }
 }

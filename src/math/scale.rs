@@ -17,6 +17,9 @@
 
 use glam::{DQuat, DVec3};
 
+use crate::alloc;
+use crate::error::Result;
+
 /// Scales within `[2^-SAFE_EXP, 2^SAFE_EXP]` need no normalisation: fifth powers of
 /// chords stay far inside the normal range (`2^±500`).
 pub const SAFE_EXP: i32 = 100;
@@ -49,6 +52,58 @@ pub fn exponent(v: f64) -> i32 {
         return exponent(v * pow2(64)) - 64;
     }
     biased - 1023
+}
+
+/// Multiplication by the power of two `2^k`, exact while the results are normal: one
+/// multiplication when `2^k` is itself a normal number (`|k| ≤ 1022`), [`ldexp`] otherwise.
+/// Carries a model built on normalised coordinates back and forth to the input's units
+/// without a pass over the data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pow2 {
+    k: i32,
+    /// `2^k`, or 0 when it is not a normal number.
+    f: f64,
+}
+
+impl Pow2 {
+    pub fn new(k: i32) -> Pow2 {
+        let f = if (-1022..=1022).contains(&k) {
+            pow2(k)
+        } else {
+            0.0
+        };
+        Pow2 { k, f }
+    }
+
+    /// The exponent `k`.
+    pub fn exp(&self) -> i32 {
+        self.k
+    }
+
+    /// `2^-k`.
+    pub fn inverse(&self) -> Pow2 {
+        Pow2::new(-self.k)
+    }
+
+    /// `x · 2^k`.
+    #[inline(always)]
+    pub fn of(&self, x: f64) -> f64 {
+        if self.f != 0.0 {
+            x * self.f
+        } else {
+            ldexp(x, self.k)
+        }
+    }
+
+    /// `v · 2^k` componentwise.
+    #[inline(always)]
+    pub fn of3(&self, v: DVec3) -> DVec3 {
+        if self.f != 0.0 {
+            v * self.f
+        } else {
+            ldexp3(v, self.k)
+        }
+    }
 }
 
 /// Largest absolute component.
@@ -119,7 +174,21 @@ pub fn curve_exponent(lo: DVec3, hi: DVec3) -> Option<i32> {
     (e.abs() > SAFE_EXP).then_some(-e)
 }
 
-/// `points · 2^k` (exact away from subnormals).
+/// `points · 2^k` (exact away from subnormals); the copy is allocated fallibly, and the
+/// out-of-memory error names `what`.
+pub fn try_scaled(what: &'static str, points: &[DVec3], k: i32) -> Result<Vec<DVec3>> {
+    use rayon::prelude::*;
+    alloc::par_collect(
+        what,
+        points
+            .par_iter()
+            .with_min_len(1 << 12)
+            .map(|p| ldexp3(*p, k)),
+    )
+}
+
+/// [`try_scaled`] with an infallible allocation, for the sweep's normalisation (which has no
+/// error path; its copy is the size of the curve, small beside the mesh it sweeps).
 pub fn scaled(points: &[DVec3], k: i32) -> Vec<DVec3> {
     use rayon::prelude::*;
     let mut out = Vec::new();

@@ -14,6 +14,7 @@ use crate::alloc;
 use crate::flesh::{self, Solution, surface};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
+type SurfaceFleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>, i32);
 type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
 type Resampled<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
@@ -116,6 +117,8 @@ pub fn minimal_rotation<'py>(
 }
 
 /// Register vertices on a rest spine surface (grid `nu × nv`); see `spinal.SurfaceBinding`.
+/// Also returns the exponent of the rest surface's normalisation (the units of some of the
+/// coordinates), which [`flesh_surface_deform`] takes back.
 #[pyfunction]
 pub fn flesh_surface_bind<'py>(
     py: Python<'py>,
@@ -123,24 +126,25 @@ pub fn flesh_surface_bind<'py>(
     nu: usize,
     nv: usize,
     vertices: PyReadonlyArray2<'py, f64>,
-) -> PyResult<FleshBinding<'py>> {
+) -> PyResult<SurfaceFleshBinding<'py>> {
     let pts = vec3s("rest_surface", &rest_points)?;
     let v = vec3s("vertices", &vertices)?;
     let stop = Stop::default();
-    let (cell, coords) = detach_stoppable(py, &stop, || {
+    let (cell, coords, exp) = detach_stoppable(py, &stop, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
-        surface::bind_surface_cancellable(&rest, v, &|| stop.requested())
+        let (cell, coords) = surface::bind_surface_cancellable(&rest, v, &|| stop.requested())?;
+        Ok::<_, crate::error::InputError>((cell, coords, rest.scale.exp()))
     })??;
     let n = cell.len();
     let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
-    Ok((PyArray1::from_vec(py, cell), coords))
+    Ok((PyArray1::from_vec(py, cell), coords, exp))
 }
 
 /// Deform vertices registered on a spine surface; see `spinal.SurfaceBinding.deform`.
 /// `directions` (one per sample, row-major, with the name of the argument they came from)
 /// replace the sample normals as the offset directions.
 #[pyfunction]
-#[pyo3(signature = (posed_points, nu, nv, cell, coords, corrected, directions=None))]
+#[pyo3(signature = (posed_points, nu, nv, cell, coords, rest_exp, corrected, directions=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn flesh_surface_deform<'py>(
     py: Python<'py>,
@@ -149,6 +153,7 @@ pub fn flesh_surface_deform<'py>(
     nv: usize,
     cell: PyReadonlyArray1<'py, i64>,
     coords: PyReadonlyArray2<'py, f64>,
+    rest_exp: i32,
     corrected: bool,
     directions: Option<(String, PyReadonlyArray2<'py, f64>)>,
 ) -> PyResult<FleshPose<'py>> {
@@ -179,7 +184,7 @@ pub fn flesh_surface_deform<'py>(
                 }
                 None => surface::Surface::new("posed_surface", pts, nu, nv)?,
             };
-            surface::deform_surface(&posed, cell, coords, corrected, buf, &mut flags)
+            surface::deform_surface(&posed, rest_exp, cell, coords, corrected, buf, &mut flags)
         })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))

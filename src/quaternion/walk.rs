@@ -57,7 +57,7 @@ impl<'a> Walker<'a> {
             return Err(InputError::new("faces", "the mesh has no faces"));
         }
         let nv = vertices.len();
-        let mut f = Vec::with_capacity(faces.len());
+        let mut f = alloc::with_capacity("walk_mesh", faces.len())?;
         for (i, tri) in faces.iter().enumerate() {
             let mut c = [0usize; 3];
             for k in 0..3 {
@@ -99,8 +99,8 @@ impl<'a> Walker<'a> {
                 ));
             }
         }
-        let (edges, slot) = mesh::edges(&f);
-        let count = mesh::edge_counts(&slot, edges.len());
+        let (edges, slot) = mesh::edges("walk_mesh", &f)?;
+        let count = mesh::edge_counts("walk_mesh", &slot, edges.len())?;
         if let Some(e) = count.iter().position(|&c| c > 2) {
             let [a, b] = edges[e];
             return Err(InputError::new(
@@ -113,8 +113,8 @@ impl<'a> Walker<'a> {
             ));
         }
         // faces on both sides of each interior edge: the first slot seen waits for the second
-        let mut first: Vec<Option<(usize, usize)>> = vec![None; edges.len()];
-        let mut adj = vec![[None; 3]; f.len()];
+        let mut first: Vec<Option<(usize, usize)>> = alloc::filled("walk_mesh", edges.len(), None)?;
+        let mut adj = alloc::filled("walk_mesh", f.len(), [None; 3])?;
         for (i, s) in slot.iter().enumerate() {
             for (k, &e) in s.iter().enumerate() {
                 if let Some((f1, k1)) = first[e] {
