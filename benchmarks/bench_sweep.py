@@ -5,8 +5,12 @@ Same spine (a helix), same number of sides, one run. For every size it times
 * ``spinal.tube(points, r, sides)`` — frames (double reflection) + mesh with normals and uv,
   float64 triangles, watertight with caps;
 * ``spinal.tube(..., dtype=np.float32)`` — the same mesh stored in float32, int32 faces;
-* VTK via PyVista on one polyline, ``PolyData.tube`` — vtkTubeFilter, float32 triangle strips
-  (less output: no uv, strips instead of triangles); and ``+ .triangulate()``
+* ``spinal.tube(..., dtype=np.float32, uv=False)`` — float32 vertices and normals, int32
+  faces: the outputs VTK's tube filter gives (points, normals, connectivity);
+* VTK via PyVista on one polyline, ``PolyData.tube`` — vtkTubeFilter, triangle strips with
+  float64 points (the input's precision), float32 normals and int64 connectivity (less
+  output: no uv, strips instead of triangles); the same on float32 points (float32 points
+  out: the like-for-like peer of spinal float32 without uv); and ``+ .triangulate()``
   (vtkTriangleFilter) for a triangle mesh like ours;
 * VTK on ``pyvista.lines_from_points(points)`` — one line cell per segment, so a separate
   capped ring pair for every segment (4× the vertices; not the same surface);
@@ -87,6 +91,9 @@ def run(sizes, repeat, bundle):
         res["spinal"] = best(lambda: spinal.tube(x, RADIUS, SIDES, **kw), rep)  # noqa: B023
         res["spinal float32"] = best(
             lambda: spinal.tube(x, RADIUS, SIDES, dtype=np.float32, **kw), rep)  # noqa: B023
+        res["spinal float32 no uv"] = best(
+            lambda: spinal.tube(x, RADIUS, SIDES, dtype=np.float32, uv=False, **kw),  # noqa: B023
+            rep)
         res["floor"] = best(lambda: floor(nv, nf), rep)  # noqa: B023
         if "pv" in p:
             pv = p["pv"]
@@ -96,6 +103,9 @@ def run(sizes, repeat, bundle):
             poly = pv.PolyData(x, lines=cells)
             res["vtk strips"] = best(lambda: poly.tube(radius=RADIUS, n_sides=SIDES, capping=True),  # noqa: B023
                                      rep)
+            poly32 = pv.PolyData(x.astype(np.float32), lines=cells)
+            res["vtk strips f32"] = best(
+                lambda: poly32.tube(radius=RADIUS, n_sides=SIDES, capping=True), rep)  # noqa: B023
             res["vtk triangles"] = best(
                 lambda: poly.tube(radius=RADIUS, n_sides=SIDES, capping=True).triangulate(),  # noqa: B023
                 rep)
@@ -202,31 +212,38 @@ def main():
     args = ap.parse_args()
     sizes = [n for n in (1_000, 10_000, 100_000, 200_000, 1_000_000) if n <= args.max]
     rows = run(sizes, args.repeat, not args.no_bundle)
-    peers_cols = ["vtk strips", "vtk triangles", "vtk lines_from_points", "trimesh sweep_polygon"]
+    peers_cols = ["vtk strips", "vtk strips f32", "vtk triangles", "vtk lines_from_points",
+                  "trimesh sweep_polygon"]
     print("Columns: spinal = spinal.tube(points, r, sides) (float64, normals, uv, int64 faces); "
-          "vtk strips = pyvista.PolyData(points, lines=[n, 0, …, n−1]).tube(radius=r, "
-          "n_sides=sides, capping=True), i.e. vtkTubeFilter on one polyline per curve, "
-          "float32 triangle strips; vtk triangles = the same + .triangulate() "
-          "(vtkTriangleFilter); vtk lines_from_points = pyvista.lines_from_points(points)"
-          ".tube(...) (one line cell per segment: a capped ring pair per segment); "
-          "NumPy write floor = np.full of arrays of spinal's float64 output size.\n")
+          "spinal float32 = the same with dtype=np.float32 (float32 vertices, normals, uv; "
+          "int32 faces); float32 no uv = dtype=np.float32, uv=False (float32 vertices and "
+          "normals, int32 faces); vtk strips = pyvista.PolyData(points, lines=[n, 0, …, n−1])"
+          ".tube(radius=r, n_sides=sides, capping=True), i.e. vtkTubeFilter on one polyline "
+          "per curve: triangle strips, float64 points (as the input), float32 normals, int64 "
+          "connectivity; vtk strips f32 = the same on float32 points (float32 points and "
+          "normals); vtk triangles = vtk strips + .triangulate() (vtkTriangleFilter); "
+          "vtk lines_from_points = pyvista.lines_from_points(points).tube(...) (one line cell "
+          "per segment: a capped ring pair per segment); NumPy write floor = np.full of "
+          "arrays of spinal's float64 output size.\n")
     print(f"tubes with {SIDES} sides; times in ms (best of runs); ratio = peer time / spinal "
           "(float64) time; NumPy write floor: ratio = spinal / floor (target ≤ 1.4× at 1M "
-          "points); spinal float32 = spinal.tube(..., dtype=np.float32) (vertices, normals, uv "
-          "float32, int32 faces), its last column = VTK time / float32 time (targets: ≥ 3× VTK "
-          "strips at 1M points, > 1× VTK triangles everywhere)\n")
+          "points); the last two columns = VTK time / spinal float32 time, with the default "
+          "options (targets: ≥ 3× VTK strips at 1M points, > 1× VTK triangles everywhere) and "
+          "without uv against VTK on float32 points (the same outputs)\n")
     f32_col = "spinal float32: VTK strips, triangles ×"
-    print("| case | spinal | spinal float32 | NumPy write floor | " + " | ".join(peers_cols)
-          + f" | {f32_col} |")
-    print("|---" * (5 + len(peers_cols)) + "|")
+    f32_like = "float32 no uv: VTK strips f32 ×"
+    print("| case | spinal | spinal float32 | float32 no uv | NumPy write floor | "
+          + " | ".join(peers_cols) + f" | {f32_col} | {f32_like} |")
+    print("|---" * (7 + len(peers_cols)) + "|")
     for r in rows:
-        f32 = r["spinal float32"]
-        cells = [r["case"], f"{1e3 * r['spinal']:.1f}", f"{1e3 * f32:.1f}",
+        f32, like = r["spinal float32"], r["spinal float32 no uv"]
+        cells = [r["case"], f"{1e3 * r['spinal']:.1f}", f"{1e3 * f32:.1f}", f"{1e3 * like:.1f}",
                  f"{1e3 * r['floor']:.1f} ({r['spinal'] / r['floor']:.2f}×)"]
         for c in peers_cols:
             cells.append(f"{1e3 * r[c]:.1f} ({r[c] / r['spinal']:.1f}×)" if c in r else "–")
         cells.append(" / ".join(f"{r[c] / f32:.1f}" for c in ("vtk strips", "vtk triangles")
                                 if c in r) or "–")
+        cells.append(f"{r['vtk strips f32'] / like:.1f}" if "vtk strips f32" in r else "–")
         print("| " + " | ".join(cells) + " |")
     if args.bundle:
         print("\n100,000 streamlines × 96 points (9.6 M points), 8 sides, one call each in a fresh "

@@ -7,7 +7,7 @@ use super::convert::{
     Stop, detach_in_pool, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut,
     slice_of, vec2s, vec3s,
 };
-use crate::sweep::{self, Options, Profile, Spine};
+use crate::sweep::{self, Options, Prepared, Spine};
 
 type MeshArrays<'py> = (
     Bound<'py, PyAny>,
@@ -47,19 +47,16 @@ pub fn sweep_mesh<'py>(
     normals: bool,
     uv: bool,
 ) -> PyResult<MeshArrays<'py>> {
-    let pts = vec3s("points", &points)?;
-    let fr = frames_of("frames", &frames)?;
-    let sc = vec2s("scale", "(n, 2)", &scale)?;
-    let tw: &[f64] = match &twist {
-        Some(t) => slice_of("twist", t)?,
-        None => &[],
+    let spine = Spine {
+        points: vec3s("points", &points)?,
+        frames: frames_of("frames", &frames)?,
+        scale: vec2s("scale", "(n, 2)", &scale)?,
+        twist: match &twist {
+            Some(t) => slice_of("twist", t)?,
+            None => &[],
+        },
     };
     let prof = vec2s("profile", "(m, 2)", &profile)?;
-    let scaled = sweep::scaled_input(pts, prof, sc);
-    let (pts, prof, sc) = match &scaled {
-        Some(s) => (&s.points[..], &s.profile[..], &s.scale[..]),
-        None => (pts, prof, sc),
-    };
     let offsets = offsets_of(&offsets)?;
     let opts = Options {
         closed,
@@ -67,29 +64,17 @@ pub fn sweep_mesh<'py>(
         miter_limit,
         split_seams,
     };
-    let spine = Spine {
-        points: pts,
-        frames: fr,
-        scale: sc,
-        twist: tw,
-    };
-    let (p, lay) = detach_in_pool(py, || {
-        let p = Profile::new(prof, profile_closed)?;
-        let lay = sweep::layout(&spine, &offsets, &p, &opts)?;
-        Ok::<_, crate::InputError>((p, lay))
+    let rename = |e| renamed(e, "scale", scale_arg);
+    let prep = detach_in_pool(py, || {
+        Prepared::new(spine, &offsets, prof, profile_closed, opts)
     })?
-    .map_err(|e| renamed(e, "scale", scale_arg))?;
+    .map_err(rename)?;
     // int32 faces only where every index fits
-    let index32 = index32 && lay.vertices <= i32::MAX as usize;
+    let index32 = index32 && prep.layout.vertices <= i32::MAX as usize;
     let job = Job {
-        spine: &spine,
-        offsets: &offsets,
-        p: &p,
-        opts: &opts,
-        lay: &lay,
+        prep: &prep,
         normals,
         uv,
-        k: scaled.as_ref().map(|s| s.k),
         scale_arg,
     };
     match (single, index32) {
@@ -102,15 +87,9 @@ pub fn sweep_mesh<'py>(
 
 /// A checked sweep, to be written into arrays of a chosen precision.
 struct Job<'a> {
-    spine: &'a Spine<'a>,
-    offsets: &'a [usize],
-    p: &'a Profile,
-    opts: &'a Options,
-    lay: &'a sweep::Layout,
+    prep: &'a Prepared<'a>,
     normals: bool,
     uv: bool,
-    /// The power of two the input was scaled by ([`sweep::scaled_input`]).
-    k: Option<i32>,
     scale_arg: &'a str,
 }
 
@@ -120,7 +99,7 @@ impl Job<'_> {
         R: sweep::Real + numpy::Element + bytemuck::Pod,
         I: sweep::Index + numpy::Element + bytemuck::Pod,
     {
-        let (nv, nf) = (self.lay.vertices, self.lay.faces);
+        let (nv, nf) = (self.prep.layout.vertices, self.prep.layout.faces);
         let v = empty::<R, numpy::Ix2>(py, &[nv, 3])?;
         let f = empty::<I, numpy::Ix2>(py, &[nf, 3])?;
         let n = match self.normals {
@@ -148,25 +127,10 @@ impl Job<'_> {
                 },
             };
             let stop = Stop::default();
-            let folds = detach_stoppable(py, &stop, || {
-                let cancel = || stop.requested();
-                let (s, o, p, lay) = (self.spine, self.offsets, self.p, self.opts);
-                sweep::sweep_into_cancellable(s, o, p, lay, self.lay, out, &cancel)
-            })?;
-            let verts: &mut [[R; 3]] = bytemuck::cast_slice_mut(slice_mut(&mut wv)?);
-            let uvs: Option<&mut [[R; 2]]> = match wu.as_mut() {
-                Some(w) => Some(bytemuck::cast_slice_mut(slice_mut(w)?)),
-                None => None,
-            };
-            let k = self.k;
-            detach_in_pool(py, || {
-                if let Some(k) = k {
-                    sweep::unscale(verts, uvs, k);
-                }
-                sweep::check_finite_out(verts)
+            detach_stoppable(py, &stop, || {
+                self.prep.write_into(out, &|| stop.requested())
             })?
-            .map_err(|e| renamed(e, "scale", self.scale_arg))?;
-            folds
+            .map_err(|e| renamed(e, "scale", self.scale_arg))?
         };
         let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
         Ok((
