@@ -886,7 +886,9 @@ impl Rings<'_> {
     /// One block of rings, [`Rings::block_body`]; on x86-64 processors with AVX2 the same
     /// code compiled for 256-bit vectors (four columns per instruction in the column loops
     /// of [`RingScratch`]; the same IEEE operations, so the same bits), chosen at run time
-    /// like the frames' scan (`crate::frames::fused`).
+    /// like the frames' scan (`crate::frames::fused`). Measured with one thread on a
+    /// 10⁵-point float32 tube: 110 instead of 204 instructions per vertex in this kernel,
+    /// 71–76 ms instead of 82–88 ms for the core call (best of 25, a loaded machine).
     fn block<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
