@@ -285,14 +285,14 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         mesh._n_rows, mesh._n_curves = n, curves
         return mesh
     fr = _sweep_frames(pts, fr, closed, offs, bundle, tg, rule)
-    v, f, nrm, uv, folds = _core.sweep_mesh(
+    v, f, nrm, uv, folds, faces_per_curve = _core.sweep_mesh(
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
         single, single, want_normals, want_uv,
     )
     if folds.size and keep_rows is not None:  # back to the rows as given
         folds = np.flatnonzero(keep_rows)[folds]
-    rings, vstart = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
+    rings, _ = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
     if folds.size:
         where = f"spine rows {_ranges(folds)}"
         fold_curves = None
@@ -316,10 +316,10 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         for k, (a, per_curve) in pdata.items():
             mesh.point_data[k] = np.repeat(a[rings[1] if per_curve else rings[0]], rings[2],
                                            axis=0)
-    if bundle:
-        fc = np.searchsorted(vstart, f[:, 0], side="right") - 1
+    if bundle:  # each curve's faces follow those of the curve before it
         small = curves <= np.iinfo(np.int32).max
-        mesh.cell_data["curve_id"] = curve_ids.astype(np.int32 if small else np.int64)[fc]
+        mesh.cell_data["curve_id"] = np.repeat(
+            curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
     return mesh
 
 

@@ -15,10 +15,12 @@ type MeshArrays<'py> = (
     Option<Bound<'py, PyAny>>,
     Option<Bound<'py, PyAny>>,
     Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
 );
 
 /// Sweep a profile along one or many spines; see `spinal.sweep`. Returns vertices, faces,
-/// normals (or None), uv (or None) and the rows where a miter was folded. Coordinates are
+/// normals (or None), uv (or None), the rows where a miter was folded and the number of
+/// faces of every spine (its faces follow those of the spine before it). Coordinates are
 /// float32 with `single` (computed in float64, stored rounded), faces int32 with `index32`
 /// when the vertex count fits (int64 otherwise). Errors about the scale name `scale_arg`
 /// (`spinal.tube` passes its radius as the scale). `scale` may have a single row (the same
@@ -133,12 +135,15 @@ impl Job<'_> {
             .map_err(|e| renamed(e, "scale", self.scale_arg))?
         };
         let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
+        let per_spine = self.prep.faces_per_spine();
+        let per_spine: Vec<i64> = per_spine.iter().map(|&k| k as i64).collect();
         Ok((
             v.into_any(),
             f.into_any(),
             n.map(Bound::into_any),
             uv.map(Bound::into_any),
             PyArray1::from_vec(py, folds),
+            PyArray1::from_vec(py, per_spine),
         ))
     }
 }

@@ -1281,6 +1281,16 @@ impl<'a> Prepared<'a> {
         })
     }
 
+    /// The number of faces of every spine's part of the mesh (its side faces, then its
+    /// caps), in the order of the spines: the parts follow one another in the face array.
+    pub fn faces_per_spine(&self) -> Vec<usize> {
+        self.layout
+            .plans
+            .iter()
+            .map(|plan| plan.faces(&self.profile))
+            .collect()
+    }
+
     /// The spine the sweep runs on (scaled or as given).
     fn view(&self) -> Spine<'_> {
         match &self.scaled {
