@@ -513,6 +513,24 @@ pub fn deform_surface(
     out: &mut [DVec3],
     flags: &mut [u8],
 ) -> Result<()> {
+    deform_surface_cancellable(posed, cell, coords, corrected, out, flags, &cancel::never)
+}
+
+/// Vertices per block of a cancellable deformation ([`deform_surface_cancellable`]).
+const DEFORM_BLOCK: usize = 1 << 12;
+
+/// [`deform_surface`] that polls `cancel` before every block of [`DEFORM_BLOCK`] vertices
+/// and skips the remaining blocks once it says stop (`out` is then incomplete; see
+/// [`crate::cancel`]).
+pub fn deform_surface_cancellable(
+    posed: &Surface,
+    cell: &[i64],
+    coords: &[f64],
+    corrected: bool,
+    out: &mut [DVec3],
+    flags: &mut [u8],
+    cancel: Cancel<'_>,
+) -> Result<()> {
     let nv = cell.len();
     if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
         return Err(InputError::new("coords", "inconsistent array sizes"));
@@ -527,32 +545,46 @@ pub fn deform_surface(
             format!("vertex {i} is bound to a cell the posed grid does not have"),
         ));
     }
-    out.par_iter_mut()
-        .zip(flags.par_iter_mut())
-        .zip(cell.par_iter().zip(coords.par_chunks(SURFACE_COORDS)))
-        .for_each(|((o, f), (&c, x))| {
-            let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
-            let l = posed.eval(i, j, x[0], x[1]);
-            let resid = DVec3::new(x[6], x[7], x[8]);
-            if resid != DVec3::ZERO {
-                let (e1, e2) = l.frame();
-                *o = l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n;
-                *f = OUTSIDE;
+    out.par_chunks_mut(DEFORM_BLOCK)
+        .zip(flags.par_chunks_mut(DEFORM_BLOCK))
+        .zip(cell.par_chunks(DEFORM_BLOCK))
+        .zip(coords.par_chunks(SURFACE_COORDS * DEFORM_BLOCK))
+        .for_each(|(((o, f), c), x)| {
+            if cancel() {
                 return;
             }
-            let h0 = x[2];
-            if !corrected {
-                *o = l.s + h0 * l.n;
-                *f = 0;
-                return;
+            let rows = o.iter_mut().zip(f.iter_mut()).zip(c);
+            for (((o, f), &c), x) in rows.zip(x.chunks_exact(SURFACE_COORDS)) {
+                deform_vertex(posed, corrected, o, f, c, x);
             }
-            let (a1, b1, c1) = l.abc();
-            let rhs = h0 * (x[3] + h0 * (0.5 * x[4] + h0 * x[5] / 3.0));
-            let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
-            *o = l.s + h1 * l.n;
-            *f = if ok { 0 } else { CLAMPED_BEND };
         });
     Ok(())
+}
+
+/// One registered vertex (cell `c`, coordinates `x`) onto the posed surface: its position
+/// `o` and clamp flag `f`.
+#[inline]
+fn deform_vertex(posed: &Surface, corrected: bool, o: &mut DVec3, f: &mut u8, c: i64, x: &[f64]) {
+    let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
+    let l = posed.eval(i, j, x[0], x[1]);
+    let resid = DVec3::new(x[6], x[7], x[8]);
+    if resid != DVec3::ZERO {
+        let (e1, e2) = l.frame();
+        *o = l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n;
+        *f = OUTSIDE;
+        return;
+    }
+    let h0 = x[2];
+    if !corrected {
+        *o = l.s + h0 * l.n;
+        *f = 0;
+        return;
+    }
+    let (a1, b1, c1) = l.abc();
+    let rhs = h0 * (x[3] + h0 * (0.5 * x[4] + h0 * x[5] / 3.0));
+    let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
+    *o = l.s + h1 * l.n;
+    *f = if ok { 0 } else { CLAMPED_BEND };
 }
 
 #[cfg(test)]
