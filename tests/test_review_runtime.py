@@ -274,6 +274,10 @@ D17_CASES = {
         ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
          "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
         "Q.camera_frames(X)"),
+    "ph.fit": (
+        ("n = 2_000_000; s = np.linspace(0, 200 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * s]\n"),
+        "ph.fit(X)"),
 }
 
 
