@@ -361,7 +361,7 @@ pub fn compute_general_cancellable(
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords(x, closed)?
+        validate::chords_cancellable(x, closed, cancel)?
     };
     if cancel() {
         return Ok(0.0);
