@@ -671,9 +671,15 @@ fn frenet_frames(
         ));
     }
     let (t, closed) = (dr.t, dr.closed);
+    // a cancelled pass leaves the remaining normals undefined (the caller discards them)
     let normals: Vec<Option<DVec3>> = (0..t.len())
         .into_par_iter()
-        .map(|i| curvature.normal(t, i, closed))
+        .map(|i| {
+            if cancel() {
+                return None;
+            }
+            curvature.normal(t, i, closed)
+        })
         .collect();
     if cancel() {
         return Ok(0.0);
