@@ -10,3 +10,258 @@ pub type Cancel<'a> = &'a (dyn Fn() -> bool + Sync);
 pub fn never() -> bool {
     false
 }
+
+#[cfg(test)]
+mod tests {
+    //! Every cancellable call, stopped at each of its polls in turn, returns without a
+    //! panic (no stage reads the incomplete output of a stage before it), and the same call
+    //! with a hook that never stops gives the plain call's bits.
+
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use glam::DVec3;
+
+    use crate::flesh::surface::{self, Surface};
+    use crate::frames::constraints::TwistRule;
+    use crate::frames::guide::Guide;
+    use crate::frames::steer::{self, Steering};
+    use crate::frames::{self, Method, Orientation, Request};
+    use crate::mesh::measure;
+    use crate::quaternion::camera;
+
+    /// A hook that counts its polls and says stop from poll `after` on.
+    struct After {
+        polls: AtomicUsize,
+        after: usize,
+    }
+
+    impl After {
+        fn new(after: usize) -> After {
+            After {
+                polls: AtomicUsize::new(0),
+                after,
+            }
+        }
+        fn stop(&self) -> bool {
+            self.polls.fetch_add(1, Ordering::Relaxed) >= self.after
+        }
+    }
+
+    /// Run `call` with a hook that never stops (its result is returned, with the number of
+    /// polls), then stopped at about 12 of those polls spread over the whole call.
+    fn stop_everywhere<T>(call: impl Fn(&(dyn Fn() -> bool + Sync)) -> T) -> (T, usize) {
+        let never = After::new(usize::MAX);
+        let full = call(&|| never.stop());
+        let polls = never.polls.load(Ordering::Relaxed);
+        assert!(polls > 3, "the call polls only {polls} times");
+        for after in (0..polls).step_by(polls.div_ceil(12)).chain([polls - 1]) {
+            let hook = After::new(after);
+            call(&|| hook.stop());
+        }
+        (full, polls)
+    }
+
+    /// A closed curve of `n` samples (a circle with a wave, curvature nowhere zero).
+    fn curve(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|i| {
+                let s = std::f64::consts::TAU * 50.0 * i as f64 / n as f64;
+                DVec3::new(s.cos(), s.sin(), 0.3 * (3.0 * s).sin())
+            })
+            .collect()
+    }
+
+    fn frames_of(req: &Request, cancel: super::Cancel<'_>) -> (Vec<f64>, f64) {
+        let mut out = vec![0.0; 9 * req.points.map_or(0, <[DVec3]>::len)];
+        let angle = frames::compute_into_cancellable(req, &mut out, cancel).expect("valid");
+        (out, angle)
+    }
+
+    fn same_bits(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    #[test]
+    fn general_frames_stop_anywhere() {
+        let x = curve(70_000);
+        let t: Vec<DVec3> = x
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (x[(i + 1) % x.len()] - *p).normalize())
+            .collect();
+        let base = Request {
+            points: Some(&x),
+            ..Request::default()
+        };
+        let requests = [
+            Request {
+                closed: true,
+                ..base
+            },
+            Request {
+                closed: true,
+                tangents: Some(&t),
+                ..base
+            },
+            Request {
+                method: Method::Frenet,
+                ..base
+            },
+            Request {
+                end: Some(Orientation::Vector(DVec3::Z)),
+                ..base
+            },
+            Request {
+                method: Method::Projection,
+                ..base
+            },
+        ];
+        for req in &requests {
+            let ((out, angle), _) = stop_everywhere(|c| frames_of(req, c));
+            let mut plain = vec![0.0; out.len()];
+            let a = frames::compute_into(req, &mut plain).expect("valid");
+            assert!(same_bits(&out, &plain) && angle.to_bits() == a.to_bits());
+        }
+    }
+
+    #[test]
+    fn steered_frames_stop_anywhere() {
+        let x = curve(70_000);
+        let req = Request {
+            points: Some(&x),
+            ..Request::default()
+        };
+        let up = [DVec3::Z];
+        let pins = [steer::Constraint {
+            row: 35_000,
+            orientation: Orientation::Vector(DVec3::Z),
+        }];
+        let guided = Steering {
+            constraints: &[],
+            rule: TwistRule::ArcLength,
+            turns: &[],
+            guide: Some(Guide {
+                vectors: &up,
+                weight: 1.0,
+                tolerance: 1e-3,
+            }),
+            previous: None,
+        };
+        let pinned = Steering {
+            constraints: &pins,
+            guide: None,
+            ..guided
+        };
+        for st in [guided, pinned] {
+            let run = |c: super::Cancel<'_>| {
+                let mut out = vec![0.0; 9 * x.len()];
+                steer::compute_steered_cancellable(&req, &st, &mut out, c).expect("valid");
+                out
+            };
+            let (out, _) = stop_everywhere(run);
+            let mut plain = vec![0.0; out.len()];
+            steer::compute_steered(&req, &st, &mut plain).expect("valid");
+            assert!(same_bits(&out, &plain));
+        }
+    }
+
+    #[test]
+    fn camera_inputs_stop_anywhere() {
+        let x = curve(100_000);
+        for mode in [
+            camera::Mode::Transport,
+            camera::Mode::Level {
+                singular_angle: 0.1,
+            },
+        ] {
+            let run = |c: super::Cancel<'_>| {
+                camera::inputs_cancellable(&x, None, None, None, true, mode, c).expect("valid")
+            };
+            let (got, _) = stop_everywhere(run);
+            let plain = camera::inputs(&x, None, None, None, true, mode).expect("valid");
+            assert!(got.tangents == plain.tangents && got.regular == plain.regular);
+        }
+    }
+
+    #[test]
+    fn mesh_measures_stop_anywhere() {
+        // 200,000 pseudo-random faces over 5,000 vertices (a linear congruential sequence)
+        let mut state = 12345u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            state >> 33
+        };
+        let v: Vec<[f64; 3]> = (0..5000)
+            .map(|_| [next(), next(), next()].map(|k| k as f64 / 2e9))
+            .collect();
+        let f: Vec<[i64; 3]> = (0..200_000)
+            .map(|_| [next(), next(), next()].map(|k| (k % 5000) as i64))
+            .collect();
+        let (vol, _) = stop_everywhere(|c| measure::volume_cancellable(&v, &f, c).expect("ok"));
+        assert_eq!(
+            vol.to_bits(),
+            measure::volume(&v, &f).expect("ok").to_bits()
+        );
+        let (area, _) = stop_everywhere(|c| measure::area_cancellable(&v, &f, c).expect("ok"));
+        assert_eq!(area.to_bits(), measure::area(&v, &f).expect("ok").to_bits());
+        let (e, _) = stop_everywhere(|c| measure::edges_cancellable(&f, 5000, c).expect("ok"));
+        assert_eq!(e, measure::edges(&f, 5000).expect("ok"));
+    }
+
+    #[test]
+    fn surface_deform_stops_anywhere() {
+        let (nu, nv) = (6, 7);
+        let grid = |bend: f64| -> Vec<DVec3> {
+            (0..nu * nv)
+                .map(|k| {
+                    let (i, j) = ((k / nv) as f64 / 5.0, (k % nv) as f64 / 6.0);
+                    DVec3::new(i, j, bend * (3.0 * i).sin())
+                })
+                .collect()
+        };
+        let rest = Surface::new("rest", &grid(0.0), nu, nv).expect("grid");
+        let posed = Surface::new("posed", &grid(0.2), nu, nv).expect("grid");
+        let vertices: Vec<DVec3> = (0..20_000)
+            .map(|k| {
+                let s = k as f64;
+                DVec3::new(
+                    (s * 0.618).fract(),
+                    (s * 0.414).fract(),
+                    0.1 * (s * 0.732).fract(),
+                )
+            })
+            .collect();
+        let (cell, coords) = surface::bind_surface(&rest, &vertices).expect("bound");
+        let n = vertices.len();
+        let run = |c: super::Cancel<'_>| {
+            let (mut out, mut flags) = (vec![DVec3::ZERO; n], vec![0u8; n]);
+            surface::deform_surface_cancellable(
+                &posed,
+                rest.scale.exp(),
+                &cell,
+                &coords,
+                true,
+                &mut out,
+                &mut flags,
+                c,
+            )
+            .expect("valid");
+            (out, flags)
+        };
+        let ((out, flags), _) = stop_everywhere(run);
+        let (mut plain, mut pflags) = (vec![DVec3::ZERO; n], vec![0u8; n]);
+        surface::deform_surface(
+            &posed,
+            rest.scale.exp(),
+            &cell,
+            &coords,
+            true,
+            &mut plain,
+            &mut pflags,
+        )
+        .expect("valid");
+        assert!(out == plain && flags == pflags);
+    }
+}

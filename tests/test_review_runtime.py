@@ -165,6 +165,9 @@ import os, signal, sys, threading, time
 import numpy as np, trimesh, spinal
 from spinal import fields as fl, quaternions as Q, ph
 spinal.set_num_threads(2)
+# Python installs its Ctrl-C handler only when SIGINT is not ignored at start-up, and a
+# shell starts background jobs with SIGINT ignored: install it here in any case
+signal.signal(signal.SIGINT, signal.default_int_handler)
 {setup}
 sent = []
 def fire():
@@ -238,6 +241,58 @@ D17_CASES = {
     "from_quaternions": (
         "q = np.tile([.1, .2, .3, .9], (10_000_000, 1))\n",
         "Q.from_quaternions(q)"),
+    "Mesh.volume": (
+        ("rng = np.random.default_rng(0); V = rng.normal(size=(2_000_000, 3))\n"
+         "mesh = spinal.Mesh(V, rng.integers(0, len(V), size=(8_000_000, 3)))\n"),
+        "mesh.volume"),
+    "Mesh.area": (
+        ("rng = np.random.default_rng(0); V = rng.normal(size=(2_000_000, 3))\n"
+         "mesh = spinal.Mesh(V, rng.integers(0, len(V), size=(8_000_000, 3)))\n"),
+        "mesh.area"),
+    "Mesh.edge_stats": (
+        ("rng = np.random.default_rng(0); V = rng.normal(size=(1_000_000, 3))\n"
+         "mesh = spinal.Mesh(V, rng.integers(0, len(V), size=(3_000_000, 3)))\n"),
+        "mesh.edge_stats()"),
+    "SurfaceBinding.deform": (
+        # binding is far slower than deforming: bind 100,000 vertices and repeat their
+        # registration 30 times (the deformation maps each registered vertex on its own)
+        ("g = np.stack(np.meshgrid(np.linspace(0, 1, 8), np.linspace(0, 1, 9),\n"
+         "                         indexing='ij'), -1)\n"
+         "S = np.concatenate([g, np.zeros(g.shape[:2] + (1,))], -1)\n"
+         "V = np.random.default_rng(0).uniform(size=(100_000, 3)) * [1, 1, .2]\n"
+         "b = spinal.SurfaceBinding(V, S)\n"
+         "b._cell, b._coords = np.tile(b._cell, 30), np.tile(b._coords, (30, 1))\n"
+         "P = S.copy(); P[..., 2] += .2 * S[..., 0] ** 2\n"),
+        "b.deform(P)"),
+    "frames_closed": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n, endpoint=False)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.frames(X, closed=True)"),
+    "frames_given_tangents": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n, endpoint=False)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"
+         "T = np.c_[-np.sin(s), np.cos(s), .9 * np.cos(3 * s)]\n"),
+        "spinal.frames(X, T, closed=True)"),
+    "frames_frenet": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.frames(X, method='frenet')"),
+    "frames_constraints": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.frames(X, constraints={n // 2: [0, 0, 1]})"),
+    "frames_guide": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.frames(X, guide=[0, 0, 1])"),
+    "camera_frames": (
+        ("n = 3_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "Q.camera_frames(X)"),
+    "ph.fit": (
+        ("n = 2_000_000; s = np.linspace(0, 200 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * s]\n"),
+        "ph.fit(X)"),
 }
 
 

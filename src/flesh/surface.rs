@@ -564,6 +564,35 @@ pub fn deform_surface(
     out: &mut [DVec3],
     flags: &mut [u8],
 ) -> Result<()> {
+    deform_surface_cancellable(
+        posed,
+        rest_exp,
+        cell,
+        coords,
+        corrected,
+        out,
+        flags,
+        &cancel::never,
+    )
+}
+
+/// Vertices per block of a cancellable deformation ([`deform_surface_cancellable`]).
+const DEFORM_BLOCK: usize = 1 << 12;
+
+/// [`deform_surface`] that polls `cancel` before every block of [`DEFORM_BLOCK`] vertices
+/// and skips the remaining blocks once it says stop (`out` is then incomplete; see
+/// [`crate::cancel`]).
+#[allow(clippy::too_many_arguments)]
+pub fn deform_surface_cancellable(
+    posed: &Surface,
+    rest_exp: i32,
+    cell: &[i64],
+    coords: &[f64],
+    corrected: bool,
+    out: &mut [DVec3],
+    flags: &mut [u8],
+    cancel: Cancel<'_>,
+) -> Result<()> {
     let nv = cell.len();
     if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
         return Err(InputError::new("coords", "inconsistent array sizes"));
@@ -579,7 +608,6 @@ pub fn deform_surface(
         ));
     }
     // lengths of the binding to the posed model's units, and its output back to the input's
-    let (to_model, to_input) = (posed.scale, posed.scale.inverse());
     let q = posed.scale.exp();
     let (Some(d), Some(d2)) = (
         q.checked_sub(rest_exp),
@@ -587,36 +615,27 @@ pub fn deform_surface(
     ) else {
         return Err(InputError::new("coords", "inconsistent scale exponent"));
     };
-    // rest model lengths (B0) and areas (A0) in the posed model's units
-    let (len1, area1) = (Pow2::new(d), Pow2::new(d2));
-    out.par_iter_mut()
-        .zip(flags.par_iter_mut())
-        .zip(cell.par_iter().zip(coords.par_chunks(SURFACE_COORDS)))
-        .for_each(|((o, f), (&c, x))| {
-            let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
-            let l = posed.eval(i, j, x[0], x[1]);
-            let resid = DVec3::new(x[6], x[7], x[8]);
-            if resid != DVec3::ZERO {
-                let resid = to_model.of3(resid);
-                let (e1, e2) = l.frame();
-                *o = to_input.of3(l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n);
-                *f = OUTSIDE;
+    let units = Units {
+        to_model: posed.scale,
+        to_input: posed.scale.inverse(),
+        // rest model lengths (B0) and areas (A0) in the posed model's units
+        len1: Pow2::new(d),
+        area1: Pow2::new(d2),
+    };
+    out.par_chunks_mut(DEFORM_BLOCK)
+        .zip(flags.par_chunks_mut(DEFORM_BLOCK))
+        .zip(cell.par_chunks(DEFORM_BLOCK))
+        .zip(coords.par_chunks(SURFACE_COORDS * DEFORM_BLOCK))
+        .for_each(|(((o, f), c), x)| {
+            if cancel() {
                 return;
             }
-            let h0 = to_model.of(x[2]);
-            if !corrected {
-                *o = to_input.of3(l.s + h0 * l.n);
-                *f = 0;
-                return;
+            let rows = o.iter_mut().zip(f.iter_mut()).zip(c);
+            for (((o, f), &c), x) in rows.zip(x.chunks_exact(SURFACE_COORDS)) {
+                deform_vertex(posed, corrected, &units, o, f, c, x);
             }
-            let (a1, b1, c1) = l.abc();
-            let (a0, b0) = (area1.of(x[3]), len1.of(x[4]));
-            let rhs = h0 * (a0 + h0 * (0.5 * b0 + h0 * x[5] / 3.0));
-            let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
-            *o = to_input.of3(l.s + h1 * l.n);
-            *f = if ok { 0 } else { CLAMPED_BEND };
         });
-    if q != 0 || rest_exp != 0 {
+    if (q != 0 || rest_exp != 0) && !cancel() {
         // a binding and a pose whose sizes differ by more than the range of f64 between
         // them, or a result past the largest float
         if let Some(i) = out.par_iter().position_first(|p| !p.is_finite()) {
@@ -632,6 +651,56 @@ pub fn deform_surface(
         }
     }
     Ok(())
+}
+
+/// One registered vertex (cell `c`, coordinates `x`) onto the posed surface: its position
+/// `o` and clamp flag `f`.
+#[inline]
+fn deform_vertex(
+    posed: &Surface,
+    corrected: bool,
+    u: &Units,
+    o: &mut DVec3,
+    f: &mut u8,
+    c: i64,
+    x: &[f64],
+) {
+    let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
+    let l = posed.eval(i, j, x[0], x[1]);
+    let resid = DVec3::new(x[6], x[7], x[8]);
+    if resid != DVec3::ZERO {
+        let resid = u.to_model.of3(resid);
+        let (e1, e2) = l.frame();
+        *o = u
+            .to_input
+            .of3(l.s + resid.x * e1 + resid.y * e2 + resid.z * l.n);
+        *f = OUTSIDE;
+        return;
+    }
+    let h0 = u.to_model.of(x[2]);
+    if !corrected {
+        *o = u.to_input.of3(l.s + h0 * l.n);
+        *f = 0;
+        return;
+    }
+    let (a1, b1, c1) = l.abc();
+    let (a0, b0) = (u.area1.of(x[3]), u.len1.of(x[4]));
+    let rhs = h0 * (a0 + h0 * (0.5 * b0 + h0 * x[5] / 3.0));
+    let (h1, ok) = surface_offset(-0.5 * b1 / a1, c1 / a1, rhs / a1);
+    *o = u.to_input.of3(l.s + h1 * l.n);
+    *f = if ok { 0 } else { CLAMPED_BEND };
+}
+
+/// The powers of two between a binding's stored numbers and the posed model's units.
+struct Units {
+    /// Input lengths to the posed model's units.
+    to_model: Pow2,
+    /// The posed model's lengths back to the input's units.
+    to_input: Pow2,
+    /// Rest model lengths (the stored `B0`) to the posed model's units.
+    len1: Pow2,
+    /// Rest model areas (the stored `A0`) to the posed model's units.
+    area1: Pow2,
 }
 
 #[cfg(test)]

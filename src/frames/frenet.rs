@@ -27,10 +27,30 @@ pub fn frenet_into(
     closed: bool,
     out: &mut [f64],
 ) {
+    frenet_into_cancellable(dr, normal, seg, closed, out, &crate::cancel::never);
+}
+
+/// Rows between two polls of the cancel hook ([`frenet_into_cancellable`]).
+const CANCEL_ROWS: usize = 1 << 16;
+
+/// [`frenet_into`] that polls `cancel` between its passes and every [`CANCEL_ROWS`] rows of
+/// the transport across gaps, and returns at once (with `out` incomplete) when it says stop
+/// (see [`crate::cancel`]).
+pub fn frenet_into_cancellable(
+    dr: &DoubleReflection,
+    normal: &[Option<DVec3>],
+    seg: &[f64],
+    closed: bool,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) {
     let t = dr.t;
     let n = t.len();
     let rows = out.len() / 9;
     let defined: Vec<usize> = (0..n).filter(|&i| normal[i].is_some()).collect();
+    if cancel() {
+        return;
+    }
     let mut r = vec![DVec3::ZERO; n];
     for &d in &defined {
         r[d] = normal[d].unwrap_or(DVec3::ZERO);
@@ -48,6 +68,9 @@ pub fn frenet_into(
             gaps.push((last, first + n));
         }
     }
+    if cancel() {
+        return;
+    }
     for (a, b) in gaps {
         // forward transport a -> b (indices mod n), then spread the mismatch in arc length
         let mut cur = r[a];
@@ -55,6 +78,9 @@ pub fn frenet_into(
         let mut prov = Vec::with_capacity(b - a);
         let mut arc = Vec::with_capacity(b - a);
         for i in a..b {
+            if (i - a) % CANCEL_ROWS == CANCEL_ROWS - 1 && cancel() {
+                return;
+            }
             cur = dr.step(i % n, cur);
             s += seg_at(i);
             prov.push(cur);
@@ -68,6 +94,9 @@ pub fn frenet_into(
             r[i % n] = rotate_about(prov[k], ti, beta * arc[k] / total);
         }
     }
+    if cancel() {
+        return;
+    }
     if !closed {
         let (first, last) = (defined[0], defined[defined.len() - 1]);
         for i in (0..first).rev() {
@@ -77,7 +106,13 @@ pub fn frenet_into(
             r[i] = dr.step(i - 1, r[i - 1]);
         }
     }
+    if cancel() {
+        return;
+    }
     for (i, f) in out.chunks_exact_mut(9).enumerate().take(n) {
+        if i % CANCEL_ROWS == CANCEL_ROWS - 1 && cancel() {
+            return;
+        }
         write_frame(f, r[i], t[i]);
     }
     if rows == n + 1 {

@@ -182,7 +182,7 @@ pub(super) fn try_open_points(
         cs,
         ext: n,
     }
-    .scan(work, out)
+    .scan_cancellable(work, out, cancel)
 }
 
 /// A given tangent made unit, as `tangents::normalize_all` does; `None` where it cannot be.

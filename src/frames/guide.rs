@@ -106,7 +106,8 @@ fn cyclic(lo: &[f64], d: &[f64], up: &[f64], b: &[f64]) -> Vec<f64> {
 /// The twist `α_i` of every distinct sample (see the module text). `r`, `t`: the RMF's
 /// reference vectors and unit tangents; `seg`: segment lengths; `closing`: the RMF's closing
 /// angle (closed curves); `pins`: fixed orientations (sorted distinct rows, unit vectors
-/// ⟂ their tangents); `turns`: extra turns across the seam of a closed curve.
+/// ⟂ their tangents); `turns`: extra turns across the seam of a closed curve. `cancel` is
+/// polled between the passes; a cancelled call returns no twist (see [`crate::cancel`]).
 #[allow(clippy::too_many_arguments)]
 pub fn twist(
     r: &[DVec3],
@@ -117,6 +118,7 @@ pub fn twist(
     guide: &Guide,
     pins: &[(usize, DVec3)],
     turns: i64,
+    cancel: crate::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     check(guide)?;
     let n = t.len();
@@ -142,6 +144,9 @@ pub fn twist(
             value[i] = signed_angle(r[i], p, t[i]);
             weight[i] = s * s;
         }
+    }
+    if cancel() {
+        return Ok(Vec::new());
     }
     // unwrap along the samples
     let mut prev: Option<f64> = None;
@@ -181,6 +186,9 @@ pub fn twist(
     } else {
         0.0
     };
+    if cancel() {
+        return Ok(Vec::new());
+    }
     let mut lo = vec![0.0; n];
     let mut up = vec![0.0; n];
     let mut d = vec![0.0; n];
@@ -198,6 +206,9 @@ pub fn twist(
             b[n - 1] += e * seam;
         }
     }
+    if cancel() {
+        return Ok(Vec::new());
+    }
     for i in 0..n {
         let mu = 0.5
             * (if i > 0 || closed {
@@ -210,6 +221,9 @@ pub fn twist(
         if c > 0.0 {
             b[i] += c * value[i];
         }
+    }
+    if cancel() {
+        return Ok(Vec::new());
     }
     // pins: identity rows, their couplings moved to the right-hand side (rows p and q couple
     // to row i through up[p] and lo[q]; across the seam these are the corners)
@@ -232,6 +246,9 @@ pub fn twist(
         lo[i] = 0.0;
         up[i] = 0.0;
         b[i] = v;
+    }
+    if cancel() {
+        return Ok(Vec::new());
     }
     if closed && !pinned.iter().any(|&p| p) {
         return Ok(cyclic(&lo, &d, &up, &b));

@@ -42,7 +42,7 @@ use crate::error::{InputError, Result};
 use double_reflection::DoubleReflection;
 use geometry::{any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 pub use tangents::TangentRule;
-use transport::{Step, Twist, transport_into};
+use transport::{Step, Twist, transport_into_cancellable};
 
 /// Frame method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -298,7 +298,7 @@ pub fn compute_into_cancellable(
     match fused::try_open_points(req, out, cancel) {
         Some(angle) => Ok(angle),
         None if cancel() => Ok(0.0),
-        None => compute_general(req, out),
+        None => compute_general_cancellable(req, out, cancel),
     }
 }
 
@@ -349,16 +349,37 @@ impl Normalised {
 /// (`check_segments`); then the frames, Frenet (`frenet_frames`) or transported with the
 /// boundary condition (`transport_frames`).
 pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
+    compute_general_cancellable(req, out, &crate::cancel::never)
+}
+
+/// [`compute_general`] that polls `cancel` between its stages and inside the long ones (the
+/// tangent estimate, the search for a defined normal, the transport and the Frenet fill) and
+/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+pub fn compute_general_cancellable(
+    req: &Request,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<f64> {
     let rows = check_input(req, out)?;
     let n = distinct_samples(req, rows)?;
     let closed = req.closed;
     let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);
+    if cancel() {
+        return Ok(0.0);
+    }
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords(x, closed)?
+        validate::chords_cancellable(x, closed, cancel)?
     };
-    let t = unit_tangents(req, x, &chords, n)?;
+    if cancel() {
+        return Ok(0.0);
+    }
+    let t = unit_tangents(req, x, &chords, n, cancel)?;
+    // a cancelled estimate is incomplete: nothing below may read it
+    if cancel() {
+        return Ok(0.0);
+    }
     let dr = DoubleReflection {
         x,
         t: &t,
@@ -366,10 +387,16 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         tangent_chords: req.tangent_chords,
     };
     check_segments(req, &dr)?;
+    if cancel() {
+        return Ok(0.0);
+    }
     let seg = segment_lengths(req, x, n, chords);
     let curvature = curvature_source(req, x, n);
+    if cancel() {
+        return Ok(0.0);
+    }
     if req.method == Method::Frenet {
-        return frenet_frames(req, &dr, &seg, &curvature, out);
+        return frenet_frames(req, &dr, &seg, &curvature, out, cancel);
     }
     let ctx = Ctx {
         req,
@@ -378,7 +405,7 @@ pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
         curvature: &curvature,
         closed,
     };
-    transport_frames(&ctx, &dr, out)
+    transport_frames(&ctx, &dr, out, cancel)
 }
 
 /// The shapes and values of the input, and the options that fit together; returns the
@@ -513,7 +540,13 @@ fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
 
 /// Unit tangents of the `n` distinct samples: the analytic derivative, the given tangents or
 /// the estimate from the points `x` (with their `chords`).
-fn unit_tangents(req: &Request, x: &[DVec3], chords: &[f64], n: usize) -> Result<Vec<DVec3>> {
+fn unit_tangents(
+    req: &Request,
+    x: &[DVec3],
+    chords: &[f64],
+    n: usize,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     let t: Vec<DVec3> = if let Some(a) = req.analytic {
         if let Some(j) = a.d1.par_iter().position_first(|d| !(d.length() > 0.0)) {
             return Err(InputError::new(
@@ -544,7 +577,7 @@ fn unit_tangents(req: &Request, x: &[DVec3], chords: &[f64], n: usize) -> Result
         })?;
         t
     } else {
-        tangents::estimate(x, chords, req.closed, req.tangent_rule)?
+        tangents::estimate_cancellable(x, chords, req.closed, req.tangent_rule, cancel)?
     };
     if req.tangent_chords && n < 4 {
         return Err(InputError::new(
@@ -632,6 +665,7 @@ fn frenet_frames(
     seg: &[f64],
     curvature: &Curvature,
     out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
 ) -> Result<f64> {
     if req.initial.is_some() || req.end.is_some() || req.turns != 0 {
         return Err(InputError::new(
@@ -646,15 +680,24 @@ fn frenet_frames(
         ));
     }
     let (t, closed) = (dr.t, dr.closed);
+    // a cancelled pass leaves the remaining normals undefined (the caller discards them)
     let normals: Vec<Option<DVec3>> = (0..t.len())
         .into_par_iter()
-        .map(|i| curvature.normal(t, i, closed))
+        .map(|i| {
+            if cancel() {
+                return None;
+            }
+            curvature.normal(t, i, closed)
+        })
         .collect();
-    if normals.iter().any(Option::is_some) {
-        frenet::frenet_into(dr, &normals, seg, closed, out);
+    if cancel() {
         return Ok(0.0);
     }
-    transport_into(
+    if normals.iter().any(Option::is_some) {
+        frenet::frenet_into_cancellable(dr, &normals, seg, closed, out, cancel);
+        return Ok(0.0);
+    }
+    transport_into_cancellable(
         dr,
         t,
         seg,
@@ -662,17 +705,23 @@ fn frenet_frames(
         any_perpendicular(t[0]),
         Twist::None,
         out,
+        cancel,
     );
     Ok(0.0)
 }
 
 /// The frames of a transport method, with the boundary condition of the request.
-fn transport_frames(ctx: &Ctx, dr: &DoubleReflection, out: &mut [f64]) -> Result<f64> {
+fn transport_frames(
+    ctx: &Ctx,
+    dr: &DoubleReflection,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<f64> {
     let (req, t) = (ctx.req, ctx.t);
     match req.method {
-        Method::DoubleReflection => ctx.run(dr, out),
-        Method::Rotation => ctx.run(&rotation::Rotation { t }, out),
-        Method::Projection => ctx.run(&projection::Projection { x: dr.x, t }, out),
+        Method::DoubleReflection => ctx.run(dr, out, cancel),
+        Method::Rotation => ctx.run(&rotation::Rotation { t }, out, cancel),
+        Method::Projection => ctx.run(&projection::Projection { x: dr.x, t }, out, cancel),
         Method::Rk4 => {
             let a = req
                 .analytic
@@ -689,6 +738,7 @@ fn transport_frames(ctx: &Ctx, dr: &DoubleReflection, out: &mut [f64]) -> Result
                     t,
                 },
                 out,
+                cancel,
             )
         }
         Method::Frenet => unreachable!("frenet_frames handles it"),
@@ -706,16 +756,28 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn run<S: Step>(&self, step: &S, out: &mut [f64]) -> Result<f64> {
+    fn run<S: Step>(
+        &self,
+        step: &S,
+        out: &mut [f64],
+        cancel: crate::cancel::Cancel<'_>,
+    ) -> Result<f64> {
         let (req, t, closed) = (self.req, self.t, self.closed);
         let n = t.len();
         let curvature = self.curvature;
         let r0 = match &req.initial {
             Some(o) => resolve(o, t[0], 0, "initial")?,
             None => {
-                let found = (0..n)
-                    .into_par_iter()
-                    .find_map_first(|i| curvature.normal(t, i, closed).map(|v| (i, v)));
+                // a cancelled search stops at once and finds the first row (discarded)
+                let found = (0..n).into_par_iter().find_map_first(|i| {
+                    if cancel() {
+                        return Some((0, t[0]));
+                    }
+                    curvature.normal(t, i, closed).map(|v| (i, v))
+                });
+                if cancel() {
+                    return Ok(0.0);
+                }
                 let p = any_perpendicular(t[0]);
                 match found {
                     None => p,
@@ -739,7 +801,9 @@ impl Ctx<'_> {
         } else {
             Twist::None
         };
-        Ok(transport_into(step, t, self.seg, closed, r0, twist, out))
+        Ok(transport_into_cancellable(
+            step, t, self.seg, closed, r0, twist, out, cancel,
+        ))
     }
 }
 
@@ -755,13 +819,25 @@ pub(crate) struct RmfParts {
 /// curve's frames are transported once round without the closing twist, so frame `n − 1`
 /// carried across the closing segment differs from frame 0 by the closing angle), written
 /// into `out`, with the [`RmfParts`].
-pub(crate) fn rmf_parts(req: &Request, out: &mut [f64]) -> Result<RmfParts> {
+pub(crate) fn rmf_parts(
+    req: &Request,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<RmfParts> {
     let base = Request {
         end: None,
         turns: 0,
         ..*req
     };
-    let closing = compute_into(&base, out)?;
+    let closing = compute_into_cancellable(&base, out, cancel)?;
+    if cancel() {
+        // the caller polls `cancel` too and discards everything
+        return Ok(RmfParts {
+            n: 0,
+            seg: Vec::new(),
+            closing,
+        });
+    }
     let rows = out.len() / 9;
     let n = distinct_samples(req, rows)?;
     let x: &[DVec3] = req.points.map(|p| &p[..n]).unwrap_or(&[]);

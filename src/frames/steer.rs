@@ -41,6 +41,18 @@ fn col(f: &[f64], k: usize) -> DVec3 {
 
 /// Frames of one curve, steered; `out` holds `9·rows` values.
 pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<()> {
+    compute_steered_cancellable(req, st, out, &crate::cancel::never)
+}
+
+/// [`compute_steered`] that polls `cancel` inside the rotation-minimising frames and between
+/// the stages after them, and returns at once (with `out` incomplete) when it says stop (see
+/// [`crate::cancel`]).
+pub fn compute_steered_cancellable(
+    req: &Request,
+    st: &Steering,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
     if req.method == Method::Frenet {
         let arg = if !st.constraints.is_empty() {
             "constraints"
@@ -92,7 +104,10 @@ pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<
             ));
         }
     }
-    let parts = rmf_parts(req, out)?;
+    let parts = rmf_parts(req, out, cancel)?;
+    if cancel() {
+        return Ok(());
+    }
     let n = parts.n;
     if let Some(g) = &st.guide {
         if g.vectors.len() != 1 && g.vectors.len() != rows {
@@ -149,6 +164,9 @@ pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<
         pins.push((0, r[0]));
     }
     pins.sort_by_key(|p| p.0);
+    if cancel() {
+        return Ok(());
+    }
     let alpha = if let Some(g) = &st.guide {
         let turns = match st.turns {
             [] => req.turns,
@@ -169,6 +187,7 @@ pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<
             g,
             &pins,
             turns,
+            cancel,
         )?
     } else {
         let own = [req.turns];
@@ -188,6 +207,9 @@ pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<
             turns,
         )?
     };
+    if cancel() {
+        return Ok(());
+    }
     out[..9 * n]
         .par_chunks_mut(9)
         .zip(alpha.par_iter())
@@ -206,6 +228,9 @@ pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<
         tail[..9].copy_from_slice(&head[..9]);
     }
     if let Some(p) = st.previous {
+        if cancel() {
+            return Ok(());
+        }
         time::align(out, p)?;
     }
     Ok(())
@@ -222,6 +247,28 @@ pub fn compute_steered_many(
     steer: &[Steering],
     out: &mut [f64],
 ) -> Result<()> {
+    compute_steered_many_cancellable(
+        template,
+        offsets,
+        initial,
+        end,
+        steer,
+        out,
+        &crate::cancel::never,
+    )
+}
+
+/// [`compute_steered_many`] that polls `cancel` before each curve and inside each (see
+/// [`compute_steered_cancellable`]).
+pub fn compute_steered_many_cancellable(
+    template: &Request,
+    offsets: &[usize],
+    initial: &[Orientation],
+    end: &[Orientation],
+    steer: &[Steering],
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
     let curves = offsets.len().saturating_sub(1);
     if steer.len() != 1 && steer.len() != curves {
         return Err(InputError::new("out", "one steering per curve expected"));
@@ -231,6 +278,9 @@ pub fn compute_steered_many(
         .into_par_iter()
         .enumerate()
         .map(|(c, buf)| {
+            if cancel() {
+                return Ok(());
+            }
             let (a, b) = (offsets[c], offsets[c + 1]);
             let req = Request {
                 points: template.points.map(|p| &p[a..b]),
@@ -240,7 +290,7 @@ pub fn compute_steered_many(
                 ..*template
             };
             let st = steer[if steer.len() == 1 { 0 } else { c }];
-            compute_steered(&req, &st, buf).map_err(|e| {
+            compute_steered_cancellable(&req, &st, buf, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {

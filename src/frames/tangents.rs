@@ -501,7 +501,7 @@ pub fn estimate_rows_cancellable(
     if cancel() {
         return Ok(Vec::new());
     }
-    let chords = crate::frames::validate::chords(&x[..n], closed)?;
+    let chords = crate::frames::validate::chords_cancellable(&x[..n], closed, cancel)?;
     if cancel() {
         return Ok(Vec::new());
     }

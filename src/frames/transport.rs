@@ -174,6 +174,20 @@ where
     where
         W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
     {
+        self.scan_cancellable(work, out, &crate::cancel::never)
+    }
+
+    /// [`Scan::scan`] whose final turning pass polls `cancel` every [`CANCEL_ROWS`] rows
+    /// and stops once it says stop (`out` is then incomplete; `work` polls on its own).
+    pub fn scan_cancellable<W>(
+        &self,
+        work: W,
+        out: &mut [f64],
+        cancel: crate::cancel::Cancel<'_>,
+    ) -> Option<f64>
+    where
+        W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
+    {
         let (n, cs, ext) = (self.n, self.cs, self.ext);
         let chunks = ext.div_ceil(cs);
         let rows = out.len() / 9;
@@ -283,6 +297,9 @@ where
                     let mut arc = len_prefix[c];
                     let (mut sin, mut cos) = angle.sin_cos();
                     for (off, f) in buf.chunks_exact_mut(9).enumerate() {
+                        if off % CANCEL_ROWS == 0 && cancel() {
+                            return;
+                        }
                         if rate != 0.0 {
                             (sin, cos) = (angle + rate * arc).sin_cos();
                             arc += seg(a + off);
@@ -317,13 +334,33 @@ pub fn transport_into<S: Step>(
     twist: Twist,
     out: &mut [f64],
 ) -> f64 {
-    let ext = if closed { t.len() } else { t.len() - 1 } + 1;
-    let (_, cs) = plan(ext, step.is_rotation());
-    transport_chunked(step, t, seg, closed, r0, twist, out, cs)
+    transport_into_cancellable(step, t, seg, closed, r0, twist, out, &crate::cancel::never)
 }
 
-/// [`transport_into`] with chunks of `cs` extended frames (the scan's result does not
-/// depend on `cs` beyond rounding).
+/// Rows of a chunk between two polls of the cancel hook ([`transport_into_cancellable`]).
+const CANCEL_ROWS: usize = 1 << 16;
+
+/// [`transport_into`] that polls `cancel` every [`CANCEL_ROWS`] rows of every chunk and
+/// stops the scan once it says stop (`out` is then incomplete and the angle 0; see
+/// [`crate::cancel`]).
+#[allow(clippy::too_many_arguments)]
+pub fn transport_into_cancellable<S: Step>(
+    step: &S,
+    t: &[DVec3],
+    seg: &[f64],
+    closed: bool,
+    r0: DVec3,
+    twist: Twist,
+    out: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> f64 {
+    let ext = if closed { t.len() } else { t.len() - 1 } + 1;
+    let (_, cs) = plan(ext, step.is_rotation());
+    transport_chunked(step, t, seg, closed, r0, twist, out, cs, cancel)
+}
+
+/// [`transport_into_cancellable`] with chunks of `cs` extended frames (the scan's result
+/// does not depend on `cs` beyond rounding).
 #[allow(clippy::too_many_arguments)]
 fn transport_chunked<S: Step>(
     step: &S,
@@ -334,6 +371,7 @@ fn transport_chunked<S: Step>(
     twist: Twist,
     out: &mut [f64],
     cs: usize,
+    cancel: crate::cancel::Cancel<'_>,
 ) -> f64 {
     let n = t.len();
     let m = if closed { n } else { n - 1 }; // segments; extended frames 0..=m
@@ -347,6 +385,9 @@ fn transport_chunked<S: Step>(
         let mut rows = buf.chunks_exact_mut(9);
         let mut r = s0;
         for i in a..b {
+            if (i - a) % CANCEL_ROWS == 0 && cancel() {
+                return None;
+            }
             if let Some(f) = rows.next() {
                 write_frame(f, r, tt(i));
             }
@@ -367,9 +408,9 @@ fn transport_chunked<S: Step>(
         cs,
         ext,
     }
-    .scan(work, out);
-    // `work` never fails, so neither does the scan
-    debug_assert!(angle.is_some());
+    .scan_cancellable(work, out, cancel);
+    // `work` fails only when cancelled, and so does the scan
+    debug_assert!(angle.is_some() || cancel());
     angle.unwrap_or(0.0)
 }
 
@@ -541,7 +582,15 @@ mod tests {
                                 let mut out = vec![0.0; 9 * rows];
                                 let raw = pool(threads).install(|| {
                                     transport_chunked(
-                                        &dr, &t, &seg, closed, r0, twist, &mut out, cs,
+                                        &dr,
+                                        &t,
+                                        &seg,
+                                        closed,
+                                        r0,
+                                        twist,
+                                        &mut out,
+                                        cs,
+                                        &crate::cancel::never,
                                     )
                                 });
                                 let what = format!(

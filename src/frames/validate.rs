@@ -88,32 +88,56 @@ pub fn repeated(a: DVec3, b: DVec3, floor: f64) -> bool {
 /// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
 /// consecutive points ([`repeated`]).
 pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
+    chords_cancellable(x, closed, &crate::cancel::never)
+}
+
+/// Rows per segment of [`chords_cancellable`] between two polls of the cancel hook.
+const CHORD_SEGMENT: usize = 1 << 20;
+
+/// [`chords`] that polls `cancel` before every segment of [`CHORD_SEGMENT`] chords and every
+/// block of the check for repeated points, and returns the chords done so far once it says
+/// stop (see [`crate::cancel`]). The chords are written in parallel into reserved room, so
+/// no thread zero-fills the whole buffer first.
+pub fn chords_cancellable(
+    x: &[DVec3],
+    closed: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<f64>> {
     let n = x.len();
     let floor = repeat_floor(x);
     let m = if closed { n } else { n.saturating_sub(1) };
-    let mut seg = alloc::filled("chord lengths", m, 0.0)?;
-    let bad = seg
-        .par_chunks_mut(CHECK_CHUNK)
-        .enumerate()
-        .filter_map(|(c, ls)| {
-            let a0 = c * CHECK_CHUNK;
-            let mut bad = None;
-            for (k, l) in ls.iter_mut().enumerate() {
-                let i = a0 + k;
-                let (a, b) = (x[i], x[if i + 1 == n { 0 } else { i + 1 }]);
-                let d = b - a;
-                *l = d.length();
-                if !(*l > 1e-150 && *l < 1e150) {
-                    // the square under- or overflowed: the length scaled first
-                    *l = crate::math::scale::length(d);
-                }
-                if bad.is_none() && repeated(a, b, floor) {
-                    bad = Some(i);
-                }
+    let next = |i: usize| if i + 1 == n { 0 } else { i + 1 };
+    let mut seg = alloc::with_capacity("chord lengths", m)?;
+    for start in (0..m).step_by(CHORD_SEGMENT) {
+        if cancel() {
+            return Ok(seg);
+        }
+        seg.par_extend(
+            (start..(start + CHORD_SEGMENT).min(m))
+                .into_par_iter()
+                .with_min_len(CHECK_CHUNK)
+                .map(|i| {
+                    let d = x[next(i)] - x[i];
+                    let l = d.length();
+                    if !(l > 1e-150 && l < 1e150) {
+                        // the square under- or overflowed: the length scaled first
+                        crate::math::scale::length(d)
+                    } else {
+                        l
+                    }
+                }),
+        );
+    }
+    // the first repeated point (a cancelled search finds none; the result is discarded)
+    let bad = (0..m.div_ceil(CHECK_CHUNK))
+        .into_par_iter()
+        .find_map_first(|c| {
+            if cancel() {
+                return None;
             }
-            bad
-        })
-        .min();
+            let a0 = c * CHECK_CHUNK;
+            (a0..(a0 + CHECK_CHUNK).min(m)).find(|&i| repeated(x[i], x[next(i)], floor))
+        });
     match bad {
         None => Ok(seg),
         Some(i) => Err(InputError::new(

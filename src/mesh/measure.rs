@@ -18,11 +18,16 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh::compensated_sum;
 
 /// Faces per block of the compensated sums (fixed, so results do not depend on threads).
 const BLOCK: usize = 1 << 14;
+
+/// Face slots per block of the sequential passes of the edge sort, between two polls of the
+/// cancel hook.
+const SCAN: usize = 1 << 16;
 
 /// A vertex row as stored by NumPy (`float64` or `float32`).
 pub trait Point: Copy + Send + Sync {
@@ -70,9 +75,15 @@ fn corners<I: Index>(t: &[I; 3]) -> [usize; 3] {
 
 /// Refuse faces with an index outside `0..n` (the first such face; errors name `faces`).
 pub fn check_faces<I: Index>(f: &[[I; 3]], n: usize) -> Result<()> {
+    check_faces_cancellable(f, n, &cancel::never)
+}
+
+/// [`check_faces`] that polls `cancel` before every block of faces; a cancelled check passes
+/// the blocks it skips (the caller discards the result, see [`crate::cancel`]).
+pub fn check_faces_cancellable<I: Index>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<()> {
     let bad = f
         .par_chunks(BLOCK)
-        .position_first(|b| !b.iter().all(|t| valid(t, n)));
+        .position_first(|b| !cancel() && !b.iter().all(|t| valid(t, n)));
     match bad {
         None => Ok(()),
         Some(c) => Err(out_of_range(f, c * BLOCK, n)),
@@ -103,15 +114,20 @@ fn out_of_range<I: Index>(f: &[[I; 3]], from: usize, n: usize) -> InputError {
 }
 
 /// The compensated sum of `term(face)` over all faces, in fixed blocks, checking the
-/// indices on the way (errors name `faces`).
+/// indices on the way (errors name `faces`). Polls `cancel` before every block; the blocks
+/// it skips count as zero (the caller discards the result).
 fn face_sum<I: Index>(
     f: &[[I; 3]],
     n: usize,
     term: impl Fn([usize; 3]) -> f64 + Sync,
+    cancel: Cancel<'_>,
 ) -> Result<f64> {
     let blocks: Vec<Option<f64>> = f
         .par_chunks(BLOCK)
         .map(|b| {
+            if cancel() {
+                return Some(0.0);
+            }
             if !b.iter().all(|t| valid(t, n)) {
                 return None;
             }
@@ -124,14 +140,20 @@ fn face_sum<I: Index>(
     Ok(compensated_sum(blocks.into_iter().flatten()))
 }
 
-/// The mean of the vertices (zero for none), summed in fixed blocks.
-fn mean<P: Point>(v: &[P]) -> DVec3 {
+/// The mean of the vertices (zero for none), summed in fixed blocks (polling `cancel`
+/// before each; skipped blocks count as zero).
+fn mean<P: Point>(v: &[P], cancel: Cancel<'_>) -> DVec3 {
     if v.is_empty() {
         return DVec3::ZERO;
     }
     let blocks: Vec<DVec3> = v
         .par_chunks(BLOCK)
-        .map(|b| b.iter().map(|p| p.dvec3()).sum::<DVec3>())
+        .map(|b| {
+            if cancel() {
+                return DVec3::ZERO;
+            }
+            b.iter().map(|p| p.dvec3()).sum::<DVec3>()
+        })
         .collect();
     blocks.into_iter().sum::<DVec3>() / v.len() as f64
 }
@@ -139,20 +161,50 @@ fn mean<P: Point>(v: &[P]) -> DVec3 {
 /// Signed volume of the mesh `(v, f)` about its mean vertex (faces checked, errors name
 /// `faces`); positive for a closed mesh wound counter-clockwise seen from outside.
 pub fn volume<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    let m = mean(v);
-    let s = face_sum(f, v.len(), |[a, b, c]| {
-        let (a, b, c) = (v[a].dvec3() - m, v[b].dvec3() - m, v[c].dvec3() - m);
-        a.dot(b.cross(c))
-    })?;
+    volume_cancellable(v, f, &cancel::never)
+}
+
+/// [`volume`] that polls `cancel` before every block of faces (a cancelled call returns a
+/// partial sum, see [`crate::cancel`]).
+pub fn volume_cancellable<P: Point, I: Index>(
+    v: &[P],
+    f: &[[I; 3]],
+    cancel: Cancel<'_>,
+) -> Result<f64> {
+    let m = mean(v, cancel);
+    let s = face_sum(
+        f,
+        v.len(),
+        |[a, b, c]| {
+            let (a, b, c) = (v[a].dvec3() - m, v[b].dvec3() - m, v[c].dvec3() - m);
+            a.dot(b.cross(c))
+        },
+        cancel,
+    )?;
     Ok(s / 6.0)
 }
 
 /// Total area of the triangles (faces checked, errors name `faces`).
 pub fn area<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    let s = face_sum(f, v.len(), |[a, b, c]| {
-        let a = v[a].dvec3();
-        (v[b].dvec3() - a).cross(v[c].dvec3() - a).length()
-    })?;
+    area_cancellable(v, f, &cancel::never)
+}
+
+/// [`area`] that polls `cancel` before every block of faces (a cancelled call returns a
+/// partial sum, see [`crate::cancel`]).
+pub fn area_cancellable<P: Point, I: Index>(
+    v: &[P],
+    f: &[[I; 3]],
+    cancel: Cancel<'_>,
+) -> Result<f64> {
+    let s = face_sum(
+        f,
+        v.len(),
+        |[a, b, c]| {
+            let a = v[a].dvec3();
+            (v[b].dvec3() - a).cross(v[c].dvec3() - a).length()
+        },
+        cancel,
+    )?;
     Ok(0.5 * s)
 }
 
@@ -228,15 +280,28 @@ impl Key for u64 {
 
 /// Edge statistics of the faces `f` over `n` vertices (faces checked, errors name `faces`).
 pub fn edges<I: Index>(f: &[[I; 3]], n: usize) -> Result<EdgeStats> {
-    check_faces(f, n)?;
+    edges_cancellable(f, n, &cancel::never)
+}
+
+/// [`edges`] that polls `cancel` between blocks of every pass (a cancelled call returns
+/// incomplete counts, see [`crate::cancel`]).
+pub fn edges_cancellable<I: Index>(
+    f: &[[I; 3]],
+    n: usize,
+    cancel: Cancel<'_>,
+) -> Result<EdgeStats> {
+    check_faces_cancellable(f, n, cancel)?;
+    if cancel() {
+        return Ok(EdgeStats::default());
+    }
     Ok(if (2 * n as u64) < u32::MAX as u64 {
-        edges_keyed::<I, u32>(f, n)
+        edges_keyed::<I, u32>(f, n, cancel)
     } else {
-        edges_keyed::<I, u64>(f, n)
+        edges_keyed::<I, u64>(f, n, cancel)
     })
 }
 
-fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
+fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> EdgeStats {
     let parts = rayon::current_num_threads().clamp(1, n.max(1));
     let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
     // each part: the slot count of every vertex in its range, and its degenerate slots
@@ -246,7 +311,7 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
             let (lo, hi) = (bounds[p], bounds[p + 1]);
             let mut count = vec![0u32; hi - lo];
             let mut degenerate = 0;
-            for t in f {
+            for t in f.chunks(SCAN).take_while(|_| !cancel()).flatten() {
                 let c = corners(t);
                 for k in 0..3 {
                     let (a, b) = (c[k], c[(k + 1) % 3]);
@@ -263,6 +328,10 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
             (count, degenerate)
         })
         .collect();
+    // a cancelled count is incomplete: the scatter below would overrun its buckets
+    if cancel() {
+        return EdgeStats::default();
+    }
     let sizes: Vec<usize> = counted
         .iter()
         .map(|(c, _)| c.iter().map(|&x| x as usize).sum())
@@ -291,7 +360,7 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
             }
             let mut cursor = start[..count.len()].to_vec();
             drop(count);
-            for t in f {
+            for t in f.chunks(SCAN).take_while(|_| !cancel()).flatten() {
                 let c = corners(t);
                 for k in 0..3 {
                     let (a, b) = (c[k], c[(k + 1) % 3]);
@@ -307,7 +376,8 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> EdgeStats {
                 degenerate,
                 ..EdgeStats::default()
             };
-            for win in start.windows(2) {
+            let buckets = start.windows(2).enumerate();
+            for (_, win) in buckets.take_while(|(v, _)| v % SCAN != 0 || !cancel()) {
                 let bucket = &mut keys[win[0]..win[1]];
                 sort_small(bucket);
                 let mut i = 0;

@@ -177,14 +177,18 @@ pub fn flesh_surface_deform<'py>(
     {
         let mut w = out.readwrite();
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
-        detach_in_pool(py, || {
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
             let posed = match dirs {
                 Some((arg, d)) => {
                     surface::Surface::with_directions("posed_surface", pts, nu, nv, arg, d)?
                 }
                 None => surface::Surface::new("posed_surface", pts, nu, nv)?,
             };
-            surface::deform_surface(&posed, rest_exp, cell, coords, corrected, buf, &mut flags)
+            let cancel = || stop.requested();
+            surface::deform_surface_cancellable(
+                &posed, rest_exp, cell, coords, corrected, buf, &mut flags, &cancel,
+            )
         })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))

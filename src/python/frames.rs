@@ -117,7 +117,10 @@ pub fn frames_analytic<'py>(
     let angle = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        detach_in_pool(py, || frames::compute_into(&req, buf))??
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            frames::compute_into_cancellable(&req, buf, &|| stop.requested())
+        })??
     };
     Ok((out, angle))
 }
@@ -289,10 +292,17 @@ pub fn frames_steered<'py>(
                 ..template
             };
             let st = steering[0];
-            detach_in_pool(py, || steer::compute_steered(&req, &st, buf))??;
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                steer::compute_steered_cancellable(&req, &st, buf, &|| stop.requested())
+            })??;
         } else {
-            detach_in_pool(py, || {
-                steer::compute_steered_many(&template, &offsets, &initial, &end, &steering, buf)
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                let cancel = || stop.requested();
+                steer::compute_steered_many_cancellable(
+                    &template, &offsets, &initial, &end, &steering, buf, &cancel,
+                )
             })?
             .map_err(|e| renamed(e, "points", points_arg))?;
         }

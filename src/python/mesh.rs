@@ -3,7 +3,7 @@
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use super::convert::{detach_in_pool, ensure_memory, triangles, vec3s};
+use super::convert::{Stop, detach_in_pool, detach_stoppable, ensure_memory, triangles, vec3s};
 use crate::math::mesh;
 use crate::mesh::measure;
 
@@ -123,10 +123,14 @@ pub fn mesh_measure(
             )));
         }
     };
-    with_mesh!(&vs, &fs, |v, f| Ok(detach_in_pool(py, || if area {
-        measure::area(v, f)
-    } else {
-        measure::volume(v, f)
+    let stop = Stop::default();
+    let cancel = || stop.requested();
+    with_mesh!(&vs, &fs, |v, f| Ok(detach_stoppable(py, &stop, || {
+        if area {
+            measure::area_cancellable(v, f, &cancel)
+        } else {
+            measure::volume_cancellable(v, f, &cancel)
+        }
     })??))
 }
 
@@ -145,14 +149,16 @@ pub fn mesh_edges(
         Faces::I32(a) => 3 * a.shape()[0],
     };
     ensure_memory("mesh edges", slots.saturating_add(n), 16)?;
+    let stop = Stop::default();
+    let cancel = || stop.requested();
     let e = match faces {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
-            detach_in_pool(py, || measure::edges(f, n))??
+            detach_stoppable(py, &stop, || measure::edges_cancellable(f, n, &cancel))??
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
-            detach_in_pool(py, || measure::edges(f, n))??
+            detach_stoppable(py, &stop, || measure::edges_cancellable(f, n, &cancel))??
         }
     };
     Ok((
@@ -167,14 +173,20 @@ pub fn mesh_edges(
 /// Refuse face indices outside `0..n` (errors name `faces`).
 #[pyfunction]
 pub fn mesh_check_faces(py: Python<'_>, faces: &Bound<'_, PyAny>, n: usize) -> PyResult<()> {
+    let stop = Stop::default();
+    let cancel = || stop.requested();
     match faces_of(faces)? {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
-            Ok(detach_in_pool(py, || measure::check_faces(f, n))??)
+            Ok(detach_stoppable(py, &stop, || {
+                measure::check_faces_cancellable(f, n, &cancel)
+            })??)
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
-            Ok(detach_in_pool(py, || measure::check_faces(f, n))??)
+            Ok(detach_stoppable(py, &stop, || {
+                measure::check_faces_cancellable(f, n, &cancel)
+            })??)
         }
     }
 }

@@ -185,7 +185,10 @@ pub fn camera_inputs<'py>(
     } else {
         camera::Mode::Transport
     };
-    let c = detach_in_pool(py, || camera::inputs(x, t, u, b, closed, mode))??;
+    let stop = Stop::default();
+    let c = detach_stoppable(py, &stop, || {
+        camera::inputs_cancellable(x, t, u, b, closed, mode, &|| stop.requested())
+    })??;
     let n = c.tangents.len();
     let ts: Vec<f64> = c.tangents.iter().flat_map(|v| v.to_array()).collect();
     Ok((

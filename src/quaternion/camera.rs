@@ -16,7 +16,7 @@
 
 use glam::DVec3;
 
-use super::unit_tangents;
+use super::unit_tangents_cancellable;
 use crate::error::{InputError, Result};
 use crate::frames::validate;
 
@@ -56,7 +56,31 @@ pub fn inputs(
     closed: bool,
     mode: Mode,
 ) -> Result<Inputs> {
-    let t = unit_tangents(x, tangents, closed)?;
+    inputs_cancellable(x, tangents, up, bank, closed, mode, &crate::cancel::never)
+}
+
+/// [`inputs`] that polls `cancel` inside the tangent estimate and between its passes, and
+/// returns at once (with incomplete inputs) when it says stop (see [`crate::cancel`]).
+pub fn inputs_cancellable(
+    x: &[DVec3],
+    tangents: Option<&[DVec3]>,
+    up: Option<DVec3>,
+    bank: Option<&[f64]>,
+    closed: bool,
+    mode: Mode,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Inputs> {
+    let t = unit_tangents_cancellable(x, tangents, closed, cancel)?;
+    let stopped = |t: Vec<DVec3>| Inputs {
+        tangents: t,
+        up: DVec3::Z,
+        vertical: false,
+        regular: None,
+    };
+    // a cancelled estimate is incomplete: nothing below may read it
+    if cancel() {
+        return Ok(stopped(t));
+    }
     let u = up.unwrap_or(DVec3::Z);
     let Some(u) = crate::math::scale::normalize(u) else {
         return Err(InputError::new(
@@ -67,6 +91,9 @@ pub fn inputs(
     let vertical = t[0].cross(u).length() <= VERTICAL_SIN;
     if let Some(b) = bank {
         validate::finite_scalars("bank", b)?;
+    }
+    if cancel() {
+        return Ok(stopped(t));
     }
     let regular = match mode {
         Mode::Transport => {

@@ -312,6 +312,17 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
 /// rows) normalised, or without them the estimate of `spinal.estimate_tangents`
 /// ([`tangent_estimate::estimate_rows`], five-point rule).
 pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> Result<Vec<DVec3>> {
+    unit_tangents_cancellable(x, t, closed, &crate::cancel::never)
+}
+
+/// [`unit_tangents`] that polls `cancel` inside the estimate and between the passes over
+/// given tangents; a cancelled call returns an incomplete result (see [`crate::cancel`]).
+pub(crate) fn unit_tangents_cancellable(
+    x: &[DVec3],
+    t: Option<&[DVec3]>,
+    closed: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     if x.len() < 2 {
         return Err(InputError::new(
             "points",
@@ -319,7 +330,12 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
         ));
     }
     let Some(t) = t else {
-        return tangent_estimate::estimate_rows(x, closed, TangentRule::FivePointBounded);
+        return tangent_estimate::estimate_rows_cancellable(
+            x,
+            closed,
+            TangentRule::FivePointBounded,
+            cancel,
+        );
     };
     if t.len() != x.len() {
         return Err(InputError::new(
@@ -327,13 +343,16 @@ pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> R
             format!("expected {} rows to match points, got {}", x.len(), t.len()),
         ));
     }
-    if let Some(i) = validate::first_bad(t, |v| v.is_finite()) {
+    // a cancelled check passes every row (the result is discarded)
+    if let Some(i) = validate::first_bad(t, |v| cancel() || v.is_finite()) {
         return Err(InputError::new(
             "tangents",
             format!("contains non-finite values (row {i})"),
         ));
     }
-    if let Some(i) = validate::first_bad(t, |v| crate::math::scale::normalize(*v).is_some()) {
+    if let Some(i) = validate::first_bad(t, |v| {
+        cancel() || crate::math::scale::normalize(*v).is_some()
+    }) {
         return Err(InputError::new(
             "tangents",
             format!("zero-length tangent at row {i}"),
