@@ -416,39 +416,36 @@ fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize) -> Result<EdgeStats> {
     }
     let st = (0..parts)
         .into_par_iter()
-        .map_init(
-            Buckets::<K>::default,
-            |bk, p| {
-                let lo = p << bits;
-                let m = n.saturating_sub(lo).min(1 << bits);
-                let mut st = EdgeStats::default();
-                if m == 0 {
-                    return st;
+        .map_init(Buckets::<K>::default, |bk, p| {
+            let lo = p << bits;
+            let m = n.saturating_sub(lo).min(1 << bits);
+            let mut st = EdgeStats::default();
+            if m == 0 {
+                return st;
+            }
+            bk.count.clear();
+            bk.count.resize(m, 0);
+            bk.table.resize(m * CAP, K::default());
+            bk.over.clear();
+            if local {
+                for &c in &reach[p] {
+                    let c = c as usize;
+                    let b = &f[c * chunk..f.len().min((c + 1) * chunk)];
+                    st.degenerate += bk.gather(b, lo, m);
                 }
-                bk.count.clear();
-                bk.count.resize(m, 0);
-                bk.table.resize(m * CAP, K::default());
-                bk.over.clear();
-                if local {
-                    for &c in &reach[p] {
-                        let c = c as usize;
-                        let b = &f[c * chunk..f.len().min((c + 1) * chunk)];
-                        st.degenerate += bk.gather(b, lo, m);
+            } else {
+                let (count, table, over) = bk.parts();
+                for d in &dist {
+                    let r = d.start[p]..d.start[p + 1];
+                    for (&v, &key) in d.v[r.clone()].iter().zip(&d.key[r]) {
+                        put(count, table, over, v as usize, key);
                     }
-                } else {
-                    let (count, table, over) = bk.parts();
-                    for d in &dist {
-                        let r = d.start[p]..d.start[p + 1];
-                        for (&v, &key) in d.v[r.clone()].iter().zip(&d.key[r]) {
-                            put(count, table, over, v as usize, key);
-                        }
-                        st.degenerate += d.degenerate[p];
-                    }
+                    st.degenerate += d.degenerate[p];
                 }
-                bk.read(m, &mut st);
-                st
-            },
-        )
+            }
+            bk.read(m, &mut st);
+            st
+        })
         .reduce(EdgeStats::default, EdgeStats::add);
     Ok(st)
 }

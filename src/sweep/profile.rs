@@ -362,7 +362,15 @@ impl Profile {
             ));
         }
         let convex = closed && strictly_convex(&p);
-        if !convex {
+        // a closed polygon on one line folds back on itself: its zero area is the clearer
+        // message
+        let on_a_line = || {
+            closed
+                && (0..m).all(|j| {
+                    orient(p[(j + m - 1) % m], p[j], p[(j + 1) % m]) == std::cmp::Ordering::Equal
+                })
+        };
+        if !convex && !on_a_line() {
             if let Some((a, b)) = sweep_crossing(&p, closed) {
                 return Err(InputError::new(
                     ARG,
