@@ -27,11 +27,14 @@ spinal float64 and VTK strips + triangulate).
     python benchmarks/bench_sweep.py              # 10^3 … 10^6 spine points
     python benchmarks/bench_sweep.py --max 2e5
     python benchmarks/bench_sweep.py --bundle     # + the 100k-streamline bundle (~10 GB)
+    python benchmarks/bench_sweep.py --spikes     # only: non-convex profiles of 10^3 … 10^5
+                                                  # packed spikes (star, comb), capped
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import subprocess
 import sys
@@ -197,6 +200,39 @@ def bundle_rows(curves=100_000, per=96, sides=8, everything=False):
     return rows
 
 
+def spiky(kind, m):
+    """A simple polygon of ``m`` vertices with ``m / 2`` densely packed spikes: ``star``
+    (radii alternating 1 and 0.2 about the origin) or ``comb`` (teeth of height 1 on a bar
+    of height 0.1, as thin as they are apart)."""
+    if kind == "star":
+        t = 2 * np.pi * np.arange(m) / m
+        r = np.where(np.arange(m) % 2 == 0, 1.0, 0.2)
+        return np.c_[r * np.cos(t), r * np.sin(t)]
+    k = (m - 3) // 4  # teeth of 4 vertices, right to left, after three bar corners
+    x0 = np.repeat(np.arange(k)[::-1] / k, 4) + np.tile([0.5, 0.5, 0.0, 0.0], k) / k
+    y = np.tile([0.1, 1.1, 1.1, 0.1], k)
+    return np.r_[[[0.0, 0.0], [1.0, 0.0], [1.0, 0.1]], np.c_[x0, y]]
+
+
+def spike_rows(repeat, limit=120.0):
+    """Seconds of a capped sweep of each spiky profile along a straight 3-point spine, from
+    ``m = 10^3`` up; a size stops the kind's row once a call takes longer than ``limit``."""
+    spine = np.c_[np.zeros(3), np.zeros(3), np.arange(3.0)]
+    print("| profile | m = 1,000 | 10,000 | 100,000 | time × per 10× m |")
+    print("|---|---|---|---|---|")
+    for kind in ("star", "comb"):
+        ts = []
+        for m in (1_000, 10_000, 100_000):
+            prof = spiky(kind, m)
+            t = best(lambda p=prof: spinal.sweep(spine, p), repeat)
+            ts.append(t)
+            if t > limit:
+                break
+        cells = [f"{t:.3g}" for t in ts] + ["–"] * (3 - len(ts))
+        growth = " / ".join(f"{b / a:.0f}" for a, b in itertools.pairwise(ts)) or "–"
+        print(f"| {kind} | " + " | ".join(cells) + f" | {growth} |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e6)
@@ -209,7 +245,15 @@ def main():
     ap.add_argument("--bundle-all", action="store_true",
                     help="with --bundle: also spinal float64 and VTK strips + triangulate "
                          "(~9 GB each)")
+    ap.add_argument("--spikes", action="store_true",
+                    help="only the scaling of a capped sweep of a profile with packed spikes "
+                         "(star and comb, m = 10^3, 10^4, 10^5 profile vertices)")
     args = ap.parse_args()
+    if args.spikes:
+        print(f"capped sweep of a spiky profile along a 3-point straight spine; seconds, best "
+              f"of {args.repeat}\n")
+        spike_rows(args.repeat)
+        return
     sizes = [n for n in (1_000, 10_000, 100_000, 200_000, 1_000_000) if n <= args.max]
     rows = run(sizes, args.repeat, not args.no_bundle)
     peers_cols = ["vtk strips", "vtk strips f32", "vtk triangles", "vtk lines_from_points",

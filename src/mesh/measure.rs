@@ -5,16 +5,21 @@
 //!   mean vertex `m` (see [`crate::math::mesh::signed_volume`]); **area** `Σ |(b − a) × (c − a)| / 2`.
 //!   Both are summed in fixed blocks of faces with Neumaier's compensation, and the block
 //!   sums again, so the result does not depend on the number of threads.
-//! * **Edges** by a counting sort of the `3F` face slots on their smaller vertex (Knuth, *The
-//!   Art of Computer Programming* vol. 3, §5.2, "distribution counting"): every vertex `v`
-//!   gets the bucket of the slots `v → w` and `w → v` with `w > v`, stored as `2w + [v → w]`;
-//!   each bucket (of the size of the vertex degree) is then sorted on its own. An edge `{v, w}`
-//!   of a closed 2-manifold has exactly two slots, traversed in opposite directions when the
-//!   faces are consistently oriented ("winding"); one slot is a boundary edge, more a
-//!   non-manifold edge. The sort runs in two parallel distributions (blocks of vertices, then
-//!   vertices within a block), each face chunk writing its own part of every block, so no
-//!   two threads write the same place and no lock is needed.
-
+//! * **Edges** by distributing the `3F` face slots to buckets on their smaller vertex (Knuth,
+//!   *The Art of Computer Programming* vol. 3, §5.2, "distribution counting"): every vertex
+//!   `v` gets the bucket of the slots `v → w` and `w → v` with `w > v`, stored as
+//!   `2w + [v → w]`; each bucket (of the size of the vertex degree) is then sorted on its own
+//!   (insertion sort). An edge `{v, w}` of a closed 2-manifold has exactly two slots,
+//!   traversed in opposite directions when the faces are consistently oriented ("winding");
+//!   one slot is a boundary edge, more a non-manifold edge. The vertices are cut into parts
+//!   of `2^10..2^14` (a part's buckets stay in the cache), one part per task, with `CAP`
+//!   places per vertex and an overflow list for the rare vertex of higher degree. A face is
+//!   ordered once (`lo < mid < hi` and its parity give its three keys). When the faces join
+//!   nearby vertices (sweeps, most meshers), every part reads just the chunks of faces whose
+//!   vertex range reaches into it, so the faces are read about twice in all (ranges, then
+//!   buckets) and nothing of size `O(F)` is allocated; otherwise every chunk of faces first
+//!   groups its slots by part (a first distribution, each chunk writing its own lists) and
+//!   every part gathers its lists. Either way no two threads write the same place.
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -24,10 +29,6 @@ use crate::math::mesh::compensated_sum;
 
 /// Faces per block of the compensated sums (fixed, so results do not depend on threads).
 const BLOCK: usize = 1 << 14;
-
-/// Face slots per block of the sequential passes of the edge sort, between two polls of the
-/// cancel hook.
-const SCAN: usize = 1 << 16;
 
 /// A vertex row as stored by NumPy (`float64` or `float32`).
 pub trait Point: Copy + Send + Sync {
@@ -283,126 +284,329 @@ pub fn edges<I: Index>(f: &[[I; 3]], n: usize) -> Result<EdgeStats> {
     edges_cancellable(f, n, &cancel::never)
 }
 
-/// [`edges`] that polls `cancel` between blocks of every pass (a cancelled call returns
-/// incomplete counts, see [`crate::cancel`]).
+/// [`edges`] that polls `cancel` before every chunk of faces and every part of the
+/// vertices (a cancelled call returns incomplete counts, see [`crate::cancel`]).
 pub fn edges_cancellable<I: Index>(
     f: &[[I; 3]],
     n: usize,
     cancel: Cancel<'_>,
 ) -> Result<EdgeStats> {
-    check_faces_cancellable(f, n, cancel)?;
-    if cancel() {
-        return Ok(EdgeStats::default());
-    }
-    Ok(if (2 * n as u64) < u32::MAX as u64 {
+    if (2 * n as u64) < u32::MAX as u64 {
         edges_keyed::<I, u32>(f, n, cancel)
     } else {
         edges_keyed::<I, u64>(f, n, cancel)
-    })
+    }
 }
 
-fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> EdgeStats {
-    let parts = rayon::current_num_threads().clamp(1, n.max(1));
-    let bounds: Vec<usize> = (0..=parts).map(|p| p * n / parts).collect();
-    // each part: the slot count of every vertex in its range, and its degenerate slots
-    let counted: Vec<(Vec<u32>, usize)> = (0..parts)
-        .into_par_iter()
-        .map(|p| {
-            let (lo, hi) = (bounds[p], bounds[p + 1]);
-            let mut count = vec![0u32; hi - lo];
-            let mut degenerate = 0;
-            for t in f.chunks(SCAN).take_while(|_| !cancel()).flatten() {
-                let c = corners(t);
-                for k in 0..3 {
-                    let (a, b) = (c[k], c[(k + 1) % 3]);
-                    let v = a.min(b);
-                    if (lo..hi).contains(&v) {
-                        if a == b {
-                            degenerate += 1;
-                        } else {
-                            count[v - lo] += 1;
-                        }
-                    }
-                }
+/// The slots of one chunk of faces, grouped by part of the vertices (part `p` in
+/// `start[p]..start[p + 1]`): a slot `v → w` or `w → v` (`v < w`) on its way to the bucket
+/// of `v` is `v` within its part (`v`) and the key `2w + [v → w]` (`key`).
+struct Distributed<K> {
+    start: Vec<usize>,
+    v: Vec<u32>,
+    key: Vec<K>,
+    degenerate: Vec<usize>,
+}
+
+/// The slots `(a, b)` of a face (the corner pairs `c[k] → c[k + 1]`).
+#[inline(always)]
+fn slots(c: [usize; 3]) -> [(usize, usize); 3] {
+    [(c[0], c[1]), (c[1], c[2]), (c[2], c[0])]
+}
+
+/// A face `(a, b, c)` of distinct corners as `(lo, mid, hi, s)`: its corners in increasing
+/// order and `s = 1` when it runs `lo → mid → hi` (an even permutation), 0 when it runs
+/// `lo → hi → mid`. Its slots are then `lo: 2 mid + s`, `lo: 2 hi + 1 − s` and
+/// `mid: 2 hi + s` (bucket: key `2w + [v → w]`).
+#[inline(always)]
+fn ordered([a, b, c]: [usize; 3]) -> (usize, usize, usize, u64) {
+    let lo = a.min(b).min(c);
+    let hi = a.max(b).max(c);
+    // the cyclic order descends once (at `hi → lo`) when it is `lo → mid → hi`, twice
+    // otherwise
+    let descents = u64::from(a > b) + u64::from(b > c) + u64::from(c > a);
+    (lo, a ^ b ^ c ^ lo ^ hi, hi, u64::from(descents == 1))
+}
+
+/// First distribution of one chunk of faces (indices checked): its slots grouped by part
+/// of their smaller vertex (parts of `2^bits` vertices). The chunk is read twice (count,
+/// then scatter), the second time from the cache.
+fn distribute<K: Key, I: Index>(f: &[[I; 3]], bits: u32, parts: usize) -> Distributed<K> {
+    let mut count = vec![0usize; parts + 1];
+    // the degenerate slots of each part (by the smallest corner of their face)
+    let mut degenerate = vec![0usize; parts];
+    for t in f {
+        let c = corners(t);
+        for (a, b) in slots(c) {
+            if a != b {
+                count[(a.min(b) >> bits) + 1] += 1;
+            } else {
+                degenerate[c[0].min(c[1]).min(c[2]) >> bits] += 1;
             }
-            (count, degenerate)
+        }
+    }
+    for p in 1..=parts {
+        count[p] += count[p - 1];
+    }
+    let start = count;
+    let mut cursor = start[..parts].to_vec();
+    let mut vs = vec![0u32; start[parts]];
+    let mut keys = vec![K::default(); start[parts]];
+    let mask = (1usize << bits) - 1;
+    for t in f {
+        for (a, b) in slots(corners(t)) {
+            if a != b {
+                let v = a.min(b);
+                let at = &mut cursor[v >> bits];
+                vs[*at] = (v & mask) as u32;
+                keys[*at] = K::new(2 * a.max(b) as u64 + u64::from(a < b));
+                *at += 1;
+            }
+        }
+    }
+    Distributed {
+        start,
+        v: vs,
+        key: keys,
+        degenerate,
+    }
+}
+
+/// The edges of one bucket (the keys `2w + [v → w]` of one vertex `v`), sorted in place.
+#[inline(always)]
+fn bucket_stats<K: Key>(b: &mut [K], st: &mut EdgeStats) {
+    sort_small(b);
+    // a closed, consistently wound neighbourhood: pairs `2w, 2w + 1` of increasing `w`
+    if b.len() % 2 == 0 {
+        let (mut ok, mut after) = (true, 0);
+        for pair in b.chunks_exact(2) {
+            let (k, l) = (pair[0].get(), pair[1].get());
+            ok &= (k & 1 == 0) & (l == k + 1) & (k >= after);
+            after = l + 1;
+        }
+        if ok {
+            st.edges += b.len() / 2;
+            return;
+        }
+    }
+    let mut i = 0;
+    while i < b.len() {
+        let k = b[i].get();
+        let w = k >> 1;
+        let mut j = i + 1;
+        while j < b.len() && b[j].get() >> 1 == w {
+            j += 1;
+        }
+        st.edges += 1;
+        match j - i {
+            1 => st.boundary += 1,
+            // sorted: `w → v` (even key) then `v → w` (odd)
+            2 if k & 1 == 1 || b[i + 1].get() & 1 == 0 => st.inconsistent += 1,
+            2 => {}
+            _ => st.non_manifold += 1,
+        }
+        i = j;
+    }
+}
+
+/// Bucket capacity per vertex in the second distribution (a vertex with more slots, rare
+/// in a mesh of degree about 6, sends the others to an overflow list).
+const CAP: usize = 8;
+
+fn edges_keyed<I: Index, K: Key>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<EdgeStats> {
+    let threads = rayon::current_num_threads().max(1);
+    // parts of 2^10 ..= 2^14 vertices (a part's buckets stay in the cache), at least four
+    // per thread when there are enough vertices, at most 2^12 parts (each chunk holds a
+    // start per part)
+    let log2 = |x: usize| x.max(1).next_power_of_two().trailing_zeros();
+    let bits = log2(n.div_ceil(4 * threads))
+        .clamp(10, 14)
+        .max(log2(n >> 12));
+    let parts = (n >> bits) + 1;
+    // chunks of faces a few times smaller than a part, so that a chunk of a mesh that joins
+    // nearby vertices mostly reaches into one part
+    let chunk = f.len().div_ceil(4 * threads).clamp(1 << 10, 1 << 12);
+    // the vertex range of every chunk of faces, checking the indices
+    let spans: Vec<Option<(usize, usize)>> = f
+        .par_chunks(chunk)
+        .map(|b| {
+            let (mut lo, mut hi) = (usize::MAX, 0);
+            if cancel() {
+                return Some((lo, hi)); // an empty span: the chunk is not read
+            }
+            for t in b {
+                if !valid(t, n) {
+                    return None;
+                }
+                let [a, b, c] = corners(t);
+                lo = lo.min(a.min(b).min(c));
+                hi = hi.max(a.max(b).max(c));
+            }
+            Some((lo, hi))
         })
         .collect();
-    // a cancelled count is incomplete: the scatter below would overrun its buckets
-    if cancel() {
-        return EdgeStats::default();
+    if let Some(c) = spans.iter().position(Option::is_none) {
+        return Err(out_of_range(f, c * chunk, n));
     }
-    let sizes: Vec<usize> = counted
+    let spans: Vec<(usize, usize)> = spans.into_iter().flatten().collect();
+    // faces that join nearby vertices (as sweeps and most meshers write them): every part
+    // reads the chunks whose vertices reach into it, straight into its buckets; otherwise
+    // the slots are first distributed by part
+    let reads: usize = spans
         .iter()
-        .map(|(c, _)| c.iter().map(|&x| x as usize).sum())
-        .collect();
-    let mut keys = vec![K::default(); sizes.iter().sum()];
-    let mut slices = Vec::with_capacity(parts);
-    let mut rest = &mut keys[..];
-    for &s in &sizes {
-        let (a, b) = rest.split_at_mut(s);
-        slices.push(a);
-        rest = b;
+        .filter(|s| s.0 <= s.1)
+        .map(|s| (s.1 >> bits) - (s.0 >> bits) + 1)
+        .sum();
+    let local = reads <= 2 * spans.len();
+    // local: the chunks that reach into every part; else the slots of (larger) chunks of
+    // faces by part
+    let mut reach: Vec<Vec<u32>> = Vec::new();
+    let mut dist: Vec<Distributed<K>> = Vec::new();
+    if local {
+        reach.resize(parts, Vec::new());
+        for (c, s) in spans.iter().enumerate().filter(|(_, s)| s.0 <= s.1) {
+            for r in &mut reach[s.0 >> bits..=s.1 >> bits] {
+                r.push(c as u32);
+            }
+        }
+    } else {
+        dist = f
+            .par_chunks(chunk << 3)
+            .map(|b| match cancel() {
+                true => distribute::<K, I>(&[], bits, parts),
+                false => distribute::<K, I>(b, bits, parts),
+            })
+            .collect();
     }
-    counted
+    let st = (0..parts)
         .into_par_iter()
-        .zip(slices)
-        .enumerate()
-        .map(|(p, ((count, degenerate), keys))| {
-            let lo = bounds[p];
-            // bucket starts (exclusive prefix sums), then cursors while scattering
-            let mut start = Vec::with_capacity(count.len() + 1);
-            let mut acc = 0usize;
-            start.push(0);
-            for &c in &count {
-                acc += c as usize;
-                start.push(acc);
+        .map_init(Buckets::<K>::default, |bk, p| {
+            let lo = p << bits;
+            let m = n.saturating_sub(lo).min(1 << bits);
+            let mut st = EdgeStats::default();
+            if m == 0 || cancel() {
+                return st;
             }
-            let mut cursor = start[..count.len()].to_vec();
-            drop(count);
-            for t in f.chunks(SCAN).take_while(|_| !cancel()).flatten() {
-                let c = corners(t);
-                for k in 0..3 {
-                    let (a, b) = (c[k], c[(k + 1) % 3]);
-                    let v = a.min(b);
-                    if a != b && (lo..bounds[p + 1]).contains(&v) {
-                        let w = a.max(b) as u64;
-                        keys[cursor[v - lo]] = K::new(2 * w + u64::from(a < b));
-                        cursor[v - lo] += 1;
+            bk.count.clear();
+            bk.count.resize(m, 0);
+            bk.table.resize(m * CAP, K::default());
+            bk.over.clear();
+            if local {
+                for &c in &reach[p] {
+                    let c = c as usize;
+                    let b = &f[c * chunk..f.len().min((c + 1) * chunk)];
+                    st.degenerate += bk.gather(b, lo, m);
+                }
+            } else {
+                let (count, table, over) = bk.parts();
+                for d in &dist {
+                    let r = d.start[p]..d.start[p + 1];
+                    for (&v, &key) in d.v[r.clone()].iter().zip(&d.key[r]) {
+                        put(count, table, over, v as usize, key);
                     }
+                    st.degenerate += d.degenerate[p];
                 }
             }
-            let mut st = EdgeStats {
-                degenerate,
-                ..EdgeStats::default()
-            };
-            let buckets = start.windows(2).enumerate();
-            for (_, win) in buckets.take_while(|(v, _)| v % SCAN != 0 || !cancel()) {
-                let bucket = &mut keys[win[0]..win[1]];
-                sort_small(bucket);
-                let mut i = 0;
-                while i < bucket.len() {
-                    let w = bucket[i].get() >> 1;
-                    let mut j = i;
-                    let mut forward = 0;
-                    while j < bucket.len() && bucket[j].get() >> 1 == w {
-                        forward += (bucket[j].get() & 1) as usize;
-                        j += 1;
-                    }
-                    let slots = j - i;
-                    st.edges += 1;
-                    match slots {
-                        1 => st.boundary += 1,
-                        2 if forward != 1 => st.inconsistent += 1,
-                        2 => {}
-                        _ => st.non_manifold += 1,
-                    }
-                    i = j;
-                }
-            }
+            bk.read(m, &mut st);
             st
         })
-        .reduce(EdgeStats::default, EdgeStats::add)
+        .reduce(EdgeStats::default, EdgeStats::add);
+    Ok(st)
+}
+
+/// Put `key` in the bucket of the vertex `v` of a part: `CAP` places per vertex in `table`,
+/// the further slots in `over`.
+#[inline(always)]
+fn put<K: Key>(count: &mut [u32], table: &mut [K], over: &mut Vec<(u32, K)>, v: usize, key: K) {
+    let c = count[v] as usize;
+    if c < CAP {
+        table[v * CAP + c] = key;
+    } else {
+        over.push((v as u32, key));
+    }
+    count[v] += 1;
+}
+
+/// The buckets of one part of the vertices: `CAP` places per vertex in `table`, the
+/// further slots of a vertex in `over`; scratch space reused from part to part.
+struct Buckets<K> {
+    count: Vec<u32>,
+    table: Vec<K>,
+    over: Vec<(u32, K)>,
+    big: Vec<K>,
+}
+
+impl<K> Default for Buckets<K> {
+    fn default() -> Self {
+        Buckets {
+            count: Vec::new(),
+            table: Vec::new(),
+            over: Vec::new(),
+            big: Vec::new(),
+        }
+    }
+}
+
+impl<K: Key> Buckets<K> {
+    /// The counts, places and overflow, borrowed apart.
+    fn parts(&mut self) -> (&mut [u32], &mut [K], &mut Vec<(u32, K)>) {
+        (&mut self.count, &mut self.table, &mut self.over)
+    }
+
+    /// Put the slots of the faces `f` whose smaller vertex lies in `lo..lo + m` (the part);
+    /// the degenerate slots of the faces whose smallest corner lies there.
+    fn gather<I: Index>(&mut self, f: &[[I; 3]], lo: usize, m: usize) -> usize {
+        let (count, table, over) = self.parts();
+        let inside = |x: usize| x.wrapping_sub(lo) < m;
+        let mut degenerate = 0;
+        for t in f {
+            let c = corners(t);
+            if c[0] == c[1] || c[1] == c[2] || c[2] == c[0] {
+                if inside(c[0].min(c[1]).min(c[2])) {
+                    degenerate += 1 + usize::from(c[0] == c[1] && c[1] == c[2]) * 2;
+                }
+                for (a, b) in slots(c) {
+                    let v = a.min(b);
+                    if a != b && inside(v) {
+                        let key = K::new(2 * a.max(b) as u64 + u64::from(a < b));
+                        put(count, table, over, v - lo, key);
+                    }
+                }
+            } else {
+                let (l, mid, h, s) = ordered(c);
+                let (m2, h2) = (2 * mid as u64, 2 * h as u64);
+                if inside(l) {
+                    put(count, table, over, l - lo, K::new(m2 + s));
+                    put(count, table, over, l - lo, K::new(h2 + 1 - s));
+                }
+                if inside(mid) {
+                    put(count, table, over, mid - lo, K::new(h2 + s));
+                }
+            }
+        }
+        degenerate
+    }
+
+    /// Add the edges of the buckets of the `m` vertices of the part to `st`.
+    fn read(&mut self, m: usize, st: &mut EdgeStats) {
+        self.over.sort_unstable();
+        let mut next = 0; // the overflow of the vertices from here on
+        for v in 0..m {
+            let c = self.count[v] as usize;
+            let b = &mut self.table[v * CAP..(v + 1) * CAP];
+            if c <= CAP {
+                bucket_stats(&mut b[..c], st);
+            } else {
+                let end = next + (c - CAP);
+                self.big.clear();
+                self.big.extend_from_slice(b);
+                self.big
+                    .extend(self.over[next..end].iter().map(|&(_, k)| k));
+                next = end;
+                bucket_stats(&mut self.big, st);
+            }
+        }
+    }
 }
 
 /// Sort a bucket: insertion sort for the few entries of a typical vertex (a library sort's
@@ -477,5 +681,96 @@ mod tests {
         assert!(err.msg.contains("face 0 refers to vertex -1"), "{err}");
         assert!(volume(&[[0.0; 3]; 3], &[[0i64, 1, 3]]).is_err());
         assert_eq!(edges::<i64>(&[], 0).unwrap(), EdgeStats::default());
+    }
+
+    /// The statistics by a map of the undirected edges (the definition, quadratic memory
+    /// aside).
+    fn brute(f: &[[i64; 3]]) -> EdgeStats {
+        let mut map = std::collections::BTreeMap::<(i64, i64), (usize, usize)>::new();
+        let mut st = EdgeStats::default();
+        for t in f {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if a == b {
+                    st.degenerate += 1;
+                    continue;
+                }
+                let e = map.entry((a.min(b), a.max(b))).or_default();
+                e.0 += 1;
+                e.1 += usize::from(a < b);
+            }
+        }
+        for &(slots, forward) in map.values() {
+            st.edges += 1;
+            match slots {
+                1 => st.boundary += 1,
+                2 if forward != 1 => st.inconsistent += 1,
+                2 => {}
+                _ => st.non_manifold += 1,
+            }
+        }
+        st
+    }
+
+    /// A closed torus grid of `r` rings of `s` vertices, wound consistently.
+    fn torus(r: i64, s: i64) -> Vec<[i64; 3]> {
+        let id = |i: i64, j: i64| (i % r) * s + j % s;
+        let mut f = Vec::new();
+        for i in 0..r {
+            for j in 0..s {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                f.push([a, b, c]);
+                f.push([a, c, d]);
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn edges_match_the_definition() {
+        // many parts of the vertices and many chunks of faces
+        for (r, s) in [(3, 3), (50, 7), (700, 16), (1000, 40)] {
+            let f = torus(r, s);
+            let n = (r * s) as usize;
+            let e = edges(&f, n).unwrap();
+            assert_eq!(e, brute(&f));
+            assert!(e.watertight(), "{r} x {s}: {e:?}");
+            assert_eq!(e.edges, 3 * n);
+            let f32i: Vec<[i32; 3]> = f.iter().map(|t| t.map(|i| i as i32)).collect();
+            assert_eq!(edges(&f32i, n).unwrap(), e);
+            // one flipped face far into the mesh, one removed, one duplicated
+            let mut g = f.clone();
+            let k = g.len() * 2 / 3;
+            g[k] = [g[k][1], g[k][0], g[k][2]];
+            let e = edges(&g, n).unwrap();
+            assert_eq!((e.inconsistent, e.closed()), (3, true));
+            assert_eq!(e, brute(&g));
+            g.remove(k / 2);
+            g.push(g[k / 3]);
+            assert_eq!(edges(&g, n).unwrap(), brute(&g));
+            // the vertices renumbered far apart: the slots are distributed by part first
+            let far: Vec<[i64; 3]> = g.iter().map(|t| t.map(|i| (i * 7919) % n as i64)).collect();
+            assert_eq!(edges(&far, n).unwrap(), brute(&g));
+        }
+        // random faces (with repeats, degenerate corners, unused vertices)
+        let mut x = 0x9e3779b97f4a7c15u64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % m) as i64
+        };
+        for (n, faces) in [(4, 20), (30, 500), (5000, 30_000), (70_000, 60_000)] {
+            let f: Vec<[i64; 3]> = (0..faces).map(|_| [next(n), next(n), next(n)]).collect();
+            assert_eq!(edges(&f, n as usize).unwrap(), brute(&f), "{n} vertices");
+        }
+        // an index out of range in a late chunk is the one reported
+        let mut f = torus(1000, 40);
+        f[70_000][2] = 40_000;
+        let err = edges(&f, 40_000).unwrap_err();
+        assert!(
+            err.msg.contains("face 70000 refers to vertex 40000"),
+            "{err}"
+        );
     }
 }

@@ -12,11 +12,12 @@
 //!
 //! **Cost.** A strictly convex polygon (every turn the same way, total turning ±2π) is
 //! simple and is fanned from its first vertex: O(m). Other polygons are checked for
-//! self-intersection on a uniform grid of about `m` cells (only segments sharing a cell are
-//! compared) and ear-clipped on a doubly linked list, testing only the reflex vertices near
-//! the candidate ear (a convex vertex whose triangle contains no reflex vertex is an ear;
-//! O'Rourke, *Computational Geometry in C*, §1.6; the grid as in Mapbox's earcut). Both are
-//! close to linear on ordinary profiles; O(m²) remains the worst case of adversarial ones.
+//! self-intersection by the sweep line of Shamos and Hoey in O(m log m) with exact
+//! orientation tests (adjacent edges that fold back onto each other count as meeting), and
+//! ear-clipped on a doubly linked list, testing only the reflex vertices near the candidate
+//! ear (a convex vertex whose triangle contains no reflex vertex is an ear; O'Rourke,
+//! *Computational Geometry in C*, §1.6; the grid as in Mapbox's earcut): close to linear on
+//! ordinary profiles, O(m²) in the worst case of adversarial ones.
 
 use glam::DVec2;
 
@@ -50,25 +51,255 @@ pub fn signed_area(p: &[DVec2]) -> f64 {
     0.5 * (0..m).map(|j| cross(p[j], p[(j + 1) % m])).sum::<f64>()
 }
 
-/// Do the closed segments `p q` and `r s` intersect (touching counts)?
+/// `a + b` as `(sum, error)`, exactly (Knuth's two-sum).
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let x = a + b;
+    let bv = x - a;
+    let av = x - bv;
+    (x, (a - av) + (b - bv))
+}
+
+/// `a − b` as `(difference, error)`, exactly.
+fn two_diff(a: f64, b: f64) -> (f64, f64) {
+    two_sum(a, -b)
+}
+
+/// `a b` as `(product, error)`, exactly (a fused multiply-add gives the error).
+fn two_product(a: f64, b: f64) -> (f64, f64) {
+    let x = a * b;
+    (x, a.mul_add(b, -x))
+}
+
+/// The side of `c` from the directed line `a → b`: `Greater` on its left, `Less` on its
+/// right, `Equal` on it; the sign of `(a − c) × (b − c)` computed exactly (barring
+/// underflow) — a floating-point filter first, then the exact sum of an expansion (Shewchuk,
+/// "Adaptive precision floating-point arithmetic and fast robust geometric predicates",
+/// 1997, §4.3 "orient2d").
+fn orient(a: DVec2, b: DVec2, c: DVec2) -> std::cmp::Ordering {
+    let detl = (a.x - c.x) * (b.y - c.y);
+    let detr = (a.y - c.y) * (b.x - c.x);
+    let det = detl - detr;
+    // Shewchuk's ccwerrboundA = (3 + 16ε) ε, ε = 2^-53
+    let bound =
+        (3.0 + 16.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2.0) * (detl.abs() + detr.abs());
+    if det > bound || -det > bound {
+        return det.partial_cmp(&0.0).unwrap_or(std::cmp::Ordering::Equal);
+    }
+    // exact: each difference as two terms, each product of two-term factors as eight
+    let (ax, ex) = two_diff(a.x, c.x);
+    let (by, ey) = two_diff(b.y, c.y);
+    let (ay, fy) = two_diff(a.y, c.y);
+    let (bx, fx) = two_diff(b.x, c.x);
+    let mut terms = [0.0; 16];
+    let pairs = [
+        (ax, by, 1.0),
+        (ax, ey, 1.0),
+        (ex, by, 1.0),
+        (ex, ey, 1.0),
+        (ay, bx, -1.0),
+        (ay, fx, -1.0),
+        (fy, bx, -1.0),
+        (fy, fx, -1.0),
+    ];
+    for (k, &(u, v, sign)) in pairs.iter().enumerate() {
+        let (x, e) = two_product(u, v);
+        terms[2 * k] = sign * x;
+        terms[2 * k + 1] = sign * e;
+    }
+    // Shewchuk's Grow-Expansion with zero elimination: a non-overlapping expansion in
+    // increasing magnitude, whose sign is that of its last non-zero component
+    let mut h: Vec<f64> = Vec::with_capacity(32);
+    for &t in &terms {
+        let mut q = t;
+        let mut g = Vec::with_capacity(h.len() + 1);
+        for &x in &h {
+            let (sum, err) = two_sum(q, x);
+            if err != 0.0 {
+                g.push(err);
+            }
+            q = sum;
+        }
+        if q != 0.0 {
+            g.push(q);
+        }
+        h = g;
+    }
+    h.last()
+        .and_then(|x| x.partial_cmp(&0.0))
+        .unwrap_or(std::cmp::Ordering::Equal)
+}
+
+/// Do the closed segments `p q` and `r s` intersect (touching counts)? Exact.
 fn segments_meet(p: DVec2, q: DVec2, r: DVec2, s: DVec2) -> bool {
-    let d1 = cross(q - p, r - p);
-    let d2 = cross(q - p, s - p);
-    let d3 = cross(s - r, p - r);
-    let d4 = cross(s - r, q - r);
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
+    use std::cmp::Ordering::Equal;
+    let d1 = orient(p, q, r);
+    let d2 = orient(p, q, s);
+    let d3 = orient(r, s, p);
+    let d4 = orient(r, s, q);
+    if d1 != Equal && d2 != Equal && d1 != d2 && d3 != Equal && d4 != Equal && d3 != d4 {
         return true;
     }
-    let on = |a: DVec2, b: DVec2, c: DVec2, d: f64| {
-        d == 0.0
+    // an endpoint on the other segment (collinear and within its box)
+    let on = |a: DVec2, b: DVec2, c: DVec2, d| {
+        d == Equal
             && c.x >= a.x.min(b.x)
             && c.x <= a.x.max(b.x)
             && c.y >= a.y.min(b.y)
             && c.y <= a.y.max(b.y)
     };
     on(p, q, r, d1) || on(p, q, s, d2) || on(r, s, p, d3) || on(r, s, q, d4)
+}
+
+/// `a` before `b` in the sweep's order: by `x`, then by `y`.
+fn lex(a: DVec2, b: DVec2) -> std::cmp::Ordering {
+    use std::cmp::Ordering::{Equal, Greater, Less};
+    if a.x < b.x || (a.x == b.x && a.y < b.y) {
+        Less
+    } else if a == b {
+        Equal
+    } else {
+        Greater
+    }
+}
+
+/// An edge in the sweep's active set: its endpoints in sweep order (`l` before `r`).
+#[derive(Clone, Copy, Debug)]
+struct Active {
+    l: DVec2,
+    r: DVec2,
+    id: usize,
+}
+
+impl Active {
+    /// The order of `self` and `t` along a sweep line that crosses both, when `self` enters
+    /// the sweep first: `Less` when `t` lies above (to the left of `l → r`).
+    fn below(&self, t: &Active) -> std::cmp::Ordering {
+        use std::cmp::Ordering::Equal;
+        match orient(self.l, self.r, t.l) {
+            Equal => match orient(self.l, self.r, t.r) {
+                Equal => self.id.cmp(&t.id), // collinear: by index
+                o => o.reverse(),
+            },
+            o => o.reverse(),
+        }
+    }
+}
+
+impl PartialEq for Active {
+    fn eq(&self, o: &Self) -> bool {
+        self.id == o.id
+    }
+}
+
+impl Eq for Active {}
+
+impl PartialOrd for Active {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Active {
+    /// Bottom to top along the sweep line (consistent while no two active edges cross,
+    /// which is all the sweep needs: it stops at the first crossing).
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        if self.id == o.id {
+            std::cmp::Ordering::Equal
+        } else if lex(self.l, o.l) != std::cmp::Ordering::Greater {
+            self.below(o)
+        } else {
+            o.below(self).reverse()
+        }
+    }
+}
+
+/// Do the edges `a b` and `b c` overlap (`c` back along `b a`: a turn of exactly 180°)?
+/// Exact: collinearity by [`orient`], the side by comparing coordinates.
+fn folds_back(a: DVec2, b: DVec2, c: DVec2) -> bool {
+    orient(a, b, c) == std::cmp::Ordering::Equal && lex(a, b) == lex(c, b)
+}
+
+/// A pair of edges `(a, b)`, `a < b`, that meet other than adjacent edges at their shared
+/// vertex (touching counts; adjacent edges that fold back onto each other meet), or `None`
+/// for a simple polyline/polygon: the sweep line of Shamos and Hoey ("Geometric intersection
+/// problems", FOCS 1976) over the endpoints in `(x, y)` order, the edges crossing the line
+/// kept in order in a B-tree, every edge tested against its neighbours when it enters and
+/// the two edges it separated when it leaves. O(m log m), with exact predicates. Several
+/// edges ending at one point and edges folding back are found before the sweep, so that
+/// the ordered edges meet only where the sweep tests them.
+fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
+    use std::collections::BTreeSet;
+    use std::ops::Bound::{Excluded, Unbounded};
+    let m = p.len();
+    let edges = if closed { m } else { m - 1 };
+    let seg: Vec<Active> = (0..edges)
+        .map(|e| {
+            let (a, b) = (p[e], p[(e + 1) % m]);
+            let (l, r) = if lex(a, b) == std::cmp::Ordering::Greater {
+                (b, a)
+            } else {
+                (a, b)
+            };
+            Active { l, r, id: e }
+        })
+        .collect();
+    // (point, 0 = enter / 1 = leave, edge): at a shared point every edge enters before
+    // any leaves, so edges that touch there are in the set together
+    let mut events: Vec<(DVec2, u8, usize)> = Vec::with_capacity(2 * edges);
+    for s in &seg {
+        events.push((s.l, 0, s.id));
+        events.push((s.r, 1, s.id));
+    }
+    events.sort_unstable_by(|x, y| lex(x.0, y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let adjacent = |a: usize, b: usize| {
+        let (a, b) = (a.min(b), a.max(b));
+        b == a + 1 || (closed && a == 0 && b == m - 1)
+    };
+    let meet = |a: &Active, b: &Active| {
+        (!adjacent(a.id, b.id) && segments_meet(a.l, a.r, b.l, b.r))
+            .then(|| (a.id.min(b.id), a.id.max(b.id)))
+    };
+    let first = usize::from(!closed);
+    if let Some(j) =
+        (first..m - first).find(|&j| folds_back(p[(j + m - 1) % m], p[j], p[(j + 1) % m]))
+    {
+        let a = (j + m - 1) % m;
+        return Some((a.min(j), a.max(j)));
+    }
+    // edges that end at the same point: around a vertex only its two edges may, so three
+    // (of which two are not adjacent) or two non-adjacent ones meet there
+    for group in events.chunk_by(|x, y| x.0 == y.0) {
+        let ids: Vec<usize> = group.iter().take(3).map(|e| e.2).collect();
+        for (i, &a) in ids.iter().enumerate() {
+            for &b in &ids[i + 1..] {
+                if !adjacent(a, b) {
+                    return Some((a.min(b), a.max(b)));
+                }
+            }
+        }
+    }
+    let mut set = BTreeSet::new();
+    for &(_, kind, e) in &events {
+        let s = seg[e];
+        let below = set.range(..s).next_back().copied();
+        let above = set.range((Excluded(s), Unbounded)).next().copied();
+        if kind == 0 {
+            set.insert(s);
+            for t in [below, above].into_iter().flatten() {
+                if let Some(hit) = meet(&s, &t) {
+                    return Some(hit);
+                }
+            }
+        } else {
+            set.remove(&s);
+            if let (Some(b), Some(a)) = (below, above) {
+                if let Some(hit) = meet(&b, &a) {
+                    return Some(hit);
+                }
+            }
+        }
+    }
+    None
 }
 
 impl Profile {
@@ -131,8 +362,16 @@ impl Profile {
             ));
         }
         let convex = closed && strictly_convex(&p);
-        if !convex {
-            if let Some((a, b)) = first_crossing(&p, closed) {
+        // a closed polygon on one line folds back on itself: its zero area is the clearer
+        // message
+        let on_a_line = || {
+            closed
+                && (0..m).all(|j| {
+                    orient(p[(j + m - 1) % m], p[j], p[(j + 1) % m]) == std::cmp::Ordering::Equal
+                })
+        };
+        if !convex && !on_a_line() {
+            if let Some((a, b)) = sweep_crossing(&p, closed) {
                 return Err(InputError::new(
                     ARG,
                     format!(
@@ -262,6 +501,7 @@ impl Cells {
 
     /// Add `item` to every cell the segment `a b` passes through (and some neighbours):
     /// samples every half cell, each with its 3 × 3 block of cells.
+    #[cfg(test)]
     fn add_segment(&mut self, a: DVec2, b: DVec2, item: usize) {
         let steps = ((b - a).length() * self.inv * 2.0).ceil().min(4e9) as usize;
         let mut last = None;
@@ -300,7 +540,9 @@ impl Cells {
 }
 
 /// The first pair of non-adjacent edges `(a, b)`, `a < b`, that meet, or `None` for a simple
-/// polyline/polygon. Edges are binned in cells; only edges sharing a cell are compared.
+/// polyline/polygon. Edges are binned in cells; only edges sharing a cell are compared
+/// (quadratic when many edges share cells; a cross-check of [`sweep_crossing`]).
+#[cfg(test)]
 fn first_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
     let m = p.len();
     let edges = if closed { m } else { m - 1 };
@@ -525,5 +767,161 @@ mod tests {
             .collect();
         assert!(Profile::new(&line, true).is_err());
         assert!(Profile::new(&line, false).is_ok());
+    }
+
+    /// The definition: any two non-adjacent edges that meet, or adjacent ones that fold
+    /// back, by testing all pairs.
+    fn brute_crossing(p: &[DVec2], closed: bool) -> bool {
+        let m = p.len();
+        let edges = if closed { m } else { m - 1 };
+        let fold = |a: usize| folds_back(p[a], p[(a + 1) % m], p[(a + 2) % m]);
+        (0..edges).any(|a| (a + 1 < edges || closed) && fold(a))
+            || (0..edges).any(|a| {
+                (a + 2..edges).any(|b| {
+                    !(closed && a == 0 && b == m - 1)
+                        && segments_meet(p[a], p[(a + 1) % m], p[b], p[(b + 1) % m])
+                })
+            })
+    }
+
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+        fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+        fn unit(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// A star-shaped polygon: `m` vertices at increasing angles, random radii (simple).
+    fn star_shaped(rng: &mut Rng, m: usize) -> Vec<DVec2> {
+        let mut t: Vec<f64> = (0..m).map(|_| rng.unit() * std::f64::consts::TAU).collect();
+        t.sort_by(f64::total_cmp);
+        t.dedup();
+        t.iter()
+            .map(|&a| (0.05 + rng.unit()) * DVec2::from_angle(a))
+            .collect()
+    }
+
+    #[test]
+    fn orientation_is_exact() {
+        // nearly collinear points where the plain cross product rounds the wrong way or
+        // to zero (Shewchuk's example: points near (0.5, 0.5) on y = x)
+        let (a, b) = (DVec2::new(12.0, 12.0), DVec2::new(24.0, 24.0));
+        let ulp = f64::EPSILON / 2.0;
+        for i in 0..64 {
+            for j in 0..64 {
+                let c = DVec2::new(0.5 + i as f64 * ulp, 0.5 + j as f64 * ulp);
+                // c lies left of a → b exactly when c.y > c.x
+                let want = c.y.partial_cmp(&c.x).unwrap();
+                assert_eq!(orient(a, b, c), want, "{c:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn sweep_finds_crossings_like_testing_all_pairs() {
+        let mut rng = Rng(0x2545f4914f6cdd1d);
+        // small polygons on a 5 × 5 grid: shared vertices, collinear and vertical edges,
+        // touching at vertices, overlapping edges
+        let mut found = [0usize; 2];
+        for _ in 0..8_000 {
+            let m = 3 + rng.below(8) as usize;
+            let mut p: Vec<DVec2> = Vec::new();
+            while p.len() < m {
+                let q = DVec2::new(rng.below(5) as f64, rng.below(5) as f64);
+                if p.last() != Some(&q) {
+                    p.push(q);
+                }
+            }
+            for closed in [false, true] {
+                if closed && p[0] == p[m - 1] {
+                    continue;
+                }
+                let want = brute_crossing(&p, closed);
+                let got = sweep_crossing(&p, closed);
+                assert_eq!(got.is_some(), want, "{p:?} closed {closed}");
+                let grid = first_crossing(&p, closed).is_some();
+                let fold = (0..m).any(|a| folds_back(p[a], p[(a + 1) % m], p[(a + 2) % m]));
+                assert!(grid == want || fold, "{p:?}");
+                if let Some((a, b)) = got {
+                    let e = |k: usize| (p[k], p[(k + 1) % m]);
+                    let ((w, x), (y, z)) = (e(a), e(b));
+                    assert!(a < b && segments_meet(w, x, y, z));
+                }
+                found[usize::from(want)] += 1;
+            }
+        }
+        assert!(found[0] > 500 && found[1] > 500, "{found:?}");
+        // star-shaped polygons are simple; one vertex moved across makes most cross
+        for m in [3, 10, 100, 2000] {
+            for _ in 0..20 {
+                let mut p = star_shaped(&mut rng, m);
+                let n = p.len();
+                assert_eq!(sweep_crossing(&p, true), None);
+                assert_eq!(sweep_crossing(&p, false), None);
+                let k = rng.below(n as u64) as usize;
+                p[k] = -1.5 * p[k];
+                if n <= 100 {
+                    for closed in [false, true] {
+                        assert_eq!(
+                            sweep_crossing(&p, closed).is_some(),
+                            brute_crossing(&p, closed)
+                        );
+                    }
+                } else {
+                    assert_eq!(
+                        sweep_crossing(&p, true).is_some(),
+                        first_crossing(&p, true).is_some()
+                    );
+                }
+            }
+        }
+    }
+
+    /// Stars and combs of many packed spikes: simple, and one spike bent onto its
+    /// neighbour is found.
+    #[test]
+    fn packed_spikes_are_checked_in_m_log_m() {
+        let star = |m: usize| -> Vec<DVec2> {
+            (0..m)
+                .map(|k| {
+                    let r = if k % 2 == 0 { 1.0 } else { 0.2 };
+                    r * DVec2::from_angle(std::f64::consts::TAU * k as f64 / m as f64)
+                })
+                .collect()
+        };
+        let comb = |k: usize| -> Vec<DVec2> {
+            let mut p = vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(1.0, 0.0),
+                DVec2::new(1.0, 0.1),
+            ];
+            for i in (0..k).rev() {
+                let x = i as f64 / k as f64;
+                let w = 0.5 / k as f64;
+                p.extend(
+                    [(x + w, 0.1), (x + w, 1.1), (x, 1.1), (x, 0.1)].map(|(x, y)| DVec2::new(x, y)),
+                );
+            }
+            p
+        };
+        for mut p in [star(100_000), comb(25_000)] {
+            assert_eq!(sweep_crossing(&p, true), None);
+            assert!(Profile::new(&p, true).is_ok());
+            let n = p.len();
+            // two vertices of neighbouring spikes swapped: their edges cross
+            let k = (n / 2) & !1;
+            p.swap(k + 1, k + 5);
+            assert!(sweep_crossing(&p, true).is_some());
+        }
     }
 }
