@@ -24,7 +24,7 @@ from dataclasses import field as _dc_field
 import numpy as np
 
 from . import _core
-from ._advect import MAX_STEPS, _progress_bar, advect
+from ._advect import MAX_STEPS, _progress_bar
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import signed_volume as _volume
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
@@ -245,10 +245,14 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     integ = mesh_err = None
     if estimate:
         clock = time.perf_counter()
-        # both runs with spinal.advect: the refined mesh's vertices near a tool's surface are
-        # carried by their side's velocity, and those on it by a blend (not Φ(rest))
-        W1 = advect(Vr, field, duration, n, t0=t0)
-        W2 = advect(Vr, field, duration, 2 * n, t0=t0)
+        # both runs with the mesh's own integrator (vertices at a tool's surface carried by
+        # their side's velocity; spinal.advect's RK4 stages step across the surface there)
+        def rerun(steps):
+            return _core.deform_mesh(Vr, Fr, field, t0, duration, steps, None, len(Vr), 0,
+                                     None)[0]
+
+        W1 = W if torn == 0 else rerun(n)
+        W2 = rerun(2 * n)
         integ = (_volume(W1, Fr) - _volume(W2, Fr)) / rest * 16 / 15
         mesh_err = change - integ
         timings["estimate"] = time.perf_counter() - clock
