@@ -6,8 +6,8 @@ bisection, ``src/deform/refine.rs``). This script runs it on closed icospheres a
 for each case: the input and output vertex counts and their ratio, the surface-area growth
 (trimesh area after / before), the relative volume change with and without refinement,
 whether the refinement converged (every edge below the threshold) or stopped at its
-``max_vertices`` bound (default 8× the input), the vertices placed at a chord midpoint where
-the flow tore an edge, the wall time (best of ``--repeat``), the time of each phase
+``max_vertices`` bound (default 8× the input), the new vertices of edges the flow tore
+apart, the wall time (best of ``--repeat``), the time of each phase
 (``DeformReport.timings``) and the peak resident-memory growth of the call.
 
 Cases: the drag (a curl translation tool of radius 0.9 centred on the unit sphere's surface,
@@ -187,8 +187,9 @@ def main() -> int:
     print()
     print("volume change: relative, of the refined mesh (DeformReport.relative_change; its "
           "volumes agree with trimesh and libigl to 1e-12 in tests/test_deform_refine.py); "
-          "unrefined: spinal.advect with the same steps. torn vertices: placed at the chord "
-          "midpoint of an edge torn by the tool's tangential slip. Peak RSS growth: VmHWM "
+          "unrefined: spinal.advect with the same steps. torn vertices: new vertices of edges "
+          "torn by the tool's tangential slip, placed halfway along their path over the two "
+          "sides and the tool's surface (DeformReport.torn_vertices). Peak RSS growth: VmHWM "
           "after the first call minus VmRSS before it (the peak reset through "
           "/proc/self/clear_refs).")
     if failed:

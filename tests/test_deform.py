@@ -607,10 +607,17 @@ def test_refinement_from_the_rest_mesh_keeps_a_long_stroke_below_1e_4():
     rest = trimesh.Trimesh(r.rest_vertices, M.faces, process=False).volume
     assert abs(rest / trimesh.Trimesh(V, F, process=False).volume - 1) < 1e-14
     np.testing.assert_array_equal(r.rest_vertices[: len(V)], V)
-    # every vertex, old or new, is Φ(rest): the same steps applied to the rest position
-    np.testing.assert_array_equal(M.vertices, spinal.advect(r.rest_vertices, PRESS, 1.0, r.steps))
-    # the Richardson split agrees with a 16×-steps reference on the refined mesh
+    # every vertex, old or new, is Φ(rest): the same steps applied to the rest position; those
+    # at the tool's surface with its outer side's velocity, where plain RK4 stages step into
+    # the tool (measured: 538 vertices within 1.7e-7 of the 16×-steps reference, where
+    # spinal.advect's steps are 1.2e-2 off it)
     ref = spinal.advect(r.rest_vertices, PRESS, 1.0, 16 * r.steps)
+    plain = spinal.advect(r.rest_vertices, PRESS, 1.0, r.steps)
+    differ = np.any(M.vertices != plain, axis=1)
+    assert differ.sum() < 0.05 * len(differ)
+    err = np.linalg.norm(M.vertices[differ] - ref[differ], axis=1)
+    assert err.max() < 1e-6, err.max()
+    # the Richardson split agrees with a 16×-steps reference on the refined mesh
     vref = trimesh.Trimesh(ref, M.faces, process=False).volume
     integration = r.volume / vref - 1
     assert abs(r.integration_error / integration - 1) < 0.2, (r, integration)

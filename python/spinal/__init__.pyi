@@ -255,6 +255,8 @@ class DeformReport:
     torn_vertices: int = 0
     step_vertices: _I | None = None
     timings: dict[str, float] | None = None
+    slip_vertices: int = 0
+    chord_vertices: int = 0
 
 class RefinementWarning(UserWarning): ...
 

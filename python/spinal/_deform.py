@@ -6,8 +6,10 @@ integration step, an edge longer than ``refine × max(its rest length, mean rest
 split — the longest edge of both its triangles first (Rivara's longest-edge bisection), both
 triangles bisected (conforming, watertight) — and the new vertex is the rest midpoint carried
 by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow tears an edge
-apart (the tangential slip at the surface of a curl tool) the new vertex goes to the slip
-surface, the tool's surface, next to the edge's chord midpoint. The work is bounded by
+apart (the tangential slip at the surface of a curl tool) the body's boundary runs along the
+tool's surface between the two torn sides: the new vertex goes halfway along that path, onto
+the material of one side or onto the tool's surface, where it moves with a blend of the two
+sides' velocities (``DeformReport.slip_vertices``). The work is bounded by
 ``max_vertices`` and ``max_passes``; when edges remain too long at the end the report says so
 and a :class:`RefinementWarning` is emitted.
 """
@@ -22,7 +24,7 @@ from dataclasses import field as _dc_field
 import numpy as np
 
 from . import _core
-from ._advect import MAX_STEPS, _progress_bar, advect
+from ._advect import MAX_STEPS, _progress_bar
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import signed_volume as _volume
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
@@ -71,22 +73,44 @@ class DeformReport:
         With ``estimate=True``: ``relative_change − integration_error``, the part due to the
         triangle mesh (flat faces between advected vertices); else None.
     rest_vertices : ndarray (V', 3) float64 or None
-        Rest positions of the output mesh's vertices (the input's, then the rest midpoints
-        of the split edges), for re-running or checking the deformation: every vertex is the
-        flow of its rest position, except the ``torn_vertices`` of torn edges.
+        Rest positions of the output mesh's vertices (the input's, then points of the split
+        rest edges: the rest midpoint, or on an edge across a tool's surface the point of the
+        edge placed halfway along its path, see ``torn_vertices``), for re-running or
+        checking the deformation. Every vertex is the flow ``Φ`` of its rest position (near
+        a curl tool's surface, the flow of the material of the side its rest position lies
+        on), except the ``slip_vertices`` and ``chord_vertices``.
     converged : bool
-        False when edges remain over the threshold at the end: ``max_vertices`` or
-        ``max_passes`` stopped the refinement, or edges across a slip that bisection cannot
-        shorten remain (a :class:`RefinementWarning` was emitted).
+        True when no edge is over the threshold at the end. False when ``max_vertices`` or
+        ``max_passes`` stopped the refinement with edges still too long (a
+        :class:`RefinementWarning` was emitted). Across a tool's slip every edge can be
+        shortened (see ``torn_vertices``), so a refinement that no bound stops converges.
     edges_over_threshold : int
         Edges longer than the threshold at the end (0 when converged).
     max_vertices : int or None
         The vertex bound the refinement ran under (None without refinement).
     torn_vertices : int
-        New vertices of edges the flow tore apart (the exact image of the rest midpoint fell
-        farther than a quarter of the edge from the chord midpoint): the chord midpoint,
-        moved onto the nearest slip surface of the field (a curl tool's surface) when one
-        passes within the edge's length.
+        New vertices of edges that the tangential slip at a curl tool's surface tore apart
+        (Zheng's thesis §12.1: only the normal velocity is continuous across it, so the
+        material at rest inside the tool and outside it part along the surface). Such an
+        edge's path runs from one end over its side's material to the surface, along the
+        surface between the two torn sides, and over the other side's material to the other
+        end. The material of a side is carried by that side's one-sided velocity ``v₊``
+        (outside) or ``v₋`` (inside); a point of the surface by the blend
+        ``v_s = (1 − s) v₊ + s v₋``, ``s ∈ [0, 1]``, which keeps it on the surface (``v₊`` and
+        ``v₋`` share the normal part, the surface's own) — ``s = ½`` moves with the tool
+        itself, and ``s`` from 0 to 1 sweeps the strip of tool surface between the torn
+        sides. The new vertex is the point halfway along the path (by the chords between its
+        images): a material point of one side, or a point of the surface with the mean blend
+        of its neighbours along the path. Both halves are then about half as long, so
+        bisection resolves every edge across the slip. Also counts the ``chord_vertices``.
+    slip_vertices : int
+        Vertices on a tool's surface at the end (carried with their blend ``s``, not the flow
+        of their rest position).
+    chord_vertices : int
+        New vertices of edges of one side's material whose image of the rest midpoint fell
+        farther than a quarter of the edge from the chord midpoint (a flow that the steps do
+        not resolve): the chord midpoint, moved onto the nearest slip surface when one passes
+        within the edge's length.
     step_vertices : ndarray (steps,) int64 or None
         Vertex count after each integration step.
     timings : dict or None
@@ -109,6 +133,8 @@ class DeformReport:
     torn_vertices: int = 0
     step_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
     timings: dict | None = _dc_field(default=None, repr=False, compare=False)
+    slip_vertices: int = 0
+    chord_vertices: int = 0
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
@@ -136,15 +162,16 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     longest-edge bisection keeps triangles from getting thinner). Edges that are long already
     at rest are split only where they stretch, so a tool that never reaches the mesh adds no
     vertex. Where the flow tears an edge apart (across the tangential slip at the surface of
-    a :func:`spinal.fields.translation` tool, whose field is only continuous in its normal
-    part there) the body's boundary runs along the tool's surface: the new vertex is the
-    edge's chord midpoint moved onto that surface, and the flow carries it along it.
-    ``refine=None`` only advects.
+    a curl tool such as :func:`spinal.fields.translation`, whose field is only continuous in
+    its normal part there) the body's boundary runs along the tool's surface between the
+    torn sides: the new vertex goes halfway along that path, onto one side's material or onto
+    the tool's surface, which it then follows with a blend of the two sides' velocities (see
+    ``DeformReport.torn_vertices``). ``refine=None`` only advects.
 
     The work is bounded: at most ``max_vertices`` vertices and ``max_passes`` passes after
-    each step. When edges remain too long at the end (a bound stopped the refinement, or an
-    edge across a slip cannot be shortened by bisection), the report has ``converged=False``
-    and the count of those edges, and a :class:`spinal.RefinementWarning` is emitted.
+    each step. When edges remain too long at the end because a bound stopped the refinement,
+    the report has ``converged=False`` and the count of those edges, and a
+    :class:`spinal.RefinementWarning` is emitted.
 
     Parameters
     ----------
@@ -209,7 +236,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     finally:
         if bar:
             bar[0][1]()
-    passes, torn, over, bounded, t_int, t_ref = stats
+    passes, torn, over, bounded, t_int, t_ref, on_slip, chord = stats
     clock = time.perf_counter()
     rest, vol = _volume(Vr, Fr), _volume(W, Fr)
     change = vol / rest - 1 if rest != 0 else float("nan")
@@ -218,8 +245,14 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     integ = mesh_err = None
     if estimate:
         clock = time.perf_counter()
-        W1 = W if torn == 0 else advect(Vr, field, duration, n, t0=t0)
-        W2 = advect(Vr, field, duration, 2 * n, t0=t0)
+        # both runs with the mesh's own integrator (vertices at a tool's surface carried by
+        # their side's velocity; spinal.advect's RK4 stages step across the surface there)
+        def rerun(steps):
+            return _core.deform_mesh(Vr, Fr, field, t0, duration, steps, None, len(Vr), 0,
+                                     None)[0]
+
+        W1 = W if torn == 0 else rerun(n)
+        W2 = rerun(2 * n)
         integ = (_volume(W1, Fr) - _volume(W2, Fr)) / rest * 16 / 15
         mesh_err = change - integ
         timings["estimate"] = time.perf_counter() - clock
@@ -228,11 +261,10 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         warnings.warn(RefinementWarning(
             f"deform: {over} edges are still longer than refine × their rest length (the "
             f"refinement stopped at max_vertices={max_vertices} or max_passes={max_passes} per "
-            f"step, or they cross a slip of the field that bisection cannot shorten); raise "
-            f"max_vertices or use more steps"), stacklevel=2)
+            f"step); raise max_vertices or max_passes"), stacklevel=2)
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
-                          counts, timings)
+                          counts, timings, on_slip, chord)
     return Mesh(W, Fr), report
 
 

@@ -20,6 +20,7 @@ pub mod keyframe;
 pub mod path;
 pub mod refine;
 pub mod rod;
+pub mod slip;
 pub mod stamp;
 pub mod tube;
 

@@ -18,24 +18,46 @@
 //!   neighbour), so a split never makes a triangle thinner than its parent;
 //! * **placement** — the rest midpoint `m = (X_a + X_b)/2` is integrated through the steps
 //!   taken so far, which gives the bits of advecting `m` from the start (the refined mesh is
-//!   `Φ(rest)` vertex by vertex). Where the flow has *torn* the edge — `Φ(m)` lies farther
-//!   than a quarter of the edge from the chord midpoint, as across the tangential slip at the
-//!   surface of a curl translation tool (thesis §12.1: only the normal velocity is continuous
-//!   there) — no rest point lands between the two sides. Across such a slip the body's
-//!   boundary runs along the tool's surface, so the new vertex is the chord midpoint moved
-//!   onto the nearest slip surface of the field ([`super::Tool::slip_surface`], a Newton step
-//!   on the tool's distance, ending a hair on its outer side), and the flow carries it on
-//!   along that surface; where no slip surface passes near, the chord midpoint itself.
-//!   Splitting a flat pair of triangles at a chord midpoint does not change the mesh's
-//!   volume;
-//!   The strip that a slip opens grows at every step, so refinement across a slip keeps
-//!   adding vertices along it: on a 10k-vertex sphere dragged half a radius by a curl tool
-//!   centred on its surface the volume change is −3.5e-6 with 6.4× the vertices (placing the
-//!   strip's vertices at plain chord midpoints gave −4.0e-4 at the 8× bound, and at 40k a
-//!   strip folded over itself);
+//!   `Φ(rest)` vertex by vertex);
+//! * **slip surfaces** — across the surface of a curl tool only the normal velocity is
+//!   continuous (thesis §12.1; [`super::Tool::slip_surface`]): the material at rest inside
+//!   the tool and the material outside it part along the surface, and a mesh edge across it
+//!   is *torn*. The deformed body's boundary then runs from the images of the outer side over
+//!   a strip of the tool's surface to the images of the inner side. Its points are the
+//!   images of a *generalized* rest mesh ([`super::slip`]): material points `X`, carried by
+//!   `Φ` — near the surface by the one-sided velocity `v₊` or `v₋` of the side where `X` lies
+//!   at rest, since RK4 stages that step across the surface would otherwise carry a point
+//!   into the other side's slip — and surface points `(p, s)`, `p` on the surface at rest and
+//!   `s ∈ [0, 1]`, carried by the blend `v_s = (1 − s) v₊ + s v₋` to `Ψ(p, s)`. Both one-sided
+//!   limits have the surface's normal velocity, so `Ψ(p, s)` stays on the surface and sweeps
+//!   the strip between `Φ₊(p) = Ψ(p, 0)` and `Φ₋(p) = Ψ(p, 1)` as `s` runs over `[0, 1]`
+//!   (`s = ½` moves with the tool itself). An edge whose ends are surface points, or material
+//!   points of different sides, runs along the path `X_a → p (side of a) → p (side of b) →
+//!   X_b`, `p` where its rest segment meets the surface (or its surface end). Its new vertex
+//!   is the point halfway along that path, measured by the chords between the images of the
+//!   path's points: a material point of one side, or a surface point `(p, s)` with the mean
+//!   blend. Both halves of the edge are then about half as long, so bisection resolves every
+//!   torn edge and the refinement converges unless a bound stops it. Every new rest point
+//!   lies on its rest edge, so the rest mesh keeps its volume.
+//!
+//!   Before, a torn edge's new vertex was its chord midpoint moved onto the tool's surface
+//!   (a hair on its outer side, carried by the outer side's flow). For an edge from a vertex
+//!   at depth `δ` inside the tool to a vertex on the surface, the projection lands next to
+//!   the surface end, so the edge to the deep vertex stays at about `max(δ, its length)`:
+//!   each step added a fan of vertices around the deep one (rest points converging to its
+//!   own) without shortening it. On a 10k-vertex sphere dragged half a radius by a curl
+//!   tool centred on its surface that left 186 edges over the threshold with 6.5× the
+//!   vertices (at 40k, 134,116 at the 8× bound); with the halfway placement the refinement
+//!   converges with 2.66× the vertices and a volume change of −4.2e-5 (3.31× and −1.5e-5 at
+//!   40k);
+//! * **chord midpoints** — where `Φ(m)` of an edge of one side's material lies farther than a
+//!   quarter of the edge from the chord midpoint (a flow the steps do not resolve), the new
+//!   vertex is the chord midpoint, moved onto the nearest slip surface a hair on its outer
+//!   side when one passes within the edge length. Splitting a flat pair of triangles at a
+//!   chord midpoint does not change the mesh's volume;
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
-//!   When a bound stops the refinement the result says so (`converged = false` and the number
-//!   of edges still over the threshold).
+//!   When edges remain over the threshold at the end — a bound stopped the refinement — the
+//!   result says so (`bounded`, and the number of those edges).
 //!
 //! The rate of change of a mesh's volume is the flux of its linearly interpolated vertex
 //! velocities, which differs from the zero flux of a divergence-free `v` through the same
@@ -49,6 +71,7 @@ use rayon::prelude::*;
 
 use super::Field;
 use super::advect::{Method, advect_steps};
+use super::slip::{self, Carry};
 use crate::error::{InputError, Result};
 
 /// No twin: a boundary half-edge.
@@ -130,7 +153,8 @@ pub struct Refinement {
 /// A deformed (and refined) mesh.
 #[derive(Debug, Clone, Default)]
 pub struct Deformed {
-    /// Rest positions: the input's, then the rest midpoints of the split edges.
+    /// Rest positions: the input's, then points of the split rest edges (the rest midpoint, or
+    /// the point halfway along a torn edge's path: see the module docs).
     pub rest: Vec<DVec3>,
     /// Deformed positions, one per rest position.
     pub vertices: Vec<DVec3>,
@@ -140,12 +164,17 @@ pub struct Deformed {
     pub passes: usize,
     /// Vertex count after each step (length = the number of steps taken).
     pub step_vertices: Vec<usize>,
-    /// Vertices placed at a torn edge's chord midpoint instead of at `Φ(rest midpoint)`.
+    /// New vertices of edges along a slip surface (placed on their generalized path).
     pub torn: usize,
+    /// New vertices of edges of material points on one side whose `Φ(rest midpoint)` was torn
+    /// away from the chord: placed at the chord midpoint instead.
+    pub fallback: usize,
+    /// Vertices on a slip surface at the end (`Ψ(rest, s)` instead of `Φ(rest)`).
+    pub slip_vertices: usize,
     /// Edges still over the threshold at the end (0 when the refinement converged).
     pub over_threshold: usize,
     /// Whether edges remain over the threshold at the end (a bound, `max_vertices` or
-    /// `max_passes`, stopped the refinement, or an edge could not be shortened by splitting).
+    /// `max_passes`, stopped the refinement).
     pub bounded: bool,
     /// Wall time of the integration of the mesh's vertices, seconds.
     pub time_integrate: f64,
@@ -295,12 +324,103 @@ struct Refiner<'a> {
     mean2: f64,
     topo: Topology,
     rest: Vec<DVec3>,
+    /// How each vertex is carried ([`slip::Carry`]): on a slip surface with its blend `s`
+    /// (`Ψ(rest, s)`), or as material of one side of it (`Φ(rest)`).
+    carry: Vec<Carry>,
+    /// The time at which the rest mesh is given (the start of the steps).
+    start: f64,
     bounded: bool,
     torn: usize,
+    fallback: usize,
     passes: usize,
 }
 
+/// A point of the generalized rest mesh (see the module docs): a material rest point, or a
+/// rest point on a slip surface with its blend `s` (0 outside, 1 inside).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Gen {
+    Material(DVec3),
+    Slip(DVec3, f64),
+}
+
+impl Gen {
+    fn rest(self) -> DVec3 {
+        match self {
+            Gen::Material(x) | Gen::Slip(x, _) => x,
+        }
+    }
+
+    /// The point a fraction `f` along the piece from `self` to `other`: a material point on
+    /// a piece with a material end, a slip point (rest point and blend interpolated) on a
+    /// piece along the slip surface.
+    fn lerp(self, other: Gen, f: f64) -> Gen {
+        match (self, other) {
+            (Gen::Slip(x, s), Gen::Slip(y, r)) => Gen::Slip(x.lerp(y, f), s + f * (r - s)),
+            _ => Gen::Material(self.rest().lerp(other.rest(), f)),
+        }
+    }
+}
+
+/// Bisection steps locating where a rest edge crosses a slip surface.
+const CROSSING_STEPS: usize = 60;
+
 impl Refiner<'_> {
+    /// The side of the nearest slip surface on which rest point `x` lies: 1 inside (`d < 0`),
+    /// 0 outside; `None` where the field has no slip surface.
+    fn side(&self, x: DVec3) -> Option<f64> {
+        let (d, _) = self.field.slip_surface(x, self.start)?;
+        Some(if d < 0.0 { 1.0 } else { 0.0 })
+    }
+
+    fn gen_of(&self, v: usize) -> Gen {
+        match self.carry[v] {
+            Carry::Surface(s) => Gen::Slip(self.rest[v], s),
+            _ => Gen::Material(self.rest[v]),
+        }
+    }
+
+    fn carry_of(&self, g: Gen) -> Carry {
+        match g {
+            Gen::Slip(_, s) => Carry::Surface(s),
+            Gen::Material(x) => self.side(x).map_or(Carry::Free, Carry::Side),
+        }
+    }
+
+    /// Where the rest segment `x → y` (ends on opposite sides) crosses the slip surface.
+    fn crossing(&self, x: DVec3, y: DVec3) -> Option<DVec3> {
+        let sx = self.side(x)?;
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..CROSSING_STEPS {
+            let mid = 0.5 * (lo + hi);
+            if self.side(x.lerp(y, mid))? == sx {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Some(x.lerp(y, 0.5 * (lo + hi)))
+    }
+
+    /// The generalized path of edge `(a, b)` when it runs along a slip surface (its ends on
+    /// the surface or on opposite sides of it): the points where it meets and leaves the
+    /// surface between its ends. `None` for an edge of material points on one side.
+    fn path(&self, a: usize, b: usize) -> Option<Vec<Gen>> {
+        let (ga, gb) = (self.gen_of(a), self.gen_of(b));
+        match (ga, gb) {
+            (Gen::Slip(..), Gen::Slip(..)) => Some(vec![ga, gb]),
+            (Gen::Material(x), Gen::Slip(y, _)) => Some(vec![ga, Gen::Slip(y, self.side(x)?), gb]),
+            (Gen::Slip(x, _), Gen::Material(y)) => Some(vec![ga, Gen::Slip(x, self.side(y)?), gb]),
+            (Gen::Material(x), Gen::Material(y)) => {
+                let (sx, sy) = (self.side(x)?, self.side(y)?);
+                if sx == sy {
+                    return None;
+                }
+                let p = self.crossing(x, y)?;
+                Some(vec![ga, Gen::Slip(p, sx), Gen::Slip(p, sy), gb])
+            }
+        }
+    }
+
     /// Whether half-edge `h` is over the threshold at positions `w`.
     fn over(&self, w: &[DVec3], h: usize) -> bool {
         let (a, b) = self.topo.ends(h);
@@ -402,32 +522,93 @@ impl Refiner<'_> {
         }
     }
 
-    /// New vertices on the chosen half-edges: `Φ(rest midpoint)` through the `done` steps,
-    /// or the chord midpoint where the edge is torn; then the splits.
+    /// The deformed positions of generalized rest points after `done` steps: `Φ` of the
+    /// material ones, `Ψ` of the slip ones.
+    fn image(&self, gens: &[Gen], done: usize) -> Vec<DVec3> {
+        let mut out: Vec<DVec3> = gens.iter().map(|g| g.rest()).collect();
+        let carry: Vec<Carry> = gens.iter().map(|&g| self.carry_of(g)).collect();
+        slip::flow(self.field, &mut out, &carry, self.runs, done);
+        out
+    }
+
+    /// New vertices on the chosen half-edges, then the splits. An edge of material points on
+    /// one side gets `Φ(rest midpoint)` (the chord midpoint where that is torn away); an edge
+    /// along a slip surface gets the point halfway along its generalized path, measured by
+    /// the chords between the images of the path's points.
     fn place_and_split(&mut self, w: &mut Vec<DVec3>, chosen: &[usize], done: usize, t: f64) {
-        let mids: Vec<DVec3> = chosen
+        let paths: Vec<Option<Vec<Gen>>> = chosen
             .iter()
             .map(|&h| {
                 let (a, b) = self.topo.ends(h);
-                0.5 * (self.rest[a] + self.rest[b])
+                self.path(a, b)
             })
             .collect();
-        let mut placed = mids.clone();
-        flow(self.field, &mut placed, self.runs, done);
-        for ((&h, mid), p) in chosen.iter().zip(mids).zip(placed) {
+        // the images of the points where the paths meet and leave a slip surface
+        let inner: Vec<Gen> = paths
+            .iter()
+            .flatten()
+            .flat_map(|p| p[1..p.len() - 1].iter().copied())
+            .collect();
+        let mut junction = self.image(&inner, done).into_iter();
+        let new: Vec<Gen> = chosen
+            .iter()
+            .zip(&paths)
+            .map(|(&h, path)| {
+                let (a, b) = self.topo.ends(h);
+                let Some(path) = path else {
+                    return Gen::Material(0.5 * (self.rest[a] + self.rest[b]));
+                };
+                let mut at = vec![w[a]];
+                at.extend(junction.by_ref().take(path.len() - 2));
+                at.push(w[b]);
+                let lens: Vec<f64> = at.windows(2).map(|q| q[0].distance(q[1])).collect();
+                let mut half = 0.5 * lens.iter().sum::<f64>();
+                let mut k = 0;
+                while k + 1 < lens.len() && half > lens[k] {
+                    half -= lens[k];
+                    k += 1;
+                }
+                let f = if lens[k] > 0.0 {
+                    (half / lens[k]).clamp(0.0, 1.0)
+                } else {
+                    0.5
+                };
+                let g = path[k].lerp(path[k + 1], f);
+                // a material point must lie on its piece's side of the surface (else the
+                // piece's end on the surface)
+                match (g, path[k], path[k + 1]) {
+                    (Gen::Material(x), Gen::Material(e), end)
+                    | (Gen::Material(x), end, Gen::Material(e))
+                        if self.side(x) != self.side(e) =>
+                    {
+                        end
+                    }
+                    _ => g,
+                }
+            })
+            .collect();
+        let placed = self.image(&new, done);
+        for ((&h, (g, p)), path) in chosen.iter().zip(new.into_iter().zip(placed)).zip(&paths) {
             let (a, b) = self.topo.ends(h);
             let chord = 0.5 * (w[a] + w[b]);
             let l = w[a].distance(w[b]);
-            // `!(d <= ...)` also catches a NaN placement
-            let p = if !(p.distance(chord) <= TORN * l) {
-                self.torn += 1;
-                self.on_slip(chord, l, t)
-            } else {
-                p
+            let (p, carry) = match g {
+                Gen::Slip(_, s) => (p, Carry::Surface(s)),
+                // `!(d <= ...)` also catches a NaN placement
+                Gen::Material(_) if path.is_none() && !(p.distance(chord) <= TORN * l) => {
+                    self.fallback += 1;
+                    self.torn += 1;
+                    (self.on_slip(chord, l, t), Carry::Free)
+                }
+                Gen::Material(x) => (p, self.carry_of(Gen::Material(x))),
             };
+            if path.is_some() {
+                self.torn += 1;
+            }
             let m = w.len();
             w.push(p);
-            self.rest.push(mid);
+            self.rest.push(g.rest());
+            self.carry.push(carry);
             self.topo.split(h, m);
         }
     }
@@ -478,10 +659,14 @@ pub fn deform(
         mean2: mean * mean,
         topo,
         rest: rest.to_vec(),
+        carry: Vec::new(),
+        start: runs.first().map_or(0.0, |r| r.t0),
         bounded: false,
         torn: 0,
+        fallback: 0,
         passes: 0,
     };
+    r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
     let mut w = rest.to_vec();
     let total: usize = runs.iter().map(|r| r.count).sum();
     let mut out = Deformed::default();
@@ -489,7 +674,7 @@ pub fn deform(
     for run in runs {
         for j in 0..run.count {
             let clock = Instant::now();
-            advect_steps(field, &mut w, run.t0, run.h, j..j + 1, Method::Rk4);
+            slip::step(field, &mut w, &r.carry, run, j);
             out.time_integrate += clock.elapsed().as_secs_f64();
             done += 1;
             if refinement.is_some() {
@@ -506,11 +691,17 @@ pub fn deform(
     if refinement.is_some() {
         out.over_threshold = r.over_edges(&w).len();
     }
-    // not converged whenever edges remain over the threshold: a bound stopped the refinement,
-    // or the remaining edges could not be bisected (their split would not shorten them)
+    // not converged whenever edges remain over the threshold: a bound stopped the refinement
+    // (every edge, torn ones too, is shortened by its split; see the module docs)
     out.bounded = out.over_threshold > 0;
     out.passes = r.passes;
     out.torn = r.torn;
+    out.fallback = r.fallback;
+    out.slip_vertices = r
+        .carry
+        .iter()
+        .filter(|c| matches!(c, Carry::Surface(_)))
+        .count();
     out.rest = r.rest;
     out.vertices = w;
     out.faces = r.topo.faces;
@@ -680,9 +871,9 @@ mod tests {
     }
 
     #[test]
-    fn a_torn_mesh_is_filled_and_bounded() {
+    fn a_torn_mesh_is_filled_and_converges() {
         // a curl tool centred on the surface: the material inside the tool slips past the
-        // material outside; refinement stays bounded and the volume is kept
+        // material outside; every edge across the slip is resolved, the volume is kept
         let (v, f) = sphere(5);
         let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
         let runs = schedule(&tool, 0.0, 1.0, 10);
@@ -701,20 +892,34 @@ mod tests {
         let (d, change) = run(Some(opts));
         let (_, plain) = run(None);
         assert!(watertight(&d.faces, d.vertices.len()));
-        assert!(d.torn > 0, "no torn edge");
-        // measured: 2.9× the vertices, −2.4e-4, a few hundred edges over the threshold that
-        // bisection cannot shorten (chord midpoints off the slip surface gave 4.7×, −7.7e-4)
+        assert!(d.torn > 0 && d.slip_vertices > 0, "no torn edge");
+        // measured: 2.16× the vertices, −1.86e-4, no edge over the threshold, no chord
+        // midpoint (chord midpoints moved onto the surface gave 2.9×, −2.4e-4 and 455 edges
+        // over the threshold: a fan of surface vertices around each vertex deep inside)
+        assert_eq!((d.over_threshold, d.bounded, d.fallback), (0, false, 0));
         assert!(
-            d.vertices.len() < 4 * v.len(),
+            d.vertices.len() * 10 < 22 * v.len(),
             "{} vertices",
             d.vertices.len()
         );
-        assert!(d.over_threshold * 33 < d.faces.len() && d.bounded); // 455 of 23,600
-        assert!(change.abs() < 4e-4, "volume change {change}");
+        assert!(change.abs() < 2.5e-4, "volume change {change}");
         assert!(
             plain.abs() > 10.0 * change.abs(),
             "unrefined {plain}, refined {change}"
         );
+        // the surface vertices lie on the tool's surface; the material vertices stay on the
+        // side of it where they were at rest (within the one-sided offset)
+        let (c0, c1) = (DVec3::new(0.0, 0.0, 0.9), DVec3::new(0.5, 0.0, 0.9));
+        let mut on = 0;
+        for (i, x) in d.vertices.iter().enumerate() {
+            let (d0, d1) = ((d.rest[i] - c0).length() - 0.9, (x - c1).length() - 0.9);
+            if d1.abs() < 1e-9 {
+                on += usize::from(i >= v.len());
+            } else {
+                assert!(d0 * d1 > 0.0, "{i}: rest {d0:e}, now {d1:e}");
+            }
+        }
+        assert!(on >= d.slip_vertices, "{on} of {}", d.slip_vertices);
     }
 
     #[test]
@@ -748,6 +953,85 @@ mod tests {
         })
         .unwrap();
         assert!(d.is_none() && seen == 3);
+    }
+
+    /// Exploration: `cargo test --release -- --ignored --nocapture over_edges_of_the_drag`.
+    #[test]
+    #[ignore]
+    fn over_edges_of_the_drag() {
+        let (v, f) = sphere(5);
+        let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
+        let runs = schedule(&tool, 0.0, 1.0, 10);
+        let opts = Refinement {
+            ratio: 1.5,
+            max_vertices: 10 * v.len(),
+            max_passes: 30,
+        };
+        let topo = Topology::new(&f, v.len()).unwrap();
+        let mean = (0..topo.twin.len())
+            .filter(|&h| h < topo.twin[h])
+            .map(|h| {
+                let (a, b) = topo.ends(h);
+                v[a].distance(v[b])
+            })
+            .sum::<f64>()
+            / (topo.twin.len() / 2) as f64;
+        let mut r = Refiner {
+            field: &tool,
+            runs: &runs,
+            opts,
+            mean2: mean * mean,
+            topo,
+            rest: v.clone(),
+            carry: Vec::new(),
+            start: 0.0,
+            bounded: false,
+            torn: 0,
+            fallback: 0,
+            passes: 0,
+        };
+        r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
+        let mut w = v.clone();
+        let mut done = 0;
+        let c = |t: f64| DVec3::new(0.5 * t, 0.0, 0.9);
+        for run in &runs {
+            for j in 0..run.count {
+                slip::step(&tool, &mut w, &r.carry, run, j);
+                done += 1;
+                let t = run.t0 + run.h * (j + 1) as f64;
+                let before = r.over_edges(&w).len();
+                r.refine(&mut w, done, t);
+                let over = r.over_edges(&w);
+                println!(
+                    "step {done}: {} vertices, over before {before}, after {}, torn {}, \
+                     fallback {}, slip {}",
+                    w.len(),
+                    over.len(),
+                    r.torn,
+                    r.fallback,
+                    r.carry
+                        .iter()
+                        .filter(|c| matches!(c, Carry::Surface(_)))
+                        .count()
+                );
+                for &h in over.iter().take(if done == 10 { 30 } else { 3 }) {
+                    let (a, b) = r.topo.ends(h);
+                    let d = |x: DVec3| (x - c(t)).length() - 0.9;
+                    let thr = 1.5 * r.rest[a].distance(r.rest[b]).max(mean);
+                    println!(
+                        "  {a}{:?} {b}{:?} len/thr {:.3} d {:+.2e} {:+.2e} rest d {:+.2e} {:+.2e} path {:?}",
+                        r.carry[a],
+                        r.carry[b],
+                        w[a].distance(w[b]) / thr,
+                        d(w[a]),
+                        d(w[b]),
+                        d(r.rest[a]),
+                        d(r.rest[b]),
+                        r.path(a, b).map(|p| p.len())
+                    );
+                }
+            }
+        }
     }
 
     /// Exploration: `cargo test --release -- --ignored --nocapture drag_stats`.

@@ -60,12 +60,13 @@ type DeformArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray1<i64>>,
-    (usize, usize, usize, bool, f64, f64),
+    (usize, usize, usize, bool, f64, f64, usize, usize),
 );
 
 /// Deform a closed mesh along a field, refining after every step (see `deform::refine`):
 /// `(vertices, rest_vertices, faces, vertices after each step, (passes, torn vertices, edges
-/// over the threshold, bounded, integration seconds, refinement seconds))`. `refine=None`
+/// over the threshold, bounded, integration seconds, refinement seconds, vertices on a slip
+/// surface, vertices at a torn edge's chord midpoint))`. `refine=None`
 /// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
 /// every step when given.
 #[pyfunction]
@@ -120,6 +121,8 @@ pub fn deform_mesh<'py>(
             d.bounded,
             d.time_integrate,
             d.time_refine,
+            d.slip_vertices,
+            d.fallback,
         ),
     ))
 }
