@@ -37,7 +37,16 @@ def test_D14_a_large_drag_is_bounded_and_says_so():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         mesh, report = spinal.deform(sphere, tool, 1.0, max_passes=20)
-    assert len(mesh.vertices) <= 8 * len(sphere.vertices)  # the default max_vertices
+    # the refinement converges well inside the default bound (8× the input's vertices)
+    assert len(mesh.vertices) <= 8 * len(sphere.vertices)
+    assert report.converged and report.edges_over_threshold == 0
+    assert not any(isinstance(w.message, spinal.RefinementWarning) for w in caught)
+    # a bound that stops it is reported and warned about
+    bound = len(sphere.vertices) + 100
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mesh, report = spinal.deform(sphere, tool, 1.0, max_passes=20, max_vertices=bound)
+    assert len(mesh.vertices) <= bound and report.max_vertices == bound
     assert not report.converged and report.edges_over_threshold > 0
     assert any(isinstance(w.message, spinal.RefinementWarning) for w in caught)
 
