@@ -90,7 +90,7 @@ impl Rod {
     }
 
     /// The nearest axis point within `ρ + R` of `x`, if any.
-    #[inline]
+    #[inline(always)]
     pub fn closest(&self, x: DVec3) -> Option<DVec3> {
         self.axis
             .closest_point(x, self.radius + self.reach)
@@ -99,7 +99,7 @@ impl Rod {
 }
 
 impl Distance for Rod {
-    #[inline]
+    #[inline(always)]
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let c = self.closest(x)?;
         let y = x - c;

@@ -68,12 +68,52 @@ struct Segment {
     /// Bounding sphere of the Bézier hull.
     centre: DVec3,
     radius: f64,
+    /// The point-independent coefficients of the foot-point equation ([`Segment::quintic`]):
+    /// `−|c₁|²`, `−3c₁·c₂`, `−(4c₁·c₃ + 2|c₂|²)`, `−5c₂·c₃`, `−3|c₃|²`.
+    k: [f64; 5],
 }
 
 impl Segment {
+    fn new(curve: Power, centre: DVec3, radius: f64) -> Segment {
+        let [_, c1, c2, c3] = curve.c;
+        let k = [
+            -c1.dot(c1),
+            -3.0 * c1.dot(c2),
+            -(4.0 * c1.dot(c3) + 2.0 * c2.dot(c2)),
+            -5.0 * c2.dot(c3),
+            -3.0 * c3.dot(c3),
+        ];
+        Segment {
+            curve,
+            centre,
+            radius,
+            k,
+        }
+    }
+
     #[inline(always)]
     fn at(&self, l: f64) -> (DVec3, DVec3, DVec3) {
         self.curve.at(l)
+    }
+
+    /// `F(λ) = (X − γ(λ))·γ′(λ)` as a quintic in `λ`, coefficients `a₀ … a₅`. With
+    /// `γ = c₀ + c₁λ + c₂λ² + c₃λ³` and `Y = X − c₀` (the segment's own origin, so that the
+    /// terms stay of the size of `|X − γ|`, not of the coordinates):
+    /// `Y·γ′ = Y·c₁ + 2Y·c₂ λ + 3Y·c₃ λ²` and
+    /// `(γ − c₀)·γ′ = |c₁|²λ + 3c₁·c₂ λ² + (4c₁·c₃ + 2|c₂|²)λ³ + 5c₂·c₃ λ⁴ + 3|c₃|² λ⁵`.
+    #[inline(always)]
+    fn quintic(&self, x: DVec3) -> [f64; 6] {
+        let [c0, c1, c2, c3] = self.curve.c;
+        let y = x - c0;
+        let k = &self.k;
+        [
+            y.dot(c1),
+            2.0 * y.dot(c2) + k[0],
+            3.0 * y.dot(c3) + k[1],
+            k[2],
+            k[3],
+            k[4],
+        ]
     }
 }
 
@@ -88,13 +128,27 @@ pub struct Axis {
     /// A sphere (`centre`, `bound`) containing every segment's hull.
     centre: DVec3,
     bound: f64,
-    /// `m_k·x`, `m_k·y`, `m_k·z` and `x_k·m_k` of the samples (four arrays, each followed
-    /// by [`BLOCK`] zeros), for [`Axis::closest_point`]'s scan by blocks.
-    planes: [Vec<f64>; 4],
+    /// The segments by blocks of [`BLOCK`], for [`Axis::closest_point`]'s scan.
+    blocks: Vec<Block>,
 }
 
-/// Samples per block of the scan of [`Axis::closest_point`].
+/// Segments per block of the scan of [`Axis::closest_point`] (at most 31: a block's
+/// sign pattern is a `u32` with one bit per sample).
 const BLOCK: usize = 16;
+
+/// [`BLOCK`] consecutive segments of an [`Axis`] (fewer in the last block).
+#[derive(Debug, Clone, PartialEq)]
+struct Block {
+    /// The axis-aligned box of the segments' Bézier hulls: a point at least `outer` outside
+    /// it in one coordinate is at least `outer` from every segment and sample of the block.
+    lo: DVec3,
+    hi: DVec3,
+    /// The normal planes `F_k = X·m_k − x_k·m_k` at the block's first `BLOCK + 1` samples,
+    /// as `m_k·x`, `m_k·y`, `m_k·z` and `x_k·m_k` (zeros past the last sample).
+    planes: [[f64; BLOCK + 1]; 4],
+    /// The number of segments in the block.
+    segs: usize,
+}
 
 /// The nearest point of an [`Axis`] to a query point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,6 +214,7 @@ impl Axis {
         }
         const CALL: &str = "strip_curve/rod axis";
         let mut segs = alloc::with_capacity(CALL, samples.len() - 1)?;
+        let mut blocks: Vec<Block> = alloc::with_capacity(CALL, (samples.len() - 2) / BLOCK + 1)?;
         // the axis at `PER` parameters per segment (and the last sample), with their
         // chord-length parameters, for the self-approach check
         let rows = alloc::product(CALL, PER, samples.len() - 1, size_of::<DVec3>())? + 1;
@@ -182,11 +237,30 @@ impl Axis {
                 .iter()
                 .map(|p| (*p - centre).length())
                 .fold(0.0, f64::max);
-            let seg = Segment {
-                curve: data.power(),
-                centre,
-                radius,
-            };
+            let seg = Segment::new(data.power(), centre, radius);
+            let (lo, hi) = hull
+                .iter()
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(*p), hi.max(*p))
+                });
+            if k % BLOCK == 0 {
+                let mut planes = [[0.0; BLOCK + 1]; 4];
+                for (j, p) in samples[k..].iter().take(BLOCK + 1).enumerate() {
+                    for (a, v) in [p.m.x, p.m.y, p.m.z, p.x.dot(p.m)].into_iter().enumerate() {
+                        planes[a][j] = v;
+                    }
+                }
+                blocks.push(Block {
+                    lo,
+                    hi,
+                    planes,
+                    segs: 1,
+                });
+            } else if let Some(b) = blocks.last_mut() {
+                b.lo = b.lo.min(lo);
+                b.hi = b.hi.max(hi);
+                b.segs += 1;
+            }
             // curvature-like bound |γ″|/|γ′|² and the arc length, on 16 sub-intervals
             let mut kmax: f64 = 0.0;
             let mut arc = 0.0;
@@ -248,39 +322,26 @@ impl Axis {
             .iter()
             .map(|g| (g.centre - centre).length() + g.radius)
             .fold(0.0, f64::max);
-        // the normal planes `F_k = X·m_k − x_k·m_k` by component, padded to whole blocks
-        let mut planes = [
-            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
-            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
-            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
-            alloc::with_capacity(CALL, samples.len() + BLOCK)?,
-        ];
-        for p in &samples {
-            for (a, v) in [p.m.x, p.m.y, p.m.z, p.x.dot(p.m)].into_iter().enumerate() {
-                planes[a].push(v);
-            }
-        }
-        for pl in planes.iter_mut() {
-            pl.resize(samples.len() + BLOCK, 0.0);
-        }
         Ok(Axis {
             samples,
             segs,
             centre,
             bound,
-            planes,
+            blocks,
         })
     }
 
-    /// The root of `F(λ) = (X − γ)·γ′` in `[0, 1]`, given `F(0) ≥ 0 > F(1)`.
+    /// The root of `F(λ) = (X − γ)·γ′` in `[0, 1]`, given `F(0) ≥ 0 > F(1)`: safeguarded
+    /// Newton on the quintic [`Segment::quintic`] (Horner's rule for `F` and
+    /// `F′ = −|γ′|² + (X − γ)·γ″`), bisection where a Newton step leaves the bracket.
     #[inline]
     fn foot(seg: &Segment, x: DVec3, f0: f64, f1: f64) -> f64 {
+        let a = seg.quintic(x);
+        let (b1, b2, b3, b4) = (2.0 * a[2], 3.0 * a[3], 4.0 * a[4], 5.0 * a[5]);
         let (mut lo, mut hi) = (0.0, 1.0);
         let mut l = (f0 / (f0 - f1)).clamp(0.0, 1.0);
         for _ in 0..64 {
-            let (g, g1, g2) = seg.at(l);
-            let w = x - g;
-            let f = w.dot(g1);
+            let f = a[0] + l * (a[1] + l * (a[2] + l * (a[3] + l * (a[4] + l * a[5]))));
             if f == 0.0 {
                 break;
             }
@@ -289,7 +350,7 @@ impl Axis {
             } else {
                 hi = l;
             }
-            let df = w.dot(g2) - g1.length_squared();
+            let df = a[1] + l * (b1 + l * (b2 + l * (b3 + l * b4)));
             let newton = l - f / df;
             if df < 0.0 && newton >= lo && newton <= hi {
                 let step = (newton - l).abs();
@@ -316,10 +377,11 @@ impl Axis {
     }
 
     /// [`Self::closest`] with the foot's point. `F_k = (X − x_k)·m_k` is evaluated at the
-    /// samples in blocks of [`BLOCK`] (a vectorisable loop); a segment is a candidate only
-    /// where `F` changes sign from `≥ 0` to `< 0` across it (then the bounding-sphere cull,
-    /// then Newton), an end cap only beyond its plane.
-    #[inline]
+    /// samples in blocks of [`BLOCK`] (a vectorisable loop; a block is skipped when `x` is
+    /// `outer` outside its segments' box); a segment is a candidate only where `F` changes
+    /// sign from `≥ 0` to `< 0` across it (then the bounding-sphere cull, then Newton), an
+    /// end cap only beyond its plane.
+    #[inline(always)]
     pub fn closest_point(&self, x: DVec3, outer: f64) -> Option<(Foot, DVec3)> {
         let o2 = outer * outer;
         let n = self.samples.len();
@@ -329,21 +391,18 @@ impl Axis {
         }
         let mut best = o2;
         let mut hit = None;
-        let [mx, my, mz, mc] = &self.planes;
-        let mut f = [0.0; BLOCK + 1];
-        let mut start = 0;
-        while start + 1 < n {
-            // samples start..start + BLOCK + 1 (zeros past the end), segments start..
-            let (bx, by, bz, bc) = (
-                &mx[start..start + BLOCK + 1],
-                &my[start..start + BLOCK + 1],
-                &mz[start..start + BLOCK + 1],
-                &mc[start..start + BLOCK + 1],
-            );
+        let last = self.blocks.len() - 1;
+        for (b, blk) in self.blocks.iter().enumerate() {
+            // no segment or end cap of this block within `outer`
+            if (x.cmple(blk.lo - outer) | x.cmpge(blk.hi + outer)).any() {
+                continue;
+            }
+            let [bx, by, bz, bc] = &blk.planes;
+            let mut f = [0.0; BLOCK + 1];
             for j in 0..BLOCK + 1 {
                 f[j] = (x.x * bx[j] + x.y * by[j]) + (x.z * bz[j] - bc[j]);
             }
-            if start == 0 && f[0] < 0.0 {
+            if b == 0 && f[0] < 0.0 {
                 let p0 = self.samples[0].x;
                 let r2 = (x - p0).length_squared();
                 if r2 < best {
@@ -355,12 +414,11 @@ impl Axis {
             for (j, fj) in f.iter().enumerate() {
                 pos |= ((*fj >= 0.0) as u32) << j;
             }
-            let segs = (n - 1 - start).min(BLOCK);
-            let mut cand = pos & !(pos >> 1) & ((1u32 << segs) - 1);
+            let mut cand = pos & !(pos >> 1) & ((1u32 << blk.segs) - 1);
             while cand != 0 {
                 let j = cand.trailing_zeros() as usize;
                 cand &= cand - 1;
-                let k = start + j;
+                let k = b * BLOCK + j;
                 let seg = &self.segs[k];
                 let lim = seg.radius + outer;
                 if (x - seg.centre).length_squared() < lim * lim {
@@ -373,13 +431,12 @@ impl Axis {
                     }
                 }
             }
-            if start + BLOCK >= n - 1 && f[n - 1 - start] >= 0.0 {
+            if b == last && f[blk.segs] >= 0.0 {
                 let pn = self.samples[n - 1].x;
                 if (x - pn).length_squared() < best {
                     hit = Some((Foot::Cap(n - 1), pn));
                 }
             }
-            start += BLOCK;
         }
         hit
     }
@@ -875,6 +932,67 @@ mod tests {
             strip_curve(&x, 0.1, f64::NAN, None, false).unwrap_err().arg,
             "speed"
         );
+    }
+
+    /// The quintic of the foot-point equation is `(X − γ)·γ′` and its derivative
+    /// `−|γ′|² + (X − γ)·γ″`, evaluated directly.
+    #[test]
+    fn the_foot_quintic_is_the_foot_equation() {
+        let axis = Axis::new(arc(9, 1.0, 1.5), 0.3).unwrap();
+        for (k, seg) in axis.segs.iter().enumerate() {
+            for i in 0..20 {
+                let q = (i * 7 + k) as f64 * 0.31;
+                let x = seg.centre + 0.4 * DVec3::new(q.sin(), (1.3 * q).cos(), (0.7 * q).sin());
+                let a = seg.quintic(x);
+                for l in [0.0, 0.2, 0.55, 1.0] {
+                    let (g, g1, g2) = seg.at(l);
+                    let f = (x - g).dot(g1);
+                    let df = (x - g).dot(g2) - g1.length_squared();
+                    let p = a[0] + l * (a[1] + l * (a[2] + l * (a[3] + l * (a[4] + l * a[5]))));
+                    let dp = a[1]
+                        + l * (2.0 * a[2] + l * (3.0 * a[3] + l * (4.0 * a[4] + l * 5.0 * a[5])));
+                    assert!((p - f).abs() < 1e-15, "{p} {f}");
+                    assert!((dp - df).abs() < 1e-15, "{dp} {df}");
+                }
+            }
+        }
+    }
+
+    /// The block boxes only skip blocks that hold no foot: the closest point of a long axis
+    /// (several blocks) against a dense polyline of it.
+    #[test]
+    fn block_boxes_keep_every_foot() {
+        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3).unwrap();
+        assert!(axis.blocks.len() >= 3);
+        let dense: Vec<DVec3> = (0..59 * 400 + 1)
+            .map(|i| {
+                let (k, l) = (
+                    (i / 400).min(58),
+                    (i - 400 * (i / 400).min(58)) as f64 / 400.0,
+                );
+                axis.segs[k].curve.value(l)
+            })
+            .collect();
+        let mut found = 0;
+        for i in 0..4000 {
+            let q = i as f64 * 0.173;
+            // about the arc and beyond its ends, in and out of reach
+            let (a, r) = (-0.3 + 4.6 * i as f64 / 4000.0, 3.0 + 0.4 * (2.7 * q).sin());
+            let x = DVec3::new(r * a.cos(), r * a.sin(), 0.25 * (1.9 * q).sin());
+            let near = dense
+                .iter()
+                .map(|p| (x - *p).length())
+                .fold(f64::INFINITY, f64::min);
+            match axis.closest_point(x, 0.3) {
+                Some((_, p)) => {
+                    found += 1;
+                    let r = (x - p).length();
+                    assert!(r <= near + 1e-12 && r > near - 1e-4, "{x} {r} {near}");
+                }
+                None => assert!(near > 0.3 - 1e-4, "{x} {near}"),
+            }
+        }
+        assert!(found > 1000 && found < 3800, "{found}");
     }
 
     #[test]
