@@ -22,7 +22,7 @@ use rayon::prelude::*;
 use super::spine::SpineModel;
 use crate::alloc;
 use crate::cancel::{self, Cancel};
-use crate::error::{InputError, Result};
+use crate::error::Result;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -174,28 +174,8 @@ pub fn bind_cancellable(
     vertices: &[DVec3],
     cancel: Cancel<'_>,
 ) -> Result<Binding> {
-    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
-        return Err(InputError::new(
-            "vertices",
-            format!("row {i} is not finite"),
-        ));
-    }
+    super::check_vertices(vertices, rest.scale, "spine")?;
     let (to_model, to_input) = (rest.scale, rest.scale.inverse());
-    if rest.scale.exp() > 0 {
-        // a spine far smaller than 1: a vertex far from it may leave the range once scaled
-        if let Some(i) = vertices
-            .par_iter()
-            .position_first(|v| !to_model.of3(*v).is_finite())
-        {
-            return Err(InputError::new(
-                "vertices",
-                format!(
-                    "row {i} is out of range: its distance from the rest spine, in units of \
-                     the spine's size, exceeds float64"
-                ),
-            ));
-        }
-    }
     let nv = vertices.len();
     let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
     let mut coords = alloc::filled(

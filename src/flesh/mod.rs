@@ -45,3 +45,37 @@ pub use bind::{Binding, COORDS, bind, bind_cancellable};
 pub use pose::{deform, deform_cancellable};
 pub use solve::Solution;
 pub use spine::SpineModel;
+
+/// Refuse vertices that are not finite, or that leave the range of `f64` once brought to the
+/// units of a rest model (`to_model`) far smaller than 1; errors name `vertices` and say
+/// which model (`"spine"` or `"surface"`).
+fn check_vertices(
+    vertices: &[glam::DVec3],
+    to_model: crate::math::scale::Pow2,
+    model: &str,
+) -> crate::error::Result<()> {
+    use crate::error::InputError;
+    use rayon::prelude::*;
+    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+        return Err(InputError::new(
+            "vertices",
+            format!("row {i} is not finite"),
+        ));
+    }
+    if to_model.exp() > 0 {
+        // a model far smaller than 1: a vertex far from it may leave the range once scaled
+        if let Some(i) = vertices
+            .par_iter()
+            .position_first(|v| !to_model.of3(*v).is_finite())
+        {
+            return Err(InputError::new(
+                "vertices",
+                format!(
+                    "row {i} is out of range: its distance from the rest {model}, in units of \
+                     the {model}'s size, exceeds float64"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -408,28 +408,8 @@ pub fn bind_surface_cancellable(
     vertices: &[DVec3],
     cancel: Cancel<'_>,
 ) -> Result<(Vec<i64>, Vec<f64>)> {
-    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
-        return Err(InputError::new(
-            "vertices",
-            format!("row {i} is not finite"),
-        ));
-    }
+    super::check_vertices(vertices, rest.scale, "surface")?;
     let (to_model, to_input) = (rest.scale, rest.scale.inverse());
-    if rest.scale.exp() > 0 {
-        // a surface far smaller than 1: a vertex far from it may leave the range once scaled
-        if let Some(i) = vertices
-            .par_iter()
-            .position_first(|v| !to_model.of3(*v).is_finite())
-        {
-            return Err(InputError::new(
-                "vertices",
-                format!(
-                    "row {i} is out of range: its distance from the rest surface, in units \
-                     of the surface's size, exceeds float64"
-                ),
-            ));
-        }
-    }
     let nv = vertices.len();
     let mut cell = alloc::filled("SurfaceBinding", nv, 0i64)?;
     let mut coords = alloc::filled(
