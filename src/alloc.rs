@@ -36,6 +36,32 @@ pub fn collect<T>(what: &'static str, it: impl ExactSizeIterator<Item = T>) -> R
     Ok(v)
 }
 
+/// The `Ok` items of an iterator of known length, or its first error (or the out-of-memory
+/// error before any item is made).
+pub fn try_collect<T>(
+    what: &'static str,
+    it: impl ExactSizeIterator<Item = Result<T>>,
+) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, it.len())?;
+    for x in it {
+        v.push(x?);
+    }
+    Ok(v)
+}
+
+/// The rows of an iterator of known length, concatenated.
+pub fn flat<T: Copy, const K: usize>(
+    what: &'static str,
+    rows: impl ExactSizeIterator<Item = [T; K]>,
+) -> Result<Vec<T>> {
+    let n = product(what, rows.len(), K, size_of::<T>())?;
+    let mut v = with_capacity(what, n)?;
+    for r in rows {
+        v.extend_from_slice(&r);
+    }
+    Ok(v)
+}
+
 /// The items of an indexed parallel iterator, in order, into a vector reserved fallibly
 /// first (rayon's `collect_into_vec` then uses the reserved room).
 pub fn par_collect<T: Send>(
@@ -87,6 +113,15 @@ mod tests {
         push("x", &mut v, 1u8).unwrap();
         assert_eq!(copied("x", &v).unwrap(), vec![1]);
         assert_eq!(collect("x", [1, 2].into_iter()).unwrap(), vec![1, 2]);
+        assert_eq!(
+            flat("x", [[1, 2], [3, 4]].into_iter()).unwrap(),
+            vec![1, 2, 3, 4]
+        );
+        assert!(flat("x", std::iter::repeat_n([0u64; 4], usize::MAX / 8)).is_err());
+        let ok: [Result<u8>; 2] = [Ok(1), Ok(2)];
+        assert_eq!(try_collect("x", ok.into_iter()).unwrap(), vec![1, 2]);
+        let bad = [Ok(1), Err(InputError::new("a", "b")), Ok(3)];
+        assert_eq!(try_collect("x", bad.into_iter()).unwrap_err().arg, "a");
         use rayon::prelude::*;
         let v = par_collect("x", (0..10_000u32).into_par_iter().map(|i| 2 * i)).unwrap();
         assert!(v.iter().enumerate().all(|(i, &x)| x == 2 * i as u32));

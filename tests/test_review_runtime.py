@@ -126,6 +126,17 @@ D16_CASES = {
         ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
         "s = np.linspace(0, 1, 10_000_000)\n"),
         "sp.evaluate(s)", ""),
+    "keyframed": (
+        ("n = 10_000_000; T = np.arange(n, dtype=float); P = np.c_[T, T, T] * 1e-6\n"
+        "tool = spinal.fields.translation([0, 0, 0], .5, [0, 0, 1])\n"),
+        "spinal.fields.keyframed(tool, T, P)", "keyframed: out of memory"),
+    "spin": (
+        "F = np.ascontiguousarray(np.broadcast_to(np.eye(3), (8_000_000, 3, 3)))\n",
+        "Q.spin(F, np.eye(3))", "spin: out of memory"),
+    "ph.invariants": (
+        ("m = 2_000_000; c = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1.]])\n"
+        "C = np.ascontiguousarray(np.broadcast_to(c, (m, 4, 3)))\n"),
+        "ph.invariants(C)", "ph.invariants: out of memory"),
 }
 
 

@@ -21,6 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Field;
+use crate::alloc;
 
 /// Integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -313,8 +314,9 @@ pub fn check_method(field: &Field, m: Method) -> crate::error::Result<()> {
 const LOCALITY_MIN: usize = 4096;
 
 /// A permutation of `points` along a Morton (Z-order) curve of 10 bits per axis over their
-/// bounding box: neighbours in the order are mostly neighbours in space.
-fn spatial_order(points: &[DVec3]) -> Vec<u32> {
+/// bounding box: neighbours in the order are mostly neighbours in space. `None` when its
+/// buffers cannot be allocated (the order is an optimisation: the caller runs unsorted).
+fn spatial_order(points: &[DVec3]) -> Option<Vec<u32>> {
     let (lo, hi) = points.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
@@ -328,17 +330,17 @@ fn spatial_order(points: &[DVec3]) -> Vec<u32> {
         x = (x | (x << 4)) & 0x030c30c3;
         (x | (x << 2)) & 0x09249249
     };
-    let mut keyed: Vec<(u32, u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
+    let mut keyed: Vec<(u32, u32)> = alloc::par_collect(
+        "advect",
+        points.par_iter().enumerate().map(|(i, p)| {
             let q = ((*p - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1023.0));
             let code = spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2);
             (code, i as u32)
-        })
-        .collect();
-    keyed.par_sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
+        }),
+    )
+    .ok()?;
+    keyed.par_sort_unstable(); // in place
+    alloc::collect("advect", keyed.into_iter().map(|(_, i)| i)).ok()
 }
 
 /// `run(points)` on the points in a spatial order when a tool of `field` benefits from it
@@ -352,8 +354,14 @@ fn with_locality<R>(field: &Field, points: &mut [DVec3], run: impl FnOnce(&mut [
     if !local {
         return run(points);
     }
-    let order = spatial_order(points);
-    let mut sorted: Vec<DVec3> = order.iter().map(|&i| points[i as usize]).collect();
+    // sort keys, order and sorted copy allocated fallibly: without room, run unsorted (the
+    // same bits, see above)
+    let Some((order, mut sorted)) = spatial_order(points).and_then(|order| {
+        let sorted = alloc::collect("advect", order.iter().map(|&i| points[i as usize])).ok()?;
+        Some((order, sorted))
+    }) else {
+        return run(points);
+    };
     let r = run(&mut sorted);
     for (p, &i) in sorted.iter().zip(&order) {
         points[i as usize] = *p;
@@ -490,7 +498,7 @@ mod tests {
                 DVec3::new((a * 0.7).sin(), (a * 1.3).cos(), (a * 0.11).sin()) * 1.2
             })
             .collect();
-        let mut order = spatial_order(&x0);
+        let mut order = spatial_order(&x0).unwrap();
         order.sort_unstable();
         assert!(order.iter().enumerate().all(|(i, &j)| i as u32 == j));
         for f in [Field::single(strip), Field::single(rod)] {

@@ -24,6 +24,7 @@ use glam::{DMat3, DQuat, DVec3};
 
 use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound, translation_bound};
 use super::{Tool, falloff};
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{ROTATION_TOL, is_rotation, mat3_from_quat, quat_from_mat3};
@@ -93,13 +94,16 @@ impl Keys {
             ));
         }
         super::finite_rows("positions", positions)?;
-        let dt: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-        let delta: Vec<DVec3> = positions
-            .windows(2)
-            .zip(&dt)
-            .map(|(w, h)| (w[1] - w[0]) / *h)
-            .collect();
-        let mut slopes = Vec::with_capacity(n);
+        const CALL: &str = "keyframed";
+        let dt = alloc::collect(CALL, times.windows(2).map(|w| w[1] - w[0]))?;
+        let delta = alloc::collect(
+            CALL,
+            positions
+                .windows(2)
+                .zip(&dt)
+                .map(|(w, h)| (w[1] - w[0]) / *h),
+        )?;
+        let mut slopes = alloc::with_capacity(CALL, n)?;
         for k in 0..n {
             slopes.push(if n == 2 {
                 delta[0]
@@ -121,7 +125,7 @@ impl Keys {
                         if let Some(i) = m.iter().position(|f| !is_rotation(f)) {
                             return Err(bad(format!("key {i} is not a rotation matrix")));
                         }
-                        m.iter().map(quat_from_mat3).collect()
+                        alloc::collect(CALL, m.iter().map(quat_from_mat3))?
                     }
                     Orientations::Quaternions(q) => {
                         if let Some(i) = q.iter().position(|q| {
@@ -131,7 +135,7 @@ impl Keys {
                                 "quaternion {i} is not a unit quaternion (x, y, z, w)"
                             )));
                         }
-                        q.iter().map(|q| q.normalize()).collect()
+                        alloc::collect(CALL, q.iter().map(|q| q.normalize()))?
                     }
                 };
                 if q.len() != n {
@@ -145,24 +149,24 @@ impl Keys {
                         q[k] = -q[k];
                     }
                 }
-                let frames = q.iter().map(|q| mat3_from_quat(*q)).collect();
-                let theta = q
-                    .windows(2)
-                    .map(|w| {
+                let frames = alloc::collect(CALL, q.iter().map(|q| mat3_from_quat(*q)))?;
+                let theta = alloc::collect(
+                    CALL,
+                    q.windows(2).map(|w| {
                         let (axis, angle) = (w[0].conjugate() * w[1]).normalize().to_axis_angle();
                         if angle.is_finite() && angle != 0.0 {
                             axis * angle
                         } else {
                             DVec3::ZERO
                         }
-                    })
-                    .collect();
+                    }),
+                )?;
                 Some((frames, theta))
             }
         };
         Ok(Keys {
-            times: times.to_vec(),
-            positions: positions.to_vec(),
+            times: alloc::copied(CALL, times)?,
+            positions: alloc::copied(CALL, positions)?,
             slopes,
             turns,
         })
@@ -329,6 +333,7 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
         self.shape.reach()
     }
     fn breakpoints(&self) -> Vec<f64> {
+        // a copy of the key times, which are held (allocated fallibly in `Keys::new`)
         self.keys.times.clone()
     }
     fn shape(&self) -> Option<ToolShape> {

@@ -207,6 +207,7 @@ impl Field {
 
     /// The sum of two fields.
     pub fn plus(&self, other: &Field) -> Field {
+        // one pointer per tool, each tool already built
         Field {
             tools: self.tools.iter().chain(&other.tools).cloned().collect(),
         }
@@ -272,6 +273,8 @@ impl Field {
 
     /// Sorted times at which a tool's velocity is only continuous in time.
     pub fn breakpoints(&self) -> Vec<f64> {
+        // the tools' breakpoints are copies of their held key or path sample times, so this
+        // is no larger than data already allocated
         let mut b: Vec<f64> = self.tools.iter().flat_map(|e| e.breakpoints()).collect();
         b.sort_by(f64::total_cmp);
         b.dedup();

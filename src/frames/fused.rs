@@ -257,6 +257,7 @@ impl<'s> Scratch<'s> {
     fn new(store: &'s mut Vec<f64>, block: usize) -> Self {
         let room = block + MARGIN;
         store.clear();
+        // `block` ≤ [`BLOCK`]: a constant size per task, not the input's
         store.resize(25 * room, 0.0);
         let mut rest: &'s mut [f64] = store;
         let mut v = || {

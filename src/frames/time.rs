@@ -139,7 +139,7 @@ pub fn frames_in_time(
                 .map(|_| ())
                 .map_err(|e| e.context(&format!("time step {k}")))
         })
-        .collect::<Result<()>>()?;
+        .collect::<Result<()>>()?; // no buffer: the first error or `()`
     if let Some(p) = previous {
         let c = best_turn(&out[..9 * rows], bytemuck::cast_slice(p));
         turn_all(&mut out[..9 * rows], c);

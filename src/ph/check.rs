@@ -7,6 +7,7 @@
 use glam::DVec3;
 
 use super::{Cubic, Invariants};
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 /// Tolerance of the control-polygon PH test for spline input.
@@ -49,7 +50,7 @@ pub fn is_ph_rows(cubics: &[Cubic], tol: f64) -> Result<Vec<bool>> {
         ));
     }
     finite_cubics(cubics)?;
-    Ok(cubics.iter().map(|c| c.is_ph(tol)).collect())
+    alloc::collect("ph.is_ph", cubics.iter().map(|c| c.is_ph(tol)))
 }
 
 /// [`Cubic::invariants`] per cubic; a control polygon with a zero-length leg (relative to
@@ -57,10 +58,9 @@ pub fn is_ph_rows(cubics: &[Cubic], tol: f64) -> Result<Vec<bool>> {
 /// straight or degenerate polygon) is an error naming the cubic.
 pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
     finite_cubics(cubics)?;
-    cubics
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
+    alloc::try_collect(
+        "ph.invariants",
+        cubics.iter().enumerate().map(|(i, c)| {
             let scale =
                 c.b.iter()
                     .map(|p| p.abs().max_element())
@@ -91,8 +91,8 @@ pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
                 ));
             }
             Ok(v)
-        })
-        .collect()
+        }),
+    )
 }
 
 /// The checks of a G¹ PH spline: at least one cubic, finite control points, `knots` (one
@@ -127,10 +127,10 @@ pub fn check_spline(cubics: &[Cubic], knots: &[f64], single: bool) -> Result<()>
         .map(|p| p.abs().max_element())
         .fold(0.0, f64::max)
         + 1.0;
-    let gaps: Vec<f64> = cubics
-        .windows(2)
-        .map(|w| (w[1].b[0] - w[0].b[3]).length())
-        .collect();
+    let gaps = alloc::collect(
+        "PHSpline",
+        cubics.windows(2).map(|w| (w[1].b[0] - w[0].b[3]).length()),
+    )?;
     if let Some((i, g)) = argmax(&gaps) {
         if g > 1e-9 * scale {
             return Err(InputError::new(
@@ -153,14 +153,15 @@ pub fn check_spline(cubics: &[Cubic], knots: &[f64], single: bool) -> Result<()>
             format!("{which}not a PH cubic (control-polygon test, tolerance {SPLINE_PH_TOL:e})"),
         ));
     }
-    let cos: Vec<f64> = cubics
-        .windows(2)
-        .map(|w| {
+    // the negated cosines (negation is exact), for the worst joint by `argmax`
+    let neg_cos = alloc::collect(
+        "PHSpline",
+        cubics.windows(2).map(|w| {
             let (a, b): (DVec3, DVec3) = (w[0].b[3] - w[0].b[2], w[1].b[1] - w[1].b[0]);
-            a.dot(b) / (a.length() * b.length())
-        })
-        .collect();
-    if let Some((i, c)) = argmax(&cos.iter().map(|c| -c).collect::<Vec<_>>()) {
+            -(a.dot(b) / (a.length() * b.length()))
+        }),
+    )?;
+    if let Some((i, c)) = argmax(&neg_cos) {
         let c = -c;
         if !(c >= 1.0 - 1e-12) {
             return Err(InputError::new(

@@ -29,6 +29,7 @@
 use glam::{DMat3, DVec3};
 
 use super::{Cubic, Quat, bern2};
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::frames::geometry::{any_perpendicular, rotate_about};
 
@@ -369,7 +370,7 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
             }
         },
     };
-    let mut out = Vec::with_capacity(cubics.len());
+    let mut out = alloc::with_capacity("PHSpline frames", cubics.len())?;
     for (i, c) in cubics.iter().enumerate() {
         let found =
             bent(c).and_then(|seg| Some((frenet_of(&seg, 0.0)?, frenet_of(&seg, 1.0)?, seg)));

@@ -151,6 +151,7 @@ pub fn hermite(p0: DVec3, t0: DVec3, p1: DVec3, t1: DVec3) -> Solutions {
     let qa = 1.0 - a * a; // = −(1 + 2C)
     let qb = 2.0 * a * md;
     let qc = -(md * md) - (ud * ud + 4.0 * wd * wd) / (b * b);
+    // at most two roots (and cubics below): sizes bounded by a constant
     let mut roots: Vec<f64> = Vec::with_capacity(2);
     if qa.abs() < EPS_LINEAR {
         if qb != 0.0 {

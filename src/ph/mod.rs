@@ -431,10 +431,12 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
     }
     check::finite_rows("A0", a0)?;
     check::finite_rows("A1", a1)?;
-    let st: Vec<[f64; 3]> = start.iter().map(|p| p.to_array()).collect();
+    const CALL: &str = "ph.from_quaternions";
+    let st = alloc::collect(CALL, start.iter().map(|p| p.to_array()))?;
     check::finite_rows("start", &st)?;
-    (0..a0.len())
-        .map(|i| {
+    alloc::try_collect(
+        CALL,
+        (0..a0.len()).map(|i| {
             let c = Cubic::from_quaternions(a0[i], a1[i], start[i]);
             if c.b.iter().all(|p| p.is_finite()) {
                 Ok(c)
@@ -447,8 +449,8 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
                     ),
                 ))
             }
-        })
-        .collect()
+        }),
+    )
 }
 
 /// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a
@@ -456,10 +458,9 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
 /// (not PH), is an error naming it (`batch`: with its index).
 pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64; 9]>> {
     check::finite_cubics(cubics)?;
-    cubics
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
+    alloc::try_collect(
+        "ph.preimage",
+        cubics.iter().enumerate().map(|(i, c)| {
             let (q0, q1, res) = c.preimage().ok_or_else(|| {
                 InputError::new(
                     "control_points",
@@ -482,8 +483,8 @@ pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64
                 ));
             }
             Ok([q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3], res])
-        })
-        .collect()
+        }),
+    )
 }
 
 #[cfg(test)]

@@ -278,7 +278,7 @@ pub fn orientations(
 }
 
 /// PH cubics from control points `(m, 4, 3)`.
-pub fn cubics_of(a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
+pub fn cubics_of(call: &'static str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
     let sh = a.shape();
     if sh[1] != 4 || sh[2] != 3 {
         return Err(value_error(format!(
@@ -286,10 +286,11 @@ pub fn cubics_of(a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
         )));
     }
     let flat: &[DVec3] = bytemuck::cast_slice(slice_of("control_points", a)?);
-    Ok(flat
-        .chunks_exact(4)
-        .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]]))
-        .collect())
+    Ok(alloc::collect(
+        call,
+        flat.chunks_exact(4)
+            .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]])),
+    )?)
 }
 
 /// `numpy.empty(shape, dtype)`: NumPy's allocator reuses freed heap memory for small arrays

@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use super::convert::{choice, detach_in_pool, empty, slice_mut, slice_of, value_error, vec3s};
+use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
     keyframe, path, rod, tube,
@@ -637,15 +638,17 @@ pub fn field_keyframed(
     let orientations = match (matrices, quaternions) {
         (Some(m), _) => {
             let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("orientations", &m)?);
-            Some(keyframe::Orientations::Matrices(
-                rows.iter()
-                    .map(|r| DMat3::from_cols_array(r).transpose())
-                    .collect(),
-            ))
+            Some(keyframe::Orientations::Matrices(alloc::collect(
+                "keyframed",
+                rows.iter().map(|r| DMat3::from_cols_array(r).transpose()),
+            )?))
         }
         (None, Some(q)) => {
             let q = super::convert::quats("orientations", &q)?;
-            Some(keyframe::Orientations::Quaternions(q.to_vec()))
+            Some(keyframe::Orientations::Quaternions(alloc::copied(
+                "keyframed",
+                q,
+            )?))
         }
         (None, None) => None,
     };

@@ -113,6 +113,8 @@ pub fn frames_analytic<'py>(
         turns,
         ..Request::default()
     };
+    // the output and the working vectors of the frames' scan, as for `frames`
+    ensure_memory("frames", pts.len(), 256)?;
     let out = empty::<f64, numpy::Ix3>(py, &[pts.len(), 3, 3])?;
     let angle = {
         let mut rw = out.readwrite();

@@ -11,6 +11,7 @@ use super::convert::{
     cubics_of, detach_in_pool, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s,
 };
 use super::frames::FramesAndAngles;
+use crate::alloc;
 use crate::ph::{self, frame::Mode};
 
 type HermiteArrays<'py> = (
@@ -51,7 +52,7 @@ pub fn ph_eval<'py>(
     s: PyReadonlyArray1<'py, f64>,
     derivative: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("PHSpline.evaluate", &control_points)?;
     let s = slice_of("s", &s)?;
     let out = detach_in_pool(py, || ph::eval_at(&cubics, s, derivative))??;
     rows_of(py, bytemuck::allocation::cast_vec(out), s.len())
@@ -63,12 +64,9 @@ pub fn ph_invariants<'py>(
     py: Python<'py>,
     control_points: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("ph.invariants", &control_points)?;
     let rows = ph::check::invariant_rows(&cubics)?;
-    let mut out = Vec::with_capacity(rows.len() * 13);
-    for v in &rows {
-        out.extend_from_slice(&v.row());
-    }
+    let out = alloc::flat("ph.invariants", rows.iter().map(|v| v.row()))?;
     let m = rows.len();
     PyArray1::from_vec(py, out).reshape([m, 13])
 }
@@ -80,7 +78,7 @@ pub fn ph_is_ph<'py>(
     control_points: PyReadonlyArray3<'py, f64>,
     tol: f64,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("ph.is_ph", &control_points)?;
     let out = ph::check::is_ph_rows(&cubics, tol)?;
     Ok(PyArray1::from_vec(py, out))
 }
@@ -93,7 +91,7 @@ pub fn ph_check_spline(
     knots: PyReadonlyArray1<'_, f64>,
     single: bool,
 ) -> PyResult<()> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("PHSpline", &control_points)?;
     let knots = slice_of("knots", &knots)?;
     Ok(ph::check::check_spline(&cubics, knots, single)?)
 }
@@ -111,11 +109,15 @@ pub fn ph_from_quaternions<'py>(
     let st = vec3s("start", &start)?;
     let cubics = ph::from_quaternion_rows(q0, q1, st)?;
     let m = cubics.len();
-    let out: Vec<f64> = cubics
-        .iter()
-        .flat_map(|c| c.b)
-        .flat_map(|p| p.to_array())
-        .collect();
+    let out = alloc::flat(
+        "ph.from_quaternions",
+        cubics.iter().map(|c| {
+            let [a, b, c, d] = c.b.map(|p| p.to_array());
+            [
+                a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2],
+            ]
+        }),
+    )?;
     rows_of(py, out, m)
 }
 
@@ -128,10 +130,10 @@ pub fn ph_preimage<'py>(
     tol: f64,
     batch: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("ph.preimage", &control_points)?;
     let rows = ph::preimage_rows(&cubics, tol, batch)?;
     let m = rows.len();
-    rows_of(py, rows.concat(), m)
+    rows_of(py, bytemuck::allocation::cast_vec(rows), m)
 }
 
 /// How the RMF starts: a reference vector `initial` or the angle `omega_start`.
@@ -155,10 +157,10 @@ pub fn ph_frame_setup<'py>(
     omega_start: f64,
     phi: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("angle_fit", &control_points)?;
     let start = start_of(initial, omega_start)?;
     let segs = detach_in_pool(py, || ph::frame::setup(&cubics, start, phi))??;
-    let out: Vec<f64> = segs.iter().flat_map(|s| s.to_row()).collect();
+    let out = alloc::flat("angle_fit", segs.iter().map(|s| s.to_row()))?;
     rows_of(py, out, segs.len())
 }
 
@@ -175,7 +177,7 @@ pub fn ph_frames<'py>(
     omega_start: f64,
     phi: Option<f64>,
 ) -> PyResult<FramesAndAngles<'py>> {
-    let cubics = cubics_of(&control_points)?;
+    let cubics = cubics_of("PHSpline.rmf", &control_points)?;
     let s = slice_of("s", &s)?;
     let start = start_of(initial, omega_start)?;
     let n = s.len();

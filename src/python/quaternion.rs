@@ -190,7 +190,8 @@ pub fn camera_inputs<'py>(
         camera::inputs_cancellable(x, t, u, b, closed, mode, &|| stop.requested())
     })??;
     let n = c.tangents.len();
-    let ts: Vec<f64> = c.tangents.iter().flat_map(|v| v.to_array()).collect();
+    // the tangents' own buffer, reinterpreted (no copy)
+    let ts: Vec<f64> = bytemuck::allocation::cast_vec(c.tangents);
     Ok((
         PyArray1::from_vec(py, ts).reshape([n, 3])?,
         PyArray1::from_vec(py, c.up.to_array().to_vec()),

@@ -17,6 +17,7 @@
 use glam::DVec3;
 
 use super::unit_tangents_cancellable;
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::frames::validate;
 
@@ -107,7 +108,10 @@ pub fn inputs_cancellable(
         }
         Mode::Level { singular_angle } => {
             let s = singular_angle.sin();
-            let regular: Vec<bool> = t.iter().map(|t| (u - t.dot(u) * *t).length() > s).collect();
+            let regular = alloc::collect(
+                "camera_frames",
+                t.iter().map(|t| (u - t.dot(u) * *t).length() > s),
+            )?;
             if !regular.contains(&true) {
                 return Err(InputError::new(
                     "points",

@@ -11,6 +11,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::frames::FRAME_TANGENT_TOL;
 use crate::frames::validate;
@@ -66,11 +67,10 @@ pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
             rb.dot(col(&fa, 1)).atan2(rb.dot(col(&fa, 0)))
         })
     };
-    let out: Vec<(f64, f64)> = (0..n)
-        .into_par_iter()
-        .with_min_len(1 << 12)
-        .map(angle)
-        .collect();
+    let out = alloc::par_collect(
+        "spin",
+        (0..n).into_par_iter().with_min_len(1 << 12).map(angle),
+    )?;
     if let Some(i) = out.iter().position(|(d, _)| !(*d <= FRAME_TANGENT_TOL)) {
         return Err(InputError::new(
             "b",
@@ -81,7 +81,7 @@ pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
             ),
         ));
     }
-    Ok(out.into_iter().map(|(_, s)| s).collect())
+    alloc::collect("spin", out.into_iter().map(|(_, s)| s))
 }
 
 #[cfg(test)]
