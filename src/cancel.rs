@@ -184,6 +184,63 @@ mod tests {
     }
 
     #[test]
+    fn sweep_setup_stops_anywhere() {
+        use crate::sweep::{MeshMut, Options, Prepared, Spine};
+        use glam::DVec2;
+        let opts = Options {
+            closed: false,
+            caps: true,
+            miter_limit: 4.0,
+            split_seams: true,
+        };
+        let profile = [DVec2::X, DVec2::Y, -DVec2::X, -DVec2::Y];
+        // near unit size, and far from it (the set-up scales the input first)
+        for size in [1.0, 1e200] {
+            let x: Vec<DVec3> = curve(70_000).into_iter().map(|p| p * size).collect();
+            let req = Request {
+                points: Some(&x),
+                ..Request::default()
+            };
+            let (flat, _) = frames_of(&req, &super::never);
+            let frames: Vec<[f64; 9]> = flat
+                .chunks_exact(9)
+                .map(|c| c.try_into().expect("9"))
+                .collect();
+            let scale = [glam::DVec2::splat(0.01 * size)];
+            let spine = Spine {
+                points: &x,
+                frames: &frames,
+                scale: &scale,
+                twist: &[],
+            };
+            // three curves: the first two short, the third long
+            let offsets = [0, 100, 200, x.len()];
+            let vertices = |p: &Prepared<'_>| {
+                let (nv, nf) = (p.layout.vertices, p.layout.faces);
+                let (mut v, mut f) = (vec![[0.0f64; 3]; nv], vec![[0i64; 3]; nf]);
+                let out = MeshMut {
+                    vertices: &mut v,
+                    faces: &mut f,
+                    normals: None,
+                    uv: None,
+                };
+                p.write_into(out, &super::never).expect("valid");
+                (v.concat(), f)
+            };
+            let run = |c: super::Cancel<'_>| {
+                Prepared::new_cancellable(spine, &offsets, &profile, true, opts, c)
+                    .expect("valid")
+                    .map(|p| vertices(&p))
+            };
+            let (got, _) = stop_everywhere(run);
+            let (v, f) = got.expect("not stopped");
+            let plain = Prepared::new(spine, &offsets, &profile, true, opts).expect("valid");
+            let (pv, pf) = vertices(&plain);
+            assert!(same_bits(&v, &pv) && f == pf);
+        }
+    }
+
+    #[test]
     fn mesh_measures_stop_anywhere() {
         // 200,000 pseudo-random faces over 5,000 vertices (a linear congruential sequence)
         let mut state = 12345u64;

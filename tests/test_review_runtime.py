@@ -304,6 +304,24 @@ D17_CASES = {
         ("n = 2_000_000; s = np.linspace(0, 200 * np.pi, n)\n"
          "X = np.c_[np.cos(s), np.sin(s), .3 * s]\n"),
         "ph.fit(X)"),
+    "tube": (
+        ("n = 2_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.tube(X, .01)"),
+    # frames given and a three-sided profile without normals or texture coordinates: the
+    # set-up (input checks and layout) is a large share of the call
+    "sweep_setup": (
+        ("n = 2_000_000; s = np.linspace(0, 1000 * np.pi, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)] * 1e200\n"
+         "F = spinal.frames(X)\n"),
+        ("spinal.sweep(X, [[1e198, 0], [0, 1e198], [-1e198, 0]], frames=F, normals=False, "
+         "uv=False)")),
+    "sweep_setup_bundle": (
+        ("s = np.linspace(0, 40, 1000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "X = np.concatenate([C + i for i in range(2000)])\n"
+         "F = spinal.frames(X, lengths=[1000] * 2000)\n"),
+        ("spinal.sweep(X, [[.01, 0], [0, .01], [-.01, 0]], frames=F, lengths=[1000] * 2000, "
+         "normals=False, uv=False)")),
 }
 
 

@@ -27,8 +27,18 @@ const CHECK_CHUNK: usize = 1 << 12;
 
 /// Index of the first element failing `ok`, scanning blocks in parallel.
 pub(crate) fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+    first_bad_cancellable(v, ok, &crate::cancel::never)
+}
+
+/// [`first_bad`] that polls `cancel` before every block and finds nothing in the blocks
+/// after it says stop (see [`crate::cancel`]; the caller discards the result then).
+pub(crate) fn first_bad_cancellable<T: Sync>(
+    v: &[T],
+    ok: impl Fn(&T) -> bool + Sync,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Option<usize> {
     v.par_chunks(CHECK_CHUNK)
-        .position_first(|c| !c.iter().all(&ok))
+        .position_first(|c| !cancel() && !c.iter().all(&ok))
         .and_then(|b| {
             let a = b * CHECK_CHUNK;
             v[a..].iter().position(|p| !ok(p)).map(|k| a + k)
@@ -36,7 +46,16 @@ pub(crate) fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Opt
 }
 
 pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
-    match first_bad(v, |p| p.is_finite()) {
+    finite_cancellable(arg, v, &crate::cancel::never)
+}
+
+/// [`finite`] that polls `cancel` before every block ([`first_bad_cancellable`]).
+pub fn finite_cancellable(
+    arg: &'static str,
+    v: &[DVec3],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
+    match first_bad_cancellable(v, |p| p.is_finite(), cancel) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             arg,

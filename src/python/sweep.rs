@@ -1,11 +1,12 @@
 //! Sweeps and tubes (`spinal.sweep`); the algorithm is in [`crate::sweep`].
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_in_pool, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut,
-    slice_of, vec2s, vec3s,
+    Stop, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s,
+    vec3s,
 };
 use crate::sweep::{self, Options, Prepared, Spine};
 
@@ -67,10 +68,16 @@ pub fn sweep_mesh<'py>(
         split_seams,
     };
     let rename = |e| renamed(e, "scale", scale_arg);
-    let prep = detach_in_pool(py, || {
-        Prepared::new(spine, &offsets, prof, profile_closed, opts)
+    let stop = Stop::default();
+    let prep = detach_stoppable(py, &stop, || {
+        let cancel = || stop.requested();
+        Prepared::new_cancellable(spine, &offsets, prof, profile_closed, opts, &cancel)
     })?
     .map_err(rename)?;
+    // stopped only when a signal handler raised, whose error detach_stoppable returned
+    let Some(prep) = prep else {
+        return Err(PyKeyboardInterrupt::new_err(()));
+    };
     // int32 faces only where every index fits
     let index32 = index32 && prep.layout.vertices <= i32::MAX as usize;
     let job = Job {

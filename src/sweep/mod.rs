@@ -137,7 +137,10 @@ impl Plan {
     }
 }
 
-fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
+/// Check one spine and plan its part of the mesh; polls `cancel` between its passes and
+/// before every block of rows within them, and returns `None` once it says stop (see
+/// [`crate::cancel`]).
+fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Result<Option<Plan>> {
     let n = s.points.len();
     if s.frames.len() != n {
         return Err(InputError::new(
@@ -157,7 +160,10 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             format!("has {} entries but points has {n} rows", s.twist.len()),
         ));
     }
-    validate::finite("points", s.points)?;
+    validate::finite_cancellable("points", s.points, cancel)?;
+    if cancel() {
+        return Ok(None);
+    }
     let mut rings = n;
     if opts.closed && n >= 2 && validate::coincide(s.points[0], s.points[n - 1]) {
         rings -= 1;
@@ -172,8 +178,11 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             ),
         ));
     }
-    let chords = validate::chords(&s.points[..rings], opts.closed)?;
-    if let Some(i) = validate::first_bad(s.frames, validate::is_rotation) {
+    let chords = validate::chords_cancellable(&s.points[..rings], opts.closed, cancel)?;
+    if cancel() {
+        return Ok(None);
+    }
+    if let Some(i) = validate::first_bad_cancellable(s.frames, validate::is_rotation, cancel) {
         return Err(InputError::new(
             "frames",
             format!(
@@ -182,7 +191,10 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             ),
         ));
     }
-    if let Some(i) = against_spine(&s.points[..rings], s.frames, opts.closed) {
+    if cancel() {
+        return Ok(None);
+    }
+    if let Some(i) = against_spine(&s.points[..rings], s.frames, opts.closed, cancel) {
         let j = if i + 1 == rings { 0 } else { i + 1 };
         return Err(InputError::new(
             "frames",
@@ -193,7 +205,11 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             ),
         ));
     }
-    if let Some(i) = validate::first_bad(s.scale, |v| v.x > 0.0 && v.y > 0.0 && v.is_finite()) {
+    if cancel() {
+        return Ok(None);
+    }
+    let positive = |v: &DVec2| v.x > 0.0 && v.y > 0.0 && v.is_finite();
+    if let Some(i) = validate::first_bad_cancellable(s.scale, positive, cancel) {
         return Err(InputError::new(
             "scale",
             format!(
@@ -203,11 +219,14 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
             ),
         ));
     }
-    if let Some(i) = validate::first_bad(s.twist, |v| v.is_finite()) {
+    if let Some(i) = validate::first_bad_cancellable(s.twist, |v| v.is_finite(), cancel) {
         return Err(InputError::new(
             "twist",
             format!("non-finite value at row {i}"),
         ));
+    }
+    if cancel() {
+        return Ok(None);
     }
     // the arc lengths in the chords' buffer (no second array of the spine's length)
     let mut arc = chords;
@@ -218,14 +237,14 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile) -> Result<Plan> {
         acc += *a;
         *a = acc;
     }
-    Ok(Plan {
+    Ok(Some(Plan {
         rings,
         segments: if opts.closed { rings } else { rings - 1 },
         caps: opts.caps && !opts.closed && p.closed,
         stored_rings: rings + usize::from(opts.closed && opts.split_seams),
         cols: p.len() + usize::from(p.closed && opts.split_seams),
         arc,
-    })
+    }))
 }
 
 /// The first segment `i` (from sample `i` to the next) that runs against the tangents of
@@ -241,17 +260,29 @@ fn shown(v: DVec2) -> String {
     }
 }
 
-fn against_spine(x: &[DVec3], frames: &[[f64; 9]], closed: bool) -> Option<usize> {
+/// Polls `cancel` before every block of segments and finds nothing in the blocks after it
+/// says stop.
+fn against_spine(
+    x: &[DVec3],
+    frames: &[[f64; 9]],
+    closed: bool,
+    cancel: Cancel<'_>,
+) -> Option<usize> {
+    const BLOCK: usize = 1 << 14;
     let n = x.len();
     let segments = if closed { n } else { n - 1 };
     let t = |k: usize| columns(&frames[k]).2;
-    (0..segments)
+    (0..segments.div_ceil(BLOCK))
         .into_par_iter()
-        .with_min_len(1 << 14)
-        .find_first(|&i| {
-            let j = if i + 1 == n { 0 } else { i + 1 };
-            let chord = x[j] - x[i];
-            chord.dot(t(i)) < 0.0 && chord.dot(t(j)) < 0.0
+        .find_map_first(|b| {
+            if cancel() {
+                return None;
+            }
+            (b * BLOCK..((b + 1) * BLOCK).min(segments)).find(|&i| {
+                let j = if i + 1 == n { 0 } else { i + 1 };
+                let chord = x[j] - x[i];
+                chord.dot(t(i)) < 0.0 && chord.dot(t(j)) < 0.0
+            })
         })
 }
 
@@ -379,9 +410,18 @@ struct Scaled {
 
 /// The [`Scaled`] input, or `None` when the input is near unit size (or not finite: the
 /// checks then report it as given).
-fn scaled_input(points: &[DVec3], profile: &[DVec2], scale: &[DVec2]) -> Option<Scaled> {
+///
+/// Polls `cancel` between its passes and returns `None` once it says stop (the caller polls
+/// again and discards the result).
+fn scaled_input(
+    points: &[DVec3],
+    profile: &[DVec2],
+    scale: &[DVec2],
+    cancel: Cancel<'_>,
+) -> Option<Scaled> {
     use crate::math::scale as s;
-    let finite = points.iter().all(|p| p.is_finite())
+    let finite = validate::first_bad_cancellable(points, |p| p.is_finite(), cancel).is_none()
+        && !cancel()
         && profile.iter().all(|p| p.is_finite())
         && scale
             .iter()
@@ -398,7 +438,7 @@ fn scaled_input(points: &[DVec3], profile: &[DVec2], scale: &[DVec2]) -> Option<
         true => Some(s::exponent(pmax)).filter(|e| e.abs() > s::SAFE_EXP),
         false => None,
     };
-    if k.is_none() && j.is_none() {
+    if (k.is_none() && j.is_none()) || cancel() {
         return None;
     }
     let (k, j) = (k.unwrap_or(0), j.unwrap_or(0));
@@ -1096,6 +1136,19 @@ fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
 /// Check a bundle of spines (`offsets[c]..offsets[c+1]` are the rows of spine `c` in the
 /// flat arrays) and size its mesh.
 pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options) -> Result<Layout> {
+    let lay = layout_cancellable(all, offsets, profile, opts, &cancel::never)?;
+    Ok(lay.expect("a hook that never stops"))
+}
+
+/// [`layout`] that polls `cancel` before every curve and within the checks of each
+/// ([`check_spine`]), and returns `None` once it says stop (see [`crate::cancel`]).
+pub fn layout_cancellable(
+    all: &Spine,
+    offsets: &[usize],
+    profile: &Profile,
+    opts: &Options,
+    cancel: Cancel<'_>,
+) -> Result<Option<Layout>> {
     let curves = offsets.len().saturating_sub(1);
     let n = all.points.len();
     validate::offsets(offsets, n)?;
@@ -1108,10 +1161,13 @@ pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options)
             ),
         ));
     }
-    let plans: Vec<Plan> = (0..curves)
+    let plans: Vec<Option<Plan>> = (0..curves)
         .into_par_iter()
         .map(|c| {
-            check_spine(&part(all, offsets, c), opts, profile).map_err(|e| {
+            if cancel() {
+                return Ok(None);
+            }
+            check_spine(&part(all, offsets, c), opts, profile, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!(
                         "curve {c} (rows {} to {})",
@@ -1124,11 +1180,14 @@ pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options)
             })
         })
         .collect::<Result<_>>()?;
-    Ok(Layout {
+    let Some(plans) = plans.into_iter().collect::<Option<Vec<Plan>>>() else {
+        return Ok(None);
+    };
+    Ok(Some(Layout {
         vertices: plans.iter().map(Plan::vertices).sum(),
         faces: plans.iter().map(|p| p.faces(profile)).sum(),
         plans,
-    })
+    }))
 }
 
 /// Sweep `profile` along every spine of a checked bundle into buffers of the sizes in
@@ -1259,7 +1318,31 @@ impl<'a> Prepared<'a> {
         profile_closed: bool,
         opts: Options,
     ) -> Result<Prepared<'a>> {
-        let scaled = scaled_input(spine.points, profile, spine.scale);
+        let prep = Prepared::new_cancellable(
+            spine,
+            offsets,
+            profile,
+            profile_closed,
+            opts,
+            &cancel::never,
+        )?;
+        Ok(prep.expect("a hook that never stops"))
+    }
+
+    /// [`Prepared::new`] that polls `cancel` between its passes and before every block of
+    /// rows within them, and returns `None` once it says stop (see [`crate::cancel`]).
+    pub fn new_cancellable(
+        spine: Spine<'a>,
+        offsets: &'a [usize],
+        profile: &[DVec2],
+        profile_closed: bool,
+        opts: Options,
+        cancel: Cancel<'_>,
+    ) -> Result<Option<Prepared<'a>>> {
+        let scaled = scaled_input(spine.points, profile, spine.scale, cancel);
+        if cancel() {
+            return Ok(None);
+        }
         let (points, prof, scale) = match &scaled {
             Some(s) => (&s.points[..], &s.profile[..], &s.scale[..]),
             None => (spine.points, profile, spine.scale),
@@ -1270,15 +1353,17 @@ impl<'a> Prepared<'a> {
             scale,
             ..spine
         };
-        let layout = layout(&view, offsets, &p, &opts)?;
-        Ok(Prepared {
+        let Some(layout) = layout_cancellable(&view, offsets, &p, &opts, cancel)? else {
+            return Ok(None);
+        };
+        Ok(Some(Prepared {
             spine,
             offsets,
             scaled,
             profile: p,
             opts,
             layout,
-        })
+        }))
     }
 
     /// The number of faces of every spine's part of the mesh (its side faces, then its
