@@ -307,8 +307,9 @@ pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
         monotone_piece(q, &all, &mut seq, &mut stack, &mut out);
         return out;
     }
-    // the edges around every vertex, counter-clockwise: the block off[v]..off[v + 1] of
-    // `adj` holds the far ends, the two polygon edges first and sorted only with diagonals
+    // the edges around every vertex: the block off[v]..off[v + 1] of `adj` holds their far
+    // ends, the two polygon edges first; blocks with diagonals are then sorted
+    // counter-clockwise (two edges need no order: each is the other's neighbour both ways)
     let next = |v: usize| if v + 1 == m { 0 } else { v + 1 };
     let prev = |v: usize| if v == 0 { m - 1 } else { v - 1 };
     let mut off = vec![2usize; m + 1];
