@@ -403,6 +403,37 @@ def _shoelace(p):
     return 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
 
 
+def _cap_areas(mesh, k):
+    """Twice the signed areas, seen from +z, of the first cap's and the last cap's ``k``
+    triangles (the last ``2 k`` faces of a one-spine sweep along z)."""
+    v = mesh.vertices[mesh.faces[-2 * k:]]
+    (ax, ay), (bx, by) = (v[:, 1, :2] - v[:, 0, :2]).T, (v[:, 2, :2] - v[:, 0, :2]).T
+    z = ax * by - ay * bx
+    return z[:k], z[k:]
+
+
+@pytest.mark.parametrize("kind", ["star", "comb"])
+def test_caps_of_100k_spike_profiles(kind):
+    """The capped sweep of a profile of 100,000 packed spikes (the size at which ear
+    clipping took tens of seconds): m − 2 triangles per cap on the profile's vertices, all of
+    them facing out of the end (none flat), covering the profile's area, in either
+    orientation; watertight with volume = area × length."""
+    p = _star(100_000) if kind == "star" else _comb(25_000)
+    m = len(p)
+    spine = np.c_[np.zeros(3), np.zeros(3), np.arange(3.0)]
+    for q in (p, p[::-1]):
+        mesh = spinal.sweep(spine, q)
+        assert len(mesh.vertices) == 3 * m
+        assert len(mesh.faces) == 2 * 2 * m + 2 * (m - 2)
+        first, last = _cap_areas(mesh, m - 2)
+        assert np.all(first < 0) and np.all(last > 0)
+        area = abs(_shoelace(q))
+        assert 0.5 * np.sum(last) == pytest.approx(area, rel=1e-12)
+        assert -0.5 * np.sum(first) == pytest.approx(area, rel=1e-12)
+        assert mesh.is_watertight
+        assert mesh.volume == pytest.approx(area * 2.0, rel=1e-9)
+
+
 @pytest.mark.parametrize("kind", ["star", "comb", "random star-shaped"])
 def test_packed_spike_profiles_sweep_closed(kind):
     """Profiles of many packed spikes (checked for self-intersection by a sweep line): the

@@ -104,7 +104,8 @@ def test_closed_knot_tube_volume_is_second_order():
 
 @pytest.mark.parametrize("turns", [2, -2])
 def test_twisted_star_along_a_line_is_second_order(turns):
-    """A non-convex (star) profile twisted twice along a line, caps by ear clipping."""
+    """A non-convex (star) profile twisted twice along a line, capped by its
+    triangulation."""
     prof, L = star(), 3.0
     exact = area(prof) * L
     errors = []

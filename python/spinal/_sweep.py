@@ -126,8 +126,9 @@ def sweep(
         The spine is a loop (a repeated first point at the end is accepted): the last ring
         is joined to the first; no caps.
     caps : bool
-        Close the ends of an open spine with the triangulated profile (ear clipping, so
-        non-convex profiles work); the mesh is then watertight.
+        Close the ends of an open spine with the triangulated profile (on its own
+        vertices, so non-convex profiles work; O(m log m) in the profile's vertices); the
+        mesh is then watertight.
     miter_limit : float
         Largest mitre stretch (≥ 1; 1 switches the stretch off).
     split_seams : bool

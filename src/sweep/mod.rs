@@ -20,9 +20,9 @@
 //! spine) vertex to vertex, two triangles per quad, wound so that the normals point to the
 //! right of the profile's direction of travel, which is outwards for a counter-clockwise
 //! closed profile; clockwise closed profiles are wound the other way, so closed sweeps always
-//! face outwards. Caps are the ear-clipping triangulation of the profile on the first and
-//! last rings. Every vertex is shared by all its faces, so closed sweeps and capped open
-//! sweeps are watertight by construction.
+//! face outwards. Caps are a triangulation of the profile on its own vertices (by monotone
+//! pieces, `monotone.rs`) on the first and last rings. Every vertex is shared by all its
+//! faces, so closed sweeps and capped open sweeps are watertight by construction.
 //!
 //! **Alternating diagonals.** A twisted quad `a b c d` (`a b` on ring `i`, `d c` on ring
 //! `i + 1`) is not planar; its two splits enclose volumes that differ by the tetrahedron on
@@ -57,6 +57,7 @@
 //! **Texture coordinates**: `u` = arc length of the spine polyline at the ring, `v` = arc
 //! length around the profile divided by its perimeter.
 
+mod monotone;
 pub mod profile;
 
 use glam::{DVec2, DVec3};

@@ -6,18 +6,17 @@
 //!   faces are wound so that they face outwards whichever way the user listed the vertices.
 //! * The `v` texture coordinate of vertex `j` is its arc length along the profile divided by
 //!   the perimeter (closed) or by the total length (open).
-//! * Caps are the ear-clipping triangulation of the polygon (Meisters 1975: every simple
-//!   polygon with more than three vertices has two non-overlapping ears), so non-convex
-//!   profiles (mouldings, stars, letters) are capped correctly and no vertex is added.
+//! * Caps are a triangulation of the polygon on its own vertices (every simple polygon of
+//!   `m` vertices splits into `m − 2` triangles by diagonals), so non-convex profiles
+//!   (mouldings, stars, letters) are capped correctly and no vertex is added.
 //!
 //! **Cost.** A strictly convex polygon (every turn the same way, total turning ±2π) is
 //! simple and is fanned from its first vertex: O(m). Other polygons are checked for
 //! self-intersection by the sweep line of Shamos and Hoey in O(m log m) with exact
 //! orientation tests (adjacent edges that fold back onto each other count as meeting), and
-//! ear-clipped on a doubly linked list, testing only the reflex vertices near the candidate
-//! ear (a convex vertex whose triangle contains no reflex vertex is an ear; O'Rourke,
-//! *Computational Geometry in C*, §1.6; the grid as in Mapbox's earcut): close to linear on
-//! ordinary profiles, O(m²) in the worst case of adversarial ones.
+//! triangulated in O(m log m) with the same tests: a second sweep cuts them into y-monotone
+//! pieces, each triangulated with a stack in linear time (de Berg et al., *Computational
+//! Geometry: Algorithms and Applications*, §3.2–3.3; see `monotone.rs`).
 
 use glam::DVec2;
 
@@ -75,17 +74,51 @@ fn two_product(a: f64, b: f64) -> (f64, f64) {
 /// underflow) — a floating-point filter first, then the exact sum of an expansion (Shewchuk,
 /// "Adaptive precision floating-point arithmetic and fast robust geometric predicates",
 /// 1997, §4.3 "orient2d").
-fn orient(a: DVec2, b: DVec2, c: DVec2) -> std::cmp::Ordering {
+pub(super) fn orient(a: DVec2, b: DVec2, c: DVec2) -> std::cmp::Ordering {
+    let sign = |x: f64| x.partial_cmp(&0.0).unwrap_or(std::cmp::Ordering::Equal);
     let detl = (a.x - c.x) * (b.y - c.y);
     let detr = (a.y - c.y) * (b.x - c.x);
     let det = detl - detr;
+    // the two products of opposite signs, or one of them zero (a rounded difference is zero
+    // only when exact, and keeps its sign): `det` has the sign of the exact value (Shewchuk's
+    // orient2d, which this follows)
+    if (detl > 0.0 && detr <= 0.0) || (detl < 0.0 && detr >= 0.0) || detl == 0.0 {
+        return sign(det);
+    }
     // Shewchuk's ccwerrboundA = (3 + 16ε) ε, ε = 2^-53
     let bound =
         (3.0 + 16.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2.0) * (detl.abs() + detr.abs());
     if det > bound || -det > bound {
-        return det.partial_cmp(&0.0).unwrap_or(std::cmp::Ordering::Equal);
+        return sign(det);
     }
-    // exact: each difference as two terms, each product of two-term factors as eight
+    // Shewchuk's Grow-Expansion with zero elimination, in place: a non-overlapping
+    // expansion in increasing magnitude (each term adds at most one component), whose sign
+    // is that of its last non-zero component
+    let mut h = [0.0; 16];
+    let mut n = 0;
+    for t in orient_terms(a, b, c) {
+        let mut q = t;
+        let mut k = 0;
+        for i in 0..n {
+            let (sum, err) = two_sum(q, h[i]);
+            if err != 0.0 {
+                h[k] = err;
+                k += 1;
+            }
+            q = sum;
+        }
+        if q != 0.0 {
+            h[k] = q;
+            k += 1;
+        }
+        n = k;
+    }
+    sign(if n == 0 { 0.0 } else { h[n - 1] })
+}
+
+/// `(a − c) × (b − c)` as sixteen floating-point numbers that add up to it exactly (barring
+/// underflow): each difference as two terms, each product of two-term factors as eight.
+fn orient_terms(a: DVec2, b: DVec2, c: DVec2) -> [f64; 16] {
     let (ax, ex) = two_diff(a.x, c.x);
     let (by, ey) = two_diff(b.y, c.y);
     let (ay, fy) = two_diff(a.y, c.y);
@@ -106,27 +139,45 @@ fn orient(a: DVec2, b: DVec2, c: DVec2) -> std::cmp::Ordering {
         terms[2 * k] = sign * x;
         terms[2 * k + 1] = sign * e;
     }
-    // Shewchuk's Grow-Expansion with zero elimination: a non-overlapping expansion in
-    // increasing magnitude, whose sign is that of its last non-zero component
-    let mut h: Vec<f64> = Vec::with_capacity(32);
-    for &t in &terms {
-        let mut q = t;
-        let mut g = Vec::with_capacity(h.len() + 1);
-        for &x in &h {
-            let (sum, err) = two_sum(q, x);
-            if err != 0.0 {
-                g.push(err);
-            }
-            q = sum;
-        }
-        if q != 0.0 {
-            g.push(q);
-        }
-        h = g;
+    terms
+}
+
+/// A sum with Neumaier's compensation (error about one rounding of the result plus
+/// `ε²` times the sum of magnitudes).
+#[cfg(test)]
+pub(super) fn accurate_sum(xs: impl IntoIterator<Item = f64>) -> f64 {
+    let (mut s, mut c) = (0.0_f64, 0.0_f64);
+    for x in xs {
+        let t = s + x;
+        c += if s.abs() >= x.abs() {
+            (s - t) + x
+        } else {
+            (x - t) + s
+        };
+        s = t;
     }
-    h.last()
-        .and_then(|x| x.partial_cmp(&0.0))
-        .unwrap_or(std::cmp::Ordering::Equal)
+    s + c
+}
+
+/// `(a − c) × (b − c)` (twice the signed area of the triangle `a b c`) to about the last
+/// bit: the exact terms of [`orient`] added up with compensation.
+#[cfg(test)]
+pub(super) fn accurate_det(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    accurate_sum(orient_terms(a, b, c))
+}
+
+/// Twice the signed area of a closed polygon to about the last bit (the shoelace formula
+/// with accurate terms and sum).
+#[cfg(test)]
+pub(super) fn accurate_area2(p: &[DVec2]) -> f64 {
+    let m = p.len();
+    accurate_sum((0..m).map(|j| accurate_det(p[j], p[(j + 1) % m], DVec2::ZERO)))
+}
+
+/// Twice the area covered by the triangles `tris` of the points `p`, to about the last bit.
+#[cfg(test)]
+pub(super) fn accurate_cover2(p: &[DVec2], tris: &[[usize; 3]]) -> f64 {
+    accurate_sum(tris.iter().map(|t| accurate_det(p[t[0]], p[t[1]], p[t[2]])))
 }
 
 /// Do the closed segments `p q` and `r s` intersect (touching counts)? Exact.
@@ -337,18 +388,8 @@ impl Profile {
         // the area and intersection tests multiply coordinates: run them on the polygon
         // divided by the power of two of its largest coordinate (exact), so that any finite
         // size works
-        let k = if scale > 0.0 {
-            -crate::math::scale::exponent(scale)
-        } else {
-            0
-        };
-        let unit = |v: &DVec2| {
-            DVec2::new(
-                crate::math::scale::ldexp(v.x, k),
-                crate::math::scale::ldexp(v.y, k),
-            )
-        };
-        let q: Vec<DVec2> = p.iter().map(unit).collect();
+        let k = unit_exponent(scale);
+        let q: Vec<DVec2> = p.iter().map(|&v| scaled(v, k)).collect();
         let (p_all, p) = (p, q);
         let scale = crate::math::scale::ldexp(scale, k);
         let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
@@ -434,8 +475,34 @@ impl Profile {
         if self.convex {
             return (1..m - 1).map(|k| [ccw[0], ccw[k], ccw[k + 1]]).collect();
         }
-        ear_clip(&self.points, &ccw)
+        // the exact predicates on the polygon brought near unit size, as in the check of
+        // [`Profile::new`]
+        let scale = (self.points.iter()).fold(0.0_f64, |a, q| a.max(q.abs().max_element()));
+        let k = unit_exponent(scale);
+        let q: Vec<DVec2> = ccw.iter().map(|&i| scaled(self.points[i], k)).collect();
+        super::monotone::triangulate(&q)
+            .into_iter()
+            .map(|t| t.map(|i| ccw[i]))
+            .collect()
     }
+}
+
+/// The power of two `k` that brings the largest coordinate `scale` of a polygon into
+/// `[1, 2)` (0 for a polygon at the origin).
+fn unit_exponent(scale: f64) -> i32 {
+    if scale > 0.0 {
+        -crate::math::scale::exponent(scale)
+    } else {
+        0
+    }
+}
+
+/// `v 2^k`, exactly while the result is normal.
+fn scaled(v: DVec2, k: i32) -> DVec2 {
+    DVec2::new(
+        crate::math::scale::ldexp(v.x, k),
+        crate::math::scale::ldexp(v.y, k),
+    )
 }
 
 /// Is the closed polygon strictly convex: every turn of the same sign and the total turning
@@ -460,6 +527,7 @@ fn strictly_convex(p: &[DVec2]) -> bool {
 /// Square cells of side `side` (the median edge length, but at least a quarter of the mean, so
 /// that a few edges far longer than the rest cross O(m) cells in all) holding items (edges or
 /// vertices), sorted by cell: memory and time follow the items, not the bounding box.
+#[cfg(test)]
 struct Cells {
     lo: DVec2,
     inv: f64,
@@ -467,6 +535,7 @@ struct Cells {
     items: Vec<(u64, usize)>,
 }
 
+#[cfg(test)]
 impl Cells {
     fn new(p: &[DVec2], closed: bool) -> Cells {
         let m = p.len();
@@ -501,7 +570,6 @@ impl Cells {
 
     /// Add `item` to every cell the segment `a b` passes through (and some neighbours):
     /// samples every half cell, each with its 3 × 3 block of cells.
-    #[cfg(test)]
     fn add_segment(&mut self, a: DVec2, b: DVec2, item: usize) {
         let steps = ((b - a).length() * self.inv * 2.0).ceil().min(4e9) as usize;
         let mut last = None;
@@ -520,22 +588,9 @@ impl Cells {
         }
     }
 
-    fn add_point(&mut self, q: DVec2, item: usize) {
-        let (x, y) = self.xy(q);
-        self.items.push((Self::key(x, y), item));
-    }
-
     fn sort(&mut self) {
         self.items.sort_unstable();
         self.items.dedup();
-    }
-
-    /// Items of the cell `(x, y)`.
-    fn at(&self, x: u64, y: u64) -> &[(u64, usize)] {
-        let k = Self::key(x, y);
-        let i = self.items.partition_point(|e| e.0 < k);
-        let j = i + self.items[i..].partition_point(|e| e.0 == k);
-        &self.items[i..j]
     }
 }
 
@@ -571,98 +626,12 @@ fn first_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
     best
 }
 
-/// Ear clipping of the simple polygon `p` listed counter-clockwise by `ccw`, on a doubly
-/// linked list; the reflex vertices are binned on a grid so that an ear test looks only at
-/// those near the ear.
-fn ear_clip(p: &[DVec2], ccw: &[usize]) -> Vec<[usize; 3]> {
-    let m = ccw.len();
-    let q: Vec<DVec2> = ccw.iter().map(|&i| p[i]).collect();
-    let mut next: Vec<usize> = (0..m).map(|k| (k + 1) % m).collect();
-    let mut prev: Vec<usize> = (0..m).map(|k| (k + m - 1) % m).collect();
-    let mut alive = vec![true; m];
-    let turn = |prev: &[usize], next: &[usize], k: usize| {
-        let (a, b, c) = (q[prev[k]], q[k], q[next[k]]);
-        cross(b - a, c - b)
-    };
-    let mut cells = Cells::new(&q, true);
-    let mut reflex = Vec::new();
-    for (k, &v) in q.iter().enumerate() {
-        if turn(&prev, &next, k) <= 0.0 {
-            cells.add_point(v, k);
-            reflex.push(k);
-        }
-    }
-    cells.sort();
-    let inside = |a: DVec2, b: DVec2, c: DVec2, v: DVec2| {
-        cross(b - a, v - a) >= 0.0 && cross(c - b, v - b) >= 0.0 && cross(a - c, v - c) >= 0.0
-    };
-    let mut tris = Vec::with_capacity(m.saturating_sub(2));
-    let (mut left, mut k, mut guard) = (m, 0, 0);
-    while left > 3 {
-        let (ia, ic) = (prev[k], next[k]);
-        let (a, b, c) = (q[ia], q[k], q[ic]);
-        let mut ear = cross(b - a, c - b) > 0.0;
-        if ear {
-            // a reflex vertex (still reflex, not a corner of the ear) inside blocks it
-            let blocks = |v: usize| {
-                alive[v]
-                    && v != ia
-                    && v != k
-                    && v != ic
-                    && turn(&prev, &next, v) <= 0.0
-                    && inside(a, b, c, q[v])
-            };
-            let ((x0, y0), (x1, y1)) = (cells.xy(a.min(b).min(c)), cells.xy(a.max(b).max(c)));
-            ear = if (x1 - x0 + 1).saturating_mul(y1 - y0 + 1) > reflex.len() as u64 {
-                !reflex.iter().any(|&v| blocks(v))
-            } else {
-                !(y0..=y1)
-                    .any(|y| (x0..=x1).any(|x| cells.at(x, y).iter().any(|&(_, v)| blocks(v))))
-            };
-        }
-        if !ear {
-            k = ic;
-            guard += 1;
-            if guard <= left {
-                continue;
-            }
-            // Only reachable through round-off on nearly collinear runs: clip the flattest
-            // convex-or-straight vertex.
-            let (mut j, mut best, mut flat) = (k, k, turn(&prev, &next, k));
-            for _ in 1..left {
-                j = next[j];
-                let t = turn(&prev, &next, j);
-                if t > flat {
-                    (best, flat) = (j, t);
-                }
-            }
-            k = best;
-        }
-        let (ia, ic) = (prev[k], next[k]);
-        tris.push([ccw[ia], ccw[k], ccw[ic]]);
-        alive[k] = false;
-        next[ia] = ic;
-        prev[ic] = ia;
-        left -= 1;
-        guard = 0;
-        if reflex.len() > 64 && 2 * reflex.iter().filter(|&&v| alive[v]).count() < reflex.len() {
-            reflex.retain(|&v| alive[v]);
-        }
-        k = ic;
-    }
-    let a = next[k];
-    tris.push([ccw[k], ccw[a], ccw[next[a]]]);
-    tris
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn area_of(p: &[DVec2], tris: &[[usize; 3]]) -> f64 {
-        tris.iter()
-            .map(|t| 0.5 * cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]))
-            .sum()
+        0.5 * accurate_cover2(p, tris)
     }
 
     /// One edge 3e9 times longer than the others: the binning stays O(m) (it asked for
@@ -716,7 +685,7 @@ mod tests {
         }
     }
 
-    /// A regular 1000-gon is convex (a fan); a gear of 400 teeth is not (ear clipping);
+    /// A regular 1000-gon is convex (a fan); a gear of 400 teeth is not (monotone pieces);
     /// both cover their area with counter-clockwise triangles, in either orientation.
     #[test]
     fn convex_and_many_vertex_profiles_are_covered() {
@@ -827,6 +796,48 @@ mod tests {
         }
     }
 
+    /// The orientation of points with integer coordinates up to 2^52 (products beyond the
+    /// 53 bits of a double) against exact integer arithmetic: random points, points
+    /// repeated (products of zero) and nearly collinear triples.
+    #[test]
+    fn orientation_matches_integer_arithmetic() {
+        let mut rng = Rng(0x5851f42d4c957f2d);
+        let exact = |a: DVec2, b: DVec2, c: DVec2| {
+            let i = |x: f64| x as i128;
+            let d = (i(a.x) - i(c.x)) * (i(b.y) - i(c.y)) - (i(a.y) - i(c.y)) * (i(b.x) - i(c.x));
+            d.cmp(&0)
+        };
+        for bits in [3u32, 20, 40, 52] {
+            let big = 1u64 << bits;
+            let pt = |rng: &mut Rng| {
+                let s = |rng: &mut Rng| rng.below(big) as f64 - (big / 2) as f64;
+                DVec2::new(s(rng), s(rng))
+            };
+            for _ in 0..20_000 {
+                let (a, b) = (pt(&mut rng), pt(&mut rng));
+                // c random, repeated, or on the line a b moved by a unit
+                let c = match rng.below(3) {
+                    0 => pt(&mut rng),
+                    1 => [a, b][rng.below(2) as usize],
+                    _ => {
+                        let t = rng.below(1 << 10) as f64;
+                        let on = a + (b - a) * t;
+                        (on + DVec2::new(rng.below(3) as f64 - 1.0, 0.0)).round()
+                    }
+                };
+                if [a, b, c]
+                    .iter()
+                    .any(|p| p.abs().max_element() >= 2f64.powi(61))
+                {
+                    continue;
+                }
+                for (x, y, z) in [(a, b, c), (b, c, a), (c, a, b), (b, a, c)] {
+                    assert_eq!(orient(x, y, z), exact(x, y, z), "{x:?} {y:?} {z:?}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn sweep_finds_crossings_like_testing_all_pairs() {
         let mut rng = Rng(0x2545f4914f6cdd1d);
@@ -887,7 +898,8 @@ mod tests {
         }
     }
 
-    /// Stars and combs of many packed spikes: simple, and one spike bent onto its
+    /// Stars and combs of many packed spikes: simple, capped by `m − 2` counter-clockwise
+    /// triangles covering the area in either orientation, and one spike bent onto its
     /// neighbour is found.
     #[test]
     fn packed_spikes_are_checked_in_m_log_m() {
@@ -916,7 +928,23 @@ mod tests {
         };
         for mut p in [star(100_000), comb(25_000)] {
             assert_eq!(sweep_crossing(&p, true), None);
-            assert!(Profile::new(&p, true).is_ok());
+            for rev in [false, true] {
+                let mut q = p.clone();
+                if rev {
+                    q.reverse();
+                }
+                let prof = Profile::new(&q, true).unwrap();
+                let tris = prof.triangulate();
+                assert_eq!(tris.len(), q.len() - 2);
+                use std::cmp::Ordering::Greater;
+                assert!(
+                    tris.iter()
+                        .all(|t| orient(q[t[0]], q[t[1]], q[t[2]]) == Greater)
+                );
+                // the covered area against the polygon's, both to about the last bit
+                let (a, want) = (area_of(&q, &tris), 0.5 * accurate_area2(&q).abs());
+                assert!((a - want).abs() < 1e-12 * a, "{a} {want}");
+            }
             let n = p.len();
             // two vertices of neighbouring spikes swapped: their edges cross
             let k = (n / 2) & !1;
