@@ -322,6 +322,30 @@ D17_CASES = {
          "F = spinal.frames(X, lengths=[1000] * 2000)\n"),
         ("spinal.sweep(X, [[.01, 0], [0, .01], [-.01, 0]], frames=F, lengths=[1000] * 2000, "
          "normals=False, uv=False)")),
+    "frames_in_time": (
+        ("n, T = 240_000, 50; s = np.linspace(0, 100, n); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "P = np.stack([C * (1 + .01 * k) for k in range(T)])\n"),
+        "spinal.frames_in_time(P)"),
+    "estimate_tangents_offsets": (
+        ("n = 20_000_000; s = np.linspace(0, 4000, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.estimate_tangents(X, lengths=[1000] * (n // 1000))"),
+    # the check, volume and centroid of a closed tool (fields.mesh_tool, fields.mesh_curl),
+    # called alone: 32 million faces of a closed tube
+    "closed_tool_centroid": (
+        ("s = np.linspace(0, 4000, 2_000_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01)\n"
+         "V, F = np.asarray(m.vertices), np.asarray(m.faces)\n"),
+        "spinal._core.mesh_closed_centroid(V, F)"),
+    # the same tube without its first face: the search for the first edge in one face
+    "closed_tool_not_watertight": (
+        ("s = np.linspace(0, 4000, 2_000_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01)\n"
+         "V, F = np.asarray(m.vertices), np.ascontiguousarray(np.asarray(m.faces)[1:])\n"
+         "def refused():\n"
+         "    try:\n"
+         "        spinal._core.mesh_closed_centroid(V, F)\n"
+         "    except ValueError:\n"
+         "        pass\n"),
+        "refused()"),
 }
 
 

@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_in_pool, detach_stoppable, empty, ensure_memory, offsets_of, orientations,
-    renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
+    Stop, detach_stoppable, empty, ensure_memory, offsets_of, orientations, renamed, slice_mut,
+    slice_of, value_error, vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
@@ -150,8 +150,10 @@ pub fn estimate_tangents<'py>(
         }
         Some(o) => {
             let offs = offsets_of(&o)?;
-            detach_in_pool(py, || {
-                frames::tangents::estimate_many(x, &offs, closed, rule)
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                let cancel = || stop.requested();
+                frames::tangents::estimate_many_cancellable(x, &offs, closed, rule, &cancel)
             })??
         }
     };
@@ -366,14 +368,16 @@ pub fn frames_in_time<'py>(
     {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        detach_in_pool(py, || {
-            frames::time::frames_in_time(
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            frames::time::frames_in_time_cancellable(
                 &template,
                 steps,
                 rows,
                 frames::pick(&initial, 0),
                 prev,
                 buf,
+                &|| stop.requested(),
             )
         })?
         .map_err(|e| match e.arg {
