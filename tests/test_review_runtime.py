@@ -355,6 +355,19 @@ def test_D17_ctrl_c_within_half_a_second(name):
     assert late_after_sigint(setup, call) < 0.5
 
 
+def test_D17_cold_sweep_stops_promptly():
+    """The first sweep of a fresh process writes into output pages never touched before
+    (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000
+    curves takes about 0.2 s, the writing seconds) stops it within a quarter second,
+    including the caps, which a stopped sweep no longer writes, and the curve ids of the
+    faces."""
+    setup = ("s = np.linspace(0, 40, 1000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+             "X = np.concatenate([C + i for i in range(2000)])\n"
+             "F = spinal.frames(X, lengths=[1000] * 2000)\n")
+    assert late_after_sigint(setup, "spinal.tube(X, .01, 8, frames=F, lengths=[1000] * 2000)",
+                             after=0.5) < 0.25
+
+
 def test_D17_threads_setting_keeps_results():
     """The calls stay bit-identical with the signal-watching pool (review: threads
     bit-identical)."""
