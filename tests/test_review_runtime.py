@@ -108,6 +108,11 @@ D16_CASES = {
         ("n = 1_200_000; s = np.linspace(0, 1000 * np.pi, n, endpoint=False)\n"
         "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
         "spinal.frames(X, method='frenet')", "frames: out of memory"),
+    # the frames' copy, the samples and the per-segment rotations of a path tool
+    "along_path": (
+        ("n = 1_000_000; s = np.linspace(0, 2000, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]; F = spinal.frames(X)\n"),
+        "spinal.fields.along_path(X, .1, 1.0, frames=F)", "along_path: out of memory"),
     "Mesh.is_watertight": (
         ("m = 30_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
         "mesh = spinal.Mesh(np.zeros((1000, 3)), F)\n"),
