@@ -268,6 +268,77 @@ mod tests {
     }
 
     #[test]
+    fn frames_in_time_stop_anywhere() {
+        use crate::frames::time;
+        let (steps, rows) = (8, 20_000);
+        let x: Vec<DVec3> = (0..steps)
+            .flat_map(|k| {
+                curve(rows)
+                    .into_iter()
+                    .map(move |p| p * (1.0 + 0.01 * k as f64))
+            })
+            .collect();
+        let req = Request {
+            points: Some(&x),
+            ..Request::default()
+        };
+        let prev = {
+            let mut f = vec![0.0; 9 * rows];
+            let one = Request {
+                points: Some(&x[..rows]),
+                ..req
+            };
+            frames::compute_into(&one, &mut f).expect("valid");
+            time::turn_all(&mut f, 0.3);
+            let f: Vec<[f64; 9]> = f
+                .chunks_exact(9)
+                .map(|c| c.try_into().expect("9"))
+                .collect();
+            f
+        };
+        for previous in [None, Some(&prev[..])] {
+            let run = |c: super::Cancel<'_>| {
+                let mut out = vec![0.0; 9 * x.len()];
+                time::frames_in_time_cancellable(&req, steps, rows, None, previous, &mut out, c)
+                    .expect("valid");
+                out
+            };
+            let (out, _) = stop_everywhere(run);
+            let mut plain = vec![0.0; out.len()];
+            time::frames_in_time(&req, steps, rows, None, previous, &mut plain).expect("valid");
+            assert!(same_bits(&out, &plain));
+        }
+    }
+
+    #[test]
+    fn tangents_of_many_curves_stop_anywhere() {
+        use crate::frames::{TangentRule, tangents};
+        let x = curve(70_000);
+        let offsets = [0, 100, 200, 35_000, 70_000];
+        for closed in [false, true] {
+            let rule = TangentRule::FivePointBounded;
+            let run = |c: super::Cancel<'_>| {
+                tangents::estimate_many_cancellable(&x, &offsets, closed, rule, c).expect("valid")
+            };
+            let (got, _) = stop_everywhere(run);
+            assert!(got == tangents::estimate_many(&x, &offsets, closed, rule).expect("valid"));
+        }
+    }
+
+    #[test]
+    fn closed_tool_stops_anywhere() {
+        use crate::mesh::closed::{self, tests::torus};
+        let (v, f) = torus(400, 200);
+        let (full, _) =
+            stop_everywhere(|c| closed::closed_volume_centroid_cancellable(&v, &f, c).expect("ok"));
+        let plain = closed::closed_volume_centroid(&v, &f).expect("ok");
+        assert!(full.0.to_bits() == plain.0.to_bits() && full.1 == plain.1);
+        let broken = &f[1..];
+        let (e, _) = stop_everywhere(|c| closed::closed_volume_centroid_cancellable(&v, broken, c));
+        assert_eq!(e, closed::closed_volume_centroid(&v, broken));
+    }
+
+    #[test]
     fn surface_deform_stops_anywhere() {
         let (nu, nv) = (6, 7);
         let grid = |bend: f64| -> Vec<DVec3> {

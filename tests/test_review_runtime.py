@@ -103,6 +103,16 @@ D16_CASES = {
         ("n = 10_000_000; s = np.linspace(0, 2000, n)\n"
         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
         "spinal.frames(X, guide=[0, 0, 1])", "frames: out of memory"),
+    # the output fits in the headroom, the Frenet frames' working vectors do not
+    "frames frenet": (
+        ("n = 1_200_000; s = np.linspace(0, 1000 * np.pi, n, endpoint=False)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .3 * np.sin(3 * s)]\n"),
+        "spinal.frames(X, method='frenet')", "frames: out of memory"),
+    # the frames' copy, the samples and the per-segment rotations of a path tool
+    "along_path": (
+        ("n = 1_000_000; s = np.linspace(0, 2000, n)\n"
+        "X = np.c_[np.cos(s), np.sin(s), .2 * s]; F = spinal.frames(X)\n"),
+        "spinal.fields.along_path(X, .1, 1.0, frames=F)", "along_path: out of memory"),
     "Mesh.is_watertight": (
         ("m = 30_000_000; F = np.arange(3 * m, dtype=np.int64).reshape(m, 3) % 1000\n"
         "mesh = spinal.Mesh(np.zeros((1000, 3)), F)\n"),
@@ -322,6 +332,30 @@ D17_CASES = {
          "F = spinal.frames(X, lengths=[1000] * 2000)\n"),
         ("spinal.sweep(X, [[.01, 0], [0, .01], [-.01, 0]], frames=F, lengths=[1000] * 2000, "
          "normals=False, uv=False)")),
+    "frames_in_time": (
+        ("n, T = 240_000, 50; s = np.linspace(0, 100, n); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "P = np.stack([C * (1 + .01 * k) for k in range(T)])\n"),
+        "spinal.frames_in_time(P)"),
+    "estimate_tangents_offsets": (
+        ("n = 20_000_000; s = np.linspace(0, 4000, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "spinal.estimate_tangents(X, lengths=[1000] * (n // 1000))"),
+    # the check, volume and centroid of a closed tool (fields.mesh_tool, fields.mesh_curl),
+    # called alone: 32 million faces of a closed tube
+    "closed_tool_centroid": (
+        ("s = np.linspace(0, 4000, 2_000_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01)\n"
+         "V, F = np.asarray(m.vertices), np.asarray(m.faces)\n"),
+        "spinal._core.mesh_closed_centroid(V, F)"),
+    # the same tube without its first face: the search for the first edge in one face
+    "closed_tool_not_watertight": (
+        ("s = np.linspace(0, 4000, 2_000_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01)\n"
+         "V, F = np.asarray(m.vertices), np.ascontiguousarray(np.asarray(m.faces)[1:])\n"
+         "def refused():\n"
+         "    try:\n"
+         "        spinal._core.mesh_closed_centroid(V, F)\n"
+         "    except ValueError:\n"
+         "        pass\n"),
+        "refused()"),
 }
 
 
@@ -329,6 +363,19 @@ D17_CASES = {
 def test_D17_ctrl_c_within_half_a_second(name):
     setup, call = D17_CASES[name]
     assert late_after_sigint(setup, call) < 0.5
+
+
+def test_D17_cold_sweep_stops_promptly():
+    """The first sweep of a fresh process writes into output pages never touched before
+    (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000
+    curves takes about 0.2 s, the writing seconds) stops it within a quarter second,
+    including the caps, which a stopped sweep no longer writes, and the curve ids of the
+    faces."""
+    setup = ("s = np.linspace(0, 40, 1000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+             "X = np.concatenate([C + i for i in range(2000)])\n"
+             "F = spinal.frames(X, lengths=[1000] * 2000)\n")
+    assert late_after_sigint(setup, "spinal.tube(X, .01, 8, frames=F, lengths=[1000] * 2000)",
+                             after=0.5) < 0.25
 
 
 def test_D17_threads_setting_keeps_results():

@@ -319,9 +319,29 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                                            axis=0)
     if bundle:  # each curve's faces follow those of the curve before it
         small = curves <= np.iinfo(np.int32).max
-        mesh.cell_data["curve_id"] = np.repeat(
+        mesh.cell_data["curve_id"] = _repeat_in_blocks(
             curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
     return mesh
+
+
+# elements per step of `_repeat_in_blocks`
+REPEAT_BLOCK = 1 << 22
+
+
+def _repeat_in_blocks(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """``np.repeat(values, counts)`` written in steps of at most ``REPEAT_BLOCK`` elements,
+    so that Ctrl-C (acted on by Python between the steps) stops a large one promptly."""
+    ends = np.cumsum(counts, dtype=np.int64)
+    starts = ends - counts
+    total = int(ends[-1]) if ends.size else 0
+    out = np.empty(total, dtype=values.dtype)
+    for a in range(0, total, REPEAT_BLOCK):
+        b = min(a + REPEAT_BLOCK, total)
+        # the values whose runs meet [a, b), their runs clipped to it
+        i = int(np.searchsorted(ends, a, side="right"))
+        j = int(np.searchsorted(starts, b, side="left"))
+        out[a:b] = np.repeat(values[i:j], np.minimum(ends[i:j], b) - np.maximum(starts[i:j], a))
+    return out
 
 
 def _orig_offsets(lens, n: int) -> np.ndarray:

@@ -332,9 +332,8 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
     fn length_scale(&self) -> f64 {
         self.shape.reach()
     }
-    fn breakpoints(&self) -> Vec<f64> {
-        // a copy of the key times, which are held (allocated fallibly in `Keys::new`)
-        self.keys.times.clone()
+    fn breakpoints(&self) -> &[f64] {
+        &self.keys.times
     }
     fn shape(&self) -> Option<ToolShape> {
         Some(ToolShape {

@@ -51,8 +51,8 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
     fn length_scale(&self) -> f64;
 
     /// Times at which the velocity is only continuous in time (a path tool's samples).
-    fn breakpoints(&self) -> Vec<f64> {
-        Vec::new()
+    fn breakpoints(&self) -> &[f64] {
+        &[]
     }
 
     /// Jacobian (columns `∂A/∂x_j`) of a curl potential `A` with `curl A = v`, for the
@@ -271,14 +271,17 @@ impl Field {
         self.tools.iter().map(|e| e.max_speed()).sum()
     }
 
-    /// Sorted times at which a tool's velocity is only continuous in time.
-    pub fn breakpoints(&self) -> Vec<f64> {
-        // the tools' breakpoints are copies of their held key or path sample times, so this
-        // is no larger than data already allocated
-        let mut b: Vec<f64> = self.tools.iter().flat_map(|e| e.breakpoints()).collect();
+    /// Sorted times at which a tool's velocity is only continuous in time, allocated
+    /// fallibly (the out-of-memory error names `what`, the calling function).
+    pub fn breakpoints(&self, what: &'static str) -> Result<Vec<f64>> {
+        let n = self.tools.iter().map(|e| e.breakpoints().len()).sum();
+        let mut b = crate::alloc::with_capacity(what, n)?;
+        for e in &self.tools {
+            b.extend_from_slice(e.breakpoints());
+        }
         b.sort_by(f64::total_cmp);
         b.dedup();
-        b
+        Ok(b)
     }
 
     /// Smallest length scale of the tools (∞ for the zero field).

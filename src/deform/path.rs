@@ -35,9 +35,13 @@ use glam::{DMat3, DVec3};
 use super::cross::Sphere;
 use super::fields::{Rotation, Swirl, SwirlKind, Translation};
 use super::{Tool, falloff, finite, positive, reach_or};
+use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{is_rotation, quat_from_mat3, rodrigues};
+
+/// The name of the call in out-of-memory errors.
+const CALL: &str = "along_path";
 
 /// One spine sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +60,8 @@ pub struct PathTool {
     /// Per segment: body axis-angle `Θ_k` and `F_k Θ_k / ΔS_k` (world ω per unit speed).
     theta: Vec<DVec3>,
     omega: Vec<DVec3>,
+    /// The times at which the tool passes the samples ([`PathTool::breakpoints`]).
+    times: Vec<f64>,
     pub params: PathToolParams,
 }
 
@@ -96,7 +102,8 @@ pub struct Pose {
 
 impl PathTool {
     /// Build from samples (positions and orthonormal right-handed frames, strictly increasing
-    /// arc length `s`, at least 2) and the parameters.
+    /// arc length `s`, at least 2) and the parameters. The per-segment buffers are allocated
+    /// fallibly (the out-of-memory error names `along_path`).
     pub fn new(samples: Vec<Sample>, params: PathToolParams) -> Result<PathTool> {
         let duration = params.duration;
         let bad = |m: String| InputError::new("field", m);
@@ -113,8 +120,8 @@ impl PathTool {
                 return Err(bad(format!("path frame {i} is not a rotation matrix")));
             }
         }
-        let mut theta = Vec::with_capacity(samples.len() - 1);
-        let mut omega = Vec::with_capacity(samples.len() - 1);
+        let mut theta = alloc::with_capacity(CALL, samples.len() - 1)?;
+        let mut omega = alloc::with_capacity(CALL, samples.len() - 1)?;
         for (k, w) in samples.windows(2).enumerate() {
             let ds = w[1].s - w[0].s;
             if !(ds > 0.0) {
@@ -133,10 +140,18 @@ impl PathTool {
             theta.push(th);
             omega.push(w[0].frame * th / ds);
         }
+        let (s0, l) = (samples[0].s, samples[samples.len() - 1].s - samples[0].s);
+        let times = alloc::collect(
+            CALL,
+            samples
+                .iter()
+                .map(|p| params.t0 + params.duration * (p.s - s0) / l),
+        )?;
         Ok(PathTool {
             samples,
             theta,
             omega,
+            times,
             params,
         })
     }
@@ -336,11 +351,8 @@ impl PathTool {
     }
 
     /// Times at which the tool passes a spine sample (its start and end included).
-    pub fn breakpoints(&self) -> impl Iterator<Item = f64> + '_ {
-        let (s0, l) = (self.samples[0].s, self.length());
-        self.samples
-            .iter()
-            .map(move |p| self.params.t0 + self.params.duration * (p.s - s0) / l)
+    pub fn breakpoints(&self) -> &[f64] {
+        &self.times
     }
 }
 
@@ -418,7 +430,7 @@ impl PathTool {
             ));
         }
         let mut s = 0.0;
-        let mut samples = Vec::with_capacity(x.len());
+        let mut samples = alloc::with_capacity(CALL, x.len())?;
         for (i, (p, f)) in x.iter().zip(a.frames).enumerate() {
             if i > 0 {
                 let chord = p.distance(x[i - 1]);
@@ -480,8 +492,8 @@ impl Tool for PathTool {
     fn length_scale(&self) -> f64 {
         self.params.reach
     }
-    fn breakpoints(&self) -> Vec<f64> {
-        PathTool::breakpoints(self).collect()
+    fn breakpoints(&self) -> &[f64] {
+        PathTool::breakpoints(self)
     }
     /// The pose once per batch, then the frozen-pose field at every point.
     #[inline]

@@ -86,33 +86,34 @@ pub use super::advect::Run;
 /// The steps of an integration from `t0` over `duration` in about `steps` equal steps, ended
 /// at the field's breakpoints ([`Field::breakpoints`]: a path tool's velocity is only C⁰ in
 /// time there) with `⌈steps·|b − a|/|duration|⌉ ≥ 1` steps on each sub-interval `[a, b]`.
-pub fn schedule(field: &Field, t0: f64, duration: f64, steps: usize) -> Vec<Run> {
+/// The list (one run per breakpoint inside) is allocated fallibly (the out-of-memory error
+/// names `deform`).
+pub fn schedule(field: &Field, t0: f64, duration: f64, steps: usize) -> Result<Vec<Run>> {
+    const CALL: &str = "deform";
     if duration == 0.0 || steps == 0 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let t1 = t0 + duration;
     let (lo, hi) = (t0.min(t1), t0.max(t1));
-    let mut cuts: Vec<f64> = field
-        .breakpoints()
-        .into_iter()
-        .filter(|&b| b > lo && b < hi)
-        .collect();
+    let mut cuts = field.breakpoints(CALL)?;
+    cuts.retain(|&b| b > lo && b < hi);
     if cuts.is_empty() {
-        return vec![Run {
+        return Ok(vec![Run {
             t0,
             h: duration / steps as f64,
             count: steps,
-        }];
+        }]);
     }
     if duration < 0.0 {
         cuts.reverse();
     }
-    let mut ts = Vec::with_capacity(cuts.len() + 2);
+    let mut ts = crate::alloc::with_capacity(CALL, cuts.len() + 2)?;
     ts.push(t0);
     ts.extend(cuts);
     ts.push(t1);
-    ts.windows(2)
-        .map(|w| {
+    crate::alloc::collect(
+        CALL,
+        ts.windows(2).map(|w| {
             let (a, b) = (w[0], w[1]);
             let n = (steps as f64 * (b - a).abs() / duration.abs() - 1e-9)
                 .ceil()
@@ -122,8 +123,8 @@ pub fn schedule(field: &Field, t0: f64, duration: f64, steps: usize) -> Vec<Run>
                 h: (b - a) / n as f64,
                 count: n,
             }
-        })
-        .collect()
+        }),
+    )
 }
 
 /// Advance `points` through the first `upto` steps of `runs` (RK4).
@@ -783,7 +784,7 @@ mod tests {
         let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
         let f = vec![[0, 1, 2], [1, 0, 2]];
         let stretch = drag(DVec3::ZERO, 3.0, DVec3::X);
-        let runs = schedule(&stretch, 0.0, 1.0, 4);
+        let runs = schedule(&stretch, 0.0, 1.0, 4).unwrap();
         let opts = Refinement {
             ratio: 1.0,
             max_vertices: 100,
@@ -812,7 +813,7 @@ mod tests {
     #[test]
     fn schedule_ends_steps_at_breakpoints_and_sums_time() {
         let f = Field::default();
-        let runs = schedule(&f, 0.5, 2.0, 8);
+        let runs = schedule(&f, 0.5, 2.0, 8).unwrap();
         assert_eq!(
             runs,
             vec![Run {
@@ -821,14 +822,14 @@ mod tests {
                 count: 8
             }]
         );
-        assert!(schedule(&f, 0.0, 0.0, 8).is_empty());
+        assert!(schedule(&f, 0.0, 0.0, 8).unwrap().is_empty());
     }
 
     #[test]
     fn a_field_that_never_reaches_the_mesh_adds_nothing() {
         let (v, f) = sphere(3);
         let far = drag(DVec3::new(10.0, 0.0, 0.0), 0.3, DVec3::X);
-        let runs = schedule(&far, 0.0, 1.0, 10);
+        let runs = schedule(&far, 0.0, 1.0, 10).unwrap();
         let opts = Refinement {
             ratio: 1.0,
             max_vertices: 8 * v.len(),
@@ -847,7 +848,7 @@ mod tests {
         // a press from outside (no slip through the mesh): every vertex is Φ(rest) bit for bit
         let (v, f) = sphere(3);
         let press = drag(DVec3::new(0.0, 0.0, 1.6), 0.5, DVec3::new(0.0, 0.0, -0.5));
-        let runs = schedule(&press, 0.0, 1.0, 16);
+        let runs = schedule(&press, 0.0, 1.0, 16).unwrap();
         let opts = Refinement {
             ratio: 1.5,
             max_vertices: 8 * v.len(),
@@ -876,7 +877,7 @@ mod tests {
     fn torn_drag() -> (Vec<DVec3>, Vec<[usize; 3]>, Field, Vec<Run>, Refinement) {
         let (v, f) = sphere(5);
         let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
-        let runs = schedule(&tool, 0.0, 1.0, 10);
+        let runs = schedule(&tool, 0.0, 1.0, 10).unwrap();
         let opts = Refinement {
             ratio: 1.5,
             max_vertices: 10 * v.len(),
@@ -934,7 +935,7 @@ mod tests {
     fn the_vertex_bound_stops_refinement_and_says_so() {
         let (v, f) = sphere(3);
         let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
-        let runs = schedule(&tool, 0.0, 1.0, 20);
+        let runs = schedule(&tool, 0.0, 1.0, 20).unwrap();
         let opts = Refinement {
             ratio: 1.5,
             max_vertices: v.len() + 50,
@@ -952,7 +953,7 @@ mod tests {
     fn tick_can_stop_the_deformation() {
         let (v, f) = sphere(1);
         let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
-        let runs = schedule(&tool, 0.0, 1.0, 20);
+        let runs = schedule(&tool, 0.0, 1.0, 20).unwrap();
         let mut seen = 0;
         let d = deform(&tool, &v, &f, &runs, None, &mut |done, total| {
             assert_eq!(total, 20);
@@ -1043,7 +1044,7 @@ mod tests {
             let (v, f) = sphere(k);
             for steps in [10, 20, 40] {
                 let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
-                let runs = schedule(&tool, 0.0, 1.0, steps);
+                let runs = schedule(&tool, 0.0, 1.0, steps).unwrap();
                 let opts = Refinement {
                     ratio: 1.5,
                     max_vertices: 10 * v.len(),

@@ -204,7 +204,7 @@ mod tests {
         // ρ = R: the mean of the one-sided velocities is the tool's velocity u, so Ψ(p, ½)
         // moves rigidly with the tool; s = 0 and s = 1 part to either side of it
         let f = tool();
-        let runs = schedule(&f, 0.0, 1.0, 10);
+        let runs = schedule(&f, 0.0, 1.0, 10).unwrap();
         let u = DVec3::new(0.5, 0.0, 0.0);
         let c = DVec3::new(0.0, 0.0, 0.9) + u; // the centre at t = 1
         let p0 = [DVec3::new(0.9, 0.0, 0.9), DVec3::new(0.0, 0.9, 0.9)];

@@ -61,8 +61,8 @@ fn turning(a: DVec3, b: DVec3) -> f64 {
 fn cumulative(t: &[DVec3], seg: &[f64], closed: bool, rule: TwistRule) -> (Vec<f64>, Vec<f64>) {
     let n = t.len();
     let m = if closed { n } else { n - 1 };
-    // per-row working vectors, within the binding's `ensure_memory` probe of 256 bytes a row (see
-    // `super::compute_into_cancellable`)
+    // per-row working vectors, within `super::WORKING_BYTES_PER_ROW` (checked free by the
+    // binding's `ensure_memory` probe)
     let mut arc = vec![0.0; m + 1];
     let mut turn = vec![0.0; m + 1];
     for i in 0..m {
@@ -110,8 +110,8 @@ pub fn twist(
     turns: &[i64],
 ) -> Result<Vec<f64>> {
     let n = t.len();
-    // per-row (and per-pin, pins ≤ rows) working vectors, within the binding's `ensure_memory`
-    // probe of 256 bytes a row (see `super::compute_into_cancellable`)
+    // per-row (and per-pin, pins ≤ rows) working vectors, within
+    // `super::WORKING_BYTES_PER_ROW` (checked free by the binding's `ensure_memory` probe)
     let mut alpha = vec![0.0; n];
     if pins.is_empty() {
         return Ok(alpha);

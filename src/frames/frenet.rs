@@ -47,8 +47,8 @@ pub fn frenet_into_cancellable(
     let t = dr.t;
     let n = t.len();
     let rows = out.len() / 9;
-    // `defined`, `r`, `gaps` and a gap's `prov`/`arc` are per-row working vectors, within the
-    // binding's `ensure_memory` probe of 256 bytes a row (see `super::compute_into_cancellable`)
+    // `defined`, `r`, `gaps` and a gap's `prov`/`arc` are per-row working vectors, within
+    // `super::WORKING_BYTES_PER_ROW` (checked free by the binding's `ensure_memory` probe)
     let defined: Vec<usize> = (0..n).filter(|&i| normal[i].is_some()).collect();
     if cancel() {
         return;

@@ -69,8 +69,8 @@ pub fn check(g: &Guide) -> Result<()> {
 /// `up_{n−1}` unused) by Thomas' algorithm; stable for the diagonally dominant systems here.
 fn thomas(lo: &[f64], d: &[f64], up: &[f64], b: &[f64]) -> Vec<f64> {
     let n = d.len();
-    // per-row working vectors (of this module: at most ~140 bytes a row at once), within the
-    // binding's `ensure_memory` probe of 256 bytes a row (see `super::compute_into_cancellable`)
+    // per-row working vectors (of this module: at most ~140 bytes a row at once), within
+    // `super::WORKING_BYTES_PER_ROW` (checked free by the binding's `ensure_memory` probe)
     let mut c = vec![0.0; n];
     let mut x = vec![0.0; n];
     let mut den = d[0];
@@ -93,8 +93,8 @@ fn cyclic(lo: &[f64], d: &[f64], up: &[f64], b: &[f64]) -> Vec<f64> {
     let n = d.len();
     let (alpha, beta) = (up[n - 1], lo[0]);
     let gamma = -d[0];
-    // per-row working vectors, within the binding's `ensure_memory` probe of 256 bytes a row (see
-    // `super::compute_into_cancellable`)
+    // per-row working vectors, within `super::WORKING_BYTES_PER_ROW` (checked free by the
+    // binding's `ensure_memory` probe)
     let mut dd = d.to_vec();
     dd[0] -= gamma;
     dd[n - 1] -= alpha * beta / gamma;
@@ -129,8 +129,8 @@ pub fn twist(
     let g = |i: usize| guide.vectors[if guide.vectors.len() == 1 { 0 } else { i }];
     let min_sin = guide.tolerance.sin();
     // data per sample: None, a guide angle with its weight, or a pin; these and the
-    // system's rows below are per-row working vectors, within the binding's `ensure_memory` probe
-    // of 256 bytes a row (see `super::compute_into_cancellable`)
+    // system's rows below are per-row working vectors, within `super::WORKING_BYTES_PER_ROW`
+    // (checked free by the binding's `ensure_memory` probe)
     let mut value = vec![f64::NAN; n];
     let mut weight = vec![0.0; n];
     let mut pinned = vec![false; n];

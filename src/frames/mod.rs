@@ -106,6 +106,22 @@ impl Default for Request<'_> {
     }
 }
 
+/// Bytes a row that a frames call may hold at once besides its output (9 × 8 = 72 bytes a
+/// row): the per-row working vectors of this module and of [`steer`], [`guide`],
+/// [`constraints`], [`frenet`] and [`time`] are allocated infallibly within this bound, which
+/// the bindings check is free before the call (`ensure_memory` of
+/// `72 + WORKING_BYTES_PER_ROW` bytes a row, output included).
+///
+/// Measured: the peak resident memory of the compiled call alone, output included (VmHWM
+/// reset through `/proc/self/clear_refs` just before it, less the resident set then), per
+/// row, for 4·10⁶ and 10⁷ rows (`benchmarks/memory_frames.py`): an open curve 72 (the fused
+/// scan keeps nothing per row; bundles too), a closed curve or given tangents 104, Frenet
+/// 168–172 (address space 160–173), an analytic curve 112 (RK4 152–160), frames in time 104
+/// (Frenet 157–167), `quaternion_frames` 136; steered: `previous` 136, constraints 144, the
+/// minimum-angular-speed rule 152, a guide 192 (closed 208–216, analytic 200), a guide with
+/// constraints on a closed curve 224, the most. `72 + 216 = 288` bytes a row is 29 % over it.
+pub const WORKING_BYTES_PER_ROW: usize = 216;
+
 /// Curvature below this (times the curve's bounding-box diagonal) counts as straight.
 pub const STRAIGHT_TOL: f64 = 1e-9;
 /// Largest accepted angle between a prescribed frame's third column and the tangent.
@@ -272,9 +288,9 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
 /// once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
 ///
 /// Memory: the per-row working vectors of this module (tangents, chords, segment lengths,
-/// normals, ω) take well under the 256 bytes per row that the binding's `ensure_memory`
-/// probe checks before the call, so they are allocated infallibly; the normalised copy of
-/// the input is allocated fallibly.
+/// normals, ω) take less than [`WORKING_BYTES_PER_ROW`], which the binding's
+/// `ensure_memory` probe checks before the call, so they are allocated infallibly; the
+/// normalised copy of the input is allocated fallibly.
 pub fn compute_into_cancellable(
     req: &Request,
     out: &mut [f64],

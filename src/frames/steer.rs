@@ -231,7 +231,7 @@ pub fn compute_steered_cancellable(
         if cancel() {
             return Ok(());
         }
-        time::align(out, p)?;
+        time::align_cancellable(out, p, cancel)?;
     }
     Ok(())
 }

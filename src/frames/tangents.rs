@@ -525,13 +525,29 @@ pub fn estimate_many(
     closed: bool,
     rule: TangentRule,
 ) -> Result<Vec<DVec3>> {
+    estimate_many_cancellable(x, offsets, closed, rule, &crate::cancel::never)
+}
+
+/// [`estimate_many`] that polls `cancel` before every curve, inside each curve's estimate
+/// ([`estimate_rows_cancellable`]) and before every [`CANCEL_SEGMENT`] rows of the copy into
+/// the result; a cancelled call returns an incomplete result (see [`crate::cancel`]).
+pub fn estimate_many_cancellable(
+    x: &[DVec3],
+    offsets: &[usize],
+    closed: bool,
+    rule: TangentRule,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     crate::frames::validate::offsets(offsets, x.len())?;
     let curves = offsets.len() - 1;
     let parts: Vec<Result<Vec<DVec3>>> = (0..curves)
         .into_par_iter()
         .map(|c| {
+            if cancel() {
+                return Ok(Vec::new());
+            }
             let (a, b) = (offsets[c], offsets[c + 1]);
-            estimate_rows(&x[a..b], closed, rule).map_err(|e| {
+            estimate_rows_cancellable(&x[a..b], closed, rule, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {
@@ -540,9 +556,17 @@ pub fn estimate_many(
             })
         })
         .collect();
+    if cancel() {
+        return Ok(Vec::new());
+    }
     let mut out = alloc::with_capacity("estimate_tangents", x.len())?;
     for p in parts {
-        out.extend(p?);
+        for block in p?.chunks(CANCEL_SEGMENT) {
+            if cancel() {
+                return Ok(out);
+            }
+            out.extend_from_slice(block);
+        }
     }
     Ok(out)
 }

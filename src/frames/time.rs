@@ -15,7 +15,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Orientation, Request, compute_into, validate};
+use super::{Orientation, Request, compute_into_cancellable, validate};
+use crate::cancel::Cancel;
 use crate::error::{InputError, Result};
 
 /// Column `k` of a row-major frame.
@@ -23,10 +24,23 @@ fn col(f: &[f64], k: usize) -> DVec3 {
     DVec3::new(f[k], f[3 + k], f[6 + k])
 }
 
+/// Rows per block of the passes over the frames (a block is skipped once the hook says
+/// stop).
+const BLOCK: usize = 1024;
+
 /// Turn every frame of `out` about its tangent by `c` (the columns `r, s`).
 pub fn turn_all(out: &mut [f64], c: f64) {
+    turn_all_cancellable(out, c, &crate::cancel::never);
+}
+
+/// [`turn_all`] that polls `cancel` before every block of rows and skips the remaining
+/// blocks once it says stop (see [`crate::cancel`]).
+pub fn turn_all_cancellable(out: &mut [f64], c: f64, cancel: Cancel<'_>) {
     let (sin, cos) = c.sin_cos();
-    out.par_chunks_mut(9 * 1024).for_each(|b| {
+    out.par_chunks_mut(9 * BLOCK).for_each(|b| {
+        if cancel() {
+            return;
+        }
         for f in b.chunks_exact_mut(9) {
             for row in 0..3 {
                 let (r, s) = (f[3 * row], f[3 * row + 1]);
@@ -40,10 +54,19 @@ pub fn turn_all(out: &mut [f64], c: f64) {
 /// The turn `c` that brings the frames `out` closest to `previous` (both row-major,
 /// `9·rows` values).
 pub fn best_turn(out: &[f64], previous: &[f64]) -> f64 {
+    best_turn_cancellable(out, previous, &crate::cancel::never)
+}
+
+/// [`best_turn`] that polls `cancel` before every block of rows (a cancelled call returns
+/// a meaningless turn, see [`crate::cancel`]).
+pub fn best_turn_cancellable(out: &[f64], previous: &[f64], cancel: Cancel<'_>) -> f64 {
     let (y, x) = out
-        .par_chunks(9 * 1024)
-        .zip(previous.par_chunks(9 * 1024))
+        .par_chunks(9 * BLOCK)
+        .zip(previous.par_chunks(9 * BLOCK))
         .map(|(a, b)| {
+            if cancel() {
+                return (0.0, 0.0);
+            }
             a.chunks_exact(9)
                 .zip(b.chunks_exact(9))
                 .fold((0.0, 0.0), |(y, x), (f, p)| {
@@ -78,10 +101,19 @@ pub fn check_previous(previous: &[[f64; 9]], rows: usize) -> Result<()> {
 
 /// Turn the frames `out` (one curve) to be closest to `previous`.
 pub fn align(out: &mut [f64], previous: &[[f64; 9]]) -> Result<()> {
+    align_cancellable(out, previous, &crate::cancel::never)
+}
+
+/// [`align`] that polls `cancel` before every block of rows of its two passes (a cancelled
+/// call leaves `out` incomplete, see [`crate::cancel`]).
+pub fn align_cancellable(out: &mut [f64], previous: &[[f64; 9]], cancel: Cancel<'_>) -> Result<()> {
     check_previous(previous, out.len() / 9)?;
     let prev: &[f64] = bytemuck::cast_slice(previous);
-    let c = best_turn(out, prev);
-    turn_all(out, c);
+    let c = best_turn_cancellable(out, prev, cancel);
+    if cancel() {
+        return Ok(());
+    }
+    turn_all_cancellable(out, c, cancel);
     Ok(())
 }
 
@@ -95,6 +127,29 @@ pub fn frames_in_time(
     initial: Option<Orientation>,
     previous: Option<&[[f64; 9]]>,
     out: &mut [f64],
+) -> Result<()> {
+    frames_in_time_cancellable(
+        template,
+        steps,
+        rows,
+        initial,
+        previous,
+        out,
+        &crate::cancel::never,
+    )
+}
+
+/// [`frames_in_time`] that polls `cancel` before every time step, inside each step's frames
+/// ([`super::compute_into_cancellable`]) and before every block of rows of the turns, and
+/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+pub fn frames_in_time_cancellable(
+    template: &Request,
+    steps: usize,
+    rows: usize,
+    initial: Option<Orientation>,
+    previous: Option<&[[f64; 9]]>,
+    out: &mut [f64],
+    cancel: Cancel<'_>,
 ) -> Result<()> {
     if template.end.is_some() {
         return Err(InputError::new(
@@ -126,6 +181,9 @@ pub fn frames_in_time(
     out.par_chunks_mut(9 * rows.max(1))
         .enumerate()
         .map(|(k, buf)| {
+            if cancel() {
+                return Ok(());
+            }
             let (a, b) = (k * rows, (k + 1) * rows);
             let req = Request {
                 points: template.points.map(|p| &p[a..b]),
@@ -135,19 +193,25 @@ pub fn frames_in_time(
                 end: None,
                 ..*template
             };
-            compute_into(&req, buf)
+            compute_into_cancellable(&req, buf, cancel)
                 .map(|_| ())
                 .map_err(|e| e.context(&format!("time step {k}")))
         })
         .collect::<Result<()>>()?; // no buffer: the first error or `()`
+    if cancel() {
+        return Ok(());
+    }
     if let Some(p) = previous {
-        let c = best_turn(&out[..9 * rows], bytemuck::cast_slice(p));
-        turn_all(&mut out[..9 * rows], c);
+        let c = best_turn_cancellable(&out[..9 * rows], bytemuck::cast_slice(p), cancel);
+        turn_all_cancellable(&mut out[..9 * rows], c, cancel);
     }
     for k in 1..steps {
+        if cancel() {
+            return Ok(());
+        }
         let (before, now) = out[9 * rows * (k - 1)..9 * rows * (k + 1)].split_at_mut(9 * rows);
-        let c = best_turn(now, before);
-        turn_all(now, c);
+        let c = best_turn_cancellable(now, before, cancel);
+        turn_all_cancellable(now, c, cancel);
     }
     Ok(())
 }

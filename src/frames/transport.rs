@@ -196,8 +196,8 @@ where
         // without an end condition the chunk angle is the whole correction: turn at once
         let turn_now = matches!(self.twist, Twist::None);
 
-        // one slot and one result per chunk (chunks ≤ rows), within the binding's `ensure_memory`
-        // probe of 256 bytes a row (see `super::compute_into_cancellable`)
+        // one slot and one result per chunk (chunks ≤ rows), within
+        // `super::WORKING_BYTES_PER_ROW` (checked free by the binding's `ensure_memory` probe)
         let mut slots: Vec<Mutex<&mut [f64]>> = out[..9 * write_rows]
             .chunks_mut(9 * cs)
             .map(Mutex::new)
@@ -276,8 +276,8 @@ where
             }
         };
         if !turn_now {
-            // one per chunk (chunks ≤ rows), within the binding's `ensure_memory` probe of 256
-            // bytes a row (see `super::compute_into_cancellable`)
+            // one per chunk (chunks ≤ rows), within `super::WORKING_BYTES_PER_ROW` (checked
+            // free by the binding's `ensure_memory` probe)
             let mut len_prefix = vec![0.0; chunks + 1];
             for (c, &(p, _)) in resolved.iter().enumerate() {
                 len_prefix[c + 1] = len_prefix[c] + p.2;

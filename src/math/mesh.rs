@@ -102,71 +102,6 @@ pub fn edge_counts(
     Ok(count)
 }
 
-/// The signed volume and the centroid of the solid bounded by a closed, consistently
-/// oriented, outward-wound triangle mesh (indices checked; errors name `mesh`): every edge in
-/// exactly two faces, each directed edge once, a positive volume. The centroid is
-/// `m + Σ 6V_f (a + b + c − 3m)/4 / (6V)` over the tetrahedra from the mean vertex `m`.
-pub fn closed_volume_centroid(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Result<(f64, DVec3)> {
-    use crate::error::InputError;
-    let bad = |m: String| InputError::new("mesh", m);
-    if f.is_empty() {
-        return Err(bad("has no faces".into()));
-    }
-    let n = v.len();
-    const CALL: &str = "closed tool";
-    let mut faces = crate::alloc::with_capacity(CALL, f.len())?;
-    for (i, t) in f.iter().enumerate() {
-        let mut c = [0usize; 3];
-        for (k, &x) in t.iter().enumerate() {
-            c[k] = usize::try_from(x).ok().filter(|&x| x < n).ok_or_else(|| {
-                bad(format!(
-                    "face {i} refers to vertex {x}, but there are {n} vertices"
-                ))
-            })?;
-        }
-        faces.push(c);
-    }
-    let (list, slot) = edges(CALL, &faces)?;
-    let count = edge_counts(CALL, &slot, list.len())?;
-    // the first bad edge in the order of the slots 0→1 of all faces, then 1→2, then 2→0
-    for k in 0..3 {
-        if let Some(s) = slot.iter().find(|s| count[s[k]] != 2) {
-            let [a, b] = list[s[k]];
-            return Err(bad(format!(
-                "not watertight: edge ({a}, {b}) belongs to {} faces (a closed tool needs exactly 2)",
-                count[s[k]]
-            )));
-        }
-    }
-    let mut directed: Vec<(usize, usize)> = crate::alloc::with_capacity(CALL, 3 * faces.len())?;
-    directed.extend(
-        faces
-            .iter()
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]),
-    );
-    directed.sort_unstable();
-    if directed.windows(2).any(|w| w[0] == w[1]) {
-        return Err(bad("faces are not consistently oriented".into()));
-    }
-    let m = v.iter().sum::<DVec3>() / n as f64;
-    let six = crate::alloc::collect(
-        CALL,
-        faces
-            .iter()
-            .map(|t| (v[t[0]] - m).dot((v[t[1]] - m).cross(v[t[2]] - m))),
-    )?;
-    let vol = compensated_sum(six.iter().copied()) / 6.0;
-    if !(vol > 0.0) {
-        return Err(bad(format!(
-            "encloses a non-positive volume ({vol:.4}); faces must be oriented outwards"
-        )));
-    }
-    let moment = faces.iter().zip(&six).fold(DVec3::ZERO, |acc, (t, w)| {
-        acc + *w * ((v[t[0]] - m) + (v[t[1]] - m) + (v[t[2]] - m))
-    });
-    Ok((vol, m + moment / (24.0 * vol)))
-}
-
 /// Test meshes shared by the unit tests of several modules.
 #[cfg(test)]
 pub(crate) mod fixtures {
@@ -199,24 +134,6 @@ pub(crate) mod fixtures {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn closed_mesh_volume_centroid_and_refusals() {
-        let (v, f) = cube();
-        let f: Vec<[i64; 3]> = f.iter().map(|t| t.map(|i| i as i64)).collect();
-        let (vol, c) = closed_volume_centroid(&v, &f).unwrap();
-        assert!((vol - 1.0).abs() < 1e-15 && (c - DVec3::splat(0.5)).length() < 1e-15);
-        let e = closed_volume_centroid(&v, &f[1..]).unwrap_err();
-        assert!(e.msg.starts_with("not watertight"), "{e}");
-        let flipped: Vec<[i64; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let e = closed_volume_centroid(&v, &flipped).unwrap_err();
-        assert!(e.msg.starts_with("encloses a non-positive volume"), "{e}");
-        let mut mixed = f.clone();
-        mixed[0] = [f[0][0], f[0][2], f[0][1]];
-        let e = closed_volume_centroid(&v, &mixed).unwrap_err();
-        assert_eq!(e.arg, "mesh");
-        assert!(closed_volume_centroid(&v, &[[0, 1, 9]]).is_err());
-    }
 
     /// The unit cube `[0, 1]³`, outward faces.
     fn cube() -> (Vec<DVec3>, Vec<[usize; 3]>) {

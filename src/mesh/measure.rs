@@ -28,7 +28,7 @@ use crate::error::{InputError, Result};
 use crate::math::mesh::compensated_sum;
 
 /// Faces per block of the compensated sums (fixed, so results do not depend on threads).
-const BLOCK: usize = 1 << 14;
+pub(crate) const BLOCK: usize = 1 << 14;
 
 /// A vertex row as stored by NumPy (`float64` or `float32`).
 pub trait Point: Copy + Send + Sync {
@@ -39,6 +39,13 @@ impl Point for [f64; 3] {
     #[inline(always)]
     fn dvec3(self) -> DVec3 {
         DVec3::from_array(self)
+    }
+}
+
+impl Point for DVec3 {
+    #[inline(always)]
+    fn dvec3(self) -> DVec3 {
+        self
     }
 }
 
@@ -69,7 +76,7 @@ impl Index for i32 {
 }
 
 #[inline(always)]
-fn corners<I: Index>(t: &[I; 3]) -> [usize; 3] {
+pub(crate) fn corners<I: Index>(t: &[I; 3]) -> [usize; 3] {
     // only after `check_faces`: every index is in `0..n`
     t.map(|i| i.get() as usize)
 }
@@ -117,7 +124,7 @@ fn out_of_range<I: Index>(f: &[[I; 3]], from: usize, n: usize) -> InputError {
 /// The compensated sum of `term(face)` over all faces, in fixed blocks, checking the
 /// indices on the way (errors name `faces`). Polls `cancel` before every block; the blocks
 /// it skips count as zero (the caller discards the result).
-fn face_sum<I: Index>(
+pub(crate) fn face_sum<I: Index>(
     f: &[[I; 3]],
     n: usize,
     term: impl Fn([usize; 3]) -> f64 + Sync,
@@ -143,7 +150,7 @@ fn face_sum<I: Index>(
 
 /// The mean of the vertices (zero for none), summed in fixed blocks (polling `cancel`
 /// before each; skipped blocks count as zero).
-fn mean<P: Point>(v: &[P], cancel: Cancel<'_>) -> DVec3 {
+pub(crate) fn mean<P: Point>(v: &[P], cancel: Cancel<'_>) -> DVec3 {
     if v.is_empty() {
         return DVec3::ZERO;
     }

@@ -101,7 +101,7 @@ pub fn deform_mesh<'py>(
     let stop = Stop::default();
     let mut ticker = Ticker::new(progress, &stop);
     let out = detach_stoppable(py, &stop, || {
-        let runs = refine::schedule(field, t0, duration, steps);
+        let runs = refine::schedule(field, t0, duration, steps)?;
         refine::deform(field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
     })??;
     ticker.finish()?;

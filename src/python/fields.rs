@@ -119,8 +119,11 @@ impl PyField {
 
     /// Times at which a path tool passes a spine sample, sorted: the velocity is only
     /// continuous in time there, so `spinal.advect` ends steps at them.
-    fn breakpoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, self.field.breakpoints())
+    fn breakpoints<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(
+            py,
+            self.field.breakpoints("Field.breakpoints")?,
+        ))
     }
 
     /// A bound of the speed `|v|` (length/time): the sum over the tools of each tool's
@@ -476,10 +479,10 @@ pub fn field_path(
     let x = vec3s("points", &points)?;
     let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
     // row-major (n, 3, 3) -> glam's column-major: transpose
-    let fr: Vec<DMat3> = rows
-        .iter()
-        .map(|r| DMat3::from_cols_array(r).transpose())
-        .collect();
+    let fr: Vec<DMat3> = crate::alloc::collect(
+        "along_path",
+        rows.iter().map(|r| DMat3::from_cols_array(r).transpose()),
+    )?;
     let args = path::PathArgs {
         points: x,
         frames: &fr,

@@ -8,10 +8,14 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_in_pool, detach_stoppable, empty, ensure_memory, offsets_of, orientations,
-    renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
+    Stop, detach_stoppable, empty, ensure_memory, offsets_of, orientations, renamed, slice_mut,
+    slice_of, value_error, vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+
+/// Bytes a row checked free before a frames call: the output (72) and the working vectors
+/// ([`frames::WORKING_BYTES_PER_ROW`], measured).
+const PROBE_BYTES_PER_ROW: usize = 72 + frames::WORKING_BYTES_PER_ROW;
 
 pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
@@ -59,6 +63,8 @@ pub fn frames_sampled<'py>(
         end: None,
         turns,
     };
+    // the output and the working vectors of the frames
+    ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
     let angles = {
         let mut rw = out.readwrite();
@@ -113,8 +119,8 @@ pub fn frames_analytic<'py>(
         turns,
         ..Request::default()
     };
-    // the output and the working vectors of the frames' scan, as for `frames`
-    ensure_memory("frames", pts.len(), 256)?;
+    // the output and the working vectors of the frames' scan
+    ensure_memory("frames", pts.len(), PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, &[pts.len(), 3, 3])?;
     let angle = {
         let mut rw = out.readwrite();
@@ -150,8 +156,10 @@ pub fn estimate_tangents<'py>(
         }
         Some(o) => {
             let offs = offsets_of(&o)?;
-            detach_in_pool(py, || {
-                frames::tangents::estimate_many(x, &offs, closed, rule)
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                let cancel = || stop.requested();
+                frames::tangents::estimate_many_cancellable(x, &offs, closed, rule, &cancel)
             })??
         }
     };
@@ -275,9 +283,8 @@ pub fn frames_steered<'py>(
         end: None,
         turns: 0,
     };
-    // the output (72 bytes a row), the rotation-minimising frames, the tangents and the
-    // twist solve
-    ensure_memory("frames", rows, 256)?;
+    // the output, the rotation-minimising frames, the tangents and the twist solve
+    ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
     {
         let mut rw = out.readwrite();
@@ -359,21 +366,23 @@ pub fn frames_in_time<'py>(
         turns,
         ..Request::default()
     };
-    // the output (72 bytes a row), the rotation-minimising frames, the tangents and the
-    // twist solve
-    ensure_memory("frames", total, 256)?;
+    // the output and every step's working vectors (the steps run in parallel, but each holds
+    // its rows' share only)
+    ensure_memory("frames", total, PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, &[total, 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
-        detach_in_pool(py, || {
-            frames::time::frames_in_time(
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            frames::time::frames_in_time_cancellable(
                 &template,
                 steps,
                 rows,
                 frames::pick(&initial, 0),
                 prev,
                 buf,
+                &|| stop.requested(),
             )
         })?
         .map_err(|e| match e.arg {

@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 
 use super::convert::{Stop, detach_in_pool, detach_stoppable, ensure_memory, triangles, vec3s};
 use crate::math::mesh;
+use crate::mesh::closed::{self, CALL as CLOSED};
 use crate::mesh::measure;
 
 /// Signed volume of a closed triangle mesh, summed about the mean vertex.
@@ -29,7 +30,17 @@ pub fn mesh_closed_centroid(
 ) -> PyResult<(f64, [f64; 3])> {
     let v = vec3s("mesh", &vertices)?;
     let f = triangles(&faces)?;
-    let (vol, c) = detach_in_pool(py, || mesh::closed_volume_centroid(v, f))??;
+    // the edge pass's distribution of the face slots and its count per vertex, as for
+    // `mesh_edges`
+    ensure_memory(
+        CLOSED,
+        f.len().saturating_mul(3).saturating_add(v.len()),
+        16,
+    )?;
+    let stop = Stop::default();
+    let (vol, c) = detach_stoppable(py, &stop, || {
+        closed::closed_volume_centroid_cancellable(v, f, &|| stop.requested())
+    })??;
     Ok((vol, c.to_array()))
 }
 

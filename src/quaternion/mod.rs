@@ -381,11 +381,16 @@ fn default_reference(x: &[DVec3], t: &[DVec3], closed: bool) -> Result<DVec3> {
         alloc::product("quaternion_frames", 9, x.len(), 8)?,
         0.0,
     )?;
-    // the scan's working vectors take under 256 bytes a row (see `frames::compute_into`):
-    // probe for them (freed at once) so that their infallible allocation cannot abort
+    // the scan's working vectors take under `frames::WORKING_BYTES_PER_ROW`: probe for them
+    // (freed at once) so that their infallible allocation cannot abort
     alloc::with_capacity::<u8>(
         "quaternion_frames",
-        alloc::product("quaternion_frames", x.len(), 256, 1)?,
+        alloc::product(
+            "quaternion_frames",
+            x.len(),
+            frames::WORKING_BYTES_PER_ROW,
+            1,
+        )?,
     )?;
     frames::compute_into(&req, &mut buf)?;
     Ok(DVec3::new(buf[0], buf[3], buf[6]))
