@@ -102,7 +102,11 @@ class DeformReport:
         sides. The new vertex is the point halfway along the path (by the chords between its
         images): a material point of one side, or a point of the surface with the mean blend
         of its neighbours along the path. Both halves are then about half as long, so
-        bisection resolves every edge across the slip. Also counts the ``chord_vertices``.
+        bisection resolves every edge across the slip. Where the halfway point would land on
+        a third vertex of the edge's triangles and join the other one by an edge longer than
+        the split one (halving would only repeat an earlier split), the new vertex goes to the
+        corner of the path nearest to it, where the path meets or leaves the tool's surface.
+        Also counts the ``chord_vertices``.
     slip_vertices : int
         Vertices on a tool's surface at the end (carried with their blend ``s``, not the flow
         of their rest position).

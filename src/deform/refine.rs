@@ -50,6 +50,23 @@
 //!   vertices (at 40k, 134,116 at the 8× bound); with the halfway placement the refinement
 //!   converges with 2.66× the vertices and a volume change of −4.2e-5 (3.31× and −1.5e-5 at
 //!   40k);
+//! * **corners** — halving the path can repeat itself. Where the strip of tool surface meets
+//!   the material of one side, take two surface vertices of the same rest point, `n` near
+//!   the bend (the junction's image) and `f` farther along the strip, and two material
+//!   vertices, `m` just below the bend and `d` deeper. The edge `(m, f)` is split halfway
+//!   along its path, onto the strip next to `n`; the new vertex's edge to `d` is over the
+//!   threshold and split halfway along its path, onto the material next to `m`; that new
+//!   vertex's edge to `f` is split again, and so on: each pair of passes adds two vertices,
+//!   converging to copies of `n` and `m`, until `max_passes` stops the refinement with an
+//!   edge still over the threshold (a 16,386-vertex octahedral sphere dragged like the
+//!   sphere above in 40 steps kept 2 edges at 1.02× the threshold). Such a split puts its
+//!   new vertex on a third vertex of its triangles (closer than [`COINCIDENT`] × the edge)
+//!   and joins it to the other third vertex by an edge over the threshold and longer than
+//!   the split one, which bisection at the chord midpoint never does (the median to a
+//!   triangle's third vertex is shorter than its longest edge; Rivara 1984). Its new vertex
+//!   goes to the corner of the path nearest to the halfway point instead: the junction where
+//!   the path meets or leaves the surface, a point of the body's boundary, so that the two
+//!   halves have one corner fewer;
 //! * **chord midpoints** — where `Φ(m)` of an edge of one side's material lies farther than a
 //!   quarter of the edge from the chord midpoint (a flow the steps do not resolve), the new
 //!   vertex is the chord midpoint, moved onto the nearest slip surface a hair on its outer
@@ -80,6 +97,10 @@ const NONE: usize = usize::MAX;
 /// A placement farther than this fraction of its edge from the chord midpoint marks the edge
 /// as torn by the flow (see the module docs).
 const TORN: f64 = 0.25;
+
+/// A torn edge's halfway point closer than this fraction of the edge to a third vertex of
+/// its triangles lands on that vertex (see the module docs: corners).
+const COINCIDENT: f64 = 0.05;
 
 pub use super::advect::Run;
 
@@ -170,6 +191,10 @@ pub struct Deformed {
     /// New vertices of edges of material points on one side whose `Φ(rest midpoint)` was torn
     /// away from the chord: placed at the chord midpoint instead.
     pub fallback: usize,
+    /// New vertices of torn edges placed at a corner of their path instead of halfway along
+    /// it, where the halfway point would have repeated an earlier split (see the module
+    /// docs).
+    pub cornered: usize,
     /// Vertices on a slip surface at the end (`Ψ(rest, s)` instead of `Φ(rest)`).
     pub slip_vertices: usize,
     /// Edges still over the threshold at the end (0 when the refinement converged).
@@ -333,6 +358,7 @@ struct Refiner<'a> {
     bounded: bool,
     torn: usize,
     fallback: usize,
+    cornered: usize,
     passes: usize,
 }
 
@@ -510,6 +536,28 @@ impl Refiner<'_> {
         }
     }
 
+    /// Whether splitting half-edge `h` at position `p` (rest point `x`) would repeat an
+    /// earlier split: `p` lands on a third vertex of `h`'s triangles (closer than
+    /// [`COINCIDENT`] × `|h|`) while its edge to a third vertex is over the threshold and
+    /// longer than `h` (at the chord midpoint the median to the third vertex is shorter than
+    /// the longest edge, which is why longest-edge bisection terminates; Rivara 1984).
+    fn repeats(&self, w: &[DVec3], h: usize, x: DVec3, p: DVec3) -> bool {
+        let l2 = len2(&self.topo, w, h);
+        let t = self.topo.twin[h];
+        let third = || {
+            [Some(h), (t != NONE).then_some(t)]
+                .into_iter()
+                .flatten()
+                .map(|e| self.topo.faces[e / 3][(e + 2) % 3])
+        };
+        let ratio2 = self.opts.ratio * self.opts.ratio;
+        third().any(|o| p.distance_squared(w[o]) < COINCIDENT * COINCIDENT * l2)
+            && third().any(|o| {
+                let d2 = p.distance_squared(w[o]);
+                d2 > l2 && d2 > ratio2 * x.distance_squared(self.rest[o]).max(self.mean2)
+            })
+    }
+
     /// A torn edge's new vertex: its chord midpoint `c`, moved onto the nearest slip surface
     /// of the field when one passes within the edge length `l` of it (a Newton step on the
     /// surface's distance, ending a hair on its positive side so that the vertex follows the
@@ -551,19 +599,34 @@ impl Refiner<'_> {
             .flat_map(|p| p[1..p.len() - 1].iter().copied())
             .collect();
         let mut junction = self.image(&inner, done).into_iter();
-        let new: Vec<Gen> = chosen
+        // per edge: the new point, and on a torn edge's path the corner (a junction that is
+        // not one of the edge's ends) nearest to its halfway point, with its image
+        let (new, corners): (Vec<Gen>, Vec<Option<(Gen, DVec3)>>) = chosen
             .iter()
             .zip(&paths)
             .map(|(&h, path)| {
                 let (a, b) = self.topo.ends(h);
                 let Some(path) = path else {
-                    return Gen::Material(0.5 * (self.rest[a] + self.rest[b]));
+                    return (Gen::Material(0.5 * (self.rest[a] + self.rest[b])), None);
                 };
                 let mut at = vec![w[a]];
                 at.extend(junction.by_ref().take(path.len() - 2));
                 at.push(w[b]);
                 let lens: Vec<f64> = at.windows(2).map(|q| q[0].distance(q[1])).collect();
-                let mut half = 0.5 * lens.iter().sum::<f64>();
+                let total: f64 = lens.iter().sum();
+                let (mut run, mut corner) = (0.0, None::<(f64, usize)>);
+                for j in 1..path.len() - 1 {
+                    run += lens[j - 1];
+                    let off = (run - 0.5 * total).abs();
+                    if path[j] != path[0]
+                        && path[j] != path[path.len() - 1]
+                        && corner.is_none_or(|(o, _)| off < o)
+                    {
+                        corner = Some((off, j));
+                    }
+                }
+                let corner = corner.map(|(_, j)| (path[j], at[j]));
+                let mut half = 0.5 * total;
                 let mut k = 0;
                 while k + 1 < lens.len() && half > lens[k] {
                     half -= lens[k];
@@ -577,7 +640,7 @@ impl Refiner<'_> {
                 let g = path[k].lerp(path[k + 1], f);
                 // a material point must lie on its piece's side of the surface (else the
                 // piece's end on the surface)
-                match (g, path[k], path[k + 1]) {
+                let g = match (g, path[k], path[k + 1]) {
                     (Gen::Material(x), Gen::Material(e), end)
                     | (Gen::Material(x), end, Gen::Material(e))
                         if self.side(x) != self.side(e) =>
@@ -585,12 +648,25 @@ impl Refiner<'_> {
                         end
                     }
                     _ => g,
-                }
+                };
+                (g, corner)
             })
-            .collect();
+            .unzip();
         let placed = self.image(&new, done);
-        for ((&h, (g, p)), path) in chosen.iter().zip(new.into_iter().zip(placed)).zip(&paths) {
+        for (((&h, (g, p)), path), corner) in chosen
+            .iter()
+            .zip(new.into_iter().zip(placed))
+            .zip(&paths)
+            .zip(corners)
+        {
             let (a, b) = self.topo.ends(h);
+            let (g, p) = match corner {
+                Some(c) if self.repeats(w, h, g.rest(), p) => {
+                    self.cornered += 1;
+                    c
+                }
+                _ => (g, p),
+            };
             let chord = 0.5 * (w[a] + w[b]);
             let l = w[a].distance(w[b]);
             let (p, carry) = match g {
@@ -665,6 +741,7 @@ pub fn deform(
         bounded: false,
         torn: 0,
         fallback: 0,
+        cornered: 0,
         passes: 0,
     };
     r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
@@ -698,6 +775,7 @@ pub fn deform(
     out.passes = r.passes;
     out.torn = r.torn;
     out.fallback = r.fallback;
+    out.cornered = r.cornered;
     out.slip_vertices = r
         .carry
         .iter()
@@ -932,6 +1010,45 @@ mod tests {
     }
 
     #[test]
+    fn a_repeating_split_goes_to_the_corner_of_its_path() {
+        // the drag of torn_drag on a 16,386-vertex sphere in 40 steps: before, two torn
+        // edges were split halfway along their paths again and again, each pair of passes
+        // adding a surface vertex and a material vertex next to the previous pair, until
+        // max_passes stopped the refinement with both edges at 1.02× the threshold
+        let (v, f) = sphere(6);
+        let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
+        let runs = schedule(&tool, 0.0, 1.0, 40);
+        let opts = Refinement {
+            ratio: 1.5,
+            max_vertices: 8 * v.len(),
+            max_passes: 30,
+        };
+        let d = deform(&tool, &v, &f, &runs, Some(opts), &mut |_, _| true)
+            .unwrap()
+            .unwrap();
+        assert_eq!((d.over_threshold, d.bounded), (0, false));
+        assert!(d.cornered > 0 && d.cornered < 100, "{} corners", d.cornered);
+        assert!(watertight(&d.faces, d.vertices.len()));
+        // measured: 46,051 vertices (2.81×), −4.8e-5, 4 new vertices at corners
+        assert!(d.vertices.len() < 3 * v.len(), "{}", d.vertices.len());
+        let change = volume(&d.vertices, &d.faces) / volume(&v, &f) - 1.0;
+        assert!(change.abs() < 1e-4, "volume change {change}");
+        // no pair of coincident vertices (the fixed point of the repeated splits: the last
+        // pair was 2.3e-10 × the mean edge apart; the shortest edge now is 4.5e-4 × it)
+        let mean = std::f64::consts::FRAC_PI_2 / 64.0; // about the mean edge: an octant arc / 2⁶
+        for t in &d.faces {
+            for k in 0..3 {
+                let e = d.vertices[t[k]].distance(d.vertices[t[(k + 1) % 3]]);
+                assert!(
+                    e > 1e-6 * mean,
+                    "edge {:?} of length {e:e}",
+                    (t[k], t[(k + 1) % 3])
+                );
+            }
+        }
+    }
+
+    #[test]
     fn the_vertex_bound_stops_refinement_and_says_so() {
         let (v, f) = sphere(3);
         let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
@@ -990,6 +1107,7 @@ mod tests {
             bounded: false,
             torn: 0,
             fallback: 0,
+            cornered: 0,
             passes: 0,
         };
         r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
