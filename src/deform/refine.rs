@@ -72,6 +72,18 @@
 //!   vertex is the chord midpoint, moved onto the nearest slip surface a hair on its outer
 //!   side when one passes within the edge length. Splitting a flat pair of triangles at a
 //!   chord midpoint does not change the mesh's volume;
+//! * **flips** — the strip along a slip surface is filled by vertices of few rest points
+//!   each (a rest point's blends `s` lie on one curve `Ψ(p, ·)`), which bisection joins into
+//!   slivers. After each step's splits, the edges of the split faces (and after the last step
+//!   every edge with a vertex on the surface) are flipped where that raises the smaller
+//!   smallest angle of their two triangles (Lawson's max-min angle flips; Lawson 1977,
+//!   "Software for C¹ surface interpolation"), keeps the mesh edge-manifold and its winding,
+//!   does not fold, keeps the rest mesh's volume and changes the enclosed volume by the
+//!   tetrahedron of the four vertices, at most `10⁻⁴ ℓ̄³` (for the unit sphere of mean edge
+//!   0.038 a thirteenth of the volume `≈ ℓ̄⁴/28` between one face and the sphere; the sum
+//!   over all flips is [`Deformed::flip_volume`]). On
+//!   the 10k-vertex drag this takes the band's faces with a smallest angle under 1° from
+//!   48% to 32% and the vertices from 2.66× to 2.34×, the volume change unchanged;
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
 //!   When edges remain over the threshold at the end — a bound stopped the refinement — the
 //!   result says so (`bounded`, and the number of those edges).
@@ -626,7 +638,8 @@ impl Refiner<'_> {
     /// `(c, d)` at positions `w`: an edge with a vertex on a slip surface whose flip raises
     /// the smaller of the two triangles' smallest angles, keeps the mesh edge-manifold (`c`
     /// and `d` distinct and not joined), does not fold (each new triangle faces within 30° of
-    /// the pair's vector area, which a flip keeps), leaves no edge over the threshold and
+    /// the pair's vector area, which a flip keeps), leaves no edge over the threshold,
+    /// keeps the rest mesh's volume (its tetrahedron of the four rest points is flat) and
     /// changes the enclosed volume — by the signed volume of the tetrahedron `abcd` — by at
     /// most [`FLIP_VOLUME`] × `ℓ̄³`.
     fn flippable(&self, w: &[DVec3], h: usize) -> bool {
@@ -648,6 +661,13 @@ impl Refiner<'_> {
         let old = min_angle(pa, pb, pc).min(min_angle(pb, pa, pd));
         let new = min_angle(pc, pa, pd).min(min_angle(pd, pb, pc));
         if !(new > old * (1.0 + 1e-9)) {
+            return false;
+        }
+        // the rest mesh keeps its volume: its tetrahedron abcd is flat (two rest points the
+        // same, as along a strip of surface points of one rest point, or exactly coplanar)
+        let x = [a, b, c, d].map(|v| self.rest[v]);
+        let same = (0..4).any(|i| (i + 1..4).any(|j| x[i] == x[j]));
+        if !same && (x[1] - x[0]).cross(x[2] - x[0]).dot(x[3] - x[0]) != 0.0 {
             return false;
         }
         let tet = (pb - pa).cross(pc - pa).dot(pd - pa) / 6.0;
