@@ -1466,13 +1466,16 @@ mod tests {
                 let change = volume(&d.vertices, &d.faces) / volume(&v, &f) - 1.0;
                 println!(
                     "n={} steps={steps} -> {} vertices ({:.2}x), torn {}, over {}, bounded {}, \
-                     volume {change:+.2e}, {:.2}s (integrate {:.2}, refine {:.2})",
+                     volume {change:+.2e}, flips {} changing it by {:+.2e}, {:.2}s (integrate \
+                     {:.2}, refine {:.2})",
                     v.len(),
                     d.vertices.len(),
                     d.vertices.len() as f64 / v.len() as f64,
                     d.torn,
                     d.over_threshold,
                     d.bounded,
+                    d.flips,
+                    d.flip_volume / volume(&v, &f),
                     clock.elapsed().as_secs_f64(),
                     d.time_integrate,
                     d.time_refine
