@@ -432,31 +432,63 @@ pub fn advect_ticked(
     every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
-    with_locality(field, points, |points| {
-        advect_blocks(field, points, run, m, every, tick)
-    })
+    advect_runs_ticked(field, points, &[run], m, every, tick)
 }
 
-/// The block loop of [`advect_ticked`].
-fn advect_blocks(
+/// [`advect_ticked`] over several runs one after the other (the runs of
+/// [`super::refine::schedule`], which end at a field's breakpoints), their steps counted as
+/// one sequence: `tick(done, total)` with `total` the sum of the runs' steps. The points are
+/// put in their spatial order once for all the runs. The bits equal [`advect_steps`] calls
+/// for the runs in turn.
+pub fn advect_runs_ticked(
     field: &Field,
     points: &mut [DVec3],
-    run: Run,
+    runs: &[Run],
     m: Method,
     every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
-    let Run {
-        t0,
-        h,
-        count: steps,
-    } = run;
+    with_locality(field, points, |points| {
+        advect_blocks(field, points, runs, m, every, tick)
+    })
+}
+
+/// Steps `span` of `runs` taken in turn (step `j` of the sequence is step `j − s` of the run
+/// whose steps start at `s`).
+fn advect_span(
+    field: &Field,
+    points: &mut [DVec3],
+    runs: &[Run],
+    span: std::ops::Range<usize>,
+    m: Method,
+) {
+    let mut start = 0;
+    for r in runs {
+        let end = start + r.count;
+        let (lo, hi) = (span.start.max(start), span.end.min(end));
+        if lo < hi {
+            advect_steps(field, points, r.t0, r.h, lo - start..hi - start, m);
+        }
+        start = end;
+    }
+}
+
+/// The block loop of [`advect_runs_ticked`].
+fn advect_blocks(
+    field: &Field,
+    points: &mut [DVec3],
+    runs: &[Run],
+    m: Method,
+    every: usize,
+    tick: &mut dyn FnMut(usize, usize) -> bool,
+) -> bool {
+    let steps = runs.iter().map(|r| r.count).sum::<usize>();
     let mut done = 0;
     let mut block = 1usize;
     while done < steps {
         let k = block.min(steps - done);
         let clock = std::time::Instant::now();
-        advect_steps(field, points, t0, h, done..done + k, m);
+        advect_span(field, points, runs, done..done + k, m);
         let dt = clock.elapsed().as_secs_f64();
         // the multiples of `every` passed inside the block, then its end
         let first = done
