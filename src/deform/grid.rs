@@ -59,8 +59,7 @@ pub struct GridTool {
 
 const BUCKETS: usize = 64;
 
-/// `w·x` lane by lane (the lanes written out, so that the compiler makes vector operations
-/// of them).
+/// `w·x` lane by lane (the row arithmetic of [`GridTool::spline_body`]).
 #[inline(always)]
 fn scale(w: f64, x: [f64; 4]) -> [f64; 4] {
     [w * x[0], w * x[1], w * x[2], w * x[3]]
