@@ -11,6 +11,7 @@ measured convergence orders, and mesh volumes from trimesh and libigl.
 
 from __future__ import annotations
 
+import itertools
 import pickle
 
 import numpy as np
@@ -294,6 +295,31 @@ def test_keyframed_pose_follows_scipy_hermite_and_slerp():
         np.testing.assert_allclose((v * n).sum(1), (rigid * n).sum(1), rtol=0, atol=1e-7)
     assert abs(kf.max_speed) < np.inf and kf.length_scale == 0.2
     np.testing.assert_array_equal(kf.breakpoints(), times)
+
+
+def test_a_keyframed_rod_advects_in_one_core_call_with_the_bits_of_one_call_per_interval():
+    """The key times are breakpoints: ``advect`` ends steps there, in one core call for all the
+    key intervals (the points put in their spatial order once). Its bits are those of one
+    core call per interval, and ``progress`` counts the steps of all of them."""
+    times = np.linspace(0, 0.3, 5)
+    keys = ARC.mean(axis=0) + np.c_[0.3 * np.sin(4 * times), 0 * times, -times]
+    turn = Rotation.from_rotvec(np.c_[0 * times, 1.5 * times, 0 * times]).as_matrix()
+    kf = fields.keyframed(fields.rod(ARC, 0.3, velocity=[0, 0, -1], reach=0.3,
+                                     center=ARC.mean(axis=0)), times, keys, turn)
+    x = ball(ARC.mean(axis=0), 0.8, 6000)  # more than the 4096 points of a spatial order
+    t0, T, steps = 0.02, 0.25, 16
+    ts = np.r_[t0, times[(times > t0) & (times < t0 + T)], t0 + T]
+    ns = [max(1, int(np.ceil(steps * (b - a) / T - 1e-9))) for a, b in itertools.pairwise(ts)]
+    assert len(ns) == 4
+    y = x
+    for a, b, n in zip(ts[:-1], ts[1:], ns):
+        y = spinal._core.advect(y, kf, float(a), float(b - a) / n, n, "rk4")
+    seen = []
+    z = spinal.advect(x, kf, T, steps, t0=t0, progress=lambda d, n: seen.append((d, n)))
+    np.testing.assert_array_equal(z, y)
+    np.testing.assert_array_equal(spinal.advect(x, kf, T, steps, t0=t0), y)
+    assert (np.linalg.norm(z - x, axis=1) > 1e-3).sum() > 500
+    assert seen == [(d, sum(ns)) for d in range(1, sum(ns) + 1)]
 
 
 # ---- integration: RK4 order, volume --------------------------------------------------------

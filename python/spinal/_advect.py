@@ -113,18 +113,17 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         ts = np.concatenate([[t0], cuts if duration > 0 else cuts[::-1], [t1]])
         ns = [max(1, int(np.ceil(steps * abs(b - a) / abs(duration) - 1e-9)))
               for a, b in itertools.pairwise(ts)]
-        update, close = _progress_bar(sum(ns), progress) if progress else (None, None)
-        done = 0
+        runs = [(float(a), float(b - a) / n, n) for a, b, n in zip(ts[:-1], ts[1:], ns)]
+        if not progress:
+            # one core call: the points are put in their spatial order once for all the runs
+            return _core.advect_runs(x, field, runs, method)
+        total = sum(ns)
+        update, close = _progress_bar(total, progress)
         try:
-            for a, b, n in zip(ts[:-1], ts[1:], ns):
-                x = _core.advect(x, field, float(a), float(b - a) / n, n, method)
-                done += n
-                if update:
-                    update(done)
+            return _core.advect_runs(x, field, runs, method,
+                                     lambda done, total: update(done), max(1, total // 100))
         finally:
-            if close:
-                close()
-        return x
+            close()
     h = duration / steps
     if not progress:
         return _core.advect(x, field, t0, h, steps, method)

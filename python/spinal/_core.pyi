@@ -342,6 +342,14 @@ def advect(
     progress: Callable[[int, int], object] | None = None,
     every: int = 0,
 ) -> npt.NDArray[np.float64]: ...
+def advect_runs(
+    points: npt.NDArray[np.float64],
+    field: Field,
+    runs: list[tuple[float, float, int]],
+    method: str,
+    progress: Callable[[int, int], object] | None = None,
+    every: int = 0,
+) -> npt.NDArray[np.float64]: ...
 def deform_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],

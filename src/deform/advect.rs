@@ -313,15 +313,30 @@ pub fn check_method(field: &Field, m: Method) -> crate::error::Result<()> {
 /// Points below which a spatial order does not pay for its sort.
 const LOCALITY_MIN: usize = 4096;
 
-/// A permutation of `points` along a Morton (Z-order) curve of 10 bits per axis over their
-/// bounding box: neighbours in the order are mostly neighbours in space. `None` when its
-/// buffers cannot be allocated (the order is an optimisation: the caller runs unsorted).
-fn spatial_order(points: &[DVec3]) -> Option<Vec<u32>> {
+/// Bits per axis of the spatial order's cells: `2²¹` cells over the points' bounding box,
+/// about one per point at 10⁶ points; a batch of lanes then spans a few neighbouring cells
+/// (finer cells would not change which table entries or branches a batch shares).
+const ORDER_BITS: u32 = 7;
+
+/// Radix digit of the spatial order's sort: two passes cover the `3 · ORDER_BITS` bits.
+const DIGIT: u32 = 11;
+
+/// The points in a spatial order: keys `code << 32 | i` sorted by the Morton (Z-order) code
+/// of the cell of point `i` (neighbours in the order are mostly neighbours in space), ties
+/// in the given order. `None` when its buffers cannot be allocated (the order is an
+/// optimisation: the caller runs unsorted).
+///
+/// The codes are sorted by a least-significant-digit radix sort (two counting passes, no
+/// comparisons). With the copies in and out of the order, 10⁶ points cost about 200
+/// instructions each and no mispredicted branch (callgrind), against about 520 and 2.4 for
+/// a comparison sort of 30-bit codes (about two RK4 steps of a sphere tool).
+fn spatial_order(points: &[DVec3]) -> Option<Vec<u64>> {
     let (lo, hi) = points.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     );
-    let scale = DVec3::splat(1023.0) / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
+    let top = ((1u32 << ORDER_BITS) - 1) as f64;
+    let scale = DVec3::splat(top) / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
     let spread = |v: u32| {
         // interleave: bit i of v goes to bit 3i
         let mut x = v & 0x3ff;
@@ -330,17 +345,47 @@ fn spatial_order(points: &[DVec3]) -> Option<Vec<u32>> {
         x = (x | (x << 4)) & 0x030c30c3;
         (x | (x << 2)) & 0x09249249
     };
-    let mut keyed: Vec<(u32, u32)> = alloc::par_collect(
+    let keys: Vec<u64> = alloc::par_collect(
         "advect",
         points.par_iter().enumerate().map(|(i, p)| {
-            let q = ((*p - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1023.0));
+            let q = ((*p - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(top));
             let code = spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2);
-            (code, i as u32)
+            (u64::from(code) << 32) | i as u64
         }),
     )
     .ok()?;
-    keyed.par_sort_unstable(); // in place
-    alloc::collect("advect", keyed.into_iter().map(|(_, i)| i)).ok()
+    radix_sort(keys)
+}
+
+/// `keys` sorted by their bits `32 .. 32 + 2·DIGIT` (stable: the low bits keep their order).
+fn radix_sort(mut keys: Vec<u64>) -> Option<Vec<u64>> {
+    const B: usize = 1 << DIGIT;
+    let digit = |k: u64, pass: u32| ((k >> (32 + pass * DIGIT)) as usize) & (B - 1);
+    // both passes' counts in one sweep, then their starts
+    let mut start = [[0usize; B]; 2];
+    for &k in &keys {
+        start[0][digit(k, 0)] += 1;
+        start[1][digit(k, 1)] += 1;
+    }
+    for s in &mut start {
+        let mut sum = 0;
+        for c in s.iter_mut() {
+            (*c, sum) = (sum, sum + *c);
+        }
+    }
+    let mut tmp = alloc::filled("advect", keys.len(), 0u64).ok()?;
+    let [mut s0, mut s1] = start;
+    for &k in &keys {
+        let d = digit(k, 0);
+        tmp[s0[d]] = k;
+        s0[d] += 1;
+    }
+    for &k in &tmp {
+        let d = digit(k, 1);
+        keys[s1[d]] = k;
+        s1[d] += 1;
+    }
+    Some(keys)
 }
 
 /// `run(points)` on the points in a spatial order when a tool of `field` benefits from it
@@ -354,17 +399,18 @@ fn with_locality<R>(field: &Field, points: &mut [DVec3], run: impl FnOnce(&mut [
     if !local {
         return run(points);
     }
-    // sort keys, order and sorted copy allocated fallibly: without room, run unsorted (the
-    // same bits, see above)
+    // sort keys and sorted copy allocated fallibly: without room, run unsorted (the same
+    // bits, see above)
+    let index = |k: u64| (k & u64::from(u32::MAX)) as usize;
     let Some((order, mut sorted)) = spatial_order(points).and_then(|order| {
-        let sorted = alloc::collect("advect", order.iter().map(|&i| points[i as usize])).ok()?;
+        let sorted = alloc::collect("advect", order.iter().map(|&k| points[index(k)])).ok()?;
         Some((order, sorted))
     }) else {
         return run(points);
     };
     let r = run(&mut sorted);
-    for (p, &i) in sorted.iter().zip(&order) {
-        points[i as usize] = *p;
+    for (p, &k) in sorted.iter().zip(&order) {
+        points[index(k)] = *p;
     }
     r
 }
@@ -386,31 +432,63 @@ pub fn advect_ticked(
     every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
-    with_locality(field, points, |points| {
-        advect_blocks(field, points, run, m, every, tick)
-    })
+    advect_runs_ticked(field, points, &[run], m, every, tick)
 }
 
-/// The block loop of [`advect_ticked`].
-fn advect_blocks(
+/// [`advect_ticked`] over several runs one after the other (the runs of
+/// [`super::refine::schedule`], which end at a field's breakpoints), their steps counted as
+/// one sequence: `tick(done, total)` with `total` the sum of the runs' steps. The points are
+/// put in their spatial order once for all the runs. The bits equal [`advect_steps`] calls
+/// for the runs in turn.
+pub fn advect_runs_ticked(
     field: &Field,
     points: &mut [DVec3],
-    run: Run,
+    runs: &[Run],
     m: Method,
     every: usize,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> bool {
-    let Run {
-        t0,
-        h,
-        count: steps,
-    } = run;
+    with_locality(field, points, |points| {
+        advect_blocks(field, points, runs, m, every, tick)
+    })
+}
+
+/// Steps `span` of `runs` taken in turn (step `j` of the sequence is step `j − s` of the run
+/// whose steps start at `s`).
+fn advect_span(
+    field: &Field,
+    points: &mut [DVec3],
+    runs: &[Run],
+    span: std::ops::Range<usize>,
+    m: Method,
+) {
+    let mut start = 0;
+    for r in runs {
+        let end = start + r.count;
+        let (lo, hi) = (span.start.max(start), span.end.min(end));
+        if lo < hi {
+            advect_steps(field, points, r.t0, r.h, lo - start..hi - start, m);
+        }
+        start = end;
+    }
+}
+
+/// The block loop of [`advect_runs_ticked`].
+fn advect_blocks(
+    field: &Field,
+    points: &mut [DVec3],
+    runs: &[Run],
+    m: Method,
+    every: usize,
+    tick: &mut dyn FnMut(usize, usize) -> bool,
+) -> bool {
+    let steps = runs.iter().map(|r| r.count).sum::<usize>();
     let mut done = 0;
     let mut block = 1usize;
     while done < steps {
         let k = block.min(steps - done);
         let clock = std::time::Instant::now();
-        advect_steps(field, points, t0, h, done..done + k, m);
+        advect_span(field, points, runs, done..done + k, m);
         let dt = clock.elapsed().as_secs_f64();
         // the multiples of `every` passed inside the block, then its end
         let first = done
@@ -498,9 +576,11 @@ mod tests {
                 DVec3::new((a * 0.7).sin(), (a * 1.3).cos(), (a * 0.11).sin()) * 1.2
             })
             .collect();
-        let mut order = spatial_order(&x0).unwrap();
+        let keys = spatial_order(&x0).unwrap();
+        assert!(keys.windows(2).all(|w| w[0] < w[1])); // by cell, ties in the given order
+        let mut order: Vec<u64> = keys.iter().map(|k| k & u64::from(u32::MAX)).collect();
         order.sort_unstable();
-        assert!(order.iter().enumerate().all(|(i, &j)| i as u32 == j));
+        assert!(order.iter().enumerate().all(|(i, &j)| i as u64 == j));
         for f in [Field::single(strip), Field::single(rod)] {
             let mut sorted = x0.clone();
             advect_in_place(&f, &mut sorted, 0.0, 0.02, 8, Method::Rk4);

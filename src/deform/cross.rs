@@ -454,10 +454,17 @@ pub fn strip(
     )?))
 }
 
-/// `impl Tool` for a tool with `eval(x, t)` and `max_speed()` whose length scale is `reach`.
+/// `impl Tool` for a tool with `eval(x, t)` and `max_speed()` whose length scale is `reach`;
+/// a last argument `true` asks for a spatial order of the path lines ([`Tool::wants_locality`]).
 macro_rules! tool {
     ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr) => {
+        tool!($t, |$s, $x, $time| $eval, false);
+    };
+    ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr, $local:expr) => {
         impl Tool for $t {
+            fn wants_locality(&self) -> bool {
+                $local
+            }
             #[inline]
             fn velocity(&self, $x: DVec3, $time: f64, _tm: f64) -> DVec3 {
                 let $s = self;
@@ -473,7 +480,11 @@ macro_rules! tool {
     };
 }
 
-tool!(Sphere, |s, x, t| s.eval(x, t));
+// the sphere's evaluation branches three ways (inside the tool, the blend shell, outside):
+// on points in no spatial order (10⁶ random points in a ball, a third in the shell) the
+// branches mispredict about 1.7 times per RK4 step, 0.3 in Morton order (callgrind's branch
+// simulation), which more than pays for the sort
+tool!(Sphere, |s, x, t| s.eval(x, t), true);
 tool!(Capsule, |s, x, t| s.eval(x, t));
 tool!(Torus, |s, x, t| s.eval(x, t));
 tool!(StripAcross, |s, x, _t| s.eval(x));

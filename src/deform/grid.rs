@@ -59,6 +59,23 @@ pub struct GridTool {
 
 const BUCKETS: usize = 64;
 
+/// `w·x` lane by lane (the row arithmetic of [`GridTool::spline_body`]).
+#[inline(always)]
+fn scale(w: f64, x: [f64; 4]) -> [f64; 4] {
+    [w * x[0], w * x[1], w * x[2], w * x[3]]
+}
+
+/// `acc + w·x` lane by lane.
+#[inline(always)]
+fn madd(acc: [f64; 4], w: f64, x: [f64; 4]) -> [f64; 4] {
+    [
+        acc[0] + w * x[0],
+        acc[1] + w * x[1],
+        acc[2] + w * x[2],
+        acc[3] + w * x[3],
+    ]
+}
+
 /// Cubic B-spline weights and their derivatives at fraction `f ∈ [0, 1]`.
 #[inline(always)]
 fn weights(f: f64) -> ([f64; 4], [f64; 4]) {
@@ -78,6 +95,45 @@ fn weights(f: f64) -> ([f64; 4], [f64; 4]) {
             0.5 * (3.0 * f2 - 4.0 * f),
             0.5 * (-3.0 * f2 + 2.0 * f + 1.0),
             0.5 * f2,
+        ],
+    )
+}
+
+/// [`weights`] of the four lanes of `f` at once (the same operations lane by lane).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn weights_avx2(
+    f: std::arch::x86_64::__m256d,
+) -> (
+    [std::arch::x86_64::__m256d; 4],
+    [std::arch::x86_64::__m256d; 4],
+) {
+    use std::arch::x86_64::{_mm256_add_pd, _mm256_mul_pd, _mm256_set1_pd, _mm256_sub_pd};
+    let k = _mm256_set1_pd;
+    let (add, sub, mul) = (_mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd);
+    const SIXTH: f64 = 1.0 / 6.0;
+    let g = sub(k(1.0), f);
+    let f2 = mul(f, f);
+    let f3 = mul(f2, f);
+    (
+        [
+            mul(mul(mul(g, g), g), k(SIXTH)),
+            mul(add(sub(mul(k(3.0), f3), mul(k(6.0), f2)), k(4.0)), k(SIXTH)),
+            mul(
+                add(
+                    add(add(mul(k(-3.0), f3), mul(k(3.0), f2)), mul(k(3.0), f)),
+                    k(1.0),
+                ),
+                k(SIXTH),
+            ),
+            mul(f3, k(SIXTH)),
+        ],
+        [
+            mul(mul(k(-0.5), g), g),
+            mul(k(0.5), sub(mul(k(3.0), f2), mul(k(4.0), f))),
+            mul(k(0.5), add(add(mul(k(-3.0), f2), mul(k(2.0), f)), k(1.0))),
+            mul(k(0.5), f2),
         ],
     )
 }
@@ -194,17 +250,26 @@ impl GridTool {
 
     /// The interpolated distance and its exact gradient at `x` (tool frame), or `None` where
     /// `d ≥ R_f` is certain (outside the grid, or a cell whose coefficients are all `≥ R_f`).
-    #[inline]
+    /// Inlined into the callers' lane loops: the cull, taken by most points, costs no call.
+    #[inline(always)]
     pub fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let g = (x - self.origin) * self.inv_spacing;
         let n = self.n;
+        // inside the grid, 0 ≤ g ≤ n − 1 on every axis (a NaN fails): one test, before any
+        // conversion, for the many points away from the tool
+        let inside = (g.x >= 0.0)
+            & (g.y >= 0.0)
+            & (g.z >= 0.0)
+            & (g.x <= self.top[0])
+            & (g.y <= self.top[1])
+            & (g.z <= self.top[2]);
+        if !inside {
+            return None;
+        }
         let mut idx = [0usize; 3];
         let mut fr = [0.0; 3];
         for a in 0..3 {
-            if !(g[a] >= 0.0 && g[a] <= self.top[a]) {
-                return None;
-            }
-            // 0 ≤ g ≤ n − 1 here, so truncation is the floor (no libm call on the baseline
+            // 0 ≤ g ≤ n − 1, so truncation is the floor (no libm call on the baseline
             // target); through i64, whose conversions are single instructions
             let i = (g[a] as i64).min(self.last[a]);
             idx[a] = i as usize;
@@ -219,8 +284,106 @@ impl GridTool {
 
     /// The B-spline and its gradient in cell `idx` at fractions `fr` (kept out of line, so
     /// that the cull of [`Self::distance`], taken by most points, stays short).
+    ///
+    /// On x86-64 processors with AVX2 the contraction runs on 256-bit vectors, a row of 4
+    /// coefficients per register ([`Self::spline_avx2`], chosen at run time as the frames'
+    /// scan chooses its AVX2 build, `crate::frames::fused`). Its operations are, lane by lane,
+    /// the IEEE operations of [`Self::spline_body`] in the same order (Rust never fuses a
+    /// multiply and an add on its own), so both give the same bits (a unit test compares
+    /// them).
     #[inline(never)]
     fn spline(&self, idx: [usize; 3], fr: [f64; 3]) -> Option<(f64, DVec3)> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `spline_avx2` only needs the processor to support AVX2, checked just
+            // above.
+            return unsafe { self.spline_avx2(idx, fr) };
+        }
+        self.spline_body(idx, fr)
+    }
+
+    /// Layer `a` of the stencil of cell `idx`: its row `b` (4 coefficients along z) starts
+    /// at `b · (n_z + 2)`.
+    #[inline(always)]
+    fn layer(&self, idx: [usize; 3], a: usize) -> Option<&[f64]> {
+        let (py, pz) = (self.n[1] + 2, self.n[2] + 2);
+        let first = ((idx[0] + a) * py + idx[1]) * pz + idx[2];
+        self.coef.get(first..first + 3 * pz + 4)
+    }
+
+    /// [`Self::spline_body`] on 256-bit vectors (the same operations lane by lane).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn spline_avx2(&self, idx: [usize; 3], fr: [f64; 3]) -> Option<(f64, DVec3)> {
+        use std::arch::x86_64::{
+            __m256d, _mm256_add_pd, _mm256_broadcastsd_pd, _mm256_castpd256_pd128, _mm256_hadd_pd,
+            _mm256_mul_pd, _mm256_permute2f128_pd, _mm256_permute4x64_pd, _mm256_set1_pd,
+            _mm256_setr_pd, _mm256_unpacklo_pd,
+        };
+        // the weights of the three axes at once (lanes x, y, z), then lane x of the k-th
+        // weight for layer k, lane y for row k, and the z weights gathered into one vector
+        let (w, dw) = weights_avx2(_mm256_setr_pd(fr[0], fr[1], fr[2], 0.0));
+        let wx = w.map(|v| _mm256_broadcastsd_pd(_mm256_castpd256_pd128(v)));
+        let dx = dw.map(|v| _mm256_broadcastsd_pd(_mm256_castpd256_pd128(v)));
+        let wy = w.map(|v| _mm256_permute4x64_pd::<0x55>(v));
+        let dy = dw.map(|v| _mm256_permute4x64_pd::<0x55>(v));
+        let lanes_z = |v: [__m256d; 4]| {
+            _mm256_permute2f128_pd::<0x31>(
+                _mm256_unpacklo_pd(v[0], v[1]),
+                _mm256_unpacklo_pd(v[2], v[3]),
+            )
+        };
+        let (vz, vdz) = (lanes_z(w), lanes_z(dw));
+        let pz = self.n[2] + 2;
+        let mut e = [_mm256_set1_pd(0.0); 3];
+        for a in 0..4 {
+            let layer = self.layer(idx, a)?;
+            let mut s = [_mm256_set1_pd(0.0); 2];
+            for b in 0..4 {
+                let r = &layer[b * pz..b * pz + 4];
+                let r = _mm256_setr_pd(r[0], r[1], r[2], r[3]);
+                let (ty, tdy) = (_mm256_mul_pd(wy[b], r), _mm256_mul_pd(dy[b], r));
+                s = if b == 0 {
+                    [ty, tdy]
+                } else {
+                    [_mm256_add_pd(s[0], ty), _mm256_add_pd(s[1], tdy)]
+                };
+            }
+            let t = [
+                _mm256_mul_pd(wx[a], s[0]),
+                _mm256_mul_pd(dx[a], s[0]),
+                _mm256_mul_pd(wx[a], s[1]),
+            ];
+            e = if a == 0 {
+                t
+            } else {
+                [
+                    _mm256_add_pd(e[0], t[0]),
+                    _mm256_add_pd(e[1], t[1]),
+                    _mm256_add_pd(e[2], t[2]),
+                ]
+            };
+        }
+        // the four dot products `(u₀w₀ + u₁w₁) + (u₂w₂ + u₃w₃)`: pairs by `hadd`, then the
+        // pair sums of each product brought into one lane
+        let p: [__m256d; 4] = [
+            _mm256_mul_pd(e[0], vz),
+            _mm256_mul_pd(e[1], vz),
+            _mm256_mul_pd(e[2], vz),
+            _mm256_mul_pd(e[0], vdz),
+        ];
+        let (h01, h23) = (_mm256_hadd_pd(p[0], p[1]), _mm256_hadd_pd(p[2], p[3]));
+        let sum = _mm256_add_pd(
+            _mm256_permute2f128_pd::<0x20>(h01, h23),
+            _mm256_permute2f128_pd::<0x31>(h01, h23),
+        );
+        let [d, gx, gy, gz]: [f64; 4] = bytemuck::cast(sum);
+        Some((d, DVec3::new(gx, gy, gz) * self.inv_spacing))
+    }
+
+    /// The work of [`Self::spline`].
+    #[inline(always)]
+    fn spline_body(&self, idx: [usize; 3], fr: [f64; 3]) -> Option<(f64, DVec3)> {
         let n = self.n;
         let (wx, dx) = weights(fr[0]);
         let (wy, dy) = weights(fr[1]);
@@ -229,28 +392,36 @@ impl GridTool {
         // layer `a`, `s0 = Σ_b wy_b c_ab·` and `sy = Σ_b dy_b c_ab·` (rows of 4 along z), then
         // `e0 = Σ_a wx_a s0`, `ex = Σ_a dx_a s0`, `ey = Σ_a wx_a sy`; finally the z weights:
         // `d = e0·wz`, `∂ξ d = ex·wz`, `∂η d = ey·wz`, `∂ζ d = e0·dz`
-        let (py, pz) = (n[1] + 2, n[2] + 2);
-        let (mut e0, mut ex, mut ey) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+        let pz = n[2] + 2;
+        let mut e = [[0.0; 4]; 3];
         for a in 0..4 {
-            let (mut s0, mut sy) = ([0.0; 4], [0.0; 4]);
-            for b in 0..4 {
-                let base = ((idx[0] + a) * py + idx[1] + b) * pz + idx[2];
-                let cs = self.coef.get(base..base + 4)?;
-                for c in 0..4 {
-                    s0[c] += wy[b] * cs[c];
-                    sy[c] += dy[b] * cs[c];
-                }
+            let layer = self.layer(idx, a)?;
+            let row = |b: usize| -> [f64; 4] {
+                let r = &layer[b * pz..b * pz + 4];
+                [r[0], r[1], r[2], r[3]]
+            };
+            let r0 = row(0);
+            let (mut s0, mut sy) = (scale(wy[0], r0), scale(dy[0], r0));
+            for b in 1..4 {
+                let r = row(b);
+                s0 = madd(s0, wy[b], r);
+                sy = madd(sy, dy[b], r);
             }
-            for c in 0..4 {
-                e0[c] += wx[a] * s0[c];
-                ex[c] += dx[a] * s0[c];
-                ey[c] += wx[a] * sy[c];
-            }
+            e = if a == 0 {
+                [scale(wx[0], s0), scale(dx[0], s0), scale(wx[0], sy)]
+            } else {
+                [
+                    madd(e[0], wx[a], s0),
+                    madd(e[1], dx[a], s0),
+                    madd(e[2], wx[a], sy),
+                ]
+            };
         }
+        let [e0, ex, ey] = e;
         let dot =
             |u: &[f64; 4], w: &[f64; 4]| (u[0] * w[0] + u[1] * w[1]) + (u[2] * w[2] + u[3] * w[3]);
         let (d, gx, gy, gz) = (dot(&e0, &wz), dot(&ex, &wz), dot(&ey, &wz), dot(&e0, &dz));
-        Some((d, DVec3::new(gx, gy, gz) * (1.0 / self.spacing)))
+        Some((d, DVec3::new(gx, gy, gz) * self.inv_spacing))
     }
 
     #[inline]
@@ -423,6 +594,56 @@ mod tests {
         assert!(g.distance(o - DVec3::new(0.01, 0.0, 0.0)).is_none());
         // a support reaching the boundary is refused
         assert!(GridTool::new(o, 1.0, n, coef, DVec3::X, m, 40.0, false, false).is_err());
+    }
+
+    /// The AVX2 contraction gives the bits of the portable one (same operations per lane).
+    #[test]
+    fn the_avx2_spline_has_the_bits_of_the_portable_one() {
+        let n = [9, 10, 11];
+        // coefficients in [0.5, 1.5], above the reach: no cell is in the support (which the
+        // constructor would refuse at the edge); the spline itself is what is compared
+        let coef: Vec<f64> = (0..(n[0] + 2) * (n[1] + 2) * (n[2] + 2))
+            .map(|i| 1.0 + 0.5 * ((i as f64) * 0.37).sin())
+            .collect();
+        let g = GridTool::new(
+            DVec3::ZERO,
+            0.1,
+            n,
+            coef,
+            DVec3::X,
+            DVec3::ZERO,
+            0.3,
+            false,
+            false,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let mut seen = 0;
+        for i in 0..500 {
+            let a = i as f64;
+            let idx = [
+                i % (g.n[0] - 1),
+                (i / 3) % (g.n[1] - 1),
+                (i / 7) % (g.n[2] - 1),
+            ];
+            let fr = [(a * 0.61).fract(), (a * 0.37).fract(), (a * 0.83).fract()];
+            let plain = g.spline_body(idx, fr).unwrap();
+            assert!(plain.0.is_finite());
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: AVX2 is available, checked just above.
+                let fast = unsafe { g.spline_avx2(idx, fr) }.unwrap();
+                assert_eq!(plain.0.to_bits(), fast.0.to_bits());
+                assert_eq!(
+                    plain.1.to_array().map(f64::to_bits),
+                    fast.1.to_array().map(f64::to_bits)
+                );
+                seen += 1;
+            }
+            assert_eq!(g.spline(idx, fr), Some(plain));
+        }
+        if cfg!(target_arch = "x86_64") && seen == 0 {
+            eprintln!("no AVX2 on this processor: only the portable spline was run");
+        }
     }
 }
 

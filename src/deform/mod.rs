@@ -75,8 +75,10 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
     }
 
     /// Whether an evaluation reads a large table at a place that depends on the point (a
-    /// distance grid, a spline's segments): then path lines are integrated in a spatial order
-    /// so that neighbouring lanes share cache lines ([`advect::advect_ticked`]).
+    /// distance grid, a spline's segments), or branches on where the point lies (inside the
+    /// tool, in the blend region, outside it): then path lines are integrated in a spatial
+    /// order, so that neighbouring lanes share cache lines and take the same branches
+    /// ([`advect::advect_ticked`]).
     fn wants_locality(&self) -> bool {
         false
     }

@@ -29,6 +29,56 @@ pub fn advect<'py>(
     progress: Option<Py<PyAny>>,
     every: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let run = deform::advect::Run {
+        t0,
+        h,
+        count: steps,
+    };
+    advect_runs_impl(py, points, &field, &[run], method, progress, every)
+}
+
+/// Advect points through runs of equal steps one after the other, `runs` a list of
+/// `(t0, h, steps)` (the sub-intervals between a field's breakpoints), in one call: the
+/// points are put in their spatial order once. The bits are those of [`advect`] called for
+/// each run in turn. `progress(done, total)` counts the steps of all the runs.
+#[pyfunction]
+#[pyo3(signature = (points, field, runs, method, progress=None, every=0))]
+pub fn advect_runs<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    field: PyRef<'py, PyField>,
+    runs: Vec<(f64, f64, usize)>,
+    method: Method,
+    progress: Option<Py<PyAny>>,
+    every: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let total = runs
+        .iter()
+        .try_fold(0usize, |s, r| s.checked_add(r.2))
+        .filter(|&n| n <= deform::MAX_STEPS);
+    if total.is_none() {
+        return Err(value_error(format!(
+            "runs: at most {} steps in all",
+            deform::MAX_STEPS
+        )));
+    }
+    let runs: Vec<deform::advect::Run> = runs
+        .into_iter()
+        .map(|(t0, h, count)| deform::advect::Run { t0, h, count })
+        .collect();
+    advect_runs_impl(py, points, &field, &runs, method, progress, every)
+}
+
+/// The work of [`advect`] and [`advect_runs`].
+fn advect_runs_impl<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    field: &PyField,
+    runs: &[deform::advect::Run],
+    method: Method,
+    progress: Option<Py<PyAny>>,
+    every: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let field = &field.field;
     deform::advect::check_method(field, method)?;
     let x = vec3s("vertices", &points)?;
@@ -41,12 +91,7 @@ pub fn advect<'py>(
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
         detach_stoppable(py, &stop, || {
-            let run = deform::advect::Run {
-                t0,
-                h,
-                count: steps,
-            };
-            deform::advect::advect_ticked(field, o, run, method, every, &mut |d, n| {
+            deform::advect::advect_runs_ticked(field, o, runs, method, every, &mut |d, n| {
                 ticker.tick(d, n)
             })
         })?;
