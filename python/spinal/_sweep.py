@@ -115,7 +115,8 @@ def sweep(
     frames : array_like (n, 3, 3), optional
         Frames from :func:`spinal.frames` (columns r, s, t). Default: the rotation-minimising
         frames by double reflection, ``spinal.frames(points, closed=closed)``, so closed
-        loops meet without a seam twist.
+        loops meet without a seam twist (computed curve by curve as the sweep goes, bit for
+        bit those of that call, without holding the ``(n, 3, 3)`` array of them).
     scale : float, (n,) or (n, 2), optional
         Positive scale of the profile at every sample (per profile axis for (n, 2)).
     twist : float or (n,), optional
