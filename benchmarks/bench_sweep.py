@@ -21,12 +21,20 @@ and prints a float64 table with the ratios, then the float32 table against VTK. 
 run adds 1 000 curves of 1 000 points (spinal in one call with ``lengths``; VTK one PolyData
 with 1 000 polylines; ``--no-bundle`` leaves it out). ``--bundle`` adds the big bundle:
 100 000 streamlines of 96 points (9.6 M points, 8 sides), time and peak memory of every
-call measured in a fresh process (spinal float32 and VTK strips; ``--bundle-all`` adds
-spinal float64 and VTK strips + triangulate).
+call measured in a fresh process (spinal float32, VTK strips and the NumPy write floor of
+spinal float32's output; ``--bundle-all`` adds spinal float64 and VTK strips +
+triangulate), each after the same call once (its output freed just before, so the measured
+call reuses warm pages). ``--bundle-first`` measures first calls instead, each after a pause:
+on a virtual machine that hands freed memory back to its host (free page reporting: on the
+machine measured, 2 MiB blocks from ~2 s after they are freed, ~250 MB/s), the first touch
+of memory so handed back costs more than the sweep (writing 2 GB with NumPy there took
+0.7 s of system time right after another process freed 4 GB, 5.8 s after a 40 s pause), so
+a first call's time depends on what ran before it.
 
     python benchmarks/bench_sweep.py              # 10^3 … 10^6 spine points
     python benchmarks/bench_sweep.py --max 2e5
-    python benchmarks/bench_sweep.py --bundle     # + the 100k-streamline bundle (~10 GB)
+    python benchmarks/bench_sweep.py --bundle     # + the 100k-streamline bundle (~5 GB)
+    python benchmarks/bench_sweep.py --bundle --bundle-first   # first calls, cold memory
     python benchmarks/bench_sweep.py --spikes     # only: non-convex profiles of 10^3 … 10^5
                                                   # packed spikes (star, comb), capped
 """
@@ -38,6 +46,7 @@ import itertools
 import json
 import subprocess
 import sys
+import time
 
 import numpy as np
 from _timing import best, helix
@@ -134,9 +143,10 @@ def run(sizes, repeat, bundle):
 
 
 BUNDLE_CHILD = r"""
-import json, sys, time
+import json, os, sys, time
 import numpy as np
 what, curves, per, sides = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+warm = sys.argv[5] == "warm"
 rng = np.random.default_rng(0)
 # smooth random streamlines: cumulative sums of slowly turning unit steps
 n = curves * per
@@ -153,10 +163,18 @@ def status(key):
         return next(int(l.split()[1]) for l in f if l.startswith(key)) * 1024
 if what.startswith("spinal"):
     import spinal
-    spinal.tube(x[:per], r, sides)  # warm-up
     kw = {"dtype": np.float32} if what == "spinal float32" else {}
     run = lambda: spinal.tube(x, r, sides, lengths=lengths, **kw)
+    small = lambda: spinal.tube(x[:per], r, sides)
     size = lambda m: sum(a.nbytes for a in (m.vertices, m.faces, m.normals, m.uv))
+elif what == "numpy floor":
+    # spinal float32's output arrays (vertices, normals, uv, int32 faces) written once
+    nv, nf = n * sides, curves * (2 * (per - 1) * sides + 2 * (sides - 2))
+    shapes = (((nv, 3), np.float32), ((nv, 3), np.float32), ((nv, 2), np.float32),
+              ((nf, 3), np.int32))
+    run = lambda: [np.full(s, 1, dtype=t) for s, t in shapes]
+    small = lambda: np.full(1000, 1.0)
+    size = lambda m: sum(a.nbytes for a in m)
 else:
     import pyvista as pv
     cells = np.empty((curves, per + 1), dtype=np.int64)
@@ -164,35 +182,46 @@ else:
     cells[:, 1:] = np.arange(n).reshape(curves, per)
     poly = pv.PolyData(x, lines=cells.ravel())
     del cells
-    poly.tube(radius=r, n_sides=sides, capping=True)  # warm-up is the whole call: skip
+    one = pv.PolyData(x[:per], lines=np.r_[per, np.arange(per)])
     if what == "vtk strips":
         run = lambda: poly.tube(radius=r, n_sides=sides, capping=True)
+        small = lambda: one.tube(radius=r, n_sides=sides, capping=True)
     else:
         run = lambda: poly.tube(radius=r, n_sides=sides, capping=True).triangulate()
+        small = lambda: one.tube(radius=r, n_sides=sides, capping=True).triangulate()
     size = lambda m: m.actual_memory_size * 1024
+# warm-up: the whole call (its output's pages freed just before the measured call, which
+# then reuses them), or for a first call one curve (imports, thread pool, code paths)
+(run if warm else small)()
 with open("/proc/self/clear_refs", "w") as f:
     f.write("5")
 before = status("VmRSS:")
-t0 = time.perf_counter()
+c0, t0 = os.times(), time.perf_counter()
 out = run()
-t = time.perf_counter() - t0
-print(json.dumps({"s": t, "peak": status("VmHWM:") - before, "output": size(out),
-                  "points": n}))
+t, c1 = time.perf_counter() - t0, os.times()
+print(json.dumps({"s": t, "user": c1.user - c0.user, "sys": c1.system - c0.system,
+                  "peak": status("VmHWM:") - before, "output": size(out), "points": n}))
 """
 
 
-def bundle_rows(curves=100_000, per=96, sides=8, everything=False):
-    """Time and peak memory of each call on the big bundle, each in a fresh process (so the
-    peaks do not mix); a call that fails (memory) is reported as such. ``everything`` adds
-    spinal float64 (~9.3 GB) and VTK strips + triangulate (~8 GB)."""
+def bundle_rows(curves=100_000, per=96, sides=8, everything=False, first=False, pause=60.0):
+    """Time, CPU seconds and peak memory of each call on the big bundle, each in a fresh
+    process (so the peaks do not mix); a call that fails (memory) is reported as such.
+    ``everything`` adds spinal float64 (~9.3 GB) and VTK strips + triangulate (~8 GB). Every
+    call is measured after the same call once, or with ``first`` as the first of its size in
+    its process, started ``pause`` seconds after the previous one (see the module
+    docstring)."""
     rows = []
     has_vtk = "pv" in peers()
-    whats = ["spinal float32"] + (["vtk strips"] if has_vtk else [])
+    whats = ["spinal float32"] + (["vtk strips"] if has_vtk else []) + ["numpy floor"]
     if everything:
         whats += ["spinal float64"] + (["vtk triangles"] if has_vtk else [])
     for what in whats:
+        if first:
+            time.sleep(pause)
         r = subprocess.run([sys.executable, "-c", BUNDLE_CHILD, what, str(curves), str(per),
-                            str(sides)], capture_output=True, text=True, check=False)
+                            str(sides), "first" if first else "warm"],
+                           capture_output=True, text=True, check=False)
         if r.returncode:
             rows.append((what, None, r.stderr.strip().splitlines()[-1:] or ["failed"]))
         else:
@@ -245,6 +274,9 @@ def main():
     ap.add_argument("--bundle-all", action="store_true",
                     help="with --bundle: also spinal float64 and VTK strips + triangulate "
                          "(~9 GB each)")
+    ap.add_argument("--bundle-first", action="store_true",
+                    help="with --bundle: measure first calls (the output's pages touched for "
+                         "the first time), each process started 60 s after the previous one")
     ap.add_argument("--spikes", action="store_true",
                     help="only the scaling of a capped sweep of a profile with packed spikes "
                          "(star and comb, m = 10^3, 10^4, 10^5 profile vertices)")
@@ -290,15 +322,23 @@ def main():
         cells.append(f"{r['vtk strips f32'] / like:.1f}" if "vtk strips f32" in r else "–")
         print("| " + " | ".join(cells) + " |")
     if args.bundle:
+        first = ("the first of its size in the process (after a one-curve warm-up; started "
+                 "60 s after the previous process), so its output's pages are touched for the "
+                 "first time" if args.bundle_first else "after the same call once (its freed "
+                 "output's pages reused)")
         print("\n100,000 streamlines × 96 points (9.6 M points), 8 sides, one call each in a fresh "
-              "process; peak = VmHWM growth of the call (reset before it)\n")
-        print("| call | time s | peak GB | output GB | peak / output | bytes per point |")
-        print("|---|---|---|---|---|---|")
-        for what, res, err in bundle_rows(everything=args.bundle_all):
+              f"process, {first}; user, system = CPU seconds of the call (all threads; system: "
+              "mostly the page faults of its output); peak = VmHWM growth of the call (reset "
+              "before it); numpy floor = np.full of spinal float32's output arrays\n")
+        print("| call | time s | user s | system s | peak GB | output GB | peak / output | "
+              "bytes per point |")
+        print("|---|---|---|---|---|---|---|---|")
+        for what, res, err in bundle_rows(everything=args.bundle_all, first=args.bundle_first):
             if res is None:
-                print(f"| {what} | failed: {err[0][:80]} | | | | |")
+                print(f"| {what} | failed: {err[0][:80]} | | | | | | |")
                 continue
-            print(f"| {what} | {res['s']:.2f} | {res['peak'] / 1e9:.2f} | "
+            print(f"| {what} | {res['s']:.2f} | {res['user']:.2f} | {res['sys']:.2f} | "
+                  f"{res['peak'] / 1e9:.2f} | "
                   f"{res['output'] / 1e9:.2f} | {res['peak'] / res['output']:.2f} | "
                   f"{res['peak'] / res['points']:.0f} |")
 

@@ -183,9 +183,12 @@ mod tests {
         }
     }
 
+    /// A sweep stopped anywhere in its set-up or its writing (each spine's frames, checks
+    /// and rings), with given frames and with the frames computed spine by spine; the
+    /// computed ones give the bits of the frames computed first (`spinal.frames`).
     #[test]
-    fn sweep_setup_stops_anywhere() {
-        use crate::sweep::{MeshMut, Options, Prepared, Spine};
+    fn sweep_stops_anywhere() {
+        use crate::sweep::{FrameSource, MeshMut, Options, Prepared, Spine};
         use glam::DVec2;
         let opts = Options {
             closed: false,
@@ -197,11 +200,14 @@ mod tests {
         // near unit size, and far from it (the set-up scales the input first)
         for size in [1.0, 1e200] {
             let x: Vec<DVec3> = curve(70_000).into_iter().map(|p| p * size).collect();
+            // three curves: the first two short, the third long
+            let offsets = [0, 100, 200, x.len()];
             let req = Request {
                 points: Some(&x),
                 ..Request::default()
             };
-            let (flat, _) = frames_of(&req, &super::never);
+            let mut flat = vec![0.0; 9 * x.len()];
+            frames::compute_many(&req, &offsets, &[], &[], &mut flat).expect("valid");
             let frames: Vec<[f64; 9]> = flat
                 .chunks_exact(9)
                 .map(|c| c.try_into().expect("9"))
@@ -213,9 +219,7 @@ mod tests {
                 scale: &scale,
                 twist: &[],
             };
-            // three curves: the first two short, the third long
-            let offsets = [0, 100, 200, x.len()];
-            let vertices = |p: &Prepared<'_>| {
+            let vertices = |p: &Prepared<'_>, c: super::Cancel<'_>| {
                 let (nv, nf) = (p.layout.vertices, p.layout.faces);
                 let (mut v, mut f) = (vec![[0.0f64; 3]; nv], vec![[0i64; 3]; nf]);
                 let out = MeshMut {
@@ -224,19 +228,29 @@ mod tests {
                     normals: None,
                     uv: None,
                 };
-                p.write_into(out, &super::never).expect("valid");
-                (v.concat(), f)
+                // a stopped sweep's result is discarded, whatever it holds
+                let folds = p.write_into(out, c);
+                (folds, v.concat(), f)
             };
-            let run = |c: super::Cancel<'_>| {
-                Prepared::new_cancellable(spine, &offsets, &profile, true, opts, c)
-                    .expect("valid")
-                    .map(|p| vertices(&p))
-            };
-            let (got, _) = stop_everywhere(run);
-            let (v, f) = got.expect("not stopped");
             let plain = Prepared::new(spine, &offsets, &profile, true, opts).expect("valid");
-            let (pv, pf) = vertices(&plain);
-            assert!(same_bits(&v, &pv) && f == pf);
+            let (folds, pv, pf) = vertices(&plain, &super::never);
+            assert!(folds.is_ok());
+            let computed = Spine {
+                frames: &[],
+                ..spine
+            };
+            let rmf = FrameSource::Rmf { tangents: None };
+            for (s, source) in [(spine, FrameSource::Given), (computed, rmf)] {
+                let run = |c: super::Cancel<'_>| {
+                    Prepared::new_cancellable(s, &offsets, &profile, true, opts, source, c)
+                        .expect("valid")
+                        .map(|p| vertices(&p, c))
+                };
+                let (got, _) = stop_everywhere(run);
+                let (folds, v, f) = got.expect("not stopped");
+                assert!(folds.is_ok());
+                assert!(same_bits(&v, &pv) && f == pf, "{source:?}");
+            }
         }
     }
 

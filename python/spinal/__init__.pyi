@@ -137,7 +137,6 @@ class Mesh:
     uv: _F | None
     fold_over: _I
     point_data: dict[str, npt.NDArray[Any]]
-    cell_data: dict[str, npt.NDArray[Any]]
     skipped_curves: _I
     def __init__(
         self,
@@ -153,6 +152,8 @@ class Mesh:
         curve_of: _Array | None = None,
         skipped_curves: _Array | None = None,
     ) -> None: ...
+    @property
+    def cell_data(self) -> dict[str, npt.NDArray[Any]]: ...
     @property
     def sample_of(self) -> _I | None: ...
     @property

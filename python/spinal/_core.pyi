@@ -85,7 +85,7 @@ def frames_in_time(
 ) -> npt.NDArray[np.float64]: ...
 def sweep_mesh(
     points: npt.NDArray[np.float64],
-    frames: npt.NDArray[np.float64],
+    frames: npt.NDArray[np.float64] | None,
     scale: npt.NDArray[np.float64],
     twist: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
@@ -100,6 +100,7 @@ def sweep_mesh(
     index32: bool = False,
     normals: bool = True,
     uv: bool = True,
+    tangents: npt.NDArray[np.float64] | None = None,
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],

@@ -187,7 +187,8 @@ class Mesh:
         value on every vertex of its ring (caps included).
     cell_data : dict of str to ndarray (F,) or (F, k)
         Per-face attributes; sweeps of a bundle put the curve of every face in
-        ``"curve_id"``.
+        ``"curve_id"`` (built when ``cell_data`` is first read: 4 bytes per face that a
+        caller who never reads it does not pay for).
     sample_of, curve_of : ndarray (V,) int64 or None
         The spine row (as given: rows of all curves back to back) and the curve of every
         vertex of a sweep (None for meshes made otherwise). Computed when first read.
@@ -230,6 +231,29 @@ class Mesh:
         mesh._rings, mesh._n_rows, mesh._n_curves = rings, rows, curves
         mesh.skipped_curves = np.zeros(0, dtype=np.int64)
         return mesh
+
+    @property
+    def cell_data(self) -> dict:
+        """Per-face attributes (see the class docstring)."""
+        runs = self.__dict__.get("_curve_id_runs")
+        if runs is not None:
+            self._curve_id_runs = None
+            self._cell_data["curve_id"] = _repeat_in_blocks(*runs)
+        return self._cell_data
+
+    @cell_data.setter
+    def cell_data(self, value) -> None:
+        self._cell_data, self._curve_id_runs = value, None
+
+    def _lazy_curve_id(self, curve_ids: np.ndarray, faces_per_curve: np.ndarray) -> None:
+        """``cell_data["curve_id"]``: ``curve_ids[c]`` on the next ``faces_per_curve[c]``
+        faces, built when ``cell_data`` is first read."""
+        self._curve_id_runs = (curve_ids, faces_per_curve)
+
+    def __setstate__(self, state) -> None:
+        if "cell_data" in state:  # pickled before cell_data was built on first read
+            state["_cell_data"] = state.pop("cell_data")
+        self.__dict__.update(state)
 
     def _ring_arrays(self):
         """The sweep's ring layout ``(ring_sample, ring_curve, cols)``, built on first use."""
@@ -614,3 +638,23 @@ def _write_vtp(mesh: Mesh, path: pathlib.Path) -> None:
 
 def _has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+# elements per step of `_repeat_in_blocks`
+REPEAT_BLOCK = 1 << 22
+
+
+def _repeat_in_blocks(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """``np.repeat(values, counts)`` written in steps of at most ``REPEAT_BLOCK`` elements,
+    so that Ctrl-C (acted on by Python between the steps) stops a large one promptly."""
+    ends = np.cumsum(counts, dtype=np.int64)
+    starts = ends - counts
+    total = int(ends[-1]) if ends.size else 0
+    out = np.empty(total, dtype=values.dtype)
+    for a in range(0, total, REPEAT_BLOCK):
+        b = min(a + REPEAT_BLOCK, total)
+        # the values whose runs meet [a, b), their runs clipped to it
+        i = int(np.searchsorted(ends, a, side="right"))
+        j = int(np.searchsorted(starts, b, side="left"))
+        out[a:b] = np.repeat(values[i:j], np.minimum(ends[i:j], b) - np.maximum(starts[i:j], a))
+    return out

@@ -8,7 +8,6 @@ import numpy as np
 
 from . import _core
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
-from ._frames import frames as _frames
 from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
 from ._validate import (
     as_bool,
@@ -116,7 +115,8 @@ def sweep(
     frames : array_like (n, 3, 3), optional
         Frames from :func:`spinal.frames` (columns r, s, t). Default: the rotation-minimising
         frames by double reflection, ``spinal.frames(points, closed=closed)``, so closed
-        loops meet without a seam twist.
+        loops meet without a seam twist (computed curve by curve as the sweep goes, bit for
+        bit those of that call, without holding the ``(n, 3, 3)`` array of them).
     scale : float, (n,) or (n, 2), optional
         Positive scale of the profile at every sample (per profile axis for (n, 2)).
     twist : float or (n,), optional
@@ -205,24 +205,26 @@ def sweep(
                        tangents, tangent_rule, dtype, normals, uv, point_data, on_short)
 
 
-def _sweep_frames(pts, fr, closed, offs, bundle, tg, rule):
-    """The sweep's frames: ``fr`` (checked frames) when given, or the RMF with the given
-    (checked) tangents ``tg`` or tangents estimated by ``rule``."""
+def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
+    """The sweep's frames as the core takes them: ``(frames, None)`` for checked frames
+    ``fr``, or ``(None, tangents)``: the RMF of :func:`spinal.frames` with the given
+    (checked) tangents ``tg``, with tangents estimated by ``rule``, or (``tangents`` None)
+    with its default tangents, which the core computes spine by spine as it sweeps (the
+    same frames, bit for bit, without an ``(n, 3, 3)`` array of them)."""
     if fr is not None:
         if tg is not None or rule != DEFAULT_TANGENT_RULE:
             which = "tangents" if tg is not None else "tangent_rule"
             raise TypeError(f"{which}: not used with frames= (the frames' t column is the "
                             f"tangent)")
-        return fr
-    kw = {"offsets": offs} if bundle else {}
+        return fr, None
     if tg is not None:
         if rule != DEFAULT_TANGENT_RULE:
             raise TypeError("tangent_rule: not used with tangents= (they replace the estimate)")
-        return _frames(pts, tg, closed=closed, **kw)
+        return None, tg
     if rule != DEFAULT_TANGENT_RULE:
-        tg = estimate_tangents(pts, closed=closed, method=rule, **kw)
-        return _frames(pts, tg, closed=closed, **kw)
-    return _frames(pts, closed=closed, **kw)
+        kw = {"offsets": offs} if bundle else {}
+        return None, estimate_tangents(pts, closed=closed, method=rule, **kw)
+    return None, None
 
 
 def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
@@ -285,11 +287,11 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         mesh.point_data = {k: a[:0] for k, (a, _) in pdata.items()}
         mesh._n_rows, mesh._n_curves = n, curves
         return mesh
-    fr = _sweep_frames(pts, fr, closed, offs, bundle, tg, rule)
+    fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
     v, f, nrm, uv, folds, faces_per_curve = _core.sweep_mesh(
         pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
         profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
-        single, single, want_normals, want_uv,
+        single, single, want_normals, want_uv, tg,
     )
     if folds.size and keep_rows is not None:  # back to the rows as given
         folds = np.flatnonzero(keep_rows)[folds]
@@ -319,29 +321,8 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                                            axis=0)
     if bundle:  # each curve's faces follow those of the curve before it
         small = curves <= np.iinfo(np.int32).max
-        mesh.cell_data["curve_id"] = _repeat_in_blocks(
-            curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
+        mesh._lazy_curve_id(curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
     return mesh
-
-
-# elements per step of `_repeat_in_blocks`
-REPEAT_BLOCK = 1 << 22
-
-
-def _repeat_in_blocks(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """``np.repeat(values, counts)`` written in steps of at most ``REPEAT_BLOCK`` elements,
-    so that Ctrl-C (acted on by Python between the steps) stops a large one promptly."""
-    ends = np.cumsum(counts, dtype=np.int64)
-    starts = ends - counts
-    total = int(ends[-1]) if ends.size else 0
-    out = np.empty(total, dtype=values.dtype)
-    for a in range(0, total, REPEAT_BLOCK):
-        b = min(a + REPEAT_BLOCK, total)
-        # the values whose runs meet [a, b), their runs clipped to it
-        i = int(np.searchsorted(ends, a, side="right"))
-        j = int(np.searchsorted(starts, b, side="left"))
-        out[a:b] = np.repeat(values[i:j], np.minimum(ends[i:j], b) - np.maximum(starts[i:j], a))
-    return out
 
 
 def _orig_offsets(lens, n: int) -> np.ndarray:

@@ -5,10 +5,10 @@ use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_stoppable, empty, frames_of, offsets_of, renamed, slice_mut, slice_of, vec2s,
-    vec3s,
+    Stop, detach_stoppable, empty, ensure_memory, frames_of, offsets_of, renamed, slice_mut,
+    slice_of, vec2s, vec3s,
 };
-use crate::sweep::{self, Options, Prepared, Spine};
+use crate::sweep::{self, FrameSource, Options, Prepared, Spine};
 
 type MeshArrays<'py> = (
     Bound<'py, PyAny>,
@@ -19,7 +19,10 @@ type MeshArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
 );
 
-/// Sweep a profile along one or many spines; see `spinal.sweep`. Returns vertices, faces,
+/// Sweep a profile along one or many spines; see `spinal.sweep`. `frames`: one per row, or
+/// `None` for the rotation-minimising frames of `spinal.frames(points, tangents)` (its
+/// defaults; `tangents` optional), computed spine by spine as the sweep goes. Returns
+/// vertices, faces,
 /// normals (or None), uv (or None), the rows where a miter was folded and the number of
 /// faces of every spine (its faces follow those of the spine before it). Coordinates are
 /// float32 with `single` (computed in float64, stored rounded), faces int32 with `index32`
@@ -29,12 +32,12 @@ type MeshArrays<'py> = (
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
                     miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
-                    normals=true, uv=true))]
+                    normals=true, uv=true, tangents=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
-    frames: PyReadonlyArray3<'py, f64>,
+    frames: Option<PyReadonlyArray3<'py, f64>>,
     scale: PyReadonlyArray2<'py, f64>,
     twist: Option<PyReadonlyArray1<'py, f64>>,
     offsets: PyReadonlyArray1<'py, i64>,
@@ -49,10 +52,14 @@ pub fn sweep_mesh<'py>(
     index32: bool,
     normals: bool,
     uv: bool,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<MeshArrays<'py>> {
     let spine = Spine {
         points: vec3s("points", &points)?,
-        frames: frames_of("frames", &frames)?,
+        frames: match &frames {
+            Some(f) => frames_of("frames", f)?,
+            None => &[],
+        },
         scale: vec2s("scale", "(n, 2)", &scale)?,
         twist: match &twist {
             Some(t) => slice_of("twist", t)?,
@@ -61,6 +68,20 @@ pub fn sweep_mesh<'py>(
     };
     let prof = vec2s("profile", "(m, 2)", &profile)?;
     let offsets = offsets_of(&offsets)?;
+    let source = match &frames {
+        Some(_) => FrameSource::Given,
+        None => {
+            let tangents = tangents
+                .as_ref()
+                .map(|t| vec3s("tangents", t))
+                .transpose()?;
+            // the frames of the longest spine and the working vectors of their computation
+            // (the bytes per row that `spinal.frames` checks for)
+            let longest = offsets.windows(2).map(|w| w[1].saturating_sub(w[0])).max();
+            ensure_memory("sweep", longest.unwrap_or(0), 256)?;
+            FrameSource::Rmf { tangents }
+        }
+    };
     let opts = Options {
         closed,
         caps,
@@ -71,7 +92,7 @@ pub fn sweep_mesh<'py>(
     let stop = Stop::default();
     let prep = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
-        Prepared::new_cancellable(spine, &offsets, prof, profile_closed, opts, &cancel)
+        Prepared::new_cancellable(spine, &offsets, prof, profile_closed, opts, source, &cancel)
     })?
     .map_err(rename)?;
     // stopped only when a signal handler raised, whose error detach_stoppable returned

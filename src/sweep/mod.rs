@@ -112,9 +112,10 @@ fn columns(f: &[f64; 9]) -> (DVec3, DVec3, DVec3) {
     )
 }
 
-/// Layout of one spine's part of the mesh.
-#[derive(Debug, Clone)]
-struct Plan {
+/// The size of one spine's part of the mesh, from its rows alone (and, on a closed spine,
+/// whether its last point repeats the first); [`check_spine`] checks the spine.
+#[derive(Debug, Clone, Copy)]
+struct Size {
     /// Distinct spine samples.
     rings: usize,
     segments: usize,
@@ -124,11 +125,29 @@ struct Plan {
     /// Vertices per stored ring (one more than the profile for a closed profile with split
     /// seams).
     cols: usize,
-    /// Arc length of the spine polyline at every ring (and after the closing chord).
-    arc: Vec<f64>,
 }
 
-impl Plan {
+impl Size {
+    /// The size of the sweep of spine `x` (a spine too short to sweep gets a size, which its
+    /// check refuses).
+    fn of(x: &[DVec3], opts: &Options, p: &Profile) -> Size {
+        let n = x.len();
+        let mut rings = n;
+        if opts.closed && n >= 2 && validate::coincide(x[0], x[n - 1]) {
+            rings -= 1;
+        }
+        Size {
+            rings,
+            segments: if opts.closed {
+                rings
+            } else {
+                rings.saturating_sub(1)
+            },
+            caps: opts.caps && !opts.closed && p.closed,
+            stored_rings: rings + usize::from(opts.closed && opts.split_seams),
+            cols: p.len() + usize::from(p.closed && opts.split_seams),
+        }
+    }
     fn vertices(&self) -> usize {
         self.stored_rings * self.cols
     }
@@ -138,10 +157,32 @@ impl Plan {
     }
 }
 
+/// A checked spine: its [`Size`] and the arc length of the spine polyline at every ring
+/// (and after the closing chord).
+#[derive(Debug, Clone)]
+struct Plan {
+    size: Size,
+    arc: Vec<f64>,
+}
+
+impl std::ops::Deref for Plan {
+    type Target = Size;
+    fn deref(&self) -> &Size {
+        &self.size
+    }
+}
+
 /// Check one spine and plan its part of the mesh; polls `cancel` between its passes and
 /// before every block of rows within them, and returns `None` once it says stop (see
-/// [`crate::cancel`]).
-fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Result<Option<Plan>> {
+/// [`crate::cancel`]). `given`: the frames came with the input and are checked too (frames
+/// computed here are rotations along the spine by construction).
+fn check_spine(
+    s: &Spine,
+    opts: &Options,
+    p: &Profile,
+    given: bool,
+    cancel: Cancel<'_>,
+) -> Result<Option<Plan>> {
     let n = s.points.len();
     if s.frames.len() != n {
         return Err(InputError::new(
@@ -165,10 +206,8 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Re
     if cancel() {
         return Ok(None);
     }
-    let mut rings = n;
-    if opts.closed && n >= 2 && validate::coincide(s.points[0], s.points[n - 1]) {
-        rings -= 1;
-    }
+    let size = Size::of(s.points, opts, p);
+    let rings = size.rings;
     let min = if opts.closed { 3 } else { 2 };
     if rings < min {
         return Err(InputError::new(
@@ -183,7 +222,11 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Re
     if cancel() {
         return Ok(None);
     }
-    if let Some(i) = validate::first_bad_cancellable(s.frames, validate::is_rotation, cancel) {
+    let bad_frame = match given {
+        true => validate::first_bad_cancellable(s.frames, validate::is_rotation, cancel),
+        false => None,
+    };
+    if let Some(i) = bad_frame {
         return Err(InputError::new(
             "frames",
             format!(
@@ -195,7 +238,11 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Re
     if cancel() {
         return Ok(None);
     }
-    if let Some(i) = against_spine(&s.points[..rings], s.frames, opts.closed, cancel) {
+    let against = match given {
+        true => against_spine(&s.points[..rings], s.frames, opts.closed, cancel),
+        false => None,
+    };
+    if let Some(i) = against {
         let j = if i + 1 == rings { 0 } else { i + 1 };
         return Err(InputError::new(
             "frames",
@@ -238,14 +285,7 @@ fn check_spine(s: &Spine, opts: &Options, p: &Profile, cancel: Cancel<'_>) -> Re
         acc += *a;
         *a = acc;
     }
-    Ok(Some(Plan {
-        rings,
-        segments: if opts.closed { rings } else { rings - 1 },
-        caps: opts.caps && !opts.closed && p.closed,
-        stored_rings: rings + usize::from(opts.closed && opts.split_seams),
-        cols: p.len() + usize::from(p.closed && opts.split_seams),
-        arc,
-    }))
+    Ok(Some(Plan { size, arc }))
 }
 
 /// The first segment `i` (from sample `i` to the next) that runs against the tangents of
@@ -511,10 +551,10 @@ pub struct MeshMut<'a, R, I> {
     pub uv: Option<&'a mut [[R; 2]]>,
 }
 
-/// The checked input of a sweep and the size of its mesh, from [`layout`].
+/// The size of a sweep's mesh and of every spine's part of it, from [`layout`].
 #[derive(Debug, Clone)]
 pub struct Layout {
-    plans: Vec<Plan>,
+    sizes: Vec<Size>,
     pub vertices: usize,
     pub faces: usize,
 }
@@ -524,57 +564,85 @@ pub struct Layout {
 /// block of 4096 vertices (~0.5 MB with normals and uv) then took up to 0.12 s.
 const BLOCK_BYTES: usize = 1 << 20;
 
+/// What every spine of a sweep shares: the profile's stored columns, the side faces of a
+/// segment, the caps' triangulation and the winding.
+struct Shared<'a> {
+    p: &'a Profile,
+    column: Columns,
+    pattern: FacePattern,
+    tris: Vec<[usize; 3]>,
+    /// −1 where the faces are wound the other way (clockwise closed profiles).
+    sign: f64,
+    /// Profile edges: one per vertex of a closed profile, one fewer for an open one.
+    edges: usize,
+}
+
+impl<'a> Shared<'a> {
+    /// `cols`: the vertices of a stored ring (the same on every spine); `caps`: some spine
+    /// has caps.
+    fn new(p: &'a Profile, cols: usize, caps: bool) -> Shared<'a> {
+        // Winding: normals to the right of the profile's direction, outward for closed
+        // profiles.
+        let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
+        let edges = if p.closed { p.len() } else { p.len() - 1 };
+        Shared {
+            p,
+            column: Columns::of(p, cols),
+            pattern: FacePattern::of(cols, edges, sign),
+            tris: if caps { p.triangulate() } else { Vec::new() },
+            sign,
+            edges,
+        }
+    }
+}
+
 /// Sweep one spine into its share of the output buffers (`out.faces`: its side faces, then
 /// its caps); returns the rows (global) that start a folded-over segment and the first
-/// vertex (local) out of the output type's range.
+/// vertex (local) out of the output type's range. `ring`: scratch for the rings of a block.
 #[allow(clippy::too_many_arguments)]
 fn sweep_one<R: Real, I: Index>(
     s: &Spine,
     plan: &Plan,
-    p: &Profile,
-    tris: &[[usize; 3]],
+    sh: &Shared,
     opts: &Options,
     vbase: usize,
     rowbase: usize,
     unscale: Option<i32>,
     out: MeshMut<R, I>,
+    ring: &mut RingScratch,
     cancel: Cancel<'_>,
 ) -> (Vec<usize>, Option<usize>) {
     // Rings per parallel task (one poll of `cancel` each): enough work (~4k vertices) to pay
     // for the task, and at most `BLOCK_BYTES` of output (unless one ring is more), so that a
     // stop waits for little writing even where the writes fault in fresh pages of the output
-    let edges = if p.closed { p.len() } else { p.len() - 1 };
     let ring_bytes = plan.cols
         * (size_of::<[R; 3]>() * (1 + usize::from(out.normals.is_some()))
             + size_of::<[R; 2]>() * usize::from(out.uv.is_some()))
-        + 2 * edges * size_of::<[I; 3]>();
+        + 2 * sh.edges * size_of::<[I; 3]>();
     let grain = (4096 / plan.cols).min(BLOCK_BYTES / ring_bytes).max(1);
-    // Winding: normals to the right of the profile's direction, outward for closed profiles.
-    let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
     let rings = Rings {
         s,
         x: &s.points[..plan.rings],
         plan,
-        p,
-        column: Columns::of(p, plan.cols),
+        p: sh.p,
+        column: &sh.column,
         closed: opts.closed,
         miter_limit: opts.miter_limit,
-        sign,
+        sign: sh.sign,
         rowbase,
     };
-    let pattern = FacePattern::of(plan.cols, edges, sign);
-    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * edges);
+    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * sh.edges);
     let side = MeshMut {
         vertices: out.vertices,
         faces: side,
         normals: out.normals,
         uv: out.uv,
     };
-    let res = rings.write(side, &pattern, vbase, unscale, grain, cancel);
+    let res = rings.write(side, &sh.pattern, vbase, unscale, grain, ring, cancel);
     // a stopped sweep writes no caps: they lie apart, and each may be the first write to a
     // fresh page of the output
     if plan.caps && !cancel() {
-        write_caps(caps, plan, tris, vbase);
+        write_caps(caps, plan, &sh.tris, vbase);
     }
     res
 }
@@ -838,7 +906,7 @@ struct Rings<'a> {
     x: &'a [DVec3],
     plan: &'a Plan,
     p: &'a Profile,
-    column: Columns,
+    column: &'a Columns,
     closed: bool,
     miter_limit: f64,
     /// −1 where the faces are wound the other way (clockwise closed profiles).
@@ -887,7 +955,9 @@ impl Rings<'_> {
     /// All stored rings and the side faces of their segments, `grain` rings per parallel
     /// task, each output element written once; returns the fold-over rows and the first
     /// vertex (local) out of the output type's range. `vbase`: the spine's first vertex;
-    /// `unscale`: see [`unscaled`].
+    /// `unscale`: see [`unscaled`]; `ring`: scratch for a spine of one block (the short
+    /// streamlines of a bundle), which is written here without setting up parallel tasks.
+    #[allow(clippy::too_many_arguments)]
     fn write<R: Real, I: Index>(
         &self,
         out: MeshMut<R, I>,
@@ -895,9 +965,23 @@ impl Rings<'_> {
         vbase: usize,
         unscale: Option<i32>,
         grain: usize,
+        ring: &mut RingScratch,
         cancel: Cancel<'_>,
     ) -> (Vec<usize>, Option<usize>) {
         let block = grain * self.plan.cols;
+        if out.vertices.len() <= block {
+            if cancel() {
+                return (Vec::new(), None);
+            }
+            let b = Block {
+                i0: 0,
+                v: out.vertices,
+                n: out.normals,
+                u: out.uv,
+                f: out.faces,
+            };
+            return self.block(b, pattern, vbase, unscale, ring);
+        }
         let blocks = out.vertices.len().div_ceil(block);
         let mut nb: Vec<Option<&mut [[R; 3]]>> = match out.normals {
             Some(a) => a.chunks_mut(block).map(Some).collect(),
@@ -926,12 +1010,16 @@ impl Rings<'_> {
                 f,
             })
             .collect();
+        let cols = self.plan.cols;
         let per_block: Vec<(Vec<usize>, Option<usize>)> = jobs
             .into_par_iter()
-            .map(|b| match cancel() {
-                true => (Vec::new(), None),
-                false => self.block(b, pattern, vbase, unscale),
-            })
+            .map_init(
+                || RingScratch::new(cols),
+                |ring, b| match cancel() {
+                    true => (Vec::new(), None),
+                    false => self.block(b, pattern, vbase, unscale, ring),
+                },
+            )
             .collect();
         let bad = per_block.iter().find_map(|b| b.1);
         (per_block.into_iter().flat_map(|b| b.0).collect(), bad)
@@ -949,14 +1037,15 @@ impl Rings<'_> {
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
+        ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `block_avx2` only needs the processor to support AVX2, checked just
             // above.
-            return unsafe { self.block_avx2(b, pattern, vbase, unscale) };
+            return unsafe { self.block_avx2(b, pattern, vbase, unscale, ring) };
         }
-        self.block_body(b, pattern, vbase, unscale)
+        self.block_body(b, pattern, vbase, unscale, ring)
     }
 
     /// [`Rings::block_body`] compiled for AVX2. Safety: call only where AVX2 is available.
@@ -968,8 +1057,9 @@ impl Rings<'_> {
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
+        ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
-        self.block_body(b, pattern, vbase, unscale)
+        self.block_body(b, pattern, vbase, unscale, ring)
     }
 
     /// The rings of a block and the faces of their segments: per ring, the vertices and
@@ -982,9 +1072,10 @@ impl Rings<'_> {
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
+        ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
         let (r_n, cols, stored) = (self.plan.rings, self.plan.cols, self.plan.stored_rings);
-        let (column, arc, per_segment) = (&self.column, &self.plan.arc[..], pattern.ac.len());
+        let (column, arc, per_segment) = (self.column, &self.plan.arc[..], pattern.ac.len());
         let Block {
             i0,
             v: bv,
@@ -993,7 +1084,6 @@ impl Rings<'_> {
             f: bf,
         } = b;
         let (mut folds, mut bad) = (Vec::new(), None);
-        let mut ring = RingScratch::new(cols);
         let mut prev = self.geo((i0 + r_n - 1) % r_n);
         let mut cur = self.geo(i0 % r_n);
         for (di, rv) in bv.chunks_mut(cols).enumerate() {
@@ -1133,7 +1223,11 @@ fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
     let (a, b) = (offsets[c], offsets[c + 1]);
     Spine {
         points: &all.points[a..b],
-        frames: &all.frames[a..b],
+        frames: if all.frames.is_empty() {
+            &[]
+        } else {
+            &all.frames[a..b]
+        },
         scale: if all.scale.len() == 1 {
             all.scale
         } else {
@@ -1147,15 +1241,69 @@ fn part<'a>(all: &Spine<'a>, offsets: &[usize], c: usize) -> Spine<'a> {
     }
 }
 
-/// Check a bundle of spines (`offsets[c]..offsets[c+1]` are the rows of spine `c` in the
-/// flat arrays) and size its mesh.
+/// Where the frames of a sweep come from.
+#[derive(Debug, Clone, Copy)]
+pub enum FrameSource<'a> {
+    /// The spine's `frames`, as given (checked: rotations whose tangents follow the spine).
+    Given,
+    /// The rotation-minimising frames of `spinal.frames(points)` with its defaults (double
+    /// reflection, Wang et al. 2008, with the five-point tangents, or with the given
+    /// `tangents`), computed for each spine as it is swept, into a buffer that the spines of
+    /// one parallel task share: the frames of a whole bundle never exist at once. The
+    /// spine's `frames` are then empty.
+    Rmf { tangents: Option<&'a [DVec3]> },
+}
+
+/// The frames of spine `c` (rows `offsets[c]..offsets[c + 1]` of `points` and `tangents`)
+/// as `spinal.frames` computes them for a bundle (the same call on the same rows, so the
+/// same bits), into `buf` (grown as needed, fallibly).
+fn rmf_into(
+    points: &[DVec3],
+    tangents: Option<&[DVec3]>,
+    offsets: &[usize],
+    c: usize,
+    closed: bool,
+    buf: &mut Vec<[f64; 9]>,
+    cancel: Cancel<'_>,
+) -> Result<()> {
+    let (a, b) = (offsets[c], offsets[c + 1]);
+    let n = b - a;
+    if buf.len() < n {
+        buf.try_reserve_exact(n - buf.len())
+            .map_err(|_| InputError::out_of_memory("frames", n, 72))?;
+        buf.resize(n, [0.0; 9]);
+    }
+    let req = crate::frames::Request {
+        points: Some(&points[a..b]),
+        tangents: tangents.map(|t| &t[a..b]),
+        closed,
+        ..crate::frames::Request::default()
+    };
+    crate::frames::compute_into_cancellable(&req, buf[..n].as_flattened_mut(), cancel)?;
+    Ok(())
+}
+
+/// An error about spine `c` of a bundle, prefixed with the curve (as `spinal.frames` and
+/// the sweep's checks name it).
+fn in_curve(e: InputError, offsets: &[usize], c: usize) -> InputError {
+    if offsets.len() > 2 {
+        let (a, b) = (offsets[c], offsets[c + 1]);
+        e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
+    } else {
+        e
+    }
+}
+
+/// Size the mesh of a bundle of spines (`offsets[c]..offsets[c+1]` are the rows of spine `c`
+/// in the flat arrays): the sizes come from the row counts, and each spine is checked as it
+/// is swept.
 pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options) -> Result<Layout> {
     let lay = layout_cancellable(all, offsets, profile, opts, &cancel::never)?;
     Ok(lay.expect("a hook that never stops"))
 }
 
-/// [`layout`] that polls `cancel` before every curve and within the checks of each
-/// ([`check_spine`]), and returns `None` once it says stop (see [`crate::cancel`]).
+/// [`layout`] that polls `cancel` before every block of curves, and returns `None` once it
+/// says stop (see [`crate::cancel`]).
 pub fn layout_cancellable(
     all: &Spine,
     offsets: &[usize],
@@ -1163,6 +1311,7 @@ pub fn layout_cancellable(
     opts: &Options,
     cancel: Cancel<'_>,
 ) -> Result<Option<Layout>> {
+    const BLOCK: usize = 1 << 14;
     let curves = offsets.len().saturating_sub(1);
     let n = all.points.len();
     validate::offsets(offsets, n)?;
@@ -1175,38 +1324,234 @@ pub fn layout_cancellable(
             ),
         ));
     }
-    let plans: Vec<Option<Plan>> = (0..curves)
-        .into_par_iter()
-        .map(|c| {
-            if cancel() {
-                return Ok(None);
-            }
-            check_spine(&part(all, offsets, c), opts, profile, cancel).map_err(|e| {
-                if curves > 1 {
-                    e.context(&format!(
-                        "curve {c} (rows {} to {})",
-                        offsets[c],
-                        offsets[c + 1].max(1) - 1
-                    ))
-                } else {
-                    e
-                }
-            })
-        })
-        .collect::<Result<_>>()?;
-    let Some(plans) = plans.into_iter().collect::<Option<Vec<Plan>>>() else {
-        return Ok(None);
-    };
+    let mut sizes = crate::alloc::with_capacity("sweep layout", curves)?;
+    for c in 0..curves {
+        if c % BLOCK == 0 && cancel() {
+            return Ok(None);
+        }
+        let x = &all.points[offsets[c]..offsets[c + 1]];
+        sizes.push(Size::of(x, opts, profile));
+    }
     Ok(Some(Layout {
-        vertices: plans.iter().map(Plan::vertices).sum(),
-        faces: plans.iter().map(|p| p.faces(profile)).sum(),
-        plans,
+        vertices: sizes.iter().map(Size::vertices).sum(),
+        faces: sizes.iter().map(|s| s.faces(profile)).sum(),
+        sizes,
     }))
 }
 
-/// Sweep `profile` along every spine of a checked bundle into buffers of the sizes in
-/// `layout` (spines in parallel). Returns the rows starting a folded-over segment; refuses
-/// vertices beyond the range of the output type ([`out_of_range`]).
+/// What sweeping one spine gave: its fold-over rows and first vertex out of range, or the
+/// error of its frames or of its checks, or nothing (stopped).
+enum Outcome {
+    Swept(Vec<usize>, Option<usize>),
+    Frames(InputError),
+    Checks(InputError),
+    Stopped,
+}
+
+/// The scratch of one parallel task, reused by the spines it sweeps: the frames of one
+/// spine ([`FrameSource::Rmf`]) and the columns of one ring.
+struct TaskScratch {
+    frames: Vec<[f64; 9]>,
+    ring: RingScratch,
+}
+
+/// A sized sweep, ready to be written: the spine as swept (`view`, brought near unit size
+/// when far from it, see [`scaled_input`]), the points as given (the computed frames come
+/// from them, as from `spinal.frames`), the frames' source, the layout and the per-call
+/// set-up.
+struct Sweep<'s> {
+    view: Spine<'s>,
+    points: &'s [DVec3],
+    frames: FrameSource<'s>,
+    offsets: &'s [usize],
+    opts: &'s Options,
+    layout: &'s Layout,
+    sh: Shared<'s>,
+    /// See [`unscaled`].
+    unscale: Option<i32>,
+}
+
+impl Sweep<'_> {
+    /// Every spine into its part of `out` (spines in parallel): per spine its frames (when
+    /// computed here), its checks and its rings. Returns the rows starting a folded-over
+    /// segment. Errors come in the order of the earlier two-call form (the frames of all
+    /// curves, then the sweep's checks, each by curve): a frames error of any curve, else the
+    /// first curve's check error, else a vertex beyond the range of the output type
+    /// ([`out_of_range`]).
+    fn write<R: Real, I: Index>(
+        &self,
+        out: MeshMut<R, I>,
+        cancel: Cancel<'_>,
+    ) -> Result<Vec<usize>> {
+        let (nv, nf) = (self.layout.vertices, self.layout.faces);
+        assert!(
+            out.vertices.len() == nv
+                && out.normals.as_ref().is_none_or(|a| a.len() == nv)
+                && out.uv.as_ref().is_none_or(|a| a.len() == nv)
+                && out.faces.len() == nf,
+            "sweep_into: buffers must have the sizes of the layout"
+        );
+        let mut out = out;
+        touch_pages(out.vertices, [R::of(0.0); 3], cancel);
+        touch_pages(out.faces, [I::of(0); 3], cancel);
+        if let Some(a) = out.normals.as_deref_mut() {
+            touch_pages(a, [R::of(0.0); 3], cancel);
+        }
+        if let Some(a) = out.uv.as_deref_mut() {
+            touch_pages(a, [R::of(0.0); 2], cancel);
+        }
+        // Split the buffers per spine.
+        let sizes = &self.layout.sizes;
+        let mut jobs = crate::alloc::with_capacity("sweep", sizes.len())?;
+        let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, out.faces);
+        let mut vbase = 0;
+        for (c, size) in sizes.iter().enumerate() {
+            let (k, kf) = (size.vertices(), size.faces(self.sh.p));
+            let (v1, v2) = v.split_at_mut(k);
+            let (n1, n2) = match nr {
+                Some(a) => {
+                    let (x, y) = a.split_at_mut(k);
+                    (Some(x), Some(y))
+                }
+                None => (None, None),
+            };
+            let (u1, u2) = match u {
+                Some(a) => {
+                    let (x, y) = a.split_at_mut(k);
+                    (Some(x), Some(y))
+                }
+                None => (None, None),
+            };
+            let (f1, f2) = f.split_at_mut(kf);
+            let mine = MeshMut {
+                vertices: v1,
+                faces: f1,
+                normals: n1,
+                uv: u1,
+            };
+            jobs.push((c, vbase, mine));
+            (v, nr, u, f) = (v2, n2, u2, f2);
+            vbase += k;
+        }
+        let cols = self.sh.column.px.len();
+        let outcomes: Vec<Outcome> = jobs
+            .into_par_iter()
+            .map_init(
+                || TaskScratch {
+                    frames: Vec::new(),
+                    ring: RingScratch::new(cols),
+                },
+                |sc, (c, vbase, mine)| self.spine(c, vbase, mine, sc, cancel),
+            )
+            .collect();
+        let (mut check, mut bad) = (None, None);
+        for o in &outcomes {
+            match o {
+                Outcome::Frames(e) => return Err(e.clone()),
+                Outcome::Checks(e) if check.is_none() => check = Some(e.clone()),
+                Outcome::Swept(_, b) if bad.is_none() => bad = *b,
+                _ => {}
+            }
+        }
+        if let Some(e) = check {
+            return Err(e);
+        }
+        if let Some(i) = bad {
+            return Err(out_of_range::<R>(i));
+        }
+        let folds = outcomes.into_iter().flat_map(|o| match o {
+            Outcome::Swept(f, _) => f,
+            _ => Vec::new(),
+        });
+        Ok(folds.collect())
+    }
+
+    /// Spine `c` into its part of the buffers, starting at vertex `vbase`.
+    fn spine<R: Real, I: Index>(
+        &self,
+        c: usize,
+        vbase: usize,
+        out: MeshMut<R, I>,
+        sc: &mut TaskScratch,
+        cancel: Cancel<'_>,
+    ) -> Outcome {
+        if cancel() {
+            return Outcome::Stopped;
+        }
+        let TaskScratch { frames, ring } = sc;
+        let mut s = part(&self.view, self.offsets, c);
+        let given = match self.frames {
+            FrameSource::Given => true,
+            FrameSource::Rmf { tangents } => {
+                let (o, closed) = (self.offsets, self.opts.closed);
+                if let Err(e) = rmf_into(self.points, tangents, o, c, closed, frames, cancel) {
+                    return Outcome::Frames(in_curve(e, o, c));
+                }
+                if cancel() {
+                    return Outcome::Stopped;
+                }
+                s.frames = &frames[..s.points.len()];
+                false
+            }
+        };
+        let plan = match check_spine(&s, self.opts, self.sh.p, given, cancel) {
+            Ok(Some(plan)) => plan,
+            Ok(None) => return Outcome::Stopped,
+            Err(e) => return Outcome::Checks(in_curve(e, self.offsets, c)),
+        };
+        let (rowbase, unscale) = (self.offsets[c], self.unscale);
+        let (folds, bad) = sweep_one(
+            &s, &plan, &self.sh, self.opts, vbase, rowbase, unscale, out, ring, cancel,
+        );
+        Outcome::Swept(folds, bad.map(|i| vbase + i))
+    }
+}
+
+/// Write `value` into one element of every 4 KiB page of `buf` (the rest of the page is not
+/// written), in parallel, polling `cancel` before every 1 MiB: the output's page faults all
+/// come at the start of a sweep, from every thread, instead of spread over its writing. An
+/// output of fresh pages costs its faults either way, but pages freed shortly before (by the
+/// previous call) are then taken before the system hands them back: on a virtual machine with
+/// free page reporting (2 MiB blocks handed back to the host from ~2 s after they are freed)
+/// a sweep slowed down by other work faulted much of its output in from the host again.
+/// Measured on the 2-core machine with three busy processes beside it, 100,000 streamlines
+/// (4.3 GB of float32 output) right after the same call: 0.4–2.5 s of system time with
+/// this, 2.1–3.8 s without (3 runs each).
+fn touch_pages<T: Copy + Send + Sync>(buf: &mut [T], value: T, cancel: Cancel<'_>) {
+    let step = (4096 / size_of::<T>()).max(1);
+    buf.par_chunks_mut(256 * step).for_each(|c| {
+        if !cancel() {
+            c.iter_mut().step_by(step).for_each(|e| *e = value);
+        }
+    });
+}
+
+/// The first curve whose frames ([`FrameSource::Rmf`]) fail, with its error; `None` when
+/// all can be computed (or `cancel` said stop).
+fn first_frames_error(
+    points: &[DVec3],
+    tangents: Option<&[DVec3]>,
+    offsets: &[usize],
+    closed: bool,
+    cancel: Cancel<'_>,
+) -> Option<InputError> {
+    let curves = offsets.len().saturating_sub(1);
+    let errors: Vec<Option<InputError>> = (0..curves)
+        .into_par_iter()
+        .map_init(Vec::new, |buf, c| match cancel() {
+            true => None,
+            false => rmf_into(points, tangents, offsets, c, closed, buf, cancel)
+                .err()
+                .map(|e| in_curve(e, offsets, c)),
+        })
+        .collect();
+    errors.into_iter().flatten().next()
+}
+
+/// Sweep `profile` along every spine of a bundle into buffers of the sizes in `layout`
+/// (spines in parallel, each checked as it is swept). Returns the rows starting a
+/// folded-over segment; refuses vertices beyond the range of the output type
+/// ([`out_of_range`]).
 pub fn sweep_into<R: Real, I: Index>(
     all: &Spine,
     offsets: &[usize],
@@ -1215,107 +1560,25 @@ pub fn sweep_into<R: Real, I: Index>(
     layout: &Layout,
     out: MeshMut<R, I>,
 ) -> Result<Vec<usize>> {
-    sweep_into_cancellable(
-        all,
+    let caps = layout.sizes.iter().any(|s| s.caps);
+    let cols = layout.sizes.first().map_or(profile.len(), |s| s.cols);
+    let sweep = Sweep {
+        view: *all,
+        points: all.points,
+        frames: FrameSource::Given,
         offsets,
-        profile,
         opts,
         layout,
-        None,
-        out,
-        &cancel::never,
-    )
-}
-
-/// [`sweep_into`] that polls `cancel` before each block of rings (see [`crate::cancel`]),
-/// for input scaled by `2^unscale` (the vertices and arc lengths are divided by it again as
-/// they are written, see [`unscaled`]).
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_into_cancellable<R: Real, I: Index>(
-    all: &Spine,
-    offsets: &[usize],
-    profile: &Profile,
-    opts: &Options,
-    layout: &Layout,
-    unscale: Option<i32>,
-    out: MeshMut<R, I>,
-    cancel: Cancel<'_>,
-) -> Result<Vec<usize>> {
-    let (nv, nf) = (layout.vertices, layout.faces);
-    assert!(
-        out.vertices.len() == nv
-            && out.normals.as_ref().is_none_or(|a| a.len() == nv)
-            && out.uv.as_ref().is_none_or(|a| a.len() == nv)
-            && out.faces.len() == nf,
-        "sweep_into: buffers must have the sizes of the layout"
-    );
-    let tris = if layout.plans.iter().any(|p| p.caps) {
-        profile.triangulate()
-    } else {
-        Vec::new()
+        sh: Shared::new(profile, cols, caps),
+        unscale: None,
     };
-    // Split the buffers per spine.
-    let mut jobs = Vec::with_capacity(layout.plans.len());
-    let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, out.faces);
-    let mut vbase = 0;
-    for (c, plan) in layout.plans.iter().enumerate() {
-        let (k, kf) = (plan.vertices(), plan.faces(profile));
-        let (v1, v2) = v.split_at_mut(k);
-        let (n1, n2) = match nr {
-            Some(a) => {
-                let (x, y) = a.split_at_mut(k);
-                (Some(x), Some(y))
-            }
-            None => (None, None),
-        };
-        let (u1, u2) = match u {
-            Some(a) => {
-                let (x, y) = a.split_at_mut(k);
-                (Some(x), Some(y))
-            }
-            None => (None, None),
-        };
-        let (f1, f2) = f.split_at_mut(kf);
-        let mine = MeshMut {
-            vertices: v1,
-            faces: f1,
-            normals: n1,
-            uv: u1,
-        };
-        jobs.push((c, vbase, mine));
-        (v, nr, u, f) = (v2, n2, u2, f2);
-        vbase += k;
-    }
-    let per_spine: Vec<(Vec<usize>, Option<usize>)> = jobs
-        .into_par_iter()
-        .map(|(c, vbase, mine)| {
-            if cancel() {
-                return (Vec::new(), None);
-            }
-            let (folds, bad) = sweep_one(
-                &part(all, offsets, c),
-                &layout.plans[c],
-                profile,
-                &tris,
-                opts,
-                vbase,
-                offsets[c],
-                unscale,
-                mine,
-                cancel,
-            );
-            (folds, bad.map(|i| vbase + i))
-        })
-        .collect();
-    if let Some(i) = per_spine.iter().find_map(|s| s.1) {
-        return Err(out_of_range::<R>(i));
-    }
-    Ok(per_spine.into_iter().flat_map(|s| s.0).collect())
+    sweep.write(out, &cancel::never)
 }
 
 /// A sweep checked and sized, to be written into buffers of a chosen precision: the input
 /// brought near unit size when it is far from it ([`scaled_input`]; the output is scaled
-/// back as it is written), the profile and the [`Layout`].
+/// back as it is written), the profile and the [`Layout`]. The spines are checked as they
+/// are swept ([`Prepared::write_into`]).
 pub struct Prepared<'a> {
     /// The spine as given.
     spine: Spine<'a>,
@@ -1323,11 +1586,13 @@ pub struct Prepared<'a> {
     scaled: Option<Scaled>,
     profile: Profile,
     opts: Options,
+    frames: FrameSource<'a>,
     pub layout: Layout,
 }
 
 impl<'a> Prepared<'a> {
-    /// Check a bundle of spines (`offsets` as in [`layout`]) with a profile polygon.
+    /// Check a bundle of spines (`offsets` as in [`layout`]) with a profile polygon, and the
+    /// spines' `frames`.
     pub fn new(
         spine: Spine<'a>,
         offsets: &'a [usize],
@@ -1341,19 +1606,26 @@ impl<'a> Prepared<'a> {
             profile,
             profile_closed,
             opts,
+            FrameSource::Given,
             &cancel::never,
         )?;
         Ok(prep.expect("a hook that never stops"))
     }
 
-    /// [`Prepared::new`] that polls `cancel` between its passes and before every block of
-    /// rows within them, and returns `None` once it says stop (see [`crate::cancel`]).
+    /// [`Prepared::new`] with the frames from `frames`, polling `cancel` between its passes
+    /// and before every block of rows within them; returns `None` once it says stop (see
+    /// [`crate::cancel`]).
+    ///
+    /// With computed frames ([`FrameSource::Rmf`]) a bad profile or option is reported only
+    /// when every curve's frames can be computed, as when the frames were a call of their
+    /// own before the sweep.
     pub fn new_cancellable(
         spine: Spine<'a>,
         offsets: &'a [usize],
         profile: &[DVec2],
         profile_closed: bool,
         opts: Options,
+        frames: FrameSource<'a>,
         cancel: Cancel<'_>,
     ) -> Result<Option<Prepared<'a>>> {
         let scaled = scaled_input(spine.points, profile, spine.scale, cancel);
@@ -1364,14 +1636,30 @@ impl<'a> Prepared<'a> {
             Some(s) => (&s.points[..], &s.profile[..], &s.scale[..]),
             None => (spine.points, profile, spine.scale),
         };
-        let p = Profile::new(prof, profile_closed)?;
         let view = Spine {
             points,
             scale,
             ..spine
         };
-        let Some(layout) = layout_cancellable(&view, offsets, &p, &opts, cancel)? else {
-            return Ok(None);
+        let set_up = Profile::new(prof, profile_closed).and_then(|p| {
+            let lay = layout_cancellable(&view, offsets, &p, &opts, cancel)?;
+            Ok(lay.map(|l| (p, l)))
+        });
+        let (p, layout) = match (set_up, frames) {
+            (Ok(Some(pl)), _) => pl,
+            (Ok(None), _) => return Ok(None),
+            (Err(e), FrameSource::Given) => return Err(e),
+            (Err(e), FrameSource::Rmf { tangents }) => {
+                validate::offsets(offsets, spine.points.len())?;
+                let (x, closed) = (spine.points, opts.closed);
+                if let Some(fe) = first_frames_error(x, tangents, offsets, closed, cancel) {
+                    return Err(fe);
+                }
+                return match cancel() {
+                    true => Ok(None),
+                    false => Err(e),
+                };
+            }
         };
         Ok(Some(Prepared {
             spine,
@@ -1379,6 +1667,7 @@ impl<'a> Prepared<'a> {
             scaled,
             profile: p,
             opts,
+            frames,
             layout,
         }))
     }
@@ -1387,9 +1676,9 @@ impl<'a> Prepared<'a> {
     /// caps), in the order of the spines: the parts follow one another in the face array.
     pub fn faces_per_spine(&self) -> Vec<usize> {
         self.layout
-            .plans
+            .sizes
             .iter()
-            .map(|plan| plan.faces(&self.profile))
+            .map(|s| s.faces(&self.profile))
             .collect()
     }
 
@@ -1405,15 +1694,28 @@ impl<'a> Prepared<'a> {
         }
     }
 
-    /// [`sweep_into_cancellable`] into buffers of the sizes in `self.layout`.
+    /// Every spine swept into buffers of the sizes in `self.layout` (see
+    /// [`sweep_into`]; with computed frames, each spine's frames first), polling `cancel`
+    /// before every spine and every block of rings within them (see [`crate::cancel`]).
     pub fn write_into<R: Real, I: Index>(
         &self,
         out: MeshMut<R, I>,
         cancel: Cancel<'_>,
     ) -> Result<Vec<usize>> {
-        let k = self.scaled.as_ref().map(|s| s.k);
-        let (s, o, p) = (self.view(), self.offsets, &self.profile);
-        sweep_into_cancellable(&s, o, p, &self.opts, &self.layout, k, out, cancel)
+        let sizes = &self.layout.sizes;
+        let caps = sizes.iter().any(|s| s.caps);
+        let cols = sizes.first().map_or(self.profile.len(), |s| s.cols);
+        let sweep = Sweep {
+            view: self.view(),
+            points: self.spine.points,
+            frames: self.frames,
+            offsets: self.offsets,
+            opts: &self.opts,
+            layout: &self.layout,
+            sh: Shared::new(&self.profile, cols, caps),
+            unscale: self.scaled.as_ref().map(|s| s.k),
+        };
+        sweep.write(out, cancel)
     }
 }
 
@@ -1808,14 +2110,18 @@ mod tests {
         };
         let p = Profile::new(&star(), true).expect("a star");
         let opts = options(false, true, true);
-        let lay = layout(&spine, &[0, n], &p, &opts).expect("a valid sweep");
-        let plan = &lay.plans[0];
+        let lay = layout(&spine, &[0, n], &p, &opts).expect("a sized sweep");
+        let plan = check_spine(&spine, &opts, &p, true, &cancel::never)
+            .expect("a valid sweep")
+            .expect("not stopped");
+        let plan = &plan;
+        let column = Columns::of(&p, plan.cols);
         let rings = Rings {
             s: &spine,
             x: &x[..plan.rings],
             plan,
             p: &p,
-            column: Columns::of(&p, plan.cols),
+            column: &column,
             closed: false,
             miter_limit: 4.0,
             sign: 1.0,
@@ -1835,9 +2141,10 @@ mod tests {
                 u: Some(&mut u),
                 f: &mut f,
             };
+            let ring = &mut RingScratch::new(plan.cols);
             let r = match avx2 {
-                true => rings.block(b, &pattern, 0, None),
-                false => rings.block_body(b, &pattern, 0, None),
+                true => rings.block(b, &pattern, 0, None, ring),
+                false => rings.block_body(b, &pattern, 0, None, ring),
             };
             let bits3 = |a: Vec<[f32; 3]>| a.iter().map(|t| t.map(f32::to_bits)).collect();
             let uv = u.iter().map(|t| t.map(f32::to_bits)).collect();
