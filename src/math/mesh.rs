@@ -129,14 +129,9 @@ pub(crate) mod fixtures {
         ];
         (v, f)
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The unit cube `[0, 1]³`, outward faces.
-    fn cube() -> (Vec<DVec3>, Vec<[usize; 3]>) {
+    /// The unit cube `[0, 1]³`, vertex `x + 2y + 4z`, faces wound outwards.
+    pub fn cube() -> (Vec<DVec3>, Vec<[usize; 3]>) {
         let v: Vec<DVec3> = (0..8)
             .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
             .collect();
@@ -154,6 +149,18 @@ mod tests {
             .collect();
         (v, f)
     }
+
+    /// [`cube`] with the face indices of a NumPy `int64` array.
+    pub fn cube_i64() -> (Vec<DVec3>, Vec<[i64; 3]>) {
+        let (v, f) = cube();
+        (v, f.iter().map(|t| t.map(|i| i as i64)).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fixtures::cube;
+    use super::*;
 
     #[test]
     fn compensated_sum_keeps_the_small_terms() {

@@ -191,25 +191,7 @@ fn first_bad_edge<I: Index>(
 pub(crate) mod tests {
     use super::*;
 
-    /// The unit cube `[0, 1]³`, outward faces.
-    fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
-        let quads = [
-            [0, 2, 3, 1], // z = 0, normal −z
-            [4, 5, 7, 6], // z = 1
-            [0, 1, 5, 4], // y = 0
-            [2, 6, 7, 3], // y = 1
-            [0, 4, 6, 2], // x = 0
-            [1, 3, 7, 5], // x = 1
-        ];
-        let f = quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        (v, f)
-    }
+    use crate::math::mesh::fixtures::cube_i64 as cube;
 
     #[test]
     fn closed_mesh_volume_centroid_and_refusals() {

@@ -438,25 +438,7 @@ pub fn walk_many_cancellable(
 mod tests {
     use super::*;
 
-    /// The unit cube `[0, 1]³`, vertex `x + 2y + 4z`, faces wound outwards.
-    fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
-        let v = (0..8)
-            .map(|i| DVec3::new(f64::from(i & 1), f64::from((i >> 1) & 1), f64::from(i >> 2)))
-            .collect();
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let f = quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        (v, f)
-    }
+    use crate::math::mesh::fixtures::cube_i64 as cube;
 
     #[test]
     fn walk_path_agrees_with_steps_by_hand() {
