@@ -377,25 +377,9 @@ pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::profile::fixtures::{Rng, star_shaped};
     use crate::sweep::profile::{Profile, accurate_area2, accurate_cover2};
     use std::collections::HashMap;
-
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        fn below(&mut self, n: u64) -> u64 {
-            self.next() % n
-        }
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// Check that `tris` triangulates the counter-clockwise simple polygon `q`: `m − 2`
     /// triangles on valid vertex indices, each counter-clockwise by the exact predicate, the
@@ -638,14 +622,7 @@ mod tests {
         polys.extend([comb(1), comb(3), comb(50), comb(2500)]);
         polys.extend([spiral(1), spiral(2), spiral(5), spiral(40)]);
         for m in [3, 5, 20, 200, 5000] {
-            let mut t: Vec<f64> = (0..m).map(|_| rng.unit() * std::f64::consts::TAU).collect();
-            t.sort_by(f64::total_cmp);
-            t.dedup();
-            polys.push(
-                t.iter()
-                    .map(|&a| (0.05 + rng.unit()) * DVec2::from_angle(a))
-                    .collect(),
-            );
+            polys.push(star_shaped(&mut rng, m));
         }
         for p in polys {
             let turned: Vec<DVec2> = p

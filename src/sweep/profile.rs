@@ -626,8 +626,46 @@ fn first_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
     best
 }
 
+/// Random polygons shared by the unit tests of the profile and its caps.
+#[cfg(test)]
+pub(crate) mod fixtures {
+    use glam::DVec2;
+
+    /// Xorshift64: a small reproducible generator for the randomised tests.
+    pub struct Rng(pub u64);
+
+    impl Rng {
+        pub fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+        /// Uniform in `0..n`.
+        pub fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+        /// Uniform in `[0, 1)`.
+        pub fn unit(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// A star-shaped polygon: up to `m` vertices at increasing angles, random radii
+    /// (simple, counter-clockwise).
+    pub fn star_shaped(rng: &mut Rng, m: usize) -> Vec<DVec2> {
+        let mut t: Vec<f64> = (0..m).map(|_| rng.unit() * std::f64::consts::TAU).collect();
+        t.sort_by(f64::total_cmp);
+        t.dedup();
+        t.iter()
+            .map(|&a| (0.05 + rng.unit()) * DVec2::from_angle(a))
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::fixtures::{Rng, star_shaped};
     use super::*;
 
     fn area_of(p: &[DVec2], tris: &[[usize; 3]]) -> f64 {
@@ -751,33 +789,6 @@ mod tests {
                         && segments_meet(p[a], p[(a + 1) % m], p[b], p[(b + 1) % m])
                 })
             })
-    }
-
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        fn below(&mut self, n: u64) -> u64 {
-            self.next() % n
-        }
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
-
-    /// A star-shaped polygon: `m` vertices at increasing angles, random radii (simple).
-    fn star_shaped(rng: &mut Rng, m: usize) -> Vec<DVec2> {
-        let mut t: Vec<f64> = (0..m).map(|_| rng.unit() * std::f64::consts::TAU).collect();
-        t.sort_by(f64::total_cmp);
-        t.dedup();
-        t.iter()
-            .map(|&a| (0.05 + rng.unit()) * DVec2::from_angle(a))
-            .collect()
     }
 
     #[test]
