@@ -62,6 +62,8 @@ pub mod profile;
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::OnceLock;
 
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
@@ -559,8 +561,8 @@ pub struct Layout {
     pub faces: usize,
 }
 
-/// Output bytes at most per block of rings of [`sweep_one`] (one poll of the cancel hook per
-/// block). A cold output array is faulted in as it is written: on a loaded 2-core machine a
+/// Output bytes at most per block of rings of [`sweep_one`], or per piece of the columns of
+/// a ring larger than this (one poll of the cancel hook per block or piece). A cold output array is faulted in as it is written: on a loaded 2-core machine a
 /// block of 4096 vertices (~0.5 MB with normals and uv) then took up to 0.12 s.
 const BLOCK_BYTES: usize = 1 << 20;
 
@@ -568,7 +570,9 @@ const BLOCK_BYTES: usize = 1 << 20;
 /// segment, the caps' triangulation and the winding.
 struct Shared<'a> {
     p: &'a Profile,
-    column: Columns,
+    /// The profile's stored columns, built by the first spine swept in whole rings (a
+    /// sweep in pieces of rings builds the columns of each piece as it goes).
+    column: OnceLock<Columns>,
     pattern: FacePattern,
     tris: Vec<[usize; 3]>,
     /// −1 where the faces are wound the other way (clockwise closed profiles).
@@ -587,7 +591,7 @@ impl<'a> Shared<'a> {
         let edges = if p.closed { p.len() } else { p.len() - 1 };
         Shared {
             p,
-            column: Columns::of(p, cols),
+            column: OnceLock::new(),
             pattern: FacePattern::of(cols, edges, sign),
             tris: if caps { p.triangulate() } else { Vec::new() },
             sign,
@@ -613,13 +617,15 @@ fn sweep_one<R: Real, I: Index>(
     cancel: Cancel<'_>,
 ) -> (Vec<usize>, Option<usize>) {
     // Rings per parallel task (one poll of `cancel` each): enough work (~4k vertices) to pay
-    // for the task, and at most `BLOCK_BYTES` of output (unless one ring is more), so that a
-    // stop waits for little writing even where the writes fault in fresh pages of the output
+    // for the task, and at most `BLOCK_BYTES` of output, so that a stop waits for little
+    // writing even where the writes fault in fresh pages of the output; a ring of more goes
+    // in pieces of its columns of at most `BLOCK_BYTES` each
     let ring_bytes = plan.cols
         * (size_of::<[R; 3]>() * (1 + usize::from(out.normals.is_some()))
             + size_of::<[R; 2]>() * usize::from(out.uv.is_some()))
         + 2 * sh.edges * size_of::<[I; 3]>();
     let grain = (4096 / plan.cols).min(BLOCK_BYTES / ring_bytes).max(1);
+    let piece = plan.cols.div_ceil(ring_bytes.div_ceil(BLOCK_BYTES));
     let rings = Rings {
         s,
         x: &s.points[..plan.rings],
@@ -638,7 +644,15 @@ fn sweep_one<R: Real, I: Index>(
         normals: out.normals,
         uv: out.uv,
     };
-    let res = rings.write(side, &sh.pattern, vbase, unscale, grain, ring, cancel);
+    let res = rings.write(
+        side,
+        &sh.pattern,
+        vbase,
+        unscale,
+        (grain, piece),
+        ring,
+        cancel,
+    );
     // a stopped sweep writes no caps: they lie apart, and each may be the first write to a
     // fresh page of the output
     if plan.caps && !cancel() {
@@ -675,14 +689,25 @@ struct Columns {
 
 impl Columns {
     fn of(p: &Profile, cols: usize) -> Columns {
-        let m = p.len();
         let mut c = Columns {
             px: Vec::with_capacity(cols),
             py: Vec::with_capacity(cols),
             w: Default::default(),
             v: Vec::with_capacity(cols),
         };
-        for j in 0..cols {
+        c.fill(p, 0..cols);
+        c
+    }
+
+    /// Stored columns `js` (replacing the ones held).
+    fn fill(&mut self, p: &Profile, js: Range<usize>) {
+        let m = p.len();
+        let c = self;
+        c.px.clear();
+        c.py.clear();
+        c.w.iter_mut().for_each(Vec::clear);
+        c.v.clear();
+        for j in js {
             let jj = if j == m { 0 } else { j };
             let (jp, jn) = if p.closed {
                 ((jj + m - 1) % m, (jj + 1) % m)
@@ -705,56 +730,114 @@ impl Columns {
             }
             c.v.push(if j == m { 1.0 } else { p.v[j] });
         }
-        c
+    }
+
+    /// The stored columns `r` (a piece of a ring, or all of it).
+    #[inline(always)]
+    fn view(&self, r: Range<usize>) -> Cols<'_> {
+        let w = &self.w;
+        Cols {
+            px: &self.px[r.clone()],
+            py: &self.py[r.clone()],
+            w: [
+                &w[0][r.clone()],
+                &w[1][r.clone()],
+                &w[2][r.clone()],
+                &w[3][r.clone()],
+                &w[4][r.clone()],
+                &w[5][r.clone()],
+            ],
+            v: &self.v[r],
+        }
     }
 }
 
-/// The side faces of a segment (ring `i` to ring `i + 1`) as vertex offsets from ring `i`'s
-/// first vertex (ring `i + 1` from `cols` on), two triangles per quad: split along `a c`, or
-/// along `b d` (`a b` on ring `i`, `d c` on ring `i + 1`), wound by `sign`. Without split
-/// seams the last column wraps to the first.
+/// A range of the [`Columns`] (all of the same length).
+#[derive(Clone, Copy)]
+struct Cols<'a> {
+    px: &'a [f64],
+    py: &'a [f64],
+    w: [&'a [f64]; 6],
+    v: &'a [f64],
+}
+
+/// The side faces of a segment (ring `i` to ring `i + 1`), two triangles per quad of profile
+/// edge `j` (`a b` on ring `i`, `d c` on ring `i + 1`, `a`, `d` in column `j`): split along
+/// `a c`, or along `b d`, wound by `sign`. Without split seams the last edge of a closed
+/// profile wraps to the first column. The indices are computed per edge (no table of the
+/// profile's size).
+#[derive(Clone, Copy)]
 struct FacePattern {
-    ac: Vec<[usize; 3]>,
-    bd: Vec<[usize; 3]>,
     cols: usize,
+    edges: usize,
+    /// Wound the other way (clockwise closed profiles).
+    flip: bool,
 }
 
 impl FacePattern {
     fn of(cols: usize, edges: usize, sign: f64) -> FacePattern {
-        let col = |j: usize| if j == cols { 0 } else { j };
-        let wind = |t: [usize; 3]| if sign > 0.0 { t } else { [t[0], t[2], t[1]] };
-        let (mut ac, mut bd) = (Vec::with_capacity(2 * edges), Vec::with_capacity(2 * edges));
-        for j in 0..edges {
-            let (a, b, c, d) = (col(j), col(j + 1), cols + col(j + 1), cols + col(j));
-            ac.extend([wind([a, b, c]), wind([a, c, d])]);
-            bd.extend([wind([a, b, d]), wind([b, c, d])]);
+        FacePattern {
+            cols,
+            edges,
+            flip: sign < 0.0,
         }
-        FacePattern { ac, bd, cols }
     }
 
-    /// The faces of the segment from the ring starting at vertex `b0` to the one starting at
-    /// `b1`.
+    /// Faces per segment.
     #[inline(always)]
-    fn write<I: Index>(&self, out: &mut [[I; 3]], bd: bool, b0: usize, b1: usize) {
-        let pat = if bd { &self.bd } else { &self.ac };
-        if b1 == b0 + self.cols {
-            for (f, t) in out.iter_mut().zip(pat) {
-                *f = [I::of(b0 + t[0]), I::of(b0 + t[1]), I::of(b0 + t[2])];
-            }
-        } else {
-            let cols = self.cols;
-            let id = |x: usize| I::of(if x < cols { b0 + x } else { b1 + x - cols });
-            for (f, t) in out.iter_mut().zip(pat) {
-                *f = t.map(id);
-            }
+    fn per_segment(&self) -> usize {
+        2 * self.edges
+    }
+
+    /// The faces of edges `e0..` (as many as `out` holds pairs) of the segment from the ring
+    /// starting at vertex `b0` to the one starting at `b1`.
+    #[inline(always)]
+    fn write<I: Index>(&self, out: &mut [[I; 3]], bd: bool, b0: usize, b1: usize, e0: usize) {
+        match (bd, self.flip) {
+            (false, false) => self.faces::<I, false, false>(out, b0, b1, e0),
+            (false, true) => self.faces::<I, false, true>(out, b0, b1, e0),
+            (true, false) => self.faces::<I, true, false>(out, b0, b1, e0),
+            (true, true) => self.faces::<I, true, true>(out, b0, b1, e0),
+        }
+    }
+
+    #[inline(always)]
+    fn faces<I: Index, const BD: bool, const FLIP: bool>(
+        &self,
+        out: &mut [[I; 3]],
+        b0: usize,
+        b1: usize,
+        e0: usize,
+    ) {
+        let cols = self.cols;
+        let wind = |t: [usize; 3]| match FLIP {
+            false => [I::of(t[0]), I::of(t[1]), I::of(t[2])],
+            true => [I::of(t[0]), I::of(t[2]), I::of(t[1])],
+        };
+        for (k, f) in out.chunks_exact_mut(2).enumerate() {
+            let j = e0 + k;
+            let jn = if j + 1 == cols { 0 } else { j + 1 };
+            let (a, b, c, d) = (b0 + j, b0 + jn, b1 + jn, b1 + j);
+            let (t0, t1) = match BD {
+                false => ([a, b, c], [a, c, d]),
+                true => ([a, b, d], [b, c, d]),
+            };
+            f[0] = wind(t0);
+            f[1] = wind(t1);
         }
     }
 }
 
-/// One block of rings' share of the outputs (`f`: the faces of its segments).
+/// One block of rings' share of the outputs (`f`: the faces of its segments): whole rings,
+/// or one piece of the columns of one ring (see [`Rings::write`]).
 struct Block<'a, R, I> {
     /// The block's first stored ring.
     i0: usize,
+    /// The block's columns of every ring (`0..cols`: whole rings).
+    j: Range<usize>,
+    /// The split of every segment (true: along `b d`) when the block holds a piece of a
+    /// ring, indexed by segment (`None`: whole rings, which test their segments here).
+    bd: Option<&'a [bool]>,
     v: &'a mut [[R; 3]],
     n: Option<&'a mut [[R; 3]]>,
     u: Option<&'a mut [[R; 2]]>,
@@ -777,6 +860,14 @@ struct RingScratch {
 }
 
 impl RingScratch {
+    /// Room for `n` columns.
+    #[inline(always)]
+    fn fit(&mut self, n: usize) {
+        if self.vx.len() < n {
+            *self = RingScratch::new(n);
+        }
+    }
+
     fn new(cols: usize) -> RingScratch {
         let z = || vec![0.0; cols];
         RingScratch {
@@ -791,7 +882,7 @@ impl RingScratch {
     }
 
     #[inline(always)]
-    fn vertices(&mut self, c: &Columns, g: &Geo) {
+    fn vertices(&mut self, c: &Cols, g: &Geo) {
         let n = c.px.len();
         let (px, py) = (&c.px[..n], &c.py[..n]);
         let (vx, vy, vz) = (&mut self.vx[..n], &mut self.vy[..n], &mut self.vz[..n]);
@@ -805,16 +896,9 @@ impl RingScratch {
 
     /// The unit normals `Σ w_k c_k / |Σ w_k c_k|`.
     #[inline(always)]
-    fn normals(&mut self, c: &Columns, cr: &[DVec3; 6]) {
+    fn normals(&mut self, c: &Cols, cr: &[DVec3; 6]) {
         let n = c.px.len();
-        let w = [
-            &c.w[0][..n],
-            &c.w[1][..n],
-            &c.w[2][..n],
-            &c.w[3][..n],
-            &c.w[4][..n],
-            &c.w[5][..n],
-        ];
+        let w = c.w.map(|w| &w[..n]);
         let (nx, ny, nz) = (&mut self.nx[..n], &mut self.ny[..n], &mut self.nz[..n]);
         let rcp = &mut self.rcp[..n];
         for j in 0..n {
@@ -899,14 +983,15 @@ fn first_non_finite<R: Real>(rv: &[[R; 3]]) -> Option<usize> {
 /// fold-over test of the segment starting there. Stored ring `i` is spine sample
 /// `i mod rings`, stored column `j` is profile vertex `j mod m` (the duplicates of split
 /// seams carry u = L and v = 1). Nothing is read back from the outputs but the ring just
-/// written; rings go in blocks so that each ring's geometry is computed once.
+/// written; rings go in blocks so that each ring's geometry is computed once (a ring of more
+/// than [`BLOCK_BYTES`] goes in pieces of its columns, each with its ring's geometry).
 struct Rings<'a> {
     s: &'a Spine<'a>,
     /// The distinct spine samples.
     x: &'a [DVec3],
     plan: &'a Plan,
     p: &'a Profile,
-    column: &'a Columns,
+    column: &'a OnceLock<Columns>,
     closed: bool,
     miter_limit: f64,
     /// −1 where the faces are wound the other way (clockwise closed profiles).
@@ -953,10 +1038,12 @@ impl Rings<'_> {
     }
 
     /// All stored rings and the side faces of their segments, `grain` rings per parallel
-    /// task, each output element written once; returns the fold-over rows and the first
-    /// vertex (local) out of the output type's range. `vbase`: the spine's first vertex;
-    /// `unscale`: see [`unscaled`]; `ring`: scratch for a spine of one block (the short
-    /// streamlines of a bundle), which is written here without setting up parallel tasks.
+    /// task (or, for a ring larger than `piece` columns, pieces of `piece` columns of one
+    /// ring per task), each output element written once; returns the fold-over rows and the
+    /// first vertex (local) out of the output type's range. `vbase`: the spine's first
+    /// vertex; `unscale`: see [`unscaled`]; `ring`: scratch for a spine of one block (the
+    /// short streamlines of a bundle), which is written here without setting up parallel
+    /// tasks.
     #[allow(clippy::too_many_arguments)]
     fn write<R: Real, I: Index>(
         &self,
@@ -964,23 +1051,31 @@ impl Rings<'_> {
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
-        grain: usize,
+        (grain, piece): (usize, usize),
         ring: &mut RingScratch,
         cancel: Cancel<'_>,
     ) -> (Vec<usize>, Option<usize>) {
-        let block = grain * self.plan.cols;
+        let cols = self.plan.cols;
+        if piece < cols {
+            return self.write_pieces(out, pattern, vbase, unscale, piece, cancel);
+        }
+        let all = self.column.get_or_init(|| Columns::of(self.p, cols));
+        let column = &all.view(0..cols);
+        let block = grain * cols;
         if out.vertices.len() <= block {
             if cancel() {
                 return (Vec::new(), None);
             }
             let b = Block {
                 i0: 0,
+                j: 0..cols,
+                bd: None,
                 v: out.vertices,
                 n: out.normals,
                 u: out.uv,
                 f: out.faces,
             };
-            return self.block(b, pattern, vbase, unscale, ring);
+            return self.block(b, column, pattern, vbase, unscale, ring);
         }
         let blocks = out.vertices.len().div_ceil(block);
         let mut nb: Vec<Option<&mut [[R; 3]]>> = match out.normals {
@@ -993,7 +1088,8 @@ impl Rings<'_> {
             None => Vec::new(),
         };
         ub.resize_with(blocks, || None);
-        let mut fb: Vec<&mut [[I; 3]]> = out.faces.chunks_mut(grain * pattern.ac.len()).collect();
+        let per_block = grain * pattern.per_segment();
+        let mut fb: Vec<&mut [[I; 3]]> = out.faces.chunks_mut(per_block).collect();
         fb.resize_with(blocks, || &mut []);
         let jobs: Vec<_> = out
             .vertices
@@ -1004,25 +1100,119 @@ impl Rings<'_> {
             .enumerate()
             .map(|(bi, (((v, n), u), f))| Block {
                 i0: bi * grain,
+                j: 0..cols,
+                bd: None,
                 v,
                 n,
                 u,
                 f,
             })
             .collect();
-        let cols = self.plan.cols;
         let per_block: Vec<(Vec<usize>, Option<usize>)> = jobs
             .into_par_iter()
             .map_init(
                 || RingScratch::new(cols),
                 |ring, b| match cancel() {
                     true => (Vec::new(), None),
-                    false => self.block(b, pattern, vbase, unscale, ring),
+                    false => self.block(b, column, pattern, vbase, unscale, ring),
                 },
             )
             .collect();
         let bad = per_block.iter().find_map(|b| b.1);
         (per_block.into_iter().flat_map(|b| b.0).collect(), bad)
+    }
+
+    /// [`Rings::write`] for rings of more than `piece` columns: first the split of every
+    /// odd segment (is any quad twisted?) piece by piece, then every ring piece by piece,
+    /// each piece a parallel task that polls `cancel`, so that no task writes much more
+    /// than [`BLOCK_BYTES`] however large the profile. The same operations per column as a
+    /// whole ring, so the same bits.
+    fn write_pieces<R: Real, I: Index>(
+        &self,
+        out: MeshMut<R, I>,
+        pattern: &FacePattern,
+        vbase: usize,
+        unscale: Option<i32>,
+        piece: usize,
+        cancel: Cancel<'_>,
+    ) -> (Vec<usize>, Option<usize>) {
+        let (cols, r_n, segments) = (self.plan.cols, self.plan.rings, self.plan.segments);
+        let edges = pattern.edges;
+        let pieces = cols.div_ceil(piece);
+        // the odd segments' splits: (segment, piece) tasks
+        let twisted: Vec<bool> = (0..segments / 2 * pieces)
+            .into_par_iter()
+            .map(|t| {
+                let (i, c) = (2 * (t / pieces) + 1, t % pieces);
+                let e = (c * piece).min(edges)..((c + 1) * piece).min(edges);
+                !cancel() && self.twisted(&self.geo(i), &self.geo((i + 1) % r_n), e)
+            })
+            .collect();
+        if cancel() {
+            return (Vec::new(), None);
+        }
+        let bd: Vec<bool> = (0..segments)
+            .map(|i| i % 2 == 1 && twisted[i / 2 * pieces..][..pieces].iter().any(|&t| t))
+            .collect();
+        // the output of every (ring, piece), in the order of the rings
+        let stored = self.plan.stored_rings;
+        let mut jobs = Vec::with_capacity(stored * pieces);
+        let mut v = out.vertices.chunks_mut(cols);
+        let mut n = out.normals.map(|a| a.chunks_mut(cols));
+        let mut u = out.uv.map(|a| a.chunks_mut(cols));
+        let mut f = out.faces.chunks_mut(pattern.per_segment());
+        for i in 0..stored {
+            let (Some(rv), rn, ru) = (
+                v.next(),
+                n.as_mut().and_then(|a| a.next()),
+                u.as_mut().and_then(|a| a.next()),
+            ) else {
+                break;
+            };
+            let rf = if i < segments { f.next() } else { None };
+            let mut rv = rv.chunks_mut(piece);
+            let mut rn = rn.map(|a| a.chunks_mut(piece));
+            let mut ru = ru.map(|a| a.chunks_mut(piece));
+            let mut rf = rf.map(|a| a.chunks_mut(2 * piece));
+            for c in 0..pieces {
+                let (Some(pv), pn, pu) = (
+                    rv.next(),
+                    rn.as_mut().and_then(|a| a.next()),
+                    ru.as_mut().and_then(|a| a.next()),
+                ) else {
+                    break;
+                };
+                let pf = rf.as_mut().and_then(|a| a.next()).unwrap_or(&mut []);
+                jobs.push(Block {
+                    i0: i,
+                    j: c * piece..((c + 1) * piece).min(cols),
+                    bd: Some(&bd),
+                    v: pv,
+                    n: pn,
+                    u: pu,
+                    f: pf,
+                });
+            }
+        }
+        let per_piece: Vec<(Vec<usize>, Option<usize>)> = jobs
+            .into_par_iter()
+            .map_init(
+                || (RingScratch::new(piece), Columns::of(self.p, 0)),
+                |(ring, column), b| match cancel() {
+                    true => (Vec::new(), None),
+                    false => {
+                        column.fill(self.p, b.j.clone());
+                        let view = &column.view(0..b.j.len());
+                        self.block(b, view, pattern, vbase, unscale, ring)
+                    }
+                },
+            )
+            .collect();
+        let bad = per_piece.iter().find_map(|b| b.1);
+        // a folded segment is reported by each of its pieces that folds
+        let mut folds: Vec<usize> = per_piece.into_iter().flat_map(|b| b.0).collect();
+        folds.dedup();
+        (folds, bad)
     }
 
     /// One block of rings, [`Rings::block_body`]; on x86-64 processors with AVX2 the same
@@ -1034,6 +1224,7 @@ impl Rings<'_> {
     fn block<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
@@ -1043,9 +1234,9 @@ impl Rings<'_> {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `block_avx2` only needs the processor to support AVX2, checked just
             // above.
-            return unsafe { self.block_avx2(b, pattern, vbase, unscale, ring) };
+            return unsafe { self.block_avx2(b, column, pattern, vbase, unscale, ring) };
         }
-        self.block_body(b, pattern, vbase, unscale, ring)
+        self.block_body(b, column, pattern, vbase, unscale, ring)
     }
 
     /// [`Rings::block_body`] compiled for AVX2. Safety: call only where AVX2 is available.
@@ -1054,42 +1245,51 @@ impl Rings<'_> {
     unsafe fn block_avx2<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
         ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
-        self.block_body(b, pattern, vbase, unscale, ring)
+        self.block_body(b, column, pattern, vbase, unscale, ring)
     }
 
     /// The rings of a block and the faces of their segments: per ring, the vertices and
     /// normals column by column into [`RingScratch`], then stored (with the unscaling and
-    /// the range check), uv, the fold-over test and the faces by [`FacePattern`].
+    /// the range check), uv, the fold-over test and the faces of the block's columns.
     #[inline(always)]
     fn block_body<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
         ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
         let (r_n, cols, stored) = (self.plan.rings, self.plan.cols, self.plan.stored_rings);
-        let (column, arc, per_segment) = (self.column, &self.plan.arc[..], pattern.ac.len());
+        let arc = &self.plan.arc[..];
         let Block {
             i0,
+            j: js,
+            bd: given_bd,
             v: bv,
             n: mut bn,
             u: mut bu,
             f: bf,
         } = b;
+        let width = js.len();
+        ring.fit(width);
+        // the block's edges of every segment and their faces
+        let edges = js.start.min(pattern.edges)..js.end.min(pattern.edges);
+        let per_segment = 2 * edges.len();
         let (mut folds, mut bad) = (Vec::new(), None);
         let mut prev = self.geo((i0 + r_n - 1) % r_n);
         let mut cur = self.geo(i0 % r_n);
-        for (di, rv) in bv.chunks_mut(cols).enumerate() {
+        for (di, rv) in bv.chunks_mut(width).enumerate() {
             let i = i0 + di;
             let next = self.geo((i + 1) % r_n);
-            let span = di * cols..(di + 1) * cols;
+            let span = di * width..(di + 1) * width;
             ring.vertices(column, &cur);
             ring.put_vertices(rv, unscale);
             if let Some(bn) = bn.as_deref_mut() {
@@ -1107,23 +1307,27 @@ impl Rings<'_> {
                 }
             }
             if bad.is_none() {
-                bad = first_non_finite(rv).map(|j| i * cols + j);
+                bad = first_non_finite(rv).map(|j| i * cols + js.start + j);
             }
             if let Some(bu) = bu.as_deref_mut() {
                 let u = unscaled::<R>(arc[i], unscale);
-                for (w, &v) in bu[span].iter_mut().zip(&column.v) {
+                for (w, &v) in bu[span].iter_mut().zip(column.v) {
                     *w = [u, R::of(v)];
                 }
             }
             if i < self.plan.segments {
-                if self.folds_over(&cur, &next) {
+                if self.folds_over(&cur, &next, column) {
                     folds.push(self.rowbase + i);
                 }
                 // split along b d on the odd twisted segments
-                let bd = i % 2 == 1 && self.twisted(&cur, &next);
+                let bd = match given_bd {
+                    Some(bd) => bd[i],
+                    None => i % 2 == 1 && self.twisted(&cur, &next, 0..pattern.edges),
+                };
                 let i1 = if i + 1 == stored { 0 } else { i + 1 };
                 let faces = &mut bf[di * per_segment..(di + 1) * per_segment];
-                pattern.write(faces, bd, vbase + i * cols, vbase + i1 * cols);
+                let (b0, b1) = (vbase + i * cols, vbase + i1 * cols);
+                pattern.write(faces, bd, b0, b1, edges.start);
             }
             prev = cur;
             cur = next;
@@ -1169,17 +1373,17 @@ impl Rings<'_> {
         ]
     }
 
-    /// Are the quads of the segment from `cur` to `next` twisted (not planar)? The quad of
+    /// Are the quads of profile edges `edges` of the segment from `cur` to `next` twisted (not
+    /// planar)? The quad of
     /// profile edge `p → p + e` has `b − a = A e`, `c − d = A′ e` and
     /// `d − a = Δx + (A′ − A) p`, with `A = (ma, mb)`; `τ = det(b − a, d − a, c − d)`.
     #[inline(always)]
-    fn twisted(&self, cur: &Geo, next: &Geo) -> bool {
+    fn twisted(&self, cur: &Geo, next: &Geo, edges: Range<usize>) -> bool {
         let (dx, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
         let pts = &self.p.points;
         let m = pts.len();
-        let edges = if self.p.closed { m } else { m - 1 };
-        (0..edges).any(|j| {
-            let (p, e) = (pts[j], pts[(j + 1) % m] - pts[j]);
+        edges.into_iter().any(|j| {
+            let (p, e) = (pts[j], pts[if j + 1 == m { 0 } else { j + 1 }] - pts[j]);
             let u = e.x * cur.ma + e.y * cur.mb;
             let w = e.x * next.ma + e.y * next.mb;
             let v = dx + p.x * dma + p.y * dmb;
@@ -1192,13 +1396,13 @@ impl Rings<'_> {
     /// tangents. The rail edge of profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb),
     /// so its components along t and t′ are affine in p.
     #[inline(always)]
-    fn folds_over(&self, cur: &Geo, next: &Geo) -> bool {
+    fn folds_over(&self, cur: &Geo, next: &Geo, column: &Cols) -> bool {
         let (dx0, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
         let along = |t: DVec3| (dx0.dot(t), DVec2::new(dma.dot(t), dmb.dot(t)));
         let ((c1, g1), (c2, g2)) = (along(cur.t), along(next.t));
         // over the stored columns (the profile's vertices; a seam's copy repeats the first),
         // without branches
-        let (px, py) = (&self.column.px, &self.column.py[..self.column.px.len()]);
+        let (px, py) = (column.px, &column.py[..column.px.len()]);
         let ok = px.iter().zip(py).fold(true, |a, (&x, &y)| {
             a & (c1 + (x * g1.x + y * g1.y) > 0.0) & (c2 + (x * g2.x + y * g2.y) > 0.0)
         });
@@ -1433,13 +1637,12 @@ impl Sweep<'_> {
             (v, nr, u, f) = (v2, n2, u2, f2);
             vbase += k;
         }
-        let cols = self.sh.column.px.len();
         let outcomes: Vec<Outcome> = jobs
             .into_par_iter()
             .map_init(
                 || TaskScratch {
                     frames: Vec::new(),
-                    ring: RingScratch::new(cols),
+                    ring: RingScratch::new(0),
                 },
                 |sc, (c, vbase, mine)| self.spine(c, vbase, mine, sc, cancel),
             )
@@ -2115,7 +2318,7 @@ mod tests {
             .expect("a valid sweep")
             .expect("not stopped");
         let plan = &plan;
-        let column = Columns::of(&p, plan.cols);
+        let column = OnceLock::from(Columns::of(&p, plan.cols));
         let rings = Rings {
             s: &spine,
             x: &x[..plan.rings],
@@ -2136,6 +2339,8 @@ mod tests {
             let mut f = vec![[0i32; 3]; 2 * plan.segments * p.len()];
             let b = Block {
                 i0: 0,
+                j: 0..plan.cols,
+                bd: None,
                 v: &mut v,
                 n: Some(&mut nn),
                 u: Some(&mut u),
@@ -2143,8 +2348,22 @@ mod tests {
             };
             let ring = &mut RingScratch::new(plan.cols);
             let r = match avx2 {
-                true => rings.block(b, &pattern, 0, None, ring),
-                false => rings.block_body(b, &pattern, 0, None, ring),
+                true => rings.block(
+                    b,
+                    &column.get().unwrap().view(0..plan.cols),
+                    &pattern,
+                    0,
+                    None,
+                    ring,
+                ),
+                false => rings.block_body(
+                    b,
+                    &column.get().unwrap().view(0..plan.cols),
+                    &pattern,
+                    0,
+                    None,
+                    ring,
+                ),
             };
             let bits3 = |a: Vec<[f32; 3]>| a.iter().map(|t| t.map(f32::to_bits)).collect();
             let uv = u.iter().map(|t| t.map(f32::to_bits)).collect();
@@ -2153,5 +2372,122 @@ mod tests {
         let (a, b) = (run(true), run(false));
         assert!(a.0.3.iter().flatten().any(|&i| i > 0), "faces written");
         assert!(a == b, "the AVX2 block differs from the baseline block");
+    }
+
+    /// Everything [`Rings::write`] gives for one spine, in `(grain, piece)` tasks: the bits
+    /// of the vertices, normals, uv and faces, the fold rows and the first vertex out of
+    /// range.
+    fn written(
+        spine: &Spine,
+        p: &Profile,
+        opts: &Options,
+        tasks: (usize, usize),
+    ) -> (Vec<u64>, Vec<i64>, Vec<usize>, Option<usize>) {
+        let plan = check_spine(spine, opts, p, true, &cancel::never)
+            .expect("a valid sweep")
+            .expect("not stopped");
+        let sh = Shared::new(p, plan.cols, false);
+        let rings = Rings {
+            s: spine,
+            x: &spine.points[..plan.rings],
+            plan: &plan,
+            p,
+            column: &sh.column,
+            closed: opts.closed,
+            miter_limit: opts.miter_limit,
+            sign: sh.sign,
+            rowbase: 7,
+        };
+        let nv = plan.vertices();
+        let (mut v, mut n) = (vec![[0f64; 3]; nv], vec![[0f64; 3]; nv]);
+        let mut u = vec![[0f64; 2]; nv];
+        let mut f = vec![[0i64; 3]; 2 * plan.segments * sh.edges];
+        let out = MeshMut {
+            vertices: &mut v,
+            faces: &mut f,
+            normals: Some(&mut n),
+            uv: Some(&mut u),
+        };
+        let ring = &mut RingScratch::new(0);
+        let (folds, bad) = rings.write(out, &sh.pattern, 3, None, tasks, ring, &cancel::never);
+        let bits: Vec<u64> = [v.as_flattened(), n.as_flattened(), u.as_flattened()]
+            .concat()
+            .iter()
+            .map(|x| x.to_bits())
+            .collect();
+        (bits, f.concat(), folds, bad)
+    }
+
+    /// A ring written in pieces of its columns (each a parallel task) gives the bits of
+    /// the ring written whole: vertices, normals, uv, faces with the twisted segments' split,
+    /// folds and the first vertex out of range. A twisted helix with a star of split seams
+    /// (and the same star clockwise), and a tight closed loop of an open profile, which
+    /// folds over, with a scale so large at one sample that a ring's vertices overflow.
+    #[test]
+    fn rings_in_pieces_equal_whole_rings() {
+        let n = 40;
+        let (x, frames): (Vec<DVec3>, Vec<[f64; 9]>) = (0..n)
+            .map(|i| {
+                let u = 0.3 * i as f64;
+                let t = DVec3::new(-u.sin(), u.cos(), 0.1).normalize();
+                (
+                    DVec3::new(u.cos(), u.sin(), 0.1 * u),
+                    frame(DVec3::new(-u.cos(), -u.sin(), 0.0), t),
+                )
+            })
+            .unzip();
+        let scale: Vec<DVec2> = (0..n)
+            .map(|i| DVec2::new(0.2 + 0.01 * i as f64, 0.3))
+            .collect();
+        let twist: Vec<f64> = (0..n).map(|i| 0.05 * i as f64).collect();
+        let helix = Spine {
+            points: &x,
+            frames: &frames,
+            scale: &scale,
+            twist: &twist,
+        };
+        let mut cw = star();
+        cw.reverse();
+        let (cx, cf) = circle(9, 1.0);
+        let ribbon: Vec<DVec2> = (0..13)
+            .map(|j| DVec2::new(0.3 * j as f64 - 1.5, 0.1 * (j % 3) as f64))
+            .collect();
+        let mut scales = vec![DVec2::ONE; 9];
+        scales[4] = DVec2::splat(1e308);
+        let loop_ = Spine {
+            points: &cx,
+            frames: &cf,
+            scale: &scales,
+            twist: &[],
+        };
+        let cases = [
+            (
+                helix,
+                Profile::new(&star(), true),
+                options(false, false, true),
+            ),
+            (helix, Profile::new(&cw, true), options(false, false, false)),
+            (
+                loop_,
+                Profile::new(&ribbon, false),
+                options(true, false, true),
+            ),
+        ];
+        for (k, (spine, p, opts)) in cases.into_iter().enumerate() {
+            let p = p.expect("a valid profile");
+            let cols = p.len() + usize::from(p.closed && opts.split_seams);
+            let whole = written(&spine, &p, &opts, (3, cols));
+            assert!(whole.1.iter().any(|&i| i > 0), "case {k}: faces written");
+            if k == 2 {
+                assert!(
+                    !whole.2.is_empty() && whole.3.is_some(),
+                    "folds and overflow"
+                );
+            }
+            for piece in [1, 2, 3, cols - 1] {
+                let pieces = written(&spine, &p, &opts, (3, piece));
+                assert!(pieces == whole, "case {k}: pieces of {piece} differ");
+            }
+        }
     }
 }
