@@ -329,18 +329,17 @@ fn against_spine(
         })
 }
 
-/// Mitre stretch at ring `i`: `(factor − 1, unit direction)`, or zero where the spine is
-/// straight or at an open end.
-fn mitre(x: &[DVec3], t: DVec3, i: usize, closed: bool, limit: f64) -> (f64, DVec3) {
-    let n = x.len();
-    if !closed && (i == 0 || i + 1 == n) {
-        return (0.0, DVec3::ZERO);
-    }
-    let prev = x[(i + n - 1) % n];
-    let next = x[(i + 1) % n];
-    // scaled by the largest component before squaring: any finite spine size
-    let unit = |v: DVec3| crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO);
-    let (din, dout) = (unit(x[i] - prev), unit(next - x[i]));
+/// The unit vector along a chord of the spine (zero for a zero chord), scaled by the largest
+/// component before squaring: any finite spine size.
+#[inline(always)]
+fn unit_chord(v: DVec3) -> DVec3 {
+    crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO)
+}
+
+/// Mitre stretch at a ring between the unit chords `din` (in) and `dout` (out) of the spine
+/// ([`unit_chord`]) with tangent `t`: `(factor − 1, unit direction)`, or zero where the
+/// spine is straight.
+fn mitre(din: DVec3, dout: DVec3, t: DVec3, limit: f64) -> (f64, DVec3) {
     let half_cos = 0.5 * (1.0 + din.dot(dout)); // cos²(φ/2)
     let k = din - dout;
     let k = k - k.dot(t) * t;
@@ -366,7 +365,8 @@ fn central_weights(h1: f64, h2: f64) -> [f64; 3] {
 /// in arc length; one-sided at open ends; two points for a two-sample spine).
 fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3], [f64; 3]) {
     if closed {
-        let (a, b) = ((i + r_n - 1) % r_n, (i + 1) % r_n);
+        let a = if i == 0 { r_n - 1 } else { i - 1 };
+        let b = if i + 1 == r_n { 0 } else { i + 1 };
         let h1 = if i == 0 {
             arc[r_n] - arc[r_n - 1]
         } else {
@@ -764,22 +764,42 @@ struct Cols<'a> {
 /// The side faces of a segment (ring `i` to ring `i + 1`), two triangles per quad of profile
 /// edge `j` (`a b` on ring `i`, `d c` on ring `i + 1`, `a`, `d` in column `j`): split along
 /// `a c`, or along `b d`, wound by `sign`. Without split seams the last edge of a closed
-/// profile wraps to the first column. The indices are computed per edge (no table of the
-/// profile's size).
-#[derive(Clone, Copy)]
+/// profile wraps to the first column. A profile of at most [`FacePattern::TABLE`] edges keeps
+/// the two splits as tables of vertex offsets from ring `i`'s first vertex (ring `i + 1`
+/// from `cols` on), which the faces copy; a larger one computes them per edge (no table of
+/// the profile's size).
 struct FacePattern {
     cols: usize,
     edges: usize,
     /// Wound the other way (clockwise closed profiles).
     flip: bool,
+    /// The tables (empty for a large profile).
+    ac: Vec<[usize; 3]>,
+    bd: Vec<[usize; 3]>,
 }
 
 impl FacePattern {
+    /// Edges at most of a profile whose faces come from tables (≤ 1.5 MiB of them).
+    const TABLE: usize = 1 << 14;
+
     fn of(cols: usize, edges: usize, sign: f64) -> FacePattern {
+        let flip = sign < 0.0;
+        let (mut ac, mut bd) = (Vec::new(), Vec::new());
+        if edges <= Self::TABLE {
+            let col = |j: usize| if j == cols { 0 } else { j };
+            let wind = |t: [usize; 3]| if flip { [t[0], t[2], t[1]] } else { t };
+            for j in 0..edges {
+                let (a, b, c, d) = (col(j), col(j + 1), cols + col(j + 1), cols + col(j));
+                ac.extend([wind([a, b, c]), wind([a, c, d])]);
+                bd.extend([wind([a, b, d]), wind([b, c, d])]);
+            }
+        }
         FacePattern {
             cols,
             edges,
-            flip: sign < 0.0,
+            flip,
+            ac,
+            bd,
         }
     }
 
@@ -793,6 +813,21 @@ impl FacePattern {
     /// starting at vertex `b0` to the one starting at `b1`.
     #[inline(always)]
     fn write<I: Index>(&self, out: &mut [[I; 3]], bd: bool, b0: usize, b1: usize, e0: usize) {
+        let table = if bd { &self.bd } else { &self.ac };
+        if let Some(pat) = table.get(2 * e0..2 * e0 + out.len()) {
+            if b1 == b0 + self.cols {
+                for (f, t) in out.iter_mut().zip(pat) {
+                    *f = [I::of(b0 + t[0]), I::of(b0 + t[1]), I::of(b0 + t[2])];
+                }
+            } else {
+                let cols = self.cols;
+                let id = |x: usize| I::of(if x < cols { b0 + x } else { b1 + x - cols });
+                for (f, t) in out.iter_mut().zip(pat) {
+                    *f = t.map(id);
+                }
+            }
+            return;
+        }
         match (bd, self.flip) {
             (false, false) => self.faces::<I, false, false>(out, b0, b1, e0),
             (false, true) => self.faces::<I, false, true>(out, b0, b1, e0),
@@ -898,7 +933,14 @@ impl RingScratch {
     #[inline(always)]
     fn normals(&mut self, c: &Cols, cr: &[DVec3; 6]) {
         let n = c.px.len();
-        let w = c.w.map(|w| &w[..n]);
+        let w = [
+            &c.w[0][..n],
+            &c.w[1][..n],
+            &c.w[2][..n],
+            &c.w[3][..n],
+            &c.w[4][..n],
+            &c.w[5][..n],
+        ];
         let (nx, ny, nz) = (&mut self.nx[..n], &mut self.ny[..n], &mut self.nz[..n]);
         let rcp = &mut self.rcp[..n];
         for j in 0..n {
@@ -1024,10 +1066,45 @@ impl Rings<'_> {
         )
     }
 
+    /// The unit chord from spine sample `k` to the next ([`unit_chord`]; on a closed spine
+    /// the last wraps to the first, on an open one it is zero).
+    #[inline(always)]
+    fn chord(&self, k: usize) -> DVec3 {
+        let n = self.x.len();
+        match k + 1 == n {
+            false => unit_chord(self.x[k + 1] - self.x[k]),
+            true if self.closed => unit_chord(self.x[0] - self.x[k]),
+            true => DVec3::ZERO,
+        }
+    }
+
+    /// Spine sample `k ± 1` (`k < rings`), wrapping around.
+    #[inline(always)]
+    fn after(&self, k: usize) -> usize {
+        if k + 1 == self.x.len() { 0 } else { k + 1 }
+    }
+
+    #[inline(always)]
+    fn before(&self, k: usize) -> usize {
+        if k == 0 { self.x.len() - 1 } else { k - 1 }
+    }
+
     #[inline(always)]
     fn geo(&self, k: usize) -> Geo {
+        self.geo_between(k, self.chord(self.before(k)), self.chord(k))
+    }
+
+    /// Ring `k` of the mitred sweep, from the unit chords into and out of sample `k`
+    /// ([`Rings::chord`] of `k − 1` and `k`: a pass along the spine computes each chord
+    /// once).
+    #[inline(always)]
+    fn geo_between(&self, k: usize, din: DVec3, dout: DVec3) -> Geo {
         let b = self.base(k);
-        let (mf, mk) = mitre(self.x, self.tangent(k), k, self.closed, self.miter_limit);
+        let end = !self.closed && (k == 0 || k + 1 == self.x.len());
+        let (mf, mk) = match end {
+            true => (0.0, DVec3::ZERO),
+            false => mitre(din, dout, self.tangent(k), self.miter_limit),
+        };
         Geo {
             k,
             b,
@@ -1136,7 +1213,7 @@ impl Rings<'_> {
         piece: usize,
         cancel: Cancel<'_>,
     ) -> (Vec<usize>, Option<usize>) {
-        let (cols, r_n, segments) = (self.plan.cols, self.plan.rings, self.plan.segments);
+        let (cols, segments) = (self.plan.cols, self.plan.segments);
         let edges = pattern.edges;
         let pieces = cols.div_ceil(piece);
         // the odd segments' splits: (segment, piece) tasks
@@ -1145,7 +1222,7 @@ impl Rings<'_> {
             .map(|t| {
                 let (i, c) = (2 * (t / pieces) + 1, t % pieces);
                 let e = (c * piece).min(edges)..((c + 1) * piece).min(edges);
-                !cancel() && self.twisted(&self.geo(i), &self.geo((i + 1) % r_n), e)
+                !cancel() && self.twisted(&self.geo(i), &self.geo(self.after(i)), e)
             })
             .collect();
         if cancel() {
@@ -1284,11 +1361,17 @@ impl Rings<'_> {
         let edges = js.start.min(pattern.edges)..js.end.min(pattern.edges);
         let per_segment = 2 * edges.len();
         let (mut folds, mut bad) = (Vec::new(), None);
-        let mut prev = self.geo((i0 + r_n - 1) % r_n);
-        let mut cur = self.geo(i0 % r_n);
+        // the unit chords out of the previous, current and next ring's samples
+        let k0 = if i0 >= r_n { i0 - r_n } else { i0 };
+        let (kp, kn) = (self.before(k0), self.after(k0));
+        let (cp, mut cc) = (self.chord(kp), self.chord(k0));
+        let mut prev = self.geo_between(kp, self.chord(self.before(kp)), cp);
+        let mut cur = self.geo_between(k0, cp, cc);
+        let mut kn = kn;
         for (di, rv) in bv.chunks_mut(width).enumerate() {
             let i = i0 + di;
-            let next = self.geo((i + 1) % r_n);
+            let cn = self.chord(kn);
+            let next = self.geo_between(kn, cc, cn);
             let span = di * width..(di + 1) * width;
             ring.vertices(column, &cur);
             ring.put_vertices(rv, unscale);
@@ -1329,8 +1412,8 @@ impl Rings<'_> {
                 let (b0, b1) = (vbase + i * cols, vbase + i1 * cols);
                 pattern.write(faces, bd, b0, b1, edges.start);
             }
-            prev = cur;
-            cur = next;
+            (prev, cur, cc) = (cur, next, cn);
+            kn = self.after(kn);
         }
         (folds, bad)
     }
@@ -1342,6 +1425,16 @@ impl Rings<'_> {
         let k = cur.k;
         let (idx, w) = spine_weights(&self.plan.arc, k, self.plan.rings, self.closed);
         let (mut dx, mut da, mut db) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+        if idx == [prev.k, k, next.k] {
+            // the rule on the neighbours at hand (inside the spine, or closed), in the same
+            // order as below
+            for (wi, bi) in w.into_iter().zip([prev.b, cur.b, next.b]) {
+                dx += wi * bi.0;
+                da += wi * bi.1;
+                db += wi * bi.2;
+            }
+            return (dx, da, db);
+        }
         for (&ii, &wi) in idx.iter().zip(&w) {
             let bi = match ii {
                 _ if ii == k => cur.b,
@@ -1388,6 +1481,17 @@ impl Rings<'_> {
             let w = e.x * next.ma + e.y * next.mb;
             let v = dx + p.x * dma + p.y * dmb;
             let tau = u.cross(v).dot(w);
+            // |τ| > 10⁻⁹ |u| |v| |w| decided on the squares (no square roots) where they are
+            // clear of it by 10⁻¹², far more than the few roundings of either side
+            let (t2, s2) = (tau * tau, 1e-18 * (u.dot(u) * v.dot(v) * w.dot(w)));
+            if s2 > 1e-290 && s2.is_finite() {
+                if t2 > s2 * (1.0 + 1e-12) {
+                    return true;
+                }
+                if t2 < s2 * (1.0 - 1e-12) {
+                    return false;
+                }
+            }
             tau.abs() > 1e-9 * (u.length() * v.length() * w.length())
         })
     }
@@ -2487,6 +2591,35 @@ mod tests {
             for piece in [1, 2, 3, cols - 1] {
                 let pieces = written(&spine, &p, &opts, (3, piece));
                 assert!(pieces == whole, "case {k}: pieces of {piece} differ");
+            }
+        }
+    }
+
+    /// The faces computed per edge (large profiles) are those of the tables (small ones):
+    /// both splits and windings, with and without a seam column, consecutive rings and the
+    /// last ring joined to the first, from every first edge.
+    #[test]
+    fn face_formula_equals_table() {
+        for (cols, edges) in [(7, 7), (8, 7), (7, 6)] {
+            for sign in [1.0, -1.0] {
+                let table = FacePattern::of(cols, edges, sign);
+                let formula = FacePattern {
+                    ac: Vec::new(),
+                    bd: Vec::new(),
+                    ..FacePattern::of(cols, edges, sign)
+                };
+                assert_eq!(table.ac.len(), 2 * edges);
+                for bd in [false, true] {
+                    for (b0, b1) in [(30, 30 + cols), (30 + 5 * cols, 30)] {
+                        for e0 in 0..edges {
+                            let k = 2 * (edges - e0);
+                            let (mut x, mut y) = (vec![[0i64; 3]; k], vec![[0i64; 3]; k]);
+                            table.write(&mut x, bd, b0, b1, e0);
+                            formula.write(&mut y, bd, b0, b1, e0);
+                            assert_eq!(x, y, "{cols} {edges} {sign} {bd} {b0} {e0}");
+                        }
+                    }
+                }
             }
         }
     }
