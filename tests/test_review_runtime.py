@@ -388,3 +388,18 @@ def test_D17_threads_setting_keeps_results():
     with spinal.threads(2):
         b = spinal.frames(h)
     np.testing.assert_array_equal(a, b)
+
+
+def test_D17_sweep_of_a_huge_profile_stops_inside_a_ring():
+    """A profile of 2**23 vertices on a two-point spine: two rings of 96 MiB of float32
+    vertices and 192 MiB of int32 faces. The writer polls Ctrl-C between pieces of at most
+    1 MiB of a ring's columns, not only between rings, and builds the profile's columns per
+    piece (0.8 GB peak); before, each ring was written whole after the columns and face
+    pattern of the whole profile were built (2.6 GB peak), and a stop waited up to seconds.
+    Signalled at two moments of the repeated call."""
+    setup = ("m = 2**23; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+             "P = np.c_[np.cos(a), np.sin(a)]\n"
+             "X = np.array([[0, 0, 0], [0, .1, 1.]])\n")
+    call = "spinal.sweep(X, P, caps=False, normals=False, uv=False, dtype='float32')"
+    for after in (0.5, 1.0):
+        assert late_after_sigint(setup, call, after=after) < 0.5

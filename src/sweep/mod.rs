@@ -62,6 +62,8 @@ pub mod profile;
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::OnceLock;
 
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
@@ -327,18 +329,17 @@ fn against_spine(
         })
 }
 
-/// Mitre stretch at ring `i`: `(factor − 1, unit direction)`, or zero where the spine is
-/// straight or at an open end.
-fn mitre(x: &[DVec3], t: DVec3, i: usize, closed: bool, limit: f64) -> (f64, DVec3) {
-    let n = x.len();
-    if !closed && (i == 0 || i + 1 == n) {
-        return (0.0, DVec3::ZERO);
-    }
-    let prev = x[(i + n - 1) % n];
-    let next = x[(i + 1) % n];
-    // scaled by the largest component before squaring: any finite spine size
-    let unit = |v: DVec3| crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO);
-    let (din, dout) = (unit(x[i] - prev), unit(next - x[i]));
+/// The unit vector along a chord of the spine (zero for a zero chord), scaled by the largest
+/// component before squaring: any finite spine size.
+#[inline(always)]
+fn unit_chord(v: DVec3) -> DVec3 {
+    crate::math::scale::normalize(v).unwrap_or(DVec3::ZERO)
+}
+
+/// Mitre stretch at a ring between the unit chords `din` (in) and `dout` (out) of the spine
+/// ([`unit_chord`]) with tangent `t`: `(factor − 1, unit direction)`, or zero where the
+/// spine is straight.
+fn mitre(din: DVec3, dout: DVec3, t: DVec3, limit: f64) -> (f64, DVec3) {
     let half_cos = 0.5 * (1.0 + din.dot(dout)); // cos²(φ/2)
     let k = din - dout;
     let k = k - k.dot(t) * t;
@@ -364,7 +365,8 @@ fn central_weights(h1: f64, h2: f64) -> [f64; 3] {
 /// in arc length; one-sided at open ends; two points for a two-sample spine).
 fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3], [f64; 3]) {
     if closed {
-        let (a, b) = ((i + r_n - 1) % r_n, (i + 1) % r_n);
+        let a = if i == 0 { r_n - 1 } else { i - 1 };
+        let b = if i + 1 == r_n { 0 } else { i + 1 };
         let h1 = if i == 0 {
             arc[r_n] - arc[r_n - 1]
         } else {
@@ -559,8 +561,8 @@ pub struct Layout {
     pub faces: usize,
 }
 
-/// Output bytes at most per block of rings of [`sweep_one`] (one poll of the cancel hook per
-/// block). A cold output array is faulted in as it is written: on a loaded 2-core machine a
+/// Output bytes at most per block of rings of [`sweep_one`], or per piece of the columns of
+/// a ring larger than this (one poll of the cancel hook per block or piece). A cold output array is faulted in as it is written: on a loaded 2-core machine a
 /// block of 4096 vertices (~0.5 MB with normals and uv) then took up to 0.12 s.
 const BLOCK_BYTES: usize = 1 << 20;
 
@@ -568,7 +570,9 @@ const BLOCK_BYTES: usize = 1 << 20;
 /// segment, the caps' triangulation and the winding.
 struct Shared<'a> {
     p: &'a Profile,
-    column: Columns,
+    /// The profile's stored columns, built by the first spine swept in whole rings (a
+    /// sweep in pieces of rings builds the columns of each piece as it goes).
+    column: OnceLock<Columns>,
     pattern: FacePattern,
     tris: Vec<[usize; 3]>,
     /// −1 where the faces are wound the other way (clockwise closed profiles).
@@ -587,7 +591,7 @@ impl<'a> Shared<'a> {
         let edges = if p.closed { p.len() } else { p.len() - 1 };
         Shared {
             p,
-            column: Columns::of(p, cols),
+            column: OnceLock::new(),
             pattern: FacePattern::of(cols, edges, sign),
             tris: if caps { p.triangulate() } else { Vec::new() },
             sign,
@@ -613,13 +617,15 @@ fn sweep_one<R: Real, I: Index>(
     cancel: Cancel<'_>,
 ) -> (Vec<usize>, Option<usize>) {
     // Rings per parallel task (one poll of `cancel` each): enough work (~4k vertices) to pay
-    // for the task, and at most `BLOCK_BYTES` of output (unless one ring is more), so that a
-    // stop waits for little writing even where the writes fault in fresh pages of the output
+    // for the task, and at most `BLOCK_BYTES` of output, so that a stop waits for little
+    // writing even where the writes fault in fresh pages of the output; a ring of more goes
+    // in pieces of its columns of at most `BLOCK_BYTES` each
     let ring_bytes = plan.cols
         * (size_of::<[R; 3]>() * (1 + usize::from(out.normals.is_some()))
             + size_of::<[R; 2]>() * usize::from(out.uv.is_some()))
         + 2 * sh.edges * size_of::<[I; 3]>();
     let grain = (4096 / plan.cols).min(BLOCK_BYTES / ring_bytes).max(1);
+    let piece = plan.cols.div_ceil(ring_bytes.div_ceil(BLOCK_BYTES));
     let rings = Rings {
         s,
         x: &s.points[..plan.rings],
@@ -638,7 +644,15 @@ fn sweep_one<R: Real, I: Index>(
         normals: out.normals,
         uv: out.uv,
     };
-    let res = rings.write(side, &sh.pattern, vbase, unscale, grain, ring, cancel);
+    let res = rings.write(
+        side,
+        &sh.pattern,
+        vbase,
+        unscale,
+        (grain, piece),
+        ring,
+        cancel,
+    );
     // a stopped sweep writes no caps: they lie apart, and each may be the first write to a
     // fresh page of the output
     if plan.caps && !cancel() {
@@ -675,14 +689,25 @@ struct Columns {
 
 impl Columns {
     fn of(p: &Profile, cols: usize) -> Columns {
-        let m = p.len();
         let mut c = Columns {
             px: Vec::with_capacity(cols),
             py: Vec::with_capacity(cols),
             w: Default::default(),
             v: Vec::with_capacity(cols),
         };
-        for j in 0..cols {
+        c.fill(p, 0..cols);
+        c
+    }
+
+    /// Stored columns `js` (replacing the ones held).
+    fn fill(&mut self, p: &Profile, js: Range<usize>) {
+        let m = p.len();
+        let c = self;
+        c.px.clear();
+        c.py.clear();
+        c.w.iter_mut().for_each(Vec::clear);
+        c.v.clear();
+        for j in js {
             let jj = if j == m { 0 } else { j };
             let (jp, jn) = if p.closed {
                 ((jj + m - 1) % m, (jj + 1) % m)
@@ -705,56 +730,149 @@ impl Columns {
             }
             c.v.push(if j == m { 1.0 } else { p.v[j] });
         }
-        c
+    }
+
+    /// The stored columns `r` (a piece of a ring, or all of it).
+    #[inline(always)]
+    fn view(&self, r: Range<usize>) -> Cols<'_> {
+        let w = &self.w;
+        Cols {
+            px: &self.px[r.clone()],
+            py: &self.py[r.clone()],
+            w: [
+                &w[0][r.clone()],
+                &w[1][r.clone()],
+                &w[2][r.clone()],
+                &w[3][r.clone()],
+                &w[4][r.clone()],
+                &w[5][r.clone()],
+            ],
+            v: &self.v[r],
+        }
     }
 }
 
-/// The side faces of a segment (ring `i` to ring `i + 1`) as vertex offsets from ring `i`'s
-/// first vertex (ring `i + 1` from `cols` on), two triangles per quad: split along `a c`, or
-/// along `b d` (`a b` on ring `i`, `d c` on ring `i + 1`), wound by `sign`. Without split
-/// seams the last column wraps to the first.
+/// A range of the [`Columns`] (all of the same length).
+#[derive(Clone, Copy)]
+struct Cols<'a> {
+    px: &'a [f64],
+    py: &'a [f64],
+    w: [&'a [f64]; 6],
+    v: &'a [f64],
+}
+
+/// The side faces of a segment (ring `i` to ring `i + 1`), two triangles per quad of profile
+/// edge `j` (`a b` on ring `i`, `d c` on ring `i + 1`, `a`, `d` in column `j`): split along
+/// `a c`, or along `b d`, wound by `sign`. Without split seams the last edge of a closed
+/// profile wraps to the first column. A profile of at most [`FacePattern::TABLE`] edges keeps
+/// the two splits as tables of vertex offsets from ring `i`'s first vertex (ring `i + 1`
+/// from `cols` on), which the faces copy; a larger one computes them per edge (no table of
+/// the profile's size).
 struct FacePattern {
+    cols: usize,
+    edges: usize,
+    /// Wound the other way (clockwise closed profiles).
+    flip: bool,
+    /// The tables (empty for a large profile).
     ac: Vec<[usize; 3]>,
     bd: Vec<[usize; 3]>,
-    cols: usize,
 }
 
 impl FacePattern {
+    /// Edges at most of a profile whose faces come from tables (≤ 1.5 MiB of them).
+    const TABLE: usize = 1 << 14;
+
     fn of(cols: usize, edges: usize, sign: f64) -> FacePattern {
-        let col = |j: usize| if j == cols { 0 } else { j };
-        let wind = |t: [usize; 3]| if sign > 0.0 { t } else { [t[0], t[2], t[1]] };
-        let (mut ac, mut bd) = (Vec::with_capacity(2 * edges), Vec::with_capacity(2 * edges));
-        for j in 0..edges {
-            let (a, b, c, d) = (col(j), col(j + 1), cols + col(j + 1), cols + col(j));
-            ac.extend([wind([a, b, c]), wind([a, c, d])]);
-            bd.extend([wind([a, b, d]), wind([b, c, d])]);
+        let flip = sign < 0.0;
+        let (mut ac, mut bd) = (Vec::new(), Vec::new());
+        if edges <= Self::TABLE {
+            let col = |j: usize| if j == cols { 0 } else { j };
+            let wind = |t: [usize; 3]| if flip { [t[0], t[2], t[1]] } else { t };
+            for j in 0..edges {
+                let (a, b, c, d) = (col(j), col(j + 1), cols + col(j + 1), cols + col(j));
+                ac.extend([wind([a, b, c]), wind([a, c, d])]);
+                bd.extend([wind([a, b, d]), wind([b, c, d])]);
+            }
         }
-        FacePattern { ac, bd, cols }
+        FacePattern {
+            cols,
+            edges,
+            flip,
+            ac,
+            bd,
+        }
     }
 
-    /// The faces of the segment from the ring starting at vertex `b0` to the one starting at
-    /// `b1`.
+    /// Faces per segment.
     #[inline(always)]
-    fn write<I: Index>(&self, out: &mut [[I; 3]], bd: bool, b0: usize, b1: usize) {
-        let pat = if bd { &self.bd } else { &self.ac };
-        if b1 == b0 + self.cols {
-            for (f, t) in out.iter_mut().zip(pat) {
-                *f = [I::of(b0 + t[0]), I::of(b0 + t[1]), I::of(b0 + t[2])];
+    fn per_segment(&self) -> usize {
+        2 * self.edges
+    }
+
+    /// The faces of edges `e0..` (as many as `out` holds pairs) of the segment from the ring
+    /// starting at vertex `b0` to the one starting at `b1`.
+    #[inline(always)]
+    fn write<I: Index>(&self, out: &mut [[I; 3]], bd: bool, b0: usize, b1: usize, e0: usize) {
+        let table = if bd { &self.bd } else { &self.ac };
+        if let Some(pat) = table.get(2 * e0..2 * e0 + out.len()) {
+            if b1 == b0 + self.cols {
+                for (f, t) in out.iter_mut().zip(pat) {
+                    *f = [I::of(b0 + t[0]), I::of(b0 + t[1]), I::of(b0 + t[2])];
+                }
+            } else {
+                let cols = self.cols;
+                let id = |x: usize| I::of(if x < cols { b0 + x } else { b1 + x - cols });
+                for (f, t) in out.iter_mut().zip(pat) {
+                    *f = t.map(id);
+                }
             }
-        } else {
-            let cols = self.cols;
-            let id = |x: usize| I::of(if x < cols { b0 + x } else { b1 + x - cols });
-            for (f, t) in out.iter_mut().zip(pat) {
-                *f = t.map(id);
-            }
+            return;
+        }
+        match (bd, self.flip) {
+            (false, false) => self.faces::<I, false, false>(out, b0, b1, e0),
+            (false, true) => self.faces::<I, false, true>(out, b0, b1, e0),
+            (true, false) => self.faces::<I, true, false>(out, b0, b1, e0),
+            (true, true) => self.faces::<I, true, true>(out, b0, b1, e0),
+        }
+    }
+
+    #[inline(always)]
+    fn faces<I: Index, const BD: bool, const FLIP: bool>(
+        &self,
+        out: &mut [[I; 3]],
+        b0: usize,
+        b1: usize,
+        e0: usize,
+    ) {
+        let cols = self.cols;
+        let wind = |t: [usize; 3]| match FLIP {
+            false => [I::of(t[0]), I::of(t[1]), I::of(t[2])],
+            true => [I::of(t[0]), I::of(t[2]), I::of(t[1])],
+        };
+        for (k, f) in out.chunks_exact_mut(2).enumerate() {
+            let j = e0 + k;
+            let jn = if j + 1 == cols { 0 } else { j + 1 };
+            let (a, b, c, d) = (b0 + j, b0 + jn, b1 + jn, b1 + j);
+            let (t0, t1) = match BD {
+                false => ([a, b, c], [a, c, d]),
+                true => ([a, b, d], [b, c, d]),
+            };
+            f[0] = wind(t0);
+            f[1] = wind(t1);
         }
     }
 }
 
-/// One block of rings' share of the outputs (`f`: the faces of its segments).
+/// One block of rings' share of the outputs (`f`: the faces of its segments): whole rings,
+/// or one piece of the columns of one ring (see [`Rings::write`]).
 struct Block<'a, R, I> {
     /// The block's first stored ring.
     i0: usize,
+    /// The block's columns of every ring (`0..cols`: whole rings).
+    j: Range<usize>,
+    /// The split of every segment (true: along `b d`) when the block holds a piece of a
+    /// ring, indexed by segment (`None`: whole rings, which test their segments here).
+    bd: Option<&'a [bool]>,
     v: &'a mut [[R; 3]],
     n: Option<&'a mut [[R; 3]]>,
     u: Option<&'a mut [[R; 2]]>,
@@ -777,6 +895,14 @@ struct RingScratch {
 }
 
 impl RingScratch {
+    /// Room for `n` columns.
+    #[inline(always)]
+    fn fit(&mut self, n: usize) {
+        if self.vx.len() < n {
+            *self = RingScratch::new(n);
+        }
+    }
+
     fn new(cols: usize) -> RingScratch {
         let z = || vec![0.0; cols];
         RingScratch {
@@ -791,7 +917,7 @@ impl RingScratch {
     }
 
     #[inline(always)]
-    fn vertices(&mut self, c: &Columns, g: &Geo) {
+    fn vertices(&mut self, c: &Cols, g: &Geo) {
         let n = c.px.len();
         let (px, py) = (&c.px[..n], &c.py[..n]);
         let (vx, vy, vz) = (&mut self.vx[..n], &mut self.vy[..n], &mut self.vz[..n]);
@@ -805,7 +931,7 @@ impl RingScratch {
 
     /// The unit normals `Σ w_k c_k / |Σ w_k c_k|`.
     #[inline(always)]
-    fn normals(&mut self, c: &Columns, cr: &[DVec3; 6]) {
+    fn normals(&mut self, c: &Cols, cr: &[DVec3; 6]) {
         let n = c.px.len();
         let w = [
             &c.w[0][..n],
@@ -899,14 +1025,15 @@ fn first_non_finite<R: Real>(rv: &[[R; 3]]) -> Option<usize> {
 /// fold-over test of the segment starting there. Stored ring `i` is spine sample
 /// `i mod rings`, stored column `j` is profile vertex `j mod m` (the duplicates of split
 /// seams carry u = L and v = 1). Nothing is read back from the outputs but the ring just
-/// written; rings go in blocks so that each ring's geometry is computed once.
+/// written; rings go in blocks so that each ring's geometry is computed once (a ring of more
+/// than [`BLOCK_BYTES`] goes in pieces of its columns, each with its ring's geometry).
 struct Rings<'a> {
     s: &'a Spine<'a>,
     /// The distinct spine samples.
     x: &'a [DVec3],
     plan: &'a Plan,
     p: &'a Profile,
-    column: &'a Columns,
+    column: &'a OnceLock<Columns>,
     closed: bool,
     miter_limit: f64,
     /// −1 where the faces are wound the other way (clockwise closed profiles).
@@ -939,10 +1066,45 @@ impl Rings<'_> {
         )
     }
 
+    /// The unit chord from spine sample `k` to the next ([`unit_chord`]; on a closed spine
+    /// the last wraps to the first, on an open one it is zero).
+    #[inline(always)]
+    fn chord(&self, k: usize) -> DVec3 {
+        let n = self.x.len();
+        match k + 1 == n {
+            false => unit_chord(self.x[k + 1] - self.x[k]),
+            true if self.closed => unit_chord(self.x[0] - self.x[k]),
+            true => DVec3::ZERO,
+        }
+    }
+
+    /// Spine sample `k ± 1` (`k < rings`), wrapping around.
+    #[inline(always)]
+    fn after(&self, k: usize) -> usize {
+        if k + 1 == self.x.len() { 0 } else { k + 1 }
+    }
+
+    #[inline(always)]
+    fn before(&self, k: usize) -> usize {
+        if k == 0 { self.x.len() - 1 } else { k - 1 }
+    }
+
     #[inline(always)]
     fn geo(&self, k: usize) -> Geo {
+        self.geo_between(k, self.chord(self.before(k)), self.chord(k))
+    }
+
+    /// Ring `k` of the mitred sweep, from the unit chords into and out of sample `k`
+    /// ([`Rings::chord`] of `k − 1` and `k`: a pass along the spine computes each chord
+    /// once).
+    #[inline(always)]
+    fn geo_between(&self, k: usize, din: DVec3, dout: DVec3) -> Geo {
         let b = self.base(k);
-        let (mf, mk) = mitre(self.x, self.tangent(k), k, self.closed, self.miter_limit);
+        let end = !self.closed && (k == 0 || k + 1 == self.x.len());
+        let (mf, mk) = match end {
+            true => (0.0, DVec3::ZERO),
+            false => mitre(din, dout, self.tangent(k), self.miter_limit),
+        };
         Geo {
             k,
             b,
@@ -953,10 +1115,12 @@ impl Rings<'_> {
     }
 
     /// All stored rings and the side faces of their segments, `grain` rings per parallel
-    /// task, each output element written once; returns the fold-over rows and the first
-    /// vertex (local) out of the output type's range. `vbase`: the spine's first vertex;
-    /// `unscale`: see [`unscaled`]; `ring`: scratch for a spine of one block (the short
-    /// streamlines of a bundle), which is written here without setting up parallel tasks.
+    /// task (or, for a ring larger than `piece` columns, pieces of `piece` columns of one
+    /// ring per task), each output element written once; returns the fold-over rows and the
+    /// first vertex (local) out of the output type's range. `vbase`: the spine's first
+    /// vertex; `unscale`: see [`unscaled`]; `ring`: scratch for a spine of one block (the
+    /// short streamlines of a bundle), which is written here without setting up parallel
+    /// tasks.
     #[allow(clippy::too_many_arguments)]
     fn write<R: Real, I: Index>(
         &self,
@@ -964,23 +1128,31 @@ impl Rings<'_> {
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
-        grain: usize,
+        (grain, piece): (usize, usize),
         ring: &mut RingScratch,
         cancel: Cancel<'_>,
     ) -> (Vec<usize>, Option<usize>) {
-        let block = grain * self.plan.cols;
+        let cols = self.plan.cols;
+        if piece < cols {
+            return self.write_pieces(out, pattern, vbase, unscale, piece, cancel);
+        }
+        let all = self.column.get_or_init(|| Columns::of(self.p, cols));
+        let column = &all.view(0..cols);
+        let block = grain * cols;
         if out.vertices.len() <= block {
             if cancel() {
                 return (Vec::new(), None);
             }
             let b = Block {
                 i0: 0,
+                j: 0..cols,
+                bd: None,
                 v: out.vertices,
                 n: out.normals,
                 u: out.uv,
                 f: out.faces,
             };
-            return self.block(b, pattern, vbase, unscale, ring);
+            return self.block(b, column, pattern, vbase, unscale, ring);
         }
         let blocks = out.vertices.len().div_ceil(block);
         let mut nb: Vec<Option<&mut [[R; 3]]>> = match out.normals {
@@ -993,7 +1165,8 @@ impl Rings<'_> {
             None => Vec::new(),
         };
         ub.resize_with(blocks, || None);
-        let mut fb: Vec<&mut [[I; 3]]> = out.faces.chunks_mut(grain * pattern.ac.len()).collect();
+        let per_block = grain * pattern.per_segment();
+        let mut fb: Vec<&mut [[I; 3]]> = out.faces.chunks_mut(per_block).collect();
         fb.resize_with(blocks, || &mut []);
         let jobs: Vec<_> = out
             .vertices
@@ -1004,25 +1177,119 @@ impl Rings<'_> {
             .enumerate()
             .map(|(bi, (((v, n), u), f))| Block {
                 i0: bi * grain,
+                j: 0..cols,
+                bd: None,
                 v,
                 n,
                 u,
                 f,
             })
             .collect();
-        let cols = self.plan.cols;
         let per_block: Vec<(Vec<usize>, Option<usize>)> = jobs
             .into_par_iter()
             .map_init(
                 || RingScratch::new(cols),
                 |ring, b| match cancel() {
                     true => (Vec::new(), None),
-                    false => self.block(b, pattern, vbase, unscale, ring),
+                    false => self.block(b, column, pattern, vbase, unscale, ring),
                 },
             )
             .collect();
         let bad = per_block.iter().find_map(|b| b.1);
         (per_block.into_iter().flat_map(|b| b.0).collect(), bad)
+    }
+
+    /// [`Rings::write`] for rings of more than `piece` columns: first the split of every
+    /// odd segment (is any quad twisted?) piece by piece, then every ring piece by piece,
+    /// each piece a parallel task that polls `cancel`, so that no task writes much more
+    /// than [`BLOCK_BYTES`] however large the profile. The same operations per column as a
+    /// whole ring, so the same bits.
+    fn write_pieces<R: Real, I: Index>(
+        &self,
+        out: MeshMut<R, I>,
+        pattern: &FacePattern,
+        vbase: usize,
+        unscale: Option<i32>,
+        piece: usize,
+        cancel: Cancel<'_>,
+    ) -> (Vec<usize>, Option<usize>) {
+        let (cols, segments) = (self.plan.cols, self.plan.segments);
+        let edges = pattern.edges;
+        let pieces = cols.div_ceil(piece);
+        // the odd segments' splits: (segment, piece) tasks
+        let twisted: Vec<bool> = (0..segments / 2 * pieces)
+            .into_par_iter()
+            .map(|t| {
+                let (i, c) = (2 * (t / pieces) + 1, t % pieces);
+                let e = (c * piece).min(edges)..((c + 1) * piece).min(edges);
+                !cancel() && self.twisted(&self.geo(i), &self.geo(self.after(i)), e)
+            })
+            .collect();
+        if cancel() {
+            return (Vec::new(), None);
+        }
+        let bd: Vec<bool> = (0..segments)
+            .map(|i| i % 2 == 1 && twisted[i / 2 * pieces..][..pieces].iter().any(|&t| t))
+            .collect();
+        // the output of every (ring, piece), in the order of the rings
+        let stored = self.plan.stored_rings;
+        let mut jobs = Vec::with_capacity(stored * pieces);
+        let mut v = out.vertices.chunks_mut(cols);
+        let mut n = out.normals.map(|a| a.chunks_mut(cols));
+        let mut u = out.uv.map(|a| a.chunks_mut(cols));
+        let mut f = out.faces.chunks_mut(pattern.per_segment());
+        for i in 0..stored {
+            let (Some(rv), rn, ru) = (
+                v.next(),
+                n.as_mut().and_then(|a| a.next()),
+                u.as_mut().and_then(|a| a.next()),
+            ) else {
+                break;
+            };
+            let rf = if i < segments { f.next() } else { None };
+            let mut rv = rv.chunks_mut(piece);
+            let mut rn = rn.map(|a| a.chunks_mut(piece));
+            let mut ru = ru.map(|a| a.chunks_mut(piece));
+            let mut rf = rf.map(|a| a.chunks_mut(2 * piece));
+            for c in 0..pieces {
+                let (Some(pv), pn, pu) = (
+                    rv.next(),
+                    rn.as_mut().and_then(|a| a.next()),
+                    ru.as_mut().and_then(|a| a.next()),
+                ) else {
+                    break;
+                };
+                let pf = rf.as_mut().and_then(|a| a.next()).unwrap_or(&mut []);
+                jobs.push(Block {
+                    i0: i,
+                    j: c * piece..((c + 1) * piece).min(cols),
+                    bd: Some(&bd),
+                    v: pv,
+                    n: pn,
+                    u: pu,
+                    f: pf,
+                });
+            }
+        }
+        let per_piece: Vec<(Vec<usize>, Option<usize>)> = jobs
+            .into_par_iter()
+            .map_init(
+                || (RingScratch::new(piece), Columns::of(self.p, 0)),
+                |(ring, column), b| match cancel() {
+                    true => (Vec::new(), None),
+                    false => {
+                        column.fill(self.p, b.j.clone());
+                        let view = &column.view(0..b.j.len());
+                        self.block(b, view, pattern, vbase, unscale, ring)
+                    }
+                },
+            )
+            .collect();
+        let bad = per_piece.iter().find_map(|b| b.1);
+        // a folded segment is reported by each of its pieces that folds
+        let mut folds: Vec<usize> = per_piece.into_iter().flat_map(|b| b.0).collect();
+        folds.dedup();
+        (folds, bad)
     }
 
     /// One block of rings, [`Rings::block_body`]; on x86-64 processors with AVX2 the same
@@ -1034,6 +1301,7 @@ impl Rings<'_> {
     fn block<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
@@ -1043,9 +1311,9 @@ impl Rings<'_> {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: `block_avx2` only needs the processor to support AVX2, checked just
             // above.
-            return unsafe { self.block_avx2(b, pattern, vbase, unscale, ring) };
+            return unsafe { self.block_avx2(b, column, pattern, vbase, unscale, ring) };
         }
-        self.block_body(b, pattern, vbase, unscale, ring)
+        self.block_body(b, column, pattern, vbase, unscale, ring)
     }
 
     /// [`Rings::block_body`] compiled for AVX2. Safety: call only where AVX2 is available.
@@ -1054,42 +1322,57 @@ impl Rings<'_> {
     unsafe fn block_avx2<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
         ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
-        self.block_body(b, pattern, vbase, unscale, ring)
+        self.block_body(b, column, pattern, vbase, unscale, ring)
     }
 
     /// The rings of a block and the faces of their segments: per ring, the vertices and
     /// normals column by column into [`RingScratch`], then stored (with the unscaling and
-    /// the range check), uv, the fold-over test and the faces by [`FacePattern`].
+    /// the range check), uv, the fold-over test and the faces of the block's columns.
     #[inline(always)]
     fn block_body<R: Real, I: Index>(
         &self,
         b: Block<R, I>,
+        column: &Cols,
         pattern: &FacePattern,
         vbase: usize,
         unscale: Option<i32>,
         ring: &mut RingScratch,
     ) -> (Vec<usize>, Option<usize>) {
         let (r_n, cols, stored) = (self.plan.rings, self.plan.cols, self.plan.stored_rings);
-        let (column, arc, per_segment) = (self.column, &self.plan.arc[..], pattern.ac.len());
+        let arc = &self.plan.arc[..];
         let Block {
             i0,
+            j: js,
+            bd: given_bd,
             v: bv,
             n: mut bn,
             u: mut bu,
             f: bf,
         } = b;
+        let width = js.len();
+        ring.fit(width);
+        // the block's edges of every segment and their faces
+        let edges = js.start.min(pattern.edges)..js.end.min(pattern.edges);
+        let per_segment = 2 * edges.len();
         let (mut folds, mut bad) = (Vec::new(), None);
-        let mut prev = self.geo((i0 + r_n - 1) % r_n);
-        let mut cur = self.geo(i0 % r_n);
-        for (di, rv) in bv.chunks_mut(cols).enumerate() {
+        // the unit chords out of the previous, current and next ring's samples
+        let k0 = if i0 >= r_n { i0 - r_n } else { i0 };
+        let (kp, kn) = (self.before(k0), self.after(k0));
+        let (cp, mut cc) = (self.chord(kp), self.chord(k0));
+        let mut prev = self.geo_between(kp, self.chord(self.before(kp)), cp);
+        let mut cur = self.geo_between(k0, cp, cc);
+        let mut kn = kn;
+        for (di, rv) in bv.chunks_mut(width).enumerate() {
             let i = i0 + di;
-            let next = self.geo((i + 1) % r_n);
-            let span = di * cols..(di + 1) * cols;
+            let cn = self.chord(kn);
+            let next = self.geo_between(kn, cc, cn);
+            let span = di * width..(di + 1) * width;
             ring.vertices(column, &cur);
             ring.put_vertices(rv, unscale);
             if let Some(bn) = bn.as_deref_mut() {
@@ -1107,26 +1390,30 @@ impl Rings<'_> {
                 }
             }
             if bad.is_none() {
-                bad = first_non_finite(rv).map(|j| i * cols + j);
+                bad = first_non_finite(rv).map(|j| i * cols + js.start + j);
             }
             if let Some(bu) = bu.as_deref_mut() {
                 let u = unscaled::<R>(arc[i], unscale);
-                for (w, &v) in bu[span].iter_mut().zip(&column.v) {
+                for (w, &v) in bu[span].iter_mut().zip(column.v) {
                     *w = [u, R::of(v)];
                 }
             }
             if i < self.plan.segments {
-                if self.folds_over(&cur, &next) {
+                if self.folds_over(&cur, &next, column) {
                     folds.push(self.rowbase + i);
                 }
                 // split along b d on the odd twisted segments
-                let bd = i % 2 == 1 && self.twisted(&cur, &next);
+                let bd = match given_bd {
+                    Some(bd) => bd[i],
+                    None => i % 2 == 1 && self.twisted(&cur, &next, 0..pattern.edges),
+                };
                 let i1 = if i + 1 == stored { 0 } else { i + 1 };
                 let faces = &mut bf[di * per_segment..(di + 1) * per_segment];
-                pattern.write(faces, bd, vbase + i * cols, vbase + i1 * cols);
+                let (b0, b1) = (vbase + i * cols, vbase + i1 * cols);
+                pattern.write(faces, bd, b0, b1, edges.start);
             }
-            prev = cur;
-            cur = next;
+            (prev, cur, cc) = (cur, next, cn);
+            kn = self.after(kn);
         }
         (folds, bad)
     }
@@ -1138,6 +1425,16 @@ impl Rings<'_> {
         let k = cur.k;
         let (idx, w) = spine_weights(&self.plan.arc, k, self.plan.rings, self.closed);
         let (mut dx, mut da, mut db) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+        if idx == [prev.k, k, next.k] {
+            // the rule on the neighbours at hand (inside the spine, or closed), in the same
+            // order as below
+            for (wi, bi) in w.into_iter().zip([prev.b, cur.b, next.b]) {
+                dx += wi * bi.0;
+                da += wi * bi.1;
+                db += wi * bi.2;
+            }
+            return (dx, da, db);
+        }
         for (&ii, &wi) in idx.iter().zip(&w) {
             let bi = match ii {
                 _ if ii == k => cur.b,
@@ -1169,21 +1466,32 @@ impl Rings<'_> {
         ]
     }
 
-    /// Are the quads of the segment from `cur` to `next` twisted (not planar)? The quad of
+    /// Are the quads of profile edges `edges` of the segment from `cur` to `next` twisted (not
+    /// planar)? The quad of
     /// profile edge `p → p + e` has `b − a = A e`, `c − d = A′ e` and
     /// `d − a = Δx + (A′ − A) p`, with `A = (ma, mb)`; `τ = det(b − a, d − a, c − d)`.
     #[inline(always)]
-    fn twisted(&self, cur: &Geo, next: &Geo) -> bool {
+    fn twisted(&self, cur: &Geo, next: &Geo, edges: Range<usize>) -> bool {
         let (dx, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
         let pts = &self.p.points;
         let m = pts.len();
-        let edges = if self.p.closed { m } else { m - 1 };
-        (0..edges).any(|j| {
-            let (p, e) = (pts[j], pts[(j + 1) % m] - pts[j]);
+        edges.into_iter().any(|j| {
+            let (p, e) = (pts[j], pts[if j + 1 == m { 0 } else { j + 1 }] - pts[j]);
             let u = e.x * cur.ma + e.y * cur.mb;
             let w = e.x * next.ma + e.y * next.mb;
             let v = dx + p.x * dma + p.y * dmb;
             let tau = u.cross(v).dot(w);
+            // |τ| > 10⁻⁹ |u| |v| |w| decided on the squares (no square roots) where they are
+            // clear of it by 10⁻¹², far more than the few roundings of either side
+            let (t2, s2) = (tau * tau, 1e-18 * (u.dot(u) * v.dot(v) * w.dot(w)));
+            if s2 > 1e-290 && s2.is_finite() {
+                if t2 > s2 * (1.0 + 1e-12) {
+                    return true;
+                }
+                if t2 < s2 * (1.0 - 1e-12) {
+                    return false;
+                }
+            }
             tau.abs() > 1e-9 * (u.length() * v.length() * w.length())
         })
     }
@@ -1192,13 +1500,13 @@ impl Rings<'_> {
     /// tangents. The rail edge of profile vertex p is (x′ − x) + p_a (ma′ − ma) + p_b (mb′ − mb),
     /// so its components along t and t′ are affine in p.
     #[inline(always)]
-    fn folds_over(&self, cur: &Geo, next: &Geo) -> bool {
+    fn folds_over(&self, cur: &Geo, next: &Geo, column: &Cols) -> bool {
         let (dx0, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
         let along = |t: DVec3| (dx0.dot(t), DVec2::new(dma.dot(t), dmb.dot(t)));
         let ((c1, g1), (c2, g2)) = (along(cur.t), along(next.t));
         // over the stored columns (the profile's vertices; a seam's copy repeats the first),
         // without branches
-        let (px, py) = (&self.column.px, &self.column.py[..self.column.px.len()]);
+        let (px, py) = (column.px, &column.py[..column.px.len()]);
         let ok = px.iter().zip(py).fold(true, |a, (&x, &y)| {
             a & (c1 + (x * g1.x + y * g1.y) > 0.0) & (c2 + (x * g2.x + y * g2.y) > 0.0)
         });
@@ -1433,13 +1741,12 @@ impl Sweep<'_> {
             (v, nr, u, f) = (v2, n2, u2, f2);
             vbase += k;
         }
-        let cols = self.sh.column.px.len();
         let outcomes: Vec<Outcome> = jobs
             .into_par_iter()
             .map_init(
                 || TaskScratch {
                     frames: Vec::new(),
-                    ring: RingScratch::new(cols),
+                    ring: RingScratch::new(0),
                 },
                 |sc, (c, vbase, mine)| self.spine(c, vbase, mine, sc, cancel),
             )
@@ -2115,7 +2422,7 @@ mod tests {
             .expect("a valid sweep")
             .expect("not stopped");
         let plan = &plan;
-        let column = Columns::of(&p, plan.cols);
+        let column = OnceLock::from(Columns::of(&p, plan.cols));
         let rings = Rings {
             s: &spine,
             x: &x[..plan.rings],
@@ -2136,6 +2443,8 @@ mod tests {
             let mut f = vec![[0i32; 3]; 2 * plan.segments * p.len()];
             let b = Block {
                 i0: 0,
+                j: 0..plan.cols,
+                bd: None,
                 v: &mut v,
                 n: Some(&mut nn),
                 u: Some(&mut u),
@@ -2143,8 +2452,22 @@ mod tests {
             };
             let ring = &mut RingScratch::new(plan.cols);
             let r = match avx2 {
-                true => rings.block(b, &pattern, 0, None, ring),
-                false => rings.block_body(b, &pattern, 0, None, ring),
+                true => rings.block(
+                    b,
+                    &column.get().unwrap().view(0..plan.cols),
+                    &pattern,
+                    0,
+                    None,
+                    ring,
+                ),
+                false => rings.block_body(
+                    b,
+                    &column.get().unwrap().view(0..plan.cols),
+                    &pattern,
+                    0,
+                    None,
+                    ring,
+                ),
             };
             let bits3 = |a: Vec<[f32; 3]>| a.iter().map(|t| t.map(f32::to_bits)).collect();
             let uv = u.iter().map(|t| t.map(f32::to_bits)).collect();
@@ -2153,5 +2476,151 @@ mod tests {
         let (a, b) = (run(true), run(false));
         assert!(a.0.3.iter().flatten().any(|&i| i > 0), "faces written");
         assert!(a == b, "the AVX2 block differs from the baseline block");
+    }
+
+    /// Everything [`Rings::write`] gives for one spine, in `(grain, piece)` tasks: the bits
+    /// of the vertices, normals, uv and faces, the fold rows and the first vertex out of
+    /// range.
+    fn written(
+        spine: &Spine,
+        p: &Profile,
+        opts: &Options,
+        tasks: (usize, usize),
+    ) -> (Vec<u64>, Vec<i64>, Vec<usize>, Option<usize>) {
+        let plan = check_spine(spine, opts, p, true, &cancel::never)
+            .expect("a valid sweep")
+            .expect("not stopped");
+        let sh = Shared::new(p, plan.cols, false);
+        let rings = Rings {
+            s: spine,
+            x: &spine.points[..plan.rings],
+            plan: &plan,
+            p,
+            column: &sh.column,
+            closed: opts.closed,
+            miter_limit: opts.miter_limit,
+            sign: sh.sign,
+            rowbase: 7,
+        };
+        let nv = plan.vertices();
+        let (mut v, mut n) = (vec![[0f64; 3]; nv], vec![[0f64; 3]; nv]);
+        let mut u = vec![[0f64; 2]; nv];
+        let mut f = vec![[0i64; 3]; 2 * plan.segments * sh.edges];
+        let out = MeshMut {
+            vertices: &mut v,
+            faces: &mut f,
+            normals: Some(&mut n),
+            uv: Some(&mut u),
+        };
+        let ring = &mut RingScratch::new(0);
+        let (folds, bad) = rings.write(out, &sh.pattern, 3, None, tasks, ring, &cancel::never);
+        let bits: Vec<u64> = [v.as_flattened(), n.as_flattened(), u.as_flattened()]
+            .concat()
+            .iter()
+            .map(|x| x.to_bits())
+            .collect();
+        (bits, f.concat(), folds, bad)
+    }
+
+    /// A ring written in pieces of its columns (each a parallel task) gives the bits of
+    /// the ring written whole: vertices, normals, uv, faces with the twisted segments' split,
+    /// folds and the first vertex out of range. A twisted helix with a star of split seams
+    /// (and the same star clockwise), and a tight closed loop of an open profile, which
+    /// folds over, with a scale so large at one sample that a ring's vertices overflow.
+    #[test]
+    fn rings_in_pieces_equal_whole_rings() {
+        let n = 40;
+        let (x, frames): (Vec<DVec3>, Vec<[f64; 9]>) = (0..n)
+            .map(|i| {
+                let u = 0.3 * i as f64;
+                let t = DVec3::new(-u.sin(), u.cos(), 0.1).normalize();
+                (
+                    DVec3::new(u.cos(), u.sin(), 0.1 * u),
+                    frame(DVec3::new(-u.cos(), -u.sin(), 0.0), t),
+                )
+            })
+            .unzip();
+        let scale: Vec<DVec2> = (0..n)
+            .map(|i| DVec2::new(0.2 + 0.01 * i as f64, 0.3))
+            .collect();
+        let twist: Vec<f64> = (0..n).map(|i| 0.05 * i as f64).collect();
+        let helix = Spine {
+            points: &x,
+            frames: &frames,
+            scale: &scale,
+            twist: &twist,
+        };
+        let mut cw = star();
+        cw.reverse();
+        let (cx, cf) = circle(9, 1.0);
+        let ribbon: Vec<DVec2> = (0..13)
+            .map(|j| DVec2::new(0.3 * j as f64 - 1.5, 0.1 * (j % 3) as f64))
+            .collect();
+        let mut scales = vec![DVec2::ONE; 9];
+        scales[4] = DVec2::splat(1e308);
+        let loop_ = Spine {
+            points: &cx,
+            frames: &cf,
+            scale: &scales,
+            twist: &[],
+        };
+        let cases = [
+            (
+                helix,
+                Profile::new(&star(), true),
+                options(false, false, true),
+            ),
+            (helix, Profile::new(&cw, true), options(false, false, false)),
+            (
+                loop_,
+                Profile::new(&ribbon, false),
+                options(true, false, true),
+            ),
+        ];
+        for (k, (spine, p, opts)) in cases.into_iter().enumerate() {
+            let p = p.expect("a valid profile");
+            let cols = p.len() + usize::from(p.closed && opts.split_seams);
+            let whole = written(&spine, &p, &opts, (3, cols));
+            assert!(whole.1.iter().any(|&i| i > 0), "case {k}: faces written");
+            if k == 2 {
+                assert!(
+                    !whole.2.is_empty() && whole.3.is_some(),
+                    "folds and overflow"
+                );
+            }
+            for piece in [1, 2, 3, cols - 1] {
+                let pieces = written(&spine, &p, &opts, (3, piece));
+                assert!(pieces == whole, "case {k}: pieces of {piece} differ");
+            }
+        }
+    }
+
+    /// The faces computed per edge (large profiles) are those of the tables (small ones):
+    /// both splits and windings, with and without a seam column, consecutive rings and the
+    /// last ring joined to the first, from every first edge.
+    #[test]
+    fn face_formula_equals_table() {
+        for (cols, edges) in [(7, 7), (8, 7), (7, 6)] {
+            for sign in [1.0, -1.0] {
+                let table = FacePattern::of(cols, edges, sign);
+                let formula = FacePattern {
+                    ac: Vec::new(),
+                    bd: Vec::new(),
+                    ..FacePattern::of(cols, edges, sign)
+                };
+                assert_eq!(table.ac.len(), 2 * edges);
+                for bd in [false, true] {
+                    for (b0, b1) in [(30, 30 + cols), (30 + 5 * cols, 30)] {
+                        for e0 in 0..edges {
+                            let k = 2 * (edges - e0);
+                            let (mut x, mut y) = (vec![[0i64; 3]; k], vec![[0i64; 3]; k]);
+                            table.write(&mut x, bd, b0, b1, e0);
+                            formula.write(&mut y, bd, b0, b1, e0);
+                            assert_eq!(x, y, "{cols} {edges} {sign} {bd} {b0} {e0}");
+                        }
+                    }
+                }
+            }
+        }
     }
 }
