@@ -361,7 +361,43 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
     fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
         super::advect::rk4_by_batches(self, x, t0, h, steps);
     }
+    /// The poses of the steps' three stage times once for all the batches of the chunk (by
+    /// runs of [`POSE_STEPS`] steps), then the batches.
+    fn rk4_chunk(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
+        use super::advect::{LANES, rk4_lanes_staged, stage_times};
+        let mut first = steps.start;
+        while first < steps.end {
+            let part = first..steps.end.min(first + POSE_STEPS);
+            let mut poses = [[None; 3]; POSE_STEPS];
+            for (p, j) in poses.iter_mut().zip(part.clone()) {
+                let (ts, tm) = stage_times(t0, h, j);
+                *p = ts.map(|t| self.keys.pose_in(t, tm));
+            }
+            for b in x.chunks_mut(LANES) {
+                rk4_lanes_staged(
+                    |p, j, stage, _t, _tm, out| {
+                        if let Some(pose) = &poses[j - part.start][STAGE_POSE[stage]] {
+                            pose.pose.add_lanes(&self.shape, p, out, |x, d, g| {
+                                self.eval_with(x, pose, d, g)
+                            });
+                        }
+                    },
+                    b,
+                    t0,
+                    h,
+                    part.clone(),
+                );
+            }
+            first = part.end;
+        }
+    }
 }
+
+/// Steps whose poses [`Keyframed`]'s `rk4_chunk` keeps at a time.
+const POSE_STEPS: usize = 32;
+
+/// The pose of each RK4 stage among a step's three stage times.
+const STAGE_POSE: [usize; 4] = [0, 1, 1, 2];
 
 #[cfg(test)]
 mod tests {
