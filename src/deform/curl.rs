@@ -66,6 +66,11 @@ pub trait Distance: Send + Sync + std::fmt::Debug {
     fn misses(&self, _lo: DVec3, _hi: DVec3) -> bool {
         false
     }
+    /// Whether [`Self::misses`] is worth a test per batch (then the batch's lanes also run
+    /// in an AVX2 build where the processor has it).
+    fn culls_boxes(&self) -> bool {
+        false
+    }
 }
 
 impl<D: Distance + ?Sized> Distance for Arc<D> {
@@ -91,6 +96,10 @@ impl<D: Distance + ?Sized> Distance for Arc<D> {
     #[inline(always)]
     fn misses(&self, lo: DVec3, hi: DVec3) -> bool {
         (**self).misses(lo, hi)
+    }
+    #[inline(always)]
+    fn culls_boxes(&self) -> bool {
+        (**self).culls_boxes()
     }
 }
 
@@ -326,10 +335,25 @@ impl Pose {
         D: Distance,
         F: Fn(DVec3, f64, DVec3) -> DVec3,
     {
-        if self.q == DMat3::IDENTITY {
-            self.add_lanes_as::<D, F, false>(shape, p, out, f)
-        } else {
-            self.add_lanes_as::<D, F, true>(shape, p, out, f)
+        match (self.q == DMat3::IDENTITY, shape.culls_boxes()) {
+            (true, true) => self.add_lanes_as::<D, F, false>(shape, p, out, f),
+            (false, true) => self.add_lanes_as::<D, F, true>(shape, p, out, f),
+            (true, false) => self.add_points::<D, F, false>(shape, p, out, f),
+            (false, false) => self.add_points::<D, F, true>(shape, p, out, f),
+        }
+    }
+
+    /// [`Self::add_lanes`] point by point, for shapes without a box test.
+    #[inline(always)]
+    fn add_points<D, F, const TURNED: bool>(&self, shape: &D, p: &[DVec3], out: &mut [DVec3], f: F)
+    where
+        D: Distance,
+        F: Fn(DVec3, f64, DVec3) -> DVec3,
+    {
+        for (o, x) in out.iter_mut().zip(p) {
+            if let Some((d, g)) = self.distance_as::<D, TURNED>(shape, *x) {
+                *o += f(*x, d, g);
+            }
         }
     }
 
