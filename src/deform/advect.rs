@@ -56,7 +56,7 @@ pub fn integrate(field: &Field, x: DVec3, t0: f64, h: f64, steps: usize, m: Meth
 /// Vertices integrated in lock-step: one RK4 step is a chain of 4 dependent field
 /// evaluations (each with a square root and a division), so a single path line is bound by
 /// latency; `LANES` independent path lines interleave and keep the pipelines full.
-const LANES: usize = 16;
+pub(crate) const LANES: usize = 16;
 
 /// `B ≤ LANES` path lines in lock-step, steps `j ∈ steps` at times `t0 + h·j` (a run split in
 /// parts gives the bits of the whole run).
@@ -152,27 +152,47 @@ pub(crate) fn rk4_lanes_with(
     h: f64,
     steps: std::ops::Range<usize>,
 ) {
+    rk4_lanes_staged(
+        |p, _s, _stage, t, tm, out| add(p, t, tm, out),
+        x,
+        t0,
+        h,
+        steps,
+    );
+}
+
+/// [`rk4_lanes_with`] with an evaluator `add(points, step, stage, t, t_mid, out)` that is
+/// also told the step `j` and the stage (0–3; the stages 1 and 2 share their time), so
+/// that it can look up what it prepared for that time.
+#[inline(always)]
+pub(crate) fn rk4_lanes_staged(
+    add: impl Fn(&[DVec3], usize, usize, f64, f64, &mut [DVec3]),
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+) {
     let n = x.len().min(LANES);
     let h2 = 0.5 * h;
     let h6 = h / 6.0;
     let mut k = [DVec3::ZERO; LANES];
     let mut acc = [DVec3::ZERO; LANES];
     let mut p = [DVec3::ZERO; LANES];
-    let eval = |p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]| {
+    let eval = |p: &[DVec3], s: usize, stage: usize, t: f64, tm: f64, out: &mut [DVec3]| {
         out.fill(DVec3::ZERO);
-        add(p, t, tm, out);
+        add(p, s, stage, t, tm, out);
     };
     for s in steps {
         let t = t0 + h * s as f64;
         let tm = t + h2;
         p[..n].copy_from_slice(&x[..n]);
-        eval(&p[..n], t, tm, &mut k[..n]);
+        eval(&p[..n], s, 0, t, tm, &mut k[..n]);
         acc[..n].copy_from_slice(&k[..n]);
-        for (w, hc, tc) in [(2.0, h2, tm), (2.0, h2, tm), (1.0, h, t + h)] {
+        for (stage, w, hc, tc) in [(1, 2.0, h2, tm), (2, 2.0, h2, tm), (3, 1.0, h, t + h)] {
             for j in 0..n {
                 p[j] = x[j] + hc * k[j];
             }
-            eval(&p[..n], tc, tm, &mut k[..n]);
+            eval(&p[..n], s, stage, tc, tm, &mut k[..n]);
             if w == 2.0 {
                 for j in 0..n {
                     acc[j] += 2.0 * k[j];
@@ -182,6 +202,30 @@ pub(crate) fn rk4_lanes_with(
         for j in 0..n {
             x[j] += h6 * (acc[j] + k[j]);
         }
+    }
+}
+
+/// The stage times of step `j` of the run `t0 + h·j` (as [`rk4_lanes_staged`] computes
+/// them): `t`, `t_mid` (stages 1 and 2) and `t + h`, with `t_mid`.
+#[inline(always)]
+pub(crate) fn stage_times(t0: f64, h: f64, j: usize) -> ([f64; 3], f64) {
+    let t = t0 + h * j as f64;
+    let tm = t + 0.5 * h;
+    ([t, tm, t + h], tm)
+}
+
+/// Path lines `x` (any number) by batches of `LANES`: the default of
+/// [`super::Tool::rk4_chunk`].
+#[inline(always)]
+pub(crate) fn rk4_chunk_by_batches<T: super::Tool + ?Sized>(
+    tool: &T,
+    x: &mut [DVec3],
+    t0: f64,
+    h: f64,
+    steps: std::ops::Range<usize>,
+) {
+    for b in x.chunks_mut(LANES) {
+        tool.rk4_lanes(b, t0, h, steps.clone());
     }
 }
 
@@ -291,11 +335,17 @@ pub fn advect_steps(
     if field.tools.is_empty() || steps.is_empty() || h == 0.0 {
         return;
     }
-    points.par_chunks_mut(CHUNK).for_each(|c| {
-        for b in c.chunks_mut(LANES) {
-            integrate_batch(field, b, t0, h, steps.clone(), m);
-        }
-    });
+    points
+        .par_chunks_mut(CHUNK)
+        .for_each(|c| match (field.tools.as_slice(), m) {
+            // a single-tool field runs the tool's own loop over the chunk's batches
+            ([tool], Method::Rk4) => tool.rk4_chunk(c, t0, h, steps.clone()),
+            _ => {
+                for b in c.chunks_mut(LANES) {
+                    integrate_batch(field, b, t0, h, steps.clone(), m);
+                }
+            }
+        });
 }
 
 /// `Ok` if `field` can be integrated by `m` (the splitting needs curl potentials).

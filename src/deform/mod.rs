@@ -103,6 +103,14 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
     fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: Range<usize>) {
         advect::rk4_batch(|p, t, tm| self.velocity(p, t, tm), x, t0, h, steps);
     }
+
+    /// RK4 on the path lines of one task (any number; by batches of lock-step lanes),
+    /// steps `j ∈ steps`, for a field of this tool alone: where a tool prepares per time
+    /// (a pose), it can do so once for all the batches.
+    #[inline]
+    fn rk4_chunk(&self, x: &mut [DVec3], t0: f64, h: f64, steps: Range<usize>) {
+        advect::rk4_chunk_by_batches(self, x, t0, h, steps);
+    }
 }
 
 /// `x` if every component is finite.

@@ -119,6 +119,13 @@ impl Distance for Rod {
     fn wants_locality(&self) -> bool {
         true
     }
+    #[inline(always)]
+    fn misses(&self, lo: DVec3, hi: DVec3) -> bool {
+        !self.axis.may_reach(lo, hi, self.radius + self.reach)
+    }
+    fn culls_boxes(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -136,6 +136,12 @@ pub struct Axis {
 /// sign pattern is a `u32` with one bit per sample).
 const BLOCK: usize = 16;
 
+/// The planes stored per block: `BLOCK + 1` rounded up to whole groups of [`GROUP`].
+const PLANES: usize = (BLOCK + 1).div_ceil(GROUP) * GROUP;
+
+/// Planes evaluated together in [`Axis::closest_point`]'s scan (a vector's width).
+const GROUP: usize = 4;
+
 /// [`BLOCK`] consecutive segments of an [`Axis`] (fewer in the last block).
 #[derive(Debug, Clone, PartialEq)]
 struct Block {
@@ -144,8 +150,9 @@ struct Block {
     lo: DVec3,
     hi: DVec3,
     /// The normal planes `F_k = X·m_k − x_k·m_k` at the block's first `BLOCK + 1` samples,
-    /// as `m_k·x`, `m_k·y`, `m_k·z` and `x_k·m_k` (zeros past the last sample).
-    planes: [[f64; BLOCK + 1]; 4],
+    /// as `m_k·x`, `m_k·y`, `m_k·z` and `x_k·m_k` (zeros past the last sample, up to
+    /// [`PLANES`]).
+    planes: [[f64; PLANES]; 4],
     /// The number of segments in the block.
     segs: usize,
 }
@@ -244,7 +251,7 @@ impl Axis {
                     (lo.min(*p), hi.max(*p))
                 });
             if k % BLOCK == 0 {
-                let mut planes = [[0.0; BLOCK + 1]; 4];
+                let mut planes = [[0.0; PLANES]; 4];
                 for (j, p) in samples[k..].iter().take(BLOCK + 1).enumerate() {
                     for (a, v) in [p.m.x, p.m.y, p.m.z, p.x.dot(p.m)].into_iter().enumerate() {
                         planes[a][j] = v;
@@ -398,9 +405,19 @@ impl Axis {
                 continue;
             }
             let [bx, by, bz, bc] = &blk.planes;
-            let mut f = [0.0; BLOCK + 1];
-            for j in 0..BLOCK + 1 {
-                f[j] = (x.x * bx[j] + x.y * by[j]) + (x.z * bz[j] - bc[j]);
+            // by groups of a vector's width (the zeros past the block's samples read as
+            // `F ≥ 0`, above the bits of the candidates)
+            let mut f = [0.0; PLANES];
+            let mut pos = 0u32;
+            for g in 0..PLANES / GROUP {
+                let mut bits = 0u32;
+                for i in 0..GROUP {
+                    let j = g * GROUP + i;
+                    let fj = (x.x * bx[j] + x.y * by[j]) + (x.z * bz[j] - bc[j]);
+                    f[j] = fj;
+                    bits |= ((fj >= 0.0) as u32) << i;
+                }
+                pos |= bits << (g * GROUP);
             }
             if b == 0 && f[0] < 0.0 {
                 let p0 = self.samples[0].x;
@@ -409,10 +426,6 @@ impl Axis {
                     best = r2;
                     hit = Some((Foot::Cap(0), p0));
                 }
-            }
-            let mut pos = 0u32;
-            for (j, fj) in f.iter().enumerate() {
-                pos |= ((*fj >= 0.0) as u32) << j;
             }
             let mut cand = pos & !(pos >> 1) & ((1u32 << blk.segs) - 1);
             while cand != 0 {
@@ -439,6 +452,41 @@ impl Axis {
             }
         }
         hit
+    }
+
+    /// Whether a point of the box `[lo, hi]` may be within `outer` of the axis: `false` when
+    /// [`Self::closest_point`] is certain to return `None` at every point of the box (each
+    /// segment's bounding-sphere cull and each end cap's test fail there). The squared
+    /// distance from the box to a point, `Σ max(lo − c, c − hi, 0)²` summed in the order of
+    /// [`DVec3::length_squared`], is at most the rounded `|x − c|²` of every `x` in the box
+    /// (rounding is monotone), so the test is exact in floating point, not only in reals.
+    /// Used once per batch of lock-step path lines, which the spatial order keeps close.
+    pub fn may_reach(&self, lo: DVec3, hi: DVec3, outer: f64) -> bool {
+        #[inline(always)]
+        fn d2(lo: DVec3, hi: DVec3, c: DVec3) -> f64 {
+            (lo - c).max(c - hi).max(DVec3::ZERO).length_squared()
+        }
+        let lim = self.bound + outer;
+        if !(d2(lo, hi, self.centre) < lim * lim) {
+            return false;
+        }
+        let o2 = outer * outer;
+        let n = self.samples.len();
+        if d2(lo, hi, self.samples[0].x) < o2 || d2(lo, hi, self.samples[n - 1].x) < o2 {
+            return true;
+        }
+        for (b, blk) in self.blocks.iter().enumerate() {
+            if (hi.cmple(blk.lo - outer) | lo.cmpge(blk.hi + outer)).any() {
+                continue;
+            }
+            for seg in &self.segs[b * BLOCK..b * BLOCK + blk.segs] {
+                let lim = seg.radius + outer;
+                if d2(lo, hi, seg.centre) < lim * lim {
+                    return true;
+                }
+            }
+        }
+        false
     }
 
     /// `γ`, `γ′`, `γ″` (in the local parameter) of segment `k` at `λ`.
@@ -960,6 +1008,39 @@ mod tests {
 
     /// The block boxes only skip blocks that hold no foot: the closest point of a long axis
     /// (several blocks) against a dense polyline of it.
+    #[test]
+    fn a_box_the_axis_cannot_reach_has_no_foot_at_any_point() {
+        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3).unwrap();
+        let (mut missed, mut reached) = (0, 0);
+        for i in 0..3000 {
+            let q = i as f64 * 0.173;
+            let r = 3.0 + 0.7 * (0.3 * q).sin();
+            let c = DVec3::new(
+                r * (0.7 * q).cos(),
+                r * (0.7 * q).sin(),
+                0.4 * (1.3 * q).sin(),
+            );
+            let h = DVec3::new(0.05, 0.08, 0.03) * (1.0 + (2.1 * q).sin());
+            let (lo, hi) = (c - h, c + h);
+            if axis.may_reach(lo, hi, 0.3) {
+                reached += 1;
+                continue;
+            }
+            missed += 1;
+            // the corners, the faces' centres and points inside
+            for k in 0..64 {
+                let t = DVec3::new(
+                    (k % 4) as f64 / 3.0,
+                    ((k / 4) % 4) as f64 / 3.0,
+                    (k / 16) as f64 / 3.0,
+                );
+                let x = lo + (hi - lo) * t;
+                assert!(axis.closest_point(x, 0.3).is_none(), "{x}");
+            }
+        }
+        assert!(missed > 300 && reached > 300, "{missed} {reached}");
+    }
+
     #[test]
     fn block_boxes_keep_every_foot() {
         let axis = Axis::new(arc(60, 3.0, 4.0), 0.3).unwrap();
