@@ -139,6 +139,10 @@ class DeformReport:
     timings: dict | None = _dc_field(default=None, repr=False, compare=False)
     slip_vertices: int = 0
     chord_vertices: int = 0
+    flips: int = 0
+    flip_volume: float = 0.0
+    collapses: int = 0
+    collapse_volume: float = 0.0
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
@@ -240,7 +244,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     finally:
         if bar:
             bar[0][1]()
-    passes, torn, over, bounded, t_int, t_ref, on_slip, chord = stats
+    (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
+        (flips, flip_volume, collapses, collapse_volume) = stats
     clock = time.perf_counter()
     rest, vol = _volume(Vr, Fr), _volume(W, Fr)
     change = vol / rest - 1 if rest != 0 else float("nan")
@@ -268,7 +273,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
             f"step); raise max_vertices or max_passes"), stacklevel=2)
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
-                          counts, timings, on_slip, chord)
+                          counts, timings, on_slip, chord, flips, flip_volume, collapses,
+                          collapse_volume)
     return Mesh(W, Fr), report
 
 

@@ -103,6 +103,8 @@ use super::advect::{Method, advect_steps};
 use super::slip::{self, Carry};
 use crate::error::{InputError, Result};
 
+mod collapse;
+
 /// No twin: a boundary half-edge.
 const NONE: usize = usize::MAX;
 
@@ -234,6 +236,12 @@ pub struct Deformed {
     /// The change of the enclosed volume by the flips (the sum of their tetrahedra's signed
     /// volumes).
     pub flip_volume: f64,
+    /// Edges collapsed along slip surfaces after the integration (see [`collapse`]): each
+    /// removes one vertex and two faces.
+    pub collapses: usize,
+    /// The change of the enclosed volume by the collapses (each placed to keep it; the sum of
+    /// what remains).
+    pub collapse_volume: f64,
     /// Wall time of the integration of the mesh's vertices, seconds.
     pub time_integrate: f64,
     /// Wall time of the refinement (edge tests, placement of new vertices, splits), seconds.
@@ -458,6 +466,8 @@ struct Refiner<'a> {
     touched: Vec<usize>,
     flips: usize,
     flip_volume: f64,
+    collapses: usize,
+    collapse_volume: f64,
 }
 
 /// A point of the generalized rest mesh (see the module docs): a material rest point, or a
@@ -936,6 +946,8 @@ pub fn deform(
         touched: Vec::new(),
         flips: 0,
         flip_volume: 0.0,
+        collapses: 0,
+        collapse_volume: 0.0,
     };
     r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
     let mut w = rest.to_vec();
@@ -961,6 +973,7 @@ pub fn deform(
         }
     }
     if refinement.is_some() {
+        let clock = Instant::now();
         // the strip goes on shearing after a step's flips: a last round over all of it
         r.touched = (0..r.topo.faces.len())
             .filter(|&f| {
@@ -970,6 +983,13 @@ pub fn deform(
             })
             .collect();
         r.flip_touched(&w);
+        // the slivers flips cannot mend: collapses, each keeping the volume
+        let end = runs.last().map_or(r.start, |l| l.t0 + l.h * l.count as f64);
+        r.collapse_slivers(&mut w, end);
+        if let Some(last) = out.step_vertices.last_mut() {
+            *last = w.len();
+        }
+        out.time_refine += clock.elapsed().as_secs_f64();
     }
     if refinement.is_some() {
         out.over_threshold = r.over_edges(&w).len();
@@ -983,6 +1003,8 @@ pub fn deform(
     out.cornered = r.cornered;
     out.flips = r.flips;
     out.flip_volume = r.flip_volume;
+    out.collapses = r.collapses;
+    out.collapse_volume = r.collapse_volume;
     out.slip_vertices = r
         .carry
         .iter()
@@ -1400,6 +1422,8 @@ mod tests {
             touched: Vec::new(),
             flips: 0,
             flip_volume: 0.0,
+            collapses: 0,
+            collapse_volume: 0.0,
         };
         r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
         let mut w = v.clone();

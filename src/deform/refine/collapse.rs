@@ -1,0 +1,519 @@
+//! Edge collapses that remove the slivers of the strip a slip surface tears open.
+//!
+//! The strip of a curl tool's surface between the two torn sides ([`super`]: slip surfaces)
+//! is filled by vertices `Ψ(p, s)` of a few rest points `p` each, at the blends `s` that the
+//! halving of torn edges gave them. Its parametrization by the rest point's place `θ` along
+//! the torn curve and the blend `s` is far from isometric: where the torn curve runs along
+//! the slip (the sides of a drag, `θ` near ±90° from the drag's direction for the
+//! translation tool) the curves `Ψ(p, ·)` of neighbouring rest points lie side by side a
+//! fraction `|cos θ|` of their rest distance apart, and the strip narrows to a line. The
+//! triangles between neighbouring curves, fine in `(θ, s)`, are needles and caps there, and
+//! the triangles of three vertices of one curve (one rest point at three blends) are flat in
+//! `(θ, s)` already. Their normals are arbitrary, which shows as teeth along the lip. Flips
+//! cannot mend a pair whose four vertices lie on one curve; an edge collapse can.
+//!
+//! **Collapse** (Hoppe, DeRose, Duchamp, McDonald, Stuetzle, "Mesh optimization", SIGGRAPH
+//! 1993, §4.2 and §6.2): the edge `(a, b)` shared by the faces `[a, b, c]` and `[b, a, d]`
+//! is contracted to one vertex `m`; the two faces vanish, the other faces of `b` become faces
+//! of `m`. On a closed 2-manifold the result is a closed 2-manifold when the *link
+//! condition* holds: the vertices joined to both `a` and `b` are exactly `c` and `d` (Dey,
+//! Edelsbrunner, Guha, Nekhayev, "Topology preserving edge contraction", 1999, §2; a third
+//! common neighbour would give an edge of three faces). The winding of every kept face is
+//! kept (a vertex index is replaced inside it), and the two pairs of outer half-edges of the
+//! vanishing faces become twins.
+//!
+//! **Which collapses.** Only edges whose two ends are points of the strip (`Carry::Surface`),
+//! of faces with a smallest angle under [`SLIVER`], after the integration: the collapse
+//! must raise the smallest angle of the faces around `a` and `b` (Hoppe et al.'s energy
+//! replaced by the max-min angle of Lawson's flips, so collapses and flips pursue one
+//! measure), not fold (no edge around `m` may have a dihedral angle over 120° unless one
+//! as large was there before, and no more such edges than before), leave no edge over the
+//! refinement threshold (the refinement stays converged), keep the rest mesh's volume (its
+//! two rest points the same — the pair of one curve `Ψ(p, ·)` — or the rest faces around
+//! them flat, as for rest points inside one face of the input) and keep the enclosed volume.
+//!
+//! **Placement.** The enclosed volume after the collapse is affine in the position `x` of
+//! `m`: `V(x) = V₀ + ∑ det(x, q, r)/6` over the kept faces `[m, q, r]` (Lindstrom and Turk,
+//! "Fast and memory efficient polygonal simplification", IEEE Visualization 1998, §3.1:
+//! the volume-preserving constraint). `m` stays on the slip surface: `x(τ)` is the point of
+//! the chord `(1 − τ) W_a + τ W_b` moved onto it ([`slip::project`]; for a pair on one curve
+//! `Ψ(p, ·)` of the translation tool, a great circle of the tool's sphere, this is a point of
+//! that curve), and `τ ∈ [0, 1]` solves `V(x(τ)) = V` by regula falsi where the volume
+//! changes sign along the chord, else is the end that changes it least. A collapse is made
+//! only when the remaining change is at most [`COLLAPSE_VOLUME`] × `ℓ̄³`, the flips' bound
+//! (the sum over all collapses is [`super::Deformed::collapse_volume`]). The rest point of
+//! `m` is `(1 − τ) X_a + τ X_b` and its blend `(1 − τ) s_a + τ s_b`.
+
+use glam::DVec3;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+pub static WHY: [AtomicUsize; 10] = [const { AtomicUsize::new(0) }; 10];
+fn why(i: usize) {
+    WHY[i].fetch_add(1, Relaxed);
+}
+
+use super::{MAX_VALENCE, NONE, Refiner, Topology, min_angle};
+use crate::deform::slip::{self, Carry};
+
+/// Faces of the strip with a smallest angle under this (1°, radians) are collapsed away.
+pub(super) const SLIVER: f64 = 1.0 * std::f64::consts::PI / 180.0;
+
+/// A collapse may change the enclosed volume by at most this fraction of `ℓ̄³` (as a flip).
+pub(super) const COLLAPSE_VOLUME: f64 = 1e-3;
+
+/// The rest faces around a collapse of two different rest points must keep the rest volume
+/// within this fraction of `ℓ̄³` (flat up to rounding).
+const REST_FLAT: f64 = 1e-12;
+
+/// `cos 120°`: two faces meeting at a dihedral angle over 120° are folded back.
+const FOLD_COS: f64 = -0.5;
+
+/// Rounds of collapses, each followed by flips over the strip.
+const COLLAPSE_ROUNDS: usize = 4;
+
+/// Regula falsi steps of the volume-preserving placement, which stop once the change is
+/// below `PLACE_TOLERANCE` × the allowed one.
+const PLACE_STEPS: usize = 12;
+const PLACE_TOLERANCE: f64 = 1e-6;
+
+impl Topology {
+    /// The half-edges out of the vertex at which `e` starts, in order around it; `None` at a
+    /// boundary or beyond [`MAX_VALENCE`] edges.
+    pub(super) fn star(&self, e: usize) -> Option<Vec<usize>> {
+        let mut out = Vec::new();
+        let mut x = e;
+        for _ in 0..MAX_VALENCE {
+            out.push(x);
+            let t = self.twin[3 * (x / 3) + (x % 3 + 2) % 3];
+            if t == NONE {
+                return None;
+            }
+            x = t;
+            if x == e {
+                return Some(out);
+            }
+        }
+        None
+    }
+
+    /// Whether the edge of half-edge `h` (faces `[a, b, c]`, `[b, a, d]`) can be collapsed
+    /// without leaving the closed 2-manifolds: it has a twin, `c ≠ d`, and `a` and `b` have no
+    /// common neighbour but `c` and `d` (the link condition). Returns the stars of `a` and
+    /// `b` (their outgoing half-edges) when it can.
+    pub(super) fn collapsible(&self, h: usize) -> Option<(Vec<usize>, Vec<usize>)> {
+        let t = self.twin[h];
+        if t == NONE {
+            return None;
+        }
+        let c = self.faces[h / 3][(h % 3 + 2) % 3];
+        let d = self.faces[t / 3][(t % 3 + 2) % 3];
+        if c == d {
+            return None;
+        }
+        let (sa, sb) = (self.star(h)?, self.star(t)?);
+        let around_b: Vec<usize> = sb.iter().map(|&e| self.ends(e).1).collect();
+        let common = sa
+            .iter()
+            .filter(|&&e| around_b.contains(&self.ends(e).1))
+            .count();
+        (common == 2).then_some((sa, sb))
+    }
+
+    /// Collapse half-edge `h` = `a → b` (faces `[a, b, c]` and `[b, a, d]`): `b` is replaced by
+    /// `a` in its other faces, the two faces are marked in `dead` and their outer half-edges
+    /// `(c, b)`/`(a, c)` and `(d, a)`/`(b, d)` become twins. The caller checked
+    /// [`Topology::collapsible`]; `star_b` is the star of `b` it returned.
+    pub(super) fn collapse(&mut self, h: usize, star_b: &[usize], dead: &mut [bool]) {
+        let t = self.twin[h];
+        let (f, k, g, j) = (h / 3, h % 3, t / 3, t % 3);
+        let (a, b) = self.ends(h);
+        let x1 = self.twin[3 * f + (k + 1) % 3]; // twin of b → c
+        let x2 = self.twin[3 * f + (k + 2) % 3]; // twin of c → a
+        let y1 = self.twin[3 * g + (j + 1) % 3]; // twin of a → d
+        let y2 = self.twin[3 * g + (j + 2) % 3]; // twin of d → b
+        for &e in star_b {
+            let q = e / 3;
+            if q != f && q != g {
+                for v in self.faces[q].iter_mut() {
+                    if *v == b {
+                        *v = a;
+                    }
+                }
+            }
+        }
+        self.twin[x1] = x2;
+        self.twin[x2] = x1;
+        self.twin[y1] = y2;
+        self.twin[y2] = y1;
+        for i in 0..3 {
+            self.twin[3 * f + i] = NONE;
+            self.twin[3 * g + i] = NONE;
+        }
+        dead[f] = true;
+        dead[g] = true;
+    }
+
+    /// Drop the faces marked in `dead`, renumbering the half-edges of the others.
+    pub(super) fn compact(&mut self, dead: &[bool]) {
+        let mut map = vec![NONE; self.faces.len()];
+        let mut n = 0;
+        for (f, &d) in dead.iter().enumerate() {
+            if !d {
+                map[f] = n;
+                n += 1;
+            }
+        }
+        let mut faces = Vec::with_capacity(n);
+        let mut twin = Vec::with_capacity(3 * n);
+        for f in (0..self.faces.len()).filter(|&f| !dead[f]) {
+            faces.push(self.faces[f]);
+            for k in 0..3 {
+                let x = self.twin[3 * f + k];
+                twin.push(if x == NONE {
+                    NONE
+                } else {
+                    3 * map[x / 3] + x % 3
+                });
+            }
+        }
+        self.faces = faces;
+        self.twin = twin;
+    }
+}
+
+/// `det(p, q, r) = p · (q × r)`: six times the signed volume of the tetrahedron `(0, p, q, r)`.
+fn det(t: [DVec3; 3]) -> f64 {
+    t[0].dot(t[1].cross(t[2]))
+}
+
+fn unit_normal(t: [DVec3; 3]) -> DVec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+}
+
+/// A collapse that passed every test: the survivor's position, rest point, blend and the
+/// change of the enclosed volume.
+struct Plan {
+    at: DVec3,
+    rest: DVec3,
+    s: f64,
+    volume: f64,
+}
+
+impl Refiner<'_> {
+    /// The collapse of half-edge `h` = `a → b` into `a` at time `time` (see the module docs),
+    /// if it passes every test, with the stars of `a` and `b`.
+    fn plan_collapse(
+        &self,
+        w: &[DVec3],
+        h: usize,
+        time: f64,
+    ) -> Option<(Plan, Vec<usize>, Vec<usize>)> {
+        let topo = &self.topo;
+        let (a, b) = topo.ends(h);
+        let (Carry::Surface(s_a), Carry::Surface(s_b)) = (self.carry[a], self.carry[b]) else {
+            why(0);
+            return None;
+        };
+        let Some((sa, sb)) = topo.collapsible(h) else {
+            why(1);
+            return None;
+        };
+        let t = topo.twin[h];
+        let (f, g) = (h / 3, t / 3);
+        let mut region: Vec<usize> = sa.iter().chain(&sb).map(|&e| e / 3).collect();
+        region.sort_unstable();
+        region.dedup();
+        let kept: Vec<usize> = region
+            .iter()
+            .copied()
+            .filter(|&q| q != f && q != g)
+            .collect();
+        let merged = |q: usize| topo.faces[q].map(|v| if v == b { a } else { v });
+        let scale3 = self.mean2 * self.mean2.sqrt();
+
+        // the rest mesh keeps its volume: its change is affine in the survivor's rest point on
+        // the rest edge, `r₀ + σ (r₁ − r₀)` at `(1 − σ) X_a + σ X_b`; σ is its zero on the edge,
+        // else the end where it is smaller
+        let (xa, xb) = (self.rest[a], self.rest[b]);
+        let rest = if xa == xb {
+            xa
+        } else {
+            let old: f64 = region
+                .iter()
+                .map(|&q| det(topo.faces[q].map(|v| self.rest[v] - xa)))
+                .sum();
+            let [r0, r1] = [xa, xb].map(|end| {
+                let new: f64 = kept
+                    .iter()
+                    .map(|&q| det(merged(q).map(|v| if v == a { end } else { self.rest[v] } - xa)))
+                    .sum();
+                (new - old) / 6.0
+            });
+            let sigma = if r0 * r1 < 0.0 {
+                r0 / (r0 - r1)
+            } else if r0.abs() <= r1.abs() {
+                0.0
+            } else {
+                1.0
+            };
+            if !((r0 + sigma * (r1 - r0)).abs() <= REST_FLAT * scale3) {
+                why(3);
+                return None;
+            }
+            xa.lerp(xb, sigma)
+        };
+
+        // the enclosed volume's change, origin at W_a (the change is origin-free: the link of
+        // the region is the same before and after)
+        let o = w[a];
+        let old: f64 = region
+            .iter()
+            .map(|&q| det(topo.faces[q].map(|v| w[v] - o)))
+            .sum();
+        let change = |x: DVec3| {
+            let new: f64 = kept
+                .iter()
+                .map(|&q| det(merged(q).map(|v| if v == a { x - o } else { w[v] - o })))
+                .sum();
+            (new - old) / 6.0
+        };
+        // the tests at a placement `x` with rest point `rest`
+        let acceptable = |x: DVec3, rest: DVec3| {
+            // the smallest angle rises, and no edge grows over the threshold
+            let place = |v: usize| if v == a { x } else { w[v] };
+            let angle = |p: [DVec3; 3]| min_angle(p[0], p[1], p[2]);
+            let (mut before, mut slivers_before) = (f64::INFINITY, 0usize);
+            for &q in &region {
+                let x = angle(topo.faces[q].map(|v| w[v]));
+                before = before.min(x);
+                slivers_before += usize::from(x < SLIVER);
+            }
+            let (mut after, mut slivers_after) = (f64::INFINITY, 0usize);
+            for &q in &kept {
+                let x = angle(merged(q).map(place));
+                after = after.min(x);
+                slivers_after += usize::from(x < SLIVER);
+            }
+            if !(after > before || (slivers_after < slivers_before && after >= 0.5 * before)) {
+                why(4);
+                return false;
+            }
+            let ratio2 = self.opts.ratio * self.opts.ratio;
+            for &e in sa.iter().chain(&sb) {
+                let v = topo.ends(e).1;
+                if v != a && v != b {
+                    let rest2 = rest.distance_squared(self.rest[v]).max(self.mean2);
+                    if x.distance_squared(w[v]) > ratio2 * rest2 {
+                        why(5);
+                        return false;
+                    }
+                }
+            }
+
+            // no fold: the dihedral angles at the edges of the region's faces, before and after
+            // (the outer half-edges of the vanishing faces pair up as in Topology::collapse)
+            let rewire = |n: usize| {
+                let (k, j) = (h % 3, t % 3);
+                let pairs = [
+                    (3 * f + (k + 1) % 3, 3 * f + (k + 2) % 3),
+                    (3 * g + (j + 1) % 3, 3 * g + (j + 2) % 3),
+                ];
+                for (p, q) in pairs {
+                    if n == p {
+                        return topo.twin[q];
+                    }
+                    if n == q {
+                        return topo.twin[p];
+                    }
+                }
+                n
+            };
+            let normal_old = |q: usize| unit_normal(topo.faces[q].map(|v| w[v]));
+            let normal_new = |q: usize| {
+                if kept.binary_search(&q).is_ok() {
+                    unit_normal(merged(q).map(place))
+                } else {
+                    normal_old(q)
+                }
+            };
+            let (mut worst_old, mut folds_old) = (1.0f64, 0usize);
+            for &q in &region {
+                let n = normal_old(q);
+                for e in 3 * q..3 * q + 3 {
+                    let c = n.dot(normal_old(topo.twin[e] / 3));
+                    worst_old = worst_old.min(c);
+                    folds_old += usize::from(c < FOLD_COS);
+                }
+            }
+            let (mut worst_new, mut folds_new) = (1.0f64, 0usize);
+            for &q in &kept {
+                let n = normal_new(q);
+                for e in 3 * q..3 * q + 3 {
+                    let c = n.dot(normal_new(rewire(topo.twin[e]) / 3));
+                    worst_new = worst_new.min(c);
+                    folds_new += usize::from(c < FOLD_COS);
+                }
+            }
+            if worst_new < worst_old.min(FOLD_COS) || folds_new > folds_old {
+                why(6);
+                return false;
+            }
+            true
+        };
+        // the volume's change is affine along the chord: a cheap first estimate of the
+        // placement, tested before the placement on the surface
+        let (v0, v1) = (change(w[a]), change(w[b]));
+        let guess = if v0 * v1 < 0.0 {
+            v0 / (v0 - v1)
+        } else if v0.abs() <= v1.abs() {
+            0.0
+        } else {
+            1.0
+        };
+        if !acceptable(w[a].lerp(w[b], guess), rest) {
+            return None;
+        }
+        let on = |tau: f64| slip::project(self.field, w[a].lerp(w[b], tau), time).map(|y| y.0);
+        let (x0, x1) = (on(0.0)?, on(1.0)?);
+        let (v0, v1) = (change(x0), change(x1));
+        let (mut tau, mut x, mut v) = if v0.abs() <= v1.abs() {
+            (0.0, x0, v0)
+        } else {
+            (1.0, x1, v1)
+        };
+        if v0 * v1 < 0.0 {
+            let (mut lo, mut flo, mut hi, mut fhi) = (0.0, v0, 1.0, v1);
+            for _ in 0..PLACE_STEPS {
+                let m = (lo - flo * (hi - lo) / (fhi - flo)).clamp(0.0, 1.0);
+                let xm = on(m)?;
+                let fm = change(xm);
+                if fm.abs() < v.abs() {
+                    (tau, x, v) = (m, xm, fm);
+                }
+                if fm.abs() <= PLACE_TOLERANCE * COLLAPSE_VOLUME * scale3 {
+                    break;
+                }
+                if (fm < 0.0) == (flo < 0.0) {
+                    (lo, flo) = (m, fm);
+                } else {
+                    (hi, fhi) = (m, fm);
+                }
+            }
+        }
+        if !(v.abs() <= COLLAPSE_VOLUME * scale3) {
+            why(2);
+            return None;
+        }
+
+        if !acceptable(x, rest) {
+            return None;
+        }
+        let plan = Plan {
+            at: x,
+            rest,
+            s: s_a + tau * (s_b - s_a),
+            volume: v,
+        };
+        Some((plan, sa, sb))
+    }
+
+    /// Collapse the slivers of the strips along slip surfaces at time `time` (see the module
+    /// docs), with flips over the strips after each round; the vertices and faces that
+    /// vanish are dropped from `w` and the refiner's arrays.
+    pub(super) fn collapse_slivers(&mut self, w: &mut Vec<DVec3>, time: f64) {
+        let clock = std::time::Instant::now();
+        let mut gone = vec![false; w.len()];
+        for _ in 0..COLLAPSE_ROUNDS {
+            let carry = &self.carry;
+            let on_strip = |v: usize| matches!(carry[v], Carry::Surface(_));
+            let mut slivers: Vec<(f64, usize)> = (0..self.topo.faces.len())
+                .filter(|&q| self.topo.faces[q].iter().any(|&v| on_strip(v)))
+                .map(|q| {
+                    let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
+                    (min_angle(p, r, s), q)
+                })
+                .filter(|&(angle, _)| angle < SLIVER)
+                .collect();
+            if slivers.is_empty() {
+                break;
+            }
+            slivers.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            let mut dead = vec![false; self.topo.faces.len()];
+            let before = self.collapses;
+            for &(_, q) in &slivers {
+                if dead[q] {
+                    continue;
+                }
+                let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
+                if !(min_angle(p, r, s) < SLIVER) {
+                    continue;
+                }
+                // the sliver's edges, shortest first
+                let mut edges: Vec<(f64, usize)> = (3 * q..3 * q + 3)
+                    .map(|e| (super::len2(&self.topo, w, e), e))
+                    .collect();
+                edges.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                for (_, e) in edges {
+                    let Some((plan, _, sb)) = self.plan_collapse(w, e, time) else {
+                        continue;
+                    };
+                    let (a, b) = self.topo.ends(e);
+                    w[a] = plan.at;
+                    self.rest[a] = plan.rest;
+                    self.carry[a] = Carry::Surface(plan.s);
+                    self.topo.collapse(e, &sb, &mut dead);
+                    gone[b] = true;
+                    self.collapses += 1;
+                    self.collapse_volume += plan.volume;
+                    break;
+                }
+            }
+            self.topo.compact(&dead);
+            if std::env::var_os("SPINAL_WHY").is_some() {
+                eprintln!(
+                    "round: slivers {} collapses {} why {:?}",
+                    slivers.len(),
+                    self.collapses - before,
+                    WHY.iter().map(|x| x.swap(0, Relaxed)).collect::<Vec<_>>()
+                );
+            }
+            if self.collapses == before {
+                break;
+            }
+            self.touched = (0..self.topo.faces.len())
+                .filter(|&q| {
+                    self.topo.faces[q]
+                        .iter()
+                        .any(|&v| matches!(self.carry[v], Carry::Surface(_)))
+                })
+                .collect();
+            let c2 = std::time::Instant::now();
+            self.flip_touched(w);
+            if std::env::var_os("SPINAL_WHY").is_some() {
+                eprintln!("flip {:.3}", c2.elapsed().as_secs_f64());
+            }
+        }
+        if std::env::var_os("SPINAL_WHY").is_some() {
+            eprintln!("collapse total {:.3}", clock.elapsed().as_secs_f64());
+        }
+        // drop the vanished vertices, keeping the order of the others
+        if gone.iter().any(|&g| g) {
+            let mut map = vec![NONE; w.len()];
+            let mut n = 0;
+            for (v, &g) in gone.iter().enumerate() {
+                if !g {
+                    map[v] = n;
+                    w[n] = w[v];
+                    self.rest[n] = self.rest[v];
+                    self.carry[n] = self.carry[v];
+                    n += 1;
+                }
+            }
+            w.truncate(n);
+            self.rest.truncate(n);
+            self.carry.truncate(n);
+            for t in self.topo.faces.iter_mut() {
+                *t = t.map(|v| map[v]);
+            }
+        }
+    }
+}
