@@ -239,8 +239,11 @@ pub struct Deformed {
     /// Edges collapsed along slip surfaces after the integration (see [`collapse`]): each
     /// removes one vertex and two faces.
     pub collapses: usize,
-    /// The change of the enclosed volume by the collapses (each placed to keep it; the sum of
-    /// what remains).
+    /// Vertices of slivers along slip surfaces moved towards their neighbours' centroid on the
+    /// surface after the collapses (see [`collapse`]).
+    pub moves: usize,
+    /// The change of the enclosed volume by the collapses and moves (each placed to keep it;
+    /// the sum of what remains).
     pub collapse_volume: f64,
     /// Wall time of the integration of the mesh's vertices, seconds.
     pub time_integrate: f64,
@@ -468,6 +471,7 @@ struct Refiner<'a> {
     flip_volume: f64,
     collapses: usize,
     collapse_volume: f64,
+    moves: usize,
 }
 
 /// A point of the generalized rest mesh (see the module docs): a material rest point, or a
@@ -948,6 +952,7 @@ pub fn deform(
         flip_volume: 0.0,
         collapses: 0,
         collapse_volume: 0.0,
+        moves: 0,
     };
     r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
     let mut w = rest.to_vec();
@@ -1005,6 +1010,7 @@ pub fn deform(
     out.flip_volume = r.flip_volume;
     out.collapses = r.collapses;
     out.collapse_volume = r.collapse_volume;
+    out.moves = r.moves;
     out.slip_vertices = r
         .carry
         .iter()
@@ -1424,6 +1430,7 @@ mod tests {
             flip_volume: 0.0,
             collapses: 0,
             collapse_volume: 0.0,
+            moves: 0,
         };
         r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
         let mut w = v.clone();
