@@ -472,6 +472,8 @@ struct Refiner<'a> {
     collapses: usize,
     collapse_volume: f64,
     moves: usize,
+    /// The input's vertex count (its vertices are never collapsed away).
+    inputs: usize,
 }
 
 /// A point of the generalized rest mesh (see the module docs): a material rest point, or a
@@ -953,6 +955,7 @@ pub fn deform(
         collapses: 0,
         collapse_volume: 0.0,
         moves: 0,
+        inputs: rest.len(),
     };
     r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
     let mut w = rest.to_vec();
@@ -1431,6 +1434,7 @@ mod tests {
             collapses: 0,
             collapse_volume: 0.0,
             moves: 0,
+            inputs: v.len(),
         };
         r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
         let mut w = v.clone();

@@ -45,11 +45,6 @@
 //! `m` is `(1 − τ) X_a + τ X_b` and its blend `(1 − τ) s_a + τ s_b`.
 
 use glam::DVec3;
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-pub static WHY: [AtomicUsize; 10] = [const { AtomicUsize::new(0) }; 10];
-fn why(i: usize) {
-    WHY[i].fetch_add(1, Relaxed);
-}
 
 use super::{MAX_VALENCE, NONE, Refiner, Topology, min_angle};
 use crate::deform::slip::{self, Carry};
@@ -209,14 +204,19 @@ impl Refiner<'_> {
     ) -> Option<(Plan, Vec<usize>, Vec<usize>)> {
         let topo = &self.topo;
         let (a, b) = topo.ends(h);
-        let (Carry::Surface(s_a), Carry::Surface(s_b)) = (self.carry[a], self.carry[b]) else {
-            why(0);
+        // the survivor is a point of the strip; the other end is one too, or a new vertex of
+        // a side's material (never a vertex of the input)
+        let Carry::Surface(s_a) = self.carry[a] else {
             return None;
         };
-        let Some((sa, sb)) = topo.collapsible(h) else {
-            why(1);
+        if b < self.inputs {
             return None;
+        }
+        let s_b = match self.carry[b] {
+            Carry::Surface(s) => s,
+            _ => s_a,
         };
+        let (sa, sb) = topo.collapsible(h)?;
         let t = topo.twin[h];
         let (f, g) = (h / 3, t / 3);
         let mut region: Vec<usize> = sa.iter().chain(&sb).map(|&e| e / 3).collect();
@@ -256,7 +256,6 @@ impl Refiner<'_> {
                 1.0
             };
             if !((r0 + sigma * (r1 - r0)).abs() <= REST_FLAT * scale3) {
-                why(3);
                 return None;
             }
             xa.lerp(xb, sigma)
@@ -293,17 +292,15 @@ impl Refiner<'_> {
                 after = after.min(x);
                 slivers_after += usize::from(x < SLIVER);
             }
-            if !(after > before || (slivers_after < slivers_before && after >= 0.5 * before)) {
-                why(4);
-                return false;
-            }
+            let sharper =
+                after > before || (slivers_after < slivers_before && after >= 0.5 * before);
+            let kept_angles = after >= 0.5 * before && slivers_after <= slivers_before;
             let ratio2 = self.opts.ratio * self.opts.ratio;
             for &e in sa.iter().chain(&sb) {
                 let v = topo.ends(e).1;
                 if v != a && v != b {
                     let rest2 = rest.distance_squared(self.rest[v]).max(self.mean2);
                     if x.distance_squared(w[v]) > ratio2 * rest2 {
-                        why(5);
                         return false;
                     }
                 }
@@ -353,8 +350,8 @@ impl Refiner<'_> {
                     folds_new += usize::from(c < FOLD_COS);
                 }
             }
-            if worst_new < worst_old.min(FOLD_COS) || folds_new > folds_old {
-                why(6);
+            let unfolded = worst_new >= worst_old.min(FOLD_COS) && folds_new <= folds_old;
+            if !((sharper && unfolded) || (kept_angles && folds_new < folds_old)) {
                 return false;
             }
             true
@@ -400,7 +397,6 @@ impl Refiner<'_> {
             }
         }
         if !(v.abs() <= COLLAPSE_VOLUME * scale3) {
-            why(2);
             return None;
         }
 
@@ -460,9 +456,7 @@ impl Refiner<'_> {
         let ratio2 = self.opts.ratio * self.opts.ratio;
         let scale3 = self.mean2 * self.mean2.sqrt();
         for lambda in [1.0, 0.5, 0.25] {
-            let Some((x, _)) = slip::project(self.field, o.lerp(centroid, lambda), time) else {
-                return None;
-            };
+            let (x, _) = slip::project(self.field, o.lerp(centroid, lambda), time)?;
             let change = (x - o).dot(g);
             if !(change.abs() <= COLLAPSE_VOLUME * scale3) {
                 continue;
@@ -472,7 +466,7 @@ impl Refiner<'_> {
                 .iter()
                 .map(|&q| angle(topo.faces[q].map(place)))
                 .fold(f64::INFINITY, f64::min);
-            if !(after > before) {
+            if !(after >= 0.5 * before) {
                 continue;
             }
             let long = star.iter().any(|&h| {
@@ -499,7 +493,10 @@ impl Refiner<'_> {
                     folds_new += usize::from(c < FOLD_COS);
                 }
             }
-            if worst_new < worst_old.min(FOLD_COS) || folds_new > folds_old {
+            let unfolded = worst_new >= worst_old.min(FOLD_COS) && folds_new <= folds_old;
+            if !((after > before && unfolded)
+                || (folds_new < folds_old && after >= before.min(SLIVER)))
+            {
                 continue;
             }
             return Some((x, change));
@@ -507,43 +504,68 @@ impl Refiner<'_> {
         None
     }
 
+    /// Whether face `q` has a smallest angle under [`SLIVER`] or is folded against a
+    /// neighbour (a dihedral angle over 120°).
+    fn bad(&self, w: &[DVec3], q: usize) -> bool {
+        let t = self.topo.faces[q].map(|v| w[v]);
+        if min_angle(t[0], t[1], t[2]) < SLIVER {
+            return true;
+        }
+        let n = unit_normal(t);
+        (3 * q..3 * q + 3).any(|e| {
+            let o = self.topo.twin[e] / 3;
+            n.dot(unit_normal(self.topo.faces[o].map(|v| w[v]))) < FOLD_COS
+        })
+    }
+
+    /// The faces with a vertex on a slip surface that are [`Refiner::bad`], by their smallest
+    /// angle.
+    fn bad_faces(&self, w: &[DVec3]) -> Vec<(f64, usize)> {
+        let mut out: Vec<(f64, usize)> = (0..self.topo.faces.len())
+            .filter(|&q| {
+                self.topo.faces[q]
+                    .iter()
+                    .any(|&v| matches!(self.carry[v], Carry::Surface(_)))
+                    && self.bad(w, q)
+            })
+            .map(|q| {
+                let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
+                (min_angle(p, r, s), q)
+            })
+            .collect();
+        out.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        out
+    }
+
     /// Collapse the slivers of the strips along slip surfaces at time `time` (see the module
     /// docs), with flips over the strips after each round; the vertices and faces that
     /// vanish are dropped from `w` and the refiner's arrays.
     pub(super) fn collapse_slivers(&mut self, w: &mut Vec<DVec3>, time: f64) {
-        let clock = std::time::Instant::now();
         let mut gone = vec![false; w.len()];
         for _ in 0..COLLAPSE_ROUNDS {
-            let carry = &self.carry;
-            let on_strip = |v: usize| matches!(carry[v], Carry::Surface(_));
-            let mut slivers: Vec<(f64, usize)> = (0..self.topo.faces.len())
-                .filter(|&q| self.topo.faces[q].iter().any(|&v| on_strip(v)))
-                .map(|q| {
-                    let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
-                    (min_angle(p, r, s), q)
-                })
-                .filter(|&(angle, _)| angle < SLIVER)
-                .collect();
-            if slivers.is_empty() {
+            let bad = self.bad_faces(w);
+            if bad.is_empty() {
                 break;
             }
-            slivers.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
             let mut dead = vec![false; self.topo.faces.len()];
             let before = self.collapses;
-            for &(_, q) in &slivers {
+            for &(_, q) in &bad {
                 if dead[q] {
                     continue;
                 }
-                let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
-                if !(min_angle(p, r, s) < SLIVER) {
+                if !self.bad(w, q) {
                     continue;
                 }
-                // the sliver's edges, shortest first
+                // the face's edges, shortest first, each collapsed either way
                 let mut edges: Vec<(f64, usize)> = (3 * q..3 * q + 3)
                     .map(|e| (super::len2(&self.topo, w, e), e))
                     .collect();
                 edges.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-                for (_, e) in edges {
+                let twins = edges
+                    .iter()
+                    .map(|&(_, e)| self.topo.twin[e])
+                    .collect::<Vec<_>>();
+                for e in edges.into_iter().map(|x| x.1).chain(twins) {
                     let Some((plan, _, sb)) = self.plan_collapse(w, e, time) else {
                         continue;
                     };
@@ -561,9 +583,8 @@ impl Refiner<'_> {
             self.topo.compact(&dead);
             // the slivers left: their vertices moved towards their neighbours' centroid
             let moved = self.moves;
-            for q in 0..self.topo.faces.len() {
-                let [p, r, s] = self.topo.faces[q].map(|v| w[v]);
-                if !(min_angle(p, r, s) < SLIVER) {
+            for (_, q) in self.bad_faces(w) {
+                if !self.bad(w, q) {
                     continue;
                 }
                 for e in 3 * q..3 * q + 3 {
@@ -575,17 +596,6 @@ impl Refiner<'_> {
                     }
                 }
             }
-            if std::env::var_os("SPINAL_WHY").is_some() {
-                eprintln!("moves {}", self.moves - moved);
-            }
-            if std::env::var_os("SPINAL_WHY").is_some() {
-                eprintln!(
-                    "round: slivers {} collapses {} why {:?}",
-                    slivers.len(),
-                    self.collapses - before,
-                    WHY.iter().map(|x| x.swap(0, Relaxed)).collect::<Vec<_>>()
-                );
-            }
             if self.collapses == before && self.moves == moved {
                 break;
             }
@@ -596,14 +606,7 @@ impl Refiner<'_> {
                         .any(|&v| matches!(self.carry[v], Carry::Surface(_)))
                 })
                 .collect();
-            let c2 = std::time::Instant::now();
             self.flip_touched(w);
-            if std::env::var_os("SPINAL_WHY").is_some() {
-                eprintln!("flip {:.3}", c2.elapsed().as_secs_f64());
-            }
-        }
-        if std::env::var_os("SPINAL_WHY").is_some() {
-            eprintln!("collapse total {:.3}", clock.elapsed().as_secs_f64());
         }
         // drop the vanished vertices, keeping the order of the others
         if gone.iter().any(|&g| g) {
