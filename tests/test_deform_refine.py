@@ -92,7 +92,8 @@ def test_d14_drag_of_a_small_sphere_is_bounded_and_fast():
     assert rep.converged == (rep.edges_over_threshold == 0)
     warned = [w for w in caught if issubclass(w.category, spinal.RefinementWarning)]
     assert len(warned) == (0 if rep.converged else 1)
-    assert 0 < rep.torn_vertices <= rep.vertices_added  # the tool's surface tears the mesh
+    # the tool's surface tears the mesh; vertices_added is net of the collapses along it
+    assert 0 < rep.torn_vertices <= rep.vertices_added + rep.collapses
     assert rep.converged and not warned, str(rep)
     assert rep.steps == DRAG.steps(1.0) == len(rep.step_vertices)
 

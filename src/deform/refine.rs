@@ -991,11 +991,14 @@ pub fn deform(
             })
             .collect();
         r.flip_touched(&w);
-        // the slivers flips cannot mend: collapses, each keeping the volume
-        let end = runs.last().map_or(r.start, |l| l.t0 + l.h * l.count as f64);
-        r.collapse_slivers(&mut w, end);
-        if let Some(last) = out.step_vertices.last_mut() {
-            *last = w.len();
+        // the slivers and folds flips cannot mend: collapses and moves, each keeping the
+        // volume, on a converged mesh (a refinement a bound stopped keeps every vertex it got)
+        if r.over_edges(&w).is_empty() {
+            let end = runs.last().map_or(r.start, |l| l.t0 + l.h * l.count as f64);
+            r.collapse_slivers(&mut w, end);
+            if let Some(last) = out.step_vertices.last_mut() {
+                *last = w.len();
+            }
         }
         out.time_refine += clock.elapsed().as_secs_f64();
     }
@@ -1031,7 +1034,7 @@ mod tests {
     use crate::deform::Translation;
 
     /// An octahedron subdivided `k` times and pushed onto the unit sphere.
-    fn sphere(k: usize) -> (Vec<DVec3>, Vec<[usize; 3]>) {
+    pub(super) fn sphere(k: usize) -> (Vec<DVec3>, Vec<[usize; 3]>) {
         let (mut v, mut f) = crate::math::mesh::fixtures::octahedron();
         for _ in 0..k {
             let mut mid = std::collections::HashMap::new();
@@ -1059,11 +1062,11 @@ mod tests {
 
     use crate::math::mesh::signed_volume as volume;
 
-    fn watertight(faces: &[[usize; 3]], n: usize) -> bool {
+    pub(super) fn watertight(faces: &[[usize; 3]], n: usize) -> bool {
         Topology::new(faces, n).is_ok_and(|t| t.twin.iter().all(|&x| x != NONE))
     }
 
-    fn drag(center: DVec3, radius: f64, velocity: DVec3) -> Field {
+    pub(super) fn drag(center: DVec3, radius: f64, velocity: DVec3) -> Field {
         Field::single(Translation {
             center,
             velocity,

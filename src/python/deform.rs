@@ -107,7 +107,7 @@ type DeformArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
     (
         (usize, usize, usize, bool, f64, f64, usize, usize),
-        (usize, f64, usize, f64),
+        (usize, f64, usize, usize, f64),
     ),
 );
 
@@ -115,7 +115,7 @@ type DeformArrays<'py> = (
 /// `(vertices, rest_vertices, faces, vertices after each step, (passes, torn vertices, edges
 /// over the threshold, bounded, integration seconds, refinement seconds, vertices on a slip
 /// surface, vertices at a torn edge's chord midpoint), (flips, their volume change, collapses,
-/// their volume change))`. `refine=None`
+/// moves, the volume change of the collapses and moves))`. `refine=None`
 /// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
 /// every step when given.
 #[pyfunction]
@@ -174,7 +174,13 @@ pub fn deform_mesh<'py>(
                 d.slip_vertices,
                 d.fallback,
             ),
-            (d.flips, d.flip_volume, d.collapses, d.collapse_volume),
+            (
+                d.flips,
+                d.flip_volume,
+                d.collapses,
+                d.moves,
+                d.collapse_volume,
+            ),
         ),
     ))
 }
