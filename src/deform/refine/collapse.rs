@@ -91,11 +91,11 @@ impl Topology {
     }
 
     /// Whether the edge of half-edge `h` (faces `[a, b, c]`, `[b, a, d]`) can be collapsed
-    /// without leaving the closed 2-manifolds: it has a twin, `c ≠ d`, `a` and `b` have no
-    /// common neighbour but `c` and `d` (the link condition), and `c` and `d` are not joined
-    /// (which also refuses the edges of a tetrahedron, whose contraction leaves two faces on
-    /// three vertices; a conservative test). Returns the stars of `a` and `b` (their
-    /// outgoing half-edges) when it can.
+    /// without leaving the closed 2-manifolds: it has a twin, `c ≠ d`, and the links of `a`
+    /// and `b` meet in the link of the edge only (Dey et al. §2): no common neighbour but `c`
+    /// and `d`, and not both faces `acd` and `bcd` (a tetrahedron, whose contraction leaves
+    /// two faces on three vertices). Returns the stars of `a` and `b` (their outgoing
+    /// half-edges) when it can.
     pub(super) fn collapsible(&self, h: usize) -> Option<(Vec<usize>, Vec<usize>)> {
         let t = self.twin[h];
         if t == NONE {
@@ -107,9 +107,15 @@ impl Topology {
             return None;
         }
         let (sa, sb) = (self.star(h)?, self.star(t)?);
-        // c and d joined too (the faces acd and bcd of a tetrahedron): the contraction would
-        // leave two faces on the same three vertices
-        if self.joined(3 * (h / 3) + (h % 3 + 2) % 3, d) != Some(false) {
+        // the edge (c, d) in both links (faces acd and bcd, as on a tetrahedron): the
+        // contraction would leave two faces on the same three vertices
+        let has_cd = |star: &[usize]| {
+            star.iter().any(|&e| {
+                let q = self.faces[e / 3];
+                q.contains(&c) && q.contains(&d)
+            })
+        };
+        if has_cd(&sa) && has_cd(&sb) {
             return None;
         }
         let around_b: Vec<usize> = sb.iter().map(|&e| self.ends(e).1).collect();
