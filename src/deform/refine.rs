@@ -84,6 +84,14 @@
 //!   over all flips is [`Deformed::flip_volume`]). On
 //!   the 10k-vertex drag this takes the band's faces with a smallest angle under 1° from
 //!   48% to 32% and the vertices from 2.66× to 2.34×, the volume change unchanged;
+//! * **collapses** — the slivers flips cannot mend (four vertices on one curve `Ψ(p, ·)`, or
+//!   the strip narrowed to a line where the torn curve runs along the slip) and the faces
+//!   folded back at the lip are collapsed after the integration, on a converged refinement:
+//!   edge collapses under the link condition with the survivor on the slip surface where it
+//!   keeps the enclosed volume, and moves of strip vertices towards their neighbours'
+//!   centroid (Hoppe et al., "Mesh optimization", SIGGRAPH 1993; see `refine/collapse.rs`). On the
+//!   10k-vertex drag the band's slivers go from 32% to 1.3%, the vertices from 2.34× to
+//!   1.90×, the volume change from −4.18e-5 to −4.22e-5;
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
 //!   When edges remain over the threshold at the end — a bound stopped the refinement — the
 //!   result says so (`bounded`, and the number of those edges).
@@ -236,11 +244,11 @@ pub struct Deformed {
     /// The change of the enclosed volume by the flips (the sum of their tetrahedra's signed
     /// volumes).
     pub flip_volume: f64,
-    /// Edges collapsed along slip surfaces after the integration (see [`collapse`]): each
+    /// Edges collapsed along slip surfaces after the integration (see `refine/collapse.rs`): each
     /// removes one vertex and two faces.
     pub collapses: usize,
     /// Vertices of slivers along slip surfaces moved towards their neighbours' centroid on the
-    /// surface after the collapses (see [`collapse`]).
+    /// surface after the collapses (see `refine/collapse.rs`).
     pub moves: usize,
     /// The change of the enclosed volume by the collapses and moves (each placed to keep it;
     /// the sum of what remains).

@@ -22,15 +22,21 @@
 //! kept (a vertex index is replaced inside it), and the two pairs of outer half-edges of the
 //! vanishing faces become twins.
 //!
-//! **Which collapses.** Only edges whose two ends are points of the strip (`Carry::Surface`),
-//! of faces with a smallest angle under [`SLIVER`], after the integration: the collapse
-//! must raise the smallest angle of the faces around `a` and `b` (Hoppe et al.'s energy
-//! replaced by the max-min angle of Lawson's flips, so collapses and flips pursue one
-//! measure), not fold (no edge around `m` may have a dihedral angle over 120° unless one
-//! as large was there before, and no more such edges than before), leave no edge over the
-//! refinement threshold (the refinement stays converged), keep the rest mesh's volume (its
-//! two rest points the same — the pair of one curve `Ψ(p, ·)` — or the rest faces around
-//! them flat, as for rest points inside one face of the input) and keep the enclosed volume.
+//! **Which collapses.** After the integration, on a converged refinement (a refinement that a
+//! bound stopped keeps every vertex it got), the edges of the faces with a vertex on the
+//! strip that are slivers (a smallest angle under [`SLIVER`]) or folded back against a
+//! neighbour (a dihedral angle over 120°), shortest first. The survivor `a` is a point of
+//! the strip (`Carry::Surface`); the vertex `b` that vanishes is one too, or a new vertex of
+//! a side's material at the lip, never a vertex of the input. The collapse must raise the
+//! smallest angle of the faces around `a` and `b` (Hoppe et al.'s energy replaced by the
+//! max-min angle of Lawson's flips, so that collapses and flips pursue one measure), or
+//! leave fewer slivers without halving it, and not fold (no dihedral angle around `m` over
+//! 120° unless one as large was there, no more such edges than before); or, failing that,
+//! leave fewer folded edges without more slivers nor halving the smallest angle. It must
+//! leave no edge over the refinement threshold (the refinement stays converged), keep the
+//! rest mesh's volume (the two rest points the same — a pair on one curve `Ψ(p, ·)` — or the
+//! rest point of `m` where the rest volume's change, affine along the rest edge, vanishes,
+//! within [`REST_FLAT`] × `ℓ̄³`) and keep the enclosed volume (below).
 //!
 //! **Placement.** The enclosed volume after the collapse is affine in the position `x` of
 //! `m`: `V(x) = V₀ + ∑ det(x, q, r)/6` over the kept faces `[m, q, r]` (Lindstrom and Turk,
@@ -40,9 +46,25 @@
 //! `Ψ(p, ·)` of the translation tool, a great circle of the tool's sphere, this is a point of
 //! that curve), and `τ ∈ [0, 1]` solves `V(x(τ)) = V` by regula falsi where the volume
 //! changes sign along the chord, else is the end that changes it least. A collapse is made
-//! only when the remaining change is at most [`COLLAPSE_VOLUME`] × `ℓ̄³`, the flips' bound
-//! (the sum over all collapses is [`super::Deformed::collapse_volume`]). The rest point of
-//! `m` is `(1 − τ) X_a + τ X_b` and its blend `(1 − τ) s_a + τ s_b`.
+//! only when the remaining change is at most [`COLLAPSE_VOLUME`] × `ℓ̄³` (for the unit sphere
+//! of mean edge 0.038 a thirtieth of the volume `≈ ℓ̄⁴/28` between one face and the sphere;
+//! the sum over all collapses and moves is [`super::Deformed::collapse_volume`]). Its blend
+//! is `(1 − τ) s_a + τ s_b` (`s_a` when `b` is material).
+//!
+//! **Moves.** A vertex of the strip of a sliver or fold left after a round of collapses is
+//! moved towards the centroid of its neighbours (a fraction 1, ½ or ¼ of the way, moved onto
+//! the surface: tangential Laplacian smoothing; Field, "Laplacian smoothing and Delaunay
+//! triangulations", 1988) where that passes the same tests; the volume's change `(x − W)·G`,
+//! `G` a third of the link's vector area, is second order in a tangential move. Rounds of
+//! collapses, moves and flips over the strip repeat while they change something, at most
+//! [`COLLAPSE_ROUNDS`] times.
+//!
+//! **Measured** on the 10,242-vertex icosphere dragged half a radius by a curl tool of radius
+//! 0.9 centred on its surface (9 steps): the band's faces with a smallest angle under 1° go
+//! from 32.3% (flips only) to 1.3%, its folded faces from 6,179 to 911, the vertices from
+//! 23,951 to 19,487 (4,464 collapses, 1,879 moves), the volume change from −4.18e-5 to
+//! −4.22e-5. The folds left are mostly at the lip between faces with vertices of a side's
+//! material, which no collapse with a survivor on the surface can move.
 
 use glam::DVec3;
 
