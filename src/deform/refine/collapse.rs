@@ -312,7 +312,18 @@ impl Refiner<'_> {
         };
         // the tests at a placement `x` with rest point `rest`
         let acceptable = |x: DVec3, rest: DVec3| {
-            // the smallest angle rises, and no edge grows over the threshold
+            // no edge grows over the threshold (the cheapest test first)
+            let ratio2 = self.opts.ratio * self.opts.ratio;
+            for &e in sa.iter().chain(&sb) {
+                let v = topo.ends(e).1;
+                if v != a && v != b {
+                    let rest2 = rest.distance_squared(self.rest[v]).max(self.mean2);
+                    if x.distance_squared(w[v]) > ratio2 * rest2 {
+                        return false;
+                    }
+                }
+            }
+            // the smallest angle rises
             let place = |v: usize| if v == a { x } else { w[v] };
             let angle = |p: [DVec3; 3]| min_angle(p[0], p[1], p[2]);
             let (mut before, mut slivers_before) = (f64::INFINITY, 0usize);
@@ -330,16 +341,6 @@ impl Refiner<'_> {
             let sharper =
                 after > before || (slivers_after < slivers_before && after >= 0.5 * before);
             let kept_angles = after >= 0.5 * before && slivers_after <= slivers_before;
-            let ratio2 = self.opts.ratio * self.opts.ratio;
-            for &e in sa.iter().chain(&sb) {
-                let v = topo.ends(e).1;
-                if v != a && v != b {
-                    let rest2 = rest.distance_squared(self.rest[v]).max(self.mean2);
-                    if x.distance_squared(w[v]) > ratio2 * rest2 {
-                        return false;
-                    }
-                }
-            }
 
             // no fold: the dihedral angles at the edges of the region's faces, before and after
             // (the outer half-edges of the vanishing faces pair up as in Topology::collapse)
@@ -577,6 +578,8 @@ impl Refiner<'_> {
     /// vanish are dropped from `w` and the refiner's arrays.
     pub(super) fn collapse_slivers(&mut self, w: &mut Vec<DVec3>, time: f64) {
         let mut gone = vec![false; w.len()];
+        // vertices moved or merged in a round: the flips after it go over their faces
+        let mut changed = vec![false; w.len()];
         for _ in 0..COLLAPSE_ROUNDS {
             let bad = self.bad_faces(w);
             if bad.is_empty() {
@@ -596,8 +599,14 @@ impl Refiner<'_> {
                     .map(|e| (super::len2(&self.topo, w, e), e))
                     .collect();
                 edges.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                // (the twin of an edge of two strip points is the same collapse, its ends renamed)
+                let strip = |v: usize| matches!(self.carry[v], Carry::Surface(_));
                 let twins = edges
                     .iter()
+                    .filter(|&&(_, e)| {
+                        let (a, b) = self.topo.ends(e);
+                        !(strip(a) && strip(b))
+                    })
                     .map(|&(_, e)| self.topo.twin[e])
                     .collect::<Vec<_>>();
                 for e in edges.into_iter().map(|x| x.1).chain(twins) {
@@ -610,6 +619,7 @@ impl Refiner<'_> {
                     self.carry[a] = Carry::Surface(plan.s);
                     self.topo.collapse(e, &sb, &mut dead);
                     gone[b] = true;
+                    changed[a] = true;
                     self.collapses += 1;
                     self.collapse_volume += plan.volume;
                     break;
@@ -624,7 +634,9 @@ impl Refiner<'_> {
                 }
                 for e in 3 * q..3 * q + 3 {
                     if let Some((x, change)) = self.plan_move(w, e, time) {
-                        w[self.topo.ends(e).0] = x;
+                        let v = self.topo.ends(e).0;
+                        w[v] = x;
+                        changed[v] = true;
                         self.moves += 1;
                         self.collapse_volume += change;
                         break;
@@ -635,12 +647,9 @@ impl Refiner<'_> {
                 break;
             }
             self.touched = (0..self.topo.faces.len())
-                .filter(|&q| {
-                    self.topo.faces[q]
-                        .iter()
-                        .any(|&v| matches!(self.carry[v], Carry::Surface(_)))
-                })
+                .filter(|&q| self.topo.faces[q].iter().any(|&v| changed[v]))
                 .collect();
+            changed.fill(false);
             self.flip_touched(w);
         }
         // drop the vanished vertices, keeping the order of the others
