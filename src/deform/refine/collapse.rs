@@ -61,8 +61,8 @@
 //!
 //! **Measured** on the 10,242-vertex icosphere dragged half a radius by a curl tool of radius
 //! 0.9 centred on its surface (9 steps): the band's faces with a smallest angle under 1° go
-//! from 32.3% (flips only) to 1.3%, its folded faces from 6,179 to 911, the vertices from
-//! 23,951 to 19,487 (4,464 collapses, 1,879 moves), the volume change from −4.18e-5 to
+//! from 32.3% (flips only) to 1.3%, its folded faces from 6,179 to 907, the vertices from
+//! 23,951 to 19,487 (4,464 collapses, 1,875 moves), the volume change from −4.18e-5 to
 //! −4.22e-5. The folds left are mostly at the lip between faces with vertices of a side's
 //! material, which no collapse with a survivor on the surface can move.
 
