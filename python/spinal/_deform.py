@@ -55,8 +55,8 @@ class DeformReport:
     Attributes
     ----------
     rest_volume : float
-        Volume of the rest mesh (refinement adds vertices on flat rest edges, so it is the
-        input's volume).
+        Volume of the rest mesh (refinement adds vertices on flat rest edges and the
+        ``collapses`` keep the rest volume, so it is the input's volume).
     volume : float
         Volume of the deformed mesh.
     relative_change : float
