@@ -92,7 +92,8 @@ def test_d14_drag_of_a_small_sphere_is_bounded_and_fast():
     assert rep.converged == (rep.edges_over_threshold == 0)
     warned = [w for w in caught if issubclass(w.category, spinal.RefinementWarning)]
     assert len(warned) == (0 if rep.converged else 1)
-    assert 0 < rep.torn_vertices <= rep.vertices_added  # the tool's surface tears the mesh
+    # the tool's surface tears the mesh; vertices_added is net of the collapses along it
+    assert 0 < rep.torn_vertices <= rep.vertices_added + rep.collapses
     assert rep.converged and not warned, str(rep)
     assert rep.steps == DRAG.steps(1.0) == len(rep.step_vertices)
 
@@ -121,7 +122,8 @@ def test_d14_drag_of_a_10k_sphere_keeps_the_volume_within_the_vertex_bound():
     check_report(M, rep, V, F)
     assert rep.converged and rep.edges_over_threshold == 0, str(rep)
     assert not refinement_warnings
-    assert rep.chord_vertices == 0 and rep.slip_vertices > 10000
+    # 7,613 slip vertices (12,051 before the collapses along the strip)
+    assert rep.chord_vertices == 0 and rep.slip_vertices > 5000
 
 
 def octahedral_sphere(subdivisions):
@@ -414,7 +416,8 @@ def test_torn_edges_get_their_vertices_on_the_slip_surface(drag):
     """Across the tangential slip at a curl tool's surface the body's boundary runs along that
     surface between the two torn sides: the new vertices there are placed on it and carried
     along it with a blend of the two sides' velocities, which keeps them on it (measured: all
-    15,311 within 2.3e-16 of the moved tool's surface; keyframed: 15,251). Every other
+    15,311 within 2.3e-16 of the moved tool's surface; keyframed: 15,251; 7,613 and 7,607
+    after the collapses along the strip, whose survivors are moved on it). Every other
     vertex stays on the side of the surface its rest position lies on (the exact flow never
     crosses it) and is the flow of its rest position, except a handful right at the surface
     (measured 6 and 12 of ~11,900), where plain RK4 steps across the surface into the other
@@ -431,7 +434,7 @@ def test_torn_edges_get_their_vertices_on_the_slip_surface(drag):
     gap = np.linalg.norm(W - centre, axis=1) - 0.9
     rest_gap = np.linalg.norm(X - [0.0, 0.0, 0.9], axis=1) - 0.9
     on = np.abs(gap) < 1e-12
-    assert on.sum() == rep.slip_vertices > 10000
+    assert on.sum() == rep.slip_vertices > 5000
     assert not on[: len(s.vertices)].any() and rep.torn_vertices >= rep.slip_vertices
     assert np.all(np.any(W[on] != exact[on], axis=1))
     off = ~on
@@ -470,8 +473,9 @@ def test_the_drag_band_is_mostly_free_of_slivers():
     changing the volume by at most 1e-4 ℓ̄³) improve it: measured on icosphere(5) 32.3% of
     the band's 24,563 faces with a smallest angle under 1° and 6,179 folded-back band faces
     (without flips: 48.5% of 31,083 and 10,752), the volume change unchanged at −4.18e-5
-    with 23,951 vertices (27,211). Most of the slivers left have all four vertices of a pair
-    on one rest point's curve Ψ(p, ·), which no flip can mend."""
+    with 23,951 vertices (27,211). Most of the slivers left had all four vertices of a pair
+    on one rest point's curve Ψ(p, ·), which no flip can mend; the collapses after the
+    integration take them to 1.3% and 907 (tests/test_deform_collapse.py)."""
     s = trimesh.creation.icosphere(5)
     M, rep = spinal.deform(s, DRAG, 1.0)
     mesh = trimesh.Trimesh(M.vertices, M.faces, process=False)

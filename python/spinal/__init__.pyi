@@ -258,6 +258,11 @@ class DeformReport:
     timings: dict[str, float] | None = None
     slip_vertices: int = 0
     chord_vertices: int = 0
+    flips: int = 0
+    flip_volume: float = 0.0
+    collapses: int = 0
+    moves: int = 0
+    collapse_volume: float = 0.0
 
 class RefinementWarning(UserWarning): ...
 

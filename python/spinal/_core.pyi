@@ -367,7 +367,10 @@ def deform_mesh(
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
-    tuple[int, int, int, bool, float, float],
+    tuple[
+        tuple[int, int, int, bool, float, float, int, int],
+        tuple[int, float, int, int, float],
+    ],
 ]: ...
 def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...
 def mesh_measure(

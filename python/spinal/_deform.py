@@ -9,7 +9,11 @@ by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow 
 apart (the tangential slip at the surface of a curl tool) the body's boundary runs along the
 tool's surface between the two torn sides: the new vertex goes halfway along that path, onto
 the material of one side or onto the tool's surface, where it moves with a blend of the two
-sides' velocities (``DeformReport.slip_vertices``). The work is bounded by
+sides' velocities (``DeformReport.slip_vertices``). Edge flips along that strip, and after
+the integration edge collapses and vertex moves on the tool's surface (Hoppe et al., "Mesh
+optimization", SIGGRAPH 1993), remove the slivers and folds that the strip's few rest points
+give, keeping the mesh closed and consistently wound and its volume (``DeformReport.flips``,
+``collapses``, ``moves``). The work is bounded by
 ``max_vertices`` and ``max_passes``; when edges remain too long at the end the report says so
 and a :class:`RefinementWarning` is emitted.
 """
@@ -51,8 +55,8 @@ class DeformReport:
     Attributes
     ----------
     rest_volume : float
-        Volume of the rest mesh (refinement adds vertices on flat rest edges, so it is the
-        input's volume).
+        Volume of the rest mesh (refinement adds vertices on flat rest edges and the
+        ``collapses`` keep the rest volume, so it is the input's volume).
     volume : float
         Volume of the deformed mesh.
     relative_change : float
@@ -63,7 +67,8 @@ class DeformReport:
         per step taken), and ``spinal.advect(rest_vertices, field, duration, steps)``
         reproduces them.
     vertices_added : int
-        Vertices added by the refinement, over ``passes`` passes.
+        Vertices added by the refinement, over ``passes`` passes, less the ``collapses``
+        (``len(mesh.vertices) − len(input vertices)``).
     passes : int
         Refinement passes that split at least one edge.
     integration_error : float or None
@@ -115,8 +120,32 @@ class DeformReport:
         farther than a quarter of the edge from the chord midpoint (a flow that the steps do
         not resolve): the chord midpoint, moved onto the nearest slip surface when one passes
         within the edge's length.
+    flips : int
+        Edges flipped along a tool's surface: the strip of the surface between the torn sides
+        is filled by vertices of few rest points each, which bisection joins into slivers; an
+        edge there is flipped where that raises the smaller smallest angle of its two
+        triangles (Lawson's max-min angle flips), keeping the mesh closed and consistently
+        wound, not folding, keeping the rest mesh's volume and changing the volume by at most
+        1e-4 × the cube of the mean rest edge.
+    flip_volume : float
+        The change of the volume by the flips (the sum of their tetrahedra's signed volumes).
+    collapses : int
+        Edges collapsed along a tool's surface after the integration, each removing a vertex
+        and two faces (Hoppe et al., "Mesh optimization", SIGGRAPH 1993): the edges of faces
+        with a smallest angle under 1° or folded back against a neighbour (dihedral angle over
+        120°) whose flips could not mend them. A collapse keeps the mesh closed, 2-manifold
+        and consistently wound (the link condition), raises the faces' smallest angle or
+        removes slivers or folds without creating others, leaves no edge over the threshold
+        and keeps the rest mesh's volume; the surviving vertex lies on the tool's surface, at
+        the point of the edge (moved onto the surface) that keeps the enclosed volume, within
+        1e-3 × the cube of the mean rest edge. Only on a refinement that converged.
+    moves : int
+        Vertices of such faces left after the collapses that were moved on the tool's surface
+        towards the centroid of their neighbours (with the same tests).
+    collapse_volume : float
+        The change of the volume by the collapses and moves (the sum of what each left).
     step_vertices : ndarray (steps,) int64 or None
-        Vertex count after each integration step.
+        Vertex count after each integration step (the last one after the collapses).
     timings : dict or None
         Wall time in seconds of each phase: ``"integrate"`` (the mesh's vertices),
         ``"refine"`` (edge tests, new vertices, splits), ``"volume"``, ``"estimate"``.
@@ -139,6 +168,11 @@ class DeformReport:
     timings: dict | None = _dc_field(default=None, repr=False, compare=False)
     slip_vertices: int = 0
     chord_vertices: int = 0
+    flips: int = 0
+    flip_volume: float = 0.0
+    collapses: int = 0
+    moves: int = 0
+    collapse_volume: float = 0.0
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
@@ -170,7 +204,11 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     its normal part there) the body's boundary runs along the tool's surface between the
     torn sides: the new vertex goes halfway along that path, onto one side's material or onto
     the tool's surface, which it then follows with a blend of the two sides' velocities (see
-    ``DeformReport.torn_vertices``). ``refine=None`` only advects.
+    ``DeformReport.torn_vertices``). Slivers and folded faces along that strip are mended by
+    edge flips during the integration and, on a converged refinement, by edge collapses and
+    vertex moves on the tool's surface afterwards, each keeping the mesh closed and
+    consistently wound and its volume (``DeformReport.flips``, ``collapses``, ``moves``).
+    ``refine=None`` only advects.
 
     The work is bounded: at most ``max_vertices`` vertices and ``max_passes`` passes after
     each step. When edges remain too long at the end because a bound stopped the refinement,
@@ -240,7 +278,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     finally:
         if bar:
             bar[0][1]()
-    passes, torn, over, bounded, t_int, t_ref, on_slip, chord = stats
+    (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
+        (flips, flip_volume, collapses, moves, collapse_volume) = stats
     clock = time.perf_counter()
     rest, vol = _volume(Vr, Fr), _volume(W, Fr)
     change = vol / rest - 1 if rest != 0 else float("nan")
@@ -268,7 +307,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
             f"step); raise max_vertices or max_passes"), stacklevel=2)
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
-                          counts, timings, on_slip, chord)
+                          counts, timings, on_slip, chord, flips, flip_volume, collapses,
+                          moves, collapse_volume)
     return Mesh(W, Fr), report
 
 

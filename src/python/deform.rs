@@ -105,13 +105,17 @@ type DeformArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray1<i64>>,
-    (usize, usize, usize, bool, f64, f64, usize, usize),
+    (
+        (usize, usize, usize, bool, f64, f64, usize, usize),
+        (usize, f64, usize, usize, f64),
+    ),
 );
 
 /// Deform a closed mesh along a field, refining after every step (see `deform::refine`):
 /// `(vertices, rest_vertices, faces, vertices after each step, (passes, torn vertices, edges
 /// over the threshold, bounded, integration seconds, refinement seconds, vertices on a slip
-/// surface, vertices at a torn edge's chord midpoint))`. `refine=None`
+/// surface, vertices at a torn edge's chord midpoint), (flips, their volume change, collapses,
+/// moves, the volume change of the collapses and moves))`. `refine=None`
 /// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
 /// every step when given.
 #[pyfunction]
@@ -160,14 +164,23 @@ pub fn deform_mesh<'py>(
         PyArray1::from_vec(py, faces).reshape([nf, 3])?,
         PyArray1::from_vec(py, counts),
         (
-            d.passes,
-            d.torn,
-            d.over_threshold,
-            d.bounded,
-            d.time_integrate,
-            d.time_refine,
-            d.slip_vertices,
-            d.fallback,
+            (
+                d.passes,
+                d.torn,
+                d.over_threshold,
+                d.bounded,
+                d.time_integrate,
+                d.time_refine,
+                d.slip_vertices,
+                d.fallback,
+            ),
+            (
+                d.flips,
+                d.flip_volume,
+                d.collapses,
+                d.moves,
+                d.collapse_volume,
+            ),
         ),
     ))
 }
