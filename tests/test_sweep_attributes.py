@@ -362,3 +362,67 @@ def test_concatenate_chunks_equals_whole_bundle():
     assert ab.point_data == {} and ab.normals is None and ab.sample_of is None
     with pytest.raises(TypeError, match="meshes: expected a non-empty sequence"):
         spinal.Mesh.concatenate([])
+
+
+def _as_bundles(curves):
+    """The same bundle as a list, a float32 list and (if nibabel is there) an ArraySequence."""
+    forms = {"list": curves, "float32": [c.astype(np.float32) for c in curves]}
+    try:
+        import nibabel as nib
+        forms["ArraySequence"] = nib.streamlines.ArraySequence(curves)
+    except ImportError:
+        pass
+    return forms
+
+
+def test_estimate_tangents_of_a_curve_list():
+    curves = bundle([30, 8, 17], seed=11)
+    lengths = [len(c) for c in curves]
+    for form, seq in _as_bundles(curves).items():
+        flat = np.concatenate([np.asarray(c, dtype=float) for c in seq])
+        np.testing.assert_array_equal(spinal.estimate_tangents(seq),
+                                      spinal.estimate_tangents(flat, lengths=lengths),
+                                      err_msg=form)
+        np.testing.assert_array_equal(
+            spinal.estimate_tangents(seq, method="circle"),
+            spinal.estimate_tangents(flat, method="circle", lengths=lengths), err_msg=form)
+    # a one-curve list is a bundle of one curve, not the curve's rows
+    np.testing.assert_array_equal(spinal.estimate_tangents([curves[0]]),
+                                  spinal.estimate_tangents(curves[0], lengths=[30]))
+    with pytest.raises(TypeError, match="lengths, offsets: not accepted with a sequence"):
+        spinal.estimate_tangents(curves, lengths=lengths)
+    with pytest.raises(ValueError, match=r"points\[1\]: expected an array of shape \(n, 3\)"):
+        spinal.estimate_tangents([curves[0], curves[1][:, :2]])
+
+
+def test_steered_frames_of_a_curve_list():
+    """Every steered path of frames (guide, constraints, previous, twist_rule, per-interval
+    turns) takes a curve sequence as the concatenated rows with lengths=."""
+    curves = bundle([30, 8, 17], seed=12)
+    lengths = [len(c) for c in curves]
+    n = sum(lengths)
+    flat = np.concatenate(curves)
+    prev = spinal.frames(flat + 0.01, lengths=lengths)
+    cons = [{0: (0.0, 0.0, 1.0), -1: (0.0, 1.0, 0.0)}, None, {3: (1.0, 0.0, 0.0)}]
+    calls = {
+        "guide": {"guide": (0.0, 0.0, 1.0)},
+        "guide per row": {"guide": np.tile([0.0, 1.0, 0.2], (n, 1))},
+        "constraints": {"constraints": cons},
+        "previous": {"previous": prev},
+        "previous_twist": {"previous": prev, "previous_twist": True},
+        "twist_rule": {"end": (0.0, 0.0, 1.0), "twist_rule": "min_angular_speed"},
+        "turns per interval": {"constraints": cons, "turns": [1]},
+    }
+    for form, seq in _as_bundles(curves).items():
+        rows = np.concatenate([np.asarray(c, dtype=float) for c in seq])
+        for what, kw in calls.items():
+            ref = spinal.frames(rows, lengths=lengths, **kw)
+            np.testing.assert_array_equal(spinal.frames(seq, **kw), ref,
+                                          err_msg=f"{form}, {what}")
+        tg = [spinal.estimate_tangents(c) for c in curves]
+        np.testing.assert_array_equal(
+            spinal.frames(seq, tg, guide=(0.0, 0.0, 1.0)),
+            spinal.frames(rows, np.concatenate(tg), lengths=lengths, guide=(0.0, 0.0, 1.0)),
+            err_msg=form)
+    with pytest.raises(TypeError, match="lengths, offsets: not accepted with a sequence"):
+        spinal.frames(curves, lengths=lengths, guide=(0.0, 0.0, 1.0))
