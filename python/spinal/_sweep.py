@@ -188,9 +188,11 @@ def sweep(
     ValueError, TypeError
         Bad shapes, non-finite values, repeated consecutive points, a self-intersecting or
         zero-area profile, non-positive scale, frames that are not rotations or whose
-        tangent runs against the spine (frames of the reversed curve), tangents of the
-        wrong shape or of zero length, ``tangents``/``tangent_rule`` together with ``frames``
-        (or with each other), and everything :func:`spinal.frames` refuses.
+        tangent at some row runs against the spine (a negative dot product with both
+        chords at the row, with the one chord at an open end: a reversed frame, or frames
+        of the reversed curve; the message names the row and, in a bundle, the curve),
+        tangents of the wrong shape or of zero length, ``tangents``/``tangent_rule``
+        together with ``frames`` (or with each other), and everything :func:`spinal.frames` refuses.
 
     Warns
     -----
