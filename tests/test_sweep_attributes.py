@@ -217,11 +217,42 @@ def test_short_curves_raise_or_are_skipped_and_reported():
     kept = spinal.tube([curves[0], curves[2], curves[4]], [0.1, 0.2, 0.3], 6)
     np.testing.assert_array_equal(mesh.vertices, kept.vertices)
     assert mesh.is_watertight
-    # a closed bundle needs 3 rows per curve; everything skipped gives an empty mesh
+    # everything skipped gives an empty mesh
     with pytest.warns(spinal.SkippedCurvesWarning, match="fewer than 2 points"):
         empty = spinal.tube([curves[1], curves[3]], 0.1, on_short="skip")
     assert len(empty.vertices) == 0 and empty.volume == 0.0
     np.testing.assert_array_equal(empty.skipped_curves, [0, 1])
+
+
+def test_short_closed_curves_are_skipped_below_three_points():
+    """closed=True needs 3 points per curve: 0-, 1- and 2-point curves are skipped (2-point
+    ones kept when open), and errors about kept curves name them as given."""
+    u = 2 * np.pi * np.arange(20) / 20
+    loop = np.c_[np.cos(u), np.sin(u), 0.1 * np.sin(2 * u)]
+    w = 2 * np.pi * np.arange(3) / 3
+    triangle = np.c_[np.cos(w), np.sin(w), np.zeros(3)] + 6  # equilateral
+    curves = [loop, loop[:2], loop[::2] + 3, loop[:1], np.zeros((0, 3)), triangle]
+    with pytest.raises(ValueError, match="points: curve 1 .*closed curve needs at least 3"):
+        spinal.tube(curves, 0.05, 6, closed=True)
+    with pytest.warns(spinal.SkippedCurvesWarning,
+                      match=r"left out 3 curve.* fewer than 3 points .*: 1, 3–4;") as rec:
+        mesh = spinal.tube(curves, 0.05, 6, closed=True, on_short="skip")
+    np.testing.assert_array_equal(rec[0].message.curves, [1, 3, 4])
+    np.testing.assert_array_equal(mesh.skipped_curves, [1, 3, 4])
+    assert set(mesh.curve_of) == {0, 2, 5}
+    kept = spinal.tube([loop, loop[::2] + 3, triangle], 0.05, 6, closed=True)
+    np.testing.assert_array_equal(mesh.vertices, kept.vertices)
+    np.testing.assert_array_equal(mesh.faces, kept.faces)
+    assert mesh.is_watertight  # closed tubes: no caps, and every curve's seam joined
+    # the same bundle open keeps the 2-point curve
+    with pytest.warns(spinal.SkippedCurvesWarning, match=r"fewer than 2 points .*: 3–4;"):
+        assert set(spinal.tube(curves, 0.05, 6, on_short="skip").curve_of) == {0, 1, 2, 5}
+    # an error about a kept curve names it and its rows as given, past the skipped ones
+    bad = curves[:5] + [loop[:3] * 2 + 6]
+    with (pytest.warns(spinal.SkippedCurvesWarning),
+          pytest.raises(ValueError, match=r"points: curve 5 \(rows 33 to 35\): the segment "
+                                          r"from row 2 to row 0 runs against its tangents")):
+        spinal.tube(bad, 0.05, 6, closed=True, on_short="skip")
 
 
 def test_fold_over_warning_names_curves_and_local_rows():
