@@ -169,3 +169,14 @@ def test_D23_sides_has_an_upper_bound(sides):
     """2**31 sides allocated 16 GiB; 2**62 and 2**70 gave numpy messages without the name."""
     with pytest.raises(ValueError, match=r"sides: at most 1,048,576 \(2\*\*20\) sides"):
         spinal.tube(TWO, 0.1, sides)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_D23_profile_vertices_have_an_upper_bound(closed):
+    """A profile of more than 2**24 vertices is refused by name (after a closed profile's
+    repeated first vertex is dropped: 2**24 + 2 rows then count 2**24 + 1)."""
+    rows = 2**24 + 1 + int(closed)
+    prof = np.zeros((rows, 2))
+    with pytest.raises(ValueError, match=r"profile: at most 16777216 vertices \(2\*\*24\), "
+                                         r"got 16777217"):
+        spinal.sweep(TWO, prof, profile_closed=closed)

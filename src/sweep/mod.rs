@@ -604,6 +604,20 @@ pub struct Layout {
     pub faces: usize,
 }
 
+impl Layout {
+    /// Whether every vertex index of the mesh fits a 32-bit signed integer (the faces can be
+    /// stored as int32): at most `i32::MAX` vertices, so 2³¹ vertices or more need int64.
+    pub fn indices_fit_i32(&self) -> bool {
+        indices_fit_i32(self.vertices)
+    }
+}
+
+/// Whether the indices `0..vertices` of a mesh of `vertices` vertices fit an `i32`, counted
+/// conservatively: at most `i32::MAX` (2³¹ − 1) vertices.
+pub fn indices_fit_i32(vertices: usize) -> bool {
+    vertices <= i32::MAX as usize
+}
+
 /// Output bytes at most per block of rings of [`sweep_one`], or per piece of the columns of
 /// a ring larger than this (one poll of the cancel hook per block or piece). A cold output array is faulted in as it is written: on a loaded 2-core machine a
 /// block of 4096 vertices (~0.5 MB with normals and uv) then took up to 0.12 s.
@@ -2249,6 +2263,26 @@ mod tests {
         assert_eq!((mesh.normals.len(), mesh.uv.len()), (v, v));
         let top = v as i64;
         assert!(mesh.faces.iter().flatten().all(|&i| (0..top).contains(&i)));
+    }
+
+    /// The faces of a float32 mesh are int32 up to 2³¹ − 1 vertices (its largest index,
+    /// 2³¹ − 2, is an `i32`) and int64 from 2³¹ vertices on (the largest counts included).
+    #[test]
+    fn faces_are_int32_below_two_to_the_31_vertices() {
+        for v in [0usize, 1, 3, 1 << 20, 2_147_483_646, 2_147_483_647] {
+            assert!(indices_fit_i32(v), "{v}");
+            assert!(v == 0 || i32::try_from(v - 1).is_ok());
+        }
+        for v in [2_147_483_648usize, 2_147_483_649, 4_294_967_295, usize::MAX] {
+            assert!(!indices_fit_i32(v), "{v}");
+        }
+        let lay = |vertices| Layout {
+            sizes: Vec::new(),
+            vertices,
+            faces: 0,
+        };
+        assert!(lay(2_147_483_647).indices_fit_i32());
+        assert!(!lay(2_147_483_648).indices_fit_i32());
     }
 
     /// A capped straight tube is a closed, consistently wound surface whose volume is that of
