@@ -217,11 +217,42 @@ def test_short_curves_raise_or_are_skipped_and_reported():
     kept = spinal.tube([curves[0], curves[2], curves[4]], [0.1, 0.2, 0.3], 6)
     np.testing.assert_array_equal(mesh.vertices, kept.vertices)
     assert mesh.is_watertight
-    # a closed bundle needs 3 rows per curve; everything skipped gives an empty mesh
+    # everything skipped gives an empty mesh
     with pytest.warns(spinal.SkippedCurvesWarning, match="fewer than 2 points"):
         empty = spinal.tube([curves[1], curves[3]], 0.1, on_short="skip")
     assert len(empty.vertices) == 0 and empty.volume == 0.0
     np.testing.assert_array_equal(empty.skipped_curves, [0, 1])
+
+
+def test_short_closed_curves_are_skipped_below_three_points():
+    """closed=True needs 3 points per curve: 0-, 1- and 2-point curves are skipped (2-point
+    ones kept when open), and errors about kept curves name them as given."""
+    u = 2 * np.pi * np.arange(20) / 20
+    loop = np.c_[np.cos(u), np.sin(u), 0.1 * np.sin(2 * u)]
+    w = 2 * np.pi * np.arange(3) / 3
+    triangle = np.c_[np.cos(w), np.sin(w), np.zeros(3)] + 6  # equilateral
+    curves = [loop, loop[:2], loop[::2] + 3, loop[:1], np.zeros((0, 3)), triangle]
+    with pytest.raises(ValueError, match="points: curve 1 .*closed curve needs at least 3"):
+        spinal.tube(curves, 0.05, 6, closed=True)
+    with pytest.warns(spinal.SkippedCurvesWarning,
+                      match=r"left out 3 curve.* fewer than 3 points .*: 1, 3–4;") as rec:
+        mesh = spinal.tube(curves, 0.05, 6, closed=True, on_short="skip")
+    np.testing.assert_array_equal(rec[0].message.curves, [1, 3, 4])
+    np.testing.assert_array_equal(mesh.skipped_curves, [1, 3, 4])
+    assert set(mesh.curve_of) == {0, 2, 5}
+    kept = spinal.tube([loop, loop[::2] + 3, triangle], 0.05, 6, closed=True)
+    np.testing.assert_array_equal(mesh.vertices, kept.vertices)
+    np.testing.assert_array_equal(mesh.faces, kept.faces)
+    assert mesh.is_watertight  # closed tubes: no caps, and every curve's seam joined
+    # the same bundle open keeps the 2-point curve
+    with pytest.warns(spinal.SkippedCurvesWarning, match=r"fewer than 2 points .*: 3–4;"):
+        assert set(spinal.tube(curves, 0.05, 6, on_short="skip").curve_of) == {0, 1, 2, 5}
+    # an error about a kept curve names it and its rows as given, past the skipped ones
+    bad = curves[:5] + [loop[:3] * 2 + 6]
+    with (pytest.warns(spinal.SkippedCurvesWarning),
+          pytest.raises(ValueError, match=r"points: curve 5 \(rows 33 to 35\): the segment "
+                                          r"from row 2 to row 0 runs against its tangents")):
+        spinal.tube(bad, 0.05, 6, closed=True, on_short="skip")
 
 
 def test_fold_over_warning_names_curves_and_local_rows():
@@ -362,3 +393,67 @@ def test_concatenate_chunks_equals_whole_bundle():
     assert ab.point_data == {} and ab.normals is None and ab.sample_of is None
     with pytest.raises(TypeError, match="meshes: expected a non-empty sequence"):
         spinal.Mesh.concatenate([])
+
+
+def _as_bundles(curves):
+    """The same bundle as a list, a float32 list and (if nibabel is there) an ArraySequence."""
+    forms = {"list": curves, "float32": [c.astype(np.float32) for c in curves]}
+    try:
+        import nibabel as nib
+        forms["ArraySequence"] = nib.streamlines.ArraySequence(curves)
+    except ImportError:
+        pass
+    return forms
+
+
+def test_estimate_tangents_of_a_curve_list():
+    curves = bundle([30, 8, 17], seed=11)
+    lengths = [len(c) for c in curves]
+    for form, seq in _as_bundles(curves).items():
+        flat = np.concatenate([np.asarray(c, dtype=float) for c in seq])
+        np.testing.assert_array_equal(spinal.estimate_tangents(seq),
+                                      spinal.estimate_tangents(flat, lengths=lengths),
+                                      err_msg=form)
+        np.testing.assert_array_equal(
+            spinal.estimate_tangents(seq, method="circle"),
+            spinal.estimate_tangents(flat, method="circle", lengths=lengths), err_msg=form)
+    # a one-curve list is a bundle of one curve, not the curve's rows
+    np.testing.assert_array_equal(spinal.estimate_tangents([curves[0]]),
+                                  spinal.estimate_tangents(curves[0], lengths=[30]))
+    with pytest.raises(TypeError, match="lengths, offsets: not accepted with a sequence"):
+        spinal.estimate_tangents(curves, lengths=lengths)
+    with pytest.raises(ValueError, match=r"points\[1\]: expected an array of shape \(n, 3\)"):
+        spinal.estimate_tangents([curves[0], curves[1][:, :2]])
+
+
+def test_steered_frames_of_a_curve_list():
+    """Every steered path of frames (guide, constraints, previous, twist_rule, per-interval
+    turns) takes a curve sequence as the concatenated rows with lengths=."""
+    curves = bundle([30, 8, 17], seed=12)
+    lengths = [len(c) for c in curves]
+    n = sum(lengths)
+    flat = np.concatenate(curves)
+    prev = spinal.frames(flat + 0.01, lengths=lengths)
+    cons = [{0: (0.0, 0.0, 1.0), -1: (0.0, 1.0, 0.0)}, None, {3: (1.0, 0.0, 0.0)}]
+    calls = {
+        "guide": {"guide": (0.0, 0.0, 1.0)},
+        "guide per row": {"guide": np.tile([0.0, 1.0, 0.2], (n, 1))},
+        "constraints": {"constraints": cons},
+        "previous": {"previous": prev},
+        "previous_twist": {"previous": prev, "previous_twist": True},
+        "twist_rule": {"end": (0.0, 0.0, 1.0), "twist_rule": "min_angular_speed"},
+        "turns per interval": {"constraints": cons, "turns": [1]},
+    }
+    for form, seq in _as_bundles(curves).items():
+        rows = np.concatenate([np.asarray(c, dtype=float) for c in seq])
+        for what, kw in calls.items():
+            ref = spinal.frames(rows, lengths=lengths, **kw)
+            np.testing.assert_array_equal(spinal.frames(seq, **kw), ref,
+                                          err_msg=f"{form}, {what}")
+        tg = [spinal.estimate_tangents(c) for c in curves]
+        np.testing.assert_array_equal(
+            spinal.frames(seq, tg, guide=(0.0, 0.0, 1.0)),
+            spinal.frames(rows, np.concatenate(tg), lengths=lengths, guide=(0.0, 0.0, 1.0)),
+            err_msg=form)
+    with pytest.raises(TypeError, match="lengths, offsets: not accepted with a sequence"):
+        spinal.frames(curves, lengths=lengths, guide=(0.0, 0.0, 1.0))

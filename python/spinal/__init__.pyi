@@ -108,7 +108,7 @@ def closing_angle(
     offsets: _Ints | None = None,
 ) -> float | _F: ...
 def estimate_tangents(
-    points: _Array,
+    points: _Array | _Curves,
     *,
     closed: bool = False,
     method: _TangentRule = "five_point_bounded",

@@ -71,6 +71,34 @@ def _analytic(curve: Curve, u: Any):
     )
 
 
+def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"):
+    """Sampled points and tangents as the core takes them: ``(pts, tgs, offs, bundle)``, rows
+    ``(N, 3)`` float64 (either may be ``None``), CSR offsets ``(C + 1,)`` and whether the
+    call is a bundle; a sequence of ``(n_i, 3)`` curves (any real dtype, nibabel's
+    ``ArraySequence``) is one bundle, as one array with ``lengths``/``offsets``."""
+    if is_curve_list(points) or (points is None and is_curve_list(tangents)):
+        # a sequence of curves: the rows back to back, the lengths from the sequence
+        pts, offs, bundle = (None, None, True) if points is None else as_curves(
+            points, lengths, offsets, points_arg)
+        tgs = None
+        if tangents is not None:
+            tgs, toffs, _ = as_curves(tangents, None, None, "tangents")
+            if offs is not None and not np.array_equal(toffs, offs):
+                raise ValueError("tangents: the curves must have the lengths of points'")
+            offs = toffs if offs is None else offs
+    else:
+        pts = None if points is None else as_points(points, points_arg)
+        tgs = None if tangents is None else as_points(tangents, "tangents")
+        offs = None
+    if pts is None and (tgs is None or reflection != "tangents"):
+        raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
+    rows = (pts if pts is not None else tgs).shape[0]
+    bundle = offs is not None
+    if offs is None:
+        offs, bundle = as_offsets(rows, lengths, offsets)
+    return pts, tgs, offs, bundle
+
+
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
              lengths, offsets, points_arg="points"):
     method = as_choice(method, "method", METHODS)
@@ -91,25 +119,8 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         return out, np.array([angle]), False
     if u is not None:
         raise TypeError("u: only used with an analytic curve from spinal.curves")
-    if is_curve_list(points) or (points is None and is_curve_list(tangents)):
-        # a sequence of curves: the rows back to back, the lengths from the sequence
-        pts, offs, bundle = (None, None, True) if points is None else as_curves(
-            points, lengths, offsets, points_arg)
-        tgs = None
-        if tangents is not None:
-            tgs, toffs, _ = as_curves(tangents, None, None, "tangents")
-            if offs is not None and not np.array_equal(toffs, offs):
-                raise ValueError("tangents: the curves must have the lengths of points'")
-            offs = toffs if offs is None else offs
-    else:
-        pts = None if points is None else as_points(points, points_arg)
-        tgs = None if tangents is None else as_points(tangents, "tangents")
-        offs = None
-    if pts is None and (tgs is None or reflection != "tangents"):
-        raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
-    rows = (pts if pts is not None else tgs).shape[0]
-    if offs is None:
-        offs, bundle = as_offsets(rows, lengths, offsets)
+    pts, tgs, offs, bundle = _sampled(points, tangents, reflection, lengths, offsets,
+                                      points_arg)
     curves = offs.size - 1
     iv, if_ = _orientation(initial, "initial", curves, bundle)
     ev, ef = _orientation(end, "end", curves, bundle)
@@ -391,16 +402,17 @@ def estimate_tangents(
     With 3–4 points the circle rule is used, with 2 points the chord. A closed curve may
     repeat its first point at the end (that row gets the first tangent). ``lengths`` /
     ``offsets``: many curves back to back, as in :func:`frames` (each curve estimated on
-    its own, in parallel; ``closed`` applies to every curve). Raises ValueError for NaN/inf,
+    its own, in parallel; ``closed`` applies to every curve); ``points`` may also be a list
+    (any sequence) of ``(n_i, 3)`` arrays, e.g. nibabel's ``ArraySequence``, whose tangents
+    come back to back in one array. Raises ValueError for NaN/inf,
     repeated consecutive points and cusps (the estimate vanishes), naming the row (and the
     curve, in a bundle).
     """
     method = as_choice(method, "method", TANGENT_RULES)
-    pts = as_points(points, "points")
     closed = as_bool(closed, "closed")
-    if lengths is None and offsets is None:
-        return _core.estimate_tangents(pts, closed, method)
-    offs, _ = as_offsets(pts.shape[0], lengths, offsets)
+    if not is_curve_list(points) and lengths is None and offsets is None:
+        return _core.estimate_tangents(as_points(points, "points"), closed, method)
+    pts, offs, _ = as_curves(points, lengths, offsets)
     return _core.estimate_tangents(pts, closed, method, offs)
 
 
@@ -434,15 +446,9 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     else:
         if u is not None:
             raise TypeError("u: only used with an analytic curve from spinal.curves")
-        pts = None if points is None else as_points(points, "points")
-        tgs = None if tangents is None else as_points(tangents, "tangents")
-        if pts is None and (tgs is None or reflection != "tangents"):
-            raise TypeError("points: required (only reflection='tangents' works from tangents "
-                            "alone)")
+        pts, tgs, offs, bundle = _sampled(points, tangents, reflection, lengths, offsets)
     rows = (pts if pts is not None else tgs).shape[0]
-    if uu is None:
-        offs, bundle = as_offsets(rows, lengths, offsets)
-    else:
+    if uu is not None:
         offs, bundle = np.array([0, rows], dtype=np.int64), False
     curves = offs.size - 1
     iv, if_ = _orientation(initial, "initial", curves, bundle)

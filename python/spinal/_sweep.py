@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -188,9 +189,11 @@ def sweep(
     ValueError, TypeError
         Bad shapes, non-finite values, repeated consecutive points, a self-intersecting or
         zero-area profile, non-positive scale, frames that are not rotations or whose
-        tangent runs against the spine (frames of the reversed curve), tangents of the
-        wrong shape or of zero length, ``tangents``/``tangent_rule`` together with ``frames``
-        (or with each other), and everything :func:`spinal.frames` refuses.
+        tangent at some row runs against the spine (a negative dot product with both
+        chords at the row, with the one chord at an open end: a reversed frame, or frames
+        of the reversed curve; the message names the row and, in a bundle, the curve),
+        tangents of the wrong shape or of zero length, ``tangents``/``tangent_rule``
+        together with ``frames`` (or with each other), and everything :func:`spinal.frames` refuses.
 
     Warns
     -----
@@ -287,12 +290,18 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         mesh.point_data = {k: a[:0] for k, (a, _) in pdata.items()}
         mesh._n_rows, mesh._n_curves = n, curves
         return mesh
-    fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
-    v, f, nrm, uv, folds, faces_per_curve = _core.sweep_mesh(
-        pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
-        profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
-        single, single, want_normals, want_uv, tg,
-    )
+    try:
+        fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
+        v, f, nrm, uv, folds, faces_per_curve = _core.sweep_mesh(
+            pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
+            profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
+            single, single, want_normals, want_uv, tg,
+        )
+    except ValueError as exc:
+        if keep_rows is None:
+            raise
+        # the core numbered the curves that were kept: back to the curves as given
+        raise ValueError(_as_given(str(exc), curve_ids, _orig_offsets(lens, n))) from None
     if folds.size and keep_rows is not None:  # back to the rows as given
         folds = np.flatnonzero(keep_rows)[folds]
     rings, _ = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
@@ -323,6 +332,15 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         small = curves <= np.iinfo(np.int32).max
         mesh._lazy_curve_id(curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
     return mesh
+
+
+def _as_given(msg: str, curve_ids: np.ndarray, starts: np.ndarray) -> str:
+    """``msg`` with its ``curve c (rows a to b)`` (curve ``c`` of the curves kept) naming the
+    curve and rows as given (``curve_ids[c]``; ``starts``: the given curves' first rows)."""
+    def given(m):
+        c = curve_ids[int(m.group(1))]
+        return f"curve {c} (rows {starts[c]} to {max(starts[c + 1], 1) - 1})"
+    return re.sub(r"curve (\d+) \(rows \d+ to \d+\)", given, msg, count=1)
 
 
 def _orig_offsets(lens, n: int) -> np.ndarray:

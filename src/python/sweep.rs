@@ -100,7 +100,7 @@ pub fn sweep_mesh<'py>(
         return Err(PyKeyboardInterrupt::new_err(()));
     };
     // int32 faces only where every index fits
-    let index32 = index32 && prep.layout.vertices <= i32::MAX as usize;
+    let index32 = index32 && prep.layout.indices_fit_i32();
     let job = Job {
         prep: &prep,
         normals,

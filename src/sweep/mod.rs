@@ -244,16 +244,34 @@ fn check_spine(
         true => against_spine(&s.points[..rings], s.frames, opts.closed, cancel),
         false => None,
     };
-    if let Some(i) = against {
-        let j = if i + 1 == rings { 0 } else { i + 1 };
-        return Err(InputError::new(
-            "frames",
-            format!(
-                "the tangent column t of rows {i} and {j} points against the spine (from \
-                 point {i} to point {j}): the sweep would be inside out; frames must be \
-                 computed for the points in their order (spinal.frames(points))"
-            ),
-        ));
+    let hint = "the sweep would be inside out there; frames must be computed for the points \
+                in their order (spinal.frames(points))";
+    match against {
+        Some(Against::Row(k)) => {
+            return Err(InputError::new(
+                "frames",
+                format!(
+                    "the tangent column t of row {k} points against the spine (negative \
+                     dot product with the chord{} at point {k}): {hint}",
+                    if opts.closed || (k > 0 && k + 1 < rings) {
+                        "s"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+        Some(Against::Segment(i)) => {
+            let j = if i + 1 == rings { 0 } else { i + 1 };
+            return Err(InputError::new(
+                "frames",
+                format!(
+                    "the tangent column t of rows {i} and {j} points against the spine (from \
+                     point {i} to point {j}): {hint}"
+                ),
+            ));
+        }
+        None => {}
     }
     if cancel() {
         return Ok(None);
@@ -290,9 +308,6 @@ fn check_spine(
     Ok(Some(Plan { size, arc }))
 }
 
-/// The first segment `i` (from sample `i` to the next) that runs against the tangents of
-/// both its ends, `(x_{i+1} − x_i)·t_i < 0` and `(x_{i+1} − x_i)·t_{i+1} < 0`: frames of the
-/// reversed curve, which would turn the mesh inside out.
 /// A row of the scale as the user gave it: one number for a radius (both factors equal),
 /// the pair otherwise.
 fn shown(v: DVec2) -> String {
@@ -303,30 +318,58 @@ fn shown(v: DVec2) -> String {
     }
 }
 
-/// Polls `cancel` before every block of segments and finds nothing in the blocks after it
-/// says stop.
+/// Where given frames point against the spine, which would turn the mesh there inside out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Against {
+    /// The tangent `t_k` of row `k` has a negative dot product with every chord at that row
+    /// (both `x_k − x_{k−1}` and `x_{k+1} − x_k`; the one chord at an open end): a reversed
+    /// frame. A tangent estimated from the points (any weighting of the two chords' unit
+    /// vectors) agrees with at least one of them, however tight the turn.
+    Row(usize),
+    /// The chord of segment `i` (from sample `i` to the next) runs against the tangents of
+    /// both its ends, `(x_{i+1} − x_i)·t_i < 0` and `(x_{i+1} − x_i)·t_{i+1} < 0`.
+    Segment(usize),
+}
+
+/// The first row `k` where the frames point against the spine ([`Against`]; a row's own
+/// test first, then the segment that starts there). Polls `cancel` before every block of
+/// rows and finds nothing in the blocks after it says stop.
 fn against_spine(
     x: &[DVec3],
     frames: &[[f64; 9]],
     closed: bool,
     cancel: Cancel<'_>,
-) -> Option<usize> {
+) -> Option<Against> {
     const BLOCK: usize = 1 << 14;
     let n = x.len();
-    let segments = if closed { n } else { n - 1 };
     let t = |k: usize| columns(&frames[k]).2;
-    (0..segments.div_ceil(BLOCK))
-        .into_par_iter()
-        .find_map_first(|b| {
-            if cancel() {
-                return None;
+    // the chord from row k to the next (None past the end of an open spine)
+    let chord = |k: usize| match (k + 1 == n, closed) {
+        (false, _) => Some(x[k + 1] - x[k]),
+        (true, true) => Some(x[0] - x[k]),
+        (true, false) => None,
+    };
+    let before = |k: usize| match (k, closed) {
+        (0, false) => None,
+        (0, true) => chord(n - 1),
+        _ => chord(k - 1),
+    };
+    (0..n.div_ceil(BLOCK)).into_par_iter().find_map_first(|b| {
+        if cancel() {
+            return None;
+        }
+        (b * BLOCK..((b + 1) * BLOCK).min(n)).find_map(|k| {
+            let tk = t(k);
+            let (cin, cout) = (before(k), chord(k));
+            let against = |c: Option<DVec3>| c.is_none_or(|c| c.dot(tk) < 0.0);
+            if (cin.is_some() || cout.is_some()) && against(cin) && against(cout) {
+                return Some(Against::Row(k));
             }
-            (b * BLOCK..((b + 1) * BLOCK).min(segments)).find(|&i| {
-                let j = if i + 1 == n { 0 } else { i + 1 };
-                let chord = x[j] - x[i];
-                chord.dot(t(i)) < 0.0 && chord.dot(t(j)) < 0.0
-            })
+            let j = if k + 1 == n { 0 } else { k + 1 };
+            cout.filter(|c| c.dot(tk) < 0.0 && c.dot(t(j)) < 0.0)
+                .map(|_| Against::Segment(k))
         })
+    })
 }
 
 /// The unit vector along a chord of the spine (zero for a zero chord), scaled by the largest
@@ -559,6 +602,20 @@ pub struct Layout {
     sizes: Vec<Size>,
     pub vertices: usize,
     pub faces: usize,
+}
+
+impl Layout {
+    /// Whether every vertex index of the mesh fits a 32-bit signed integer (the faces can be
+    /// stored as int32): at most `i32::MAX` vertices, so 2³¹ vertices or more need int64.
+    pub fn indices_fit_i32(&self) -> bool {
+        indices_fit_i32(self.vertices)
+    }
+}
+
+/// Whether the indices `0..vertices` of a mesh of `vertices` vertices fit an `i32`, counted
+/// conservatively: at most `i32::MAX` (2³¹ − 1) vertices.
+pub fn indices_fit_i32(vertices: usize) -> bool {
+    vertices <= i32::MAX as usize
 }
 
 /// Output bytes at most per block of rings of [`sweep_one`], or per piece of the columns of
@@ -2206,6 +2263,26 @@ mod tests {
         assert_eq!((mesh.normals.len(), mesh.uv.len()), (v, v));
         let top = v as i64;
         assert!(mesh.faces.iter().flatten().all(|&i| (0..top).contains(&i)));
+    }
+
+    /// The faces of a float32 mesh are int32 up to 2³¹ − 1 vertices (its largest index,
+    /// 2³¹ − 2, is an `i32`) and int64 from 2³¹ vertices on (the largest counts included).
+    #[test]
+    fn faces_are_int32_below_two_to_the_31_vertices() {
+        for v in [0usize, 1, 3, 1 << 20, 2_147_483_646, 2_147_483_647] {
+            assert!(indices_fit_i32(v), "{v}");
+            assert!(v == 0 || i32::try_from(v - 1).is_ok());
+        }
+        for v in [2_147_483_648usize, 2_147_483_649, 4_294_967_295, usize::MAX] {
+            assert!(!indices_fit_i32(v), "{v}");
+        }
+        let lay = |vertices| Layout {
+            sizes: Vec::new(),
+            vertices,
+            faces: 0,
+        };
+        assert!(lay(2_147_483_647).indices_fit_i32());
+        assert!(!lay(2_147_483_648).indices_fit_i32());
     }
 
     /// A capped straight tube is a closed, consistently wound surface whose volume is that of
