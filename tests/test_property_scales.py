@@ -221,3 +221,58 @@ def test_fields_scale(tool, seed, k, t):
     assert np.isfinite(got).all()
     assert np.abs(ref).max() > 0  # the points meet the tool
     np.testing.assert_allclose(got / s, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+def _sheet(rng, n=13):
+    """A random smooth height-field sheet over [-1, 1]² and a random smooth bend of it."""
+    x = np.linspace(-1, 1, n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    a = rng.uniform(-0.3, 0.3, 5)
+    rest = np.stack([X, Y, a[0] * X**2 + a[1] * Y**2 + a[2] * X * Y], -1)
+    b = rng.uniform(-0.3, 0.3, 4)
+    posed = np.stack([X * (1 + b[0] * Y), Y + b[1] * X, rest[..., 2] + b[2] * X**2
+                      - b[3] * Y**2], -1)
+    return rest, posed
+
+
+def _sheet_points(rng, rest, k=40, h=0.15):
+    """Points within h of the sheet's middle (above and below it)."""
+    i = rng.integers(2, rest.shape[0] - 2, (k, 2))
+    return rest[i[:, 0], i[:, 1]] + np.c_[rng.uniform(-0.05, 0.05, (k, 2)),
+                                         rng.uniform(-h, h, k)]
+
+
+@SETTINGS
+@given(SEEDS, st.integers(-300, 300), st.sampled_from(["offset", "none"]))
+def test_flesh_surface_scales(seed, k, solution):
+    """flesh_surface of a sheet, its bend and the points scaled by 10^k: the unscaled
+    answer times 10^k (or the same named error), never a NaN; the binding gives the same."""
+    rng = np.random.default_rng(seed)
+    s = 10.0**k
+    rest, posed = _sheet(rng)
+    V = _sheet_points(rng, rest)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # fold-over warnings: the same at every scale
+        same_or_named_error(
+            lambda: spinal.flesh_surface(V * s, rest * s, posed * s, solution=solution),
+            lambda: spinal.flesh_surface(V, rest, posed, solution=solution), back=s)
+        same_or_named_error(
+            lambda: spinal.SurfaceBinding(V * s, rest * s).deform(posed * s,
+                                                                  solution=solution),
+            lambda: spinal.flesh_surface(V, rest, posed, solution=solution), back=s)
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(SEEDS, st.sampled_from(["offset", "none"]))
+def test_flesh_surface_rigid_motion(seed, solution):
+    """A sheet moved rigidly (x ↦ Rx + c, R a random rotation) carries the bound points
+    with it: flesh_surface gives R V + c (an independent closed form), finite."""
+    rng = np.random.default_rng(seed)
+    rest, _ = _sheet(rng)
+    V = _sheet_points(rng, rest)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    R = q * np.sign(np.linalg.det(q))
+    c = rng.normal(size=3) * 3
+    out = spinal.flesh_surface(V, rest, rest @ R.T + c, solution=solution)
+    assert np.isfinite(out).all()
+    assert np.abs(out - (V @ R.T + c)).max() < 1e-9
