@@ -198,7 +198,9 @@ ARRAYS = {
 #: Parameters whose kind is not in the annotation/default: name -> kind, per callable
 #: (``"*"`` for every callable). Kinds: real, finite, count (int >= 0 or >= 1), int, bool, str.
 KINDS = {
-    "*": {"duration": "finite", "radius": "finite", "reach": "real", "rate": "finite",
+    "*": {"max_passes": "count", "max_segments": "count", "n_per_segment": "count",
+          "sides": "count", "resolution": "count", "iterations": "count",
+          "derivative": "count", "duration": "finite", "radius": "finite", "reach": "real", "rate": "finite",
           "steps": "count", "max_vertices": "count", "refine": "real", "progress": "bool",
           "angular_speed": "finite", "spacing": "finite", "speed": "finite", "major": "finite",
           "minor": "finite", "tol": "real", "segments": "count", "phi": "finite",
@@ -241,7 +243,8 @@ ACCEPTED = {
     ("*", "guide_weight"): {"inf": "the guide alone"},
     ("*", "dtype"): {"5": "a numpy dtype-like; checked by numpy with the name"},
     ("*", "n"): {"None": "the default (all threads)"},
-    ("*", "max_vertices"): {"None": "the default"},
+    ("*", "max_vertices"): {"None": "the default",
+                            "10**12": "a cap on the refinement: nothing is allocated for it"},
     ("*", "segments"): {"None": "the default (adaptive)"},
 }
 
@@ -279,7 +282,8 @@ def _bad_values(kind: str):
         return num + [("nan", math.nan), ("inf", math.inf), ("-inf", -math.inf)] + (
             [("-1", -1.0)] if kind == "finite" else [])
     if kind in ("int", "count"):
-        return num + [("1.5", 1.5), ("nan", math.nan), ("2**70", 2**70), ("-1", -1)]
+        return num + [("1.5", 1.5), ("nan", math.nan), ("2**70", 2**70), ("-1", -1)] + (
+            [("10**12", 10**12)] if kind == "count" else [])
     raise AssertionError(kind)
 
 
@@ -349,3 +353,49 @@ def test_bad_scalars_raise_named_errors(qual):
                 failures.append(f"{p.name}={label}: accepted")
     assert not unknown, f"{qual}: classify {unknown} in KINDS or ARRAYS"
     assert not failures, f"{qual}:\n  " + "\n  ".join(failures)
+
+
+# ---- the audit's reproducers -------------------------------------------------------------
+
+def _named(exc, name, call):
+    with pytest.raises(exc) as got:
+        call()
+    assert str(got.value).startswith(f"{name}:"), str(got.value)
+
+
+@pytest.mark.parametrize("bad", [math.nan, -1.0, 0.0, None, [1, 2]])
+def test_preimage_tol_is_blamed_not_control_points(bad):
+    _named((TypeError, ValueError), "tol", lambda: ph.preimage(CP, tol=bad))
+
+
+def test_audit_counts_are_bounded_and_named():
+    """Before: a numpy MemoryError without a name (10**12 samples), a > 200 s fit, 10**12
+    refinement passes accepted, ``u:`` for a count ``n``."""
+    import time
+
+    _named(ValueError, "n_per_segment", lambda: SPLINE.samples(10**12))
+    _named(ValueError, "n_per_segment", lambda: SPLINE.rmf(n_per_segment=10**12))
+    _named(ValueError, "n", lambda: curves.Helix().sample(10**12))
+    _named(ValueError, "n", lambda: curves.Helix().parameters(1))
+    t = time.perf_counter()
+    _named(ValueError, "max_segments",
+           lambda: ph.fit(curves.Helix(), tol=1e-300, max_segments=10**9))
+    assert time.perf_counter() - t < 1.0
+    _named(ValueError, "max_passes", lambda: spinal.deform(SPHERE, FIELD, 0.01, max_passes=10**12))
+
+
+def test_audit_types_and_values_are_named():
+    _named(TypeError, "duration", lambda: FIELD.steps("x"))
+    _named(TypeError, "duration", lambda: FIELD.steps(True))
+    _named(TypeError, "kind", lambda: fields.strip((0, 0, 0), (1, 0, 0), 0.2, (0.1, 0, 0),
+                                                   kind=5))
+    for call in (lambda: ph.is_ph(CP, tol=[1, 2]), lambda: ph.fit(curves.Helix(), tol=[1, 2])):
+        _named(TypeError, "tol", call)
+    for call in (lambda: SPLINE.rmf(omega_start=[1, 2]),
+                 lambda: SPLINE.angle([0.5], omega_start=[1, 2]),
+                 lambda: SPLINE.sweep(PROFILE, omega_start=[1, 2])):
+        _named(TypeError, "omega_start", call)
+    for p in (1.5, 0, -2, 2**70):
+        _named((TypeError, ValueError), "p", lambda p=p: curves.TorusKnot(p, 7))
+        _named((TypeError, ValueError), "q", lambda p=p: curves.TorusKnot(2, p))
+    _named(ValueError, "angle", lambda: curves.Helix().rmf(_u, angle=math.nan))
