@@ -48,7 +48,7 @@ def test_curve_bad_input():
         Polynomial([[0, 0, 0], [np.nan, 1, 0]])
     with pytest.raises(ValueError, match="u: contains non-finite"):
         Helix().point([0.0, np.nan])
-    with pytest.raises(ValueError, match="u: a sample count must be an integer >= 2"):
+    with pytest.raises(ValueError, match="n: a sample count must be at least 2"):
         Helix().parameters(1)
     with pytest.raises(TypeError, match="u: expected an array of real numbers"):
         Helix().point("x")

@@ -149,17 +149,130 @@ def test_quaternions_of_any_size(q, q2, k0, k1):
         np.testing.assert_allclose(np.abs(mid @ Q.slerp(q, q2, 0.3)), 1.0, atol=1e-12)
 
 
-@SETTINGS
-@given(SEEDS, st.integers(-150, 150))
-def test_fields_scale(seed, k):
-    """A translation tool and its points scaled alike: the velocity scales with them (the
-    falloff is a function of the ratios), finite everywhere."""
+def _unit(rng):
+    a = rng.normal(size=3)
+    return a / np.linalg.norm(a)
+
+
+def _ball_grid(c, radius, n=24):
+    """The signed distance of the ball (c, radius) sampled on n³ nodes over the cube of side
+    10·radius about c: (grid, origin, spacing)."""
+    h = 10 * radius / (n - 1)
+    o = c - 5 * radius
+    x = o[:, None] + h * np.arange(n)[None, :]
+    X = np.stack(np.meshgrid(x[0], x[1], x[2], indexing="ij"), -1)
+    return np.linalg.norm(X - c, axis=-1) - radius, o, h
+
+
+#: name -> builder(rng draws, s): the field of every constructor with positions, radii
+#: and speeds scaled by s (angular speeds unscaled, a twist rate (rad/(length·time)) by 1/s,
+#: a bend rate (rad/(length²·time)) by 1/s²). Velocities then scale by s.
+FIELD_BUILDERS = {
+    "translation": lambda d, s: fl.translation(d["c"] * s, 0.4 * s, d["u"] * s,
+                                               falloff_power=d["p"]),
+    "rotation": lambda d, s: fl.rotation(d["c"] * s, 0.4 * s, d["a"], d["w"],
+                                         falloff_power=d["p"]),
+    "sphere": lambda d, s: fl.sphere(d["c"] * s, 0.4 * s, d["u"] * s, blend=d["blend"]),
+    "capsule": lambda d, s: fl.capsule(d["c"] * s, (d["c"] + 0.6 * d["a"]) * s, 0.3 * s,
+                                       d["u"] * s, blend=d["blend"]),
+    "strip_along": lambda d, s: fl.strip(d["c"] * s, (d["c"] + d["a"]) * s, 0.3 * s,
+                                         d["a"] * d["w"] * s),
+    "strip_across": lambda d, s: fl.strip(d["c"] * s, (d["c"] + d["a"]) * s, 0.3 * s,
+                                          d["n"] * d["w"] * s, kind="across"),
+    "torus": lambda d, s: fl.torus(d["c"] * s, d["a"], 0.5 * s, 0.15 * s, d["w"] * s),
+    "twist": lambda d, s: fl.twist(d["c"] * s, d["a"], d["w"] / s, 0.6 * s, form=d["form"]),
+    "bend": lambda d, s: fl.bend(d["c"] * s, d["a"], d["w"] / s**2, 0.6 * s, form=d["form"]),
+    "rod": lambda d, s: fl.rod(d["axis"] * s, 0.2 * s, velocity=d["u"] * s),
+    "strip_curve": lambda d, s: fl.strip_curve(d["axis"] * s, 0.3 * s, d["w"] * s),
+    "along_path": lambda d, s: fl.along_path(d["axis"] * s, 0.3 * s, 2.0, kind="twist",
+                                             rate=d["w"] / s),
+    "sdf_tool": lambda d, s: fl.sdf_tool(d["grid"][0] * s, d["grid"][1] * s,
+                                         d["grid"][2] * s, d["u"] * s, reach=0.6 * s),
+    "sdf_curl": lambda d, s: fl.sdf_curl(d["grid"][0] * s, d["grid"][1] * s,
+                                         d["grid"][2] * s, angular_velocity=d["a"] * d["w"],
+                                         reach=0.6 * s),
+}
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(SEEDS, st.integers(-150, 150), st.floats(0.0, 0.3))
+@pytest.mark.parametrize("tool", sorted(FIELD_BUILDERS))
+def test_fields_scale(tool, seed, k, t):
+    """Every field constructor with its positions, radii and speeds scaled alike: the
+    velocity at the scaled points (and time) is the unscaled velocity times s (each falloff
+    is a function of ratios of lengths), finite everywhere."""
     rng = np.random.default_rng(seed)
     s = 10.0**k
-    center, vel = rng.normal(size=3), rng.normal(size=3)
-    pts = center + rng.normal(size=(20, 3)) * 0.5
-    f, fs = fl.translation(center, 0.3, vel), fl.translation(center * s, 0.3 * s, vel * s)
-    ref = f(pts)
-    got = fs(pts * s)
+    c = rng.normal(size=3)
+    a = _unit(rng)
+    n = np.cross(a, _unit(rng))
+    u = np.linspace(0, 1, 9)
+    d = {"c": c, "u": rng.normal(size=3), "a": a, "n": n / np.linalg.norm(n),
+         "w": rng.uniform(0.5, 2.0) * rng.choice([-1, 1]), "p": int(rng.choice([2, 4])),
+         "blend": str(rng.choice(["c1", "linear"])), "form": str(rng.choice(["rate", "curl"])),
+         "axis": c + np.c_[u, 0.3 * np.sin(2 * u), 0.2 * u**2] @ np.linalg.qr(
+             rng.normal(size=(3, 3)))[0],
+         "grid": _ball_grid(c, 0.3)}
+    f, fs = FIELD_BUILDERS[tool](d, 1.0), FIELD_BUILDERS[tool](d, s)
+    pts = c + rng.normal(size=(30, 3)) * 0.4
+    pts[15:] += d["u"] * t  # about a tool moving with u
+    ref = np.concatenate([f(pts, 0.0), f(pts, t)])
+    got = np.concatenate([fs(pts * s, 0.0), fs(pts * s, t * 1.0)])
     assert np.isfinite(got).all()
-    np.testing.assert_allclose(got / s, ref, rtol=1e-9, atol=1e-12)
+    assert np.abs(ref).max() > 0  # the points meet the tool
+    np.testing.assert_allclose(got / s, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+
+
+def _sheet(rng, n=13):
+    """A random smooth height-field sheet over [-1, 1]² and a random smooth bend of it."""
+    x = np.linspace(-1, 1, n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    a = rng.uniform(-0.3, 0.3, 5)
+    rest = np.stack([X, Y, a[0] * X**2 + a[1] * Y**2 + a[2] * X * Y], -1)
+    b = rng.uniform(-0.3, 0.3, 4)
+    posed = np.stack([X * (1 + b[0] * Y), Y + b[1] * X, rest[..., 2] + b[2] * X**2
+                      - b[3] * Y**2], -1)
+    return rest, posed
+
+
+def _sheet_points(rng, rest, k=40, h=0.15):
+    """Points within h of the sheet's middle (above and below it)."""
+    i = rng.integers(2, rest.shape[0] - 2, (k, 2))
+    return rest[i[:, 0], i[:, 1]] + np.c_[rng.uniform(-0.05, 0.05, (k, 2)),
+                                         rng.uniform(-h, h, k)]
+
+
+@SETTINGS
+@given(SEEDS, st.integers(-300, 300), st.sampled_from(["offset", "none"]))
+def test_flesh_surface_scales(seed, k, solution):
+    """flesh_surface of a sheet, its bend and the points scaled by 10^k: the unscaled
+    answer times 10^k (or the same named error), never a NaN; the binding gives the same."""
+    rng = np.random.default_rng(seed)
+    s = 10.0**k
+    rest, posed = _sheet(rng)
+    V = _sheet_points(rng, rest)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # fold-over warnings: the same at every scale
+        same_or_named_error(
+            lambda: spinal.flesh_surface(V * s, rest * s, posed * s, solution=solution),
+            lambda: spinal.flesh_surface(V, rest, posed, solution=solution), back=s)
+        same_or_named_error(
+            lambda: spinal.SurfaceBinding(V * s, rest * s).deform(posed * s,
+                                                                  solution=solution),
+            lambda: spinal.flesh_surface(V, rest, posed, solution=solution), back=s)
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(SEEDS, st.sampled_from(["offset", "none"]))
+def test_flesh_surface_rigid_motion(seed, solution):
+    """A sheet moved rigidly (x ↦ Rx + c, R a random rotation) carries the bound points
+    with it: flesh_surface gives R V + c (an independent closed form), finite."""
+    rng = np.random.default_rng(seed)
+    rest, _ = _sheet(rng)
+    V = _sheet_points(rng, rest)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    R = q * np.sign(np.linalg.det(q))
+    c = rng.normal(size=3) * 3
+    out = spinal.flesh_surface(V, rest, rest @ R.T + c, solution=solution)
+    assert np.isfinite(out).all()
+    assert np.abs(out - (V @ R.T + c)).max() < 1e-9

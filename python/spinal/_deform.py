@@ -39,6 +39,8 @@ __all__ = ["DeformReport", "RefinementWarning", "StampReport", "deform", "stamp"
 # bounds of the stamper's work: frames per call, secant corrections per frame
 MAX_FRAMES = 1_000_000
 MAX_ITERATIONS = 1000
+#: Each refinement pass halves the longest edges: 1000 passes is beyond any useful refinement.
+MAX_PASSES = 1000
 
 
 class RefinementWarning(UserWarning):
@@ -223,7 +225,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     field, duration, steps, t0 : as in :func:`spinal.advect`.
     refine : float ≥ 1 or None
         The split threshold τ (default 1.5, Zheng's "1.5 × the mean initial edge length").
-    max_passes : int ≥ 0
+    max_passes : int in 0 … 1000
         Refinement passes after each step (each splits a set of edges with disjoint
         triangles).
     max_vertices : int, optional
@@ -251,9 +253,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {n}")
     if refine is not None:
         refine = as_real(refine, "refine")  # the core checks refine ≥ 1
-    max_passes = as_int(max_passes, "max_passes")
-    if max_passes < 0:
-        raise ValueError(f"max_passes: must be ≥ 0, got {max_passes}")
+    max_passes = as_int(max_passes, "max_passes", 0, MAX_PASSES, out_of_bounds=lambda x: (
+        f"must be ≥ 0 and at most {MAX_PASSES}, got {x}"))
     if max_vertices is None:
         max_vertices = 8 * len(V)
     else:

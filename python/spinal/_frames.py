@@ -12,10 +12,12 @@ from ._validate import (
     as_bool,
     as_choice,
     as_curves,
+    as_finite,
     as_float_array,
     as_int,
     as_offsets,
     as_points,
+    as_real,
     is_curve_list,
 )
 from .curves import Curve
@@ -320,6 +322,14 @@ def frames(
     (200, 3, 3)
     """
     previous_twist = as_bool(previous_twist, "previous_twist")
+    # checked even when no guide or previous uses them (the same bounds as the core's)
+    guide_weight = as_real(guide_weight, "guide_weight")
+    if not 0.0 < guide_weight < np.inf:
+        raise ValueError(f"guide_weight: must be a positive finite number, got {guide_weight}")
+    guide_tolerance = as_finite(guide_tolerance, "guide_tolerance", 0.0)
+    if not guide_tolerance < np.pi / 2:
+        raise ValueError(f"guide_tolerance: must be an angle in [0, π/2) radians, got "
+                         f"{guide_tolerance}")
     if previous_twist and previous is None:
         raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
     if (constraints is not None or guide is not None or previous is not None

@@ -190,6 +190,10 @@ def as_positive(x: Any, name: str) -> float:
 #: Integers reach the core as 64-bit values.
 INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
+#: The most samples a count argument may ask for (``n`` points, parameters, steps): 10⁸
+#: rows of float64 ``(n, 3)`` are 2.4 GB, beyond which a count is a typo, not a request.
+MAX_SAMPLES = 100_000_000
+
 
 def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None, *,
            out_of_bounds=None) -> int:

@@ -22,9 +22,12 @@ import math
 
 import numpy as np
 
-from ._validate import as_finite, as_float_array, as_int, as_positive
+from ._validate import MAX_SAMPLES, as_finite, as_float_array, as_int, as_positive
 
 __all__ = ["Bezier", "Curve", "Helix", "Polynomial", "TorusKnot", "Viviani"]
+
+#: The largest winding number of a :class:`TorusKnot` (its third derivative grows as ``q³``).
+_MAX_WINDINGS = 1_000_000
 
 
 def _u(u) -> np.ndarray:
@@ -65,9 +68,9 @@ class Curve:
 
     def parameters(self, n: int) -> np.ndarray:
         """``n`` uniformly spaced parameters over :attr:`domain` (both ends included)."""
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-            raise ValueError(f"u: a sample count must be an integer >= 2, got {n!r}")
-        return np.linspace(self.domain[0], self.domain[1], as_int(n, "u"))
+        n = as_int(n, "n", 2, MAX_SAMPLES, out_of_bounds=lambda x: (
+            f"a sample count must be at least 2 and at most {MAX_SAMPLES:,}, got {x}"))
+        return np.linspace(self.domain[0], self.domain[1], n)
 
     def sample(self, n: int) -> np.ndarray:
         """``n`` points at uniformly spaced parameters over :attr:`domain`."""
@@ -139,6 +142,7 @@ class Helix(Curve):
         turned back by the integrated torsion (Wang et al. 2008, Eq. 3). ``angle`` is the
         angle of ``r`` from the principal normal ``N`` at ``u[0]``.
         """
+        angle = as_finite(angle, "angle")
         uu = _u(u)
         f = self.frenet(uu)
         c = math.hypot(self.a, self.b)
@@ -157,7 +161,10 @@ class TorusKnot(Curve):
     closed = True
 
     def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3):
-        as_finite(p, "p"), as_finite(q, "q")  # real numbers (integers for a closed knot)
+        # positive integers: the curve closes after u = 2π only then
+        p, q = (as_int(v, k, 1, _MAX_WINDINGS, out_of_bounds=lambda x: (
+            f"the winding number must be a positive integer at most {_MAX_WINDINGS:,}, got {x}"))
+            for v, k in ((p, "p"), (q, "q")))
         R, r = as_finite(R, "R"), as_finite(r, "r")
         if not (R > 0 and r > 0):
             raise ValueError("R, r: radii must be positive")

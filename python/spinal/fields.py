@@ -58,7 +58,16 @@ import numpy as np
 from . import _core
 from ._core import Field
 from ._mesh import mesh_arrays
-from ._validate import as_bool, as_float_array, as_int, as_points, as_real, as_vector
+from ._validate import (
+    as_bool,
+    as_finite,
+    as_float_array,
+    as_int,
+    as_points,
+    as_positive,
+    as_real,
+    as_vector,
+)
 
 __all__ = [
     "Field",
@@ -418,9 +427,7 @@ def _sdf_samples(grid, origin, spacing):
     if a.size > 300**3:
         raise ValueError(f"grid: {a.size} nodes is too many (at most 300³)")
     o = as_vector(origin, "origin")
-    h = as_real(spacing, "spacing")
-    if not h > 0:
-        raise ValueError(f"spacing: must be positive, got {h}")
+    h = as_positive(spacing, "spacing")
     return np.array(a, dtype=np.float64), o, h
 
 
@@ -563,7 +570,7 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
     if f.shape != (len(x), 3, 3):
         raise ValueError(f"frames: expected shape {(len(x), 3, 3)}, got {f.shape}")
     return _core.field_path(x, np.ascontiguousarray(f), as_real(radius, "radius"),
-                            as_real(duration, "duration"), kind, tool, as_real(rate, "rate"),
+                            as_real(duration, "duration"), kind, tool, as_finite(rate, "rate"),
                             as_real(t0, "t0"), _opt(reach, "reach"), _power(falloff_power),
                             blend)
 

@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._validate import as_bool, as_float_array, as_int
+from ._validate import MAX_SAMPLES, as_bool, as_finite, as_float_array, as_int, as_positive, as_real
 
 __all__ = [
     "PHSpline",
@@ -168,7 +168,7 @@ def is_ph(control_points, tol: float = 1e-9):
     Returns a bool for ``(4, 3)`` input, a bool array ``(m,)`` for ``(m, 4, 3)``.
     """
     cp, single = _cubics(control_points)
-    out = _core.ph_is_ph(cp, float(as_float_array(tol, "tol")))
+    out = _core.ph_is_ph(cp, as_real(tol, "tol"))  # value: the core
     return bool(out[0]) if single else out
 
 
@@ -213,8 +213,9 @@ def preimage(control_points, *, scalar_first: bool = False, tol: float = 1e-9):
     (the cubic is not PH). Returns ``(A0, A1)``, each ``(4,)`` or ``(m, 4)``.
     """
     sf = as_bool(scalar_first, "scalar_first")
+    tol = as_positive(tol, "tol")
     cp, single = _cubics(control_points)
-    rows = _core.ph_preimage(cp, float(as_float_array(tol, "tol")), not single)
+    rows = _core.ph_preimage(cp, tol, not single)
     q0, q1 = rows[:, 0:4], rows[:, 4:8]
     if not sf:
         q0, q1 = np.roll(q0, -1, axis=1), np.roll(q1, -1, axis=1)
@@ -298,8 +299,8 @@ def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = N
     if not single:
         raise ValueError("control_points: expected one cubic (4, 3); use PHSpline.angle_fit")
     _core.ph_check_spline(cp, np.arange(2.0), True)
-    om = float(as_float_array(omega_start, "omega_start"))
-    ph = None if phi is None else float(as_float_array(phi, "phi"))
+    om = as_finite(omega_start, "omega_start")
+    ph = None if phi is None else as_finite(phi, "phi")
     rows = _core.ph_frame_setup(cp, None, om, ph)
     return _fit_dict(rows, True)
 
@@ -511,7 +512,10 @@ class PHSpline:
 
     def samples(self, n_per_segment: int = 16) -> np.ndarray:
         """``m·n + 1`` uniformly spaced spline parameters ``s`` (the joints included)."""
-        n = as_int(n_per_segment, "n_per_segment", minimum=1)
+        most = max(1, (MAX_SAMPLES - 1) // self.segments)
+        n = as_int(n_per_segment, "n_per_segment", 1, most, out_of_bounds=lambda x: (
+            f"must be at least 1 and at most {most:,} ({self.segments} cubics, at most "
+            f"{MAX_SAMPLES:,} samples), got {x}"))
         return np.linspace(0.0, self.segments, self.segments * n + 1)
 
     def parameter(self, u) -> np.ndarray:
@@ -541,7 +545,7 @@ class PHSpline:
         return np.ascontiguousarray(r)
 
     def _frames(self, s, mode, initial, omega_start):
-        om = float(as_float_array(omega_start, "omega_start"))
+        om = as_finite(omega_start, "omega_start")
         return _core.ph_frames(self._cp, self._s(s), mode, self._initial(initial), om, None)
 
     def frenet(self, s) -> np.ndarray:
@@ -583,7 +587,7 @@ class PHSpline:
     def angle_fit(self, *, initial=None, omega_start: float = 0.0) -> dict:
         """Per-cubic data of the rational angle function (see :func:`angle_fit`; the start
         as in :meth:`rmf`). Values are ``(m,)`` arrays, ``beta``/``gamma`` ``(m, 3)``."""
-        om = float(as_float_array(omega_start, "omega_start"))
+        om = as_finite(omega_start, "omega_start")
         rows = _core.ph_frame_setup(self._cp, self._initial(initial), om, None)
         return _fit_dict(rows, False)
 
@@ -884,7 +888,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
     given = [x is not None for x in (tol, segments, knots)]
     if sum(given) > 1:
         raise TypeError("tol, segments, knots: pass at most one of them")
-    max_segments = as_int(max_segments, "max_segments")
+    max_segments = as_int(max_segments, "max_segments", 1, _MAX_FIT_SEGMENTS)
     analytic = isinstance(curve, Curve)
     if analytic:
         if tangents is not None:
@@ -950,9 +954,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         sp.deviation = deviation(cp, k)
         return sp
 
-    tol = 1e-5 * diag if tol is None else float(as_float_array(tol, "tol"))
-    if not (tol > 0 and np.isfinite(tol)):
-        raise ValueError(f"tol: must be positive and finite, got {tol}")
+    tol = 1e-5 * diag if tol is None else as_positive(tol, "tol")
     k = _initial_knots(curve, pts, data, analytic, lo, hi, diag)
     h_min = 1e-6 * (hi - lo) if analytic else 1.0
     # work queue, processed in batches

@@ -173,14 +173,17 @@ impl Falloff {
         if !(e > 0.0) {
             return None;
         }
-        let (ep, rp) = match p {
-            2 => (e, reach * reach),
-            3 => (e * e, reach * reach * reach),
-            _ => (e * e * e, (reach * reach) * (reach * reach)),
+        // k = (e/R)^{p−1}/R: the ratio e/R ∈ (0, 1] keeps R^p from overflowing (or
+        // underflowing) at any scale of the tool
+        let q = e / reach;
+        let qp = match p {
+            2 => q,
+            3 => q * q,
+            _ => q * q * q,
         };
         let pf = p as f64;
         Some(Falloff {
-            k: ep / rp,
+            k: qp / reach,
             e,
             ps: if d < 0.0 { -pf } else { pf },
         })

@@ -39,29 +39,22 @@ use super::{Tool, bounded, falloff as falloff_power, finite, finite3, positive, 
 use crate::error::Result;
 use crate::math::rotation::rodrigues;
 
-/// `(R − |d|)^(p−1)` and `(R − |d|)` for `|d| < R`, `None` outside the support.
+/// `((R − |d|)/R)^(p−1)` and `e = R − |d|` for `|d| < R`, `None` outside the support. The
+/// factor `e^{p−1}/R^p` of the curl fields is the first value over `R`: written with the
+/// ratio `e/R ∈ (0, 1]`, it neither overflows nor underflows at any scale of the tool.
 #[inline(always)]
 fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
     let e = reach - d.abs();
     if !(e > 0.0) {
         return None;
     }
-    let ep = match p {
-        2 => e,
-        3 => e * e,
-        _ => e * e * e,
+    let q = e / reach;
+    let qp = match p {
+        2 => q,
+        3 => q * q,
+        _ => q * q * q,
     };
-    Some((ep, e))
-}
-
-/// `R^p` for `p ∈ {2, 3, 4}` (no `powi` call in the hot path).
-#[inline(always)]
-fn pow_p(r: f64, p: u8) -> f64 {
-    match p {
-        2 => r * r,
-        3 => r * r * r,
-        _ => (r * r) * (r * r),
-    }
+    Some((qp, e))
 }
 
 /// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
@@ -126,7 +119,7 @@ impl Translation {
             return DVec3::ZERO;
         };
         let u = self.velocity;
-        let k = ep / pow_p(self.reach, self.power);
+        let k = ep / self.reach; // e^{p−1}/R^p
         if !(r > 0.0) {
             return u * (k * e);
         }
@@ -152,7 +145,7 @@ impl Translation {
         let Some((ep, e)) = falloff(d, self.reach, self.power) else {
             return glam::DMat3::ZERO;
         };
-        let k = -0.5 / pow_p(self.reach, self.power);
+        let k = -0.5 / self.reach; // with ep = (e/R)^{p−1}: −1/(2R^p) · R^{p−1}
         let u = self.velocity;
         let phi = ep * e;
         let sg = if d < 0.0 { -1.0 } else { 1.0 };
@@ -271,7 +264,7 @@ impl Rotation {
             return DVec3::ZERO;
         };
         let y = x - self.pivot;
-        let k = ep / (3.0 * pow_p(self.reach, self.power));
+        let k = ep / (3.0 * self.reach); // e^{p−1}/(3R^p)
         let swirl = self.omega.cross(y) * (3.0 * e);
         if !(rc > 0.0) {
             return k * swirl;

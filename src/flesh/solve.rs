@@ -353,3 +353,79 @@ mod tests {
         }
     }
 }
+
+/// Property tests (proptest) of the radial solve: the root, its branch, the inverse of the
+/// unbend step and the scale freedom.
+#[cfg(test)]
+mod proptests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// `2/√27`: the fold limit of `α m³ + m² − 1` for `α < 0`.
+    const LIMIT: f64 = 0.384_900_179_459_750_5;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(500))]
+
+        /// Within the limit the ratio is a root on the increasing (fold-free) branch
+        /// `3αm + 2 > 0`, in `(0, 1)` for `α > 0` and in `[1, −2/(3α)]` for `α < 0`; the
+        /// fast path agrees with the safeguarded iteration.
+        #[test]
+        fn radial_ratio_is_the_fold_free_root(alpha in -LIMIT * 0.999_999..50.0f64) {
+            let (m, ok) = radial_ratio(alpha);
+            prop_assert!(ok);
+            let f = (alpha * m + 1.0) * m * m - 1.0;
+            prop_assert!(f.abs() < 1e-13, "f({m}) = {f}");
+            prop_assert!(3.0 * alpha * m + 2.0 > 0.0);
+            if alpha > 0.0 {
+                prop_assert!(m > 0.0 && m < 1.0);
+            } else {
+                prop_assert!(m >= 1.0 && m <= -2.0 / (3.0 * alpha) + 1e-15);
+            }
+            let (ms, _) = radial_ratio_safe(alpha);
+            prop_assert!((m - ms).abs() < 1e-14 * m.max(1.0), "{m} {ms}");
+        }
+
+        /// Past the limit: the focal ratio `−2/(3α)`, reported.
+        #[test]
+        fn radial_ratio_past_the_limit_is_clamped(alpha in -1e6..-LIMIT * 1.000_001) {
+            let (m, ok) = radial_ratio(alpha);
+            prop_assert!(!ok);
+            prop_assert!((m + 2.0 / (3.0 * alpha)).abs() < 1e-15 * m);
+        }
+
+        /// Bending back by the curvature that was unbent (no stretch) returns the point:
+        /// `r* = r0 √(1 − ⅔ c)` has the root `r1 = r0` of `r1²(1 − ⅔ r1 κ cos θ) = r*²` on
+        /// the fold-free branch iff `c = κ r0 cos θ < 1`. With a stretch λ the bent point
+        /// solves that cubic for `r_t = |d|/√λ`, and the solve is free of scale.
+        #[test]
+        fn radial_bend_inverts_unbend_and_solves_the_cubic(
+            d in (-1.0..1.0f64, -1.0..1.0f64), k in (-2.0..2.0f64, -2.0..2.0f64),
+            lam in 0.25..4.0f64, e in -900i32..900,
+        ) {
+            let (d, k) = (DVec2::new(d.0, d.1), DVec2::new(k.0, k.1));
+            prop_assume!(d.length() > 1e-3);
+            let mut flags = 0u8;
+            if d.dot(k) < 0.95 {
+                let u = unbend(Solution::Radial, d, k, &mut flags);
+                let back = bend(Solution::Radial, u, k, 1.0, &mut flags);
+                prop_assert_eq!(flags, 0);
+                prop_assert!((back - d).length() < 1e-12 * d.length(), "{back} {d}");
+            }
+            let mut flags = 0u8;
+            let b = bend(Solution::Radial, d, k, lam, &mut flags);
+            if flags == 0 {
+                let (r1, rt) = (b.length(), d.length() / lam.sqrt());
+                let c = b.dot(k); // κ r1 cos θ1 (the angle is kept)
+                prop_assert!(b.perp_dot(d).abs() < 1e-12 * d.length_squared());
+                let res = r1 * r1 * (1.0 - (2.0 / 3.0) * c) - rt * rt;
+                prop_assert!(res.abs() < 1e-12 * rt * rt, "residual {res}");
+            }
+            let s = crate::math::scale::ldexp(1.0, e);
+            let mut f2 = 0u8;
+            let bs = bend(Solution::Radial, d * s, k / s, lam, &mut f2);
+            prop_assert_eq!(flags, f2);
+            prop_assert!((bs / s - b).length() < 1e-13 * b.length().max(1e-300));
+        }
+    }
+}

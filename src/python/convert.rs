@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
-use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use super::threads;
@@ -336,6 +336,25 @@ pub fn quat_array<'py>(py: Python<'py>, q: Vec<DQuat>) -> PyResult<Bound<'py, Py
     PyArray1::from_vec(py, bytemuck::allocation::cast_vec::<DQuat, f64>(q)).reshape([n, 4])
 }
 
+/// Read a real number (not a bool, not a string): `"{arg}: expected a real number, got T"`
+/// otherwise. The value is not checked here.
+pub fn real(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<f64> {
+    let ty = || {
+        obj.get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string())
+    };
+    if obj.is_instance_of::<pyo3::types::PyBool>() || obj.is_instance_of::<pyo3::types::PyString>()
+    {
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: expected a real number, got {}",
+            ty()
+        )));
+    }
+    obj.extract::<f64>()
+        .map_err(|_| PyTypeError::new_err(format!("{arg}: expected a real number, got {}", ty())))
+}
+
 /// Read a string option: `"{arg}: unknown {what} 'x'; expected 'a', 'b' or 'c'"` when it is
 /// not one of `choices` (listed in that order).
 pub fn choice<T: Copy>(
@@ -344,15 +363,23 @@ pub fn choice<T: Copy>(
     what: &str,
     choices: &[(&str, T)],
 ) -> PyResult<T> {
-    let s: &str = obj.extract()?;
-    if let Some(&(_, v)) = choices.iter().find(|(name, _)| *name == s) {
-        return Ok(v);
-    }
     let names: Vec<String> = choices.iter().map(|(n, _)| format!("'{n}'")).collect();
     let list = match names.split_last() {
         Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
         _ => names.join(""),
     };
+    let Ok(s) = obj.extract::<&str>() else {
+        let ty = obj
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string());
+        return Err(PyTypeError::new_err(format!(
+            "{arg}: expected a string, {list}, got {ty}"
+        )));
+    };
+    if let Some(&(_, v)) = choices.iter().find(|(name, _)| *name == s) {
+        return Ok(v);
+    }
     Err(value_error(format!(
         "{arg}: unknown {what} {s:?}; expected {list}"
     )))

@@ -11,7 +11,9 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use super::convert::{choice, detach_in_pool, empty, slice_mut, slice_of, value_error, vec3s};
+use super::convert::{
+    choice, detach_in_pool, empty, real, slice_mut, slice_of, value_error, vec3s,
+};
 use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -144,8 +146,8 @@ impl PyField {
 
     /// Default step count: `max(4, ⌈|duration|·8·max_speed/length_scale⌉)` (a step moves a
     /// point by at most 1/8 of the length scale); more than 10⁸ steps raises `ValueError`.
-    fn steps(&self, duration: f64) -> PyResult<usize> {
-        let d = deform::finite("duration", duration)?;
+    fn steps(&self, duration: &Bound<'_, PyAny>) -> PyResult<usize> {
+        let d = deform::finite("duration", real(duration, "duration")?)?;
         Ok(self.field.default_steps(d)?)
     }
 
