@@ -34,6 +34,9 @@ pub struct PyField {
     names: Vec<String>,
     /// One `(constructor name, args, kwargs)` per constructor call, for pickling.
     recipe: Vec<Py<PyAny>>,
+    /// Terms built without a recorded call (a constructor that forgot to record itself):
+    /// such a field refuses to pickle rather than coming back as a different field.
+    unrecorded: usize,
 }
 
 impl PyField {
@@ -42,6 +45,7 @@ impl PyField {
             field,
             names: vec![name.to_string()],
             recipe: Vec::new(),
+            unrecorded: 1,
         }
     }
 
@@ -55,6 +59,7 @@ impl PyField {
                 .chain(&other.recipe)
                 .map(|r| r.clone_ref(py))
                 .collect(),
+            unrecorded: self.unrecorded + other.unrecorded,
         }
     }
 }
@@ -160,6 +165,15 @@ impl PyField {
 
     /// Pickle support: rebuilt by calling the constructors again.
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        if self.unrecorded > 0 {
+            let pickling = py.import("pickle")?.getattr("PicklingError")?;
+            return Err(PyErr::from_value(pickling.call1((format!(
+                "{}: {} of its terms were not built by a recorded constructor of \
+                 spinal.fields, so it cannot be rebuilt",
+                self.__repr__(),
+                self.unrecorded
+            ),))?));
+        }
         let rebuild = py.import("spinal.fields")?.getattr("_rebuild")?;
         let recipe: Vec<Py<PyAny>> = self.recipe.iter().map(|r| r.clone_ref(py)).collect();
         PyTuple::new(
@@ -191,6 +205,7 @@ impl PyField {
             field: self.field.clone(),
             names: self.names.clone(),
             recipe: vec![entry.into_any().unbind()],
+            unrecorded: 0,
         })
     }
 }
@@ -517,6 +532,7 @@ pub fn field_zero() -> PyField {
         field: Field::default(),
         names: Vec::new(),
         recipe: Vec::new(),
+        unrecorded: 0,
     }
 }
 
