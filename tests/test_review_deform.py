@@ -15,10 +15,61 @@ from spinal import fields as fl
 trimesh = pytest.importorskip("trimesh")
 
 
-def test_D08_an_overflowing_speed_bound_is_refused_not_stepped_four_times():
-    # was: max_speed inf, steps(1.0) == 4
-    with pytest.raises(ValueError, match="^velocity: .*out of floating-point range"):
-        fl.translation([0, 0, 1], .3, [1e200, 0, 0])
+def _d08_grid():
+    g = np.linspace(-1, 1, 41)
+    X, Y, Z = np.meshgrid(g, g, g, indexing="ij")
+    return np.sqrt(X**2 + Y**2 + Z**2) - 0.4, [-1, -1, -1], 0.05
+
+
+_D08_BIG = 1e308
+_D08_U = [_D08_BIG, 0, 0]
+_D08_LINE = np.c_[np.linspace(0, 1, 5), np.zeros(5), np.zeros(5)]
+
+# every constructor taking a speed, velocity or rate, with a finite value whose field's
+# speed bound overflows, and the argument its error names
+_D08_CASES = {
+    "translation": ("velocity", lambda: fl.translation([0, 0, 1], .3, [1e200, 0, 0])),
+    "rotation": ("angular_speed", lambda: fl.rotation([0, 0, 0], .3, [0, 0, 1], _D08_BIG)),
+    "sphere": ("velocity", lambda: fl.sphere([0, 0, 0], .3, _D08_U)),
+    "capsule": ("velocity", lambda: fl.capsule([0, 0, 0], [1, 0, 0], .3, _D08_U)),
+    "strip(along)": ("velocity", lambda: fl.strip([0, 0, 0], [1, 0, 0], .3, _D08_U)),
+    "strip(across)": ("velocity", lambda: fl.strip([0, 0, 0], [1, 0, 0], .3,
+                                                   [0, _D08_BIG, 0], kind="across")),
+    "torus": ("speed", lambda: fl.torus([0, 0, 0], [0, 0, 1], 1, .2, _D08_BIG)),
+    "strip_curve": ("speed", lambda: fl.strip_curve(_D08_LINE, .1, _D08_BIG)),
+    "sdf_tool": ("velocity", lambda: fl.sdf_tool(*_d08_grid(), _D08_U, reach=.3)),
+    "mesh_tool": ("velocity", lambda: fl.mesh_tool(trimesh.creation.icosphere(2, radius=.4),
+                                                   _D08_U, reach=.3, resolution=32)),
+    "sdf_curl": ("velocity", lambda: fl.sdf_curl(*_d08_grid(), velocity=_D08_U, reach=.3)),
+    "sdf_curl(angular)": ("angular_velocity", lambda: fl.sdf_curl(
+        *_d08_grid(), angular_velocity=_D08_U, reach=.3)),
+    "mesh_curl": ("velocity", lambda: fl.mesh_curl(trimesh.creation.icosphere(2, radius=.4),
+                                                   velocity=_D08_U, reach=.3, resolution=32)),
+    "rod": ("velocity", lambda: fl.rod(_D08_LINE, .1, velocity=_D08_U)),
+    "rod(angular)": ("angular_velocity", lambda: fl.rod(_D08_LINE, .1, angular_velocity=_D08_U)),
+    "along_path": ("duration", lambda: fl.along_path(_D08_LINE, .1, 1e-308)),
+    "keyframed": ("times", lambda: fl.keyframed(fl.translation([0, 0, 0], .3, [0, 0, 0]),
+                                                [0, 1e-300], [[0, 0, 0], [1e300, 0, 0]])),
+}
+
+
+@pytest.mark.parametrize("case", sorted(_D08_CASES))
+def test_D08_an_overflowing_speed_bound_is_refused_not_stepped_four_times(case):
+    # was: max_speed inf, steps(1.0) == 4 (translation; strip_curve and strip(across) too)
+    arg, build = _D08_CASES[case]
+    with pytest.raises(ValueError, match=f"^{arg}: .*(out of floating-point range|is inf)"):
+        build()
+
+
+def test_D08_twist_bend_and_path_rates_stay_finite():
+    """The swirls' bound is ``|rate|·radius^k`` times a constant below 1: a finite rate
+    gives a finite bound (no overflow to refuse), and steps() refuses the step count it asks."""
+    for f in (fl.twist([0, 0, 0], [0, 0, 1], _D08_BIG, .3), fl.bend([0, 0, 0], [0, 0, 1],
+                                                                   _D08_BIG, .3),
+              fl.along_path(_D08_LINE, .1, 1.0, kind="twist", rate=_D08_BIG)):
+        assert np.isfinite(f.max_speed) and f.max_speed > 1e300
+        with pytest.raises(ValueError, match="^steps: the default step rule needs"):
+            f.steps(1.0)
 
 
 def test_D13_strip_curve_builds_2000_samples_quickly():

@@ -259,6 +259,7 @@ def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
         as_bool(moving, "moving"))
 
 
+@_recorded
 def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Field:
     """A strip of type I along a curved axis (thesis §11.2.2, "sticking", type I): the material
     within ``radius`` of the axis flows along it at ``speed`` (length/time, from

@@ -370,18 +370,21 @@ impl StripAcross {
         } else {
             DVec3::ZERO
         };
-        Ok(StripAcross {
-            a,
-            b,
-            velocity,
-            radius,
-            reach,
-            linear,
-            ab,
-            inv_len2: 1.0 / (l * l),
-            tangent: t,
-            side,
-        })
+        bounded(
+            "velocity",
+            StripAcross {
+                a,
+                b,
+                velocity,
+                radius,
+                reach,
+                linear,
+                ab,
+                inv_len2: 1.0 / (l * l),
+                tangent: t,
+                side,
+            },
+        )
     }
 
     #[inline]

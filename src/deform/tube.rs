@@ -573,7 +573,8 @@ impl StripAlong {
 
 /// The strip of `spinal.fields.strip_curve` from its axis samples (positions, derivatives
 /// `dγ/dS` of the clamped C² spline, cumulative chord lengths), validated: `radius` and
-/// `reach` (default `radius`) positive, `speed` finite, then [`StripAlong::new`]'s checks.
+/// `reach` (default `radius`) positive, `speed` finite, then [`StripAlong::new`]'s checks and
+/// a finite speed bound.
 pub fn strip_along(
     samples: Vec<AxisSample>,
     radius: f64,
@@ -584,7 +585,10 @@ pub fn strip_along(
     let radius = super::positive("radius", radius)?;
     let reach = super::reach_or(reach, radius)?;
     let speed = super::finite("speed", speed)?;
-    StripAlong::new(samples, speed, radius, reach, linear)
+    super::bounded(
+        "speed",
+        StripAlong::new(samples, speed, radius, reach, linear)?,
+    )
 }
 
 impl super::Tool for StripAlong {

@@ -36,6 +36,9 @@ pub struct PyField {
     names: Vec<String>,
     /// One `(constructor name, args, kwargs)` per constructor call, for pickling.
     recipe: Vec<Py<PyAny>>,
+    /// Terms built without a recorded call (a constructor that forgot to record itself):
+    /// such a field refuses to pickle rather than coming back as a different field.
+    unrecorded: usize,
 }
 
 impl PyField {
@@ -44,6 +47,7 @@ impl PyField {
             field,
             names: vec![name.to_string()],
             recipe: Vec::new(),
+            unrecorded: 1,
         }
     }
 
@@ -57,6 +61,7 @@ impl PyField {
                 .chain(&other.recipe)
                 .map(|r| r.clone_ref(py))
                 .collect(),
+            unrecorded: self.unrecorded + other.unrecorded,
         }
     }
 }
@@ -162,6 +167,15 @@ impl PyField {
 
     /// Pickle support: rebuilt by calling the constructors again.
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        if self.unrecorded > 0 {
+            let pickling = py.import("pickle")?.getattr("PicklingError")?;
+            return Err(PyErr::from_value(pickling.call1((format!(
+                "{}: {} of its terms were not built by a recorded constructor of \
+                 spinal.fields, so it cannot be rebuilt",
+                self.__repr__(),
+                self.unrecorded
+            ),))?));
+        }
         let rebuild = py.import("spinal.fields")?.getattr("_rebuild")?;
         let recipe: Vec<Py<PyAny>> = self.recipe.iter().map(|r| r.clone_ref(py)).collect();
         PyTuple::new(
@@ -193,6 +207,7 @@ impl PyField {
             field: self.field.clone(),
             names: self.names.clone(),
             recipe: vec![entry.into_any().unbind()],
+            unrecorded: 0,
         })
     }
 }
@@ -519,6 +534,7 @@ pub fn field_zero() -> PyField {
         field: Field::default(),
         names: Vec::new(),
         recipe: Vec::new(),
+        unrecorded: 0,
     }
 }
 
