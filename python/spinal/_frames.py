@@ -9,6 +9,7 @@ import numpy as np
 from . import _core
 from ._steer import previous_frames, steering
 from ._validate import (
+    MAX_SAMPLES,
     as_bool,
     as_choice,
     as_curves,
@@ -52,7 +53,8 @@ def _analytic(curve: Curve, u: Any):
     if u is None:
         raise TypeError("u: required with an analytic curve (parameter values or a sample count)")
     if isinstance(u, (int, np.integer)) and not isinstance(u, bool):
-        count = as_int(u, "u", minimum=2)
+        count = as_int(u, "u", 2, MAX_SAMPLES, out_of_bounds=lambda x: (
+            f"a sample count must be at least 2 and at most {MAX_SAMPLES:,}, got {x}"))
         try:
             uu = curve.parameters(count)
         except MemoryError:

@@ -309,15 +309,9 @@ def camera_frames(
         f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
     else:
         f = _level_frames(pts, t, u, regular, closed)
-    if b is not None:
-        c, s = np.cos(b)[:, None], np.sin(b)[:, None]
-        r, q = f[:, :, 0].copy(), f[:, :, 1].copy()
-        f = f.copy()
-        # a right-handed turn by b about the gaze t: up' = cos b up + sin b (t × up)
-        f[:, :, 0] = c * r + s * q
-        f[:, :, 1] = c * q - s * r
-    # spinal frame (r, s, t) = (up, right, gaze)  →  camera (right, up, −gaze)
-    return np.stack([f[:, :, 1], f[:, :, 0], -f[:, :, 2]], axis=2)
+    # spinal frame (r, s, t) = (up, right, gaze), rolled by the bank about the gaze
+    # (up' = cos b up + sin b (t × up)), then reordered to camera (right, up, −gaze)
+    return _core.camera_orient(np.ascontiguousarray(f), b)
 
 
 def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
@@ -336,11 +330,7 @@ def _level_frames(pts, t, u, regular, closed):
     """Level-horizon frames; ``regular``: the rows where ``u`` projects onto the normal plane
     (checked by the core: at least one)."""
     n = len(pts)
-    w = u - (t @ u)[:, None] * t
-    wn = np.linalg.norm(w, axis=1)
-    f = np.empty((n, 3, 3))
-    r = w[regular] / wn[regular][:, None]
-    f[regular] = np.stack([r, np.cross(t[regular], r), t[regular]], axis=2)
+    f = _core.camera_level(t, u, regular)
     if regular.all():
         return f
     shift = 0

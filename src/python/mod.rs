@@ -33,6 +33,8 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(quaternion::quat_slerp, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_slerp_frames, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::camera_inputs, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::camera_level, m)?)?;
+    m.add_function(wrap_pyfunction!(quaternion::camera_orient, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_path_length, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::quat_transport, m)?)?;
     m.add_function(wrap_pyfunction!(quaternion::walk_mesh, m)?)?;

@@ -200,6 +200,52 @@ pub fn camera_inputs<'py>(
     ))
 }
 
+/// Level-horizon frames at the `regular` rows (zero elsewhere); see
+/// `spinal.quaternions.camera_frames(mode="up")`.
+#[pyfunction]
+pub fn camera_level<'py>(
+    py: Python<'py>,
+    tangents: PyReadonlyArray2<'py, f64>,
+    up: PyReadonlyArray1<'py, f64>,
+    regular: PyReadonlyArray1<'py, bool>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let t = vec3s("tangents", &tangents)?;
+    let u = vec3_of("up", &up, "expected 3 values")?;
+    let g = slice_of("regular", &regular)?;
+    let out = empty::<f64, numpy::Ix3>(py, &[t.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            camera::level_rows_cancellable(t, u, g, buf, &|| stop.requested())
+        })??;
+    }
+    Ok(out)
+}
+
+/// Camera rotations `(right, up, back)` of spinal frames rolled by `bank`; see
+/// `spinal.quaternions.camera_frames`.
+#[pyfunction]
+pub fn camera_orient<'py>(
+    py: Python<'py>,
+    frames: PyReadonlyArray3<'py, f64>,
+    bank: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let fr = frames_of("frames", &frames)?;
+    let b = bank.as_ref().map(|b| slice_of("bank", b)).transpose()?;
+    let out = empty::<f64, numpy::Ix3>(py, &[fr.len(), 3, 3])?;
+    {
+        let mut rw = out.readwrite();
+        let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            camera::orient_cancellable(fr, b, buf, &|| stop.requested())
+        })??;
+    }
+    Ok(out)
+}
+
 /// Positions, faces and row-major frames (columns e₁, e₂, e₃) of walker states.
 /// `call` names the Python function in `MemoryError`.
 fn walker_states(

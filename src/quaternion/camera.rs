@@ -11,10 +11,13 @@
 //!   normal plane defines the camera's up there; at least one such row is needed;
 //! * the bank (roll) angles, finite.
 //!
-//! The frames themselves are then the rotation-minimising frames or the level frames of
-//! the Python layer.
+//! The frames themselves are the rotation-minimising frames of `spinal.frames` or the level
+//! frames ([`level_rows_cancellable`] on the regular rows, carried by the rotation-minimising
+//! frame across the singular runs); [`orient_cancellable`] then rolls them by the bank and
+//! reorders them into camera columns.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::unit_tangents_cancellable;
 use crate::alloc;
@@ -130,6 +133,85 @@ pub fn inputs_cancellable(
     })
 }
 
+/// Rows per block of the writing loops: the first write to a fresh output page costs a
+/// page fault, so the loops poll `cancel` between blocks, not only between passes.
+const GRAIN: usize = 1 << 12;
+
+/// The level-horizon frames `(r, t × r, t)` (row-major, columns `r, s, t`) at the rows where
+/// `regular` is true, `r = (u − (t·u) t)/|u − (t·u) t|` the world up projected onto the normal
+/// plane of the unit tangent `t`; the other rows are zero (the caller carries the
+/// rotation-minimising frame across them). Stops between blocks once `cancel` says so (`out`
+/// is then incomplete).
+pub fn level_rows_cancellable(
+    tangents: &[DVec3],
+    up: DVec3,
+    regular: &[bool],
+    out: &mut [[f64; 9]],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
+    if regular.len() != tangents.len() || out.len() != tangents.len() {
+        return Err(InputError::new(
+            "regular",
+            "expected one flag and one output frame per tangent",
+        ));
+    }
+    out.par_chunks_mut(GRAIN)
+        .zip(tangents.par_chunks(GRAIN).zip(regular.par_chunks(GRAIN)))
+        .for_each(|(o, (t, g))| {
+            if cancel() {
+                return;
+            }
+            for ((o, t), g) in o.iter_mut().zip(t).zip(g) {
+                *o = if *g {
+                    let w = up - t.dot(up) * *t;
+                    let r = w / w.length();
+                    let s = t.cross(r);
+                    [r.x, s.x, t.x, r.y, s.y, t.y, r.z, s.z, t.z]
+                } else {
+                    [0.0; 9]
+                };
+            }
+        });
+    Ok(())
+}
+
+/// Camera rotations `(right, up, back)` (row-major columns) of spinal frames `(r, s, t)`
+/// rolled by `bank` about the gaze `t`: `up = cos b r + sin b s`, `right = cos b s − sin b r`,
+/// `back = −t` (a right-handed turn by `b` about the direction of travel). Stops between
+/// blocks once `cancel` says so (`out` is then incomplete).
+pub fn orient_cancellable(
+    frames: &[[f64; 9]],
+    bank: Option<&[f64]>,
+    out: &mut [[f64; 9]],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
+    if out.len() != frames.len() || bank.is_some_and(|b| b.len() != frames.len()) {
+        return Err(InputError::new(
+            "bank",
+            "expected one angle and one output frame per frame",
+        ));
+    }
+    out.par_chunks_mut(GRAIN)
+        .zip(frames.par_chunks(GRAIN))
+        .enumerate()
+        .for_each(|(k, (o, f))| {
+            if cancel() {
+                return;
+            }
+            let b = bank.map(|b| &b[k * GRAIN..(k * GRAIN + f.len())]);
+            for (i, (o, f)) in o.iter_mut().zip(f).enumerate() {
+                let (sn, c) = b.map_or((0.0, 1.0), |b| b[i].sin_cos());
+                for row in 0..3 {
+                    let (r, s, t) = (f[3 * row], f[3 * row + 1], f[3 * row + 2]);
+                    o[3 * row] = c * s - sn * r;
+                    o[3 * row + 1] = c * r + sn * s;
+                    o[3 * row + 2] = -t;
+                }
+            }
+        });
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,5 +281,53 @@ mod tests {
         assert!(e.msg.starts_with("the path is parallel to up everywhere"));
         let ok = inputs(&x, None, None, None, false, LEVEL).expect("horizontal");
         assert_eq!(ok.regular, Some(vec![true; 5]));
+    }
+
+    fn col(f: &[f64; 9], j: usize) -> DVec3 {
+        DVec3::new(f[j], f[3 + j], f[6 + j])
+    }
+
+    #[test]
+    fn level_rows_are_the_projected_up_and_zero_elsewhere() {
+        let t = [DVec3::new(1.0, 0.0, 1.0).normalize(), DVec3::Z];
+        let mut out = [[1.0; 9]; 2];
+        level_rows_cancellable(
+            &t,
+            DVec3::Z,
+            &[true, false],
+            &mut out,
+            &crate::cancel::never,
+        )
+        .expect("valid");
+        // up projected onto the plane normal to (1, 0, 1)/√2 is (−1, 0, 1)/√2
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((col(&out[0], 0) - DVec3::new(-h, 0.0, h)).length() < 1e-15);
+        assert!((col(&out[0], 1) - t[0].cross(col(&out[0], 0))).length() < 1e-15);
+        assert_eq!(col(&out[0], 2), t[0]);
+        assert_eq!(out[1], [0.0; 9]);
+    }
+
+    #[test]
+    fn orient_reorders_and_rolls_right_handed_about_the_gaze() {
+        // (r, s, t) = (Z, −Y, X): travel along X, up Z, s = t × r = −Y
+        let f = [[0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0]; 2];
+        let b = [0.0, std::f64::consts::FRAC_PI_2];
+        let mut out = [[0.0; 9]; 2];
+        orient_cancellable(&f, Some(&b), &mut out, &crate::cancel::never).expect("valid");
+        // no roll: right = s, up = r, back = −t
+        assert_eq!(col(&out[0], 0), -DVec3::Y);
+        assert_eq!(col(&out[0], 1), DVec3::Z);
+        assert_eq!(col(&out[0], 2), -DVec3::X);
+        // a quarter turn about the travel direction X takes up = Z to −Y (right-handed about
+        // +X turns Z towards −Y), and right = −Y to −Z
+        assert!((col(&out[1], 1) + DVec3::Y).length() < 1e-15);
+        assert!((col(&out[1], 0) + DVec3::Z).length() < 1e-15);
+        let mut short = [[0.0; 9]; 1];
+        assert_eq!(
+            orient_cancellable(&f, None, &mut short, &crate::cancel::never)
+                .expect_err("sizes")
+                .arg,
+            "bank"
+        );
     }
 }
