@@ -38,7 +38,8 @@ region function ``D = b(clamp(d/R_f, 0, 1))``, ``b = 4σ³ − 3σ⁴`` (C¹) or
 translation and rotation above with the signed distance ``d`` of any shape and its exact
 gradient ``g = ∇d`` in place of the sphere's, divergence-free for any C¹ ``d`` —
 :func:`sdf_curl` (a sampled distance), :func:`mesh_curl` (a closed mesh), :func:`rod` (a tube
-about a spline axis; a capsule). :func:`keyframed` moves the shape of such a tool (or of a
+about a spline axis, the thesis's strip along a curve — §11.2.2's region about an inner axis —
+in curl form; two points give a capsule). :func:`keyframed` moves the shape of such a tool (or of a
 sphere or grid tool) rigidly through keys ``(t_k, c_k, Q_k)``.
 
 **Tools along a path** — :func:`along_path`: a sphere tool travels along a spine curve at
