@@ -669,42 +669,72 @@ del _ctor
 
 @_recorded
 def keyframed(tool, times, positions, orientations=None, *,
-              falloff_power: int | None = None) -> Field:
-    """The shape of ``tool`` following keyframed rigid poses ``(t_k, c_k, Q_k)``: at time ``t``
-    the curl translation with ``u = ċ(t)`` plus, with ``orientations``, the curl rotation with
-    ``Ω = ω(t)`` about ``c(t)`` (the formulas of :func:`sdf_curl`), with the shape's distance
-    at the current pose, ``d(C + Qᵀ(X − c))``, its gradient turned back by ``Q``. On the tool
-    surface the normal velocity is the rigid motion's, ``(ċ + ω × (X − c))·n``. Zero before
-    the first and after the last key (the tool rests there).
+              falloff_power: int | None = None, center=None) -> Field:
+    """``tool`` following keyframed rigid poses ``(t_k, c_k, Q_k)``: the pose ``(c(t), Q(t))``
+    takes the tool's point ``C`` to ``c(t)`` and turns it by ``Q(t)`` about it (``c_k = C``,
+    ``Q_k = I`` leave it in place). Every field can be keyframed, in one of two ways.
 
-    **Shape.** ``tool`` is a field of one tool with a shape: :func:`translation` or
-    :func:`rotation` (their sphere), :func:`sdf_curl`, :func:`mesh_curl`, :func:`rod` (a
-    capsule: two points), :func:`sdf_tool`, :func:`mesh_tool` or another keyframed tool.
-    The shape is taken where the tool is at ``t = 0``; its centre ``C`` goes to ``c_k`` and
-    it is turned by ``Q_k`` about it (``c_k = C``, ``Q_k = I`` leave it in place). The reach
-    is the tool's; ``falloff_power`` defaults to the tool's (2 for sdf_tool/mesh_tool).
+    **A tool with a shape** (a field of one tool: :func:`translation`, :func:`rotation`,
+    :func:`sphere` (its ball), :func:`capsule`, :func:`strip` (the rod of its two end points),
+    :func:`strip_curve` (the rod about its axis, same spline), :func:`torus` (the torus'
+    distance ``√((ρ − R_t)² + z²) − r_t``), :func:`sdf_curl`, :func:`mesh_curl`, :func:`rod`,
+    :func:`sdf_tool`, :func:`mesh_tool` or a keyframed shape): the shape is moved, and the
+    field is the curl tool of the moving shape. At time ``t`` the curl translation with
+    ``u = ċ(t)`` and ``Y = X − c(t)`` plus, with ``orientations``, the curl rotation with
+    ``Ω = ω(t)`` about ``c(t)`` (the formulas of :func:`sdf_curl`), with the shape's distance at
+    the current pose, ``d(C + Qᵀ(X − c))`` (``d`` the distance of the shape as built), and its
+    gradient turned back by ``Q``. On the tool surface the normal velocity is the rigid
+    motion's, ``(ċ + ω × (X − c))·n``. Zero before the first and after the last key (the tool
+    rests there). The shape is taken as the tool was built (where it is at ``t = 0``); ``C``
+    defaults to the shape's centre
+    ``C_s`` (a sphere's or torus' centre, a segment's midpoint, the centroid of a rod's or
+    strip's sample polyline, a grid tool's ``center``), and a point on the shape is at
+    ``c + Q (X_s − C)``. The reach is the tool's; ``falloff_power`` defaults to the tool's
+    (2 for the cross-product tools sphere, capsule, strip, torus, strip_curve, sdf_tool,
+    mesh_tool, whose blend the curl field does not use).
+
+    **Any other field** (:func:`twist`, :func:`bend`, :func:`along_path`, a keyframed carried
+    field, sums such as ``f + g`` or :func:`sum`): the whole field ``v₀`` is carried rigidly,
+
+        v(X, t) = Q(t) v₀(C + Q(t)ᵀ(X − c(t)), t),
+
+    the field seen in the moving frame of the pose. A rigid change of coordinates of a
+    divergence-free field, so ``div v = 0`` (its Jacobian ``Q J₀ Qᵀ`` has ``J₀``'s trace); no
+    rigid velocity ``ċ + ω × (X − c)`` is added (the field's action moves with the pose, the
+    material is not dragged by it), and outside the keys the first or last pose is held (the
+    field still acts there). ``center`` ``C`` defaults to the centre of a :func:`twist` or
+    :func:`bend`; for sums, :func:`along_path` and carried fields it is required
+    (``ValueError`` naming ``center``); ``falloff_power`` does not apply (``ValueError``).
+    ``v₀`` keeps its own clock (it is evaluated at the same ``t``), so its breakpoints — an
+    :func:`along_path`'s sample times, already counted from its ``t0`` — are not shifted:
+    the field's :meth:`Field.breakpoints` are the key times together with ``v₀``'s. The
+    default step count (:meth:`Field.steps`) uses ``max_speed`` = ``v₀``'s bound plus the
+    speed of the pattern past the material, ``max|ċ| + max|ω| E`` with ``E`` the radius of
+    ``v₀``'s support about ``C`` (twist, bend, along_path; ``max|ċ|`` alone for fields whose
+    support moves without bound).
 
     **Interpolation.** Positions: cubic Hermite through the keys with Bessel tangents (the
     derivative of the parabola through three neighbouring keys, Catmull–Rom's for uniform
     times), so keys on a line at constant speed give exactly that motion; the velocity
-    ``ċ`` is continuous. Orientations: slerp along the shorter arc,
-    ``Q = Q_k Exp(λ Log(Q_kᵀ Q_{k+1}))``, ``ω = Q_k Log(Q_kᵀ Q_{k+1})/Δt_k`` constant on each
-    interval (it jumps at the keys). The key times are the field's
-    :meth:`Field.breakpoints`, so :func:`spinal.advect` ends steps there and keeps RK4's
-    order.
+    ``ċ`` (length/time) is continuous. Orientations: slerp along the shorter arc,
+    ``Q = Q_k Exp(λ Log(Q_kᵀ Q_{k+1}))``, ``ω = Q_k Log(Q_kᵀ Q_{k+1})/Δt_k`` (rad/time)
+    constant on each interval (it jumps at the keys). The key times are breakpoints, so
+    :func:`spinal.advect` ends steps there and keeps RK4's order.
 
-    For a tool orbiting a pivot this is a translation of the centre plus a spin about it:
+    For a shape orbiting a pivot this is a translation of the centre plus a spin about it:
     the same rigid motion (the same normal velocity on the tool) as :func:`rotation` about the
     pivot, with a different tangential flow.
 
     Parameters
     ----------
-    tool : a Field of one tool with a shape (see above).
+    tool : a Field (see above).
     times : (k,) key times, k ≥ 2, strictly increasing.
-    positions : (k, 3) positions of the shape's centre.
+    positions : (k, 3) positions ``c_k`` of the point ``C``.
     orientations : (k, 3, 3) rotation matrices or (k, 4) unit quaternions ``(x, y, z, w)``
-        (as :mod:`spinal.quaternions`); None: the shape does not turn.
-    falloff_power : p in {2, 3, 4}, default the tool's.
+        (as :mod:`spinal.quaternions`); None: no turning (``Q = I``).
+    falloff_power : p in {2, 3, 4}, default the tool's; only for a tool with a shape.
+    center : (3,) the point ``C`` of the field taken to ``c_k``; default the shape's centre
+        or the swirl's centre; required for sums and along_path.
     """
     if not isinstance(tool, Field):
         raise TypeError(f"tool: expected a spinal.fields.Field, got {type(tool).__name__}")
@@ -722,4 +752,5 @@ def keyframed(tool, times, positions, orientations=None, *,
         else:
             raise ValueError(f"orientations: expected shape (k, 3, 3) or (k, 4), got {o.shape}")
     p = None if falloff_power is None else _power(falloff_power)
-    return _core.field_keyframed(tool, np.ascontiguousarray(t), x, mats, quats, p)
+    c = None if center is None else as_vector(center, "center")
+    return _core.field_keyframed(tool, np.ascontiguousarray(t), x, mats, quats, p, c)

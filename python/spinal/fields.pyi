@@ -202,4 +202,5 @@ def keyframed(
     orientations: _Array | None = None,
     *,
     falloff_power: _Power | None = None,
+    center: _Array | None = None,
 ) -> Field: ...

@@ -30,6 +30,7 @@
 
 use glam::DVec3;
 
+use super::curl::{Ball, Ring, Shape, ToolShape};
 use super::{Field, Tool, bounded, finite, finite3, positive, reach_or, unit};
 use crate::error::{InputError, Result};
 
@@ -457,13 +458,27 @@ pub fn strip(
     )?))
 }
 
-/// `impl Tool` for a tool with `eval(x, t)` and `max_speed()` whose length scale is `reach`;
-/// a last argument `true` asks for a spatial order of the path lines ([`Tool::wants_locality`]).
-macro_rules! tool {
-    ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr) => {
-        tool!($t, |$s, $x, $time| $eval, false);
+/// The shape a keyframed pose moves ([`super::keyframe`]): a segment's rod (two points, a
+/// capsule) or, for a degenerate segment, its ball; no falloff power of its own.
+fn segment_shape(a: DVec3, b: DVec3, radius: f64, reach: f64) -> Option<ToolShape> {
+    let shape = if a == b {
+        Shape::Ball(Ball {
+            center: a,
+            radius,
+            reach,
+        })
+    } else {
+        let rod = super::rod::Rod::from_points(&[a, b], radius, Some(reach), None).ok()?;
+        Shape::Rod(std::sync::Arc::new(rod))
     };
-    ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr, $local:expr) => {
+    Some(ToolShape { shape, power: None })
+}
+
+/// `impl Tool` for a tool with `eval(x, t)` and `max_speed()` whose length scale is `reach`,
+/// whether it asks for a spatial order of the path lines ([`Tool::wants_locality`]) and its
+/// shape for keyframed poses.
+macro_rules! tool {
+    ($t:ty, |$s:ident, $x:ident, $time:ident| $eval:expr, $local:expr, |$me:ident| $shape:expr) => {
         impl Tool for $t {
             fn wants_locality(&self) -> bool {
                 $local
@@ -479,6 +494,10 @@ macro_rules! tool {
             fn length_scale(&self) -> f64 {
                 self.reach
             }
+            fn shape(&self) -> Option<ToolShape> {
+                let $me = self;
+                $shape
+            }
         }
     };
 }
@@ -487,7 +506,27 @@ macro_rules! tool {
 // on points in no spatial order (10⁶ random points in a ball, a third in the shell) the
 // branches mispredict about 1.7 times per RK4 step, 0.3 in Morton order (callgrind's branch
 // simulation), which more than pays for the sort
-tool!(Sphere, |s, x, t| s.eval(x, t), true);
-tool!(Capsule, |s, x, t| s.eval(x, t));
-tool!(Torus, |s, x, t| s.eval(x, t));
-tool!(StripAcross, |s, x, _t| s.eval(x));
+tool!(Sphere, |s, x, t| s.eval(x, t), true, |s| Some(ToolShape {
+    shape: Shape::Ball(Ball {
+        center: s.center,
+        radius: s.radius,
+        reach: s.reach,
+    }),
+    power: None,
+}));
+tool!(Capsule, |s, x, t| s.eval(x, t), false, |s| segment_shape(
+    s.a, s.b, s.radius, s.reach
+));
+tool!(Torus, |s, x, t| s.eval(x, t), false, |s| Some(ToolShape {
+    shape: Shape::Ring(Ring {
+        center: s.center,
+        axis: s.axis,
+        major: s.major,
+        minor: s.minor,
+        reach: s.reach,
+    }),
+    power: None,
+}));
+tool!(StripAcross, |s, x, _t| s.eval(x), false, |s| segment_shape(
+    s.a, s.b, s.radius, s.reach
+));

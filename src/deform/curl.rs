@@ -135,6 +135,50 @@ impl Distance for Ball {
     }
 }
 
+/// A torus about the unit `axis` through `center` (major radius `R_t`, tube radius `r_t`):
+/// `d = √((ρ − R_t)² + z²) − r_t` with `z = k·Y`, `ρ = |Y − z k|`, `Y = X − center`, and
+/// `∇d = ((ρ − R_t) e_ρ + z k)/√((ρ − R_t)² + z²)` (zero on the core circle). Smooth in the
+/// support `|d| < R` when `r_t + R < R_t` (away from the axis and the core circle's inside).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ring {
+    pub center: DVec3,
+    pub axis: DVec3,
+    pub major: f64,
+    pub minor: f64,
+    pub reach: f64,
+}
+
+impl Distance for Ring {
+    #[inline(always)]
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
+        let y = x - self.center;
+        let z = self.axis.dot(y);
+        let yp = y - self.axis * z;
+        let rho = yp.length();
+        let dr = rho - self.major;
+        let dist = (dr * dr + z * z).sqrt();
+        let d = dist - self.minor;
+        if !(d.abs() < self.reach) || !(rho > 0.0) {
+            return None;
+        }
+        let g = if dist > 0.0 {
+            (yp * (dr / rho) + self.axis * z) * (1.0 / dist)
+        } else {
+            DVec3::ZERO
+        };
+        Some((d, g))
+    }
+    fn reach(&self) -> f64 {
+        self.reach
+    }
+    fn center(&self) -> DVec3 {
+        self.center
+    }
+    fn extent(&self) -> f64 {
+        self.major + self.minor + self.reach
+    }
+}
+
 impl Distance for GridTool {
     #[inline(always)]
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
@@ -590,6 +634,25 @@ pub enum Shape {
     Ball(Ball),
     Rod(Arc<Rod>),
     Grid(Arc<GridTool>),
+    Ring(Ring),
+}
+
+impl Shape {
+    /// The shape's centre `C`.
+    pub fn center(&self) -> DVec3 {
+        match self {
+            Shape::Ball(b) => b.center(),
+            Shape::Rod(r) => r.center(),
+            Shape::Grid(g) => Distance::center(&**g),
+            Shape::Ring(r) => r.center(),
+        }
+    }
+}
+
+impl From<Ring> for Shape {
+    fn from(r: Ring) -> Shape {
+        Shape::Ring(r)
+    }
 }
 
 impl From<Ball> for Shape {

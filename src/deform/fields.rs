@@ -418,6 +418,12 @@ impl Tool for Swirl {
     fn length_scale(&self) -> f64 {
         self.reach
     }
+    fn natural_center(&self) -> Option<DVec3> {
+        Some(self.pivot)
+    }
+    fn support_radius(&self, about: DVec3) -> Option<f64> {
+        Some((self.pivot - about).length() + self.reach)
+    }
 }
 
 #[cfg(test)]

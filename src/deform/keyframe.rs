@@ -22,7 +22,7 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound, translation_bound};
+use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound};
 use super::{Tool, falloff};
 use crate::alloc;
 use crate::error::{InputError, Result};
@@ -220,6 +220,23 @@ impl Keys {
         })
     }
 
+    /// The pose at time `t` of a step whose midpoint time is `tm`, held at the first or last
+    /// key's outside the keys (`ċ = ω = 0` there).
+    pub fn pose_held(&self, t: f64, tm: f64) -> Pose {
+        if let Some(p) = self.pose_in(t, tm) {
+            return p.pose;
+        }
+        let k = if tm < self.times[0] {
+            0
+        } else {
+            self.times.len() - 1
+        };
+        Pose {
+            c: self.positions[k],
+            q: self.turns.as_ref().map_or(DMat3::IDENTITY, |(f, _)| f[k]),
+        }
+    }
+
     /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`.
     pub fn rates(&self) -> (f64, f64) {
         let mut v: f64 = 0.0;
@@ -248,12 +265,22 @@ pub struct Keyframed<D> {
     pub shape: D,
     pub keys: Keys,
     pub power: u8,
+    /// `C − C_shape`: the point `C` taken to the key positions, from the shape's centre
+    /// (zero unless the caller names another `C`).
+    offset: DVec3,
 }
 
 impl<D: Distance> Keyframed<D> {
-    /// The tool, validated: a finite speed bound (errors name `times`).
-    pub fn new(shape: D, keys: Keys, power: u8) -> Result<Keyframed<D>> {
-        let tool = Keyframed { shape, keys, power };
+    /// The tool, validated: a finite speed bound (errors name `times`); `center` is the point
+    /// `C` of the shape taken to the key positions (default the shape's centre).
+    pub fn new(shape: D, keys: Keys, power: u8, center: Option<DVec3>) -> Result<Keyframed<D>> {
+        let offset = center.map_or(DVec3::ZERO, |c| c - shape.center());
+        let tool = Keyframed {
+            shape,
+            keys,
+            power,
+            offset,
+        };
         let s = tool.max_speed();
         if !s.is_finite() {
             return Err(InputError::new(
@@ -264,10 +291,24 @@ impl<D: Distance> Keyframed<D> {
         Ok(tool)
     }
 
+    /// The shape's own pose for the key pose `p` (which takes `C` to `c`): its centre at
+    /// `c − Q (C − C_shape)`.
+    #[inline(always)]
+    fn shape_pose(&self, p: &Pose) -> Pose {
+        if self.offset == DVec3::ZERO {
+            *p
+        } else {
+            Pose {
+                c: p.c - p.q * self.offset,
+                q: p.q,
+            }
+        }
+    }
+
     /// The velocity at `x` for the tool at pose `p`.
     #[inline(always)]
     pub fn eval_at(&self, x: DVec3, p: &KeyPose) -> DVec3 {
-        match p.pose.distance(&self.shape, x) {
+        match self.shape_pose(&p.pose).distance(&self.shape, x) {
             Some((d, g)) => self.eval_with(x, p, d, g),
             None => DVec3::ZERO,
         }
@@ -296,26 +337,188 @@ impl<D: Distance> Keyframed<D> {
         }
     }
 
+    /// The curl bounds with `|Y| = |X − c|` at most the shape's extent plus `|C − C_shape|`.
     pub fn max_speed(&self) -> f64 {
         let (v, w) = self.keys.rates();
-        translation_bound(v, &self.shape, self.power)
-            + rotation_bound(w, 0.0, &self.shape, self.power)
+        let arm = self.offset.length();
+        let s = &self.shape;
+        v * (1.0 + 0.5 * self.power as f64 * s.gradient_bound() * (s.extent() + arm) / s.reach())
+            + rotation_bound(w, arm, s, self.power)
     }
 }
 
-/// The keyframed tool of a built tool's shape: `power` (2, 3 or 4) overrides the tool's
-/// falloff power; a tool without one (not a curl field) defaults to 2.
-pub fn keyframed(shape: ToolShape, keys: Keys, power: Option<i64>) -> Result<super::Field> {
+/// The keyframed tool of a built field (see [`Carried`] for the rule): a field of one tool
+/// with a shape moves that shape (`power` (2, 3 or 4) overrides the tool's falloff power; a
+/// tool without one, not a curl field, defaults to 2; `center` the point `C` taken to the
+/// keys, default the shape's centre); any other field is carried rigidly about `center`
+/// (default the tool's natural centre; required for sums), and `power` is refused.
+pub fn keyframed(
+    field: &super::Field,
+    keys: Keys,
+    power: Option<i64>,
+    center: Option<DVec3>,
+) -> Result<super::Field> {
+    let center = center.map(|c| super::finite3("center", c)).transpose()?;
+    let shape = match field.tools.as_slice() {
+        [one] => one.shape(),
+        _ => None,
+    };
+    let Some(shape) = shape else {
+        if power.is_some() {
+            return Err(InputError::new(
+                "falloff_power",
+                "only applies to a tool with a shape (a field carried rigidly keeps its own \
+                 falloff)",
+            ));
+        }
+        let c = match (center, field.tools.as_slice()) {
+            (Some(c), _) => c,
+            (None, [one]) => one.natural_center().ok_or_else(|| {
+                InputError::new(
+                    "center",
+                    "required: this tool has no shape and no natural centre (give the point \
+                     C of the field that the keys move)",
+                )
+            })?,
+            (None, _) => {
+                return Err(InputError::new(
+                    "center",
+                    format!(
+                        "required for a sum of {} tools (give the point C of the field that \
+                         the keys move)",
+                        field.tools.len()
+                    ),
+                ));
+            }
+        };
+        return Ok(super::Field::single(Carried::new(field.clone(), keys, c)?));
+    };
     let p = match (power, shape.power) {
         (Some(p), _) => falloff(p)?,
         (None, Some(p)) => p,
         (None, None) => 2,
     };
     Ok(match shape.shape {
-        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p)?),
-        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p)?),
-        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p)?),
+        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p, center)?),
+        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p, center)?),
+        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p, center)?),
+        Shape::Ring(r) => super::Field::single(Keyframed::new(r, keys, p, center)?),
     })
+}
+
+/// A whole field carried rigidly by keyframed poses: with the pose `(c(t), Q(t))` of the keys
+/// (held at the first or last key outside them),
+///
+/// `v(X, t) = Q v₀(C + Qᵀ(X − c), t)`,
+///
+/// the field `v₀` seen in the frame that takes its point `C` to `c` and turns it by `Q`.
+/// A rigid change of coordinates keeps `div v = 0` (the Jacobian `Q J₀ Qᵀ` has `J₀`'s
+/// trace); no rigid velocity is added (the field's action moves, the material is not
+/// dragged along). `v₀` keeps its own clock, so its breakpoints stay where they are and the
+/// field's are those and the key times.
+#[derive(Debug, Clone)]
+pub struct Carried {
+    pub field: super::Field,
+    pub keys: Keys,
+    pub center: DVec3,
+    breaks: Vec<f64>,
+    speed: f64,
+}
+
+impl Carried {
+    /// The carried field, validated: a finite speed bound (errors name `times`).
+    pub fn new(field: super::Field, keys: Keys, center: DVec3) -> Result<Carried> {
+        const CALL: &str = "keyframed";
+        let own = field.breakpoints(CALL)?;
+        let mut breaks = alloc::with_capacity(CALL, own.len() + keys.times.len())?;
+        breaks.extend_from_slice(&own);
+        breaks.extend_from_slice(&keys.times);
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup();
+        // the step rule's speed: the field's own plus the speed at which the pose moves its
+        // pattern past the material, |ċ| + |ω| E with E the support's radius about C (|ċ|
+        // alone where the support is unbounded)
+        let (v, w) = keys.rates();
+        let pattern = v + field.support_radius(center).map_or(0.0, |e| w * e);
+        let speed = field.max_speed() + pattern;
+        if !speed.is_finite() {
+            return Err(InputError::new(
+                "times",
+                format!("keys too close in time: the field's speed bound is {speed}"),
+            ));
+        }
+        Ok(Carried {
+            field,
+            keys,
+            center,
+            breaks,
+            speed,
+        })
+    }
+
+    /// `C + Qᵀ(x − c)`.
+    #[inline(always)]
+    fn body(&self, p: &Pose, x: DVec3) -> DVec3 {
+        self.center + p.q.transpose() * (x - p.c)
+    }
+
+    #[inline]
+    pub fn eval(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        let p = self.keys.pose_held(t, tm);
+        p.q * self.field.eval_in(self.body(&p, x), t, tm)
+    }
+}
+
+impl Tool for Carried {
+    fn wants_locality(&self) -> bool {
+        self.field.tools.iter().any(|e| e.wants_locality())
+    }
+    #[inline]
+    fn velocity(&self, x: DVec3, t: f64, tm: f64) -> DVec3 {
+        self.eval(x, t, tm)
+    }
+    fn max_speed(&self) -> f64 {
+        self.speed
+    }
+    fn length_scale(&self) -> f64 {
+        self.field.length_scale()
+    }
+    fn breakpoints(&self) -> &[f64] {
+        &self.breaks
+    }
+    /// The field's slip surfaces in the carried frame (the pose of the first or last key
+    /// outside the keys).
+    fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
+        let p = self.keys.pose_held(t, t);
+        self.field
+            .slip_surface(self.body(&p, x), t)
+            .map(|(d, g)| (d, p.q * g))
+    }
+    /// The pose once per batch, the points into the field's frame, the field's own batch
+    /// evaluation, the velocities turned back.
+    #[inline]
+    fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
+        const N: usize = super::advect::LANES;
+        let pose = self.keys.pose_held(t, tm);
+        for (p, out) in p.chunks(N).zip(out.chunks_mut(N)) {
+            let n = p.len();
+            let mut xb = [DVec3::ZERO; N];
+            let mut vb = [DVec3::ZERO; N];
+            for (b, x) in xb.iter_mut().zip(p) {
+                *b = self.body(&pose, *x);
+            }
+            for e in &self.field.tools {
+                e.add_lanes(&xb[..n], t, tm, &mut vb[..n]);
+            }
+            for (o, v) in out.iter_mut().zip(&vb) {
+                *o += pose.q * *v;
+            }
+        }
+    }
+    #[inline]
+    fn rk4_lanes(&self, x: &mut [DVec3], t0: f64, h: f64, steps: std::ops::Range<usize>) {
+        super::advect::rk4_by_batches(self, x, t0, h, steps);
+    }
 }
 
 impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
@@ -346,15 +549,17 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
     fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
         let ts = &self.keys.times;
         let t = t.clamp(ts[0], ts[ts.len() - 1]);
-        self.keys.pose_in(t, t)?.pose.distance(&self.shape, x)
+        let p = self.keys.pose_in(t, t)?.pose;
+        self.shape_pose(&p).distance(&self.shape, x)
     }
     /// The pose once per batch, then the frozen-pose field at every point.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
         if let Some(pose) = self.keys.pose_in(t, tm) {
-            pose.pose.add_lanes(&self.shape, p, out, |x, d, g| {
-                self.eval_with(x, &pose, d, g)
-            });
+            self.shape_pose(&pose.pose)
+                .add_lanes(&self.shape, p, out, |x, d, g| {
+                    self.eval_with(x, &pose, d, g)
+                });
         }
     }
     #[inline]
@@ -377,7 +582,8 @@ impl<D: Distance + Clone + Into<Shape>> Tool for Keyframed<D> {
                 rk4_lanes_staged(
                     |p, j, stage, _t, _tm, out| {
                         if let Some(pose) = &poses[j - part.start][STAGE_POSE[stage]] {
-                            pose.pose.add_lanes(&self.shape, p, out, |x, d, g| {
+                            let at = self.shape_pose(&pose.pose);
+                            at.add_lanes(&self.shape, p, out, |x, d, g| {
                                 self.eval_with(x, pose, d, g)
                             });
                         }
@@ -445,7 +651,7 @@ mod tests {
             .collect();
         for o in [None, Some(Orientations::Quaternions(turn))] {
             let keys = Keys::new(&times, &pos, o).unwrap();
-            let tool = Keyframed::new(rod.clone(), keys, 2).unwrap();
+            let tool = Keyframed::new(rod.clone(), keys, 2, None).unwrap();
             let (mut moved, mut skipped) = (0, 0);
             for b in 0..400 {
                 let q = b as f64 * 0.37;

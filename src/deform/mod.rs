@@ -89,6 +89,20 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The point a keyframed carry of a shape-less tool takes to the key positions when the
+    /// caller names none ([`keyframe::Carried`]): a swirl's centre; `None` for tools
+    /// without a natural centre.
+    fn natural_center(&self) -> Option<DVec3> {
+        None
+    }
+
+    /// The radius of a ball about `about` outside which the velocity is zero at every time,
+    /// where one is known (a swirl, a path tool); `None` otherwise (a moving tool's support
+    /// travels without bound).
+    fn support_radius(&self, _about: DVec3) -> Option<f64> {
+        None
+    }
+
     /// `out[j] += v(p[j], t)` for a batch of points.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {
@@ -274,6 +288,14 @@ impl Field {
             .iter()
             .filter_map(|e| e.slip_surface(x, t))
             .min_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
+    }
+
+    /// The largest [`Tool::support_radius`] of the tools about `about` (`None` if a tool
+    /// has none; 0 for the zero field).
+    pub fn support_radius(&self, about: DVec3) -> Option<f64> {
+        self.tools
+            .iter()
+            .try_fold(0.0, |m: f64, e| e.support_radius(about).map(|r| m.max(r)))
     }
 
     /// Sum of the tools' speed bounds.

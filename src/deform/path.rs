@@ -495,6 +495,22 @@ impl Tool for PathTool {
     fn breakpoints(&self) -> &[f64] {
         PathTool::breakpoints(self)
     }
+    /// The centre stays within `1.5 ΔS_k` of the samples of its segment (a Hermite segment
+    /// with tangents of length `ΔS_k` leaves the chord's end by at most `(1 + 8/27) ΔS_k`),
+    /// and the field within `radius + reach` of the centre.
+    fn support_radius(&self, about: DVec3) -> Option<f64> {
+        let near = self
+            .samples
+            .iter()
+            .map(|p| (p.x - about).length())
+            .fold(0.0, f64::max);
+        let ds = self
+            .samples
+            .windows(2)
+            .map(|w| w[1].s - w[0].s)
+            .fold(0.0, f64::max);
+        Some(near + 1.5 * ds + self.params.radius + self.params.reach)
+    }
     /// The pose once per batch, then the frozen-pose field at every point.
     #[inline]
     fn add_lanes(&self, p: &[DVec3], t: f64, tm: f64, out: &mut [DVec3]) {

@@ -67,8 +67,16 @@ impl Rod {
             ));
         }
         let axis = Axis::new(samples, radius + reach)?;
+        let center = center.map(|c| super::finite3("center", c)).transpose()?;
+        Ok(Rod::with_axis(axis, radius, reach, center))
+    }
+
+    /// The rod about an axis already checked for `radius + reach` ([`Axis::new`]), `center`
+    /// finite or, when not given, the centroid of the sample polyline (segments weighted by
+    /// their length).
+    pub fn with_axis(axis: Axis, radius: f64, reach: f64, center: Option<DVec3>) -> Rod {
         let center = match center {
-            Some(c) => super::finite3("center", c)?,
+            Some(c) => c,
             None => {
                 let (mut m, mut l) = (DVec3::ZERO, 0.0);
                 for w in axis.samples.windows(2) {
@@ -80,13 +88,13 @@ impl Rod {
             }
         };
         let bound = axis.extent_about(center);
-        Ok(Rod {
+        Rod {
             axis,
             radius,
             reach,
             center,
             bound,
-        })
+        }
     }
 
     /// The nearest axis point within `ρ + R` of `x`, if any.

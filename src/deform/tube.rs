@@ -599,6 +599,15 @@ impl super::Tool for StripAlong {
     fn velocity(&self, x: DVec3, _t: f64, _tm: f64) -> DVec3 {
         self.eval(x)
     }
+    /// The rod about the strip's axis (the same axis, checked for the same
+    /// `radius + reach`), for keyframed poses.
+    fn shape(&self) -> Option<super::curl::ToolShape> {
+        let rod = super::rod::Rod::with_axis(self.axis.clone(), self.radius, self.reach, None);
+        Some(super::curl::ToolShape {
+            shape: super::curl::Shape::Rod(std::sync::Arc::new(rod)),
+            power: None,
+        })
+    }
     fn max_speed(&self) -> f64 {
         StripAlong::max_speed(self)
     }

@@ -11,9 +11,7 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use super::convert::{
-    choice, detach_in_pool, empty, real, slice_mut, slice_of, value_error, vec3s,
-};
+use super::convert::{choice, detach_in_pool, empty, real, slice_mut, slice_of, vec3s};
 use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -632,9 +630,11 @@ pub fn field_rod(
     curl_field(rod, mo, falloff_power, moving, "rod")
 }
 
-/// `spinal.fields.keyframed`: the shape of `tool` (a field of one tool) following keys;
-/// orientations as rotation matrices `(k, 3, 3)` or quaternions `(k, 4)` `(x, y, z, w)`.
+/// `spinal.fields.keyframed`: `tool` (a field) following keys — its shape when it is one tool
+/// with a shape, else the whole field carried rigidly about `center`; orientations as
+/// rotation matrices `(k, 3, 3)` or quaternions `(k, 4)` `(x, y, z, w)`.
 #[pyfunction]
+#[allow(clippy::too_many_arguments)]
 pub fn field_keyframed(
     tool: &PyField,
     times: PyReadonlyArray1<'_, f64>,
@@ -642,18 +642,8 @@ pub fn field_keyframed(
     matrices: Option<PyReadonlyArray3<'_, f64>>,
     quaternions: Option<PyReadonlyArray2<'_, f64>>,
     falloff_power: Option<i64>,
+    center: Option<[f64; 3]>,
 ) -> PyResult<PyField> {
-    let shape = match tool.field.tools.as_slice() {
-        [one] => one.shape(),
-        _ => None,
-    };
-    let Some(shape) = shape else {
-        return Err(value_error(format!(
-            "tool: expected a field of one tool with a shape (translation, rotation, sdf_curl, \
-             mesh_curl, rod, sdf_tool, mesh_tool or keyframed), got {}",
-            tool.__repr__()
-        )));
-    };
     let t = slice_of("times", &times)?;
     let x = vec3s("positions", &positions)?;
     let orientations = match (matrices, quaternions) {
@@ -674,6 +664,6 @@ pub fn field_keyframed(
         (None, None) => None,
     };
     let keys = keyframe::Keys::new(t, x, orientations)?;
-    let f = keyframe::keyframed(shape, keys, falloff_power)?;
+    let f = keyframe::keyframed(&tool.field, keys, falloff_power, center.map(DVec3::from))?;
     Ok(PyField::new(f, "keyframed"))
 }
