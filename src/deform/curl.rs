@@ -787,6 +787,45 @@ mod tests {
         );
     }
 
+    /// The torus distance's gradient is the central difference of its distance, and it is
+    /// the distance to the core circle minus the tube radius.
+    #[test]
+    fn a_ring_has_the_exact_gradient_of_its_distance() {
+        let axis = DVec3::new(0.3, -0.4, 0.8).normalize();
+        let ring = Ring {
+            center: DVec3::new(0.1, -0.2, 0.3),
+            axis,
+            major: 0.6,
+            minor: 0.12,
+            reach: 0.15,
+        };
+        let e1 = axis.any_orthonormal_vector();
+        let e2 = axis.cross(e1);
+        let mut seen = 0;
+        for i in 0..400 {
+            let a = i as f64 * 0.37;
+            let x = ring.center
+                + DVec3::new(0.8 * a.sin(), 0.8 * (1.3 * a).cos(), 0.3 * (0.7 * a).sin());
+            let Some((d, g)) = ring.distance(x) else {
+                continue;
+            };
+            seen += 1;
+            let y = x - ring.center;
+            let (u, v, z) = (y.dot(e1), y.dot(e2), y.dot(axis));
+            let core = (u.hypot(v) - 0.6).hypot(z);
+            assert!((d - (core - 0.12)).abs() < 1e-14);
+            let h = 1e-6;
+            for k in 0..3 {
+                let mut e = DVec3::ZERO;
+                e[k] = h;
+                let fd =
+                    (ring.distance(x + e).unwrap().0 - ring.distance(x - e).unwrap().0) / (2.0 * h);
+                assert!((fd - g[k]).abs() < 1e-8, "{fd} {}", g[k]);
+            }
+        }
+        assert!(seen > 40, "{seen}");
+    }
+
     #[test]
     fn motion_needs_exactly_one_velocity() {
         let z = DVec3::ZERO;
