@@ -39,8 +39,12 @@ translation and rotation above with the signed distance ``d`` of any shape and i
 gradient ``g = ∇d`` in place of the sphere's, divergence-free for any C¹ ``d`` —
 :func:`sdf_curl` (a sampled distance), :func:`mesh_curl` (a closed mesh), :func:`rod` (a tube
 about a spline axis, the thesis's strip along a curve — §11.2.2's region about an inner axis —
-in curl form; two points give a capsule). :func:`keyframed` moves the shape of such a tool (or of a
-sphere or grid tool) rigidly through keys ``(t_k, c_k, Q_k)``.
+in curl form; two points give a capsule).
+
+**Keyframed tools** — :func:`keyframed` moves any field rigidly through keys
+``(t_k, c_k, Q_k)``: a tool with a shape (the curl tools, and the sphere, capsule, strip,
+torus, strip_curve and grid tools by their shapes) as the curl tool of the moving shape; any
+other field (twist, bend, along_path, sums) carried whole, ``v = Q v₀(C + Qᵀ(X − c), t)``.
 
 **Tools along a path** — :func:`along_path`: a sphere tool travels along a spine curve at
 constant speed, posed by Hermite positions and the interpolated rotation-minimizing frames

@@ -1,5 +1,7 @@
-//! Tools following keyframed rigid poses `(t_k, c_k, Q_k)` (the thesis's tools move rigidly
+//! Fields following keyframed rigid poses `(t_k, c_k, Q_k)` (the thesis's tools move rigidly
 //! with their object space, Zheng Ch. 11.2, §11.2.6; the curl fields are those of Ch. 12).
+//! The pose takes a point `C` of the field (by default a shape's centre) to `c(t)` and turns
+//! it by `Q(t)` about it.
 //!
 //! **Pose.** In key interval `k`, `λ = (t − t_k)/Δt_k`:
 //!
@@ -12,13 +14,17 @@
 //!   arc: consecutive quaternions are sign-aligned), world angular velocity
 //!   `ω = Q_k Θ_k / Δt_k`, constant in each interval. `Q(t)` is C⁰ in its rate at the keys.
 //!
-//! **Field** at time `t`: the curl translation of [`super::curl`] with `u = ċ(t)` and
-//! `Y = X − c(t)`, plus (when orientations are given) the curl rotation with `Ω = ω(t)` about
-//! `c(t)`, both with the shape's distance at the current pose, `d(C + Qᵀ(X − c))` and its
-//! gradient turned back by `Q`. Their normal velocity on the tool surface is the rigid
-//! motion's, `(ċ + ω × (X − c))·n`. Zero before the first and after the last key (the tool
-//! rests); the key times are breakpoints, and a step's midpoint time `tm` picks the interval
-//! (and whether the tool moves) for all its stages.
+//! **A tool with a shape** ([`Keyframed`]), at time `t`: the curl translation of
+//! [`super::curl`] with `u = ċ(t)` and `Y = X − c(t)`, plus (when orientations are given)
+//! the curl rotation with `Ω = ω(t)` about `c(t)`, both with the shape's distance at the
+//! current pose, `d(C + Qᵀ(X − c))` and its gradient turned back by `Q`. Their normal
+//! velocity on the tool surface is the rigid motion's, `(ċ + ω × (X − c))·n`. Zero before
+//! the first and after the last key (the tool rests); the key times are breakpoints, and a
+//! step's midpoint time `tm` picks the interval (and whether the tool moves) for all its
+//! stages.
+//!
+//! **Any other field** ([`Carried`]): carried whole, `v = Q v₀(C + Qᵀ(X − c), t)`, with the
+//! first or last key's pose held outside the keys.
 
 use glam::{DMat3, DQuat, DVec3};
 

@@ -24,8 +24,8 @@ use crate::deform::{
 /// `field(points, t=0.0)` returns the `(n, 3)` velocities at time `t`; `f + g` (and the
 /// builtin `sum`) is the sum field; `max_speed` bounds `|v|`, `length_scale` is the smallest
 /// reach, `steps(duration)` the default RK4 step count of `spinal.advect`, `breakpoints()`
-/// the times at which a path tool passes a spine sample. Fields are immutable and pickle by
-/// rebuilding from their constructor arguments.
+/// the times at which a path tool passes a spine sample or a keyframed tool a key. Fields are
+/// immutable and pickle by rebuilding from their constructor arguments.
 #[pyclass(frozen, name = "Field", module = "spinal.fields")]
 pub struct PyField {
     /// The built tools.
@@ -122,8 +122,8 @@ impl PyField {
         self.field.tools.len()
     }
 
-    /// Times at which a path tool passes a spine sample, sorted: the velocity is only
-    /// continuous in time there, so `spinal.advect` ends steps at them.
+    /// Times at which a path tool passes a spine sample or a keyframed tool a key, sorted:
+    /// the velocity is only continuous in time there, so `spinal.advect` ends steps at them.
     fn breakpoints<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(PyArray1::from_vec(
             py,
