@@ -141,17 +141,22 @@ def keyed(kind, tool=None, times=TIMES, pos=POS, rot=ROT, **kw):
     return fields.keyframed(tool, times, pos, None if rot is None else rot.as_matrix(), **kw)
 
 
-def scipy_pose(t, times=TIMES, pos=POS, rot=ROT):
-    """c, ċ, Q (a Rotation), ω: Bessel-tangent Hermite positions and slerp, in SciPy."""
+def bessel_spline(times=TIMES, pos=POS):
+    """SciPy's cubic Hermite spline through the keys with Bessel tangents."""
     dt = np.diff(times)
     de = np.diff(pos, axis=0) / dt[:, None]
     m = np.empty_like(pos)
     m[1:-1] = (de[:-1] * dt[1:, None] + de[1:] * dt[:-1, None]) / (dt[:-1] + dt[1:])[:, None]
     m[0] = de[0] + (de[0] - de[1]) * dt[0] / (dt[0] + dt[1])
     m[-1] = de[-1] + (de[-1] - de[-2]) * dt[-1] / (dt[-1] + dt[-2])
-    cs = CubicHermiteSpline(times, pos, m)
+    return CubicHermiteSpline(times, pos, m)
+
+
+def scipy_pose(t, times=TIMES, pos=POS, rot=ROT):
+    """c, ċ, Q (a Rotation), ω: Bessel-tangent Hermite positions and slerp, in SciPy."""
+    cs = bessel_spline(times, pos)
     k = min(max(np.searchsorted(times, t) - 1, 0), len(times) - 2)
-    om = (rot[k + 1] * rot[k].inv()).as_rotvec() / dt[k]
+    om = (rot[k + 1] * rot[k].inv()).as_rotvec() / (times[k + 1] - times[k])
     return cs(t), cs(t, 1), Slerp(times, rot)([t])[0], om
 
 
@@ -174,6 +179,21 @@ def test_breakpoints_are_the_keys_and_the_tools_own(kind):
     expect = np.union1d(TIMES, [0.1, 1.1]) if kind == "along_path" else TIMES
     np.testing.assert_array_equal(f.breakpoints(), expect)
     np.testing.assert_array_equal(f.breakpoints(), np.union1d(TIMES, own))
+
+
+def test_the_step_rule_counts_the_speed_of_the_carried_pattern():
+    """A carried twist's speed bound is the twist's plus the speed at which the pose moves
+    its support (radius R about C) past the material, max|ċ| + max|ω| R (max|ċ| sampled
+    densely from SciPy's spline, the core samples 17 points per interval with a 5 % margin):
+    the default steps grow with the keys' speed; identity keys add nothing."""
+    tw = CARRIED["twist"][0]()
+    vmax = np.linalg.norm(bessel_spline()(np.linspace(0, 1, 2001), 1), axis=1).max()
+    wmax = max(np.linalg.norm(scipy_pose(t)[3]) for t in MID)
+    low = tw.max_speed + vmax + wmax * 0.6
+    assert low <= keyed("twist").max_speed <= low + 0.1 * vmax
+    still = keyed("twist", pos=np.tile(C0, (4, 1)), rot=None)
+    assert still.max_speed == tw.max_speed and still.steps(1.0) == tw.steps(1.0)
+    assert keyed("twist").steps(1.0) > 2 * tw.steps(1.0)
 
 
 # ---- divergence ----------------------------------------------------------------------------
