@@ -413,6 +413,10 @@ def test_keyframed_fields_pickle(kind):
      "center"),
     (lambda: fields.keyframed(fields.twist(C0, A, 1.0, 0.5), [0, 1e-300],
                               [[0, 0, 0], [1e300, 0, 0]]), "times"),
+    # a turning key pose about a centre 1e300 from the twist's support: w·E overflows
+    (lambda: fields.keyframed(fields.twist(C0, A, 1.0, 0.5), [0.0, 1.0], POS[:2],
+                              [[0, 0, 0, 1], [0, 0, np.sin(0.5), np.cos(0.5)]],
+                              center=[1e300, 0, 0]), "^center: too far"),
 ])
 def test_bad_input_names_the_argument(call, match):
     with pytest.raises(ValueError, match=match):

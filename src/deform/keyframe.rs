@@ -445,7 +445,17 @@ impl Carried {
         // pattern past the material, |ċ| + |ω| E with E the support's radius about C (|ċ|
         // alone where the support is unbounded)
         let (v, w) = keys.rates();
-        let pattern = v + field.support_radius(center).map_or(0.0, |e| w * e);
+        let reach = field.support_radius(center);
+        if let Some(e) = reach.filter(|e| v.is_finite() && w.is_finite() && !(w * e).is_finite()) {
+            return Err(InputError::new(
+                "center",
+                format!(
+                    "too far from the field's support ({e:e} away) for the keys' turning \
+                     rate {w:e}: the speed bound is out of floating-point range"
+                ),
+            ));
+        }
+        let pattern = v + reach.map_or(0.0, |e| w * e);
         let speed = field.max_speed() + pattern;
         if !speed.is_finite() {
             return Err(InputError::new(
