@@ -260,6 +260,20 @@ def test_a_keyframed_spin_about_a_fixed_point_reproduces_the_rotation(quaternion
                                atol=1e-7)
 
 
+def bessel_hermite(times, pos):
+    """SciPy's cubic Hermite spline through the keys with Bessel tangents (the derivative of
+    the parabola through three neighbouring keys; at the ends that of the end parabola)."""
+    times = np.asarray(times, float)
+    pos = np.asarray(pos, float)
+    dt = np.diff(times)
+    de = np.diff(pos, axis=0) / dt[:, None]
+    m = np.empty_like(pos)
+    m[1:-1] = (de[:-1] * dt[1:, None] + de[1:] * dt[:-1, None]) / (dt[:-1] + dt[1:])[:, None]
+    m[0] = de[0] + (de[0] - de[1]) * dt[0] / (dt[0] + dt[1])
+    m[-1] = de[-1] + (de[-1] - de[-2]) * dt[-1] / (dt[-1] + dt[-2])
+    return CubicHermiteSpline(times, pos, m)
+
+
 def test_keyframed_pose_follows_scipy_hermite_and_slerp():
     """A rod tool on a curved key path with turns: on the tool surface the normal velocity is
     the rigid motion's, (ċ + ω × (X − c))·n, with c, ċ from SciPy's Hermite spline (Bessel
@@ -270,12 +284,7 @@ def test_keyframed_pose_follows_scipy_hermite_and_slerp():
     cap = fields.rod([[-0.3, 0, 0], [0.3, 0, 0]], 0.15, velocity=[1, 0, 0], reach=0.2)
     kf = fields.keyframed(cap, times, pos, rot.as_quat())
     dt = np.diff(times)
-    de = np.diff(pos, axis=0) / dt[:, None]
-    m = np.empty_like(pos)
-    m[1:-1] = (de[:-1] * dt[1:, None] + de[1:] * dt[:-1, None]) / (dt[:-1] + dt[1:])[:, None]
-    m[0] = de[0] + (de[0] - de[1]) * dt[0] / (dt[0] + dt[1])
-    m[-1] = de[-1] + (de[-1] - de[-2]) * dt[-1] / (dt[-1] + dt[-2])
-    cs = CubicHermiteSpline(times, pos, m)
+    cs = bessel_hermite(times, pos)
     from scipy.spatial.transform import Slerp
 
     slerp = Slerp(times, rot)
@@ -328,9 +337,11 @@ def path_samples(f, x, T, t0=0.0, n=16):
     return [x] + [spinal.advect(x, f, T * k / n, 8 * k, t0=t0) for k in range(1, n + 1)]
 
 
-def rk4_ratios(f, x, T, t0=0.0):
-    ref = spinal.advect(x, f, T, 4096, t0=t0)
-    err = [np.abs(spinal.advect(x, f, T, n, t0=t0) - ref).max() for n in (8, 16, 32, 64, 128)]
+def rk4_ratios(f, x, T, t0=0.0, steps=(8, 16, 32, 64, 128), ref_steps=4096):
+    """The largest RK4 error at each step count (against a ``ref_steps`` run), its ratios
+    per halving."""
+    ref = spinal.advect(x, f, T, ref_steps, t0=t0)
+    err = [np.abs(spinal.advect(x, f, T, n, t0=t0) - ref).max() for n in steps]
     return np.divide(err[:-1], err[1:])
 
 
