@@ -8,7 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    cubics_of, detach_in_pool, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s,
+    Stop, cubics_of, detach_in_pool, detach_stoppable, empty, quats, rows_of, slice_mut, slice_of,
+    vec3_of, vec3s,
 };
 use super::frames::FramesAndAngles;
 use crate::alloc;
@@ -65,7 +66,10 @@ pub fn ph_invariants<'py>(
     control_points: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of("ph.invariants", &control_points)?;
-    let rows = ph::check::invariant_rows(&cubics)?;
+    let stop = Stop::default();
+    let rows = detach_stoppable(py, &stop, || {
+        ph::check::invariant_rows_cancellable(&cubics, &|| stop.requested())
+    })??;
     let out = alloc::flat("ph.invariants", rows.iter().map(|v| v.row()))?;
     let m = rows.len();
     PyArray1::from_vec(py, out).reshape([m, 13])
@@ -79,7 +83,10 @@ pub fn ph_is_ph<'py>(
     tol: f64,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let cubics = cubics_of("ph.is_ph", &control_points)?;
-    let out = ph::check::is_ph_rows(&cubics, tol)?;
+    let stop = Stop::default();
+    let out = detach_stoppable(py, &stop, || {
+        ph::check::is_ph_rows_cancellable(&cubics, tol, &|| stop.requested())
+    })??;
     Ok(PyArray1::from_vec(py, out))
 }
 
@@ -131,7 +138,10 @@ pub fn ph_preimage<'py>(
     batch: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of("ph.preimage", &control_points)?;
-    let rows = ph::preimage_rows(&cubics, tol, batch)?;
+    let stop = Stop::default();
+    let rows = detach_stoppable(py, &stop, || {
+        ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())
+    })??;
     let m = rows.len();
     rows_of(py, bytemuck::allocation::cast_vec(rows), m)
 }
