@@ -29,7 +29,7 @@ HEADROOM = 100 << 20
 
 PRELUDE = """
 import resource, sys, numpy as np, trimesh, spinal
-from spinal import ph, quaternions as Q
+from spinal import ph, quaternions as Q, fields as fl
 spinal.set_num_threads(2)
 u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]
 spinal.frames(H); spinal.tube(H, .1, 8)  # the worker pool and its arenas exist
@@ -80,6 +80,10 @@ D16_CASES = {
         "b = trimesh.creation.box(); M = np.tile([[1e6, .1234]], (30, 1))\n",
         "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), M)",
         "walk_mesh: out of memory: moves: a walk of total length 3.000e7"),
+    "deform": (
+        ("s = np.linspace(0, 400, 300_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01, 8)\n"
+         "f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n"),
+        "spinal.deform(m, f, 1.0, 2)", "deform: out of memory"),
     "slerp": (
         ("q = np.tile([.1, .2, .3, .9], (5_000_000, 1)); q /= np.linalg.norm(q[0])\n"
          "q1 = q[::-1].copy(); u = np.linspace(0, 1, len(q))\n"),
