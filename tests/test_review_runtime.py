@@ -84,6 +84,16 @@ D16_CASES = {
         ("s = np.linspace(0, 400, 300_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01, 8)\n"
          "f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n"),
         "spinal.deform(m, f, 1.0, 2)", "deform: out of memory"),
+    # a profile of 2**22 vertices on a two-point spine (the profile's copies and, for the
+    # star, the working memory of its self-intersection test and cap triangulation)
+    "sweep huge profile": (
+        ("m = 2**22; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; X = np.array([[0, 0, 0], [0, .1, 1.]])\n"),
+        "spinal.sweep(X, P)", "sweep: out of memory"),
+    "sweep huge star profile": (
+        ("m = 2**22; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; P[::2] *= .9; X = np.array([[0, 0, 0], [0, .1, 1.]])\n"),
+        "spinal.sweep(X, P, normals=False, uv=False, dtype='float32')", "sweep: out of memory"),
     "slerp": (
         ("q = np.tile([.1, .2, .3, .9], (5_000_000, 1)); q /= np.linalg.norm(q[0])\n"
          "q1 = q[::-1].copy(); u = np.linspace(0, 1, len(q))\n"),
