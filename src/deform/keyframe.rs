@@ -25,6 +25,7 @@ use glam::{DMat3, DQuat, DVec3};
 use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound, translation_bound};
 use super::{Tool, falloff};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{ROTATION_TOL, is_rotation, mat3_from_quat, quat_from_mat3};
@@ -66,6 +67,24 @@ impl Keys {
         positions: &[DVec3],
         orientations: Option<Orientations>,
     ) -> Result<Keys> {
+        Keys::new_cancellable(times, positions, orientations, &cancel::never)
+    }
+
+    /// [`Keys::new`] that polls `cancel` between its passes over the keys and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        times: &[f64],
+        positions: &[DVec3],
+        orientations: Option<Orientations>,
+        cancel: Cancel<'_>,
+    ) -> Result<Keys> {
+        let poll = || {
+            if cancel() {
+                Err(cancel::stopped())
+            } else {
+                Ok(())
+            }
+        };
         let n = times.len();
         if n < 2 {
             return Err(InputError::new(
@@ -93,7 +112,9 @@ impl Keys {
                 format!("expected {n} rows (one per key), got {}", positions.len()),
             ));
         }
+        poll()?;
         super::finite_rows("positions", positions)?;
+        poll()?;
         const CALL: &str = "keyframed";
         let dt = alloc::collect(CALL, times.windows(2).map(|w| w[1] - w[0]))?;
         let delta = alloc::collect(
@@ -103,8 +124,12 @@ impl Keys {
                 .zip(&dt)
                 .map(|(w, h)| (w[1] - w[0]) / *h),
         )?;
+        poll()?;
         let mut slopes = alloc::with_capacity(CALL, n)?;
         for k in 0..n {
+            if k % cancel::BLOCK == 0 {
+                poll()?;
+            }
             slopes.push(if n == 2 {
                 delta[0]
             } else if k == 0 {
@@ -138,6 +163,7 @@ impl Keys {
                         alloc::collect(CALL, q.iter().map(|q| q.normalize()))?
                     }
                 };
+                poll()?;
                 if q.len() != n {
                     return Err(bad(format!(
                         "expected {n} orientations (one per key), got {}",
@@ -149,7 +175,9 @@ impl Keys {
                         q[k] = -q[k];
                     }
                 }
+                poll()?;
                 let frames = alloc::collect(CALL, q.iter().map(|q| mat3_from_quat(*q)))?;
+                poll()?;
                 let theta = alloc::collect(
                     CALL,
                     q.windows(2).map(|w| {
@@ -164,6 +192,7 @@ impl Keys {
                 Some((frames, theta))
             }
         };
+        poll()?;
         Ok(Keys {
             times: alloc::copied(CALL, times)?,
             positions: alloc::copied(CALL, positions)?,
@@ -222,8 +251,18 @@ impl Keys {
 
     /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`.
     pub fn rates(&self) -> (f64, f64) {
+        self.rates_cancellable(&cancel::never)
+            .expect("never stopped")
+    }
+
+    /// [`Keys::rates`] that polls `cancel` every [`cancel::BLOCK`] intervals (`None` once it
+    /// says stop).
+    pub fn rates_cancellable(&self, cancel: Cancel<'_>) -> Option<(f64, f64)> {
         let mut v: f64 = 0.0;
         for k in 0..self.times.len() - 1 {
+            if k % cancel::BLOCK == 0 && cancel() {
+                return None;
+            }
             let seg = self.segment(k);
             let h = self.times[k + 1] - self.times[k];
             for i in 0..=16 {
@@ -238,7 +277,7 @@ impl Keys {
                 .map(|(th, t)| th.length() / (t[1] - t[0]))
                 .fold(0.0, f64::max),
         };
-        (1.05 * v, w)
+        Some((1.05 * v, w))
     }
 }
 
@@ -253,8 +292,20 @@ pub struct Keyframed<D> {
 impl<D: Distance> Keyframed<D> {
     /// The tool, validated: a finite speed bound (errors name `times`).
     pub fn new(shape: D, keys: Keys, power: u8) -> Result<Keyframed<D>> {
+        Keyframed::new_cancellable(shape, keys, power, &cancel::never)
+    }
+
+    /// [`Keyframed::new`] that polls `cancel` in the speed bound and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        shape: D,
+        keys: Keys,
+        power: u8,
+        cancel: Cancel<'_>,
+    ) -> Result<Keyframed<D>> {
+        let (v, w) = keys.rates_cancellable(cancel).ok_or_else(cancel::stopped)?;
         let tool = Keyframed { shape, keys, power };
-        let s = tool.max_speed();
+        let s = tool.speed_bound(v, w);
         if !s.is_finite() {
             return Err(InputError::new(
                 "times",
@@ -298,6 +349,11 @@ impl<D: Distance> Keyframed<D> {
 
     pub fn max_speed(&self) -> f64 {
         let (v, w) = self.keys.rates();
+        self.speed_bound(v, w)
+    }
+
+    /// The speed bound of the tool for the key rates `(|ċ|, |ω|)` ([`Keys::rates`]).
+    fn speed_bound(&self, v: f64, w: f64) -> f64 {
         translation_bound(v, &self.shape, self.power)
             + rotation_bound(w, 0.0, &self.shape, self.power)
     }
@@ -306,15 +362,25 @@ impl<D: Distance> Keyframed<D> {
 /// The keyframed tool of a built tool's shape: `power` (2, 3 or 4) overrides the tool's
 /// falloff power; a tool without one (not a curl field) defaults to 2.
 pub fn keyframed(shape: ToolShape, keys: Keys, power: Option<i64>) -> Result<super::Field> {
+    keyframed_cancellable(shape, keys, power, &cancel::never)
+}
+
+/// [`keyframed`] that polls `cancel` in the speed bound (see [`Keyframed::new_cancellable`]).
+pub fn keyframed_cancellable(
+    shape: ToolShape,
+    keys: Keys,
+    power: Option<i64>,
+    cancel: Cancel<'_>,
+) -> Result<super::Field> {
     let p = match (power, shape.power) {
         (Some(p), _) => falloff(p)?,
         (None, Some(p)) => p,
         (None, None) => 2,
     };
     Ok(match shape.shape {
-        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p)?),
-        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p)?),
-        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p)?),
+        Shape::Ball(b) => super::Field::single(Keyframed::new_cancellable(b, keys, p, cancel)?),
+        Shape::Rod(r) => super::Field::single(Keyframed::new_cancellable(r, keys, p, cancel)?),
+        Shape::Grid(g) => super::Field::single(Keyframed::new_cancellable(g, keys, p, cancel)?),
     })
 }
 
