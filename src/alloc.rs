@@ -49,6 +49,27 @@ pub fn try_collect<T>(
     Ok(v)
 }
 
+/// Items between polls of [`try_collect_cancellable`].
+pub const CANCEL_ITEMS: usize = 1 << 14;
+
+/// [`try_collect`] that polls `cancel` before every [`CANCEL_ITEMS`] items and returns the
+/// items made so far once it says stop (an incomplete result the caller discards; see
+/// [`crate::cancel`]).
+pub fn try_collect_cancellable<T>(
+    what: &'static str,
+    it: impl ExactSizeIterator<Item = Result<T>>,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<T>> {
+    let mut v = with_capacity(what, it.len())?;
+    for (i, x) in it.enumerate() {
+        if i % CANCEL_ITEMS == 0 && cancel() {
+            break;
+        }
+        v.push(x?);
+    }
+    Ok(v)
+}
+
 /// The rows of an iterator of known length, concatenated.
 pub fn flat<T: Copy, const K: usize>(
     what: &'static str,
@@ -122,6 +143,11 @@ mod tests {
         assert_eq!(try_collect("x", ok.into_iter()).unwrap(), vec![1, 2]);
         let bad = [Ok(1), Err(InputError::new("a", "b")), Ok(3)];
         assert_eq!(try_collect("x", bad.into_iter()).unwrap_err().arg, "a");
+        let many = (0..3 * CANCEL_ITEMS).map(Ok);
+        let stop_now = try_collect_cancellable("x", many.clone(), &|| true).unwrap();
+        assert!(stop_now.is_empty());
+        let all = try_collect_cancellable("x", many, &crate::cancel::never).unwrap();
+        assert_eq!(all.len(), 3 * CANCEL_ITEMS);
         use rayon::prelude::*;
         let v = par_collect("x", (0..10_000u32).into_par_iter().map(|i| 2 * i)).unwrap();
         assert!(v.iter().enumerate().all(|(i, &x)| x == 2 * i as u32));

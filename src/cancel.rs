@@ -11,6 +11,15 @@ pub fn never() -> bool {
     false
 }
 
+/// The error of a computation stopped by its hook (the caller, which asked it to stop,
+/// discards it and raises its own).
+pub fn stopped() -> crate::error::InputError {
+    crate::error::InputError::new("cancel", "stopped on request")
+}
+
+/// Items (rows, keys, cubics) between polls of a sequential cancellable loop.
+pub const BLOCK: usize = 1 << 14;
+
 #[cfg(test)]
 mod tests {
     //! Every cancellable call, stopped at each of its polls in turn, returns without a

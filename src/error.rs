@@ -53,6 +53,16 @@ impl InputError {
         }
     }
 
+    /// An out-of-memory error of `what` with its own explanation (a size derived from the
+    /// input's numbers rather than one buffer's element count).
+    pub fn oom_message(what: &'static str, msg: String) -> Self {
+        InputError {
+            arg: what,
+            msg: format!("out of memory: {msg}"),
+            kind: ErrorKind::OutOfMemory,
+        }
+    }
+
     /// The same error with a prefix locating it (used for curve bundles).
     pub fn context(self, prefix: &str) -> Self {
         InputError {

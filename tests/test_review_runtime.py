@@ -29,7 +29,7 @@ HEADROOM = 100 << 20
 
 PRELUDE = """
 import resource, sys, numpy as np, trimesh, spinal
-from spinal import ph, quaternions as Q
+from spinal import ph, quaternions as Q, fields as fl
 spinal.set_num_threads(2)
 u = np.linspace(0, 4 * np.pi, 60); H = np.c_[np.cos(u), np.sin(u), .2 * u]
 spinal.frames(H); spinal.tube(H, .1, 8)  # the worker pool and its arenas exist
@@ -66,15 +66,38 @@ D16_CASES = {
         "spinal.estimate_tangents(X)", "estimate_tangents: out of memory"),
     "to_quaternions": (
         "F = np.ascontiguousarray(np.broadcast_to(np.eye(3), (4_000_000, 3, 3)))\n",
-        "Q.to_quaternions(F)", ""),
+        "Q.to_quaternions(F)", "to_quaternions: out of memory"),
     "quaternion_frames": (
         ("n = 4_000_000; s = np.linspace(0, 800, n)\n"
         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
-        "Q.quaternion_frames(X)", ""),
+        "Q.quaternion_frames(X)", "quaternion_frames: out of memory"),
     "walk_mesh": (
         "b = trimesh.creation.box()\n",
         "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), [[3e7, .1234]])",
-        "walk_mesh: out of memory"),
+        "walk_mesh: out of memory: moves: a walk of total length 3.000e7"),
+    # moves each short enough, together too long: refused before the walk starts
+    "walk_mesh many moves": (
+        "b = trimesh.creation.box(); M = np.tile([[1e6, .1234]], (30, 1))\n",
+        "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), M)",
+        "walk_mesh: out of memory: moves: a walk of total length 3.000e7"),
+    "deform": (
+        ("s = np.linspace(0, 400, 300_000); m = spinal.tube(np.c_[np.cos(s), np.sin(s), .2 * s], .01, 8)\n"
+         "f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n"),
+        "spinal.deform(m, f, 1.0, 2)", "deform: out of memory"),
+    # a profile of 2**22 vertices on a two-point spine (the profile's copies and, for the
+    # star, the working memory of its self-intersection test and cap triangulation)
+    "sweep huge profile": (
+        ("m = 2**22; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; X = np.array([[0, 0, 0], [0, .1, 1.]])\n"),
+        "spinal.sweep(X, P)", "sweep: out of memory"),
+    "sweep huge star profile": (
+        ("m = 2**22; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; P[::2] *= .9; X = np.array([[0, 0, 0], [0, .1, 1.]])\n"),
+        "spinal.sweep(X, P, normals=False, uv=False, dtype='float32')", "sweep: out of memory"),
+    "slerp": (
+        ("q = np.tile([.1, .2, .3, .9], (5_000_000, 1)); q /= np.linalg.norm(q[0])\n"
+         "q1 = q[::-1].copy(); u = np.linspace(0, 1, len(q))\n"),
+        "Q.slerp(q, q1, u)", "slerp: out of memory"),
     "walk_mesh_many": (
         ("b = trimesh.creation.box(); w, k = 100_000, 60\n"
         "P = np.repeat(b.vertices[b.faces[0]].mean(0)[None], w, 0)\n"
@@ -90,7 +113,7 @@ D16_CASES = {
         "spinal.SpineBinding(V, H)", "SpineBinding: out of memory"),
     "flesh": (
         "V = np.random.default_rng(0).normal(size=(5_000_000, 3))\n",
-        "spinal.flesh(V, H, H * 1.1)", "out of memory"),
+        "spinal.flesh(V, H, H * 1.1)", "flesh: SpineBinding: out of memory"),
     "SurfaceBinding": (
         ("g = np.stack(np.meshgrid(np.linspace(0, 1, 8), np.linspace(0, 1, 9), indexing='ij'), -1)\n"
         "S = np.concatenate([g, np.zeros(g.shape[:2] + (1,))], -1)\n"
@@ -98,7 +121,7 @@ D16_CASES = {
         "spinal.SurfaceBinding(V, S)", "SurfaceBinding: out of memory"),
     "ph.hermite": (
         "m = 1_000_000; P0 = np.zeros((m, 3)); P1 = np.ones((m, 3)); T = np.ones((m, 3))\n",
-        "ph.hermite(P0, T, P1, T)", ""),
+        "ph.hermite(P0, T, P1, T)", "ph.hermite: out of memory"),
     "frames guided": (
         ("n = 10_000_000; s = np.linspace(0, 2000, n)\n"
         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
@@ -128,14 +151,14 @@ D16_CASES = {
     "strip_curve": (
         ("n = 2_000_000; s = np.linspace(0, 2000, n)\n"
         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
-        "spinal.fields.strip_curve(X, .1, 1.0)", "out of memory"),
+        "spinal.fields.strip_curve(X, .1, 1.0)", "strip_curve/rod axis: out of memory"),
     "SpineBinding at 1e200": (
         "V = np.random.default_rng(0).normal(size=(5_000_000, 3)) * 1e200\n",
         "spinal.SpineBinding(V, H * 1e200)", "SpineBinding: out of memory"),
     "PHSpline.evaluate": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
         "s = np.linspace(0, 1, 10_000_000)\n"),
-        "sp.evaluate(s)", ""),
+        "sp.evaluate(s)", "PHSpline.evaluate: out of memory"),
     "keyframed": (
         ("n = 10_000_000; T = np.arange(n, dtype=float); P = np.c_[T, T, T] * 1e-6\n"
         "tool = spinal.fields.translation([0, 0, 0], .5, [0, 0, 1])\n"),
@@ -155,8 +178,8 @@ def test_D16_out_of_memory_raises_memory_error(name):
     setup, call, words = D16_CASES[name]
     r = run_limited(setup, call)
     assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
-    assert "MemoryError:" in r.stdout, r.stdout
-    assert words in r.stdout, r.stdout
+    # the message starts with the call's name
+    assert f"MemoryError: {words}" in r.stdout, r.stdout
 
 
 def test_D16_memory_error_comes_from_the_core_not_an_abort():
@@ -363,6 +386,113 @@ D17_CASES = {
 def test_D17_ctrl_c_within_half_a_second(name):
     setup, call = D17_CASES[name]
     assert late_after_sigint(setup, call) < 0.5
+
+
+SIGINT_ONCE_CHILD = """
+import hashlib, os, signal, sys, threading, time
+import numpy as np, trimesh, spinal
+from spinal import fields as fl, quaternions as Q, ph
+spinal.set_num_threads(2)
+signal.signal(signal.SIGINT, signal.default_int_handler)
+{setup}
+def run():
+    return {call}
+def digest(x, h):
+    if isinstance(x, np.ndarray):
+        h.update(repr((x.dtype, x.shape)).encode()); h.update(np.ascontiguousarray(x).tobytes())
+    elif isinstance(x, dict):
+        for k in sorted(x):
+            h.update(repr(k).encode()); digest(x[k], h)
+    elif isinstance(x, (tuple, list)):
+        for v in x:
+            digest(v, h)
+    else:
+        h.update(repr(x).encode())
+    return h.hexdigest()
+start = time.perf_counter()
+first = digest(run(), hashlib.sha256())
+full = time.perf_counter() - start
+assert full >= {least}, f'the uninterrupted call takes only {{full:.2f}} s'
+def fire():
+    os.kill(os.getpid(), signal.SIGINT)
+# measured from the planned moment: a call holding the GIL also delays the timer thread
+planned = time.perf_counter() + {after}
+threading.Timer({after}, fire).start()
+try:
+    run()
+except KeyboardInterrupt:
+    late = time.perf_counter() - planned
+else:
+    print(f'finished, no KeyboardInterrupt'); sys.exit(3)
+# no worker left running: the process stays idle after the interrupt
+cpu = time.process_time(); time.sleep(0.3); busy = time.process_time() - cpu
+same = digest(run(), hashlib.sha256()) == first
+print(f'interrupted {{late:.3f}} s after the signal; {{full:.2f}} s uninterrupted; '
+      f'{{busy:.3f}} s of CPU idle; same after {{same}}')
+"""
+
+
+def interrupt_once(setup: str, call: str, after: float = 0.3, least: float = 1.5):
+    """Run `call` once uninterrupted (it must take at least `least` seconds, so the case
+    cannot pass by returning before the signal), once with SIGINT `after` seconds in, then
+    again: returns (seconds from the signal to the KeyboardInterrupt, CPU seconds used in
+    0.3 s of sleep after it, whether the last run gave the first run's bits)."""
+    code = SIGINT_ONCE_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after,
+                                    least=least)
+    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                       text=True, timeout=600)
+    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
+    w = r.stdout.split()
+    return float(w[1]), float(w[9]), w[-1] == "True"
+
+
+# the calls stopped inside one run (each takes 1.5 s or more uninterrupted)
+D17_ONCE_CASES = {
+    "walk_mesh": (
+        "b = trimesh.creation.box(); p = b.vertices[b.faces[0]].mean(0)\n",
+        "Q.walk_mesh(b.vertices, b.faces, 0, p, [[4e6, .1234]])"),
+    "quaternion_frames": (
+        ("n = 12_000_000; s = np.linspace(0, 4000, n)\n"
+         "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
+        "Q.quaternion_frames(X)"),
+    "ph.invariants": (
+        ("c = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1.]])\n"
+         "C = np.ascontiguousarray(np.broadcast_to(c, (3_000_000, 4, 3)))\n"),
+        "ph.invariants(C)"),
+    "ph.is_ph": (
+        ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
+         "C = np.ascontiguousarray(np.broadcast_to(c, (12_000_000, 4, 3)))\n"),
+        "ph.is_ph(C)"),
+    "ph.preimage": (
+        ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
+         "C = np.ascontiguousarray(np.broadcast_to(c, (5_000_000, 4, 3)))\n"),
+        "ph.preimage(C)"),
+    # the fields' builds, each evaluated at a few points (their bits compared)
+    "keyframed": (
+        ("T = np.arange(9_000_000.0); P = np.c_[T, T, T] * 1e-6\n"
+         "tool = fl.translation([0, 0, 0], .5, [0, 0, 1]); Z = np.linspace(-1, 1, 30).reshape(10, 3)\n"),
+        "fl.keyframed(tool, T, P)(Z, 1.0)"),
+    "along_path": (
+        ("s = np.linspace(0, 2000, 5_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "F = spinal.frames(X); Z = X[::500_000] + .05\n"),
+        "fl.along_path(X, .1, 1.0, frames=F)(Z, .5)"),
+    "strip_curve": (
+        ("s = np.linspace(0, 2000, 1_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "Z = X[::100_000] + .05\n"),
+        "fl.strip_curve(X, .1, 1.0)(Z)"),
+    "PHSpline.rmf": (
+        ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
+         "s = np.linspace(0, 1, 16_000_000)\n"),
+        "sp.rmf(s)[::1_000_000]"),
+}
+
+
+@pytest.mark.parametrize("name", list(D17_ONCE_CASES))
+def test_D17_ctrl_c_within_half_a_second_inside_one_call(name):
+    late, busy, same = interrupt_once(*D17_ONCE_CASES[name])
+    assert late < 0.5
+    assert busy < 0.05  # no worker thread still running
+    assert same
 
 
 def test_D17_cold_sweep_stops_promptly():

@@ -590,7 +590,11 @@ def flesh(
     >>> round(1 - np.linalg.norm(P[0] - [0, 1, 0]), 6)  # radial: r1²(1 − ⅔ r1) = 0.09
     0.341342
     """
-    return SpineBinding(vertices, rest_spine, closed=closed).deform(
+    try:
+        binding = SpineBinding(vertices, rest_spine, closed=closed)
+    except MemoryError as e:
+        raise MemoryError(f"flesh: {e}") from None
+    return binding.deform(
         posed_spine,
         solution=solution,
         stretchable=stretchable,
@@ -780,6 +784,10 @@ def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "off
     One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``
     (``posed_frames``/``posed_up``: the directions the offsets are laid along).
     """
-    return SurfaceBinding(vertices, rest_surface).deform(
+    try:
+        binding = SurfaceBinding(vertices, rest_surface)
+    except MemoryError as e:
+        raise MemoryError(f"flesh_surface: {e}") from None
+    return binding.deform(
         posed_surface, solution=solution, strict=strict, return_clamped=return_clamped,
         posed_frames=posed_frames, posed_up=posed_up)

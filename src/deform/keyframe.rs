@@ -31,6 +31,7 @@ use glam::{DMat3, DQuat, DVec3};
 use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound};
 use super::{Tool, falloff};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{ROTATION_TOL, is_rotation, mat3_from_quat, quat_from_mat3};
@@ -72,6 +73,24 @@ impl Keys {
         positions: &[DVec3],
         orientations: Option<Orientations>,
     ) -> Result<Keys> {
+        Keys::new_cancellable(times, positions, orientations, &cancel::never)
+    }
+
+    /// [`Keys::new`] that polls `cancel` between its passes over the keys and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        times: &[f64],
+        positions: &[DVec3],
+        orientations: Option<Orientations>,
+        cancel: Cancel<'_>,
+    ) -> Result<Keys> {
+        let poll = || {
+            if cancel() {
+                Err(cancel::stopped())
+            } else {
+                Ok(())
+            }
+        };
         let n = times.len();
         if n < 2 {
             return Err(InputError::new(
@@ -99,7 +118,9 @@ impl Keys {
                 format!("expected {n} rows (one per key), got {}", positions.len()),
             ));
         }
+        poll()?;
         super::finite_rows("positions", positions)?;
+        poll()?;
         const CALL: &str = "keyframed";
         let dt = alloc::collect(CALL, times.windows(2).map(|w| w[1] - w[0]))?;
         let delta = alloc::collect(
@@ -109,8 +130,12 @@ impl Keys {
                 .zip(&dt)
                 .map(|(w, h)| (w[1] - w[0]) / *h),
         )?;
+        poll()?;
         let mut slopes = alloc::with_capacity(CALL, n)?;
         for k in 0..n {
+            if k % cancel::BLOCK == 0 {
+                poll()?;
+            }
             slopes.push(if n == 2 {
                 delta[0]
             } else if k == 0 {
@@ -144,6 +169,7 @@ impl Keys {
                         alloc::collect(CALL, q.iter().map(|q| q.normalize()))?
                     }
                 };
+                poll()?;
                 if q.len() != n {
                     return Err(bad(format!(
                         "expected {n} orientations (one per key), got {}",
@@ -155,7 +181,9 @@ impl Keys {
                         q[k] = -q[k];
                     }
                 }
+                poll()?;
                 let frames = alloc::collect(CALL, q.iter().map(|q| mat3_from_quat(*q)))?;
+                poll()?;
                 let theta = alloc::collect(
                     CALL,
                     q.windows(2).map(|w| {
@@ -170,6 +198,7 @@ impl Keys {
                 Some((frames, theta))
             }
         };
+        poll()?;
         Ok(Keys {
             times: alloc::copied(CALL, times)?,
             positions: alloc::copied(CALL, positions)?,
@@ -245,8 +274,18 @@ impl Keys {
 
     /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`.
     pub fn rates(&self) -> (f64, f64) {
+        self.rates_cancellable(&cancel::never)
+            .expect("never stopped")
+    }
+
+    /// [`Keys::rates`] that polls `cancel` every [`cancel::BLOCK`] intervals (`None` once it
+    /// says stop).
+    pub fn rates_cancellable(&self, cancel: Cancel<'_>) -> Option<(f64, f64)> {
         let mut v: f64 = 0.0;
         for k in 0..self.times.len() - 1 {
+            if k % cancel::BLOCK == 0 && cancel() {
+                return None;
+            }
             let seg = self.segment(k);
             let h = self.times[k + 1] - self.times[k];
             for i in 0..=16 {
@@ -261,7 +300,7 @@ impl Keys {
                 .map(|(th, t)| th.length() / (t[1] - t[0]))
                 .fold(0.0, f64::max),
         };
-        (1.05 * v, w)
+        Some((1.05 * v, w))
     }
 }
 
@@ -280,6 +319,19 @@ impl<D: Distance> Keyframed<D> {
     /// The tool, validated: a finite speed bound (errors name `times`); `center` is the point
     /// `C` of the shape taken to the key positions (default the shape's centre).
     pub fn new(shape: D, keys: Keys, power: u8, center: Option<DVec3>) -> Result<Keyframed<D>> {
+        Keyframed::new_cancellable(shape, keys, power, center, &cancel::never)
+    }
+
+    /// [`Keyframed::new`] that polls `cancel` in the speed bound and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        shape: D,
+        keys: Keys,
+        power: u8,
+        center: Option<DVec3>,
+        cancel: Cancel<'_>,
+    ) -> Result<Keyframed<D>> {
+        let (v, w) = keys.rates_cancellable(cancel).ok_or_else(cancel::stopped)?;
         let offset = center.map_or(DVec3::ZERO, |c| c - shape.center());
         let tool = Keyframed {
             shape,
@@ -287,7 +339,7 @@ impl<D: Distance> Keyframed<D> {
             power,
             offset,
         };
-        let s = tool.max_speed();
+        let s = tool.speed_bound(v, w);
         if !s.is_finite() {
             return Err(InputError::new(
                 "times",
@@ -346,6 +398,11 @@ impl<D: Distance> Keyframed<D> {
     /// The curl bounds with `|Y| = |X − c|` at most the shape's extent plus `|C − C_shape|`.
     pub fn max_speed(&self) -> f64 {
         let (v, w) = self.keys.rates();
+        self.speed_bound(v, w)
+    }
+
+    /// The speed bound for the key rates `(|ċ|, |ω|)` ([`Keys::rates`]).
+    fn speed_bound(&self, v: f64, w: f64) -> f64 {
         let arm = self.offset.length();
         let s = &self.shape;
         v * (1.0 + 0.5 * self.power as f64 * s.gradient_bound() * (s.extent() + arm) / s.reach())
@@ -363,6 +420,17 @@ pub fn keyframed(
     keys: Keys,
     power: Option<i64>,
     center: Option<DVec3>,
+) -> Result<super::Field> {
+    keyframed_cancellable(field, keys, power, center, &cancel::never)
+}
+
+/// [`keyframed`] that polls `cancel` in the speed bound (see [`Keyframed::new_cancellable`]).
+pub fn keyframed_cancellable(
+    field: &super::Field,
+    keys: Keys,
+    power: Option<i64>,
+    center: Option<DVec3>,
+    cancel: Cancel<'_>,
 ) -> Result<super::Field> {
     let center = center.map(|c| super::finite3("center", c)).transpose()?;
     let shape = match field.tools.as_slice() {
@@ -397,7 +465,12 @@ pub fn keyframed(
                 ));
             }
         };
-        return Ok(super::Field::single(Carried::new(field.clone(), keys, c)?));
+        return Ok(super::Field::single(Carried::new_cancellable(
+            field.clone(),
+            keys,
+            c,
+            cancel,
+        )?));
     };
     let p = match (power, shape.power) {
         (Some(p), _) => falloff(p)?,
@@ -405,10 +478,18 @@ pub fn keyframed(
         (None, None) => 2,
     };
     Ok(match shape.shape {
-        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p, center)?),
-        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p, center)?),
-        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p, center)?),
-        Shape::Ring(r) => super::Field::single(Keyframed::new(r, keys, p, center)?),
+        Shape::Ball(b) => {
+            super::Field::single(Keyframed::new_cancellable(b, keys, p, center, cancel)?)
+        }
+        Shape::Rod(r) => {
+            super::Field::single(Keyframed::new_cancellable(r, keys, p, center, cancel)?)
+        }
+        Shape::Grid(g) => {
+            super::Field::single(Keyframed::new_cancellable(g, keys, p, center, cancel)?)
+        }
+        Shape::Ring(r) => {
+            super::Field::single(Keyframed::new_cancellable(r, keys, p, center, cancel)?)
+        }
     })
 }
 
@@ -434,6 +515,17 @@ pub struct Carried {
 impl Carried {
     /// The carried field, validated: a finite speed bound (errors name `times`).
     pub fn new(field: super::Field, keys: Keys, center: DVec3) -> Result<Carried> {
+        Carried::new_cancellable(field, keys, center, &cancel::never)
+    }
+
+    /// [`Carried::new`] that polls `cancel` in the speed bound and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        field: super::Field,
+        keys: Keys,
+        center: DVec3,
+        cancel: Cancel<'_>,
+    ) -> Result<Carried> {
         const CALL: &str = "keyframed";
         let own = field.breakpoints(CALL)?;
         let mut breaks = alloc::with_capacity(CALL, own.len() + keys.times.len())?;
@@ -444,7 +536,7 @@ impl Carried {
         // the step rule's speed: the field's own plus the speed at which the pose moves its
         // pattern past the material, |ċ| + |ω| E with E the support's radius about C (|ċ|
         // alone where the support is unbounded)
-        let (v, w) = keys.rates();
+        let (v, w) = keys.rates_cancellable(cancel).ok_or_else(cancel::stopped)?;
         let reach = field.support_radius(center);
         if let Some(e) = reach.filter(|e| v.is_finite() && w.is_finite() && !(w * e).is_finite()) {
             return Err(InputError::new(

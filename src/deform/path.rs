@@ -36,6 +36,7 @@ use super::cross::Sphere;
 use super::fields::{Rotation, Swirl, SwirlKind, Translation};
 use super::{Tool, falloff, finite, positive, reach_or};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{is_rotation, quat_from_mat3, rodrigues};
@@ -105,6 +106,20 @@ impl PathTool {
     /// arc length `s`, at least 2) and the parameters. The per-segment buffers are allocated
     /// fallibly (the out-of-memory error names `along_path`).
     pub fn new(samples: Vec<Sample>, params: PathToolParams) -> Result<PathTool> {
+        PathTool::new_cancellable(samples, params, &cancel::never)
+    }
+
+    /// [`PathTool::new`] that polls `cancel` every [`cancel::BLOCK`] samples and fails with
+    /// [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        samples: Vec<Sample>,
+        params: PathToolParams,
+        cancel: Cancel<'_>,
+    ) -> Result<PathTool> {
+        let poll = |i: usize| match i % cancel::BLOCK == 0 && cancel() {
+            true => Err(cancel::stopped()),
+            false => Ok(()),
+        };
         let duration = params.duration;
         let bad = |m: String| InputError::new("field", m);
         if samples.len() < 2 {
@@ -116,6 +131,7 @@ impl PathTool {
             )));
         }
         for (i, p) in samples.iter().enumerate() {
+            poll(i)?;
             if !is_rotation(&p.frame) {
                 return Err(bad(format!("path frame {i} is not a rotation matrix")));
             }
@@ -123,6 +139,7 @@ impl PathTool {
         let mut theta = alloc::with_capacity(CALL, samples.len() - 1)?;
         let mut omega = alloc::with_capacity(CALL, samples.len() - 1)?;
         for (k, w) in samples.windows(2).enumerate() {
+            poll(k)?;
             let ds = w[1].s - w[0].s;
             if !(ds > 0.0) {
                 return Err(bad(format!(
@@ -291,9 +308,19 @@ impl PathTool {
     /// A bound of `|v|`: the parts' bounds at the largest tool speed and turning rate
     /// (sampled at 17 points per segment, ×1.05).
     pub fn max_speed(&self) -> f64 {
+        self.max_speed_cancellable(&cancel::never)
+            .expect("never stopped")
+    }
+
+    /// [`PathTool::max_speed`] that polls `cancel` every [`cancel::BLOCK`] segments (`None`
+    /// once it says stop).
+    pub fn max_speed_cancellable(&self, cancel: Cancel<'_>) -> Option<f64> {
         let u = self.length() / self.params.duration;
         let mut vmax: f64 = 0.0;
-        for w in self.samples.windows(2) {
+        for (k, w) in self.samples.windows(2).enumerate() {
+            if k % cancel::BLOCK == 0 && cancel() {
+                return None;
+            }
             let ds = w[1].s - w[0].s;
             let curve = Self::segment(&w[0], &w[1]);
             for i in 0..=16 {
@@ -347,7 +374,7 @@ impl PathTool {
         if self.params.bend != 0.0 {
             m += self.swirl(&pose, SwirlKind::Bend).max_speed();
         }
-        m
+        Some(m)
     }
 
     /// Times at which the tool passes a spine sample (its start and end included).
@@ -400,6 +427,16 @@ impl PathTool {
     /// The tool of `spinal.fields.along_path`, validated (errors name its arguments): at least
     /// 2 finite samples with no repeated consecutive point, one rotation per sample.
     pub fn from_args(a: PathArgs<'_>) -> Result<PathTool> {
+        PathTool::from_args_cancellable(a, &cancel::never)
+    }
+
+    /// [`PathTool::from_args`] that polls `cancel` between and inside its passes over the
+    /// samples and fails with [`cancel::stopped`] once it says stop.
+    pub fn from_args_cancellable(a: PathArgs<'_>, cancel: Cancel<'_>) -> Result<PathTool> {
+        let poll = |i: usize| match i % cancel::BLOCK == 0 && cancel() {
+            true => Err(cancel::stopped()),
+            false => Ok(()),
+        };
         let x = a.points;
         if x.len() < 2 {
             return Err(InputError::new(
@@ -423,6 +460,7 @@ impl PathTool {
                 ),
             ));
         }
+        poll(0)?;
         if let Some(i) = a.frames.iter().position(|f| !is_rotation(f)) {
             return Err(InputError::new(
                 "frames",
@@ -432,6 +470,7 @@ impl PathTool {
         let mut s = 0.0;
         let mut samples = alloc::with_capacity(CALL, x.len())?;
         for (i, (p, f)) in x.iter().zip(a.frames).enumerate() {
+            poll(i)?;
             if i > 0 {
                 let chord = p.distance(x[i - 1]);
                 if !(chord > 0.0) {
@@ -469,8 +508,10 @@ impl PathTool {
                 0.0
             },
         };
-        let tool = PathTool::new(samples, params)?;
-        let speed = tool.max_speed();
+        let tool = PathTool::new_cancellable(samples, params, cancel)?;
+        let speed = tool
+            .max_speed_cancellable(cancel)
+            .ok_or_else(cancel::stopped)?;
         if !speed.is_finite() {
             return Err(InputError::new(
                 "duration",

@@ -109,12 +109,16 @@ use rayon::prelude::*;
 use super::Field;
 use super::advect::{Method, advect_steps};
 use super::slip::{self, Carry};
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 mod collapse;
 
 /// No twin: a boundary half-edge.
 const NONE: usize = usize::MAX;
+
+/// The call named in out-of-memory errors.
+const CALL: &str = "deform";
 
 /// A placement farther than this fraction of its edge from the chord midpoint marks the edge
 /// as torn by the flow (see the module docs).
@@ -147,7 +151,6 @@ pub use super::advect::Run;
 /// The list (one run per breakpoint inside) is allocated fallibly (the out-of-memory error
 /// names `deform`).
 pub fn schedule(field: &Field, t0: f64, duration: f64, steps: usize) -> Result<Vec<Run>> {
-    const CALL: &str = "deform";
     if duration == 0.0 || steps == 0 {
         return Ok(Vec::new());
     }
@@ -165,11 +168,11 @@ pub fn schedule(field: &Field, t0: f64, duration: f64, steps: usize) -> Result<V
     if duration < 0.0 {
         cuts.reverse();
     }
-    let mut ts = crate::alloc::with_capacity(CALL, cuts.len() + 2)?;
+    let mut ts = alloc::with_capacity(CALL, cuts.len() + 2)?;
     ts.push(t0);
     ts.extend(cuts);
     ts.push(t1);
-    crate::alloc::collect(
+    alloc::collect(
         CALL,
         ts.windows(2).map(|w| {
             let (a, b) = (w[0], w[1]);
@@ -285,14 +288,15 @@ impl Topology {
                 ));
             }
         }
-        let mut keys: Vec<(usize, usize, usize)> = (0..3 * faces.len())
-            .map(|h| {
+        let mut keys: Vec<(usize, usize, usize)> = alloc::collect(
+            CALL,
+            (0..3 * faces.len()).map(|h| {
                 let (a, b) = (faces[h / 3][h % 3], faces[h / 3][(h + 1) % 3]);
                 (a.min(b), a.max(b), h)
-            })
-            .collect();
+            }),
+        )?;
         keys.par_sort_unstable();
-        let mut twin = vec![NONE; keys.len()];
+        let mut twin = alloc::filled(CALL, keys.len(), NONE)?;
         let mut i = 0;
         while i < keys.len() {
             let mut j = i + 1;
@@ -328,7 +332,7 @@ impl Topology {
             i = j;
         }
         Ok(Topology {
-            faces: faces.to_vec(),
+            faces: alloc::copied(CALL, faces)?,
             twin,
         })
     }
@@ -608,17 +612,34 @@ impl Refiner<'_> {
         })
     }
 
+    /// Room for the vertices, faces and half-edges `new` splits add (each adds a vertex,
+    /// at most two faces and six half-edges, and touches at most four faces), asked for
+    /// before the splits so that running out of memory is an error, not an abort.
+    fn reserve_splits(&mut self, w: &mut Vec<DVec3>, new: usize) -> Result<()> {
+        fn room<T>(v: &mut Vec<T>, extra: usize) -> Result<()> {
+            v.try_reserve(extra).map_err(|_| {
+                InputError::out_of_memory(CALL, v.len().saturating_add(extra), size_of::<T>())
+            })
+        }
+        room(w, new)?;
+        room(&mut self.rest, new)?;
+        room(&mut self.carry, new)?;
+        room(&mut self.topo.faces, 2 * new)?;
+        room(&mut self.topo.twin, 6 * new)?;
+        room(&mut self.touched, 4 * new)
+    }
+
     /// Refinement passes after step `done` (1-based count of the steps taken), at time `t`.
-    fn refine(&mut self, w: &mut Vec<DVec3>, done: usize, t: f64) {
+    fn refine(&mut self, w: &mut Vec<DVec3>, done: usize, t: f64) -> Result<()> {
         for _ in 0..self.opts.max_passes {
             let over = self.over_edges(w);
             if over.is_empty() {
-                return;
+                return Ok(());
             }
             let room = self.opts.max_vertices.saturating_sub(w.len());
             if room == 0 {
                 self.bounded = true;
-                return;
+                return Ok(());
             }
             // terminal edges: the longest of both their triangles, longest first
             let mut pick: Vec<(f64, usize)> = over
@@ -630,7 +651,7 @@ impl Refiner<'_> {
                 .map(|h| (len2(&self.topo, w, h), h))
                 .collect();
             pick.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-            let mut used = vec![false; self.topo.faces.len()];
+            let mut used = alloc::filled(CALL, self.topo.faces.len(), false)?;
             let mut chosen = Vec::new();
             for &(_, h) in &pick {
                 if chosen.len() == room {
@@ -648,14 +669,16 @@ impl Refiner<'_> {
                 chosen.push(h);
             }
             if chosen.is_empty() {
-                return;
+                return Ok(());
             }
+            self.reserve_splits(w, chosen.len())?;
             self.place_and_split(w, &chosen, done, t);
             self.passes += 1;
         }
         if !self.over_edges(w).is_empty() {
             self.bounded = true;
         }
+        Ok(())
     }
 
     /// Whether the edge of half-edge `h` (faces `[a, b, c]` and `[b, a, d]`) is flipped to
@@ -949,7 +972,7 @@ pub fn deform(
         }),
         mean2: mean * mean,
         topo,
-        rest: rest.to_vec(),
+        rest: alloc::copied(CALL, rest)?,
         carry: Vec::new(),
         start: runs.first().map_or(0.0, |r| r.t0),
         bounded: false,
@@ -965,8 +988,8 @@ pub fn deform(
         moves: 0,
         inputs: rest.len(),
     };
-    r.carry = rest.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
-    let mut w = rest.to_vec();
+    r.carry = alloc::collect(CALL, rest.iter().map(|&x| r.carry_of(Gen::Material(x))))?;
+    let mut w = alloc::copied(CALL, rest)?;
     let total: usize = runs.iter().map(|r| r.count).sum();
     let mut out = Deformed::default();
     let mut done = 0;
@@ -978,7 +1001,7 @@ pub fn deform(
             done += 1;
             if refinement.is_some() {
                 let clock = Instant::now();
-                r.refine(&mut w, done, run.t0 + run.h * (j + 1) as f64);
+                r.refine(&mut w, done, run.t0 + run.h * (j + 1) as f64)?;
                 r.flip_touched(&w);
                 out.time_refine += clock.elapsed().as_secs_f64();
             }
@@ -1003,7 +1026,7 @@ pub fn deform(
         // volume, on a converged mesh (a refinement a bound stopped keeps every vertex it got)
         if r.over_edges(&w).is_empty() {
             let end = runs.last().map_or(r.start, |l| l.t0 + l.h * l.count as f64);
-            r.collapse_slivers(&mut w, end);
+            r.collapse_slivers(&mut w, end)?;
             if let Some(last) = out.step_vertices.last_mut() {
                 *last = w.len();
             }
@@ -1457,7 +1480,7 @@ mod tests {
                 done += 1;
                 let t = run.t0 + run.h * (j + 1) as f64;
                 let before = r.over_edges(&w).len();
-                r.refine(&mut w, done, t);
+                r.refine(&mut w, done, t).unwrap();
                 let over = r.over_edges(&w);
                 println!(
                     "step {done}: {} vertices, over before {before}, after {}, torn {}, \

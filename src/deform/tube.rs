@@ -47,6 +47,7 @@ use glam::DVec3;
 
 use super::cross::{blend, translate};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
 
@@ -187,6 +188,18 @@ impl StripAlong {
         reach: f64,
         linear: bool,
     ) -> Result<StripAlong> {
+        StripAlong::new_cancellable(samples, speed, radius, reach, linear, &cancel::never)
+    }
+
+    /// [`StripAlong::new`] polling `cancel` in the axis checks ([`Axis::new_cancellable`]).
+    pub fn new_cancellable(
+        samples: Vec<AxisSample>,
+        speed: f64,
+        radius: f64,
+        reach: f64,
+        linear: bool,
+        cancel: Cancel<'_>,
+    ) -> Result<StripAlong> {
         if !speed.is_finite() {
             return Err(InputError::new(
                 "speed",
@@ -194,7 +207,7 @@ impl StripAlong {
             ));
         }
         Ok(StripAlong {
-            axis: Axis::new(samples, radius + reach)?,
+            axis: Axis::new_cancellable(samples, radius + reach, cancel)?,
             speed,
             radius,
             reach,
@@ -209,6 +222,16 @@ impl Axis {
     /// arc) below 1 and no approach of distant parts closer than `2·outer` (errors name
     /// `points`).
     pub fn new(samples: Vec<AxisSample>, outer: f64) -> Result<Axis> {
+        Axis::new_cancellable(samples, outer, &cancel::never)
+    }
+
+    /// [`Axis::new`] that polls `cancel` every [`cancel::BLOCK`] segments and in the
+    /// self-approach search, and fails with [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        samples: Vec<AxisSample>,
+        outer: f64,
+        cancel: Cancel<'_>,
+    ) -> Result<Axis> {
         let bad = |m: String| InputError::new("points", m);
         let axis = bad;
         if samples.len() < 2 {
@@ -230,6 +253,9 @@ impl Axis {
         // (segment, curvature × (radius + reach + arc), curvature) of the worst bend
         let mut worst: (usize, f64, f64) = (0, 0.0, 0.0);
         for (k, w) in samples.windows(2).enumerate() {
+            if k % cancel::BLOCK == 0 && cancel() {
+                return Err(cancel::stopped());
+            }
             let ds = w[1].s - w[0].s;
             if !(ds > 0.0) {
                 return Err(bad(format!(
@@ -307,7 +333,11 @@ impl Axis {
         let last = samples[samples.len() - 1];
         dense.push(last.x);
         param.push(last.s);
-        if let Some((i, j, d)) = self_approach(&dense, &param, outer) {
+        let approach = self_approach(&dense, &param, outer, cancel);
+        if cancel() {
+            return Err(cancel::stopped());
+        }
+        if let Some((i, j, d)) = approach {
             let seg = |i: usize| (i / PER).min(segs.len() - 1);
             return Err(axis(format!(
                 "the axis comes within {} < 2·(radius + reach) = {} of itself (segments {} \
@@ -582,12 +612,24 @@ pub fn strip_along(
     reach: Option<f64>,
     linear: bool,
 ) -> Result<StripAlong> {
+    strip_along_cancellable(samples, radius, speed, reach, linear, &cancel::never)
+}
+
+/// [`strip_along`] polling `cancel` in the axis checks (see [`Axis::new_cancellable`]).
+pub fn strip_along_cancellable(
+    samples: Vec<AxisSample>,
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    linear: bool,
+    cancel: Cancel<'_>,
+) -> Result<StripAlong> {
     let radius = super::positive("radius", radius)?;
     let reach = super::reach_or(reach, radius)?;
     let speed = super::finite("speed", speed)?;
     super::bounded(
         "speed",
-        StripAlong::new(samples, speed, radius, reach, linear)?,
+        StripAlong::new_cancellable(samples, speed, radius, reach, linear, cancel)?,
     )
 }
 
@@ -668,6 +710,12 @@ pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Re
 /// the clamped C² cubic spline through them ([`clamped_spline_slopes`]) whose end derivatives
 /// are the five-point unit tangents of `spinal.estimate_tangents` (errors name `points`).
 pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
+    axis_samples_cancellable(points, &cancel::never)
+}
+
+/// [`axis_samples`] that polls `cancel` in its passes over the points and fails with
+/// [`cancel::stopped`] once it says stop.
+pub fn axis_samples_cancellable(points: &[DVec3], cancel: Cancel<'_>) -> Result<Vec<AxisSample>> {
     if points.len() < 2 {
         return Err(InputError::new(
             "points",
@@ -678,6 +726,9 @@ pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
     let mut s = alloc::with_capacity("strip_curve/rod axis", points.len())?;
     s.push(0.0);
     for (i, w) in points.windows(2).enumerate() {
+        if i % cancel::BLOCK == 0 && cancel() {
+            return Err(cancel::stopped());
+        }
         let chord = w[0].distance(w[1]);
         if !(chord > 0.0) {
             return Err(InputError::new(
@@ -687,11 +738,15 @@ pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
         }
         s.push(s[i] + chord);
     }
-    let tangents = crate::frames::tangents::estimate_rows(
+    let tangents = crate::frames::tangents::estimate_rows_cancellable(
         points,
         false,
         crate::frames::TangentRule::FivePointBounded,
+        cancel,
     )?;
+    if cancel() {
+        return Err(cancel::stopped());
+    }
     let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1])?;
     alloc::collect(
         "strip_curve/rod axis",
@@ -712,7 +767,21 @@ pub fn strip_curve(
     reach: Option<f64>,
     linear: bool,
 ) -> Result<StripAlong> {
-    strip_along(axis_samples(points)?, radius, speed, reach, linear)
+    strip_curve_cancellable(points, radius, speed, reach, linear, &cancel::never)
+}
+
+/// [`strip_curve`] polling `cancel` in the axis samples and checks (see
+/// [`Axis::new_cancellable`]).
+pub fn strip_curve_cancellable(
+    points: &[DVec3],
+    radius: f64,
+    speed: f64,
+    reach: Option<f64>,
+    linear: bool,
+    cancel: Cancel<'_>,
+) -> Result<StripAlong> {
+    let samples = axis_samples_cancellable(points, cancel)?;
+    strip_along_cancellable(samples, radius, speed, reach, linear, cancel)
 }
 
 /// Points per segment at which the axis is checked.
@@ -746,7 +815,14 @@ fn g4(x: f64) -> String {
 /// `|p_i − p_j′| ≥ |p_i − p_j| − (L_j′ − L_j)`, so after a point at distance `d ≥ 2·outer`
 /// the scan jumps (binary search on `L`) to the first point at least `d − 2·outer` further
 /// along: a finely sampled axis costs O(log) per run and point, not its sampling density.
-fn self_approach(p: &[DVec3], t: &[f64], outer: f64) -> Option<(usize, usize, f64)> {
+/// The search polls `cancel` every [`cancel::BLOCK`] points and returns `None` once it says
+/// stop (the caller checks `cancel` again).
+fn self_approach(
+    p: &[DVec3],
+    t: &[f64],
+    outer: f64,
+    cancel: Cancel<'_>,
+) -> Option<(usize, usize, f64)> {
     use std::collections::HashMap;
     let n = p.len();
     if n < 2 {
@@ -775,6 +851,9 @@ fn self_approach(p: &[DVec3], t: &[f64], outer: f64) -> Option<(usize, usize, f6
     let mut cells: HashMap<[i64; 3], Vec<(usize, usize)>> = HashMap::new();
     let mut run = (key(p[0]), 0);
     for (i, x) in p.iter().enumerate().skip(1) {
+        if i % cancel::BLOCK == 0 && cancel() {
+            return None;
+        }
         let k = key(*x);
         if k != run.0 {
             cells.entry(run.0).or_default().push((run.1, i));
@@ -786,6 +865,9 @@ fn self_approach(p: &[DVec3], t: &[f64], outer: f64) -> Option<(usize, usize, f6
     let mut here = None;
     let mut first = 0; // the first index with t > t_i + π·outer
     for i in 0..n {
+        if i % cancel::BLOCK == 0 && cancel() {
+            return None;
+        }
         let k = key(p[i]);
         if here != Some(k) {
             here = Some(k);
@@ -922,7 +1004,10 @@ mod tests {
             }
             let t: Vec<f64> = (0..n).map(|i| 0.15 * i as f64).collect();
             for outer in [0.01, 0.05, 0.1, 0.3] {
-                assert_eq!(self_approach(&p, &t, outer), brute(&p, &t, outer));
+                assert_eq!(
+                    self_approach(&p, &t, outer, &cancel::never),
+                    brute(&p, &t, outer)
+                );
             }
         }
         // a hairpin: two straight legs 0.5 apart, joined by a half circle
@@ -942,10 +1027,13 @@ mod tests {
             t.push(t.last().unwrap() + (w[1] - w[0]).length());
         }
         for outer in [0.2, 0.249, 0.251, 0.3] {
-            assert_eq!(self_approach(&p, &t, outer), brute(&p, &t, outer));
+            assert_eq!(
+                self_approach(&p, &t, outer, &cancel::never),
+                brute(&p, &t, outer)
+            );
         }
-        assert!(self_approach(&p, &t, 0.249).is_none());
-        assert!(self_approach(&p, &t, 0.251).is_some());
+        assert!(self_approach(&p, &t, 0.249, &cancel::never).is_none());
+        assert!(self_approach(&p, &t, 0.251, &cancel::never).is_some());
     }
 
     #[test]

@@ -8,6 +8,7 @@ use glam::DVec3;
 
 use super::{Cubic, Invariants};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// Tolerance of the control-polygon PH test for spline input.
@@ -43,6 +44,12 @@ pub fn finite_rows<const N: usize>(arg: &'static str, rows: &[[f64; N]]) -> Resu
 
 /// [`Cubic::is_ph`] per cubic, after checking the cubics (finite) and `tol` (≥ 0).
 pub fn is_ph_rows(cubics: &[Cubic], tol: f64) -> Result<Vec<bool>> {
+    is_ph_rows_cancellable(cubics, tol, &cancel::never)
+}
+
+/// [`is_ph_rows`] that polls `cancel` between blocks of cubics (an incomplete result once it
+/// says stop; see [`crate::cancel`]).
+pub fn is_ph_rows_cancellable(cubics: &[Cubic], tol: f64, cancel: Cancel<'_>) -> Result<Vec<bool>> {
     if !(tol >= 0.0) {
         return Err(InputError::new(
             "tol",
@@ -50,15 +57,21 @@ pub fn is_ph_rows(cubics: &[Cubic], tol: f64) -> Result<Vec<bool>> {
         ));
     }
     finite_cubics(cubics)?;
-    alloc::collect("ph.is_ph", cubics.iter().map(|c| c.is_ph(tol)))
+    alloc::try_collect_cancellable("ph.is_ph", cubics.iter().map(|c| Ok(c.is_ph(tol))), cancel)
 }
 
 /// [`Cubic::invariants`] per cubic; a control polygon with a zero-length leg (relative to
 /// the largest coordinate, 1e-14) or with undefined invariants (any but κ/τ non-finite: a
 /// straight or degenerate polygon) is an error naming the cubic.
 pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
+    invariant_rows_cancellable(cubics, &cancel::never)
+}
+
+/// [`invariant_rows`] that polls `cancel` between blocks of cubics (an incomplete result
+/// once it says stop; see [`crate::cancel`]).
+pub fn invariant_rows_cancellable(cubics: &[Cubic], cancel: Cancel<'_>) -> Result<Vec<Invariants>> {
     finite_cubics(cubics)?;
-    alloc::try_collect(
+    alloc::try_collect_cancellable(
         "ph.invariants",
         cubics.iter().enumerate().map(|(i, c)| {
             let scale =
@@ -92,6 +105,7 @@ pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
             }
             Ok(v)
         }),
+        cancel,
     )
 }
 

@@ -462,20 +462,57 @@ pub fn frames_at(
     frames: &mut [[f64; 9]],
     angles: &mut [f64],
 ) -> Result<()> {
+    frames_at_cancellable(
+        cubics,
+        s,
+        start,
+        phi,
+        mode,
+        frames,
+        angles,
+        &crate::cancel::never,
+    )
+}
+
+/// Rows of a block of [`frames_at_cancellable`] between polls.
+const CANCEL_ROWS: usize = 1 << 16;
+
+/// [`frames_at`] that polls `cancel` before every block of [`CANCEL_ROWS`] rows and skips
+/// the remaining blocks once it says stop (the outputs are then incomplete; see
+/// [`crate::cancel`]).
+#[allow(clippy::too_many_arguments)]
+pub fn frames_at_cancellable(
+    cubics: &[Cubic],
+    s: &[f64],
+    start: Start,
+    phi: Option<f64>,
+    mode: Mode,
+    frames: &mut [[f64; 9]],
+    angles: &mut [f64],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<()> {
     use rayon::prelude::*;
     debug_assert!(frames.len() == s.len() && angles.len() == s.len());
     super::check_params(cubics.len(), s)?;
     let segs = setup(cubics, start, phi)?;
     frames
-        .par_iter_mut()
-        .zip(angles.par_iter_mut())
-        .zip(s.par_iter())
-        .for_each(|((f, a), &x)| {
-            let (i, v) = super::locate(cubics.len(), x);
-            let (m, om) = frame_at(&cubics[i], &segs[i], v, mode);
-            // glam is column-major; the NumPy frame is row-major with columns r, s, t
-            *f = m.transpose().to_cols_array();
-            *a = om;
+        .par_chunks_mut(CANCEL_ROWS)
+        .zip(angles.par_chunks_mut(CANCEL_ROWS))
+        .zip(s.par_chunks(CANCEL_ROWS))
+        .for_each(|((fb, ab), sb)| {
+            if cancel() {
+                return;
+            }
+            fb.par_iter_mut()
+                .zip(ab.par_iter_mut())
+                .zip(sb.par_iter())
+                .for_each(|((f, a), &x)| {
+                    let (i, v) = super::locate(cubics.len(), x);
+                    let (m, om) = frame_at(&cubics[i], &segs[i], v, mode);
+                    // glam is column-major; the NumPy frame is row-major with columns r, s, t
+                    *f = m.transpose().to_cols_array();
+                    *a = om;
+                });
         });
     Ok(())
 }

@@ -457,8 +457,19 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
 /// zero-length leg, or whose residual exceeds `tol` times the length of its control polygon
 /// (not PH), is an error naming it (`batch`: with its index).
 pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64; 9]>> {
+    preimage_rows_cancellable(cubics, tol, batch, &crate::cancel::never)
+}
+
+/// [`preimage_rows`] that polls `cancel` between blocks of cubics (an incomplete result
+/// once it says stop; see [`crate::cancel`]).
+pub fn preimage_rows_cancellable(
+    cubics: &[Cubic],
+    tol: f64,
+    batch: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<Vec<[f64; 9]>> {
     check::finite_cubics(cubics)?;
-    alloc::try_collect(
+    alloc::try_collect_cancellable(
         "ph.preimage",
         cubics.iter().enumerate().map(|(i, c)| {
             let (q0, q1, res) = c.preimage().ok_or_else(|| {
@@ -484,6 +495,7 @@ pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64
             }
             Ok([q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3], res])
         }),
+        cancel,
     )
 }
 

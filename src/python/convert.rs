@@ -279,18 +279,28 @@ pub fn orientations(
 
 /// PH cubics from control points `(m, 4, 3)`.
 pub fn cubics_of(call: &'static str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
+    Ok(cubics_from(call, cubic_points(a)?)?)
+}
+
+/// The control points of `(m, 4, 3)` cubics, four rows per cubic (see [`cubics_from`]).
+pub fn cubic_points<'a>(a: &'a PyReadonlyArray3<'_, f64>) -> PyResult<&'a [DVec3]> {
     let sh = a.shape();
     if sh[1] != 4 || sh[2] != 3 {
         return Err(value_error(format!(
             "control_points: expected shape (m, 4, 3), got {sh:?}"
         )));
     }
-    let flat: &[DVec3] = bytemuck::cast_slice(slice_of("control_points", a)?);
-    Ok(alloc::collect(
+    Ok(bytemuck::cast_slice(slice_of("control_points", a)?))
+}
+
+/// The cubics of [`cubic_points`] (allocated fallibly, naming `call`); needs no Python, so
+/// a heavy call makes them with the GIL released.
+pub fn cubics_from(call: &'static str, flat: &[DVec3]) -> crate::error::Result<Vec<ph::Cubic>> {
+    alloc::collect(
         call,
         flat.chunks_exact(4)
             .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]])),
-    )?)
+    )
 }
 
 /// `numpy.empty(shape, dtype)`: NumPy's allocator reuses freed heap memory for small arrays

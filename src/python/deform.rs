@@ -138,10 +138,12 @@ pub fn deform_mesh<'py>(
     let field = &field.field;
     let x = vec3s("mesh", &vertices)?;
     // negative indices become out of range, which the core reports
-    let f: Vec<[usize; 3]> = triangles(&faces)?
-        .iter()
-        .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
-        .collect();
+    let f: Vec<[usize; 3]> = alloc::collect(
+        "deform",
+        triangles(&faces)?
+            .iter()
+            .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX))),
+    )?;
     let opts = refine.map(|ratio| refine::Refinement {
         ratio,
         max_vertices,
@@ -155,9 +157,9 @@ pub fn deform_mesh<'py>(
     })??;
     ticker.finish()?;
     let d = out.ok_or_else(|| value_error("deform: stopped"))?;
-    let faces: Vec<i64> = d.faces.iter().flatten().map(|&i| i as i64).collect();
+    let faces = alloc::flat("deform", d.faces.iter().map(|f| f.map(|i| i as i64)))?;
     let nf = d.faces.len();
-    let counts: Vec<i64> = d.step_vertices.iter().map(|&c| c as i64).collect();
+    let counts = alloc::collect("deform", d.step_vertices.iter().map(|&c| c as i64))?;
     Ok((
         vec3_array(py, d.vertices)?,
         vec3_array(py, d.rest)?,
@@ -204,10 +206,12 @@ pub fn stamp<'py>(
 ) -> PyResult<StampArrays<'py>> {
     let x = vec3s("vertices", &vertices)?;
     // negative indices become out of range, which the stamper reports
-    let f: Vec<[usize; 3]> = triangles(&faces)?
-        .iter()
-        .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX)))
-        .collect();
+    let f: Vec<[usize; 3]> = alloc::collect(
+        "stamp",
+        triangles(&faces)?
+            .iter()
+            .map(|t| t.map(|i| usize::try_from(i).unwrap_or(usize::MAX))),
+    )?;
     let mut v = alloc::copied("stamp", x)?;
     let stop = Stop::default();
     let mut ticker = Ticker::new(None, &stop);
@@ -229,10 +233,11 @@ pub fn stamp<'py>(
         return Err(value_error("stamp: stopped"));
     }
     let n = rep.len();
-    let rows: Vec<f64> = rep
-        .iter()
-        .flat_map(|r| [r.dent, r.time, r.residual, r.contact as f64])
-        .collect();
+    let rows = alloc::flat(
+        "stamp",
+        rep.iter()
+            .map(|r| [r.dent, r.time, r.residual, r.contact as f64]),
+    )?;
     Ok((
         vec3_array(py, v)?,
         PyArray1::from_vec(py, rows).reshape([n, 4])?,

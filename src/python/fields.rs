@@ -11,7 +11,9 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use super::convert::{choice, detach_in_pool, empty, real, slice_mut, slice_of, vec3s};
+use super::convert::{
+    Stop, choice, detach_in_pool, detach_stoppable, empty, real, slice_mut, slice_of, vec3s,
+};
 use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -440,7 +442,10 @@ pub fn field_strip_curve(
     blend: Blend,
 ) -> PyResult<PyField> {
     let x = vec3s("points", &points)?;
-    let tool = detach_in_pool(py, || tube::strip_curve(x, radius, speed, reach, blend.0))??;
+    let stop = Stop::default();
+    let tool = detach_stoppable(py, &stop, || {
+        tube::strip_curve_cancellable(x, radius, speed, reach, blend.0, &|| stop.requested())
+    })??;
     Ok(PyField::new(Field::single(tool), "strip_curve"))
 }
 
@@ -479,6 +484,7 @@ pub fn field_grid(
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn field_path(
+    py: Python<'_>,
     points: PyReadonlyArray2<'_, f64>,
     frames: PyReadonlyArray3<'_, f64>,
     radius: f64,
@@ -521,7 +527,10 @@ pub fn field_path(
         },
         if tool.0 { "carry" } else { "push" }
     );
-    let p = path::PathTool::from_args(args)?;
+    let stop = Stop::default();
+    let p = detach_stoppable(py, &stop, || {
+        path::PathTool::from_args_cancellable(args, &|| stop.requested())
+    })??;
     Ok(PyField::new(Field::single(p), &name))
 }
 
@@ -636,6 +645,7 @@ pub fn field_rod(
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn field_keyframed(
+    py: Python<'_>,
     tool: &PyField,
     times: PyReadonlyArray1<'_, f64>,
     positions: PyReadonlyArray2<'_, f64>,
@@ -663,7 +673,17 @@ pub fn field_keyframed(
         }
         (None, None) => None,
     };
-    let keys = keyframe::Keys::new(t, x, orientations)?;
-    let f = keyframe::keyframed(&tool.field, keys, falloff_power, center.map(DVec3::from))?;
+    let stop = Stop::default();
+    let f = detach_stoppable(py, &stop, || {
+        let cancel = || stop.requested();
+        let keys = keyframe::Keys::new_cancellable(t, x, orientations, &cancel)?;
+        keyframe::keyframed_cancellable(
+            &tool.field,
+            keys,
+            falloff_power,
+            center.map(DVec3::from),
+            &cancel,
+        )
+    })??;
     Ok(PyField::new(f, "keyframed"))
 }

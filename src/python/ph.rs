@@ -8,7 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    cubics_of, detach_in_pool, empty, quats, rows_of, slice_mut, slice_of, vec3_of, vec3s,
+    Stop, cubic_points, cubics_from, cubics_of, detach_in_pool, detach_stoppable, empty, quats,
+    rows_of, slice_mut, slice_of, vec3_of, vec3s,
 };
 use super::frames::FramesAndAngles;
 use crate::alloc;
@@ -64,8 +65,12 @@ pub fn ph_invariants<'py>(
     py: Python<'py>,
     control_points: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of("ph.invariants", &control_points)?;
-    let rows = ph::check::invariant_rows(&cubics)?;
+    let points = cubic_points(&control_points)?;
+    let stop = Stop::default();
+    let rows = detach_stoppable(py, &stop, || {
+        let cubics = cubics_from("ph.invariants", points)?;
+        ph::check::invariant_rows_cancellable(&cubics, &|| stop.requested())
+    })??;
     let out = alloc::flat("ph.invariants", rows.iter().map(|v| v.row()))?;
     let m = rows.len();
     PyArray1::from_vec(py, out).reshape([m, 13])
@@ -78,8 +83,12 @@ pub fn ph_is_ph<'py>(
     control_points: PyReadonlyArray3<'py, f64>,
     tol: f64,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-    let cubics = cubics_of("ph.is_ph", &control_points)?;
-    let out = ph::check::is_ph_rows(&cubics, tol)?;
+    let points = cubic_points(&control_points)?;
+    let stop = Stop::default();
+    let out = detach_stoppable(py, &stop, || {
+        let cubics = cubics_from("ph.is_ph", points)?;
+        ph::check::is_ph_rows_cancellable(&cubics, tol, &|| stop.requested())
+    })??;
     Ok(PyArray1::from_vec(py, out))
 }
 
@@ -130,8 +139,12 @@ pub fn ph_preimage<'py>(
     tol: f64,
     batch: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let cubics = cubics_of("ph.preimage", &control_points)?;
-    let rows = ph::preimage_rows(&cubics, tol, batch)?;
+    let points = cubic_points(&control_points)?;
+    let stop = Stop::default();
+    let rows = detach_stoppable(py, &stop, || {
+        let cubics = cubics_from("ph.preimage", points)?;
+        ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())
+    })??;
     let m = rows.len();
     rows_of(py, bytemuck::allocation::cast_vec(rows), m)
 }
@@ -188,8 +201,11 @@ pub fn ph_frames<'py>(
         let frames: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let mut ra = angles.readwrite();
         let a = slice_mut(&mut ra)?;
-        detach_in_pool(py, || {
-            ph::frame::frames_at(&cubics, s, start, phi, mode, frames, a)
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            ph::frame::frames_at_cancellable(&cubics, s, start, phi, mode, frames, a, &|| {
+                stop.requested()
+            })
         })??;
     }
     Ok((out, angles))

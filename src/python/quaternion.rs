@@ -87,7 +87,7 @@ pub fn quat_slerp<'py>(
             "q0, q1 and u must have the same number of rows",
         ));
     }
-    let mut out = vec![DQuat::IDENTITY; a.len()];
+    let mut out = alloc::filled("slerp", a.len(), DQuat::IDENTITY)?;
     detach_in_pool(py, || quaternion::slerp_many(a, b, us, &mut out))??;
     quat_array(py, out)
 }
@@ -144,8 +144,9 @@ pub fn quat_transport<'py>(
         .transpose()?;
     let rows = x.len() + usize::from(closed && closing_row);
     let mut out = alloc::filled("quaternion_frames", rows, DQuat::IDENTITY)?;
-    let angle = detach_in_pool(py, || {
-        quaternion::transport(x, t, r, closed, turns, &mut out)
+    let stop = Stop::default();
+    let angle = detach_stoppable(py, &stop, || {
+        quaternion::transport_cancellable(x, t, r, closed, turns, &mut out, &|| stop.requested())
     })??;
     Ok((quat_array(py, out)?, angle))
 }
@@ -300,9 +301,10 @@ pub fn walk_mesh<'py>(
         Some(_) => return Err(value_error("direction: expected 3 values")),
         None => None,
     };
-    let walk = detach_in_pool(py, || {
+    let stop = Stop::default();
+    let walk = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
-        walk::walk_path(&w, face, p, d, mv)
+        walk::walk_path_cancellable(&w, face, p, d, mv, &|| stop.requested())
     })??;
     let (states, path) = (&walk.states, &walk.path);
     let k = states.len();
@@ -359,9 +361,10 @@ pub fn walk_mesh_many<'py>(
         ));
     }
     let mv = vec2s("moves", "(w·k, 2)", &moves)?;
-    let starts: Vec<walk::Start> = (0..fc.len())
-        .map(|i| (fc[i], p[i], d.map(|d| d[i])))
-        .collect();
+    let starts: Vec<walk::Start> = alloc::collect(
+        "walk_mesh_many",
+        (0..fc.len()).map(|i| (fc[i], p[i], d.map(|d| d[i]))),
+    )?;
     let stop = Stop::default();
     let states = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
@@ -369,7 +372,10 @@ pub fn walk_mesh_many<'py>(
     })??;
     let nw = starts.len();
     let (pts, fcs, frs) = walker_states("walk_mesh_many", &states)?;
-    let mut stopped = alloc::with_capacity("walk_mesh_many", nw * k)?;
+    let mut stopped = alloc::with_capacity(
+        "walk_mesh_many",
+        alloc::product("walk_mesh_many", nw, k, 1)?,
+    )?;
     stopped.extend(
         states
             .chunks(k + 1)

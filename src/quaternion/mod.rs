@@ -310,13 +310,9 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
 
 /// The unit tangents at the points `x` (`n ≥ 2` rows): the given `t` (finite, non-zero
 /// rows) normalised, or without them the estimate of `spinal.estimate_tangents`
-/// ([`tangent_estimate::estimate_rows`], five-point rule).
-pub(crate) fn unit_tangents(x: &[DVec3], t: Option<&[DVec3]>, closed: bool) -> Result<Vec<DVec3>> {
-    unit_tangents_cancellable(x, t, closed, &crate::cancel::never)
-}
-
-/// [`unit_tangents`] that polls `cancel` inside the estimate and between the passes over
-/// given tangents; a cancelled call returns an incomplete result (see [`crate::cancel`]).
+/// ([`tangent_estimate::estimate_rows`], five-point rule). Polls `cancel` inside the
+/// estimate and between the passes over given tangents; a cancelled call returns an
+/// incomplete result (see [`crate::cancel`]).
 pub(crate) fn unit_tangents_cancellable(
     x: &[DVec3],
     t: Option<&[DVec3]>,
@@ -368,7 +364,12 @@ pub(crate) fn unit_tangents_cancellable(
 
 /// The reference vector at row 0 of the rotation-method frames of `x` with unit tangents
 /// `t` ([`frames::compute_into`], spinal's default initial vector).
-fn default_reference(x: &[DVec3], t: &[DVec3], closed: bool) -> Result<DVec3> {
+fn default_reference(
+    x: &[DVec3],
+    t: &[DVec3],
+    closed: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<DVec3> {
     let req = Request {
         points: Some(x),
         tangents: Some(t),
@@ -392,7 +393,7 @@ fn default_reference(x: &[DVec3], t: &[DVec3], closed: bool) -> Result<DVec3> {
             1,
         )?,
     )?;
-    frames::compute_into(&req, &mut buf)?;
+    frames::compute_into_cancellable(&req, &mut buf, cancel)?;
     Ok(DVec3::new(buf[0], buf[3], buf[6]))
 }
 
@@ -418,11 +419,33 @@ pub fn transport(
     turns: i64,
     out: &mut [DQuat],
 ) -> Result<f64> {
-    let t = &unit_tangents(x, t, closed)?;
+    transport_cancellable(x, t, initial, closed, turns, out, &crate::cancel::never)
+}
+
+/// [`transport`] that polls `cancel` inside the tangent estimate and the default frames and
+/// before every segment of [`CANCEL_SEGMENT`] rows of the recurrence and the closing
+/// correction; once it says stop the rows not yet written are left as they are and `out`
+/// is incomplete (see [`crate::cancel`]).
+pub fn transport_cancellable(
+    x: &[DVec3],
+    t: Option<&[DVec3]>,
+    initial: Option<DVec3>,
+    closed: bool,
+    turns: i64,
+    out: &mut [DQuat],
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<f64> {
+    let t = &unit_tangents_cancellable(x, t, closed, cancel)?;
+    if cancel() {
+        return Ok(0.0);
+    }
     let r0 = match initial {
         Some(v) => frames::resolve(&Orientation::Vector(v), t[0], 0, "initial")?,
-        None => default_reference(x, t, closed)?,
+        None => default_reference(x, t, closed, cancel)?,
     };
+    if cancel() {
+        return Ok(0.0);
+    }
     let n = t.len();
     debug_assert!(out.len() == n || (closed && out.len() == n + 1));
     let q0 = canonical(from_matrix(&{
@@ -443,6 +466,9 @@ pub fn transport(
         })
     };
     for i in 0..n - 1 {
+        if i % CANCEL_SEGMENT == 0 && cancel() {
+            return Ok(0.0);
+        }
         let q = (step(i)? * out[i]).normalize();
         out[i + 1] = q;
     }
@@ -458,6 +484,9 @@ pub fn transport(
     let mut acc = 0.0;
     arc.push(0.0);
     for i in 0..n {
+        if i % CANCEL_SEGMENT == 0 && cancel() {
+            return Ok(0.0);
+        }
         acc += crate::math::scale::length(x[(i + 1) % n] - x[i]);
         arc.push(acc);
     }
@@ -465,13 +494,24 @@ pub fn transport(
     if out.len() == n + 1 {
         out[n] = q_end;
     }
-    out.par_iter_mut()
+    out.par_chunks_mut(CANCEL_SEGMENT)
         .enumerate()
-        .with_min_len(GRAIN)
-        .for_each(|(i, q)| {
-            let a = 0.5 * total * arc[i] / len;
-            *q = (*q * DQuat::from_xyzw(0.0, 0.0, a.sin(), a.cos())).normalize();
+        .for_each(|(c, rows)| {
+            if cancel() {
+                return;
+            }
+            rows.par_iter_mut()
+                .enumerate()
+                .with_min_len(GRAIN)
+                .for_each(|(j, q)| {
+                    let i = c * CANCEL_SEGMENT + j;
+                    let a = 0.5 * total * arc[i] / len;
+                    *q = (*q * DQuat::from_xyzw(0.0, 0.0, a.sin(), a.cos())).normalize();
+                });
         });
+    if cancel() {
+        return Ok(0.0);
+    }
     make_continuous(out);
     Ok(alpha)
 }

@@ -20,6 +20,12 @@ use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh;
 
+/// Most edge crossings (about) of one move; a longer move is refused by name.
+const MAX_CROSSINGS: f64 = 1e8;
+
+/// Edge crossings between polls of a cancellable move ([`Walker::step_cancellable`]).
+const CANCEL_CROSSINGS: usize = 1 << 14;
+
 /// A triangle mesh prepared for walking: faces and edge adjacency.
 pub struct Walker<'a> {
     v: &'a [DVec3],
@@ -203,6 +209,24 @@ impl<'a> Walker<'a> {
     /// One move of `(dx, dy)` in the walker's `(e₁, e₂)` axes. `path` receives every edge
     /// crossing (point and the face entered).
     pub fn step(&self, s: State, mv: DVec2, path: &mut Vec<(DVec3, usize)>) -> Result<State> {
+        self.step_cancellable(s, mv, path, &cancel::never)
+    }
+
+    /// The edges a move of length `length` crosses, about (`length / shortest edge`).
+    fn crossings_of(&self, length: f64) -> f64 {
+        length / self.min_edge
+    }
+
+    /// [`Walker::step`] that polls `cancel` every [`CANCEL_CROSSINGS`] edge crossings; once
+    /// it says stop the move ends where it is (the result is then meaningless and the
+    /// caller discards it; see [`crate::cancel`]).
+    pub fn step_cancellable(
+        &self,
+        s: State,
+        mv: DVec2,
+        path: &mut Vec<(DVec3, usize)>,
+        cancel: Cancel<'_>,
+    ) -> Result<State> {
         if !mv.is_finite() {
             return Err(InputError::new("moves", "contains a non-finite value"));
         }
@@ -220,8 +244,8 @@ impl<'a> Walker<'a> {
         let mut entered: Option<usize> = None;
         // A straight path crosses at most about length/(shortest edge) edges per face it
         // visits; the cap guards against a malformed mesh looping forever.
-        let per_edge = left / self.min_edge;
-        if !(per_edge < 1e8) {
+        let per_edge = self.crossings_of(left);
+        if !(per_edge < MAX_CROSSINGS) {
             return Err(InputError::new(
                 "moves",
                 format!(
@@ -231,7 +255,10 @@ impl<'a> Walker<'a> {
             ));
         }
         let cap = 64 + 16 * self.f.len() + 4 * per_edge.ceil() as usize;
-        for _ in 0..cap {
+        for crossed in 0..cap {
+            if crossed % CANCEL_CROSSINGS == CANCEL_CROSSINGS - 1 && cancel() {
+                return Ok(st);
+            }
             let corners = self.corners(st.face);
             let mut best: Option<(f64, usize)> = None;
             for k in 0..3 {
@@ -330,7 +357,58 @@ pub fn walk_path(
     direction: Option<DVec3>,
     moves: &[DVec2],
 ) -> Result<Walk> {
+    walk_path_cancellable(w, face, point, direction, moves, &cancel::never)
+}
+
+/// Bytes a crossing of the path takes: its [`PathPoint`] and the rows the binding makes of
+/// it (point, face, move).
+const PATH_BYTES: usize = size_of::<PathPoint>() + 5 * 8;
+
+/// The memory the crossing path of `moves` needs (about `Σ |move| / shortest edge`
+/// crossings, see [`Walker::step`]), checked before the walk: a refusal is a
+/// `MemoryError` naming `moves`, and the walk does not start.
+fn check_path_memory(w: &Walker, moves: &[DVec2]) -> Result<()> {
+    // a non-finite or overlong move is refused by name when the walk reaches it
+    if moves
+        .iter()
+        .any(|m| !(w.crossings_of(m.x.hypot(m.y)) < MAX_CROSSINGS))
+    {
+        return Ok(());
+    }
+    let length: f64 = moves.iter().map(|m| m.x.hypot(m.y)).sum();
+    let crossings = w.crossings_of(length) + moves.len() as f64 + 1.0;
+    let bytes = crossings * PATH_BYTES as f64;
+    let refused = || {
+        InputError::oom_message(
+            "walk_mesh",
+            format!(
+                "moves: a walk of total length {length:.3e} crosses about {crossings:.2e} \
+                 edges of this mesh (shortest edge {:.3e}), {:.3} GB of path; split it into \
+                 calls of fewer or shorter moves",
+                w.min_edge,
+                bytes / 1e9
+            ),
+        )
+    };
+    if !(bytes <= isize::MAX as f64) {
+        return Err(refused());
+    }
+    alloc::with_capacity::<u8>("walk_mesh", bytes as usize).map_err(|_| refused())?;
+    Ok(())
+}
+
+/// [`walk_path`] that polls `cancel` before every move and inside long moves (see
+/// [`Walker::step_cancellable`]); a cancelled walk returns an incomplete result.
+pub fn walk_path_cancellable(
+    w: &Walker,
+    face: i64,
+    point: DVec3,
+    direction: Option<DVec3>,
+    moves: &[DVec2],
+    cancel: Cancel<'_>,
+) -> Result<Walk> {
     let mut s = w.start(face, point, direction)?;
+    check_path_memory(w, moves)?;
     let mut states = alloc::with_capacity("walk_mesh", moves.len() + 1)?;
     states.push(s);
     let mut path = alloc::with_capacity("walk_mesh", moves.len() + 1)?;
@@ -341,8 +419,11 @@ pub fn walk_path(
     });
     let mut crossings = Vec::new();
     for (k, m) in moves.iter().enumerate() {
+        if cancel() {
+            break;
+        }
         crossings.clear();
-        s = w.step(s, *m, &mut crossings)?;
+        s = w.step_cancellable(s, *m, &mut crossings, cancel)?;
         path.try_reserve(crossings.len() + 1).map_err(|_| {
             InputError::out_of_memory(
                 "walk_mesh",
@@ -420,7 +501,9 @@ pub fn walk_many_cancellable(
                         return Ok(());
                     }
                     crossings.clear();
-                    s = w.step(s, *m, &mut crossings).map_err(ctx)?;
+                    s = w
+                        .step_cancellable(s, *m, &mut crossings, cancel)
+                        .map_err(ctx)?;
                     out[j + 1] = s;
                 }
                 Ok(())

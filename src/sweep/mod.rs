@@ -641,19 +641,19 @@ struct Shared<'a> {
 impl<'a> Shared<'a> {
     /// `cols`: the vertices of a stored ring (the same on every spine); `caps`: some spine
     /// has caps.
-    fn new(p: &'a Profile, cols: usize, caps: bool) -> Shared<'a> {
+    fn new(p: &'a Profile, cols: usize, caps: bool) -> Result<Shared<'a>> {
         // Winding: normals to the right of the profile's direction, outward for closed
         // profiles.
         let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
         let edges = if p.closed { p.len() } else { p.len() - 1 };
-        Shared {
+        Ok(Shared {
             p,
             column: OnceLock::new(),
             pattern: FacePattern::of(cols, edges, sign),
-            tris: if caps { p.triangulate() } else { Vec::new() },
+            tris: if caps { p.triangulate()? } else { Vec::new() },
             sign,
             edges,
-        }
+        })
     }
 }
 
@@ -1933,7 +1933,7 @@ pub fn sweep_into<R: Real, I: Index>(
         offsets,
         opts,
         layout,
-        sh: Shared::new(profile, cols, caps),
+        sh: Shared::new(profile, cols, caps)?,
         unscale: None,
     };
     sweep.write(out, &cancel::never)
@@ -2076,7 +2076,7 @@ impl<'a> Prepared<'a> {
             offsets: self.offsets,
             opts: &self.opts,
             layout: &self.layout,
-            sh: Shared::new(&self.profile, cols, caps),
+            sh: Shared::new(&self.profile, cols, caps)?,
             unscale: self.scaled.as_ref().map(|s| s.k),
         };
         sweep.write(out, cancel)
@@ -2567,7 +2567,7 @@ mod tests {
         let plan = check_spine(spine, opts, p, true, &cancel::never)
             .expect("a valid sweep")
             .expect("not stopped");
-        let sh = Shared::new(p, plan.cols, false);
+        let sh = Shared::new(p, plan.cols, false).unwrap();
         let rings = Rings {
             s: spine,
             x: &spine.points[..plan.rings],

@@ -20,6 +20,7 @@
 
 use glam::DVec2;
 
+use crate::alloc;
 use crate::error::{InputError, Result};
 
 /// A validated profile.
@@ -353,6 +354,24 @@ fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
     None
 }
 
+/// The call named in out-of-memory errors.
+const CALL: &str = "sweep";
+
+/// Bytes per profile vertex that the self-intersection test and the cap triangulation of a
+/// non-convex profile take at most (their sorted events, sweep-line trees and edge lists;
+/// about 40 measured on a 2²²-vertex star).
+const WORKING_BYTES_PER_VERTEX: usize = 64;
+
+/// Fails with the out-of-memory error unless the working memory of the sweep-line passes
+/// over `m` profile vertices can be had now (their trees allocate infallibly); the probe is
+/// freed at once.
+fn probe(m: usize) -> Result<()> {
+    let bytes = alloc::product(CALL, m, WORKING_BYTES_PER_VERTEX, 1)?;
+    alloc::with_capacity::<u8>(CALL, bytes)
+        .map_err(|_| InputError::out_of_memory(CALL, m, WORKING_BYTES_PER_VERTEX))?;
+    Ok(())
+}
+
 impl Profile {
     /// Validate `points` (an `(m, 2)` polygon). A closed profile may repeat its first vertex
     /// at the end; it is dropped.
@@ -361,7 +380,7 @@ impl Profile {
         if let Some(j) = points.iter().position(|p| !p.is_finite()) {
             return Err(InputError::new(ARG, format!("non-finite value at row {j}")));
         }
-        let mut p = points.to_vec();
+        let mut p = alloc::copied(CALL, points)?;
         let scale = p.iter().fold(0.0_f64, |a, q| a.max(q.abs().max_element()));
         let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
         if closed && p.len() >= 2 && same(p[0], p[p.len() - 1]) {
@@ -389,7 +408,7 @@ impl Profile {
         // divided by the power of two of its largest coordinate (exact), so that any finite
         // size works
         let k = unit_exponent(scale);
-        let q: Vec<DVec2> = p.iter().map(|&v| scaled(v, k)).collect();
+        let q: Vec<DVec2> = alloc::collect(CALL, p.iter().map(|&v| scaled(v, k)))?;
         let (p_all, p) = (p, q);
         let scale = crate::math::scale::ldexp(scale, k);
         let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
@@ -412,6 +431,7 @@ impl Profile {
                 })
         };
         if !convex && !on_a_line() {
+            probe(m)?;
             if let Some((a, b)) = sweep_crossing(&p, closed) {
                 return Err(InputError::new(
                     ARG,
@@ -434,7 +454,7 @@ impl Profile {
         // the area in the units of the input (it fits where the polygon does)
         let area = crate::math::scale::ldexp(area, -2 * k);
         let p = p_all;
-        let mut v = Vec::with_capacity(m);
+        let mut v = alloc::with_capacity(CALL, m)?;
         let mut acc = 0.0;
         for j in 0..m {
             v.push(acc);
@@ -464,26 +484,28 @@ impl Profile {
 
     /// Triangles `[a, b, c]` covering the polygon, counter-clockwise in the profile plane
     /// (so their normal is `+t`, the direction of travel).
-    pub fn triangulate(&self) -> Vec<[usize; 3]> {
+    pub fn triangulate(&self) -> Result<Vec<[usize; 3]>> {
         let m = self.points.len();
         // Counter-clockwise vertex order.
         let ccw: Vec<usize> = if self.area > 0.0 {
-            (0..m).collect()
+            alloc::collect(CALL, 0..m)?
         } else {
-            (0..m).rev().collect()
+            alloc::collect(CALL, (0..m).rev())?
         };
         if self.convex {
-            return (1..m - 1).map(|k| [ccw[0], ccw[k], ccw[k + 1]]).collect();
+            return alloc::collect(CALL, (1..m - 1).map(|k| [ccw[0], ccw[k], ccw[k + 1]]));
         }
+        probe(m)?;
         // the exact predicates on the polygon brought near unit size, as in the check of
         // [`Profile::new`]
         let scale = (self.points.iter()).fold(0.0_f64, |a, q| a.max(q.abs().max_element()));
         let k = unit_exponent(scale);
-        let q: Vec<DVec2> = ccw.iter().map(|&i| scaled(self.points[i], k)).collect();
-        super::monotone::triangulate(&q)
-            .into_iter()
-            .map(|t| t.map(|i| ccw[i]))
-            .collect()
+        let q: Vec<DVec2> = alloc::collect(CALL, ccw.iter().map(|&i| scaled(self.points[i], k)))?;
+        let mut tris = super::monotone::triangulate(&q);
+        for t in tris.iter_mut() {
+            *t = t.map(|i| ccw[i]);
+        }
+        Ok(tris)
     }
 }
 
@@ -712,7 +734,7 @@ mod tests {
                     p.reverse();
                 }
                 let prof = Profile::new(&p, true).unwrap();
-                let tris = prof.triangulate();
+                let tris = prof.triangulate().unwrap();
                 assert_eq!(tris.len(), p.len() - 2);
                 // every triangle counter-clockwise, total = |area|
                 for t in &tris {
@@ -744,7 +766,7 @@ mod tests {
                 }
                 let prof = Profile::new(&p, true).unwrap();
                 assert_eq!(prof.convex, convex);
-                let tris = prof.triangulate();
+                let tris = prof.triangulate().unwrap();
                 assert_eq!(tris.len(), p.len() - 2);
                 for t in &tris {
                     assert!(cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]) > 0.0);
@@ -945,7 +967,7 @@ mod tests {
                     q.reverse();
                 }
                 let prof = Profile::new(&q, true).unwrap();
-                let tris = prof.triangulate();
+                let tris = prof.triangulate().unwrap();
                 assert_eq!(tris.len(), q.len() - 2);
                 use std::cmp::Ordering::Greater;
                 assert!(

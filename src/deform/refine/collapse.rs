@@ -68,8 +68,10 @@
 
 use glam::DVec3;
 
-use super::{MAX_VALENCE, NONE, Refiner, Topology, min_angle};
+use super::{CALL, MAX_VALENCE, NONE, Refiner, Topology, min_angle};
+use crate::alloc;
 use crate::deform::slip::{self, Carry};
+use crate::error::Result;
 
 /// Faces of the strip with a smallest angle under this (1°, radians) are collapsed away.
 pub(super) const SLIVER: f64 = 1.0 * std::f64::consts::PI / 180.0;
@@ -183,8 +185,8 @@ impl Topology {
     }
 
     /// Drop the faces marked in `dead`, renumbering the half-edges of the others.
-    pub(super) fn compact(&mut self, dead: &[bool]) {
-        let mut map = vec![NONE; self.faces.len()];
+    pub(super) fn compact(&mut self, dead: &[bool]) -> Result<()> {
+        let mut map = alloc::filled(CALL, self.faces.len(), NONE)?;
         let mut n = 0;
         for (f, &d) in dead.iter().enumerate() {
             if !d {
@@ -192,8 +194,8 @@ impl Topology {
                 n += 1;
             }
         }
-        let mut faces = Vec::with_capacity(n);
-        let mut twin = Vec::with_capacity(3 * n);
+        let mut faces = alloc::with_capacity(CALL, n)?;
+        let mut twin = alloc::with_capacity(CALL, 3 * n)?;
         for f in (0..self.faces.len()).filter(|&f| !dead[f]) {
             faces.push(self.faces[f]);
             for k in 0..3 {
@@ -207,6 +209,7 @@ impl Topology {
         }
         self.faces = faces;
         self.twin = twin;
+        Ok(())
     }
 }
 
@@ -576,16 +579,16 @@ impl Refiner<'_> {
     /// Collapse the slivers of the strips along slip surfaces at time `time` (see the module
     /// docs), with flips over the strips after each round; the vertices and faces that
     /// vanish are dropped from `w` and the refiner's arrays.
-    pub(super) fn collapse_slivers(&mut self, w: &mut Vec<DVec3>, time: f64) {
-        let mut gone = vec![false; w.len()];
+    pub(super) fn collapse_slivers(&mut self, w: &mut Vec<DVec3>, time: f64) -> Result<()> {
+        let mut gone = alloc::filled(CALL, w.len(), false)?;
         // vertices moved or merged in a round: the flips after it go over their faces
-        let mut changed = vec![false; w.len()];
+        let mut changed = alloc::filled(CALL, w.len(), false)?;
         for _ in 0..COLLAPSE_ROUNDS {
             let bad = self.bad_faces(w);
             if bad.is_empty() {
                 break;
             }
-            let mut dead = vec![false; self.topo.faces.len()];
+            let mut dead = alloc::filled(CALL, self.topo.faces.len(), false)?;
             let before = self.collapses;
             for &(_, q) in &bad {
                 if dead[q] {
@@ -625,7 +628,7 @@ impl Refiner<'_> {
                     break;
                 }
             }
-            self.topo.compact(&dead);
+            self.topo.compact(&dead)?;
             // the slivers left: their vertices moved towards their neighbours' centroid
             let moved = self.moves;
             for (_, q) in self.bad_faces(w) {
@@ -654,7 +657,7 @@ impl Refiner<'_> {
         }
         // drop the vanished vertices, keeping the order of the others
         if gone.iter().any(|&g| g) {
-            let mut map = vec![NONE; w.len()];
+            let mut map = alloc::filled(CALL, w.len(), NONE)?;
             let mut n = 0;
             for (v, &g) in gone.iter().enumerate() {
                 if !g {
@@ -672,6 +675,7 @@ impl Refiner<'_> {
                 *t = t.map(|v| map[v]);
             }
         }
+        Ok(())
     }
 }
 
@@ -722,7 +726,7 @@ mod tests {
         v[a] = (0.5 * (v[a] + v[b])).normalize();
         t.collapse(h, &sb, &mut dead);
         assert_eq!(dead.iter().filter(|&&d| d).count(), 2);
-        t.compact(&dead);
+        t.compact(&dead).unwrap();
         assert_eq!(t.faces.len(), f.len() - 2);
         assert!(t.faces.iter().all(|q| !q.contains(&b)), "b is gone");
         assert!(valid(&t.faces, v.len()));
@@ -784,7 +788,7 @@ mod tests {
                     assert!(valid(&forced(&t, h), n), "{h}");
                     let mut dead = vec![false; t.faces.len()];
                     t.collapse(h, &sb, &mut dead);
-                    t.compact(&dead);
+                    t.compact(&dead).unwrap();
                     assert!(valid(&t.faces, n));
                     assert_eq!(Topology::new(&t.faces, n).unwrap().twin, t.twin);
                     collapses += 1;
