@@ -459,10 +459,6 @@ D17_ONCE_CASES = {
         ("c = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1.]])\n"
          "C = np.ascontiguousarray(np.broadcast_to(c, (3_000_000, 4, 3)))\n"),
         "ph.invariants(C)"),
-    "ph.is_ph": (
-        ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
-         "C = np.ascontiguousarray(np.broadcast_to(c, (12_000_000, 4, 3)))\n"),
-        "ph.is_ph(C)"),
     "ph.preimage": (
         ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
          "C = np.ascontiguousarray(np.broadcast_to(c, (5_000_000, 4, 3)))\n"),
@@ -480,10 +476,6 @@ D17_ONCE_CASES = {
         ("s = np.linspace(0, 2000, 1_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
          "Z = X[::100_000] + .05\n"),
         "fl.strip_curve(X, .1, 1.0)(Z)"),
-    "PHSpline.rmf": (
-        ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
-         "s = np.linspace(0, 1, 16_000_000)\n"),
-        "sp.rmf(s)[::1_000_000]"),
 }
 
 

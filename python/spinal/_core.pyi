@@ -338,6 +338,7 @@ def field_keyframed(
     matrices: npt.NDArray[np.float64] | None,
     quaternions: npt.NDArray[np.float64] | None,
     falloff_power: int | None,
+    center: tuple[float, float, float] | npt.NDArray[np.float64] | None,
 ) -> Field: ...
 def advect(
     points: npt.NDArray[np.float64],

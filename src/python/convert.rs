@@ -279,7 +279,7 @@ pub fn orientations(
 
 /// PH cubics from control points `(m, 4, 3)`.
 pub fn cubics_of(call: &'static str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
-    Ok(cubics_from(call, cubic_points(a)?)?)
+    Ok(cubics_from(call, cubic_points(a)?, &crate::cancel::never)?)
 }
 
 /// The control points of `(m, 4, 3)` cubics, four rows per cubic (see [`cubics_from`]).
@@ -293,14 +293,26 @@ pub fn cubic_points<'a>(a: &'a PyReadonlyArray3<'_, f64>) -> PyResult<&'a [DVec3
     Ok(bytemuck::cast_slice(slice_of("control_points", a)?))
 }
 
-/// The cubics of [`cubic_points`] (allocated fallibly, naming `call`); needs no Python, so
-/// a heavy call makes them with the GIL released.
-pub fn cubics_from(call: &'static str, flat: &[DVec3]) -> crate::error::Result<Vec<ph::Cubic>> {
-    alloc::collect(
-        call,
-        flat.chunks_exact(4)
-            .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]])),
-    )
+/// The cubics of [`cubic_points`] (allocated fallibly, naming `call`), polling `cancel` every
+/// [`crate::cancel::BLOCK`] cubics; needs no Python, so a heavy call makes them with the GIL
+/// released.
+pub fn cubics_from(
+    call: &'static str,
+    flat: &[DVec3],
+    cancel: crate::cancel::Cancel<'_>,
+) -> crate::error::Result<Vec<ph::Cubic>> {
+    let mut out = alloc::with_capacity(call, flat.len() / 4)?;
+    for block in flat.chunks(4 * crate::cancel::BLOCK) {
+        if cancel() {
+            return Err(crate::cancel::stopped());
+        }
+        out.extend(
+            block
+                .chunks_exact(4)
+                .map(|c| ph::Cubic::new([c[0], c[1], c[2], c[3]])),
+        );
+    }
+    Ok(out)
 }
 
 /// `numpy.empty(shape, dtype)`: NumPy's allocator reuses freed heap memory for small arrays

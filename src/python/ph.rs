@@ -68,7 +68,7 @@ pub fn ph_invariants<'py>(
     let points = cubic_points(&control_points)?;
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
-        let cubics = cubics_from("ph.invariants", points)?;
+        let cubics = cubics_from("ph.invariants", points, &|| stop.requested())?;
         ph::check::invariant_rows_cancellable(&cubics, &|| stop.requested())
     })??;
     let out = alloc::flat("ph.invariants", rows.iter().map(|v| v.row()))?;
@@ -86,7 +86,7 @@ pub fn ph_is_ph<'py>(
     let points = cubic_points(&control_points)?;
     let stop = Stop::default();
     let out = detach_stoppable(py, &stop, || {
-        let cubics = cubics_from("ph.is_ph", points)?;
+        let cubics = cubics_from("ph.is_ph", points, &|| stop.requested())?;
         ph::check::is_ph_rows_cancellable(&cubics, tol, &|| stop.requested())
     })??;
     Ok(PyArray1::from_vec(py, out))
@@ -142,7 +142,7 @@ pub fn ph_preimage<'py>(
     let points = cubic_points(&control_points)?;
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
-        let cubics = cubics_from("ph.preimage", points)?;
+        let cubics = cubics_from("ph.preimage", points, &|| stop.requested())?;
         ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())
     })??;
     let m = rows.len();
