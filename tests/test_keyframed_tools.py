@@ -16,9 +16,9 @@ import pickle
 
 import numpy as np
 import pytest
-from scipy.interpolate import CubicHermiteSpline
 from scipy.spatial.transform import Rotation, Slerp
 from test_deform import icosphere, jacobian, volumes
+from test_deform_curl import bessel_hermite
 from test_deform_tools import Axis
 
 import spinal
@@ -143,13 +143,7 @@ def keyed(kind, tool=None, times=TIMES, pos=POS, rot=ROT, **kw):
 
 def bessel_spline(times=TIMES, pos=POS):
     """SciPy's cubic Hermite spline through the keys with Bessel tangents."""
-    dt = np.diff(times)
-    de = np.diff(pos, axis=0) / dt[:, None]
-    m = np.empty_like(pos)
-    m[1:-1] = (de[:-1] * dt[1:, None] + de[1:] * dt[:-1, None]) / (dt[:-1] + dt[1:])[:, None]
-    m[0] = de[0] + (de[0] - de[1]) * dt[0] / (dt[0] + dt[1])
-    m[-1] = de[-1] + (de[-1] - de[-2]) * dt[-1] / (dt[-1] + dt[-2])
-    return CubicHermiteSpline(times, pos, m)
+    return bessel_hermite(times, pos)
 
 
 def scipy_pose(t, times=TIMES, pos=POS, rot=ROT):
