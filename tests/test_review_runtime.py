@@ -450,31 +450,31 @@ def interrupt_once(setup: str, call: str, after: float = 0.3, least: float = 1.5
 D17_ONCE_CASES = {
     "walk_mesh": (
         "b = trimesh.creation.box(); p = b.vertices[b.faces[0]].mean(0)\n",
-        "Q.walk_mesh(b.vertices, b.faces, 0, p, [[4e6, .1234]])"),
+        "Q.walk_mesh(b.vertices, b.faces, 0, p, [[7e6, .1234]])"),
     "quaternion_frames": (
-        ("n = 12_000_000; s = np.linspace(0, 4000, n)\n"
+        ("n = 24_000_000; s = np.linspace(0, 8000, n)\n"
          "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),
         "Q.quaternion_frames(X)"),
     "ph.invariants": (
         ("c = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1.]])\n"
-         "C = np.ascontiguousarray(np.broadcast_to(c, (3_000_000, 4, 3)))\n"),
+         "C = np.ascontiguousarray(np.broadcast_to(c, (7_000_000, 4, 3)))\n"),
         "ph.invariants(C)"),
     "ph.preimage": (
         ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
-         "C = np.ascontiguousarray(np.broadcast_to(c, (5_000_000, 4, 3)))\n"),
+         "C = np.ascontiguousarray(np.broadcast_to(c, (8_500_000, 4, 3)))\n"),
         "ph.preimage(C)"),
     # the fields' builds, each evaluated at a few points (their bits compared)
     "keyframed": (
-        ("T = np.arange(9_000_000.0); P = np.c_[T, T, T] * 1e-6\n"
+        ("T = np.arange(16_000_000.0); P = np.c_[T, T, T] * 1e-6\n"
          "tool = fl.translation([0, 0, 0], .5, [0, 0, 1]); Z = np.linspace(-1, 1, 30).reshape(10, 3)\n"),
         "fl.keyframed(tool, T, P)(Z, 1.0)"),
     "along_path": (
-        ("s = np.linspace(0, 2000, 5_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
-         "F = spinal.frames(X); Z = X[::500_000] + .05\n"),
+        ("s = np.linspace(0, 3600, 9_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "F = spinal.frames(X); Z = X[::900_000] + .05\n"),
         "fl.along_path(X, .1, 1.0, frames=F)(Z, .5)"),
     "strip_curve": (
-        ("s = np.linspace(0, 2000, 1_000_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
-         "Z = X[::100_000] + .05\n"),
+        ("s = np.linspace(0, 3200, 1_600_000); X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
+         "Z = X[::160_000] + .05\n"),
         "fl.strip_curve(X, .1, 1.0)(Z)"),
 }
 
