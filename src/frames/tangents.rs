@@ -6,7 +6,11 @@
 //!   weights by Fornberg's algorithm, centred where possible, one-sided at open ends,
 //!   periodic for loops). For equal chords it is the formula below; for unequal spacing it
 //!   stays 4th order in the direction and is exact on straight lines whatever the spacing,
-//!   where index-based stencils can even point backwards. Guard: where it turns more than
+//!   where index-based stencils can even point backwards. At an open end whose first chord
+//!   is much longer than the next ones the one-sided quartic extrapolates from a distant
+//!   cluster and amplifies rounding by ~(H/h)³; there the farthest samples are dropped
+//!   (cubic, quadratic, down to the end chord) until the amplification is at most 10³, which
+//!   keeps equal and moderately uneven chords (ratios up to ~7) at 4th order. Guard: where it turns more than
 //!   60° away from the circle estimate below (the quartic overshooting at a kink next to
 //!   very uneven chords), the circle estimate is used instead.
 //! * Bounded ends (the default rule, `FivePointBounded`): the five-point chord-length rule
@@ -147,26 +151,53 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
     for v in tau.iter_mut() {
         *v -= z;
     }
-    // For j ≠ at: L_j′(0) = Π_{m≠j,at}(−τ_m) / Π_{m≠j}(τ_j − τ_m); Σ_j w_j = 0, so the
-    // derivative is Σ_{j≠at} w_j (x_j − x_at).
     let p0 = x[idx(first + at as isize, n, closed)];
-    let mut d = DVec3::ZERO;
-    for j in 0..5 {
-        if j == at {
-            continue;
+    let mut rel = [DVec3::ZERO; 5];
+    for (j, r) in rel.iter_mut().enumerate() {
+        *r = x[idx(first + j as isize, n, closed)] - p0;
+    }
+    // Nodes in use, nearest to τ = 0 first; the farthest is dropped while the stencil
+    // amplifies rounding by more than `MAX_AMPLIFICATION` (a one-sided end whose first
+    // chord is ~7× longer than the next ones extrapolates a quartic from a distant cluster:
+    // amplification ~(H/h)³, 3·10⁸ at a ratio of 600). Two nodes give the chord (factor 1).
+    let mut order: Vec<usize> = (0..5).filter(|&j| j != at).collect();
+    order.sort_by(|&a, &b| tau[a].abs().total_cmp(&tau[b].abs()));
+    let mut used = 4;
+    loop {
+        let (d, amplification) = lagrange_derivative(&tau, &rel, &order[..used]);
+        if used == 1 || d == DVec3::ZERO || amplification <= MAX_AMPLIFICATION {
+            return d;
         }
-        let (mut num, mut den) = (1.0, 1.0);
-        for m in 0..5 {
+        used -= 1;
+    }
+}
+
+/// Largest accepted ratio `Σ_j |w_j| |x_j − x_at| / |Σ_j w_j (x_j − x_at)|` of an end stencil:
+/// the factor by which it amplifies relative rounding in the samples (15 for equal chords).
+/// Above it the stencil loses more than ~10⁻¹³ of the direction to rounding alone.
+const MAX_AMPLIFICATION: f64 = 1e3;
+
+/// The derivative at `τ = 0` of the polynomial through `(0, 0)` and `(τ_j, rel_j)` for the
+/// nodes `j` in `nodes`, and its rounding amplification (see [`MAX_AMPLIFICATION`]).
+/// For each node, `L_j′(0) = Π_{m≠j}(−τ_m) / (τ_j Π_{m≠j}(τ_j − τ_m))` over the other nodes
+/// (the node at 0 contributes nothing, its value being 0).
+fn lagrange_derivative(tau: &[f64; 5], rel: &[DVec3; 5], nodes: &[usize]) -> (DVec3, f64) {
+    let mut d = DVec3::ZERO;
+    let mut size = 0.0;
+    for &j in nodes {
+        let (mut num, mut den) = (1.0, tau[j]);
+        for &m in nodes {
             if m != j {
                 den *= tau[j] - tau[m];
-                if m != at {
-                    num *= -tau[m];
-                }
+                num *= -tau[m];
             }
         }
-        d += (num / den) * (x[idx(first + j as isize, n, closed)] - p0);
+        let w = num / den;
+        d += w * rel[j];
+        size += w.abs() * rel[j].length();
     }
-    d
+    let l = d.length();
+    (d, if l > 0.0 { size / l } else { f64::INFINITY })
 }
 
 /// The direction of `chord_five_point` at a centred stencil (a positive multiple of the
@@ -638,6 +669,40 @@ mod tests {
         };
         let ratio = err(64) / err(128);
         assert!((14.0..18.0).contains(&ratio), "ratio {ratio}");
+    }
+
+    /// A long first chord before a tight cluster (ratio 610): the one-sided quartic at the
+    /// first sample would amplify rounding ~3·10⁸ times (a 6.6·10⁻⁹ error on a straight
+    /// line); the stencil drops to the end chord there and stays exact.
+    #[test]
+    fn long_end_chord_before_a_cluster_keeps_a_line_exact() {
+        let d = DVec3::new(0.0, -0.8641143000711117, 0.853716779585615).normalize();
+        let mut x = vec![DVec3::new(1.0, 2.0, 3.0)];
+        for h in [6.096199463032909, 0.01, 0.01, 0.01] {
+            x.push(*x.last().unwrap() + h * d);
+        }
+        for rule in [TangentRule::FivePoint, TangentRule::FivePointBounded] {
+            let t = estimate_rows(&x, false, rule).unwrap();
+            for (i, ti) in t.iter().enumerate() {
+                assert!((*ti - d).length() < 1e-12, "{rule:?} {i}: {ti} {d}");
+            }
+        }
+        // on a circle of radius 2 (chord 3, then 0.01): a quadratic through the end and the
+        // cluster (amplification ~600), leaning from the true tangent (0, 1, 0) by less than
+        // half the end chord's lean (0.26 against 0.75 rad)
+        let s = [0.0, 3.0, 3.01, 3.02, 3.03];
+        let x: Vec<DVec3> = s
+            .iter()
+            .map(|&u: &f64| DVec3::new((u / 2.0).cos(), (u / 2.0).sin(), 0.0) * 2.0)
+            .collect();
+        let t = estimate_rows(&x, false, TangentRule::FivePoint).unwrap();
+        let exact = DVec3::Y;
+        let chord = (x[1] - x[0]).normalize();
+        assert!(
+            t[0].angle_between(exact) < 0.5 * chord.angle_between(exact),
+            "{}",
+            t[0]
+        );
     }
 
     #[test]
