@@ -156,19 +156,23 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
     for (j, r) in rel.iter_mut().enumerate() {
         *r = x[idx(first + j as isize, n, closed)] - p0;
     }
-    // Nodes in use, nearest to τ = 0 first; the farthest is dropped while the stencil
-    // amplifies rounding by more than `MAX_AMPLIFICATION` (a one-sided end whose first
-    // chord is ~7× longer than the next ones extrapolates a quartic from a distant cluster:
-    // amplification ~(H/h)³, 3·10⁸ at a ratio of 600). Two nodes give the chord (factor 1).
-    let mut order: Vec<usize> = (0..5).filter(|&j| j != at).collect();
-    order.sort_by(|&a, &b| tau[a].abs().total_cmp(&tau[b].abs()));
-    let mut used = 4;
+    // The nodes in use (in index order, `at` among them); the one farthest from τ = 0 is
+    // dropped while the stencil amplifies rounding by more than `MAX_AMPLIFICATION` (a
+    // one-sided end whose first chord is ~7× longer than the next ones extrapolates a
+    // quartic from a distant cluster: amplification ~(H/h)³, 3·10⁸ at a ratio of 600).
+    // Two nodes give the chord (factor 1).
+    let mut nodes = [true; 5];
     loop {
-        let (d, amplification) = lagrange_derivative(&tau, &rel, &order[..used]);
-        if used == 1 || d == DVec3::ZERO || amplification <= MAX_AMPLIFICATION {
+        let (d, amplification) = lagrange_derivative(&tau, &rel, at, &nodes);
+        let left = nodes.iter().filter(|&&u| u).count();
+        if left == 2 || d == DVec3::ZERO || amplification <= MAX_AMPLIFICATION {
             return d;
         }
-        used -= 1;
+        let far = (0..5)
+            .filter(|&j| nodes[j] && j != at)
+            .max_by(|&a, &b| tau[a].abs().total_cmp(&tau[b].abs()))
+            .unwrap_or(at);
+        nodes[far] = false;
     }
 }
 
@@ -177,19 +181,29 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
 /// Above it the stencil loses more than ~10⁻¹³ of the direction to rounding alone.
 const MAX_AMPLIFICATION: f64 = 1e3;
 
-/// The derivative at `τ = 0` of the polynomial through `(0, 0)` and `(τ_j, rel_j)` for the
-/// nodes `j` in `nodes`, and its rounding amplification (see [`MAX_AMPLIFICATION`]).
-/// For each node, `L_j′(0) = Π_{m≠j}(−τ_m) / (τ_j Π_{m≠j}(τ_j − τ_m))` over the other nodes
-/// (the node at 0 contributes nothing, its value being 0).
-fn lagrange_derivative(tau: &[f64; 5], rel: &[DVec3; 5], nodes: &[usize]) -> (DVec3, f64) {
+/// The derivative at `τ_at = 0` of the polynomial through `(τ_j, rel_j)` for the nodes `j`
+/// with `used[j]` (`rel_at = 0`), and its rounding amplification (see
+/// [`MAX_AMPLIFICATION`]). For `j ≠ at`: `L_j′(0) = Π_{m≠j,at}(−τ_m) / Π_{m≠j}(τ_j − τ_m)`
+/// over the nodes in use; `Σ_j w_j = 0`, so the derivative is `Σ_{j≠at} w_j (x_j − x_at)`.
+fn lagrange_derivative(
+    tau: &[f64; 5],
+    rel: &[DVec3; 5],
+    at: usize,
+    used: &[bool; 5],
+) -> (DVec3, f64) {
     let mut d = DVec3::ZERO;
     let mut size = 0.0;
-    for &j in nodes {
-        let (mut num, mut den) = (1.0, tau[j]);
-        for &m in nodes {
-            if m != j {
+    for j in 0..5 {
+        if j == at || !used[j] {
+            continue;
+        }
+        let (mut num, mut den) = (1.0, 1.0);
+        for m in 0..5 {
+            if m != j && used[m] {
                 den *= tau[j] - tau[m];
-                num *= -tau[m];
+                if m != at {
+                    num *= -tau[m];
+                }
             }
         }
         let w = num / den;
