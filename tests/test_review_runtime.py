@@ -512,6 +512,19 @@ def test_D17_threads_setting_keeps_results():
     np.testing.assert_array_equal(a, b)
 
 
+def test_D17_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
+    """A star profile of 2**22 vertices is not convex: the sweep first tests it for
+    self-intersection (a sweep line over its 2**23 edge ends, about 4 s here) and then
+    triangulates its caps (about 3 s), each in O(m log m) and each polling Ctrl-C every
+    few thousand events; before, neither polled, and a stop waited for both."""
+    setup = ("m = 2**22; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+             "r = 1 + .3 * (np.arange(m) % 2); P = np.c_[r * np.cos(a), r * np.sin(a)]\n"
+             "X = np.array([[0, 0, 0], [0, .1, 1.]])\n")
+    call = "spinal.sweep(X, P, normals=False, uv=False, dtype='float32')"
+    for after in (1.0, 3.0, 5.5):
+        assert late_after_sigint(setup, call, after=after) < 0.5
+
+
 def test_D17_sweep_of_a_huge_profile_stops_inside_a_ring():
     """A profile of 2**23 vertices on a two-point spine: two rings of 96 MiB of float32
     vertices and 192 MiB of int32 faces. The writer polls Ctrl-C between pieces of at most

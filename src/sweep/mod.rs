@@ -640,8 +640,8 @@ struct Shared<'a> {
 
 impl<'a> Shared<'a> {
     /// `cols`: the vertices of a stored ring (the same on every spine); `caps`: some spine
-    /// has caps.
-    fn new(p: &'a Profile, cols: usize, caps: bool) -> Result<Shared<'a>> {
+    /// has caps; `cancel` is polled while a non-convex profile's caps are triangulated.
+    fn new(p: &'a Profile, cols: usize, caps: bool, cancel: Cancel<'_>) -> Result<Shared<'a>> {
         // Winding: normals to the right of the profile's direction, outward for closed
         // profiles.
         let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
@@ -650,7 +650,10 @@ impl<'a> Shared<'a> {
             p,
             column: OnceLock::new(),
             pattern: FacePattern::of(cols, edges, sign),
-            tris: if caps { p.triangulate()? } else { Vec::new() },
+            tris: match caps {
+                true => p.triangulate_cancellable(cancel)?,
+                false => Vec::new(),
+            },
             sign,
             edges,
         })
@@ -1933,7 +1936,7 @@ pub fn sweep_into<R: Real, I: Index>(
         offsets,
         opts,
         layout,
-        sh: Shared::new(profile, cols, caps)?,
+        sh: Shared::new(profile, cols, caps, &cancel::never)?,
         unscale: None,
     };
     sweep.write(out, &cancel::never)
@@ -2005,14 +2008,20 @@ impl<'a> Prepared<'a> {
             scale,
             ..spine
         };
-        let set_up = Profile::new(prof, profile_closed).and_then(|p| {
+        let set_up = Profile::new_cancellable(prof, profile_closed, cancel).and_then(|p| {
             let lay = layout_cancellable(&view, offsets, &p, &opts, cancel)?;
             Ok(lay.map(|l| (p, l)))
         });
         let (p, layout) = match (set_up, frames) {
             (Ok(Some(pl)), _) => pl,
             (Ok(None), _) => return Ok(None),
-            (Err(e), FrameSource::Given) => return Err(e),
+            // a stopped check of the profile is no error
+            (Err(e), FrameSource::Given) => {
+                return match cancel() {
+                    true => Ok(None),
+                    false => Err(e),
+                };
+            }
             (Err(e), FrameSource::Rmf { tangents }) => {
                 validate::offsets(offsets, spine.points.len())?;
                 let (x, closed) = (spine.points, opts.closed);
@@ -2076,7 +2085,7 @@ impl<'a> Prepared<'a> {
             offsets: self.offsets,
             opts: &self.opts,
             layout: &self.layout,
-            sh: Shared::new(&self.profile, cols, caps)?,
+            sh: Shared::new(&self.profile, cols, caps, cancel)?,
             unscale: self.scaled.as_ref().map(|s| s.k),
         };
         sweep.write(out, cancel)
@@ -2567,7 +2576,7 @@ mod tests {
         let plan = check_spine(spine, opts, p, true, &cancel::never)
             .expect("a valid sweep")
             .expect("not stopped");
-        let sh = Shared::new(p, plan.cols, false).unwrap();
+        let sh = Shared::new(p, plan.cols, false, &cancel::never).unwrap();
         let rings = Rings {
             s: spine,
             x: &spine.points[..plan.rings],

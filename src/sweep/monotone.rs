@@ -21,6 +21,8 @@ use std::collections::BTreeMap;
 use glam::DVec2;
 
 use super::profile::orient;
+use crate::cancel::{self, BLOCK, Cancel};
+use crate::error::Result;
 
 /// Is `a` above `b` in the sweep order (higher, or as high and further left)?
 fn above(a: DVec2, b: DVec2) -> bool {
@@ -133,7 +135,7 @@ impl Ord for Status {
 /// split and merge vertex gets a diagonal to the *helper* of the edge directly left of it
 /// (the lowest vertex above it seen horizontally from that edge), found in a B-tree of the
 /// edges crossing the sweep line with the interior to their right. O(m log m).
-fn diagonals(q: &[DVec2], order: &[usize]) -> Vec<[usize; 2]> {
+fn diagonals(q: &[DVec2], order: &[usize], cancel: Cancel<'_>) -> Result<Vec<[usize; 2]>> {
     let m = q.len();
     let next = |v: usize| if v + 1 == m { 0 } else { v + 1 };
     let prev = |v: usize| if v == 0 { m - 1 } else { v - 1 };
@@ -145,7 +147,10 @@ fn diagonals(q: &[DVec2], order: &[usize]) -> Vec<[usize; 2]> {
     };
     let mut status: BTreeMap<Status, usize> = BTreeMap::new();
     let mut out = Vec::new();
-    for &v in order {
+    for (i, &v) in order.iter().enumerate() {
+        if i % BLOCK == 0 && cancel() {
+            return Err(cancel::stopped());
+        }
         // the edge that ends at v leaves the status; its helper, if a merge vertex, joins v
         let close = |status: &mut BTreeMap<Status, usize>, out: &mut Vec<[usize; 2]>| {
             if let Some(h) = status.remove(&edge(prev(v))) {
@@ -190,7 +195,7 @@ fn diagonals(q: &[DVec2], order: &[usize]) -> Vec<[usize; 2]> {
         }
     }
     debug_assert!(status.is_empty());
-    out
+    Ok(out)
 }
 
 /// `a` before `b` counter-clockwise around `c`, starting from the direction `+x`: by half
@@ -290,22 +295,30 @@ fn monotone_piece(
 /// Triangles `[a, b, c]`, counter-clockwise, indices into `q`, covering the simple polygon
 /// `q` listed counter-clockwise: `m − 2` triangles on its own vertices, each of positive
 /// area, every edge of `q` in one triangle (in its direction) and every diagonal in two (in
-/// opposite directions). O(m log m).
-pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
+/// opposite directions). O(m log m). Polls `cancel` between its passes and every
+/// [`BLOCK`] vertices within them, and fails with [`cancel::stopped`] when it says stop.
+pub fn triangulate(q: &[DVec2], cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
     let m = q.len();
     let mut out = Vec::with_capacity(m.saturating_sub(2));
     if m < 3 {
-        return out;
+        return Ok(out);
     }
+    let stop = || match cancel() {
+        true => Err(cancel::stopped()),
+        false => Ok(()),
+    };
     let mut order: Vec<usize> = (0..m).collect();
-    order.sort_unstable_by(|&a, &b| sweep_order(q[a], q[b]));
-    let diag = diagonals(q, &order);
+    // the vertices of a simple polygon are distinct
+    if !cancel::sort_by(&mut order, |&a, &b| sweep_order(q[a], q[b]), cancel) {
+        return Err(cancel::stopped());
+    }
+    let diag = diagonals(q, &order, cancel)?;
     drop(order);
     let (mut seq, mut stack) = (Vec::new(), Vec::new());
     if diag.is_empty() {
         let all: Vec<usize> = (0..m).collect();
         monotone_piece(q, &all, &mut seq, &mut stack, &mut out);
-        return out;
+        return Ok(out);
     }
     // the edges around every vertex: the block off[v]..off[v + 1] of `adj` holds their far
     // ends, the two polygon edges first; blocks with diagonals are then sorted
@@ -335,7 +348,11 @@ pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
         fill[b] += 1;
     }
     drop(fill);
+    stop()?;
     for v in 0..m {
+        if v % BLOCK == 0 {
+            stop()?;
+        }
         let block = &mut adj[off[v]..off[v + 1]];
         if block.len() > 2 {
             block.sort_unstable_by(|&a, &b| around(q[v], q[a], q[b]));
@@ -347,6 +364,9 @@ pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
     let mut seen = vec![false; adj.len()];
     let mut cyc = Vec::new();
     for v in 0..m {
+        if v % BLOCK == 0 {
+            stop()?;
+        }
         for s in off[v]..off[v + 1] {
             if seen[s] || adj[s] == prev(v) {
                 continue;
@@ -371,7 +391,7 @@ pub fn triangulate(q: &[DVec2]) -> Vec<[usize; 3]> {
             monotone_piece(q, &cyc, &mut seq, &mut stack, &mut out);
         }
     }
-    out
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -433,7 +453,7 @@ mod tests {
         for s in [0, m / 3, 2 * m / 3] {
             let mut q = ccw.clone();
             q.rotate_left(s);
-            check(&q, &triangulate(&q));
+            check(&q, &triangulate(&q, &cancel::never).unwrap());
         }
     }
 
@@ -693,7 +713,7 @@ mod tests {
         order.sort_unstable_by(|&a, &b| sweep_order(p[a], p[b]));
         // level vertices: the one further left first
         assert_eq!(order, [5, 3, 4, 1, 0, 2]);
-        assert_eq!(diagonals(&p, &order), [[1, 4]]);
-        check(&p, &triangulate(&p));
+        assert_eq!(diagonals(&p, &order, &cancel::never).unwrap(), [[1, 4]]);
+        check(&p, &triangulate(&p, &cancel::never).unwrap());
     }
 }

@@ -21,6 +21,7 @@
 use glam::DVec2;
 
 use crate::alloc;
+use crate::cancel::{self, BLOCK, Cancel};
 use crate::error::{InputError, Result};
 
 /// A validated profile.
@@ -278,8 +279,13 @@ fn folds_back(a: DVec2, b: DVec2, c: DVec2) -> bool {
 /// kept in order in a B-tree, every edge tested against its neighbours when it enters and
 /// the two edges it separated when it leaves. O(m log m), with exact predicates. Several
 /// edges ending at one point and edges folding back are found before the sweep, so that
-/// the ordered edges meet only where the sweep tests them.
-fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
+/// the ordered edges meet only where the sweep tests them. Polls `cancel` between its
+/// passes and every [`BLOCK`] events within them ([`cancel::stopped`] when it says stop).
+fn sweep_crossing(p: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Option<(usize, usize)>> {
+    let stop = || match cancel() {
+        true => Err(cancel::stopped()),
+        false => Ok(()),
+    };
     use std::collections::BTreeSet;
     use std::ops::Bound::{Excluded, Unbounded};
     let m = p.len();
@@ -302,7 +308,14 @@ fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
         events.push((s.l, 0, s.id));
         events.push((s.r, 1, s.id));
     }
-    events.sort_unstable_by(|x, y| lex(x.0, y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    stop()?;
+    // the keys are distinct (an edge enters and leaves once)
+    let by = |x: &(DVec2, u8, usize), y: &(DVec2, u8, usize)| {
+        lex(x.0, y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2))
+    };
+    if !cancel::sort_by(&mut events, by, cancel) {
+        return Err(cancel::stopped());
+    }
     let adjacent = |a: usize, b: usize| {
         let (a, b) = (a.min(b), a.max(b));
         b == a + 1 || (closed && a == 0 && b == m - 1)
@@ -316,22 +329,29 @@ fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
         (first..m - first).find(|&j| folds_back(p[(j + m - 1) % m], p[j], p[(j + 1) % m]))
     {
         let a = (j + m - 1) % m;
-        return Some((a.min(j), a.max(j)));
+        return Ok(Some((a.min(j), a.max(j))));
     }
+    stop()?;
     // edges that end at the same point: around a vertex only its two edges may, so three
     // (of which two are not adjacent) or two non-adjacent ones meet there
-    for group in events.chunk_by(|x, y| x.0 == y.0) {
+    for (g, group) in events.chunk_by(|x, y| x.0 == y.0).enumerate() {
+        if g % BLOCK == 0 {
+            stop()?;
+        }
         let ids: Vec<usize> = group.iter().take(3).map(|e| e.2).collect();
         for (i, &a) in ids.iter().enumerate() {
             for &b in &ids[i + 1..] {
                 if !adjacent(a, b) {
-                    return Some((a.min(b), a.max(b)));
+                    return Ok(Some((a.min(b), a.max(b))));
                 }
             }
         }
     }
     let mut set = BTreeSet::new();
-    for &(_, kind, e) in &events {
+    for (i, &(_, kind, e)) in events.iter().enumerate() {
+        if i % BLOCK == 0 {
+            stop()?;
+        }
         let s = seg[e];
         let below = set.range(..s).next_back().copied();
         let above = set.range((Excluded(s), Unbounded)).next().copied();
@@ -339,19 +359,19 @@ fn sweep_crossing(p: &[DVec2], closed: bool) -> Option<(usize, usize)> {
             set.insert(s);
             for t in [below, above].into_iter().flatten() {
                 if let Some(hit) = meet(&s, &t) {
-                    return Some(hit);
+                    return Ok(Some(hit));
                 }
             }
         } else {
             set.remove(&s);
             if let (Some(b), Some(a)) = (below, above) {
                 if let Some(hit) = meet(&b, &a) {
-                    return Some(hit);
+                    return Ok(Some(hit));
                 }
             }
         }
     }
-    None
+    Ok(None)
 }
 
 /// The call named in out-of-memory errors.
@@ -376,6 +396,12 @@ impl Profile {
     /// Validate `points` (an `(m, 2)` polygon). A closed profile may repeat its first vertex
     /// at the end; it is dropped.
     pub fn new(points: &[DVec2], closed: bool) -> Result<Profile> {
+        Profile::new_cancellable(points, closed, &cancel::never)
+    }
+
+    /// [`Profile::new`], polling `cancel` in the self-intersection test of a non-convex
+    /// profile (O(m log m)); fails with [`cancel::stopped`] when it says stop.
+    pub fn new_cancellable(points: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Profile> {
         const ARG: &str = "profile";
         if let Some(j) = points.iter().position(|p| !p.is_finite()) {
             return Err(InputError::new(ARG, format!("non-finite value at row {j}")));
@@ -432,7 +458,7 @@ impl Profile {
         };
         if !convex && !on_a_line() {
             probe(m)?;
-            if let Some((a, b)) = sweep_crossing(&p, closed) {
+            if let Some((a, b)) = sweep_crossing(&p, closed, cancel)? {
                 return Err(InputError::new(
                     ARG,
                     format!(
@@ -485,6 +511,12 @@ impl Profile {
     /// Triangles `[a, b, c]` covering the polygon, counter-clockwise in the profile plane
     /// (so their normal is `+t`, the direction of travel).
     pub fn triangulate(&self) -> Result<Vec<[usize; 3]>> {
+        self.triangulate_cancellable(&cancel::never)
+    }
+
+    /// [`Profile::triangulate`], polling `cancel` in the triangulation of a non-convex
+    /// profile (O(m log m)); fails with [`cancel::stopped`] when it says stop.
+    pub fn triangulate_cancellable(&self, cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
         let m = self.points.len();
         // Counter-clockwise vertex order.
         let ccw: Vec<usize> = if self.area > 0.0 {
@@ -501,7 +533,7 @@ impl Profile {
         let scale = (self.points.iter()).fold(0.0_f64, |a, q| a.max(q.abs().max_element()));
         let k = unit_exponent(scale);
         let q: Vec<DVec2> = alloc::collect(CALL, ccw.iter().map(|&i| scaled(self.points[i], k)))?;
-        let mut tris = super::monotone::triangulate(&q);
+        let mut tris = super::monotone::triangulate(&q, cancel)?;
         for t in tris.iter_mut() {
             *t = t.map(|i| ccw[i]);
         }
@@ -891,7 +923,7 @@ mod tests {
                     continue;
                 }
                 let want = brute_crossing(&p, closed);
-                let got = sweep_crossing(&p, closed);
+                let got = sweep_crossing(&p, closed, &cancel::never).unwrap();
                 assert_eq!(got.is_some(), want, "{p:?} closed {closed}");
                 let grid = first_crossing(&p, closed).is_some();
                 let fold = (0..m).any(|a| folds_back(p[a], p[(a + 1) % m], p[(a + 2) % m]));
@@ -910,20 +942,22 @@ mod tests {
             for _ in 0..20 {
                 let mut p = star_shaped(&mut rng, m);
                 let n = p.len();
-                assert_eq!(sweep_crossing(&p, true), None);
-                assert_eq!(sweep_crossing(&p, false), None);
+                assert_eq!(sweep_crossing(&p, true, &cancel::never).unwrap(), None);
+                assert_eq!(sweep_crossing(&p, false, &cancel::never).unwrap(), None);
                 let k = rng.below(n as u64) as usize;
                 p[k] = -1.5 * p[k];
                 if n <= 100 {
                     for closed in [false, true] {
                         assert_eq!(
-                            sweep_crossing(&p, closed).is_some(),
+                            sweep_crossing(&p, closed, &cancel::never)
+                                .unwrap()
+                                .is_some(),
                             brute_crossing(&p, closed)
                         );
                     }
                 } else {
                     assert_eq!(
-                        sweep_crossing(&p, true).is_some(),
+                        sweep_crossing(&p, true, &cancel::never).unwrap().is_some(),
                         first_crossing(&p, true).is_some()
                     );
                 }
@@ -960,7 +994,7 @@ mod tests {
             p
         };
         for mut p in [star(100_000), comb(25_000)] {
-            assert_eq!(sweep_crossing(&p, true), None);
+            assert_eq!(sweep_crossing(&p, true, &cancel::never).unwrap(), None);
             for rev in [false, true] {
                 let mut q = p.clone();
                 if rev {
@@ -982,7 +1016,7 @@ mod tests {
             // two vertices of neighbouring spikes swapped: their edges cross
             let k = (n / 2) & !1;
             p.swap(k + 1, k + 5);
-            assert!(sweep_crossing(&p, true).is_some());
+            assert!(sweep_crossing(&p, true, &cancel::never).unwrap().is_some());
         }
     }
 }
