@@ -743,6 +743,9 @@ struct Geo {
 struct Columns {
     px: Vec<f64>,
     py: Vec<f64>,
+    /// The edge from the column's profile vertex to the next (`p[j + 1] − p[j]`, wrapping).
+    ex: Vec<f64>,
+    ey: Vec<f64>,
     w: [Vec<f64>; 6],
     v: Vec<f64>,
 }
@@ -752,6 +755,8 @@ impl Columns {
         let mut c = Columns {
             px: Vec::with_capacity(cols),
             py: Vec::with_capacity(cols),
+            ex: Vec::with_capacity(cols),
+            ey: Vec::with_capacity(cols),
             w: Default::default(),
             v: Vec::with_capacity(cols),
         };
@@ -765,6 +770,8 @@ impl Columns {
         let c = self;
         c.px.clear();
         c.py.clear();
+        c.ex.clear();
+        c.ey.clear();
         c.w.iter_mut().for_each(Vec::clear);
         c.v.clear();
         for j in js {
@@ -777,6 +784,9 @@ impl Columns {
             let (pj, dp) = (p.points[jj], p.points[jn] - p.points[jp]);
             c.px.push(pj.x);
             c.py.push(pj.y);
+            let e = p.points[if jj + 1 == m { 0 } else { jj + 1 }] - pj;
+            c.ex.push(e.x);
+            c.ey.push(e.y);
             let w = [
                 dp.x,
                 dp.y,
@@ -799,6 +809,8 @@ impl Columns {
         Cols {
             px: &self.px[r.clone()],
             py: &self.py[r.clone()],
+            ex: &self.ex[r.clone()],
+            ey: &self.ey[r.clone()],
             w: [
                 &w[0][r.clone()],
                 &w[1][r.clone()],
@@ -817,6 +829,8 @@ impl Columns {
 struct Cols<'a> {
     px: &'a [f64],
     py: &'a [f64],
+    ex: &'a [f64],
+    ey: &'a [f64],
     w: [&'a [f64]; 6],
     v: &'a [f64],
 }
@@ -1465,7 +1479,7 @@ impl Rings<'_> {
                 // split along b d on the odd twisted segments
                 let bd = match given_bd {
                     Some(bd) => bd[i],
-                    None => i % 2 == 1 && self.twisted(&cur, &next, 0..pattern.edges),
+                    None => i % 2 == 1 && self.twisted_ring(&cur, &next, column, pattern.edges),
                 };
                 let i1 = if i + 1 == stored { 0 } else { i + 1 };
                 let faces = &mut bf[di * per_segment..(di + 1) * per_segment];
@@ -1554,6 +1568,32 @@ impl Rings<'_> {
             }
             tau.abs() > 1e-9 * (u.length() * v.length() * w.length())
         })
+    }
+
+    /// [`Rings::twisted`] on edges `0..edges` of whole rings (`column`: all the stored
+    /// columns): the same test on every edge without branches (a loop the compiler turns
+    /// into vector instructions), deciding where every edge is clear of the threshold on
+    /// the squares; where one is not, [`Rings::twisted`] decides (the test is an or over
+    /// the edges, so the same answer).
+    #[inline(always)]
+    fn twisted_ring(&self, cur: &Geo, next: &Geo, column: &Cols, edges: usize) -> bool {
+        let (dx, dma, dmb) = (next.b.0 - cur.b.0, next.ma - cur.ma, next.mb - cur.mb);
+        let n = edges.min(column.px.len());
+        let (px, py) = (&column.px[..n], &column.py[..n]);
+        let (ex, ey) = (&column.ex[..n], &column.ey[..n]);
+        let (mut yes, mut unsure) = (false, false);
+        for j in 0..n {
+            let u = ex[j] * cur.ma + ey[j] * cur.mb;
+            let w = ex[j] * next.ma + ey[j] * next.mb;
+            let v = dx + px[j] * dma + py[j] * dmb;
+            let tau = u.cross(v).dot(w);
+            let (t2, s2) = (tau * tau, 1e-18 * (u.dot(u) * v.dot(v) * w.dot(w)));
+            let clear = (s2 > 1e-290) & s2.is_finite();
+            let (hi, lo) = (t2 > s2 * (1.0 + 1e-12), t2 < s2 * (1.0 - 1e-12));
+            yes |= clear & hi;
+            unsure |= !(clear & (hi | lo));
+        }
+        yes || (unsure && self.twisted(cur, next, 0..edges))
     }
 
     /// Fold-over of the segment from `cur` to `next`: rail edges must advance along both
