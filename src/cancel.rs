@@ -343,6 +343,49 @@ mod tests {
     }
 
     #[test]
+    fn ph_rows_stop_anywhere() {
+        use crate::ph::{self, Cubic};
+        // a spatial PH cubic (from a quaternion preimage), 200,000 times
+        let c = Cubic::from_quaternions([0.3, -1.2, 0.7, 0.4], [-0.5, 0.2, 1.1, -0.9], DVec3::ZERO);
+        let cubics = vec![c; 200_000];
+        let m = cubics.len();
+        let (is_ph, polls) =
+            stop_everywhere(|k| ph::check::is_ph_rows_cancellable(&cubics, 1e-9, k));
+        assert!(polls >= m / crate::alloc::CANCEL_ITEMS, "{polls} polls");
+        assert_eq!(is_ph.expect("valid"), vec![true; m]);
+        let (inv, polls) = stop_everywhere(|k| ph::check::invariant_rows_cancellable(&cubics, k));
+        assert!(polls >= m / crate::alloc::CANCEL_ITEMS, "{polls} polls");
+        assert_eq!(inv.expect("valid").len(), m);
+        let (pre, _) = stop_everywhere(|k| ph::preimage_rows_cancellable(&cubics, 1e-9, true, k));
+        assert_eq!(pre.expect("valid").len(), m);
+    }
+
+    #[test]
+    fn ph_spline_frames_stop_anywhere() {
+        use crate::ph::{Cubic, frame};
+        // two joined PH cubics, frames at 500,000 parameters over both
+        let a = Cubic::from_quaternions([0.3, -1.2, 0.7, 0.4], [-0.5, 0.2, 1.1, -0.9], DVec3::ZERO);
+        let b = Cubic::from_quaternions([-0.5, 0.2, 1.1, -0.9], [0.6, 0.1, -0.8, 0.3], a.b[3]);
+        let cubics = [a, b];
+        let n = 500_000;
+        let s: Vec<f64> = (0..n).map(|i| 2.0 * i as f64 / (n - 1) as f64).collect();
+        for mode in [frame::Mode::Exact, frame::Mode::Rational] {
+            let run = |k: super::Cancel<'_>| {
+                let (mut f, mut om) = (vec![[0.0; 9]; n], vec![0.0; n]);
+                let start = frame::Start::Angle(0.0);
+                frame::frames_at_cancellable(&cubics, &s, start, None, mode, &mut f, &mut om, k)
+                    .expect("valid");
+                (f.concat(), om)
+            };
+            let ((f, om), polls) = stop_everywhere(run);
+            assert!(polls >= n / (1 << 16), "{polls} polls");
+            // the uninterrupted call matches the one without a hook
+            let (want_f, want_om) = run(&super::never);
+            assert!(same_bits(&f, &want_f) && same_bits(&om, &want_om));
+        }
+    }
+
+    #[test]
     fn mesh_measures_stop_anywhere() {
         // 200,000 pseudo-random faces over 5,000 vertices (a linear congruential sequence)
         let mut state = 12345u64;
