@@ -399,10 +399,15 @@ def estimate_tangents(
       these are the 5-point formulas of Wang et al. (2008, §6.1),
       ``x_{i−2} − 8x_{i−1} + 8x_{i+1} − x_{i+2}``; for unequal spacing the direction stays
       O(h⁴) accurate and straight runs give the exact direction. Double reflection with these
-      tangents is 4th order. Where the estimate turns more than 60° away from the
-      ``"circle"`` estimate (at a kink next to very uneven chords the quartic can swing round
-      and point backwards), the circle estimate is used; on smooth samplings the two agree
-      to O(h²), so this never triggers there.
+      tangents is 4th order. At an open end whose first chord is much longer than the next
+      ones the one-sided quartic would extrapolate from a distant cluster and amplify the
+      rounding of the samples ~(H/h)³ times; there the farthest samples are dropped (cubic,
+      quadratic, then the end chord) until the amplification is at most 10³ (equal chords:
+      15), which leaves end chords up to about 7.5× their neighbours at the quartic. Where
+      the estimate turns more than 60° away from the ``"circle"`` estimate (at a kink next
+      to very uneven chords the quartic can swing round and point backwards), the circle
+      estimate is used; on smooth samplings the two agree to O(h²), so this never triggers
+      there.
     * ``"five_point_uniform"``: the paper's stencils with the sample index as parameter:
       O(h⁴) only if the samples come from a uniform step of a smooth parameterisation
       (kept to reproduce the paper; it can point backwards on very uneven spacing).

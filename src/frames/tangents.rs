@@ -10,9 +10,10 @@
 //!   is much longer than the next ones the one-sided quartic extrapolates from a distant
 //!   cluster and amplifies rounding by ~(H/h)³; there the farthest samples are dropped
 //!   (cubic, quadratic, down to the end chord) until the amplification is at most 10³, which
-//!   keeps equal and moderately uneven chords (ratios up to ~7) at 4th order. Guard: where it turns more than
-//!   60° away from the circle estimate below (the quartic overshooting at a kink next to
-//!   very uneven chords), the circle estimate is used instead.
+//!   keeps equal and moderately uneven chords (ratios up to about 7.5) at 4th order.
+//!   Guard: where it turns more than 60° away from the circle estimate below (the quartic
+//!   overshooting at a kink next to very uneven chords), the circle estimate is used
+//!   instead.
 //! * Bounded ends (the default rule, `FivePointBounded`): the five-point chord-length rule
 //!   with each open end tangent kept inside the cone about the end chord `ĉ` whose
 //!   half-angle is the turn `φ` between the end chord and its neighbour (the discrete
@@ -158,7 +159,7 @@ fn chord_five_point(x: &[DVec3], chords: &[f64], i: usize, closed: bool) -> DVec
     }
     // The nodes in use (in index order, `at` among them); the one farthest from τ = 0 is
     // dropped while the stencil amplifies rounding by more than `MAX_AMPLIFICATION` (a
-    // one-sided end whose first chord is ~7× longer than the next ones extrapolates a
+    // one-sided end whose first chord is over 7.5× longer than the next ones extrapolates a
     // quartic from a distant cluster: amplification ~(H/h)³, 3·10⁸ at a ratio of 600).
     // Two nodes give the chord (factor 1).
     let mut nodes = [true; 5];
