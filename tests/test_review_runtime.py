@@ -170,6 +170,15 @@ D16_CASES = {
         ("m = 2_000_000; c = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1.]])\n"
         "C = np.ascontiguousarray(np.broadcast_to(c, (m, 4, 3)))\n"),
         "ph.invariants(C)", "ph.invariants: out of memory"),
+    # the working data fit in the headroom, the NumPy output arrays do not
+    "sweep output": (
+        ("m = 1 << 20; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; X = np.array([[0, 0, 0], [0, 0, 1.]])\n"),
+        "spinal.sweep(X, P, caps=False)", "sweep: out of memory for an output array"),
+    "PHSpline.rmf output": (
+        ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
+         "s = np.linspace(0, 1, 10_000_000)\n"),
+        "sp.rmf(s)", "PHSpline frames: out of memory for an output array"),
 }
 
 

@@ -319,13 +319,25 @@ pub fn cubics_from(
 /// and asks for transparent huge pages for large ones, and nothing is zeroed, so an output
 /// that is written once costs about what NumPy's own write floor costs. Every caller writes
 /// every element before the array reaches Python.
+/// A refused allocation is a `MemoryError` naming `call` and NumPy's reason (the size and
+/// shape).
 pub fn empty<'py, T: Element, D: Dimension>(
     py: Python<'py>,
+    call: &'static str,
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyArray<T, D>>> {
     let np = py.import("numpy")?;
-    let shape = pyo3::types::PyTuple::new(py, shape)?;
-    let a = np.getattr("empty")?.call1((shape, numpy::dtype::<T>(py)))?;
+    let tuple = pyo3::types::PyTuple::new(py, shape)?;
+    let a = match np.getattr("empty")?.call1((tuple, numpy::dtype::<T>(py))) {
+        Ok(a) => a,
+        Err(e) if e.is_instance_of::<PyMemoryError>(py) => {
+            return Err(PyMemoryError::new_err(format!(
+                "{call}: out of memory for an output array: {}",
+                e.value(py)
+            )));
+        }
+        Err(e) => return Err(e),
+    };
     Ok(a.cast_into::<PyArray<T, D>>()?)
 }
 

@@ -83,7 +83,7 @@ fn advect_runs_impl<'py>(
     deform::advect::check_method(field, method)?;
     let x = vec3s("vertices", &points)?;
     deform::finite_rows("vertices", x)?;
-    let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+    let out = empty::<f64, numpy::Ix2>(py, "advect", &[x.len(), 3])?;
     let stop = Stop::default();
     let mut ticker = Ticker::every(progress, every, &stop);
     {

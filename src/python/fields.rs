@@ -86,7 +86,7 @@ impl PyField {
         let x = vec3s("points", &arr)?;
         deform::finite_rows("points", x)?;
         let t = deform::finite("t", t)?;
-        let out = empty::<f64, numpy::Ix2>(py, &[x.len(), 3])?;
+        let out = empty::<f64, numpy::Ix2>(py, "Field", &[x.len(), 3])?;
         {
             let mut w = out.readwrite();
             let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);

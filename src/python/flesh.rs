@@ -74,7 +74,7 @@ pub fn flesh_deform<'py>(
         None => &[],
     };
     let nv = edge.len();
-    let out = empty::<f64, numpy::Ix2>(py, &[nv, 3])?;
+    let out = empty::<f64, numpy::Ix2>(py, "SpineBinding.deform", &[nv, 3])?;
     let mut flags = alloc::filled("flesh", nv, 0u8)?;
     {
         let mut w = out.readwrite();
@@ -172,7 +172,7 @@ pub fn flesh_surface_deform<'py>(
     let cell = slice_of("cell", &cell)?;
     let coords = slice_of("coords", &coords)?;
     let n = cell.len();
-    let out = empty::<f64, numpy::Ix2>(py, &[n, 3])?;
+    let out = empty::<f64, numpy::Ix2>(py, "SurfaceBinding.deform", &[n, 3])?;
     let mut flags = alloc::filled("flesh_surface", n, 0u8)?;
     {
         let mut w = out.readwrite();

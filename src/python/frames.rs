@@ -65,7 +65,7 @@ pub fn frames_sampled<'py>(
     };
     // the output and the working vectors of the frames
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3])?;
     let angles = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
@@ -121,7 +121,7 @@ pub fn frames_analytic<'py>(
     };
     // the output and the working vectors of the frames' scan
     ensure_memory("frames", pts.len(), PROBE_BYTES_PER_ROW)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[pts.len(), 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "frames", &[pts.len(), 3, 3])?;
     let angle = {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
@@ -285,7 +285,7 @@ pub fn frames_steered<'py>(
     };
     // the output, the rotation-minimising frames, the tangents and the twist solve
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[rows, 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
@@ -369,7 +369,7 @@ pub fn frames_in_time<'py>(
     // the output and every step's working vectors (the steps run in parallel, but each holds
     // its rows' share only)
     ensure_memory("frames", total, PROBE_BYTES_PER_ROW)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[total, 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "frames_in_time", &[total, 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;

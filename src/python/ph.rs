@@ -194,8 +194,8 @@ pub fn ph_frames<'py>(
     let s = slice_of("s", &s)?;
     let start = start_of(initial, omega_start)?;
     let n = s.len();
-    let out = empty::<f64, numpy::Ix3>(py, &[n, 3, 3])?;
-    let angles = empty::<f64, numpy::Ix1>(py, &[n])?;
+    let out = empty::<f64, numpy::Ix3>(py, "PHSpline frames", &[n, 3, 3])?;
+    let angles = empty::<f64, numpy::Ix1>(py, "PHSpline frames", &[n])?;
     {
         let mut rw = out.readwrite();
         let frames: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);

@@ -50,7 +50,7 @@ pub fn quat_to_frames<'py>(
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let qs = quats("quaternions", &q)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[qs.len(), 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "quaternions.from_quaternions", &[qs.len(), 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
@@ -102,7 +102,7 @@ pub fn quat_slerp_frames<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let fr = frames_of("frames", &frames)?;
     let (ku, nu) = (slice_of("key_u", &key_u)?, slice_of("new_u", &new_u)?);
-    let out = empty::<f64, numpy::Ix3>(py, &[nu.len(), 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "quaternions.slerp_frames", &[nu.len(), 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
@@ -213,7 +213,7 @@ pub fn camera_level<'py>(
     let t = vec3s("tangents", &tangents)?;
     let u = vec3_of("up", &up, "expected 3 values")?;
     let g = slice_of("regular", &regular)?;
-    let out = empty::<f64, numpy::Ix3>(py, &[t.len(), 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "quaternions.camera_frames", &[t.len(), 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
@@ -235,7 +235,7 @@ pub fn camera_orient<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let fr = frames_of("frames", &frames)?;
     let b = bank.as_ref().map(|b| slice_of("bank", b)).transpose()?;
-    let out = empty::<f64, numpy::Ix3>(py, &[fr.len(), 3, 3])?;
+    let out = empty::<f64, numpy::Ix3>(py, "quaternions.camera_frames", &[fr.len(), 3, 3])?;
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);

@@ -130,14 +130,14 @@ impl Job<'_> {
         I: sweep::Index + numpy::Element + bytemuck::Pod,
     {
         let (nv, nf) = (self.prep.layout.vertices, self.prep.layout.faces);
-        let v = empty::<R, numpy::Ix2>(py, &[nv, 3])?;
-        let f = empty::<I, numpy::Ix2>(py, &[nf, 3])?;
+        let v = empty::<R, numpy::Ix2>(py, "sweep", &[nv, 3])?;
+        let f = empty::<I, numpy::Ix2>(py, "sweep", &[nf, 3])?;
         let n = match self.normals {
-            true => Some(empty::<R, numpy::Ix2>(py, &[nv, 3])?),
+            true => Some(empty::<R, numpy::Ix2>(py, "sweep", &[nv, 3])?),
             false => None,
         };
         let uv = match self.uv {
-            true => Some(empty::<R, numpy::Ix2>(py, &[nv, 2])?),
+            true => Some(empty::<R, numpy::Ix2>(py, "sweep", &[nv, 2])?),
             false => None,
         };
         let folds = {
