@@ -496,6 +496,35 @@ def test_D17_ctrl_c_within_half_a_second_inside_one_call(name):
     assert same
 
 
+# calls that pass a second only on inputs of gigabytes: each is run at a size that takes
+# about half a second and signalled a sixth of the way in; a call that did not poll would
+# finish the remaining five sixths before raising
+D17_FRACTION_CASES = {
+    "ph.is_ph": (
+        ("c = ph.from_quaternions([[.3, -1.2, .7, .4]], [[-.5, .2, 1.1, -.9]])[0]\n"
+         "C = np.ascontiguousarray(np.broadcast_to(c, (8_000_000, 4, 3)))\n"),
+        "ph.is_ph(C)"),
+    "PHSpline.rmf": (
+        ("sp = ph.fit(spinal.curves.Helix(), segments=8); s = np.linspace(0, 1, 16_000_000)\n"),
+        "sp.rmf(s)"),
+}
+
+
+@pytest.mark.parametrize("name", list(D17_FRACTION_CASES))
+def test_D17_ctrl_c_within_a_fraction_of_a_short_call(name):
+    setup, call = D17_FRACTION_CASES[name]
+    code = SIGINT_ONCE_CHILD.format(setup=textwrap.dedent(setup), call=call,
+                                    after="full / 6", least=0.3)
+    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
+                       text=True, timeout=600)
+    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
+    w = r.stdout.split()
+    late, full, busy = float(w[1]), float(w[6]), float(w[9])
+    assert late < 0.2 * full, r.stdout
+    assert busy < 0.05  # no worker thread still running
+    assert w[-1] == "True", r.stdout
+
+
 def test_D17_cold_sweep_stops_promptly():
     """The first sweep of a fresh process writes into output pages never touched before
     (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000
