@@ -290,6 +290,32 @@ mod tests {
         }
     }
 
+    /// The checks of a large convex profile (its copy, scaling, convexity and arc lengths)
+    /// poll within their passes, not only between them, and give the plain checks' bits.
+    #[test]
+    fn convex_profile_checks_stop_anywhere() {
+        use crate::sweep::Profile;
+        use glam::DVec2;
+        let m = 200_000;
+        let profile: Vec<DVec2> = (0..m)
+            .map(|j| DVec2::from_angle(std::f64::consts::TAU * j as f64 / m as f64) * 3.0)
+            .collect();
+        let run = |c: super::Cancel<'_>| match Profile::new_cancellable(&profile, true, c) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                assert_eq!(e.to_string(), super::stopped().to_string());
+                None
+            }
+        };
+        let (got, polls) = stop_everywhere(run);
+        let got = got.expect("not stopped");
+        let plain = Profile::new(&profile, true).expect("valid");
+        // the convexity test and the arc lengths, each polling every block of vertices
+        assert!(polls >= 2 * m / super::BLOCK, "{polls} polls");
+        assert!(got.convex && plain.convex && got.area.to_bits() == plain.area.to_bits());
+        assert!(same_bits(&got.v, &plain.v));
+    }
+
     #[test]
     fn non_convex_profile_sweep_stops_anywhere() {
         use crate::sweep::{FrameSource, MeshMut, Options, Prepared, Spine};

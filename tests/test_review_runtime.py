@@ -507,6 +507,12 @@ D17_FRACTION_CASES = {
     "PHSpline.rmf": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8); s = np.linspace(0, 1, 16_000_000)\n"),
         "sp.rmf(s)"),
+    # the first ~0.4 s of this sweep check its convex profile of 2**23 vertices (copy,
+    # scaling, convexity, arc lengths): signalled there, not only while the rings are written
+    "sweep (profile checks)": (
+        ("m = 2**23; a = np.linspace(0, 2 * np.pi, m, endpoint=False)\n"
+         "P = np.c_[np.cos(a), np.sin(a)]; X = np.array([[0, 0, 0], [0, .1, 1.]])\n"),
+        "spinal.sweep(X, P, caps=False, normals=False, uv=False, dtype='float32')"),
 }
 
 

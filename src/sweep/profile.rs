@@ -403,10 +403,20 @@ impl Profile {
     /// profile (O(m log m)); fails with [`cancel::stopped`] when it says stop.
     pub fn new_cancellable(points: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Profile> {
         const ARG: &str = "profile";
-        if let Some(j) = points.iter().position(|p| !p.is_finite()) {
+        // each pass over the vertices is followed by a poll, the slow ones (the convexity
+        // test's arc tangents, the arc lengths) poll every [`BLOCK`] vertices as well
+        let poll = || match cancel() {
+            true => Err(cancel::stopped()),
+            false => Ok(()),
+        };
+        if let Some(j) =
+            crate::frames::validate::first_bad_cancellable(points, |p| p.is_finite(), cancel)
+        {
             return Err(InputError::new(ARG, format!("non-finite value at row {j}")));
         }
+        poll()?;
         let mut p = alloc::copied(CALL, points)?;
+        poll()?;
         let scale = p.iter().fold(0.0_f64, |a, q| a.max(q.abs().max_element()));
         let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
         if closed && p.len() >= 2 && same(p[0], p[p.len() - 1]) {
@@ -434,7 +444,9 @@ impl Profile {
         // divided by the power of two of its largest coordinate (exact), so that any finite
         // size works
         let k = unit_exponent(scale);
+        poll()?;
         let q: Vec<DVec2> = alloc::collect(CALL, p.iter().map(|&v| scaled(v, k)))?;
+        poll()?;
         let (p_all, p) = (p, q);
         let scale = crate::math::scale::ldexp(scale, k);
         let same = |a: DVec2, b: DVec2| (a - b).abs().max_element() <= 8.0 * f64::EPSILON * scale;
@@ -447,7 +459,8 @@ impl Profile {
                 ),
             ));
         }
-        let convex = closed && strictly_convex(&p);
+        poll()?;
+        let convex = closed && strictly_convex(&p, cancel)?;
         // a closed polygon on one line folds back on itself: its zero area is the clearer
         // message
         let on_a_line = || {
@@ -470,6 +483,7 @@ impl Profile {
                 ));
             }
         }
+        poll()?;
         let area = if closed { signed_area(&p) } else { 0.0 };
         if closed && !(area.abs() > 1e-12 * scale * scale) {
             return Err(InputError::new(
@@ -483,6 +497,9 @@ impl Profile {
         let mut v = alloc::with_capacity(CALL, m)?;
         let mut acc = 0.0;
         for j in 0..m {
+            if j % BLOCK == 0 {
+                poll()?;
+            }
             v.push(acc);
             if j + 1 < m || closed {
                 acc += crate::math::scale::length((p[(j + 1) % m] - p[j]).extend(0.0));
@@ -561,21 +578,24 @@ fn scaled(v: DVec2, k: i32) -> DVec2 {
 
 /// Is the closed polygon strictly convex: every turn of the same sign and the total turning
 /// ±2π (a convex polygon wound once is simple)?
-fn strictly_convex(p: &[DVec2]) -> bool {
+fn strictly_convex(p: &[DVec2], cancel: Cancel<'_>) -> Result<bool> {
     let m = p.len();
     let (mut pos, mut neg, mut turning) = (false, false, 0.0);
     for j in 0..m {
+        if j % BLOCK == 0 && cancel() {
+            return Err(cancel::stopped());
+        }
         let e1 = p[(j + 1) % m] - p[j];
         let e2 = p[(j + 2) % m] - p[(j + 1) % m];
         let c = cross(e1, e2);
         pos |= c > 0.0;
         neg |= c < 0.0;
         if !(c != 0.0) || (pos && neg) {
-            return false;
+            return Ok(false);
         }
         turning += c.atan2(e1.dot(e2));
     }
-    (turning.abs() - std::f64::consts::TAU).abs() < 1.0
+    Ok((turning.abs() - std::f64::consts::TAU).abs() < 1.0)
 }
 
 /// Square cells of side `side` (the median edge length, but at least a quarter of the mean, so
