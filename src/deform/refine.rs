@@ -582,14 +582,16 @@ impl Refiner<'_> {
     }
 
     /// Every undirected edge over the threshold, once (the half-edge with the smaller index).
-    fn over_edges(&self, w: &[DVec3]) -> Vec<usize> {
-        (0..self.topo.twin.len())
-            .into_par_iter()
-            .filter(|&h| {
-                let t = self.topo.twin[h];
-                (t == NONE || h < t) && self.over(w, h)
-            })
-            .collect()
+    /// Marked in parallel, then gathered into a buffer asked for fallibly.
+    fn over_edges(&self, w: &[DVec3]) -> Result<Vec<usize>> {
+        let mut mark = alloc::filled(CALL, self.topo.twin.len(), false)?;
+        mark.par_iter_mut().enumerate().for_each(|(h, m)| {
+            let t = self.topo.twin[h];
+            *m = (t == NONE || h < t) && self.over(w, h);
+        });
+        let mut over = alloc::with_capacity(CALL, mark.iter().filter(|&&m| m).count())?;
+        over.extend(mark.iter().enumerate().filter_map(|(h, &m)| m.then_some(h)));
+        Ok(over)
     }
 
     /// Whether the two triangles of `h` share their third vertex too (the two faces of a
@@ -632,7 +634,7 @@ impl Refiner<'_> {
     /// Refinement passes after step `done` (1-based count of the steps taken), at time `t`.
     fn refine(&mut self, w: &mut Vec<DVec3>, done: usize, t: f64) -> Result<()> {
         for _ in 0..self.opts.max_passes {
-            let over = self.over_edges(w);
+            let over = self.over_edges(w)?;
             if over.is_empty() {
                 return Ok(());
             }
@@ -642,17 +644,18 @@ impl Refiner<'_> {
                 return Ok(());
             }
             // terminal edges: the longest of both their triangles, longest first
-            let mut pick: Vec<(f64, usize)> = over
-                .into_iter()
-                .filter(|&h| {
-                    let t = self.topo.twin[h];
-                    self.longest_in_face(w, h) && (t == NONE || self.longest_in_face(w, t))
-                })
-                .map(|h| (len2(&self.topo, w, h), h))
-                .collect();
+            let mut pick: Vec<(f64, usize)> = alloc::with_capacity(CALL, over.len())?;
+            pick.extend(
+                over.into_iter()
+                    .filter(|&h| {
+                        let t = self.topo.twin[h];
+                        self.longest_in_face(w, h) && (t == NONE || self.longest_in_face(w, t))
+                    })
+                    .map(|h| (len2(&self.topo, w, h), h)),
+            );
             pick.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
             let mut used = alloc::filled(CALL, self.topo.faces.len(), false)?;
-            let mut chosen = Vec::new();
+            let mut chosen = alloc::with_capacity(CALL, room.min(pick.len()))?;
             for &(_, h) in &pick {
                 if chosen.len() == room {
                     self.bounded = true;
@@ -675,7 +678,7 @@ impl Refiner<'_> {
             self.place_and_split(w, &chosen, done, t);
             self.passes += 1;
         }
-        if !self.over_edges(w).is_empty() {
+        if !self.over_edges(w)?.is_empty() {
             self.bounded = true;
         }
         Ok(())
@@ -738,21 +741,25 @@ impl Refiner<'_> {
 
     /// Flips (see [`Refiner::flippable`]) over the edges of the faces split since the last
     /// call, then over the edges of the flipped faces, for at most [`FLIP_ROUNDS`] rounds.
-    fn flip_touched(&mut self, w: &[DVec3]) {
-        let mut queue: Vec<usize> = self
-            .touched
-            .drain(..)
-            .flat_map(|f| 3 * f..3 * f + 3)
-            .collect();
+    fn flip_touched(&mut self, w: &[DVec3]) -> Result<()> {
+        let mut queue = alloc::with_capacity(CALL, self.touched.len().saturating_mul(3))?;
+        queue.extend(self.touched.drain(..).flat_map(|f| 3 * f..3 * f + 3));
         for _ in 0..FLIP_ROUNDS {
             if queue.is_empty() {
                 break;
             }
             queue.sort_unstable();
             queue.dedup();
-            let mut next = Vec::new();
+            let mut next: Vec<usize> = Vec::new();
             for &h in &queue {
                 if self.flippable(w, h) {
+                    next.try_reserve(6).map_err(|_| {
+                        InputError::out_of_memory(
+                            CALL,
+                            next.len().saturating_add(6),
+                            size_of::<usize>(),
+                        )
+                    })?;
                     let (f, g) = (h / 3, self.topo.twin[h] / 3);
                     let [a, b, c] = [0, 1, 2].map(|i| w[self.topo.faces[f][(h % 3 + i) % 3]]);
                     let d = w[self.topo.faces[g][(self.topo.twin[h] % 3 + 2) % 3]];
@@ -765,6 +772,7 @@ impl Refiner<'_> {
             }
             queue = next;
         }
+        Ok(())
     }
 
     /// Whether splitting half-edge `h` at position `p` (rest point `x`) would repeat an
@@ -1002,7 +1010,7 @@ pub fn deform(
             if refinement.is_some() {
                 let clock = Instant::now();
                 r.refine(&mut w, done, run.t0 + run.h * (j + 1) as f64)?;
-                r.flip_touched(&w);
+                r.flip_touched(&w)?;
                 out.time_refine += clock.elapsed().as_secs_f64();
             }
             out.step_vertices.push(w.len());
@@ -1014,17 +1022,17 @@ pub fn deform(
     if refinement.is_some() {
         let clock = Instant::now();
         // the strip goes on shearing after a step's flips: a last round over all of it
-        r.touched = (0..r.topo.faces.len())
-            .filter(|&f| {
-                r.topo.faces[f]
-                    .iter()
-                    .any(|&v| matches!(r.carry[v], Carry::Surface(_)))
-            })
-            .collect();
-        r.flip_touched(&w);
+        let mut touched = alloc::with_capacity(CALL, r.topo.faces.len())?;
+        touched.extend((0..r.topo.faces.len()).filter(|&f| {
+            r.topo.faces[f]
+                .iter()
+                .any(|&v| matches!(r.carry[v], Carry::Surface(_)))
+        }));
+        r.touched = touched;
+        r.flip_touched(&w)?;
         // the slivers and folds flips cannot mend: collapses and moves, each keeping the
         // volume, on a converged mesh (a refinement a bound stopped keeps every vertex it got)
-        if r.over_edges(&w).is_empty() {
+        if r.over_edges(&w)?.is_empty() {
             let end = runs.last().map_or(r.start, |l| l.t0 + l.h * l.count as f64);
             r.collapse_slivers(&mut w, end)?;
             if let Some(last) = out.step_vertices.last_mut() {
@@ -1034,7 +1042,7 @@ pub fn deform(
         out.time_refine += clock.elapsed().as_secs_f64();
     }
     if refinement.is_some() {
-        out.over_threshold = r.over_edges(&w).len();
+        out.over_threshold = r.over_edges(&w)?.len();
     }
     // not converged whenever edges remain over the threshold: a bound stopped the refinement
     // (every edge, torn ones too, is shortened by its split; see the module docs)
@@ -1479,9 +1487,9 @@ mod tests {
                 slip::step(&tool, &mut w, &r.carry, run, j);
                 done += 1;
                 let t = run.t0 + run.h * (j + 1) as f64;
-                let before = r.over_edges(&w).len();
+                let before = r.over_edges(&w).unwrap().len();
                 r.refine(&mut w, done, t).unwrap();
-                let over = r.over_edges(&w);
+                let over = r.over_edges(&w).unwrap();
                 println!(
                     "step {done}: {} vertices, over before {before}, after {}, torn {}, \
                      fallback {}, slip {}",

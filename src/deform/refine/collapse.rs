@@ -649,11 +649,14 @@ impl Refiner<'_> {
             if self.collapses == before && self.moves == moved {
                 break;
             }
-            self.touched = (0..self.topo.faces.len())
-                .filter(|&q| self.topo.faces[q].iter().any(|&v| changed[v]))
-                .collect();
+            let mut touched = alloc::with_capacity(CALL, self.topo.faces.len())?;
+            touched.extend(
+                (0..self.topo.faces.len())
+                    .filter(|&q| self.topo.faces[q].iter().any(|&v| changed[v])),
+            );
+            self.touched = touched;
             changed.fill(false);
-            self.flip_touched(w);
+            self.flip_touched(w)?;
         }
         // drop the vanished vertices, keeping the order of the others
         if gone.iter().any(|&g| g) {
