@@ -435,6 +435,47 @@ def test_walk_long_moves_on_a_closed_mesh():
         Q.walk_mesh(torus.vertices, torus.faces, 5, p, [[1e300, 0.0]])
 
 
+def _split_edge_near_a_corner(v, f, eps):
+    """The mesh with the edge of face 0 from corner 0 to corner 1 split at ``eps`` of its
+    length from corner 0, in both faces that share it: the same surface, one edge tiny."""
+    a, b = f[0, 0], f[0, 1]
+    v = np.vstack([v, v[a] + eps * (v[b] - v[a])])
+    n = len(v) - 1
+    out = []
+    for tri in f.tolist():
+        for k in range(3):
+            x, y, z = tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]
+            if {x, y} == {a, b}:
+                out += [[x, n, z], [n, y, z]]
+                break
+        else:
+            out.append(tri)
+    return v, np.array(out)
+
+
+@pytest.mark.parametrize("eps", [1e-3, 1e-6, 1e-9])
+def test_walk_on_a_mesh_with_one_tiny_edge_is_the_walk_on_the_mesh_without_it(eps):
+    """Splitting an edge leaves the surface as it was, so the walk must end where it ends on
+    the unsplit mesh; a near-degenerate edge (as scanned meshes have) must not make ordinary
+    moves look too long (a shortest-edge estimate refused a 0.5 move on the unit sphere)."""
+    import trimesh
+
+    s = trimesh.creation.icosphere(3)
+    v, f = _split_edge_near_a_corner(s.vertices, s.faces, eps)
+    t = trimesh.Trimesh(v, f, process=False)
+    assert t.is_watertight and t.edges_unique_length.min() < 2 * eps
+    start = s.vertices[s.faces[0]].mean(axis=0)
+    moves = [[0.5, 0.0], [3.0, 1.0], [40.0, -7.0]]
+    ref = Q.walk_mesh(s.vertices, s.faces, 0, start, moves)
+    # face 0 of the split mesh is the old face 1; the start lies in the old face 0's part
+    # on the side of corner 2 (its half [n, b, c] when split near corner 0)
+    f0 = next(i for i, tri in enumerate(f) if set(tri) == {len(v) - 1, s.faces[0, 1], s.faces[0, 2]})
+    res = Q.walk_mesh(v, f, f0, start, moves, direction=s.vertices[s.faces[0, 1]] - s.vertices[s.faces[0, 0]])
+    assert np.abs(res.points - ref.points).max() < 1e-8
+    assert np.abs(res.frames - ref.frames).max() < 1e-8
+    assert len(res.path) >= len(ref.path)
+
+
 def test_many_walkers_equal_one_walker_at_a_time():
     """walk_mesh_many is walk_mesh per walker (same states bit for bit), with shared or
     per-walker moves and directions; bad input names the walker or the argument."""

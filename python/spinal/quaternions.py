@@ -410,7 +410,10 @@ def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkRes
     looking straight down at the surface.
 
     Raises ValueError for out-of-range or degenerate faces, non-manifold edges (more than two
-    faces), a start point off the face, non-finite values.
+    faces), a start point off the face, non-finite values, and a move that would cross more
+    than about 10⁸ edges (its length over the median edge length of the mesh); MemoryError,
+    before the walk starts, when the crossing path of all the moves (about 72 bytes per
+    crossing) cannot be allocated.
     """
     v = as_points(vertices, "vertices")
     fa = _faces(faces)

@@ -12,6 +12,13 @@
 //!
 //! A walk stops at a boundary edge. A path that hits a vertex exactly is nudged along the
 //! edge by a round-off amount (Ma assumes it never happens).
+//!
+//! Sizes: a straight path of length `L` crosses about `L / ℓ` edges, `ℓ` the median edge
+//! length of the mesh (an estimate, not a bound: it sizes the memory check and refuses
+//! absurd moves). The shortest edge plays no part, so one near-degenerate edge of a
+//! scanned mesh does not turn ordinary moves into refusals. The loop over the crossings
+//! of one move is capped (`64 + 16·F + 64·L/ℓ` crossings, `F` faces), a guard against a
+//! malformed mesh, never reached by a straight path on a valid one.
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
@@ -20,7 +27,8 @@ use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh;
 
-/// Most edge crossings (about) of one move; a longer move is refused by name.
+/// Most edge crossings (estimated, see the module docs) of one move; a longer move is
+/// refused by name.
 const MAX_CROSSINGS: f64 = 1e8;
 
 /// Edge crossings between polls of a cancellable move ([`Walker::step_cancellable`]).
@@ -34,8 +42,8 @@ pub struct Walker<'a> {
     /// face and its local index of the shared edge.
     adj: Vec<[Option<(usize, usize)>; 3]>,
     scale: f64,
-    /// Shortest edge (bounds the number of crossings of a move).
-    min_edge: f64,
+    /// Median edge length (sizes the crossings of a move; see the module docs).
+    typical_edge: f64,
 }
 
 /// The state of a walker after a move.
@@ -88,12 +96,6 @@ impl<'a> Walker<'a> {
         );
         let diag = (hi - lo).length();
         let scale = if diag > 0.0 { diag } else { 1.0 };
-        let mut min_edge = f64::INFINITY;
-        for c in &f {
-            for k in 0..3 {
-                min_edge = min_edge.min((vertices[c[(k + 1) % 3]] - vertices[c[k]]).length());
-            }
-        }
         for (i, c) in f.iter().enumerate() {
             let area2 = (vertices[c[1]] - vertices[c[0]])
                 .cross(vertices[c[2]] - vertices[c[0]])
@@ -105,6 +107,15 @@ impl<'a> Walker<'a> {
                 ));
             }
         }
+        // every face has positive area here, so every edge a positive length
+        let mut lengths = alloc::flat(
+            "walk_mesh",
+            f.iter()
+                .map(|c| [0, 1, 2].map(|k| vertices[c[(k + 1) % 3]].distance(vertices[c[k]]))),
+        )?;
+        let mid = lengths.len() / 2;
+        let typical_edge = *lengths.select_nth_unstable_by(mid, f64::total_cmp).1;
+        drop(lengths);
         let (edges, slot) = mesh::edges("walk_mesh", &f)?;
         let count = mesh::edge_counts("walk_mesh", &slot, edges.len())?;
         if let Some(e) = count.iter().position(|&c| c > 2) {
@@ -136,7 +147,7 @@ impl<'a> Walker<'a> {
             f,
             adj,
             scale,
-            min_edge,
+            typical_edge,
         })
     }
 
@@ -212,9 +223,9 @@ impl<'a> Walker<'a> {
         self.step_cancellable(s, mv, path, &cancel::never)
     }
 
-    /// The edges a move of length `length` crosses, about (`length / shortest edge`).
+    /// The edges a move of length `length` crosses, about (`length / median edge`).
     fn crossings_of(&self, length: f64) -> f64 {
-        length / self.min_edge
+        length / self.typical_edge
     }
 
     /// [`Walker::step`] that polls `cancel` every [`CANCEL_CROSSINGS`] edge crossings; once
@@ -242,19 +253,20 @@ impl<'a> Walker<'a> {
         let m = mv / left;
         let mut u = (m.x * st.frame.x_axis + m.y * st.frame.y_axis).normalize();
         let mut entered: Option<usize> = None;
-        // A straight path crosses at most about length/(shortest edge) edges per face it
-        // visits; the cap guards against a malformed mesh looping forever.
+        // about length / (median edge) crossings; the cap (see the module docs) guards
+        // against a malformed mesh looping forever
         let per_edge = self.crossings_of(left);
         if !(per_edge < MAX_CROSSINGS) {
             return Err(InputError::new(
                 "moves",
                 format!(
                     "a move of length {left:.3e} would cross about {per_edge:.1e} edges of \
-                     this mesh; split it into shorter moves"
+                     this mesh (median edge {:.3e}); split it into shorter moves",
+                    self.typical_edge
                 ),
             ));
         }
-        let cap = 64 + 16 * self.f.len() + 4 * per_edge.ceil() as usize;
+        let cap = (64 + 16 * self.f.len()).saturating_add(64 * per_edge.ceil() as usize);
         for crossed in 0..cap {
             if crossed % CANCEL_CROSSINGS == CANCEL_CROSSINGS - 1 && cancel() {
                 return Ok(st);
@@ -364,9 +376,10 @@ pub fn walk_path(
 /// it (point, face, move).
 const PATH_BYTES: usize = size_of::<PathPoint>() + 5 * 8;
 
-/// The memory the crossing path of `moves` needs (about `Σ |move| / shortest edge`
-/// crossings, see [`Walker::step`]), checked before the walk: a refusal is a
-/// `MemoryError` naming `moves`, and the walk does not start.
+/// The memory the crossing path of `moves` needs (about `Σ |move| / median edge`
+/// crossings, see the module docs), checked before the walk: a refusal is a
+/// `MemoryError` naming `moves`, and the walk does not start. The path also grows
+/// fallibly, so an estimate that falls short still ends in the same error.
 fn check_path_memory(w: &Walker, moves: &[DVec2]) -> Result<()> {
     // a non-finite or overlong move is refused by name when the walk reaches it
     if moves
@@ -383,9 +396,9 @@ fn check_path_memory(w: &Walker, moves: &[DVec2]) -> Result<()> {
             "walk_mesh",
             format!(
                 "moves: a walk of total length {length:.3e} crosses about {crossings:.2e} \
-                 edges of this mesh (shortest edge {:.3e}), {:.3} GB of path; split it into \
+                 edges of this mesh (median edge {:.3e}), {:.3} GB of path; split it into \
                  calls of fewer or shorter moves",
-                w.min_edge,
+                w.typical_edge,
                 bytes / 1e9
             ),
         )
