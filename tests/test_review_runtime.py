@@ -15,6 +15,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -441,18 +442,26 @@ print(f'interrupted {{late:.3f}} s after the signal; {{full:.2f}} s uninterrupte
 """
 
 
-def interrupt_once(setup: str, call: str, after: float = 0.3, least: float = 1.5):
+class Interrupted(NamedTuple):
+    late: float  # seconds from the signal to the KeyboardInterrupt
+    full: float  # seconds of the uninterrupted call
+    busy: float  # CPU seconds used in 0.3 s of sleep after the interrupt
+    same: bool  # whether the run after the interrupt gave the first run's bits
+    report: str  # the child's line, for assertion messages
+
+
+def interrupt_once(setup: str, call: str, after: float | str = 0.3,
+                   least: float = 1.5) -> Interrupted:
     """Run `call` once uninterrupted (it must take at least `least` seconds, so the case
-    cannot pass by returning before the signal), once with SIGINT `after` seconds in, then
-    again: returns (seconds from the signal to the KeyboardInterrupt, CPU seconds used in
-    0.3 s of sleep after it, whether the last run gave the first run's bits)."""
+    cannot pass by returning before the signal), once with SIGINT `after` seconds in (a
+    number, or an expression of the uninterrupted time `full`), then again."""
     code = SIGINT_ONCE_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after,
                                     least=least)
     r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
                        text=True, timeout=600)
     assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
     w = r.stdout.split()
-    return float(w[1]), float(w[9]), w[-1] == "True"
+    return Interrupted(float(w[1]), float(w[6]), float(w[9]), w[-1] == "True", r.stdout)
 
 
 # the calls stopped inside one run (each takes 1.5 s or more uninterrupted)
@@ -490,10 +499,10 @@ D17_ONCE_CASES = {
 
 @pytest.mark.parametrize("name", list(D17_ONCE_CASES))
 def test_D17_ctrl_c_within_half_a_second_inside_one_call(name):
-    late, busy, same = interrupt_once(*D17_ONCE_CASES[name])
-    assert late < 0.5
-    assert busy < 0.05  # no worker thread still running
-    assert same
+    r = interrupt_once(*D17_ONCE_CASES[name])
+    assert r.late < 0.5, r.report
+    assert r.busy < 0.05, r.report  # no worker thread still running
+    assert r.same, r.report
 
 
 # calls that pass a second only on inputs of gigabytes: each is run at a size that takes
@@ -518,17 +527,10 @@ D17_FRACTION_CASES = {
 
 @pytest.mark.parametrize("name", list(D17_FRACTION_CASES))
 def test_D17_ctrl_c_within_a_fraction_of_a_short_call(name):
-    setup, call = D17_FRACTION_CASES[name]
-    code = SIGINT_ONCE_CHILD.format(setup=textwrap.dedent(setup), call=call,
-                                    after="full / 6", least=0.3)
-    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
-                       text=True, timeout=600)
-    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
-    w = r.stdout.split()
-    late, full, busy = float(w[1]), float(w[6]), float(w[9])
-    assert late < 0.2 * full, r.stdout
-    assert busy < 0.05  # no worker thread still running
-    assert w[-1] == "True", r.stdout
+    r = interrupt_once(*D17_FRACTION_CASES[name], after="full / 6", least=0.3)
+    assert r.late < 0.2 * r.full, r.report
+    assert r.busy < 0.05, r.report  # no worker thread still running
+    assert r.same, r.report
 
 
 def test_D17_cold_sweep_stops_promptly():
