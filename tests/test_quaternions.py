@@ -476,6 +476,20 @@ def test_walk_on_a_mesh_with_one_tiny_edge_is_the_walk_on_the_mesh_without_it(ep
     assert len(res.path) >= len(ref.path)
 
 
+def test_walk_moves_too_long_for_the_mesh_are_refused_by_name():
+    """A move that would cross about 10⁹ edges (its length over the median edge) is refused
+    before it is walked, by walk_mesh and, naming the walker, by walk_mesh_many."""
+    import trimesh
+
+    b = trimesh.creation.box()
+    p = b.vertices[b.faces[0]].mean(axis=0)
+    with pytest.raises(ValueError, match=r"^moves: a move of length 1\.000e9 would cross about"):
+        Q.walk_mesh(b.vertices, b.faces, 0, p, [[1e9, 0.1]])
+    with pytest.raises(ValueError, match=r"^moves: walker 1: a move of length 1\.000e9"):
+        Q.walk_mesh_many(b.vertices, b.faces, np.zeros(2, int), np.repeat(p[None], 2, 0),
+                         [[[0.1, 0.0], [0.2, 0.0]], [[0.1, 0.0], [1e9, 0.1]]])
+
+
 def test_many_walkers_equal_one_walker_at_a_time():
     """walk_mesh_many is walk_mesh per walker (same states bit for bit), with shared or
     per-walker moves and directions; bad input names the walker or the argument."""

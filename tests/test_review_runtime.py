@@ -516,6 +516,10 @@ D17_FRACTION_CASES = {
     "PHSpline.rmf": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8); s = np.linspace(0, 1, 16_000_000)\n"),
         "sp.rmf(s)"),
+    "slerp": (
+        ("q = np.tile([.1, .2, .3, .9], (8_000_000, 1)); q /= np.linalg.norm(q[0])\n"
+         "q1 = q[::-1].copy(); u = np.linspace(0, 1, len(q))\n"),
+        "Q.slerp(q, q1, u)"),
     # the first ~0.4 s of this sweep check its convex profile of 2**23 vertices (copy,
     # scaling, convexity, arc lengths): signalled there, not only while the rings are written
     "sweep (profile checks)": (

@@ -88,7 +88,10 @@ pub fn quat_slerp<'py>(
         ));
     }
     let mut out = alloc::filled("slerp", a.len(), DQuat::IDENTITY)?;
-    detach_in_pool(py, || quaternion::slerp_many(a, b, us, &mut out))??;
+    let stop = Stop::default();
+    detach_stoppable(py, &stop, || {
+        quaternion::slerp_many_cancellable(a, b, us, &mut out, &|| stop.requested())
+    })??;
     quat_array(py, out)
 }
 

@@ -31,6 +31,7 @@ use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
 
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::tangents::{self as tangent_estimate, TangentRule};
 use crate::frames::{self, Method, Orientation, Request, validate};
@@ -203,8 +204,20 @@ pub fn slerp(a: DQuat, b: DQuat, u: f64) -> DQuat {
 
 /// Slerp row by row (all three slices have the same length).
 pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Result<()> {
+    slerp_many_cancellable(a, b, u, out, &cancel::never)
+}
+
+/// [`slerp_many`] that polls `cancel` in its checks and between blocks of rows (an
+/// incomplete result once it says stop; see [`crate::cancel`]).
+pub fn slerp_many_cancellable(
+    a: &[DQuat],
+    b: &[DQuat],
+    u: &[f64],
+    out: &mut [DQuat],
+    cancel: Cancel<'_>,
+) -> Result<()> {
     for (arg, v) in [("q0", a), ("q1", b)] {
-        if let Some(i) = validate::first_bad(v, normalisable) {
+        if let Some(i) = validate::first_bad_cancellable(v, normalisable, cancel) {
             return Err(InputError::new(
                 arg,
                 format!("row {i} is zero or not finite"),
@@ -212,10 +225,15 @@ pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Res
         }
     }
     validate::finite_scalars("u", u)?;
-    out.par_iter_mut()
-        .enumerate()
-        .with_min_len(GRAIN)
-        .for_each(|(i, o)| *o = slerp(unit_checked(a[i]), unit_checked(b[i]), u[i]));
+    out.par_chunks_mut(GRAIN).enumerate().for_each(|(c, o)| {
+        if cancel() {
+            return;
+        }
+        for (k, o) in o.iter_mut().enumerate() {
+            let i = c * GRAIN + k;
+            *o = slerp(unit_checked(a[i]), unit_checked(b[i]), u[i]);
+        }
+    });
     Ok(())
 }
 
