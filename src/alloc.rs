@@ -94,13 +94,18 @@ pub fn par_collect<T: Send>(
     Ok(v)
 }
 
+/// Room for `extra` more elements in a growing vector (amortised doubling, as
+/// `Vec::reserve`), failing instead of aborting when it cannot be had.
+pub fn reserve<T>(what: &'static str, v: &mut Vec<T>, extra: usize) -> Result<()> {
+    v.try_reserve(extra)
+        .map_err(|_| InputError::out_of_memory(what, v.len().saturating_add(extra), size_of::<T>()))
+}
+
 /// Push onto a growing vector (amortised doubling, as `Vec::push`), failing instead of
 /// aborting when the next block cannot be had.
 pub fn push<T>(what: &'static str, v: &mut Vec<T>, x: T) -> Result<()> {
     if v.len() == v.capacity() {
-        v.try_reserve(1).map_err(|_| {
-            InputError::out_of_memory(what, v.len().saturating_mul(2), size_of::<T>())
-        })?;
+        reserve(what, v, 1)?;
     }
     v.push(x);
     Ok(())

@@ -618,17 +618,12 @@ impl Refiner<'_> {
     /// at most two faces and six half-edges, and touches at most four faces), asked for
     /// before the splits so that running out of memory is an error, not an abort.
     fn reserve_splits(&mut self, w: &mut Vec<DVec3>, new: usize) -> Result<()> {
-        fn room<T>(v: &mut Vec<T>, extra: usize) -> Result<()> {
-            v.try_reserve(extra).map_err(|_| {
-                InputError::out_of_memory(CALL, v.len().saturating_add(extra), size_of::<T>())
-            })
-        }
-        room(w, new)?;
-        room(&mut self.rest, new)?;
-        room(&mut self.carry, new)?;
-        room(&mut self.topo.faces, 2 * new)?;
-        room(&mut self.topo.twin, 6 * new)?;
-        room(&mut self.touched, 4 * new)
+        alloc::reserve(CALL, w, new)?;
+        alloc::reserve(CALL, &mut self.rest, new)?;
+        alloc::reserve(CALL, &mut self.carry, new)?;
+        alloc::reserve(CALL, &mut self.topo.faces, 2 * new)?;
+        alloc::reserve(CALL, &mut self.topo.twin, 6 * new)?;
+        alloc::reserve(CALL, &mut self.touched, 4 * new)
     }
 
     /// Refinement passes after step `done` (1-based count of the steps taken), at time `t`.
@@ -753,13 +748,7 @@ impl Refiner<'_> {
             let mut next: Vec<usize> = Vec::new();
             for &h in &queue {
                 if self.flippable(w, h) {
-                    next.try_reserve(6).map_err(|_| {
-                        InputError::out_of_memory(
-                            CALL,
-                            next.len().saturating_add(6),
-                            size_of::<usize>(),
-                        )
-                    })?;
+                    alloc::reserve(CALL, &mut next, 6)?;
                     let (f, g) = (h / 3, self.topo.twin[h] / 3);
                     let [a, b, c] = [0, 1, 2].map(|i| w[self.topo.faces[f][(h % 3 + i) % 3]]);
                     let d = w[self.topo.faces[g][(self.topo.twin[h] % 3 + 2) % 3]];

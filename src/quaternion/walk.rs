@@ -437,13 +437,7 @@ pub fn walk_path_cancellable(
         }
         crossings.clear();
         s = w.step_cancellable(s, *m, &mut crossings, cancel)?;
-        path.try_reserve(crossings.len() + 1).map_err(|_| {
-            InputError::out_of_memory(
-                "walk_mesh",
-                path.len() + crossings.len() + 1,
-                size_of::<PathPoint>(),
-            )
-        })?;
+        alloc::reserve("walk_mesh", &mut path, crossings.len() + 1)?;
         path.extend(crossings.iter().map(|&(point, face)| PathPoint {
             point,
             face,
