@@ -20,6 +20,71 @@ pub fn stopped() -> crate::error::InputError {
 /// Items (rows, keys, cubics) between polls of a sequential cancellable loop.
 pub const BLOCK: usize = 1 << 14;
 
+/// Rows per block of [`fill`]: large enough that a poll costs nothing beside the rows,
+/// small enough that each block (and the page faults of its fresh output) ends within
+/// well under a millisecond.
+pub const GRAIN: usize = 1 << 12;
+
+/// `out[i] = row(i)` for every index, on the current thread pool in blocks of [`GRAIN`]
+/// rows, polling `cancel` before each block. Once it says stop the remaining blocks are
+/// skipped and `false` is returned (`out` is then incomplete; the caller discards it).
+pub fn fill<T: Send>(out: &mut [T], cancel: Cancel<'_>, row: impl Fn(usize) -> T + Sync) -> bool {
+    fill_in_blocks(out, GRAIN, cancel, row)
+}
+
+/// [`fill`] with blocks of `grain` rows (for rows that cost microseconds each).
+pub fn fill_in_blocks<T: Send>(
+    out: &mut [T],
+    grain: usize,
+    cancel: Cancel<'_>,
+    row: impl Fn(usize) -> T + Sync,
+) -> bool {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stopped = AtomicBool::new(false);
+    let grain = grain.max(1);
+    out.par_chunks_mut(grain)
+        .enumerate()
+        .for_each(|(b, block)| {
+            if stopped.load(Ordering::Relaxed) || cancel() {
+                stopped.store(true, Ordering::Relaxed);
+                return;
+            }
+            for (k, o) in block.iter_mut().enumerate() {
+                *o = row(b * grain + k);
+            }
+        });
+    !stopped.into_inner()
+}
+
+/// The first index of `0..n` failing `ok`, scanning blocks of [`GRAIN`] indices in
+/// parallel and polling `cancel` before each block; once it says stop the blocks after it
+/// count as passing (the caller, told to stop, discards the answer).
+pub fn first_bad_index(
+    n: usize,
+    cancel: Cancel<'_>,
+    ok: impl Fn(usize) -> bool + Sync,
+) -> Option<usize> {
+    use rayon::prelude::*;
+    (0..n.div_ceil(GRAIN))
+        .into_par_iter()
+        .position_first(|b| !cancel() && !(b * GRAIN..n.min((b + 1) * GRAIN)).all(&ok))
+        .and_then(|b| (b * GRAIN..n).find(|&i| !ok(i)))
+}
+
+/// The rows `row(0..n)` in a vector reserved fallibly ([`crate::alloc`], out of memory
+/// named by `what`) and written by [`fill_in_blocks`]; `Ok(None)` when `cancel` said stop.
+pub fn collect<T: Send + Default + Clone>(
+    what: &'static str,
+    n: usize,
+    grain: usize,
+    cancel: Cancel<'_>,
+    row: impl Fn(usize) -> T + Sync,
+) -> crate::error::Result<Option<Vec<T>>> {
+    let mut out = crate::alloc::filled(what, n, T::default())?;
+    Ok(fill_in_blocks(&mut out, grain, cancel, row).then_some(out))
+}
+
 /// Sort `v` by `cmp` on the current thread pool, polling `cancel` between the sorts of
 /// pieces of 2¹⁶ items (each a few milliseconds); the sorted pieces are then merged by a
 /// stable parallel merge sort, which finds them as runs (2²³ items in about 0.2 s on two
@@ -399,16 +464,219 @@ mod tests {
             let run = |k: super::Cancel<'_>| {
                 let (mut f, mut om) = (vec![[0.0; 9]; n], vec![0.0; n]);
                 let start = frame::Start::Angle(0.0);
-                frame::frames_at_cancellable(&cubics, &s, start, None, mode, &mut f, &mut om, k)
-                    .expect("valid");
-                (f.concat(), om)
+                let r = frame::frames_at_cancellable(
+                    &cubics, &s, start, None, mode, &mut f, &mut om, k,
+                );
+                unless_stopped(r).map(|()| (f.concat(), om))
             };
-            let ((f, om), polls) = stop_everywhere(run);
+            let (got, polls) = stop_everywhere(run);
+            let (f, om) = got.expect("not stopped");
             assert!(polls >= n / (1 << 16), "{polls} polls");
             // the uninterrupted call matches the one without a hook
-            let (want_f, want_om) = run(&super::never);
+            let (want_f, want_om) = run(&super::never).expect("not stopped");
             assert!(same_bits(&f, &want_f) && same_bits(&om, &want_om));
         }
+    }
+
+    /// A chain of `m` G¹ PH cubics: the Hermite interpolants of a helix.
+    fn ph_chain(m: usize) -> Vec<crate::ph::Cubic> {
+        let at = |u: f64| {
+            let (s, c) = u.sin_cos();
+            (DVec3::new(c, s, 0.3 * u), DVec3::new(-s, c, 0.3))
+        };
+        (0..m)
+            .map(|i| {
+                let ((p0, t0), (p1, t1)) = (at(0.4 * i as f64), at(0.4 * (i + 1) as f64));
+                crate::ph::hermite::hermite(p0, t0.normalize(), p1, t1.normalize()).cubics[0]
+            })
+            .collect()
+    }
+
+    /// The frame set-up of a long spline (the reference vector carried in one pass, the
+    /// angle fits in parallel) stops anywhere, and its fits are those of each segment fitted
+    /// on its own.
+    #[test]
+    fn ph_spline_setup_stops_anywhere() {
+        use crate::ph::frame::{self, Start};
+        let cubics = ph_chain(3000);
+        let run = |k: super::Cancel<'_>| {
+            unless_stopped(frame::setup_cancellable(
+                &cubics,
+                Start::Angle(0.2),
+                None,
+                k,
+            ))
+        };
+        let (got, polls) = stop_everywhere(run);
+        let segs = got.expect("not stopped");
+        assert!(polls > 3000 / 16, "{polls} polls");
+        assert_eq!(
+            segs,
+            frame::setup(&cubics, Start::Angle(0.2), None).expect("valid")
+        );
+        for (c, seg) in cubics.iter().zip(&segs) {
+            let alone = frame::segment(c, seg.omega0, None).expect("bent");
+            assert_eq!(alone.fit, seg.fit);
+        }
+    }
+
+    /// The PH rows (Hermite interpolation, evaluation) stop anywhere and give the plain
+    /// calls' bits.
+    #[test]
+    fn ph_hermite_and_evaluation_stop_anywhere() {
+        use crate::ph::{self, hermite};
+        let cubics = ph_chain(70_000);
+        let p0: Vec<DVec3> = cubics.iter().map(|c| c.b[0]).collect();
+        let p1: Vec<DVec3> = cubics.iter().map(|c| c.b[3]).collect();
+        let t0: Vec<DVec3> = cubics.iter().map(|c| c.b[1] - c.b[0]).collect();
+        let t1: Vec<DVec3> = cubics.iter().map(|c| c.b[3] - c.b[2]).collect();
+        let run = |k: super::Cancel<'_>| {
+            unless_stopped(hermite::hermite_rows_cancellable(
+                &p0, &t0, &p1, &t1, false, true, k,
+            ))
+        };
+        let (got, _) = stop_everywhere(run);
+        let got = got.expect("not stopped");
+        let plain = hermite::hermite_rows(&p0, &t0, &p1, &t1, false, true).expect("valid");
+        assert!(same_bits(&got.candidates, &plain.candidates) && got.counts == plain.counts);
+        let m = cubics.len() as f64;
+        let s: Vec<f64> = (0..100_000).map(|i| m * i as f64 / 99_999.0).collect();
+        for d in 0..4 {
+            let run = |k: super::Cancel<'_>| {
+                let mut out = vec![DVec3::ZERO; s.len()];
+                ph::eval_into_cancellable(&cubics, &s, d, &mut out, k).expect("valid");
+                out
+            };
+            let (got, _) = stop_everywhere(run);
+            assert!(got == ph::eval_at(&cubics, &s, d).expect("valid"));
+        }
+    }
+
+    /// The quaternion rows (spin, slerp between key frames, path length, signs) stop
+    /// anywhere and give the plain calls' bits.
+    #[test]
+    fn quaternion_rows_stop_anywhere() {
+        use crate::quaternion::{self as q, spin};
+        let x = curve(100_000);
+        let req = Request {
+            points: Some(&x),
+            ..Request::default()
+        };
+        let mut flat = vec![0.0; 9 * x.len()];
+        frames::compute_into(&req, &mut flat).expect("valid");
+        let a: Vec<[f64; 9]> = flat
+            .chunks_exact(9)
+            .map(|c| c.try_into().expect("9"))
+            .collect();
+        // b: a turned about each tangent by 0.3 rad
+        let b: Vec<[f64; 9]> = a
+            .iter()
+            .map(|f| {
+                let m = glam::DMat3::from_cols_array(f).transpose();
+                let turned = m * glam::DMat3::from_rotation_z(0.3);
+                turned.transpose().to_cols_array()
+            })
+            .collect();
+        let run = |k: super::Cancel<'_>| {
+            let mut out = vec![0.0; x.len()];
+            spin::spin_into_cancellable(&a, &b, &mut out, k).expect("valid");
+            out
+        };
+        let (got, _) = stop_everywhere(run);
+        assert!(same_bits(&got, &spin::spin(&a, &b).expect("valid")));
+        assert!(got.iter().all(|v| (v - 0.3).abs() < 1e-12));
+
+        let quats = q::from_frames(&a, false).expect("rotations");
+        let run = |k: super::Cancel<'_>| q::continuous_cancellable(&quats, k).expect("valid");
+        let (got, _) = stop_everywhere(run);
+        assert!(got == q::continuous(&quats).expect("valid"));
+        let run = |k: super::Cancel<'_>| q::path_length_cancellable(&quats, true, k);
+        let (got, _) = stop_everywhere(run);
+        let want = q::path_length(&quats, true).expect("valid");
+        assert_eq!(got.expect("valid").to_bits(), want.to_bits());
+
+        let keys = &a[..1000];
+        let ku: Vec<f64> = (0..1000).map(f64::from).collect();
+        let nu: Vec<f64> = (0..100_000).map(|i| 999.0 * i as f64 / 99_999.0).collect();
+        let run = |k: super::Cancel<'_>| {
+            let mut out = vec![[0.0; 9]; nu.len()];
+            let r = q::slerp_frames_cancellable(keys, &ku, &nu, &mut out, k);
+            unless_stopped(r).map(|()| out.concat())
+        };
+        let (got, _) = stop_everywhere(run);
+        let mut want = vec![[0.0; 9]; nu.len()];
+        q::slerp_frames(keys, &ku, &nu, &mut want).expect("valid");
+        assert!(same_bits(&got.expect("not stopped"), &want.concat()));
+    }
+
+    /// A field evaluated at many points, and a rod tool built from many axis samples, stop
+    /// anywhere; the uninterrupted calls give the plain ones' bits.
+    #[test]
+    fn field_evaluation_and_rod_stop_anywhere() {
+        use crate::deform::{Field, advect, fields::Translation, rod::Rod};
+        let tool = Translation::new(DVec3::new(0.0, 0.0, 1.0), 0.5, DVec3::X, None, 3, false);
+        let field = Field::single(tool.expect("valid"));
+        let p = curve(50_000);
+        let run = |k: super::Cancel<'_>| {
+            let mut out = vec![DVec3::ZERO; p.len()];
+            advect::eval_into(&field, &p, 0.0, &mut out, k);
+            out
+        };
+        let (got, _) = stop_everywhere(run);
+        assert!(got.iter().zip(&p).all(|(v, x)| *v == field.eval(*x, 0.0)));
+        let axis: Vec<DVec3> = (0..50_000)
+            .map(|i| {
+                let s = i as f64 * 0.01;
+                DVec3::new(s.cos(), s.sin(), 0.3 * s)
+            })
+            .collect();
+        let run = |k: super::Cancel<'_>| {
+            unless_stopped(Rod::from_points_cancellable(&axis, 0.05, None, None, k))
+        };
+        let (got, _) = stop_everywhere(run);
+        let rod = got.expect("not stopped");
+        let plain = Rod::from_points(&axis, 0.05, None, None).expect("valid");
+        assert_eq!(rod.center, plain.center);
+        let x = DVec3::new(1.02, 0.0, 0.0);
+        assert_eq!(rod.closest(x), plain.closest(x));
+    }
+
+    /// The result of a cancellable call, `None` when it was stopped (any other error fails).
+    fn unless_stopped<T>(r: crate::error::Result<T>) -> Option<T> {
+        match r {
+            Ok(v) => Some(v),
+            Err(e) => {
+                assert_eq!(e.to_string(), super::stopped().to_string());
+                None
+            }
+        }
+    }
+
+    #[test]
+    fn fill_and_first_bad_index_by_blocks() {
+        let n = 3 * super::GRAIN + 17;
+        let mut out = vec![0usize; n];
+        assert!(super::fill(&mut out, &super::never, |i| 2 * i));
+        assert!(out.iter().enumerate().all(|(i, &v)| v == 2 * i));
+        let mut out = vec![0usize; n];
+        assert!(!super::fill(&mut out, &|| true, |i| i + 1));
+        assert!(out.iter().all(|&v| v == 0));
+        // the first failing index, with failures in several blocks
+        let bad = |i: usize| !(i == super::GRAIN + 5 || i == 2 * super::GRAIN || i == n - 1);
+        assert_eq!(
+            super::first_bad_index(n, &super::never, bad),
+            Some(super::GRAIN + 5)
+        );
+        assert_eq!(super::first_bad_index(n, &super::never, |_| true), None);
+        assert_eq!(super::first_bad_index(n, &|| true, bad), None);
+        let got = super::collect("x", n, 7, &super::never, |i| i as u32).expect("room");
+        assert!(
+            got.expect("not stopped")
+                .iter()
+                .enumerate()
+                .all(|(i, &v)| v == i as u32)
+        );
+        assert_eq!(super::collect("x", n, 7, &|| true, |i| i as u32), Ok(None));
     }
 
     #[test]

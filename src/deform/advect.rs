@@ -22,6 +22,7 @@ use rayon::prelude::*;
 
 use super::Field;
 use crate::alloc;
+use crate::cancel::Cancel;
 
 /// Integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -563,15 +564,10 @@ fn advect_blocks(
 /// Wall time aimed at per block of [`advect_ticked`], seconds.
 pub const BLOCK_SECONDS: f64 = 0.02;
 
-/// Evaluate the field at `points` into `out`.
-pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3]) {
-    out.par_chunks_mut(CHUNK)
-        .zip(points.par_chunks(CHUNK))
-        .for_each(|(o, p)| {
-            for (o, p) in o.iter_mut().zip(p) {
-                *o = field.eval(*p, t);
-            }
-        });
+/// Evaluate the field at `points` into `out` (as many rows), polling `cancel` between
+/// blocks of points (`out` incomplete once it says stop; see [`crate::cancel`]).
+pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3], cancel: Cancel<'_>) {
+    crate::cancel::fill_in_blocks(out, CHUNK, cancel, |i| field.eval(points[i], t));
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ use glam::DVec3;
 
 use super::curl::Distance;
 use super::tube::{Axis, AxisSample};
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// A rod about a spline axis (see the module docs).
@@ -42,7 +43,20 @@ impl Rod {
         reach: Option<f64>,
         center: Option<DVec3>,
     ) -> Result<Rod> {
-        Rod::new(super::tube::axis_samples(points)?, radius, reach, center)
+        Rod::from_points_cancellable(points, radius, reach, center, &cancel::never)
+    }
+
+    /// [`Rod::from_points`] polling `cancel` in the axis set-up and checks (see
+    /// [`Axis::new_cancellable`]); fails with [`cancel::stopped`] once it says stop.
+    pub fn from_points_cancellable(
+        points: &[DVec3],
+        radius: f64,
+        reach: Option<f64>,
+        center: Option<DVec3>,
+        cancel: Cancel<'_>,
+    ) -> Result<Rod> {
+        let samples = super::tube::axis_samples_cancellable(points, cancel)?;
+        Rod::new_cancellable(samples, radius, reach, center, cancel)
     }
 
     /// The rod, validated: `radius` and `reach` (default `radius`) positive, finite `center`
@@ -55,6 +69,17 @@ impl Rod {
         reach: Option<f64>,
         center: Option<DVec3>,
     ) -> Result<Rod> {
+        Rod::new_cancellable(samples, radius, reach, center, &cancel::never)
+    }
+
+    /// [`Rod::new`] polling `cancel` in the axis checks ([`Axis::new_cancellable`]).
+    pub fn new_cancellable(
+        samples: Vec<AxisSample>,
+        radius: f64,
+        reach: Option<f64>,
+        center: Option<DVec3>,
+        cancel: Cancel<'_>,
+    ) -> Result<Rod> {
         let radius = super::positive("radius", radius)?;
         let reach = super::reach_or(reach, radius)?;
         if let Some(i) = samples
@@ -66,7 +91,7 @@ impl Rod {
                 format!("row {i} is not finite (NaN or inf)"),
             ));
         }
-        let axis = Axis::new(samples, radius + reach)?;
+        let axis = Axis::new_cancellable(samples, radius + reach, cancel)?;
         let center = center.map(|c| super::finite3("center", c)).transpose()?;
         Ok(Rod::with_axis(axis, radius, reach, center))
     }

@@ -37,12 +37,7 @@ pub(crate) fn first_bad_cancellable<T: Sync>(
     ok: impl Fn(&T) -> bool + Sync,
     cancel: crate::cancel::Cancel<'_>,
 ) -> Option<usize> {
-    v.par_chunks(CHECK_CHUNK)
-        .position_first(|c| !cancel() && !c.iter().all(&ok))
-        .and_then(|b| {
-            let a = b * CHECK_CHUNK;
-            v[a..].iter().position(|p| !ok(p)).map(|k| a + k)
-        })
+    crate::cancel::first_bad_index(v.len(), cancel, |i| ok(&v[i]))
 }
 
 pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
@@ -148,15 +143,7 @@ pub fn chords_cancellable(
         );
     }
     // the first repeated point (a cancelled search finds none; the result is discarded)
-    let bad = (0..m.div_ceil(CHECK_CHUNK))
-        .into_par_iter()
-        .find_map_first(|c| {
-            if cancel() {
-                return None;
-            }
-            let a0 = c * CHECK_CHUNK;
-            (a0..(a0 + CHECK_CHUNK).min(m)).find(|&i| repeated(x[i], x[next(i)], floor))
-        });
+    let bad = crate::cancel::first_bad_index(m, cancel, |i| !repeated(x[i], x[next(i)], floor));
     match bad {
         None => Ok(seg),
         Some(i) => Err(InputError::new(
@@ -186,10 +173,7 @@ pub fn aligned(
         let d = v.dot(t[i] + t[j]);
         d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * v.length_squared()
     };
-    let bad = (0..m.div_ceil(CHECK_CHUNK))
-        .into_par_iter()
-        .position_first(|c| !(c * CHECK_CHUNK..((c + 1) * CHECK_CHUNK).min(m)).all(&ok))
-        .and_then(|c| (c * CHECK_CHUNK..m).find(|&i| !ok(i)));
+    let bad = crate::cancel::first_bad_index(m, &crate::cancel::never, ok);
     match bad {
         None => Ok(()),
         Some(i) => Err(InputError::new(

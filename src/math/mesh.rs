@@ -42,26 +42,6 @@ pub fn compensated_sum(terms: impl Iterator<Item = f64>) -> f64 {
     sum + c
 }
 
-/// [`signed_volume`] of a mesh given with `i64` face indices as they come from NumPy, each
-/// checked to lie in `0..v.len()` (errors name `faces`).
-pub fn signed_volume_checked(v: &[DVec3], f: &[[i64; 3]]) -> crate::error::Result<f64> {
-    let n = v.len();
-    let mut faces = crate::alloc::with_capacity("signed_volume", f.len())?;
-    for (i, t) in f.iter().enumerate() {
-        let mut c = [0usize; 3];
-        for (k, &x) in t.iter().enumerate() {
-            c[k] = usize::try_from(x).ok().filter(|&x| x < n).ok_or_else(|| {
-                crate::error::InputError::new(
-                    "faces",
-                    format!("face {i} refers to vertex {x}, but there are {n} vertices"),
-                )
-            })?;
-        }
-        faces.push(c);
-    }
-    Ok(signed_volume(v, &faces))
-}
-
 /// The sorted undirected edges of a mesh and the edge id of every face slot.
 pub type EdgeList = (Vec<[usize; 2]>, Vec<[usize; 3]>);
 

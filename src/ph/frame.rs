@@ -30,6 +30,7 @@ use glam::{DMat3, DVec3};
 
 use super::{Cubic, Quat, bern2};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::geometry::{any_perpendicular, rotate_about};
 
@@ -336,6 +337,24 @@ pub enum Start {
 /// Frame data of every segment of a G¹ PH spline.
 /// `omega_start` and `phi`, when given, must be finite.
 pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Segment>> {
+    setup_cancellable(cubics, start, phi, &cancel::never)
+}
+
+/// Segments between polls of the sequential pass of [`setup_cancellable`].
+const CHAIN_BLOCK: usize = 1 << 10;
+/// Segments per block of the parallel angle fits (each about 30 µs).
+const FIT_GRAIN: usize = 16;
+
+/// [`setup`] that polls `cancel` and fails with [`cancel::stopped`] once it says stop.
+/// The reference vector is carried from segment to segment in one sequential pass; the
+/// rational angle fits ([`fit_angle`], which depend only on their own segment) follow in
+/// parallel, so the result is that of fitting each segment in the pass.
+pub fn setup_cancellable(
+    cubics: &[Cubic],
+    start: Start,
+    phi: Option<f64>,
+    cancel: Cancel<'_>,
+) -> Result<Vec<Segment>> {
     if let Start::Angle(om) = start {
         if !om.is_finite() {
             return Err(InputError::new("omega_start", "must be finite"));
@@ -372,6 +391,9 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
     };
     let mut out = alloc::with_capacity("PHSpline frames", cubics.len())?;
     for (i, c) in cubics.iter().enumerate() {
+        if i % CHAIN_BLOCK == 0 && cancel() {
+            return Err(cancel::stopped());
+        }
         let found =
             bent(c).and_then(|seg| Some((frenet_of(&seg, 0.0)?, frenet_of(&seg, 1.0)?, seg)));
         match found {
@@ -399,12 +421,25 @@ pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Seg
             Some(((n0, b0, _), (n1, b1, _), mut seg)) => {
                 seg.omega0 = r.dot(b0).atan2(r.dot(n0));
                 seg.omega1 = seg.omega(1.0);
-                seg.fit = fit_angle(&seg, phi);
                 seg.r = r; // fallback should the frame be undefined somewhere (a cusp)
                 r = seg.omega1.sin() * b1 + seg.omega1.cos() * n1;
                 out.push(seg);
             }
         }
+    }
+    let fit = |i: usize| {
+        let seg = &out[i];
+        if seg.straight {
+            seg.fit
+        } else {
+            fit_angle(seg, phi)
+        }
+    };
+    let Some(fits) = cancel::collect("PHSpline frames", out.len(), FIT_GRAIN, cancel, fit)? else {
+        return Err(cancel::stopped());
+    };
+    for (seg, fit) in out.iter_mut().zip(fits) {
+        seg.fit = fit;
     }
     Ok(out)
 }
@@ -493,8 +528,8 @@ pub fn frames_at_cancellable(
 ) -> Result<()> {
     use rayon::prelude::*;
     debug_assert!(frames.len() == s.len() && angles.len() == s.len());
-    super::check_params(cubics.len(), s)?;
-    let segs = setup(cubics, start, phi)?;
+    super::check_params_cancellable(cubics.len(), s, cancel)?;
+    let segs = setup_cancellable(cubics, start, phi, cancel)?;
     frames
         .par_chunks_mut(CANCEL_ROWS)
         .zip(angles.par_chunks_mut(CANCEL_ROWS))

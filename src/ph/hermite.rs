@@ -36,6 +36,7 @@ use glam::DVec3;
 
 use super::Cubic;
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::geometry::any_perpendicular;
 
@@ -222,6 +223,21 @@ pub fn hermite_rows(
     all: bool,
     batch: bool,
 ) -> Result<Rows> {
+    hermite_rows_cancellable(p0, t0, p1, t1, all, batch, &cancel::never)
+}
+
+/// [`hermite_rows`] that polls `cancel` every [`cancel::BLOCK`] rows and fails with
+/// [`cancel::stopped`] once it says stop.
+#[allow(clippy::too_many_arguments)]
+pub fn hermite_rows_cancellable(
+    p0: &[DVec3],
+    t0: &[DVec3],
+    p1: &[DVec3],
+    t1: &[DVec3],
+    all: bool,
+    batch: bool,
+    cancel: Cancel<'_>,
+) -> Result<Rows> {
     let m = p0.len();
     if t0.len() != m || p1.len() != m || t1.len() != m {
         return Err(InputError::new(
@@ -229,16 +245,20 @@ pub fn hermite_rows(
             "must have the same number of rows",
         ));
     }
+    // reserved, then written row by row: the pages are touched between the polls, not
+    // all at once before the first
     let mut out = Rows {
-        candidates: alloc::filled(
+        candidates: alloc::with_capacity(
             "ph.hermite",
             alloc::product("ph.hermite", m, CANDIDATE_ROW, 8)?,
-            0.0,
         )?,
-        counts: alloc::filled("ph.hermite", m, 0)?,
-        codes: alloc::filled("ph.hermite", m, 0)?,
+        counts: alloc::with_capacity("ph.hermite", m)?,
+        codes: alloc::with_capacity("ph.hermite", m)?,
     };
     for i in 0..m {
+        if i % cancel::BLOCK == 0 && cancel() {
+            return Err(cancel::stopped());
+        }
         let at = |arg: &'static str, msg: &str| {
             let msg = if batch {
                 format!("row {i}: {msg}")
@@ -265,14 +285,15 @@ pub fn hermite_rows(
             if !all {
                 return Err(at("p0, t0, p1, t1", r.message()));
             }
-            out.codes[i] = r.code();
         }
-        out.counts[i] = sol.cubics.len() as i64;
+        out.codes.push(sol.reason.map_or(0, |r| r.code()));
+        out.counts.push(sol.cubics.len() as i64);
+        let mut row = [0.0; CANDIDATE_ROW];
         for (j, c) in sol.cubics.iter().enumerate() {
-            let o = i * CANDIDATE_ROW + j * 12;
             let f: &[f64] = bytemuck::cast_slice(&c.b);
-            out.candidates[o..o + 12].copy_from_slice(f);
+            row[j * 12..j * 12 + 12].copy_from_slice(f);
         }
+        out.candidates.extend_from_slice(&row);
     }
     Ok(out)
 }

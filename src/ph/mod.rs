@@ -24,9 +24,9 @@ pub mod frame;
 pub mod hermite;
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 use crate::math::cubic::Bezier;
@@ -386,12 +386,17 @@ pub fn locate(m: usize, s: f64) -> (usize, f64) {
 /// Check global parameters `s` of a spline of `m` segments: at least one segment, every
 /// value finite and within `[0, m]`.
 pub fn check_params(m: usize, s: &[f64]) -> Result<()> {
+    check_params_cancellable(m, s, &cancel::never)
+}
+
+/// [`check_params`] scanning `s` in parallel blocks that poll `cancel` (a stopped check
+/// passes; see [`crate::cancel`]).
+pub fn check_params_cancellable(m: usize, s: &[f64], cancel: Cancel<'_>) -> Result<()> {
     if m == 0 {
         return Err(InputError::new("control_points", "no segments"));
     }
-    if s.iter()
-        .any(|x| !(x.is_finite() && *x >= 0.0 && *x <= m as f64))
-    {
+    let inside = |x: &f64| x.is_finite() && *x >= 0.0 && *x <= m as f64;
+    if crate::frames::validate::first_bad_cancellable(s, inside, cancel).is_some() {
         return Err(InputError::new(
             "s",
             format!("values must be finite and within [0, {m}]"),
@@ -403,7 +408,21 @@ pub fn check_params(m: usize, s: &[f64]) -> Result<()> {
 /// Points (`derivative = 0`) or derivatives of order 1..=3 with respect to the local `v`
 /// of the spline `cubics` at the global parameters `s` (see [`locate`]), in parallel.
 pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVec3>> {
-    check_params(cubics.len(), s)?;
+    let mut out = alloc::filled("PHSpline.evaluate", s.len(), DVec3::ZERO)?;
+    eval_into_cancellable(cubics, s, derivative, &mut out, &cancel::never)?;
+    Ok(out)
+}
+
+/// [`eval_at`] into `out` (one row per parameter), polling `cancel` in the checks and
+/// between blocks of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
+pub fn eval_into_cancellable(
+    cubics: &[Cubic],
+    s: &[f64],
+    derivative: usize,
+    out: &mut [DVec3],
+    cancel: Cancel<'_>,
+) -> Result<()> {
+    check_params_cancellable(cubics.len(), s, cancel)?;
     check::finite_cubics(cubics)?;
     if derivative > 3 {
         return Err(InputError::new(
@@ -411,14 +430,14 @@ pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVe
             format!("must be 0, 1, 2 or 3, got {derivative}"),
         ));
     }
-    let mut out = alloc::with_capacity("PHSpline.evaluate", s.len())?;
-    s.par_iter()
-        .map(|&x| {
-            let (i, v) = locate(cubics.len(), x);
-            cubics[i].derivative(derivative, v)
-        })
-        .collect_into_vec(&mut out);
-    Ok(out)
+    if out.len() != s.len() {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
+    cancel::fill(out, cancel, |j| {
+        let (i, v) = locate(cubics.len(), s[j]);
+        cubics[i].derivative(derivative, v)
+    });
+    Ok(())
 }
 
 /// [`Cubic::from_quaternions`] row by row (preimages scalar first).

@@ -11,9 +11,7 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use super::convert::{
-    Stop, choice, detach_in_pool, detach_stoppable, empty, real, slice_mut, slice_of, vec3s,
-};
+use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
 use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -91,7 +89,10 @@ impl PyField {
             let mut w = out.readwrite();
             let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
             let field = &self.field;
-            detach_in_pool(py, || deform::advect::eval_into(field, x, t, o))?;
+            let stop = Stop::default();
+            detach_stoppable(py, &stop, || {
+                deform::advect::eval_into(field, x, t, o, &|| stop.requested())
+            })?;
         }
         Ok(out)
     }
@@ -632,8 +633,10 @@ pub fn field_rod(
     moving: bool,
 ) -> PyResult<PyField> {
     let x = vec3s("points", &points)?;
-    let rod = detach_in_pool(py, || {
-        rod::Rod::from_points(x, radius, reach, center.map(DVec3::from))
+    let stop = Stop::default();
+    let rod = detach_stoppable(py, &stop, || {
+        let c = center.map(DVec3::from);
+        rod::Rod::from_points_cancellable(x, radius, reach, c, &|| stop.requested())
     })??;
     let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
     curl_field(rod, mo, falloff_power, moving, "rod")

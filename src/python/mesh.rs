@@ -3,12 +3,12 @@
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use super::convert::{Stop, detach_in_pool, detach_stoppable, ensure_memory, triangles, vec3s};
-use crate::math::mesh;
+use super::convert::{Stop, detach_stoppable, ensure_memory, triangles, vec3s};
 use crate::mesh::closed::{self, CALL as CLOSED};
 use crate::mesh::measure;
 
-/// Signed volume of a closed triangle mesh, summed about the mean vertex.
+/// Signed volume of a closed triangle mesh, summed about the mean vertex
+/// ([`measure::volume`]).
 #[pyfunction]
 pub fn mesh_volume(
     py: Python<'_>,
@@ -17,7 +17,10 @@ pub fn mesh_volume(
 ) -> PyResult<f64> {
     let v = vec3s("vertices", &vertices)?;
     let f = triangles(&faces)?;
-    Ok(detach_in_pool(py, || mesh::signed_volume_checked(v, f))??)
+    let stop = Stop::default();
+    Ok(detach_stoppable(py, &stop, || {
+        measure::volume_cancellable(v, f, &|| stop.requested())
+    })??)
 }
 
 /// Volume and centroid of the solid bounded by a closed, outward-wound mesh (errors name

@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, cubic_points, cubics_from, cubics_of, detach_in_pool, detach_stoppable, empty, quats,
-    rows_of, slice_mut, slice_of, vec3_of, vec3s,
+    Stop, cubic_points, cubics_from, cubics_of, detach_stoppable, empty, quats, rows_of, slice_mut,
+    slice_of, vec3_of, vec3s,
 };
 use super::frames::FramesAndAngles;
 use crate::alloc;
@@ -36,7 +36,11 @@ pub fn ph_hermite<'py>(
 ) -> PyResult<HermiteArrays<'py>> {
     let (p0, t0) = (vec3s("p0", &p0)?, vec3s("t0", &t0)?);
     let (p1, t1) = (vec3s("p1", &p1)?, vec3s("t1", &t1)?);
-    let rows = detach_in_pool(py, || ph::hermite::hermite_rows(p0, t0, p1, t1, all, batch))??;
+    let stop = Stop::default();
+    let rows = detach_stoppable(py, &stop, || {
+        let cancel = || stop.requested();
+        ph::hermite::hermite_rows_cancellable(p0, t0, p1, t1, all, batch, &cancel)
+    })??;
     Ok((
         rows_of(py, rows.candidates, p0.len())?,
         PyArray1::from_vec(py, rows.counts),
@@ -55,8 +59,16 @@ pub fn ph_eval<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of("PHSpline.evaluate", &control_points)?;
     let s = slice_of("s", &s)?;
-    let out = detach_in_pool(py, || ph::eval_at(&cubics, s, derivative))??;
-    rows_of(py, bytemuck::allocation::cast_vec(out), s.len())
+    let out = empty::<f64, numpy::Ix2>(py, "PHSpline.evaluate", &[s.len(), 3])?;
+    {
+        let mut rw = out.readwrite();
+        let o: &mut [glam::DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            ph::eval_into_cancellable(&cubics, s, derivative, o, &|| stop.requested())
+        })??;
+    }
+    Ok(out)
 }
 
 /// `[L1, L2, L3, cθ, sθ, Δ, a, b, c, k, κ/τ, σ_min, κ_max]` per cubic.
@@ -172,7 +184,10 @@ pub fn ph_frame_setup<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let cubics = cubics_of("angle_fit", &control_points)?;
     let start = start_of(initial, omega_start)?;
-    let segs = detach_in_pool(py, || ph::frame::setup(&cubics, start, phi))??;
+    let stop = Stop::default();
+    let segs = detach_stoppable(py, &stop, || {
+        ph::frame::setup_cancellable(&cubics, start, phi, &|| stop.requested())
+    })??;
     let out = alloc::flat("angle_fit", segs.iter().map(|s| s.to_row()))?;
     rows_of(py, out, segs.len())
 }

@@ -9,8 +9,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_in_pool, detach_stoppable, empty, frames_of, quat_array, quats, slice_mut,
-    slice_of, triangles, value_error, vec2s, vec3_of, vec3s,
+    Stop, detach_stoppable, empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles,
+    value_error, vec2s, vec3_of, vec3s,
 };
 use crate::alloc;
 use crate::quaternion::{self, camera, walk};
@@ -39,8 +39,17 @@ pub fn quat_spin<'py>(
     b: PyReadonlyArray3<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (fa, fb) = (frames_of("a", &a)?, frames_of("b", &b)?);
-    let out = detach_in_pool(py, || quaternion::spin::spin(fa, fb))??;
-    Ok(PyArray1::from_vec(py, out))
+    let n = quaternion::spin::rows(fa, fb)?;
+    let out = empty::<f64, numpy::Ix1>(py, "quaternions.spin", &[n])?;
+    {
+        let mut rw = out.readwrite();
+        let o = slice_mut(&mut rw)?;
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            quaternion::spin::spin_into_cancellable(fa, fb, o, &|| stop.requested())
+        })??;
+    }
+    Ok(out)
 }
 
 /// Frames of quaternions `(x, y, z, w)`.
@@ -69,7 +78,10 @@ pub fn quat_continuous<'py>(
     q: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let qs = quats("quaternions", &q)?;
-    let v = detach_in_pool(py, || quaternion::continuous(qs))??;
+    let stop = Stop::default();
+    let v = detach_stoppable(py, &stop, || {
+        quaternion::continuous_cancellable(qs, &|| stop.requested())
+    })??;
     quat_array(py, v)
 }
 
@@ -109,7 +121,10 @@ pub fn quat_slerp_frames<'py>(
     {
         let mut rw = out.readwrite();
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
-        detach_in_pool(py, || quaternion::slerp_frames(fr, ku, nu, buf))??;
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            quaternion::slerp_frames_cancellable(fr, ku, nu, buf, &|| stop.requested())
+        })??;
     }
     Ok(out)
 }
@@ -122,7 +137,10 @@ pub fn quat_path_length(
     closed: bool,
 ) -> PyResult<f64> {
     let qs = quats("quaternions", &q)?;
-    Ok(detach_in_pool(py, || quaternion::path_length(qs, closed))??)
+    let stop = Stop::default();
+    Ok(detach_stoppable(py, &stop, || {
+        quaternion::path_length_cancellable(qs, closed, &|| stop.requested())
+    })??)
 }
 
 /// Parallel transport as a quaternion recurrence; returns (quaternions, closing angle).

@@ -37,7 +37,7 @@ use crate::frames::tangents::{self as tangent_estimate, TangentRule};
 use crate::frames::{self, Method, Orientation, Request, validate};
 use crate::math::rotation;
 
-const GRAIN: usize = 1 << 12;
+use crate::cancel::GRAIN;
 
 /// Rows per segment of a cancellable conversion ([`from_frames_cancellable`]).
 const CANCEL_SEGMENT: usize = 1 << 20;
@@ -69,10 +69,19 @@ pub fn canonical(q: DQuat) -> DQuat {
 /// Flip signs so that consecutive quaternions have a non-negative dot product, starting
 /// from the canonical sign of the first.
 pub fn make_continuous(q: &mut [DQuat]) {
+    make_continuous_cancellable(q, &cancel::never);
+}
+
+/// [`make_continuous`] that polls `cancel` every [`cancel::BLOCK`] rows and leaves the rest
+/// as they are once it says stop (see [`crate::cancel`]).
+pub fn make_continuous_cancellable(q: &mut [DQuat], cancel: Cancel<'_>) {
     if let Some(first) = q.first_mut() {
         *first = canonical(*first);
     }
     for i in 1..q.len() {
+        if i % cancel::BLOCK == 0 && cancel() {
+            return;
+        }
         if q[i].dot(q[i - 1]) < 0.0 {
             q[i] = -q[i];
         }
@@ -81,14 +90,27 @@ pub fn make_continuous(q: &mut [DQuat]) {
 
 /// A sign-continuous copy of quaternions ([`make_continuous`]); non-finite rows are refused.
 pub fn continuous(q: &[DQuat]) -> Result<Vec<DQuat>> {
-    if let Some(i) = validate::first_bad(q, |v| v.is_finite()) {
+    continuous_cancellable(q, &cancel::never)
+}
+
+/// [`continuous`] that polls `cancel` in its check and every [`cancel::BLOCK`] rows of the
+/// sign pass (an incomplete result once it says stop; see [`crate::cancel`]).
+pub fn continuous_cancellable(q: &[DQuat], cancel: Cancel<'_>) -> Result<Vec<DQuat>> {
+    if let Some(i) = validate::first_bad_cancellable(q, |v| v.is_finite(), cancel) {
         return Err(InputError::new(
             "quaternions",
             format!("contains non-finite values (row {i})"),
         ));
     }
-    let mut v = alloc::copied("quaternions", q)?;
-    make_continuous(&mut v);
+    // copied in blocks that poll, then the signs
+    let mut v = alloc::with_capacity("quaternions", q.len())?;
+    for block in q.chunks(cancel::BLOCK) {
+        if cancel() {
+            return Ok(v);
+        }
+        v.extend_from_slice(block);
+    }
+    make_continuous_cancellable(&mut v, cancel);
     Ok(v)
 }
 
@@ -127,8 +149,8 @@ pub fn from_frames_cancellable(
                 .map(|f| canonical(from_matrix(f))),
         );
     }
-    if continuous && !cancel() {
-        make_continuous(&mut q);
+    if continuous {
+        make_continuous_cancellable(&mut q, cancel);
     }
     Ok(q)
 }
@@ -175,16 +197,7 @@ pub fn to_frames_cancellable(
     if out.len() != q.len() {
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }
-    out.par_chunks_mut(GRAIN)
-        .zip(q.par_chunks(GRAIN))
-        .for_each(|(o, v)| {
-            if cancel() {
-                return;
-            }
-            for (o, v) in o.iter_mut().zip(v) {
-                *o = to_matrix(unit_checked(*v));
-            }
-        });
+    cancel::fill(out, cancel, |i| to_matrix(unit_checked(q[i])));
     Ok(())
 }
 
@@ -225,14 +238,8 @@ pub fn slerp_many_cancellable(
         }
     }
     validate::finite_scalars("u", u)?;
-    out.par_chunks_mut(GRAIN).enumerate().for_each(|(c, o)| {
-        if cancel() {
-            return;
-        }
-        for (k, o) in o.iter_mut().enumerate() {
-            let i = c * GRAIN + k;
-            *o = slerp(unit_checked(a[i]), unit_checked(b[i]), u[i]);
-        }
+    cancel::fill(out, cancel, |i| {
+        slerp(unit_checked(a[i]), unit_checked(b[i]), u[i])
     });
     Ok(())
 }
@@ -248,6 +255,18 @@ pub fn slerp_frames(
     new_u: &[f64],
     out: &mut [[f64; 9]],
 ) -> Result<()> {
+    slerp_frames_cancellable(frames, key_u, new_u, out, &cancel::never)
+}
+
+/// [`slerp_frames`] that polls `cancel` in its checks and between blocks of rows (an
+/// incomplete result once it says stop; see [`crate::cancel`]).
+pub fn slerp_frames_cancellable(
+    frames: &[[f64; 9]],
+    key_u: &[f64],
+    new_u: &[f64],
+    out: &mut [[f64; 9]],
+    cancel: Cancel<'_>,
+) -> Result<()> {
     let n = frames.len();
     if n < 2 {
         return Err(InputError::new(
@@ -261,21 +280,24 @@ pub fn slerp_frames(
             format!("expected {n} values to match frames, got {}", key_u.len()),
         ));
     }
-    if let Some(i) = (0..n).find(|&i| !key_u[i].is_finite() || (i > 0 && key_u[i] <= key_u[i - 1]))
-    {
+    let increasing = |i: usize| key_u[i].is_finite() && (i == 0 || key_u[i] > key_u[i - 1]);
+    if let Some(i) = (0..n).find(|&i| (i % cancel::BLOCK == 0 && cancel()) || !increasing(i)) {
+        if cancel() {
+            return Err(cancel::stopped());
+        }
         return Err(InputError::new(
             "key_u",
             format!("must be finite and strictly increasing (index {i})"),
         ));
     }
-    if let Some(i) = validate::first_bad(new_u, |u| u.is_finite()) {
+    if let Some(i) = validate::first_bad_cancellable(new_u, |u| u.is_finite(), cancel) {
         return Err(InputError::new(
             "new_u",
             format!("contains non-finite values (index {i})"),
         ));
     }
     let (lo, hi) = (key_u[0], key_u[n - 1]);
-    if let Some(i) = validate::first_bad(new_u, |&u| (lo..=hi).contains(&u)) {
+    if let Some(i) = validate::first_bad_cancellable(new_u, |&u| (lo..=hi).contains(&u), cancel) {
         return Err(InputError::new(
             "new_u",
             format!(
@@ -284,19 +306,20 @@ pub fn slerp_frames(
             ),
         ));
     }
-    let q = from_frames(frames, true)?;
-    out.par_iter_mut()
-        .zip(new_u.par_iter())
-        .with_min_len(GRAIN)
-        .for_each(|(o, &u)| {
-            let i = key_u
-                .partition_point(|&k| k <= u)
-                .saturating_sub(1)
-                .min(n - 2);
-            let w = (u - key_u[i]) / (key_u[i + 1] - key_u[i]);
-            let s = slerp(q[i].normalize(), q[i + 1].normalize(), w);
-            *o = to_matrix(s.normalize());
-        });
+    let q = from_frames_cancellable(frames, true, cancel)?;
+    if cancel() {
+        return Ok(());
+    }
+    cancel::fill(out, cancel, |j| {
+        let u = new_u[j];
+        let i = key_u
+            .partition_point(|&k| k <= u)
+            .saturating_sub(1)
+            .min(n - 2);
+        let w = (u - key_u[i]) / (key_u[i + 1] - key_u[i]);
+        let s = slerp(q[i].normalize(), q[i + 1].normalize(), w);
+        to_matrix(s.normalize())
+    });
     Ok(())
 }
 
@@ -311,7 +334,15 @@ fn arc(a: DQuat, b: DQuat) -> f64 {
 /// Length of the quaternion curve (unit quaternions, any signs), `closed` adding the arc
 /// from the last to the first.
 pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
-    if let Some(i) = validate::first_bad(q, normalisable) {
+    path_length_cancellable(q, closed, &cancel::never)
+}
+
+/// [`path_length`] that polls `cancel` in its check and between blocks of arcs (a
+/// meaningless result once it says stop; see [`crate::cancel`]). The arcs are summed per
+/// block of [`GRAIN`] and the block sums in order, so the result does not depend on the
+/// number of threads.
+pub fn path_length_cancellable(q: &[DQuat], closed: bool, cancel: Cancel<'_>) -> Result<f64> {
+    if let Some(i) = validate::first_bad_cancellable(q, normalisable, cancel) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite"),
@@ -319,11 +350,11 @@ pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
     }
     let n = q.len();
     let m = if closed { n } else { n.saturating_sub(1) };
-    Ok((0..m)
-        .into_par_iter()
-        .with_min_len(GRAIN)
-        .map(|i| arc(unit_checked(q[i]), unit_checked(q[(i + 1) % n])))
-        .sum())
+    let arc_at = |i: usize| arc(unit_checked(q[i]), unit_checked(q[(i + 1) % n]));
+    let sums = cancel::collect("quaternion_length", m.div_ceil(GRAIN), 1, cancel, |b| {
+        (b * GRAIN..m.min((b + 1) * GRAIN)).map(arc_at).sum::<f64>()
+    })?;
+    Ok(sums.map_or(0.0, |s| s.iter().sum()))
 }
 
 /// The unit tangents at the points `x` (`n ≥ 2` rows): the given `t` (finite, non-zero
@@ -527,10 +558,7 @@ pub fn transport_cancellable(
                     *q = (*q * DQuat::from_xyzw(0.0, 0.0, a.sin(), a.cos())).normalize();
                 });
         });
-    if cancel() {
-        return Ok(0.0);
-    }
-    make_continuous(out);
+    make_continuous_cancellable(out, cancel);
     Ok(alpha)
 }
 

@@ -9,9 +9,9 @@
 //! angle about `t_a` is not the twist between them.
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::FRAME_TANGENT_TOL;
 use crate::frames::validate;
@@ -22,15 +22,17 @@ fn col(f: &[f64; 9], k: usize) -> DVec3 {
     DVec3::new(f[k], f[3 + k], f[6 + k])
 }
 
-/// Finite rotation matrices, else an error naming `arg` and the row.
-fn check_frames(arg: &'static str, f: &[[f64; 9]]) -> Result<()> {
-    if let Some(i) = validate::first_bad(f, |m| m.iter().all(|v| v.is_finite())) {
+/// Finite rotation matrices, else an error naming `arg` and the row (a stopped check finds
+/// nothing; see [`crate::cancel`]).
+fn check_frames(arg: &'static str, f: &[[f64; 9]], cancel: Cancel<'_>) -> Result<()> {
+    let finite = |m: &[f64; 9]| m.iter().all(|v| v.is_finite());
+    if let Some(i) = validate::first_bad_cancellable(f, finite, cancel) {
         return Err(InputError::new(
             arg,
             format!("non-finite value in frame {i}"),
         ));
     }
-    if let Some(i) = validate::first_bad(f, validate::is_rotation) {
+    if let Some(i) = validate::first_bad_cancellable(f, validate::is_rotation, cancel) {
         return Err(InputError::new(
             arg,
             format!(
@@ -42,11 +44,9 @@ fn check_frames(arg: &'static str, f: &[[f64; 9]]) -> Result<()> {
     Ok(())
 }
 
-/// The signed angle from `a[i]`'s reference vector to `b[i]`'s about `a[i]`'s tangent, for
-/// `n` rows (one of `a`, `b` may hold a single frame, used for every row).
-pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
-    check_frames("a", a)?;
-    check_frames("b", b)?;
+/// The number of rows of [`spin`]'s result: that of `a` and `b`, or of the one that holds
+/// more than a single frame.
+pub fn rows(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<usize> {
     let n = a.len().max(b.len());
     if !(a.len() == b.len() || a.len() == 1 || b.len() == 1) || n == 0 {
         return Err(InputError::new(
@@ -59,29 +59,48 @@ pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
             ),
         ));
     }
+    Ok(n)
+}
+
+/// The signed angle from `a[i]`'s reference vector to `b[i]`'s about `a[i]`'s tangent, for
+/// `n` rows (one of `a`, `b` may hold a single frame, used for every row).
+pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
+    let mut out = alloc::filled("spin", rows(a, b)?, 0.0)?;
+    spin_into_cancellable(a, b, &mut out, &cancel::never)?;
+    Ok(out)
+}
+
+/// [`spin`] into `out` (of [`rows`] rows), polling `cancel` in the checks and between blocks
+/// of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
+pub fn spin_into_cancellable(
+    a: &[[f64; 9]],
+    b: &[[f64; 9]],
+    out: &mut [f64],
+    cancel: Cancel<'_>,
+) -> Result<()> {
+    check_frames("a", a, cancel)?;
+    check_frames("b", b, cancel)?;
+    let n = rows(a, b)?;
+    if out.len() != n {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
     let pick = |v: &[[f64; 9]], i: usize| v[if v.len() == 1 { 0 } else { i }];
-    let angle = |i: usize| {
-        let (fa, fb) = (pick(a, i), pick(b, i));
-        (col(&fa, 2).angle_between(col(&fb, 2)), {
-            let rb = col(&fb, 0);
-            rb.dot(col(&fa, 1)).atan2(rb.dot(col(&fa, 0)))
-        })
-    };
-    let out = alloc::par_collect(
-        "spin",
-        (0..n).into_par_iter().with_min_len(1 << 12).map(angle),
-    )?;
-    if let Some(i) = out.iter().position(|(d, _)| !(*d <= FRAME_TANGENT_TOL)) {
+    let turn = |i: usize| col(&pick(a, i), 2).angle_between(col(&pick(b, i), 2));
+    if let Some(i) = cancel::first_bad_index(n, cancel, |i| turn(i) <= FRAME_TANGENT_TOL) {
         return Err(InputError::new(
             "b",
             format!(
                 "the tangent of frame {i} (third column) differs from a's by {:.3e} rad: the \
                  spin is the twist between frames with the same tangent",
-                out[i].0
+                turn(i)
             ),
         ));
     }
-    alloc::collect("spin", out.into_iter().map(|(_, s)| s))
+    cancel::fill(out, cancel, |i| {
+        let (fa, rb) = (pick(a, i), col(&pick(b, i), 0));
+        rb.dot(col(&fa, 1)).atan2(rb.dot(col(&fa, 0)))
+    });
+    Ok(())
 }
 
 #[cfg(test)]
