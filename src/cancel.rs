@@ -20,6 +20,17 @@ pub fn stopped() -> crate::error::InputError {
 /// Items (rows, keys, cubics) between polls of a sequential cancellable loop.
 pub const BLOCK: usize = 1 << 14;
 
+/// The poll of a sequential loop at item `i`: [`stopped`] when `i` starts a block of
+/// [`BLOCK`] items and `cancel` says stop (`cancel::poll(i, cancel)?` in the loop).
+#[inline]
+pub fn poll(i: usize, cancel: Cancel<'_>) -> crate::error::Result<()> {
+    if i % BLOCK == 0 && cancel() {
+        Err(stopped())
+    } else {
+        Ok(())
+    }
+}
+
 /// Rows per block of [`fill`]: large enough that a poll costs nothing beside the rows,
 /// small enough that each block (and the page faults of its fresh output) ends within
 /// well under a millisecond.
@@ -448,7 +459,24 @@ mod tests {
         assert!(polls >= m / crate::alloc::CANCEL_ITEMS, "{polls} polls");
         assert_eq!(inv.expect("valid").len(), m);
         let (pre, _) = stop_everywhere(|k| ph::preimage_rows_cancellable(&cubics, 1e-9, true, k));
-        assert_eq!(pre.expect("valid").len(), m);
+        let pre = pre.expect("valid");
+        assert_eq!(pre.len(), m);
+        // and back, from (x, y, z, w) rows and one start for all
+        let xyzw = |r: &[f64]| [r[1], r[2], r[3], r[0]];
+        let a0: Vec<ph::Quat> = pre.iter().map(|r| xyzw(&r[0..4])).collect();
+        let a1: Vec<ph::Quat> = pre.iter().map(|r| xyzw(&r[4..8])).collect();
+        let run = |k: super::Cancel<'_>| {
+            let mut out = vec![[0.0; 12]; m];
+            ph::from_quaternion_rows_into(&a0, &a1, &[DVec3::ZERO], false, &mut out, k)
+                .expect("valid");
+            out
+        };
+        let (back, _) = stop_everywhere(run);
+        let want: Vec<f64> = c.b.iter().flat_map(|p| p.to_array()).collect();
+        assert!(
+            back.iter()
+                .all(|r| r.iter().zip(&want).all(|(x, y)| (x - y).abs() < 1e-12))
+        );
     }
 
     #[test]
@@ -639,6 +667,55 @@ mod tests {
         assert_eq!(rod.center, plain.center);
         let x = DVec3::new(1.02, 0.0, 0.0);
         assert_eq!(rod.closest(x), plain.closest(x));
+    }
+
+    /// A long spine's model (checks, curvatures, Hermite pieces) and the compass walk of a
+    /// posed spine stop anywhere, and give the plain calls' results.
+    #[test]
+    fn spine_model_and_compass_walk_stop_anywhere() {
+        use crate::flesh::{SpineModel, spine};
+        // a closed wavy circle with its frames: r along z, t along the circle
+        let n = 70_000;
+        let x = curve(n);
+        let mut pts: Vec<DVec3> = x.clone();
+        pts.push(x[0]);
+        let mut frames = Vec::with_capacity(9 * (n + 1));
+        for i in 0..=n {
+            let t = (pts[(i + 1) % n] - pts[(i + n - 1) % n]).normalize();
+            let r = (DVec3::Z - t * t.z).normalize();
+            let q = t.cross(r);
+            frames.extend_from_slice(&[r.x, q.x, t.x, r.y, q.y, t.y, r.z, q.z, t.z]);
+        }
+        let run = |k: super::Cancel<'_>| {
+            unless_stopped(SpineModel::new_cancellable(
+                "rest_spine",
+                &pts,
+                &frames,
+                true,
+                k,
+            ))
+        };
+        let (got, polls) = stop_everywhere(run);
+        let got = got.expect("not stopped");
+        assert!(polls >= 4 * n / super::BLOCK, "{polls} polls");
+        let plain = SpineModel::new("rest_spine", &pts, &frames, true).expect("valid");
+        for (k, a) in [(0, 0.3), (n / 2, 0.7), (n - 1, 1.0)] {
+            let (g, p) = (got.eval(k, a), plain.eval(k, a));
+            assert!(g.q == p.q && g.t == p.t && g.u == p.u && g.kappa == p.kappa);
+        }
+        // the walk with chords of a third of the edges: three steps to an edge
+        let chords: Vec<f64> = pts
+            .windows(2)
+            .flat_map(|w| [w[0].distance(w[1]) / 3.0; 3])
+            .collect();
+        let run =
+            |k: super::Cancel<'_>| unless_stopped(spine::compass_walk_located(&pts, &chords, k));
+        let (got, _) = stop_everywhere(run);
+        let (walked, at) = got.expect("not stopped");
+        let (plain, plain_at) =
+            spine::compass_walk_located(&pts, &chords, &super::never).expect("ok");
+        assert!(walked == plain && same_bits(&at, &plain_at));
+        assert_eq!(walked, spine::compass_walk(&pts, &chords).expect("ok"));
     }
 
     /// The result of a cancellable call, `None` when it was stopped (any other error fails).

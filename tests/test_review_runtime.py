@@ -156,6 +156,10 @@ D16_CASES = {
     "SpineBinding at 1e200": (
         "V = np.random.default_rng(0).normal(size=(5_000_000, 3)) * 1e200\n",
         "spinal.SpineBinding(V, H * 1e200)", "SpineBinding: out of memory"),
+    "ph.from_quaternions": (
+        ("rng = np.random.default_rng(0); A0 = rng.normal(size=(12_000_000, 4))\n"
+         "A1 = rng.normal(size=(12_000_000, 4))\n"),
+        "ph.from_quaternions(A0, A1)", "ph.from_quaternions: out of memory for an output array"),
     "PHSpline.evaluate": (
         ("sp = ph.fit(spinal.curves.Helix(), segments=8)\n"
         "s = np.linspace(0, 1, 10_000_000)\n"),
@@ -511,6 +515,12 @@ D17_ONCE_CASES = {
     "PHSpline.angle_fit": (
         PH_CHAIN.format(m=150_000),
         "sp.angle_fit()"),
+    # a spine of 6M samples: its model (edge checks, curvatures, Hermite pieces) is built
+    # before the vertices are registered
+    "SpineBinding (spine set-up)": (
+        ("n = 6_000_000; rest = np.c_[np.linspace(0, 1, n), np.zeros(n), np.zeros(n)]\n"
+         "V = np.random.default_rng(0).normal(size=(10, 3)) * .01\n"),
+        "spinal.SpineBinding(V, rest).offset"),
     "PHSpline.rmf (set-up)": (
         PH_CHAIN.format(m=150_000) + "s = np.linspace(0, 150_000, 200_000)\n",
         "sp.rmf(s, exact=True)"),
@@ -564,6 +574,10 @@ D17_FRACTION_CASES = {
          "X = np.c_[np.cos(u), np.sin(u), .3 * u]; T = np.c_[-np.sin(u), np.cos(u), .3 + 0 * u]\n"
          "P0, T0, P1, T1 = X[:-1].copy(), T[:-1].copy(), X[1:].copy(), T[1:].copy()\n"),
         "ph.hermite(P0, T0, P1, T1)"),
+    "ph.from_quaternions": (
+        ("rng = np.random.default_rng(0); A0 = rng.normal(size=(12_000_000, 4))\n"
+         "A1 = rng.normal(size=(12_000_000, 4))\n"),
+        "ph.from_quaternions(A0, A1)"),
     "PHSpline.evaluate": (
         "sp = ph.fit(spinal.curves.Helix(), segments=8); s = np.linspace(0, 8, 32_000_000)\n",
         "sp.evaluate(s)"),

@@ -191,10 +191,13 @@ def ph_eval(
 def ph_invariants(control_points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def ph_is_ph(control_points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]: ...
 def ph_from_quaternions(
-    a0: npt.NDArray[np.float64], a1: npt.NDArray[np.float64], start: npt.NDArray[np.float64]
+    a0: npt.NDArray[np.float64],
+    a1: npt.NDArray[np.float64],
+    start: npt.NDArray[np.float64],
+    scalar_first: bool,
 ) -> npt.NDArray[np.float64]: ...
 def ph_preimage(
-    control_points: npt.NDArray[np.float64], tol: float, batch: bool
+    control_points: npt.NDArray[np.float64], tol: float, batch: bool, scalar_first: bool
 ) -> npt.NDArray[np.float64]: ...
 def ph_check_spline(
     control_points: npt.NDArray[np.float64], knots: npt.NDArray[np.float64], single: bool

@@ -172,13 +172,6 @@ def is_ph(control_points, tol: float = 1e-9):
     return bool(out[0]) if single else out
 
 
-def _quats(q: Any, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
-    a, single = _vectors(q, name, 4)
-    if not scalar_first:
-        a = np.ascontiguousarray(np.roll(a, 1, axis=1))
-    return a, single
-
-
 def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = False) -> np.ndarray:
     """The PH cubic with the quaternion preimage ``A(v) = A0(1 − v) + A1 v``.
 
@@ -189,16 +182,15 @@ def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = Fals
     ``scalar_first``. Returns ``(4, 3)`` or ``(m, 4, 3)``.
     """
     sf = as_bool(scalar_first, "scalar_first")
-    q0, single = _quats(A0, "A0", sf)
-    q1, _ = _quats(A1, "A1", sf)
+    q0, single = _vectors(A0, "A0", 4)
+    q1, _ = _vectors(A1, "A1", 4)
     if q1.shape != q0.shape:
         raise ValueError(f"A1: expected the shape of A0 {q0.shape}, got {q1.shape}")
     st, _ = _vectors(start, "start")
-    if st.shape[0] == 1 and q0.shape[0] > 1:
-        st = np.ascontiguousarray(np.repeat(st, q0.shape[0], axis=0))
-    if st.shape[0] != q0.shape[0]:
+    if st.shape[0] not in (1, q0.shape[0]):
         raise ValueError(f"start: expected (3,) or ({q0.shape[0]}, 3), got {st.shape}")
-    out = _core.ph_from_quaternions(q0, q1, st).reshape(-1, 4, 3)
+    # the core reads (x, y, z, w) rows in place (no reordered copy) and the one start for all
+    out = _core.ph_from_quaternions(q0, q1, st, sf).reshape(-1, 4, 3)
     return out[0] if single else out
 
 
@@ -215,11 +207,8 @@ def preimage(control_points, *, scalar_first: bool = False, tol: float = 1e-9):
     sf = as_bool(scalar_first, "scalar_first")
     tol = as_positive(tol, "tol")
     cp, single = _cubics(control_points)
-    rows = _core.ph_preimage(cp, tol, not single)
-    q0, q1 = rows[:, 0:4], rows[:, 4:8]
-    if not sf:
-        q0, q1 = np.roll(q0, -1, axis=1), np.roll(q1, -1, axis=1)
-    q0, q1 = np.ascontiguousarray(q0), np.ascontiguousarray(q1)
+    rows = _core.ph_preimage(cp, tol, not single, sf)  # in the order asked for
+    q0, q1 = np.ascontiguousarray(rows[:, 0:4]), np.ascontiguousarray(rows[:, 4:8])
     return (q0[0], q1[0]) if single else (q0, q1)
 
 

@@ -10,6 +10,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
 use crate::math::rotation::minimal_rotate;
@@ -45,18 +46,25 @@ pub struct SpineModel {
 /// Sample curvature vectors: central differences of the unit tangents in chord length,
 /// made normal to the tangent (one-sided at the ends; across the seam of a loop, whose last
 /// sample repeats the first).
-fn curvatures(call: &'static str, c: &[DVec3], t: &[DVec3], closed: bool) -> Result<Vec<DVec3>> {
+fn curvatures(
+    call: &'static str,
+    c: &[DVec3],
+    t: &[DVec3],
+    closed: bool,
+    cancel: Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     let n = c.len();
-    let mut kv = alloc::collect(
+    let mut kv = alloc::try_collect(
         call,
         (0..n).map(|j| {
+            cancel::poll(j, cancel)?;
             let (a, b) = (j.saturating_sub(1), (j + 1).min(n - 1));
             let mut len = 0.0;
             for i in a..b {
                 len += (c[i + 1] - c[i]).length();
             }
             let k = (t[b] - t[a]) / len;
-            k - t[j] * t[j].dot(k)
+            Ok(k - t[j] * t[j].dot(k))
         }),
     )?;
     if closed && n >= 3 {
@@ -96,6 +104,18 @@ impl SpineModel {
         frames: &[f64],
         closed: bool,
     ) -> Result<SpineModel> {
+        SpineModel::new_cancellable(arg, points, frames, closed, &cancel::never)
+    }
+
+    /// [`SpineModel::new`] that polls `cancel` every [`cancel::BLOCK`] samples of its
+    /// passes and fails with [`cancel::stopped`] once it says stop.
+    pub fn new_cancellable(
+        arg: &'static str,
+        points: &[DVec3],
+        frames: &[f64],
+        closed: bool,
+        cancel: Cancel<'_>,
+    ) -> Result<SpineModel> {
         let n = points.len();
         let min = if closed { 4 } else { 2 };
         if n < min {
@@ -131,6 +151,7 @@ impl SpineModel {
         let mut t = alloc::with_capacity(call, n)?;
         let mut r = alloc::with_capacity(call, n)?;
         for (i, f) in frames.chunks_exact(9).enumerate() {
+            cancel::poll(i, cancel)?;
             let ri = DVec3::new(f[0], f[3], f[6]);
             let ti = DVec3::new(f[2], f[5], f[8]);
             if !(ri.is_finite() && ti.is_finite() && points[i].is_finite()) {
@@ -140,6 +161,7 @@ impl SpineModel {
             r.push(ri);
         }
         for k in 0..n - 1 {
+            cancel::poll(k, cancel)?;
             let e = points[k + 1] - points[k];
             // σ = E·t(a) > 0 on the whole edge iff it is at both ends
             if !(e.dot(t[k]) > 0.0 && e.dot(t[k + 1]) > 0.0) {
@@ -159,10 +181,11 @@ impl SpineModel {
                 ));
             }
         }
-        let kv = curvatures(call, points, &t, closed)?;
+        let kv = curvatures(call, points, &t, closed, cancel)?;
         let mut m = alloc::with_capacity(call, n - 1)?;
         let mut pc = alloc::with_capacity(call, n - 1)?;
         for k in 0..n - 1 {
+            cancel::poll(k, cancel)?;
             let e = points[k + 1] - points[k];
             let h = e.length();
             let pos = Hermite::new(points[k], points[k + 1], h * t[k], h * t[k + 1]).power();
@@ -185,9 +208,12 @@ impl SpineModel {
             m.push(coef);
             pc.push(pos);
         }
-        let rb = alloc::collect(
+        let rb = alloc::try_collect(
             call,
-            (0..n - 1).map(|k| minimal_rotate(t[k + 1], t[k], r[k + 1])),
+            (0..n - 1).map(|k| {
+                cancel::poll(k, cancel)?;
+                Ok(minimal_rotate(t[k + 1], t[k], r[k + 1]))
+            }),
         )?;
         Ok(SpineModel {
             scale: to_model,
@@ -293,7 +319,7 @@ impl SpineModel {
 /// `posed_spine` and `rest_spine`, whose chords they are).
 pub fn compass_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<Vec<DVec3>> {
     check_walk(posed, chords)?;
-    scaled_walk(posed, chords, &mut Vec::new())
+    scaled_walk(posed, chords, &mut Vec::new(), &cancel::never)
 }
 
 /// The input checks of [`compass_walk`].
@@ -315,14 +341,17 @@ fn check_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<()> {
 }
 
 /// [`compass_walk`], with the polyline position `k + u` of every point (on edge `k` of
-/// `posed` at the fraction `u`; `u > 1` past the end, along the last edge).
+/// `posed` at the fraction `u`; `u > 1` past the end, along the last edge). Polls `cancel`
+/// every [`cancel::BLOCK`] steps of the walk and fails with [`cancel::stopped`] once it
+/// says stop.
 pub fn compass_walk_located(
     posed: &[DVec3],
     chords: &[f64],
+    cancel: Cancel<'_>,
 ) -> crate::error::Result<(Vec<DVec3>, Vec<f64>)> {
     check_walk(posed, chords)?;
     let mut at = alloc::with_capacity("SpineBinding.deform", chords.len() + 1)?;
-    let pts = scaled_walk(posed, chords, &mut at)?;
+    let pts = scaled_walk(posed, chords, &mut at, cancel)?;
     Ok((pts, at))
 }
 
@@ -333,18 +362,19 @@ fn scaled_walk(
     posed: &[DVec3],
     chords: &[f64],
     at: &mut Vec<f64>,
+    cancel: Cancel<'_>,
 ) -> crate::error::Result<Vec<DVec3>> {
     use crate::error::InputError;
     let (lo, hi) = crate::frames::geometry::bounds(posed);
     let out = match crate::math::scale::curve_exponent(lo, hi) {
-        None => walk(posed, chords, at)?,
+        None => walk(posed, chords, at, cancel)?,
         Some(k) => {
             let p = scale::try_scaled("SpineBinding.deform", posed, k)?;
             let h = alloc::collect(
                 "SpineBinding.deform",
                 chords.iter().map(|&c| scale::ldexp(c, k)),
             )?;
-            scale::try_scaled("SpineBinding.deform", &walk(&p, &h, at)?, -k)?
+            scale::try_scaled("SpineBinding.deform", &walk(&p, &h, at, cancel)?, -k)?
         }
     };
     if let Some(i) = out.windows(2).position(|w| w[0] == w[1]) {
@@ -365,7 +395,12 @@ fn scaled_walk(
 }
 
 /// The walk; pushes the polyline positions onto `at` when it is given with capacity.
-fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Result<Vec<DVec3>> {
+fn walk(
+    posed: &[DVec3],
+    chords: &[f64],
+    at: &mut Vec<f64>,
+    cancel: Cancel<'_>,
+) -> Result<Vec<DVec3>> {
     let record = at.capacity() > 0;
     let mut out = alloc::with_capacity("SpineBinding.deform", chords.len() + 1)?;
     let mut c = posed[0];
@@ -375,8 +410,12 @@ fn walk(posed: &[DVec3], chords: &[f64], at: &mut Vec<f64>) -> Result<Vec<DVec3>
     }
     let last = posed.len() - 2;
     let mut seg = 0;
+    // steps taken (chords and edges passed), for the polls
+    let mut steps = 0usize;
     for &h in chords {
         let next = loop {
+            cancel::poll(steps, cancel)?;
+            steps += 1;
             let (a, b) = (posed[seg], posed[seg + 1]);
             let e = b - a;
             // |a + t e − c|² = h², the larger root (ahead of c)

@@ -442,34 +442,84 @@ pub fn eval_into_cancellable(
 
 /// [`Cubic::from_quaternions`] row by row (preimages scalar first).
 pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result<Vec<Cubic>> {
-    if a1.len() != a0.len() || start.len() != a0.len() {
+    let mut out = alloc::filled("ph.from_quaternions", a0.len(), [0.0; 12])?;
+    from_quaternion_rows_into(a0, a1, start, true, &mut out, &cancel::never)?;
+    Ok(out
+        .iter()
+        .map(|r| Cubic::new([0, 3, 6, 9].map(|k| DVec3::new(r[k], r[k + 1], r[k + 2]))))
+        .collect())
+}
+
+/// [`Cubic::from_quaternions`] row by row into `out` (one row `[b₀, b₁, b₂, b₃]` per pair of
+/// preimages): `a0`, `a1` scalar first, or `(x, y, z, w)` when not `scalar_first`; `start`
+/// holds one point for every row or one per row. Polls `cancel` in the checks and between
+/// blocks of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
+pub fn from_quaternion_rows_into(
+    a0: &[Quat],
+    a1: &[Quat],
+    start: &[DVec3],
+    scalar_first: bool,
+    out: &mut [[f64; 12]],
+    cancel: Cancel<'_>,
+) -> Result<()> {
+    let m = a0.len();
+    if a1.len() != m || !(start.len() == m || start.len() == 1) || out.len() != m {
         return Err(InputError::new(
             "A0, A1, start",
-            "must have the same number of rows",
+            "must have the same number of rows (or one start)",
         ));
     }
-    check::finite_rows("A0", a0)?;
-    check::finite_rows("A1", a1)?;
-    const CALL: &str = "ph.from_quaternions";
-    let st = alloc::collect(CALL, start.iter().map(|p| p.to_array()))?;
-    check::finite_rows("start", &st)?;
-    alloc::try_collect(
-        CALL,
-        (0..a0.len()).map(|i| {
-            let c = Cubic::from_quaternions(a0[i], a1[i], start[i]);
-            if c.b.iter().all(|p| p.is_finite()) {
-                Ok(c)
-            } else {
-                Err(InputError::new(
-                    "A0, A1",
-                    format!(
-                        "row {i}: the control points (of size |A|² plus start) are out of \
-                         the representable range of float64"
-                    ),
-                ))
-            }
-        }),
-    )
+    let finite = |arg: &'static str, rows: &[Quat]| {
+        let bad = crate::frames::validate::first_bad_cancellable(
+            rows,
+            |r| r.iter().all(|x| x.is_finite()),
+            cancel,
+        );
+        bad.map_or(Ok(()), |i| {
+            Err(InputError::new(
+                arg,
+                format!("contains non-finite values (in row {i})"),
+            ))
+        })
+    };
+    finite("A0", a0)?;
+    finite("A1", a1)?;
+    if let Some(i) = start.iter().position(|p| !p.is_finite()) {
+        return Err(InputError::new(
+            "start",
+            format!("contains non-finite values (in row {i})"),
+        ));
+    }
+    let order = |q: Quat| {
+        if scalar_first {
+            q
+        } else {
+            [q[3], q[0], q[1], q[2]]
+        }
+    };
+    let row = |i: usize| {
+        let p = start[if start.len() == 1 { 0 } else { i }];
+        let c = Cubic::from_quaternions(order(a0[i]), order(a1[i]), p);
+        let mut r = [0.0; 12];
+        for (k, b) in c.b.iter().enumerate() {
+            r[3 * k..3 * k + 3].copy_from_slice(&b.to_array());
+        }
+        r
+    };
+    if !cancel::fill(out, cancel, row) {
+        return Ok(());
+    }
+    let inside = |r: &[f64; 12]| r.iter().all(|x| x.is_finite());
+    match crate::frames::validate::first_bad_cancellable(out, inside, cancel) {
+        None => Ok(()),
+        Some(i) => Err(InputError::new(
+            "A0, A1",
+            format!(
+                "row {i}: the control points (of size |A|² plus start) are out of the \
+                 representable range of float64"
+            ),
+        )),
+    }
 }
 
 /// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a
@@ -596,8 +646,15 @@ mod tests {
         let e = from_quaternion_rows(&a0, &a1[..1], &[DVec3::ZERO; 2]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "A0, A1, start: must have the same number of rows"
+            "A0, A1, start: must have the same number of rows (or one start)"
         );
+        // one start for every row: the cubics of each row's own start
+        let from_origin = from_quaternion_rows(&a0, &a1, &[DVec3::ZERO]).unwrap();
+        for (i, x) in from_origin.iter().enumerate() {
+            assert_eq!(x.b, Cubic::from_quaternions(a0[i], a1[i], DVec3::ZERO).b);
+        }
+        let e = from_quaternion_rows(&a0, &a1, &[DVec3::ZERO; 3]).unwrap_err();
+        assert_eq!(e.arg, "A0, A1, start");
         let flat = Cubic::new([DVec3::ZERO, DVec3::ZERO, DVec3::X, DVec3::Y]);
         let e = preimage_rows(&[c[0], flat], 1e-9, true).unwrap_err();
         assert!(

@@ -7,9 +7,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::convert::{
-    Stop, detach_in_pool, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s,
-};
+use super::convert::{Stop, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s};
 use crate::alloc;
 use crate::flesh::{self, Solution, surface};
 
@@ -18,17 +16,13 @@ type SurfaceFleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<
 type FleshPose<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>);
 type Resampled<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// A spine from its points `(n, 3)` and frames `(n, 3, 3)`, both named `arg` (`closed`: a
-/// loop with its first row repeated at the end).
-fn spine_of<'py>(
+/// The points `(n, 3)` and frames `(n, 3, 3)` of a spine, both named `arg`.
+fn spine_arrays<'a>(
     arg: &'static str,
-    points: &PyReadonlyArray2<'py, f64>,
-    frames: &PyReadonlyArray3<'py, f64>,
-    closed: bool,
-) -> PyResult<flesh::SpineModel> {
-    let pts = vec3s(arg, points)?;
-    let fr = slice_of(arg, frames)?;
-    Ok(flesh::SpineModel::new(arg, pts, fr, closed)?)
+    points: &'a PyReadonlyArray2<'_, f64>,
+    frames: &'a PyReadonlyArray3<'_, f64>,
+) -> PyResult<(&'a [DVec3], &'a [f64])> {
+    Ok((vec3s(arg, points)?, slice_of(arg, frames)?))
 }
 
 /// Register vertices on a rest spine; see `spinal.SpineBinding`.
@@ -41,11 +35,13 @@ pub fn flesh_bind<'py>(
     vertices: PyReadonlyArray2<'py, f64>,
     closed: bool,
 ) -> PyResult<FleshBinding<'py>> {
-    let rest = spine_of("rest_spine", &rest_points, &rest_frames, closed)?;
+    let (pts, fr) = spine_arrays("rest_spine", &rest_points, &rest_frames)?;
     let v = vec3s("vertices", &vertices)?;
     let stop = Stop::default();
     let b = detach_stoppable(py, &stop, || {
-        flesh::bind_cancellable(&rest, v, &|| stop.requested())
+        let cancel = || stop.requested();
+        let rest = flesh::SpineModel::new_cancellable("rest_spine", pts, fr, closed, &cancel)?;
+        flesh::bind_cancellable(&rest, v, &cancel)
     })??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
@@ -66,7 +62,7 @@ pub fn flesh_deform<'py>(
     twist: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
 ) -> PyResult<FleshPose<'py>> {
-    let posed = spine_of("posed_spine", &posed_points, &posed_frames, closed)?;
+    let (pts, fr) = spine_arrays("posed_spine", &posed_points, &posed_frames)?;
     let edge = slice_of("edge", &edge)?;
     let coords = slice_of("coords", &coords)?;
     let tw: &[f64] = match &twist {
@@ -82,6 +78,8 @@ pub fn flesh_deform<'py>(
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
             let cancel = || stop.requested();
+            let posed =
+                flesh::SpineModel::new_cancellable("posed_spine", pts, fr, closed, &cancel)?;
             flesh::deform_cancellable(&posed, edge, coords, solution, tw, buf, &mut flags, &cancel)
         })??;
     }
@@ -98,7 +96,10 @@ pub fn flesh_resample<'py>(
 ) -> PyResult<Resampled<'py>> {
     let pts = vec3s("posed_spine", &posed_points)?;
     let ch = slice_of("chords", &chords)?;
-    let (out, at) = detach_in_pool(py, || flesh::spine::compass_walk_located(pts, ch))??;
+    let stop = Stop::default();
+    let (out, at) = detach_stoppable(py, &stop, || {
+        flesh::spine::compass_walk_located(pts, ch, &|| stop.requested())
+    })??;
     Ok((vec3_array(py, out)?, PyArray1::from_vec(py, at)))
 }
 

@@ -117,45 +117,56 @@ pub fn ph_check_spline(
     Ok(ph::check::check_spline(&cubics, knots, single)?)
 }
 
-/// Control points `(m, 12)` from quaternion preimages `(m, 4)` (scalar first) and starts.
+/// Control points `(m, 12)` from quaternion preimages `(m, 4)` (scalar first, or
+/// `(x, y, z, w)`) and one start or one per row.
 #[pyfunction]
 pub fn ph_from_quaternions<'py>(
     py: Python<'py>,
     a0: PyReadonlyArray2<'py, f64>,
     a1: PyReadonlyArray2<'py, f64>,
     start: PyReadonlyArray2<'py, f64>,
+    scalar_first: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let q0: &[ph::Quat] = bytemuck::cast_slice(quats("A0", &a0)?);
     let q1: &[ph::Quat] = bytemuck::cast_slice(quats("A1", &a1)?);
     let st = vec3s("start", &start)?;
-    let cubics = ph::from_quaternion_rows(q0, q1, st)?;
-    let m = cubics.len();
-    let out = alloc::flat(
-        "ph.from_quaternions",
-        cubics.iter().map(|c| {
-            let [a, b, c, d] = c.b.map(|p| p.to_array());
-            [
-                a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2], d[0], d[1], d[2],
-            ]
-        }),
-    )?;
-    rows_of(py, out, m)
+    let out = empty::<f64, numpy::Ix2>(py, "ph.from_quaternions", &[q0.len(), 12])?;
+    {
+        let mut rw = out.readwrite();
+        let o: &mut [[f64; 12]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let cancel = || stop.requested();
+            ph::from_quaternion_rows_into(q0, q1, st, scalar_first, o, &cancel)
+        })??;
+    }
+    Ok(out)
 }
 
-/// Quaternion preimages `(m, 9)`: `A0` (4, scalar first), `A1` (4), residual; a residual
-/// above `tol` times the polygon length raises (`batch`: naming the cubic).
+/// Quaternion preimages `(m, 9)`: `A0` (4), `A1` (4), residual, the quaternions scalar first
+/// or `(x, y, z, w)`; a residual above `tol` times the polygon length raises (`batch`:
+/// naming the cubic).
 #[pyfunction]
 pub fn ph_preimage<'py>(
     py: Python<'py>,
     control_points: PyReadonlyArray3<'py, f64>,
     tol: f64,
     batch: bool,
+    scalar_first: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use rayon::prelude::*;
     let points = cubic_points(&control_points)?;
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
         let cubics = cubics_from("ph.preimage", points, &|| stop.requested())?;
-        ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())
+        let mut rows = ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())?;
+        if !scalar_first {
+            rows.par_iter_mut().with_min_len(1 << 12).for_each(|r| {
+                r[0..4].rotate_left(1);
+                r[4..8].rotate_left(1);
+            });
+        }
+        Ok::<_, crate::error::InputError>(rows)
     })??;
     let m = rows.len();
     rows_of(py, bytemuck::allocation::cast_vec(rows), m)
