@@ -718,6 +718,39 @@ mod tests {
         assert_eq!(walked, spine::compass_walk(&pts, &chords).expect("ok"));
     }
 
+    /// A distance-grid tool's set-up (coefficient checks, copy, the cell minima) stops
+    /// anywhere and gives the plain tool.
+    #[test]
+    fn grid_tool_stops_anywhere() {
+        use crate::deform::grid;
+        let (n, h) = (60usize, 1.0 / 59.0);
+        let p = n + 2;
+        let origin = DVec3::splat(-0.5);
+        let coef: Vec<f64> = (0..p * p * p)
+            .map(|q| {
+                let (i, j, k) = (q / (p * p), (q / p) % p, q % p);
+                let x = origin + DVec3::new(i as f64, j as f64, k as f64) * h - DVec3::splat(h);
+                x.length() - 0.3
+            })
+            .collect();
+        let build = |k: super::Cancel<'_>| {
+            let (u, c) = (DVec3::X, DVec3::ZERO);
+            grid::grid_tool(origin, h, [p; 3], &coef, u, c, 0.1, false, true, k)
+        };
+        let (got, polls) = stop_everywhere(|k| unless_stopped(build(k)));
+        let got = got.expect("not stopped");
+        assert!(polls >= 4 * (n - 1), "{polls} polls");
+        let plain = build(&super::never).expect("valid");
+        for x in [
+            DVec3::ZERO,
+            DVec3::new(0.31, 0.0, 0.0),
+            DVec3::new(0.2, -0.25, 0.1),
+        ] {
+            assert_eq!(got.distance(x), plain.distance(x));
+        }
+        assert_eq!(got.support_extent(), plain.support_extent());
+    }
+
     /// The result of a cancellable call, `None` when it was stopped (any other error fails).
     fn unless_stopped<T>(r: crate::error::Result<T>) -> Option<T> {
         match r {

@@ -30,6 +30,7 @@ use glam::DVec3;
 
 use super::cross::{speed_factor, translate};
 use crate::alloc;
+use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// A tool given by a signed-distance grid (see the module docs).
@@ -151,6 +152,29 @@ impl GridTool {
         linear: bool,
         moving: bool,
     ) -> Result<GridTool> {
+        let t = (velocity, center, reach, linear, moving);
+        GridTool::new_cancellable(origin, spacing, n, coef, t, &cancel::never)
+    }
+
+    /// [`GridTool::new`] (its last five arguments in `tool`) that polls `cancel` between
+    /// the planes of its passes over the cells and fails with [`cancel::stopped`] once it
+    /// says stop.
+    pub fn new_cancellable(
+        origin: DVec3,
+        spacing: f64,
+        n: [usize; 3],
+        coef: Vec<f64>,
+        tool: (DVec3, DVec3, f64, bool, bool),
+        cancel: Cancel<'_>,
+    ) -> Result<GridTool> {
+        let (velocity, center, reach, linear, moving) = tool;
+        let stop = || {
+            if cancel() {
+                Err(cancel::stopped())
+            } else {
+                Ok(())
+            }
+        };
         let bad = |m: String| InputError::new("field", m);
         if n.iter().any(|&k| k < 4) {
             return Err(bad(format!(
@@ -174,12 +198,16 @@ impl GridTool {
         // each smaller than `coef` (checked above), allocated fallibly
         let mut mz = alloc::filled("sdf grid", p[0] * p[1] * c[2], 0.0)?;
         for i in 0..p[0] * p[1] {
+            if i % p[1] == 0 {
+                stop()?;
+            }
             for k in 0..c[2] {
                 mz[i * c[2] + k] = win(&coef, i * p[2] + k, 1);
             }
         }
         let mut my = alloc::filled("sdf grid", p[0] * c[1] * c[2], 0.0)?;
         for i in 0..p[0] {
+            stop()?;
             for j in 0..c[1] {
                 for k in 0..c[2] {
                     my[(i * c[1] + j) * c[2] + k] = win(&mz, (i * p[1] + j) * c[2] + k, c[2]);
@@ -188,6 +216,7 @@ impl GridTool {
         }
         let mut cell_min = alloc::filled("sdf grid", c[0] * c[1] * c[2], 0.0)?;
         for i in 0..c[0] {
+            stop()?;
             for j in 0..c[1] {
                 for k in 0..c[2] {
                     cell_min[(i * c[1] + j) * c[2] + k] =
@@ -198,6 +227,7 @@ impl GridTool {
         let mut y_max = [0.0f64; BUCKETS];
         let half = 0.5 * spacing * 3f64.sqrt();
         for i in 0..c[0] {
+            stop()?;
             for j in 0..c[1] {
                 for k in 0..c[2] {
                     let m = cell_min[(i * c[1] + j) * c[2] + k];
@@ -463,18 +493,20 @@ pub const MIN_CELLS_PER_REACH: f64 = 4.0;
 /// `shape = (nx + 2, ny + 2, nz + 2)` for a distance sampled on `(nx, ny, nz)` nodes,
 /// validated: at least 4 nodes per axis, finite vectors, positive spacing and reach, at
 /// least [`MIN_CELLS_PER_REACH`] cells per reach, and a support that stays inside the grid
-/// ([`GridTool::new`]).
+/// ([`GridTool::new`]). The coefficients are copied (fallibly); `cancel` is polled in the
+/// checks and the passes over the cells ([`GridTool::new_cancellable`]).
 #[allow(clippy::too_many_arguments)]
 pub fn grid_tool(
     origin: DVec3,
     spacing: f64,
     shape: [usize; 3],
-    coef: Vec<f64>,
+    coef: &[f64],
     velocity: DVec3,
     center: DVec3,
     reach: f64,
     linear: bool,
     moving: bool,
+    cancel: Cancel<'_>,
 ) -> Result<GridTool> {
     if shape.iter().any(|&k| k < 6) || coef.len() != shape.iter().product::<usize>() {
         return Err(InputError::new(
@@ -498,15 +530,16 @@ pub fn grid_tool(
             ),
         ));
     }
-    if let Some(i) = coef.iter().position(|c| !c.is_finite()) {
+    if let Some(i) = crate::frames::validate::first_bad_cancellable(coef, |c| c.is_finite(), cancel)
+    {
         return Err(InputError::new(
             "grid",
             format!("spline coefficient {i} is not finite"),
         ));
     }
-    let tool = GridTool::new(
-        origin, spacing, n, coef, velocity, center, reach, linear, moving,
-    )?;
+    let coef = alloc::copied("grid", coef)?;
+    let t = (velocity, center, reach, linear, moving);
+    let tool = GridTool::new_cancellable(origin, spacing, n, coef, t, cancel)?;
     super::bounded("velocity", tool)
 }
 

@@ -455,6 +455,7 @@ pub fn field_strip_curve(
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn field_grid(
+    py: Python<'_>,
     coefficients: PyReadonlyArray3<'_, f64>,
     origin: [f64; 3],
     spacing: f64,
@@ -466,17 +467,14 @@ pub fn field_grid(
     name: &str,
 ) -> PyResult<PyField> {
     let (shape, coef) = coefficients_of(&coefficients)?;
-    let tool = grid::grid_tool(
-        origin.into(),
-        spacing,
-        shape,
-        coef,
-        velocity.into(),
-        center.into(),
-        reach,
-        blend.0,
-        moving,
-    )?;
+    let stop = Stop::default();
+    let tool = detach_stoppable(py, &stop, || {
+        let (o, u, c) = (origin.into(), velocity.into(), center.into());
+        let cancel = || stop.requested();
+        grid::grid_tool(
+            o, spacing, shape, coef, u, c, reach, blend.0, moving, &cancel,
+        )
+    })??;
     Ok(PyField::new(Field::single(tool), name))
 }
 
@@ -547,9 +545,9 @@ pub fn field_zero() -> PyField {
 }
 
 /// A grid's B-spline coefficients and their array shape (checked by the core).
-fn coefficients_of(c: &PyReadonlyArray3<'_, f64>) -> PyResult<([usize; 3], Vec<f64>)> {
+fn coefficients_of<'a>(c: &'a PyReadonlyArray3<'_, f64>) -> PyResult<([usize; 3], &'a [f64])> {
     let sh = c.shape();
-    Ok(([sh[0], sh[1], sh[2]], slice_of("grid", c)?.to_vec()))
+    Ok(([sh[0], sh[1], sh[2]], slice_of("grid", c)?))
 }
 
 /// A field of one curl tool of `shape` (shared by the tool's copies).
@@ -588,6 +586,7 @@ fn motion(
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 pub fn field_grid_curl(
+    py: Python<'_>,
     coefficients: PyReadonlyArray3<'_, f64>,
     origin: [f64; 3],
     spacing: f64,
@@ -601,17 +600,23 @@ pub fn field_grid_curl(
     name: &str,
 ) -> PyResult<PyField> {
     let (shape, coef) = coefficients_of(&coefficients)?;
-    let shape = grid::grid_tool(
-        origin.into(),
-        spacing,
-        shape,
-        coef,
-        DVec3::ZERO,
-        center.into(),
-        reach,
-        false,
-        false,
-    )?;
+    let stop = Stop::default();
+    let shape = detach_stoppable(py, &stop, || {
+        let (o, c) = (origin.into(), center.into());
+        let cancel = || stop.requested();
+        grid::grid_tool(
+            o,
+            spacing,
+            shape,
+            coef,
+            DVec3::ZERO,
+            c,
+            reach,
+            false,
+            false,
+            &cancel,
+        )
+    })??;
     let center = shape.center;
     let m = motion(velocity, angular_velocity, pivot, center)?;
     curl_field(shape, m, falloff_power, moving, name)
