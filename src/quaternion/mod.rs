@@ -281,10 +281,7 @@ pub fn slerp_frames_cancellable(
         ));
     }
     let increasing = |i: usize| key_u[i].is_finite() && (i == 0 || key_u[i] > key_u[i - 1]);
-    if let Some(i) = (0..n).find(|&i| (i % cancel::BLOCK == 0 && cancel()) || !increasing(i)) {
-        if cancel() {
-            return Err(cancel::stopped());
-        }
+    if let Some(i) = cancel::first_bad_index(n, cancel, increasing) {
         return Err(InputError::new(
             "key_u",
             format!("must be finite and strictly increasing (index {i})"),
