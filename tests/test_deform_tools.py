@@ -449,3 +449,55 @@ def test_core_strip_and_grid_constructors_refuse_bad_input():
         _core.field_grid(bad, *grid)
     with pytest.raises(ValueError, match="^grid"):
         _core.field_grid(coef[:4, :4, :4].copy(), *grid)
+
+
+def _prefilter_numpy(values):
+    """The natural cubic B-spline prefilter in NumPy, axis by axis (Thomas algorithm over
+    whole planes): the formulation the core reproduces operation by operation."""
+    c = values
+    for axis in range(3):
+        a = np.moveaxis(c, axis, 0)
+        n = a.shape[0]
+        out = np.empty((n + 2,) + a.shape[1:])
+        out[1], out[n] = a[0], a[-1]
+        rhs = 6 * a[1:-1].copy()
+        rhs[0] -= a[0]
+        rhs[-1] -= a[-1]
+        k = n - 2
+        cp = np.zeros(k)
+        cp[0] = 0.25
+        rhs[0] *= 0.25
+        for i in range(1, k):
+            w = 4 - cp[i - 1]
+            cp[i] = 1 / w
+            rhs[i] = (rhs[i] - rhs[i - 1]) / w
+        for i in range(k - 2, -1, -1):
+            rhs[i] -= cp[i] * rhs[i + 1]
+        out[2:n] = rhs
+        out[0] = 2 * out[1] - out[2]
+        out[n + 1] = 2 * out[n] - out[n - 1]
+        c = np.moveaxis(out, 0, axis)
+    return np.ascontiguousarray(c)
+
+
+@pytest.mark.parametrize("shape", [(4, 4, 4), (5, 9, 4), (23, 7, 31), (64, 40, 52)])
+def test_grid_coefficients_interpolate_and_match_the_numpy_formulation(shape):
+    """The core's B-spline coefficients (parallel, line by line) have the bits of the NumPy
+    formulation, and the spline they define passes through the samples: at a node the
+    uniform cubic B-spline is (c_{i-1} + 4c_i + c_{i+1})/6 along each axis."""
+    d = np.random.default_rng(sum(shape)).normal(size=shape)
+    c = fields._spline_prefilter(d)
+    assert c.shape == tuple(k + 2 for k in shape)
+    np.testing.assert_array_equal(c, _prefilter_numpy(d))
+    for axis in range(3):
+        c = np.moveaxis(c, axis, 0)
+        c = (c[:-2] + 4 * c[1:-1] + c[2:]) / 6
+        c = np.moveaxis(c, 0, axis)
+    np.testing.assert_allclose(c, d, rtol=0, atol=1e-12)
+    # the input is not modified
+    np.testing.assert_array_equal(d, np.random.default_rng(sum(shape)).normal(size=shape))
+
+
+def test_grid_coefficients_refuse_small_grids():
+    with pytest.raises(ValueError, match=r"^grid: expected at least 4 nodes per axis"):
+        _core.field_grid_coefficients(np.zeros((3, 8, 8)))

@@ -596,6 +596,24 @@ def test_D17_ctrl_c_within_a_fraction_of_a_short_call(name):
     assert r.same, r.report
 
 
+SDF_GRID = ("n = 300; x = np.linspace(-1, 1, n); X, Y, Z = np.meshgrid(x, x, x, indexing='ij')\n"
+            "D = np.sqrt(X**2 + Y**2 + Z**2) - .5; del X, Y, Z\n")
+
+
+@pytest.mark.parametrize("tool", ["sdf_tool(D, [-1, -1, -1], 2 / (n - 1), [1, 0, 0]",
+                                  "sdf_curl(D, [-1, -1, -1], 2 / (n - 1), velocity=[1, 0, 0]"])
+def test_D17_distance_grid_tools_stop_within_half_a_second(tool):
+    """A tool from the largest distance grid accepted (300³ nodes): the B-spline coefficients
+    and the tool's cell minima are computed in Rust, polling Ctrl-C; what stays in NumPy
+    (the default centre and reach) are single operations of well under half a second.
+    Signalled halfway through."""
+    call = f"fl.{tool}, center=[0, 0, 0], reach=.3)([[0, 0, .6]])"
+    r = interrupt_once(SDF_GRID, call, after="full / 2", least=0.5)
+    assert r.late < 0.5, r.report
+    assert r.busy < 0.05, r.report
+    assert r.same, r.report
+
+
 def test_D17_cold_sweep_stops_promptly():
     """The first sweep of a fresh process writes into output pages never touched before
     (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000

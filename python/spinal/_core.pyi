@@ -296,6 +296,7 @@ def field_grid(
     moving: bool,
     name: str,
 ) -> Field: ...
+def field_grid_coefficients(values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def field_path(
     points: npt.NDArray[np.float64],
     frames: npt.NDArray[np.float64],

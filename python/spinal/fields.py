@@ -313,31 +313,8 @@ def _spline_prefilter(values: np.ndarray) -> np.ndarray:
     """Coefficients (n + 2 per axis, one ghost layer each side) of the natural cubic B-spline
     interpolating ``values`` on a unit grid: per axis ``c_0 = d_0``, ``c_{n−1} = d_{n−1}``,
     ``c_{i−1} + 4c_i + c_{i+1} = 6d_i`` inside, ghosts ``c_{−1} = 2c_0 − c_1`` (zero second
-    derivative at the end nodes)."""
-    c = values
-    for axis in range(3):
-        a = np.moveaxis(c, axis, 0)
-        n = a.shape[0]
-        out = np.empty((n + 2,) + a.shape[1:])
-        out[1], out[n] = a[0], a[-1]
-        rhs = 6 * a[1:-1].copy()
-        rhs[0] -= a[0]
-        rhs[-1] -= a[-1]
-        k = n - 2
-        cp = np.zeros(k)
-        cp[0] = 0.25
-        rhs[0] *= 0.25
-        for i in range(1, k):
-            w = 4 - cp[i - 1]
-            cp[i] = 1 / w
-            rhs[i] = (rhs[i] - rhs[i - 1]) / w
-        for i in range(k - 2, -1, -1):
-            rhs[i] -= cp[i] * rhs[i + 1]
-        out[2:n] = rhs
-        out[0] = 2 * out[1] - out[2]
-        out[n + 1] = 2 * out[n] - out[n - 1]
-        c = np.moveaxis(out, 0, axis)
-    return c
+    derivative at the end nodes). Solved in the core, line by line in parallel."""
+    return _core.field_grid_coefficients(np.ascontiguousarray(values, dtype=np.float64))
 
 
 def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name):
@@ -368,7 +345,7 @@ def _grid_spline(values, origin, h, center, reach):
         reach = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
     else:
         reach = as_real(reach, "reach")
-    return np.ascontiguousarray(_spline_prefilter(values)), c, reach
+    return _spline_prefilter(values), c, reach
 
 
 @_recorded

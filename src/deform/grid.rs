@@ -486,6 +486,143 @@ impl GridTool {
     }
 }
 
+/// The coefficients, `(nx + 2) (ny + 2) (nz + 2)` in C order, of the natural cubic B-spline
+/// interpolating `values` sampled on a unit grid of `n = (nx, ny, nz)` nodes (C order),
+/// written into `out`. Per axis, on every line `d_0 … d_{m−1}` along it: `c_0 = d_0`,
+/// `c_{m−1} = d_{m−1}`, `c_{i−1} + 4c_i + c_{i+1} = 6d_i` inside (solved by the Thomas
+/// algorithm), and one ghost coefficient each side, `c_{−1} = 2c_0 − c_1` (zero second
+/// derivative at the end nodes). The axes are filtered in turn, each line's operations in
+/// the order of the NumPy formulation (the same bits). At least 4 nodes per axis (errors name
+/// `grid`); polls `cancel` between lines and between the steps of long ones (`out`
+/// incomplete once it says stop; see [`crate::cancel`]).
+pub fn spline_coefficients(
+    values: &[f64],
+    n: [usize; 3],
+    out: &mut [f64],
+    cancel: Cancel<'_>,
+) -> Result<()> {
+    if n.iter().any(|&k| k < 4) {
+        return Err(InputError::new(
+            "grid",
+            format!("expected at least 4 nodes per axis, got shape {n:?}"),
+        ));
+    }
+    let p = n.map(|k| k + 2);
+    let size = |s: [usize; 3]| s[0].checked_mul(s[1]).and_then(|a| a.checked_mul(s[2]));
+    if size(n) != Some(values.len()) || size(p) != Some(out.len()) {
+        return Err(InputError::new(
+            "grid",
+            "values and coefficients do not match the shape",
+        ));
+    }
+    const CALL: &str = "grid coefficients";
+    // axis 0: (nx, ny, nz) -> (nx+2, ny, nz); axis 1: -> (nx+2, ny+2, nz); axis 2: -> out
+    let mut a = alloc::filled(CALL, p[0] * n[1] * n[2], 0.0)?;
+    if !prefilter_axis(values, n[0], n[1] * n[2], &mut a, cancel)? {
+        return Ok(());
+    }
+    let mut b = alloc::filled(CALL, p[0] * p[1] * n[2], 0.0)?;
+    if !prefilter_axis(&a, n[1], n[2], &mut b, cancel)? {
+        return Ok(());
+    }
+    drop(a);
+    prefilter_axis(&b, n[2], 1, out, cancel)?;
+    Ok(())
+}
+
+/// One axis of [`spline_coefficients`]: `src` of shape `(outer, m, inner)` into `dst` of
+/// shape `(outer, m + 2, inner)`, the `outer` slabs in parallel, each step of the recurrence
+/// over a whole row of `inner` values (as NumPy's planes). Returns `false` when stopped.
+fn prefilter_axis(
+    src: &[f64],
+    m: usize,
+    inner: usize,
+    dst: &mut [f64],
+    cancel: Cancel<'_>,
+) -> Result<bool> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    // the forward elimination's factors depend on m only
+    let k = m - 2;
+    let mut cp = alloc::filled("grid coefficients", k, 0.0)?;
+    cp[0] = 0.25;
+    for i in 1..k {
+        cp[i] = 1.0 / (4.0 - cp[i - 1]);
+    }
+    let stopped = AtomicBool::new(false);
+    // a poll before every slab, and before every step of slabs of long rows
+    let step_polls = inner >= 1 << 12;
+    let stop = || {
+        let s = stopped.load(Ordering::Relaxed) || cancel();
+        if s {
+            stopped.store(true, Ordering::Relaxed);
+        }
+        s
+    };
+    let slabs = dst
+        .par_chunks_mut((m + 2) * inner)
+        .zip(src.par_chunks(m * inner));
+    slabs
+        .with_min_len(1.max((1 << 14) / (m * inner).max(1)))
+        .for_each(|(o, a)| {
+            if stop() {
+                return;
+            }
+            let row = |i: usize| i * inner..(i + 1) * inner;
+            // rows 2..m of `o` hold the right-hand side, then the solution (NumPy's `rhs`)
+            o[row(1)].copy_from_slice(&a[row(0)]);
+            o[row(m)].copy_from_slice(&a[row(m - 1)]);
+            for j in 0..k {
+                let (d, r) = (row(j + 1), row(j + 2));
+                for (x, &v) in o[r].iter_mut().zip(&a[d]) {
+                    *x = 6.0 * v;
+                }
+            }
+            for (x, &v) in o[row(2)].iter_mut().zip(&a[row(0)]) {
+                *x -= v;
+            }
+            for (x, &v) in o[row(k + 1)].iter_mut().zip(&a[row(m - 1)]) {
+                *x -= v;
+            }
+            for x in &mut o[row(2)] {
+                *x *= 0.25;
+            }
+            for i in 1..k {
+                if step_polls && stop() {
+                    return;
+                }
+                let w = 4.0 - cp[i - 1];
+                let (head, tail) = o.split_at_mut((i + 2) * inner);
+                for (x, &prev) in tail[..inner].iter_mut().zip(&head[(i + 1) * inner..]) {
+                    *x = (*x - prev) / w;
+                }
+            }
+            for i in (0..k.saturating_sub(1)).rev() {
+                if step_polls && stop() {
+                    return;
+                }
+                let (head, tail) = o.split_at_mut((i + 3) * inner);
+                for (x, &next) in head[(i + 2) * inner..].iter_mut().zip(&tail[..inner]) {
+                    *x -= cp[i] * next;
+                }
+            }
+            let (first, rest) = o.split_at_mut(inner);
+            for ((g, &c1), &c2) in first
+                .iter_mut()
+                .zip(&rest[..inner])
+                .zip(&rest[inner..2 * inner])
+            {
+                *g = 2.0 * c1 - c2;
+            }
+            let (rest, last) = o.split_at_mut((m + 1) * inner);
+            let (cm1, cm) = (&rest[(m - 1) * inner..m * inner], &rest[m * inner..]);
+            for ((g, &c1), &c2) in last.iter_mut().zip(cm).zip(cm1) {
+                *g = 2.0 * c1 - c2;
+            }
+        });
+    Ok(!stopped.into_inner())
+}
+
 /// Cells per reach below which a grid is too coarse for the blend region.
 pub const MIN_CELLS_PER_REACH: f64 = 4.0;
 

@@ -5,8 +5,8 @@
 
 use glam::{DMat3, DVec3};
 use numpy::{
-    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3,
-    PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -542,6 +542,29 @@ pub fn field_zero() -> PyField {
         recipe: Vec::new(),
         unrecorded: 0,
     }
+}
+
+/// The B-spline coefficients `(nx+2, ny+2, nz+2)` interpolating distances sampled on
+/// `(nx, ny, nz)` nodes ([`grid::spline_coefficients`]).
+#[pyfunction]
+pub fn field_grid_coefficients<'py>(
+    py: Python<'py>,
+    values: PyReadonlyArray3<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let sh = values.shape();
+    let n = [sh[0], sh[1], sh[2]];
+    let v = slice_of("grid", &values)?;
+    let p = n.map(|k| k.saturating_add(2));
+    let out = empty::<f64, numpy::Ix3>(py, "grid coefficients", &p)?;
+    {
+        let mut rw = out.readwrite();
+        let o = slice_mut(&mut rw)?;
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            grid::spline_coefficients(v, n, o, &|| stop.requested())
+        })??;
+    }
+    Ok(out)
 }
 
 /// A grid's B-spline coefficients and their array shape (checked by the core).

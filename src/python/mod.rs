@@ -58,6 +58,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fields::field_torus, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_strip_curve, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(fields::field_grid_coefficients, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_path, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_zero, m)?)?;
     m.add_function(wrap_pyfunction!(fields::field_grid_curl, m)?)?;
