@@ -105,7 +105,10 @@ pub fn reserve<T>(what: &'static str, v: &mut Vec<T>, extra: usize) -> Result<()
 /// aborting when the next block cannot be had.
 pub fn push<T>(what: &'static str, v: &mut Vec<T>, x: T) -> Result<()> {
     if v.len() == v.capacity() {
-        reserve(what, v, 1)?;
+        // a full vector asks for about twice its length
+        v.try_reserve(1).map_err(|_| {
+            InputError::out_of_memory(what, v.len().saturating_mul(2), size_of::<T>())
+        })?;
     }
     v.push(x);
     Ok(())

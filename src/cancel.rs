@@ -647,7 +647,7 @@ mod tests {
         let p = curve(50_000);
         let run = |k: super::Cancel<'_>| {
             let mut out = vec![DVec3::ZERO; p.len()];
-            advect::eval_into(&field, &p, 0.0, &mut out, k);
+            advect::eval_into(&field, &p, 0.0, &mut out, k).expect("sizes match");
             out
         };
         let (got, _) = stop_everywhere(run);

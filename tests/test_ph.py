@@ -866,3 +866,36 @@ def test_garbage_never_gives_nan_and_inputs_are_copied():
     with pytest.raises(ValueError, match="^curve: bad Hermite data"):
         ph.fit(np.array([[0.0, 0, 0], [1, 0, 0], [1, 0, 0], [2, 1, 0]]),
                tangents=np.ones((4, 3)), segments=3)
+
+
+def test_from_quaternions_orders_starts_and_empty_input():
+    """(x, y, z, w) rows give the cubics of the same quaternions scalar first, one start
+    serves every row as the same start repeated does, and no rows give no cubics. The
+    control points are checked against the closed form b₁ = b₀ + A0 i A0*/3 …"""
+    rng = np.random.default_rng(7)
+    A0, A1 = random_quats(rng, 50)                       # scalar first
+    xyzw = lambda q: np.roll(q, -1, axis=1)
+    p = np.array([1.0, -2.0, 0.5])
+    a = ph.from_quaternions(A0, A1, p, scalar_first=True)
+    b = ph.from_quaternions(xyzw(A0), xyzw(A1), np.tile(p, (50, 1)))
+    np.testing.assert_array_equal(a, b)
+
+    def qmul(u, v):  # Hamilton product, scalar first
+        w0, x0, y0, z0 = u
+        w1, x1, y1, z1 = v
+        return np.array([w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
+                         w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
+                         w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
+                         w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1])
+
+    def aib(u, v):  # vector part of u i v*
+        return qmul(qmul(u, [0.0, 1.0, 0.0, 0.0]), v * [1, -1, -1, -1])[1:]
+
+    for i in (0, 17, 49):
+        b1 = p + aib(A0[i], A0[i]) / 3
+        b2 = b1 + (aib(A0[i], A1[i]) + aib(A1[i], A0[i])) / 6
+        b3 = b2 + aib(A1[i], A1[i]) / 3
+        np.testing.assert_allclose(a[i], [p, b1, b2, b3], rtol=0, atol=1e-12)
+    assert ph.from_quaternions(np.zeros((0, 4)), np.zeros((0, 4))).shape == (0, 4, 3)
+    with pytest.raises(ValueError, match=r"^start: expected \(3,\) or \(50, 3\)"):
+        ph.from_quaternions(A0, A1, np.zeros((2, 3)))

@@ -566,8 +566,21 @@ pub const BLOCK_SECONDS: f64 = 0.02;
 
 /// Evaluate the field at `points` into `out` (as many rows), polling `cancel` between
 /// blocks of points (`out` incomplete once it says stop; see [`crate::cancel`]).
-pub fn eval_into(field: &Field, points: &[DVec3], t: f64, out: &mut [DVec3], cancel: Cancel<'_>) {
+pub fn eval_into(
+    field: &Field,
+    points: &[DVec3],
+    t: f64,
+    out: &mut [DVec3],
+    cancel: Cancel<'_>,
+) -> crate::error::Result<()> {
+    if out.len() != points.len() {
+        return Err(crate::error::InputError::new(
+            "out",
+            "output buffer has the wrong size",
+        ));
+    }
     crate::cancel::fill_in_blocks(out, CHUNK, cancel, |i| field.eval(points[i], t));
+    Ok(())
 }
 
 #[cfg(test)]

@@ -486,6 +486,24 @@ impl GridTool {
     }
 }
 
+/// `x[c] = f(x[c], y[c])` over one row, in parallel pieces when `wide`.
+#[inline]
+fn zip_rows(x: &mut [f64], y: &[f64], wide: bool, f: impl Fn(f64, f64) -> f64 + Sync) {
+    use rayon::prelude::*;
+    let piece = |(x, y): (&mut [f64], &[f64])| {
+        for (x, &y) in x.iter_mut().zip(y) {
+            *x = f(*x, y);
+        }
+    };
+    if wide {
+        x.par_chunks_mut(1 << 12)
+            .zip(y.par_chunks(1 << 12))
+            .for_each(piece);
+    } else {
+        piece((x, y));
+    }
+}
+
 /// The coefficients, `(nx + 2) (ny + 2) (nz + 2)` in C order, of the natural cubic B-spline
 /// interpolating `values` sampled on a unit grid of `n = (nx, ny, nz)` nodes (C order),
 /// written into `out`. Per axis, on every line `d_0 … d_{m−1}` along it: `c_0 = d_0`,
@@ -531,8 +549,9 @@ pub fn spline_coefficients(
 }
 
 /// One axis of [`spline_coefficients`]: `src` of shape `(outer, m, inner)` into `dst` of
-/// shape `(outer, m + 2, inner)`, the `outer` slabs in parallel, each step of the recurrence
-/// over a whole row of `inner` values (as NumPy's planes). Returns `false` when stopped.
+/// shape `(outer, m + 2, inner)`, each step of the recurrence over a whole row of `inner`
+/// values (as NumPy's planes); in parallel over the slabs, and within the rows when they are
+/// long. Returns `false` when stopped.
 fn prefilter_axis(
     src: &[f64],
     m: usize,
@@ -559,6 +578,11 @@ fn prefilter_axis(
         }
         s
     };
+    // the first axis has a single slab: its parallelism is within the rows
+    let wide = inner >= 1 << 14;
+    let rows = |x: &mut [f64], y: &[f64], f: fn(f64, f64, f64) -> f64, w: f64| {
+        zip_rows(x, y, wide, |x, y| f(x, y, w));
+    };
     let slabs = dst
         .par_chunks_mut((m + 2) * inner)
         .zip(src.par_chunks(m * inner));
@@ -573,17 +597,10 @@ fn prefilter_axis(
             o[row(1)].copy_from_slice(&a[row(0)]);
             o[row(m)].copy_from_slice(&a[row(m - 1)]);
             for j in 0..k {
-                let (d, r) = (row(j + 1), row(j + 2));
-                for (x, &v) in o[r].iter_mut().zip(&a[d]) {
-                    *x = 6.0 * v;
-                }
+                rows(&mut o[row(j + 2)], &a[row(j + 1)], |_, v, _| 6.0 * v, 0.0);
             }
-            for (x, &v) in o[row(2)].iter_mut().zip(&a[row(0)]) {
-                *x -= v;
-            }
-            for (x, &v) in o[row(k + 1)].iter_mut().zip(&a[row(m - 1)]) {
-                *x -= v;
-            }
+            rows(&mut o[row(2)], &a[row(0)], |x, v, _| x - v, 0.0);
+            rows(&mut o[row(k + 1)], &a[row(m - 1)], |x, v, _| x - v, 0.0);
             for x in &mut o[row(2)] {
                 *x *= 0.25;
             }
@@ -593,32 +610,43 @@ fn prefilter_axis(
                 }
                 let w = 4.0 - cp[i - 1];
                 let (head, tail) = o.split_at_mut((i + 2) * inner);
-                for (x, &prev) in tail[..inner].iter_mut().zip(&head[(i + 1) * inner..]) {
-                    *x = (*x - prev) / w;
-                }
+                rows(
+                    &mut tail[..inner],
+                    &head[(i + 1) * inner..],
+                    |x, p, w| (x - p) / w,
+                    w,
+                );
             }
             for i in (0..k.saturating_sub(1)).rev() {
                 if step_polls && stop() {
                     return;
                 }
                 let (head, tail) = o.split_at_mut((i + 3) * inner);
-                for (x, &next) in head[(i + 2) * inner..].iter_mut().zip(&tail[..inner]) {
-                    *x -= cp[i] * next;
-                }
+                let next = &tail[..inner];
+                rows(
+                    &mut head[(i + 2) * inner..],
+                    next,
+                    |x, n, c| x - c * n,
+                    cp[i],
+                );
             }
+            // the ghosts 2c₁ − c₂ (first row from rows 1, 2; last from rows m, m − 1)
             let (first, rest) = o.split_at_mut(inner);
-            for ((g, &c1), &c2) in first
-                .iter_mut()
-                .zip(&rest[..inner])
-                .zip(&rest[inner..2 * inner])
-            {
-                *g = 2.0 * c1 - c2;
-            }
+            first.copy_from_slice(&rest[..inner]);
+            rows(
+                first,
+                &rest[inner..2 * inner],
+                |c1, c2, _| 2.0 * c1 - c2,
+                0.0,
+            );
             let (rest, last) = o.split_at_mut((m + 1) * inner);
-            let (cm1, cm) = (&rest[(m - 1) * inner..m * inner], &rest[m * inner..]);
-            for ((g, &c1), &c2) in last.iter_mut().zip(cm).zip(cm1) {
-                *g = 2.0 * c1 - c2;
-            }
+            last.copy_from_slice(&rest[m * inner..]);
+            rows(
+                last,
+                &rest[(m - 1) * inner..m * inner],
+                |c1, c2, _| 2.0 * c1 - c2,
+                0.0,
+            );
         });
     Ok(!stopped.into_inner())
 }

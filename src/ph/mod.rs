@@ -442,12 +442,14 @@ pub fn eval_into_cancellable(
 
 /// [`Cubic::from_quaternions`] row by row (preimages scalar first).
 pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result<Vec<Cubic>> {
-    let mut out = alloc::filled("ph.from_quaternions", a0.len(), [0.0; 12])?;
+    const CALL: &str = "ph.from_quaternions";
+    let mut out = alloc::filled(CALL, a0.len(), [0.0; 12])?;
     from_quaternion_rows_into(a0, a1, start, true, &mut out, &cancel::never)?;
-    Ok(out
-        .iter()
-        .map(|r| Cubic::new([0, 3, 6, 9].map(|k| DVec3::new(r[k], r[k + 1], r[k + 2]))))
-        .collect())
+    alloc::collect(
+        CALL,
+        out.iter()
+            .map(|r| Cubic::new([0, 3, 6, 9].map(|k| DVec3::new(r[k], r[k + 1], r[k + 2])))),
+    )
 }
 
 /// [`Cubic::from_quaternions`] row by row into `out` (one row `[b₀, b₁, b₂, b₃]` per pair of
@@ -463,11 +465,14 @@ pub fn from_quaternion_rows_into(
     cancel: Cancel<'_>,
 ) -> Result<()> {
     let m = a0.len();
-    if a1.len() != m || !(start.len() == m || start.len() == 1) || out.len() != m {
+    if a1.len() != m || !(start.len() == m || start.len() == 1) {
         return Err(InputError::new(
             "A0, A1, start",
             "must have the same number of rows (or one start)",
         ));
+    }
+    if out.len() != m {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
     }
     let finite = |arg: &'static str, rows: &[Quat]| {
         let bad = crate::frames::validate::first_bad_cancellable(

@@ -92,7 +92,7 @@ impl PyField {
             let stop = Stop::default();
             detach_stoppable(py, &stop, || {
                 deform::advect::eval_into(field, x, t, o, &|| stop.requested())
-            })?;
+            })??;
         }
         Ok(out)
     }

@@ -303,8 +303,12 @@ pub fn slerp_frames_cancellable(
             ),
         ));
     }
+    if out.len() != new_u.len() {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
     let q = from_frames_cancellable(frames, true, cancel)?;
-    if cancel() {
+    // a stopped conversion returns fewer rows
+    if q.len() != n || cancel() {
         return Ok(());
     }
     cancel::fill(out, cancel, |j| {

@@ -65,12 +65,13 @@ pub fn rows(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<usize> {
 /// The signed angle from `a[i]`'s reference vector to `b[i]`'s about `a[i]`'s tangent, for
 /// `n` rows (one of `a`, `b` may hold a single frame, used for every row).
 pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
-    let mut out = alloc::filled("spin", rows(a, b)?, 0.0)?;
+    let mut out = alloc::filled("spin", a.len().max(b.len()), 0.0)?;
     spin_into_cancellable(a, b, &mut out, &cancel::never)?;
     Ok(out)
 }
 
-/// [`spin`] into `out` (of [`rows`] rows), polling `cancel` in the checks and between blocks
+/// [`spin`] into `out` (of [`rows`] rows: `max(len a, len b)` when the lengths are valid),
+/// the frames checked before the lengths, polling `cancel` in the checks and between blocks
 /// of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
 pub fn spin_into_cancellable(
     a: &[[f64; 9]],
