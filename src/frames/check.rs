@@ -1,0 +1,186 @@
+//! The input checks of the driver: shapes, finite values, analytic samples, options that
+//! fit together, the distinct samples of a closed curve and the segments against the tangents.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::double_reflection::DoubleReflection;
+use super::request::{Analytic, Method, Request};
+use super::validate;
+use crate::error::{InputError, Result};
+
+/// `tangents` must have one row per point.
+pub(super) fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
+    if points.len() == tangents.len() {
+        return Ok(());
+    }
+    Err(InputError::new(
+        "tangents",
+        format!(
+            "shape ({}, 3) does not match points ({}, 3): one tangent per point",
+            tangents.len(),
+            points.len()
+        ),
+    ))
+}
+
+/// The shapes and values of the input, and the options that fit together; returns the
+/// number of rows.
+pub(super) fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
+    let rows = check_shapes(req, out)?;
+    if let Some(a) = req.analytic {
+        check_analytic(&a, rows)?;
+    }
+    check_options(req)?;
+    Ok(rows)
+}
+
+/// Row counts of the sample arrays and the output buffer, and finite samples.
+fn check_shapes(req: &Request, out: &[f64]) -> Result<usize> {
+    let rows = match (req.points, req.tangents) {
+        (Some(p), _) => p.len(),
+        (None, Some(t)) => t.len(),
+        (None, None) => return Err(InputError::new("points", "points or tangents are required")),
+    };
+    if let (Some(p), Some(t)) = (req.points, req.tangents) {
+        rows_match(p, t)?;
+    }
+    if rows < 2 {
+        return Err(InputError::new(
+            if req.analytic.is_some() {
+                "u"
+            } else if req.points.is_some() {
+                "points"
+            } else {
+                "tangents"
+            },
+            format!("need at least 2 samples, got {rows}"),
+        ));
+    }
+    if out.len() != 9 * rows {
+        return Err(InputError::new("out", "output buffer has the wrong size"));
+    }
+    if let Some(p) = req.points {
+        validate::finite("points", p)?;
+    }
+    if let Some(t) = req.tangents {
+        validate::finite("tangents", t)?;
+    }
+    Ok(rows)
+}
+
+/// The analytic samples: `rows` parameter values increasing strictly, `2·rows − 1` finite
+/// derivatives of each order.
+fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
+    if a.u.len() != rows || a.d1.len() != 2 * rows - 1 || a.d2.len() != 2 * rows - 1 {
+        return Err(InputError::new(
+            "u",
+            "analytic samples have inconsistent lengths",
+        ));
+    }
+    validate::finite_scalars("u", a.u)?;
+    validate::finite("points", a.d1)?;
+    validate::finite("points", a.d2)?;
+    if let Some(i) = a.u.windows(2).position(|w| !(w[1] > w[0])) {
+        return Err(InputError::new(
+            "u",
+            format!(
+                "parameter values must increase strictly (index {i} to {})",
+                i + 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The method, the tangents-only chords, the input they need and the end condition.
+fn check_options(req: &Request) -> Result<()> {
+    if req.method == Method::Rk4 && req.analytic.is_none() {
+        return Err(InputError::new(
+            "method",
+            "'rk4' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass a \
+             spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), u=200, \
+             method='rk4')",
+        ));
+    }
+    if req.tangent_chords && req.method != Method::DoubleReflection && req.method != Method::Frenet
+    {
+        return Err(InputError::new(
+            "reflection",
+            "'tangents' (tangents-only chords) applies to method='double_reflection' only",
+        ));
+    }
+    if req.points.is_none() && !req.tangent_chords {
+        return Err(InputError::new(
+            "points",
+            "points are required for this method",
+        ));
+    }
+    if req.closed && req.end.is_some() {
+        return Err(InputError::new(
+            "end",
+            "cannot be combined with closed=True (a closed curve's end is its start)",
+        ));
+    }
+    Ok(())
+}
+
+/// The number of distinct samples: a closed curve drops a repeated first sample at the end.
+pub(super) fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
+    if !req.closed {
+        return Ok(rows);
+    }
+    let repeat = match (req.points, req.tangents) {
+        (Some(p), _) => validate::coincide(p[rows - 1], p[0]),
+        (None, Some(t)) => validate::coincide(t[rows - 1], t[0]),
+        _ => false,
+    };
+    let mut n = rows;
+    if repeat {
+        n = rows - 1;
+    } else if req.analytic.is_some() {
+        return Err(InputError::new(
+            "u",
+            "closed=True on an analytic curve needs u to span whole periods \
+             (x(u_last) = x(u_first))",
+        ));
+    }
+    if n < 3 {
+        return Err(InputError::new(
+            "points",
+            format!("a closed curve needs at least 3 distinct points, got {n}"),
+        ));
+    }
+    Ok(n)
+}
+
+/// Every segment must run along its tangents; the projection method also needs each chord
+/// to cross the next normal plane.
+pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()> {
+    let (t, closed) = (dr.t, dr.closed);
+    let n = t.len();
+    if req.method != Method::Rk4 {
+        let what = if req.tangent_chords {
+            "tangents"
+        } else {
+            "points"
+        };
+        validate::aligned(t, closed, |i| dr.chord(i), what)?;
+    }
+    if req.method == Method::Projection {
+        let m = if closed { n } else { n - 1 };
+        if let Some(i) = (0..m).into_par_iter().position_first(|i| {
+            let d = dr.chord(i);
+            !(d.dot(t[(i + 1) % n]) > 1e-9 * d.length())
+        }) {
+            return Err(InputError::new(
+                "points",
+                format!(
+                    "the projection method needs each chord to cross the next normal plane; \
+                     the segment from row {i} lies in it; sample more densely"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
