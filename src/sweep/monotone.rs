@@ -20,7 +20,7 @@ use std::collections::BTreeMap;
 
 use glam::DVec2;
 
-use super::profile::orient;
+use super::predicates::orient;
 use crate::cancel::{self, BLOCK, Cancel};
 use crate::error::Result;
 
@@ -397,8 +397,9 @@ pub fn triangulate(q: &[DVec2], cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::predicates::{accurate_area2, accurate_cover2};
+    use crate::sweep::profile::Profile;
     use crate::sweep::profile::fixtures::{Rng, star_shaped};
-    use crate::sweep::profile::{Profile, accurate_area2, accurate_cover2};
     use std::collections::HashMap;
 
     /// Check that `tris` triangulates the counter-clockwise simple polygon `q`: `m − 2`
