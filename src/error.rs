@@ -23,6 +23,9 @@ pub enum ErrorKind {
     Invalid,
     /// A buffer sized by the input could not be allocated.
     OutOfMemory,
+    /// Consecutive samples that coincide: invalid as given, which the Python layer answers
+    /// by merging them (`frames::validate::distinct_rows`) where it can.
+    Repeated,
 }
 
 impl InputError {
@@ -61,6 +64,11 @@ impl InputError {
             msg: format!("out of memory: {msg}"),
             kind: ErrorKind::OutOfMemory,
         }
+    }
+
+    /// The same error of another kind.
+    pub fn with_kind(self, kind: ErrorKind) -> Self {
+        InputError { kind, ..self }
     }
 
     /// The same error with a prefix locating it (used for curve bundles).

@@ -135,10 +135,13 @@ def test_D19_distinct_points_a_few_ulps_apart_far_from_the_origin():
     x = np.c_[1e12 + np.arange(5) * 1e-3, np.zeros(5), np.zeros(5)]
     f = spinal.frames(x)
     np.testing.assert_allclose(f[:, :, 2], np.tile([1.0, 0, 0], (5, 1)), atol=1e-12)
-    # exact repeats are still refused
-    x[3] = x[2]
-    with pytest.raises(ValueError, match="points: rows 2 and 3 coincide"):
-        spinal.frames(x)
+    # exact repeats (and samples within 2⁻⁴⁰ of the curve's size) are merged
+    y = x.copy()
+    y[3] = y[2]
+    np.testing.assert_array_equal(spinal.frames(y), spinal.frames(np.delete(x, 3, axis=0))[
+        [0, 1, 2, 2, 3]])
+    y[3, 0] = y[2, 0] + 4e-3 * 2.0**-40 * 0.9  # 4e-3 long: under the floor
+    assert np.array_equal(spinal.frames(y)[3], spinal.frames(y)[2])
 
 
 def test_D20_huge_finite_vectors_do_not_overflow():

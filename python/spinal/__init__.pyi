@@ -204,6 +204,7 @@ def sweep(
     uv: bool = True,
     point_data: _PointData | None = None,
     on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
 ) -> Mesh: ...
 def tube(
     points: _Array | _Curves,
@@ -225,6 +226,7 @@ def tube(
     uv: bool = True,
     point_data: _PointData | None = None,
     on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------

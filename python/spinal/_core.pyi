@@ -36,6 +36,13 @@ def frames_analytic(
     end_frames: npt.NDArray[np.float64] | None,
     turns: int,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
+class RepeatedPointsError(ValueError): ...
+
+def distinct_rows(
+    points: npt.NDArray[np.float64],
+    offsets: npt.NDArray[np.int64],
+    closed: bool,
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.uint8]]: ...
 def estimate_tangents(
     points: npt.NDArray[np.float64],
     closed: bool,

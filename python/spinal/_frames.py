@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
+from . import _core, _merge
 from ._steer import previous_frames, steering
 from ._validate import (
     MAX_SAMPLES,
@@ -131,10 +131,16 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     # reflection="tangents": the chords of double reflection come from a quadrature of the
     # tangents (the core's `tangent_chords` flag)
     chords_from_tangents = reflection == "tangents"
-    out, angles = _core.frames_sampled(
-        pts, tgs, offs, method, DEFAULT_TANGENT_RULE, chords_from_tangents, closed,
-        iv, if_, ev, ef, turns, points_arg,
-    )
+
+    def run(pts, offs, tgs):
+        return _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE,
+                                    chords_from_tangents, closed, iv, if_, ev, ef, turns,
+                                    points_arg)
+
+    if pts is None:
+        out, angles = run(pts, offs, tgs)
+    else:  # consecutive repeated samples merged
+        out, angles = _merge.on_rows(run, pts, offs, closed, bundle, (tgs,), points_arg)
     return out, angles, bundle
 
 
@@ -309,9 +315,10 @@ def frames(
         Non-numeric input, wrong argument types.
     ValueError
         Wrong shapes, fewer than 2 points (3 for a closed curve), NaN/inf, repeated
-        consecutive points (zero-length segments), zero tangents, a cusp or a segment whose
-        chord runs against its tangents (``(x_{i+1} − x_i)·(t_i + t_{i+1}) ≤ 0``: a reversal
-        or far too coarse a sampling), an ``initial``/``end`` vector parallel to the tangent,
+        consecutive points (zero-length segments), zero tangents, an exact reversal, a
+        segment whose chord runs against given ``tangents`` (``(x_{i+1} − x_i)·(t_i +
+        t_{i+1}) ≤ 0``; estimated tangents never do, see :func:`estimate_tangents`), an
+        ``initial``/``end`` vector parallel to the tangent,
         a constraint row out of range or a constraint parallel to its tangent, a ``guide`` or
         ``previous`` of the wrong shape. The message names the argument and the row.
 
@@ -385,9 +392,9 @@ def estimate_tangents(
 
     * ``"five_point_bounded"`` (default): ``"five_point"`` below, with each open end tangent
       bounded by the turn of the last two chords: with ``ĉ`` the end chord and ``φ`` its
-      angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than ``φ``
-      from ``ĉ`` is turned towards ``ĉ`` onto the cone ``∠(t, ĉ) = φ`` (in the plane of ``ĉ``
-      and ``t``). On smooth samplings the exact end tangent leans ``κh/2 + O(h²)`` from the
+      angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than
+      ``min(φ, 45°)`` from ``ĉ`` is turned towards ``ĉ`` onto the cone
+      ``∠(t, ĉ) = min(φ, 45°)`` (in the plane of ``ĉ`` and ``t``). On smooth samplings the exact end tangent leans ``κh/2 + O(h²)`` from the
       end chord, inside the cone, so the estimate stays O(h⁴) there; on coarse samplings
       (e.g. 20-point streamlines) the one-sided quartic extrapolates the last bends and can
       lean far past the end chord (chisel-shaped tube ends), which the bound removes. The
@@ -414,7 +421,28 @@ def estimate_tangents(
     * ``"circle"``: the tangent of the circle through each point and its two neighbours,
       ``|b|² a + |a|² b`` with ``a = x_i − x_{i−1}``, ``b = x_{i+1} − x_i`` (Zheng 2008 §7.1,
       whose printed weights ``|b| a + |a| b`` are exact only for equal chords); exact on
-      circles for any spacing, O(h²) in general.
+      circles for any spacing (with turns under 30° per sample, see below), O(h²) in general.
+
+    Every rule ends with a chord guard, so that tangents exist on any polyline and tubes
+    keep their cross-section through its corners. With ``p̂, q̂`` the unit chords at a sample,
+    ``φ`` the turn between them and ``b̂`` their bisector (the tangent of a corner: the
+    straight tubes about the two chords meet in its normal plane):
+
+    1. where the chords turn by more than 30° (fewer than 12 samples per turn of a circle),
+       the estimate is blended towards ``b̂``, ``t = normalise((1 − w) t₀ + w b̂)`` with ``w``
+       the smoothstep ``3s² − 2s³`` of ``s = (cos 30° − cos φ)/(cos 30° − cos 60°)`` clamped
+       to [0, 1]: the bisector itself from 60° on;
+    2. where the result still points more than about 60° away from a chord (margin
+       ``m = min(t·p̂, t·q̂) / cos(φ/2)`` below 1/2; 1 for the bisector), it is blended
+       towards ``b̂`` with ``w = min(1, 1 − 2m)``, which leaves a margin of at least
+       ``cos(φ/2)/2`` against both chords.
+
+    Both steps are continuous in the points. Then every segment runs along the tangents at
+    its ends (``(x_{i+1} − x_i)·(t_i + t_{i+1}) > 0``) short of an exact reversal, where the
+    tangent is normal to the chord. Samplings that turn by less than 30° per sample with
+    estimates within 60° of both chords (any reasonably sampled smooth curve) are never
+    touched, so the orders above hold there. The unbounded rules' open end tangents
+    (``"five_point"``, ``"five_point_uniform"``) are left as their stencils give them.
 
     With 3–4 points the circle rule is used, with 2 points the chord. A closed curve may
     repeat its first point at the end (that row gets the first tangent). ``lengths`` /
@@ -422,15 +450,24 @@ def estimate_tangents(
     its own, in parallel; ``closed`` applies to every curve); ``points`` may also be a list
     (any sequence) of ``(n_i, 3)`` arrays, e.g. nibabel's ``ArraySequence``, whose tangents
     come back to back in one array. Raises ValueError for NaN/inf,
-    repeated consecutive points and cusps (the estimate vanishes), naming the row (and the
-    curve, in a bundle).
+    repeated consecutive points and exact reversals (the estimate vanishes), naming the row
+    (and the curve, in a bundle).
     """
     method = as_choice(method, "method", TANGENT_RULES)
     closed = as_bool(closed, "closed")
     if not is_curve_list(points) and lengths is None and offsets is None:
-        return _core.estimate_tangents(as_points(points, "points"), closed, method)
-    pts, offs, _ = as_curves(points, lengths, offsets)
-    return _core.estimate_tangents(pts, closed, method, offs)
+        pts = as_points(points, "points")
+        offs, bundle = np.array([0, len(pts)], dtype=np.int64), False
+
+        def run(pts, offs):
+            return _core.estimate_tangents(pts, closed, method)
+    else:
+        pts, offs, bundle = as_curves(points, lengths, offsets)
+
+        def run(pts, offs):
+            return _core.estimate_tangents(pts, closed, method, offs)
+    # consecutive repeated samples merged (they get the tangent of the row they join)
+    return _merge.on_rows(run, pts, offs, closed, bundle)
 
 
 def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,

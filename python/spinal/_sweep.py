@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import functools
 import re
 import warnings
 
 import numpy as np
 
-from . import _core
+from . import _core, _merge
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
 from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
 from ._validate import (
@@ -88,6 +89,7 @@ def sweep(
     uv: bool = True,
     point_data=None,
     on_short: str = "raise",
+    on_invalid: str = "raise",
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -152,8 +154,8 @@ def sweep(
         How the tangents are estimated when neither ``frames`` nor ``tangents`` is given:
         a ``method`` of :func:`spinal.estimate_tangents` — ``"five_point_bounded"`` (default:
         the 4th-order five-point chord-length rule whose end tangents lean from the end chord
-        by at most the turn of the last two chords, so coarse spines get no chisel-shaped
-        ends), ``"five_point"`` (ends unbounded), ``"five_point_uniform"`` or ``"circle"``.
+        by at most the turn of the last two chords and at most 45°, so coarse spines get no
+        chisel-shaped ends), ``"five_point"`` (ends unbounded), ``"five_point_uniform"`` or ``"circle"``.
     dtype : "float64" or "float32" (or numpy.float64, numpy.float32)
         Precision of ``vertices``, ``normals`` and ``uv``. With ``float32`` everything is
         still computed in double precision and stored rounded (the same topology, vertices
@@ -171,6 +173,16 @@ def sweep(
         What to do with curves of a bundle that have too few rows to sweep (0 or 1; 2 on a
         closed spine): refuse them (ValueError) or leave them out, with a
         :class:`SkippedCurvesWarning` naming them and ``Mesh.skipped_curves``.
+    on_invalid : {"raise", "skip"}
+        What to do with curves (of a bundle, or the one curve) that hold a NaN or an
+        infinity or have fewer than 2 (closed: 3) distinct points: refuse them (ValueError
+        naming the curve and row) or leave them out like ``on_short="skip"`` (a
+        :class:`SkippedCurvesWarning` naming them and why; ``Mesh.skipped_curves``).
+
+    Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
+    bounding box's largest side) are one point: they are merged into the first of them,
+    which gets the ring (its ``point_data`` is the ring's; ``sample_of`` names it; the
+    ``scale``/``twist``/``frames`` of the rows merged into it are not used).
 
     Returns
     -------
@@ -187,7 +199,7 @@ def sweep(
     Raises
     ------
     ValueError, TypeError
-        Bad shapes, non-finite values, repeated consecutive points, a self-intersecting or
+        Bad shapes, non-finite values (unless ``on_invalid="skip"``), a self-intersecting or
         zero-area profile, non-positive scale, frames that are not rotations or whose
         tangent at some row runs against the spine (a negative dot product with both
         chords at the row, with the one chord at an open end: a reversed frame, or frames
@@ -205,7 +217,8 @@ def sweep(
     """
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
-                       tangents, tangent_rule, dtype, normals, uv, point_data, on_short)
+                       tangents, tangent_rule, dtype, normals, uv, point_data, on_short,
+                       on_invalid)
 
 
 def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
@@ -233,7 +246,8 @@ def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
 def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
-                normals=True, uv=True, point_data=None, on_short="raise") -> Mesh:
+                normals=True, uv=True, point_data=None, on_short="raise",
+                on_invalid="raise") -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     pts, offs, bundle = as_curves(points, lengths, offsets)
@@ -247,6 +261,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     want_normals = as_bool(normals, "normals")
     want_uv = as_bool(uv, "uv")
     on_short = as_choice(on_short, "on_short", ("raise", "skip"))
+    on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
     miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
@@ -265,46 +280,79 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     tw = None if twist is None else as_per_row(twist, "twist", n)
     pdata = _point_data(point_data, n, curves if bundle else None)
     # curves too short to sweep: refused by the core (on_short="raise") or left out here
-    row0, curve_ids, skipped = offs[:-1], np.arange(curves), np.zeros(0, dtype=np.int64)
-    keep_rows = None
+    # and curves with NaN/inf or too few distinct points (on_invalid)
+    curve_ids, skipped = np.arange(curves), np.zeros(0, dtype=np.int64)
+    keep_rows = None  # the given rows swept, where some are left out
+    need = 3 if closed else 2
+    counts = lens if lens is not None else (np.array([n]) if not bundle else None)
+    short = np.zeros(curves, dtype=bool)
     if on_short == "skip" and lens is not None:
-        short = lens < (3 if closed else 2)
+        short = lens < need
         if short.any():
-            skipped = np.flatnonzero(short).astype(np.int64)
-            keep_rows = np.repeat(~short, lens)
-            pts = np.ascontiguousarray(pts[keep_rows])
-            fr = None if fr is None else np.ascontiguousarray(fr[keep_rows])
-            tg = None if tg is None else np.ascontiguousarray(tg[keep_rows])
-            if sc.shape[0] > 1:
-                sc = np.ascontiguousarray(sc[keep_rows])
-            tw = None if tw is None else np.ascontiguousarray(tw[keep_rows])
-            row0, curve_ids = row0[~short], curve_ids[~short]
-            offs = np.concatenate([[0], np.cumsum(lens[~short])]).astype(np.int64)
             warnings.warn(SkippedCurvesWarning(
-                f"points: left out {len(skipped)} curve(s) with fewer than "
-                f"{3 if closed else 2} points (on_short='skip'): {_ranges(skipped)}; see "
-                f"Mesh.skipped_curves", skipped), stacklevel=3)
+                f"points: left out {int(short.sum())} curve(s) with fewer than {need} points "
+                f"(on_short='skip'): {_ranges(np.flatnonzero(short))}; see "
+                f"Mesh.skipped_curves", np.flatnonzero(short)), stacklevel=3)
+    if on_invalid == "skip" and counts is not None:
+        status = _merge.plan(pts, offs, closed).status
+        nan, few = status == _merge.NON_FINITE, (status == _merge.TOO_FEW) & ~short
+        if (nan | few).any():
+            parts = [f"with NaN or inf: {_ranges(np.flatnonzero(nan))}"] if nan.any() else []
+            if few.any():
+                parts.append(f"with fewer than {need} distinct points: "
+                             f"{_ranges(np.flatnonzero(few))}")
+            warnings.warn(SkippedCurvesWarning(
+                f"points: left out {int((nan | few).sum())} invalid curve(s) "
+                f"(on_invalid='skip'): {'; '.join(parts)}; see Mesh.skipped_curves",
+                np.flatnonzero(nan | few)), stacklevel=3)
+            short = short | nan | few
+    if short.any():
+        skipped = np.flatnonzero(short).astype(np.int64)
+        keep_rows = np.repeat(~short, counts)
+        pts, fr, tg, sc, tw = _cut(keep_rows, pts, fr, tg, sc, tw)
+        curve_ids = curve_ids[~short]
+        offs = np.concatenate([[0], np.cumsum(counts[~short])]).astype(np.int64)
     if offs.size == 1:  # every curve left out
         mesh = Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)),
                     np.zeros((0, 2)), skipped_curves=skipped)
         mesh.point_data = {k: a[:0] for k, (a, _) in pdata.items()}
         mesh._n_rows, mesh._n_curves = n, curves
         return mesh
-    try:
+    given = _orig_offsets(lens, n)
+
+    def core(pts, offs, fr, tg, sc, tw):
         fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
-        v, f, nrm, uv, folds, faces_per_curve = _core.sweep_mesh(
+        return _core.sweep_mesh(
             pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
             profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
             single, single, want_normals, want_uv, tg,
         )
+
+    try:
+        try:
+            v, f, nrm, uv, folds, faces_per_curve = core(pts, offs, fr, tg, sc, tw)
+        except _core.RepeatedPointsError:
+            # consecutive repeated samples: merged (a ring for the first row of each group)
+            p = _merge.plan(pts, offs, closed)
+            err = _merge.too_few_error(p, offs, closed, bundle)
+            if err is not None:
+                raise err from None
+            pts, fr, tg, sc, tw = _cut(p.keep, pts, fr, tg, sc, tw)
+            offs = p.offsets
+            if keep_rows is None:
+                keep_rows = p.keep
+            else:
+                keep_rows[keep_rows] = p.keep
+            v, f, nrm, uv, folds, faces_per_curve = core(pts, offs, fr, tg, sc, tw)
     except ValueError as exc:
-        if keep_rows is None:
+        if curve_ids.size == curves:
             raise
         # the core numbered the curves that were kept: back to the curves as given
-        raise ValueError(_as_given(str(exc), curve_ids, _orig_offsets(lens, n))) from None
-    if folds.size and keep_rows is not None:  # back to the rows as given
-        folds = np.flatnonzero(keep_rows)[folds]
-    rings, _ = _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, len(v))
+        raise ValueError(_as_given(str(exc), curve_ids, given)) from None
+    row_of = None if keep_rows is None else np.flatnonzero(keep_rows)
+    if folds.size and row_of is not None:  # back to the rows as given
+        folds = row_of[folds]
+    rings, _ = _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, len(v))
     if folds.size:
         where = f"spine rows {_ranges(folds)}"
         fold_curves = None
@@ -393,12 +441,20 @@ def _point_data(data, n: int, curves: int | None) -> dict:
     return out
 
 
-def _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, nv):
+def _cut(keep, pts, fr, tg, sc, tw):
+    """The per-row inputs of a sweep on the rows ``keep`` (a scale of one row stays)."""
+    def cut(a):
+        return None if a is None else np.ascontiguousarray(a[keep])
+    return cut(pts), cut(fr), cut(tg), (cut(sc) if sc.shape[0] > 1 else sc), cut(tw)
+
+
+def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv):
     """The stored rings of a sweep, as the core lays them out: per curve, one ring per
     distinct sample (a closed curve's repeated first point has none; split seams on a
-    closed curve repeat its first ring at the end). Returns a function giving ``(ring_sample,
-    ring_curve, cols)`` (given rows and curves; O(rings) memory, so only built when asked
-    for) and the first vertex of every curve ``(C + 1,)``."""
+    closed curve repeat its first ring at the end). ``row_of``: the given row of every row
+    swept (None: the same). Returns a function giving ``(ring_sample, ring_curve, cols)``
+    (given rows and curves; O(rings) memory, so only built when asked for) and the first
+    vertex of every curve ``(C + 1,)``."""
     lens = np.diff(offs)
     rings = lens.copy()
     if closed:
@@ -412,14 +468,20 @@ def _ring_layout(pts, offs, row0, curve_ids, closed, split_seams, nv):
     if cols * total != nv:
         raise RuntimeError("spinal: the sweep's vertex layout is not one ring per sample")
     starts = np.concatenate([[0], np.cumsum(stored)])
-
-    def per_ring():
-        local = np.arange(total) - np.repeat(starts[:-1], stored)
-        sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
-        return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64),
-                cols)
-
+    per_ring = functools.partial(_per_ring, offs[:-1], stored, rings, starts, row_of,
+                                 curve_ids, cols)
     return per_ring, starts * cols
+
+
+def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols):
+    """``(ring_sample, ring_curve, cols)`` of :func:`_ring_layout` (a module-level function
+    bound with :func:`functools.partial`, so meshes that hold it pickle)."""
+    total = int(starts[-1])
+    local = np.arange(total) - np.repeat(starts[:-1], stored)
+    sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
+    if row_of is not None:
+        sample = row_of[sample]
+    return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64), cols)
 
 
 def tube(
@@ -442,6 +504,7 @@ def tube(
     uv: bool = True,
     point_data=None,
     on_short: str = "raise",
+    on_invalid: str = "raise",
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -451,7 +514,7 @@ def tube(
     ``radius``: scalar or (n,) positive values (one per spine row), or for a bundle (C,)
     (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
     Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
-    ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``) as in
+    ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``) as in
     :func:`sweep`.
     """
     # the core sees only the polygon built here
@@ -463,4 +526,4 @@ def tube(
     # the core checks the radius' values, naming radius
     return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
-                       dtype, normals, uv, point_data, on_short)
+                       dtype, normals, uv, point_data, on_short, on_invalid)

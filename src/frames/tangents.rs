@@ -17,13 +17,20 @@
 //! * Bounded ends (the default rule, `FivePointBounded`): the five-point chord-length rule
 //!   with each open end tangent kept inside the cone about the end chord `ĉ` whose
 //!   half-angle is the turn `φ` between the end chord and its neighbour (the discrete
-//!   curvature at the end, `φ ≈ κh`); a tangent leaning further is turned towards `ĉ` onto
-//!   the cone, in the plane of `ĉ` and the tangent. On a smooth curve the exact end tangent
+//!   curvature at the end, `φ ≈ κh`), and never wider than 45°; a tangent leaning further is
+//!   turned towards `ĉ` onto the cone, in the plane of `ĉ` and the tangent. On a smooth curve the exact end tangent
 //!   leans `κh/2 + O(h²)` from the end chord, half the cone, so fine samplings keep the 4th
 //!   order untouched; on coarse samplings (20-point streamlines) the one-sided quartic
 //!   extrapolates the last bends and overshoots, which made chisel-shaped tube ends. (The
 //!   cone is ours: Wang et al. §6.1 give only the one-sided stencils; the circle rule of
 //!   Zheng §7.1 at an end leans exactly by the circle's half-turn, inside the same cone.)
+//! * Chord guard (every rule, at every sample with two chords; [`guard_chords`]): where the
+//!   chords turn by more than 30° the estimate is blended towards their bisector, the tangent
+//!   of a corner (fully from 60° on), and an estimate that points more than about 60° from
+//!   either chord is turned towards the bisector until its margin against both chords is at
+//!   least half the bisector's. So no segment of a jagged polyline (a random walk, a coarse
+//!   streamline, a hairpin) runs against its tangents, and tubes keep their cross-section
+//!   through sharp corners. Smooth samplings never reach it.
 //! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
 //!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
 //!   samples come from a uniform step of a smooth parameterisation):
@@ -58,7 +65,7 @@ pub enum TangentRule {
     /// at least 5 points, else the circle rule (3–4 points) or the chord (2 points).
     FivePoint,
     /// [`TangentRule::FivePoint`] with bounded open ends (the default): an end tangent leans
-    /// from the end chord by at most the turn between the last two chords.
+    /// from the end chord by at most the turn between the last two chords, and at most 45°.
     FivePointBounded,
     /// The uniform five-point stencils of the TOG paper (index as parameter).
     FivePointUniform,
@@ -338,10 +345,23 @@ pub fn estimate_cancellable(
                     let v = raw_tangent(x, chords, i, closed, rule, five);
                     let l = v.length();
                     let u = v * (1.0 / l);
+                    let interior = closed || (i > 0 && i + 1 < n);
                     if !(l > 0.0 && u.is_finite()) {
-                        DVec3::ZERO
-                    } else if five && chordal {
-                        guard_overshoot(x, i, closed, u)
+                        // the neighbours cancel (a symmetric reversal): the chord guard's
+                        // bisector, at a sample with two chords
+                        if !(interior && v == DVec3::ZERO) {
+                            return DVec3::ZERO;
+                        }
+                    }
+                    let u = match (l > 0.0, five && chordal) {
+                        (false, _) => DVec3::ZERO,
+                        (true, true) => guard_overshoot(x, i, closed, u),
+                        (true, false) => u,
+                    };
+                    if interior {
+                        let ii = i as isize;
+                        let (a, b) = (x[idx(ii - 1, n, closed)], x[idx(ii + 1, n, closed)]);
+                        guard_chords(x[i] - a, b - x[i], u)
                     } else {
                         u
                     }
@@ -353,6 +373,11 @@ pub fn estimate_cancellable(
             let ti = t[inner];
             let c = chord.normalize_or_zero();
             t[end] = (2.0 * c.dot(ti) * c - ti).normalize_or_zero();
+            if rule == TangentRule::FivePointBounded {
+                // the default rule's end cone also on 3 and 4 points (the circle's end
+                // tangent leans by half its turn over the end chord, up to 90°)
+                t[end] = bound_end(x, end, t[end]);
+            }
         }
     }
     match first_zero(&t) {
@@ -377,9 +402,17 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
     })
 }
 
+/// Cosine of the widest end cone of [`bound_end`], 45°.
+pub const END_CONE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
 /// The end tangent `u` at the open end `i` (0 or n − 1, `n ≥ 3`), turned towards the end
-/// chord `ĉ` onto the cone of half-angle `φ = ∠(ĉ, p̂)` about it (`p̂` the neighbouring chord)
-/// where it leans further than `φ`; unchanged inside the cone.
+/// chord `ĉ` onto the cone of half-angle `min(φ, 45°)` about it, `φ = ∠(ĉ, p̂)` (`p̂` the
+/// neighbouring chord), where it leans further; unchanged inside the cone. The 45° cap
+/// keeps the end faces of coarse tubes within 45° of their end chord however sharply the
+/// last chords turn (a smooth curve's end leans `κh/2`, far inside it). Where the end chords
+/// turn by more than 30° (a corner of the polyline, as [`guard_chords`] has it) the result
+/// is then blended towards `ĉ` with the same smoothstep weight, `ĉ` itself from 60° on: the
+/// end of a coarse polyline is cut square to its last chord.
 #[inline]
 pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
     let n = x.len();
@@ -391,18 +424,32 @@ pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
     let (Some(c), Some(p)) = (c.try_normalize(), p.try_normalize()) else {
         return u;
     };
-    let cos_phi = c.dot(p);
-    if u.dot(c) >= cos_phi {
-        return u;
+    // the cone's half-angle: the turn φ of the end chords, at most 45°
+    let d = c.dot(p);
+    let (cos_phi, sin_phi) = match d {
+        d if d >= END_CONE_COS => (d, c.cross(p).length()),
+        _ => (END_CONE_COS, END_CONE_COS),
+    };
+    let u = if u.dot(c) >= cos_phi {
+        u
+    } else {
+        // the direction of the lean in the normal plane of ĉ; for a tangent along −ĉ, the
+        // turn of the chords continued (away from p̂), or any normal on a straight end
+        let side = (u - u.dot(c) * c)
+            .try_normalize()
+            .or_else(|| (c * cos_phi - p).try_normalize())
+            .unwrap_or_else(|| super::geometry::any_perpendicular(c));
+        (cos_phi * c + sin_phi * side).normalize_or(c)
+    };
+    // a corner next to the end (a turn over 30°): towards the end chord, as the chord guard
+    // turns interior tangents towards the bisector, fully from 60° on
+    let s = ((CORNER_COS[0] - d) / (CORNER_COS[0] - CORNER_COS[1])).clamp(0.0, 1.0);
+    if s > 0.0 {
+        let w = s * s * (3.0 - 2.0 * s);
+        ((1.0 - w) * u + w * c).normalize_or(c)
+    } else {
+        u
     }
-    // the direction of the lean in the normal plane of ĉ; for a tangent along −ĉ, the turn
-    // of the chords continued (away from p̂), or any normal on a straight end
-    let side = (u - u.dot(c) * c)
-        .try_normalize()
-        .or_else(|| (c * cos_phi - p).try_normalize())
-        .unwrap_or_else(|| super::geometry::any_perpendicular(c));
-    let sin_phi = c.cross(p).length();
-    (cos_phi * c + sin_phi * side).normalize_or(c)
 }
 
 /// The guarded five-point chord-length tangent of [`TangentRule::FivePoint`] at `i` of an
@@ -423,10 +470,107 @@ pub fn five_point_unit_unbounded(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64
     };
     let l = v.length();
     let u = v * (1.0 / l);
-    if !(l > 0.0 && u.is_finite()) {
-        return None;
+    let interior = i > 0 && i + 1 < n;
+    let u = match (l > 0.0 && u.is_finite(), interior && v == DVec3::ZERO) {
+        (true, _) => guard_overshoot(x, i, false, u),
+        // the neighbours cancel (a symmetric reversal): the chord guard's bisector
+        (false, true) => DVec3::ZERO,
+        (false, false) => return None,
+    };
+    Some(if interior {
+        guard_chords(x[i] - x[i - 1], x[i + 1] - x[i], u)
+    } else {
+        u
+    })
+}
+
+/// Smallest accepted margin of an estimated tangent against the chords at its sample,
+/// relative to the bisector's (see [`guard_chords`]).
+pub const CHORD_MARGIN: f64 = 0.5;
+
+/// `|p̂ + q̂| = 2 cos(φ/2)` at or below which two unit chords reverse (a turn within 10⁻⁶ rad
+/// of 180°): their bisector would be rounding noise (see [`guard_chords`]).
+const REVERSAL: f64 = 1e-6;
+
+/// Cosine of the turn between two chords below which an estimate is left alone (30°), and
+/// of the turn from which the bisector replaces it (60°); see [`guard_chords`].
+pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
+
+/// The unit tangent `u` estimated at a sample between the chords `c_in = x_i − x_{i−1}` and
+/// `c_out = x_{i+1} − x_i`, turned towards their bisector where the polyline turns sharply
+/// there or where `u` points too far from either chord.
+///
+/// With `p̂, q̂` the unit chords and `φ` the turn between them, the bisector
+/// `b̂ = (p̂ + q̂)/|p̂ + q̂|` is the tangent of a corner: the normal plane of `b̂` is the plane
+/// in which the straight tubes about the two chords meet, and `b̂·p̂ = b̂·q̂ = cos(φ/2)`, larger
+/// than the smaller dot product of any other unit vector. Two steps, each continuous in the
+/// points:
+///
+/// 1. **Corners.** Where the chords turn by more than 30° the samples no longer resolve a
+///    smooth curve (fewer than 12 samples per turn of a circle), and the estimate, which
+///    interpolates across the corner, is blended towards `b̂`:
+///    `u ← normalise((1 − w) u + w b̂)` with `w` the smoothstep `3s² − 2s³` of
+///    `s = (cos 30° − cos φ)/(cos 30° − cos 60°)` clamped to `[0, 1]`: the bisector itself
+///    from 60° on, so tubes of coarse polylines keep their cross-section through corners.
+/// 2. **Margin.** With `m = min(u·p̂, u·q̂) / cos(φ/2)` (1 for the bisector), an estimate with
+///    `m < ½` (pointing more than about 60° from a chord: a quartic overshooting next to very
+///    uneven chords) becomes `normalise((1 − w) u + w b̂)`, `w = min(1, (½ − m)/½)`, whose
+///    margin against both chords is at least `½ cos(φ/2)`.
+///
+/// So every segment runs along the tangents of its ends (`ĉ·(t_i + t_{i+1}) > 0`) short of
+/// an exact reversal, and double reflection and the sweep's rings exist on any polyline (a
+/// jagged random walk, a coarse streamline, a hairpin). At an exact reversal (`p̂ = −q̂`) the
+/// result is normal to the chord, the limit of the bisectors of near reversals.
+///
+/// A smooth curve sampled with turns under 30° and estimates within 60° of both chords (the
+/// cheap test made first) keeps its 4th-order estimate bit for bit. (Our rule: Wang et al.
+/// 2008 §4.4 only require that no segment runs against its tangents.)
+#[inline(always)]
+pub fn guard_chords(c_in: DVec3, c_out: DVec3, u: DVec3) -> DVec3 {
+    let (a, b) = (u.dot(c_in), u.dot(c_out));
+    let m2 = CHORD_MARGIN * CHORD_MARGIN;
+    if c_in.dot(c_out) >= CORNER_COS[0] * (c_in.length() * c_out.length())
+        && a >= 0.0
+        && b >= 0.0
+        && a * a >= m2 * c_in.length_squared()
+        && b * b >= m2 * c_out.length_squared()
+    {
+        return u;
     }
-    Some(guard_overshoot(x, i, false, u))
+    towards_bisector(c_in, c_out, u)
+}
+
+/// The two steps of [`guard_chords`] past its cheap test.
+#[cold]
+fn towards_bisector(c_in: DVec3, c_out: DVec3, u: DVec3) -> DVec3 {
+    let scale = crate::math::scale::normalize;
+    let (Some(p), Some(q)) = (scale(c_in), scale(c_out)) else {
+        return u; // a zero chord: refused by the chord check
+    };
+    let sum = p + q;
+    if !(sum.length() > REVERSAL) {
+        // a reversal (the curve turns back onto its last chord, to within 10⁻⁶ rad, where
+        // the bisector would be the rounding of p + q): no direction runs forwards along
+        // both chords; the limit of the bisectors of near reversals is normal to the
+        // chord, on the side the estimate leans to
+        return (u - u.dot(p) * p)
+            .try_normalize()
+            .unwrap_or_else(|| super::geometry::any_perpendicular(p));
+    }
+    let b = sum / sum.length();
+    let blend = |u: DVec3, w: f64| ((1.0 - w) * u + w * b).try_normalize().unwrap_or(b);
+    let s = ((CORNER_COS[0] - p.dot(q)) / (CORNER_COS[0] - CORNER_COS[1])).clamp(0.0, 1.0);
+    let u = if s > 0.0 {
+        blend(u, s * s * (3.0 - 2.0 * s))
+    } else {
+        u
+    };
+    let half = 0.5 * sum.length(); // cos(φ/2)
+    let m = u.dot(p).min(u.dot(q)) / half;
+    if m >= CHORD_MARGIN {
+        return u;
+    }
+    blend(u, ((CHORD_MARGIN - m) / CHORD_MARGIN).min(1.0))
 }
 
 /// Smallest accepted cosine between the five-point estimate and the circle (3-point)
@@ -722,15 +866,29 @@ mod tests {
 
     #[test]
     fn circle_rule_exact_on_circle() {
-        let x: Vec<DVec3> = [0.0, 0.3, 1.1, 1.2]
+        // uneven arcs 0.2, 0.4, 0.1 rad: turns of 0.3 and 0.25 rad (under 30°)
+        let u = [0.0_f64, 0.2, 0.6, 0.7];
+        let x: Vec<DVec3> = u
             .iter()
-            .map(|&u: &f64| DVec3::new(u.cos(), u.sin(), 0.0))
+            .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
             .collect();
         let t = estimate(&x, &ch(&x), false, TangentRule::Circle).unwrap();
-        for (i, &u) in [0.0_f64, 0.3, 1.1, 1.2].iter().enumerate() {
+        for (i, &u) in u.iter().enumerate() {
             let e = DVec3::new(-u.sin(), u.cos(), 0.0);
             assert!((t[i] - e).length() < 1e-14, "{i}");
         }
+        // turns of 60° or more are corners of the polyline: the chords' bisector there
+        let u = [0.0_f64, 0.3, 2.3, 2.4];
+        let x: Vec<DVec3> = u
+            .iter()
+            .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
+            .collect();
+        let t = estimate(&x, &ch(&x), false, TangentRule::Circle).unwrap();
+        let b = ((x[1] - x[0]).normalize() + (x[2] - x[1]).normalize()).normalize();
+        assert!(
+            (t[1] - b).length() < 1e-15
+                && (t[1] - DVec3::new(-0.3f64.sin(), 0.3f64.cos(), 0.0)).length() > 0.1
+        );
     }
 
     #[test]
@@ -922,10 +1080,148 @@ mod tests {
         assert!(e.to_string().contains("curve 1 (rows 4 to 8)"), "{e}");
     }
 
+    /// A deterministic stream of numbers in [−1, 1) (a linear congruential generator).
+    fn stream(seed: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
     #[test]
-    fn cusp_is_an_error() {
+    fn chord_guard_keeps_estimates_near_both_chords_and_bounds_the_rest() {
+        let mut r = stream(7);
+        let mut v = || DVec3::new(r(), r(), r());
+        let (mut kept, mut turned) = (0, 0);
+        for _ in 0..20_000 {
+            let (ci, co, u) = (v() * 3.0, v() * 0.5, v().normalize());
+            let g = guard_chords(ci, co, u);
+            let (p, q) = (ci.normalize(), co.normalize());
+            let half = 0.5 * (p + q).length(); // cos(φ/2)
+            if half < 1e-6 {
+                continue;
+            }
+            assert!((g.length() - 1.0).abs() < 1e-14);
+            if u.dot(p) >= 0.5 && u.dot(q) >= 0.5 && p.dot(q) >= CORNER_COS[0] + 1e-12 {
+                // within 60° of both chords turning by less than 30°: the estimate, bit for bit
+                assert_eq!(g, u);
+                kept += 1;
+            } else if u.dot(p).min(u.dot(q)) < 0.5 * half {
+                turned += 1;
+            }
+            if p.dot(q) <= CORNER_COS[1] {
+                // a corner of 60° or more: its bisector
+                assert!((g - (p + q).normalize()).length() < 1e-12, "{g}");
+            }
+            // against both chords by at least half the bisector's margin
+            assert!(
+                g.dot(p).min(g.dot(q)) >= 0.5 * half - 1e-12,
+                "{ci} {co} {u} -> {g}"
+            );
+        }
+        assert!(kept > 100 && turned > 1000, "{kept} {turned}");
+    }
+
+    #[test]
+    fn chord_guard_is_continuous() {
+        // an estimate swung round through the whole circle, chords turning by 150°
+        let (ci, co) = (DVec3::X, DVec3::new(-0.866, 0.5, 0.0));
+        let steps = 100_000;
+        let at = |k: usize| {
+            let a = std::f64::consts::TAU * k as f64 / steps as f64;
+            guard_chords(ci, co, DVec3::new(a.cos(), a.sin(), 0.3).normalize())
+        };
+        let step = std::f64::consts::TAU / steps as f64;
+        let worst = (0..steps)
+            .map(|k| (at(k + 1) - at(k)).length())
+            .fold(0.0, f64::max);
+        // the guard stretches the estimate's motion by a bounded factor, never jumps
+        assert!(worst < 20.0 * step, "{worst} against a step of {step}");
+    }
+
+    #[test]
+    fn jagged_polylines_get_tangents_along_their_chords() {
+        // Gaussian-like random walks: turns of every size, up to near reversals
+        let mut r = stream(11);
+        for rule in [
+            TangentRule::FivePointBounded,
+            TangentRule::FivePoint,
+            TangentRule::FivePointUniform,
+            TangentRule::Circle,
+        ] {
+            for n in 3..60 {
+                for closed in [false, true] {
+                    let mut x = vec![DVec3::ZERO];
+                    for _ in 1..n {
+                        let d = DVec3::new(r() + r(), r() + r(), r() + r());
+                        x.push(*x.last().unwrap() + d);
+                    }
+                    let t = estimate(&x, &ch_closed(&x, closed), closed, rule).unwrap();
+                    let m = if closed { n } else { n - 1 };
+                    // the unbounded rules leave their end tangents as the quartic gives them
+                    let unbounded =
+                        matches!(rule, TangentRule::FivePoint | TangentRule::FivePointUniform);
+                    let skip_ends = unbounded && !closed && n >= 5;
+                    let inner = if skip_ends { 1..m - 1 } else { 0..m };
+                    for i in inner {
+                        let j = (i + 1) % n;
+                        let c = (x[j] - x[i]).normalize();
+                        let d = c.dot(t[i] + t[j]);
+                        assert!(d > 1e-6, "{rule:?} n={n} closed={closed} segment {i}: {d}");
+                    }
+                    if rule == TangentRule::FivePointBounded && !closed && n >= 5 {
+                        for (e, c) in [(0, x[1] - x[0]), (n - 1, x[n - 1] - x[n - 2])] {
+                            let lean = t[e].angle_between(c);
+                            assert!(lean <= std::f64::consts::FRAC_PI_4 + 1e-12, "{lean}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn ch_closed(x: &[DVec3], closed: bool) -> Vec<f64> {
+        crate::frames::validate::chords(x, closed).unwrap()
+    }
+
+    #[test]
+    fn exact_reversals_get_a_tangent_normal_to_the_chord() {
+        // three points: the circle rule's estimate vanishes at the reversal
         let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO];
-        assert!(estimate(&x, &ch(&x), false, TangentRule::FivePoint).is_err());
+        let t = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        assert_eq!(t[1].dot(DVec3::X), 0.0);
+        assert!((t[1].length() - 1.0).abs() < 1e-15);
+        assert!(t[0].dot(DVec3::X) > 0.7 && t[2].dot(DVec3::X) < -0.7);
+        // a symmetric reversal inside a longer curve: the five-point estimate vanishes too;
+        // normal to the chord, as the bisectors of near reversals are (in their plane: the
+        // collinear exact one has no side to lean to)
+        let y = |e: f64| {
+            let x = [
+                DVec3::new(-2.0, 1.0, 0.0),
+                DVec3::new(-1.0, 0.5, 0.0),
+                DVec3::ZERO,
+                DVec3::new(-1.0, 0.5 + e, 0.0),
+                DVec3::new(-2.0, 1.0 + e, 0.0),
+            ];
+            estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap()[2]
+        };
+        let (exact, near) = (y(0.0), y(1e-9));
+        assert!(
+            exact.dot(DVec3::new(-1.0, 0.5, 0.0)).abs() < 1e-15,
+            "{exact}"
+        );
+        assert!((exact.length() - 1.0).abs() < 1e-15);
+        // (the bisector of chords 1e-9 from opposite carries their rounding, ε/1e-9 ≈ 1e-7)
+        assert!(near.dot(DVec3::new(-1.0, 0.5, 0.0)).abs() < 1e-6, "{near}");
+        assert!(near.z == 0.0 && near.y > 0.0, "{near}");
+        // two reversals in a row leave a segment with no forward tangent: refused
+        let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO, DVec3::X];
+        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let c = x[2] - x[1];
+        assert!(c.dot(t[1] + t[2]) <= 1e-6);
     }
 }
 

@@ -535,7 +535,10 @@ fn errors_name_the_argument() {
         (
             "points",
             Request {
+                // given tangents that run against a segment (estimated ones never do: the
+                // zig-zag of two swapped samples is a valid polyline, tested below)
                 points: Some(&reversed),
+                tangents: Some(&t),
                 ..base
             },
             30,
@@ -705,6 +708,24 @@ fn errors_name_the_argument() {
             Err(e) => assert_eq!(&e.arg, arg, "case {k}: {e}"),
             Ok(_) => panic!("case {k} ({arg}) was accepted"),
         }
+    }
+    // two swapped samples with estimated tangents: a zig-zag, framed (every method)
+    for method in [
+        Method::DoubleReflection,
+        Method::Rotation,
+        Method::Projection,
+    ] {
+        let mut out = vec![0.0; 9 * 30];
+        let req = Request {
+            points: Some(&reversed),
+            method,
+            ..base
+        };
+        compute_into(&req, &mut out).unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        assert!(
+            out.chunks_exact(9)
+                .all(|f| validate::is_rotation(f.try_into().unwrap()))
+        );
     }
     let mut out = vec![0.0; 9 * 30];
     let two = [Orientation::Vector(DVec3::Z); 2];

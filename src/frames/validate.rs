@@ -2,19 +2,23 @@
 //! first offending row, naming the argument.
 //!
 //! * Non-finite values (NaN, ±inf) are refused.
-//! * Consecutive samples closer than `2⁻⁶⁰` times the curve's size
-//!   (`|x_{i+1} − x_i|_∞ ≤ 2⁻⁶⁰·extent`) make a zero-length segment: refused (the reflection `R₁` is undefined and no tangent
-//!   can be estimated there).
-//! * A segment whose chord runs against its tangents, `v̂₁·(t_i + t_{i+1}) ≤ 10⁻⁶`, is a
-//!   reversal (cusp) or far too coarse a sampling: refused. This is exactly the condition
-//!   under which double reflection degenerates (`v₂ → 0`, TOG §4.4) and the rotation method
-//!   meets opposite tangents.
+//! * Consecutive samples closer than `2⁻⁴⁰ ≈ 9.1·10⁻¹³` times the curve's size
+//!   (`|x_{i+1} − x_i|_∞ ≤ 2⁻⁴⁰·extent`) make a zero-length segment (the reflection `R₁` is
+//!   undefined and no tangent can be estimated there): refused here with
+//!   [`ErrorKind::Repeated`], on which the Python layer merges them ([`distinct_rows`]) and
+//!   computes again.
+//! * A segment whose chord runs against its tangents, `v̂₁·(t_i + t_{i+1}) ≤ 10⁻⁶`, is
+//!   refused: double reflection degenerates there (`v₂ → 0`, TOG §4.4) and the rotation
+//!   method meets opposite tangents. Estimated tangents pass it on any polyline short of an
+//!   exact reversal (their chord guard, `tangents::guard_chords`); given tangents (or frames)
+//!   that point backwards along a segment, and the unbounded end tangents of the `FivePoint`
+//!   and `FivePointUniform` rules, can fail it.
 
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 use crate::alloc;
-use crate::error::{InputError, Result};
+use crate::error::{ErrorKind, InputError, Result};
 use crate::math::rotation;
 
 /// Relative round-off tolerance for coinciding points.
@@ -82,10 +86,11 @@ pub fn coincide(a: DVec3, b: DVec3) -> bool {
 }
 
 /// Consecutive samples closer than this fraction of the curve's size (the largest side of
-/// its bounding box) make a zero-length segment. Relative to the size, not to the
-/// coordinates: samples a few ulps apart far from the origin are distinct points (1e-3 apart
-/// at 1e12), and every chord that passes keeps its fifth power in the normal range.
-pub const REPEAT_REL: f64 = 1.0 / (1u64 << 60) as f64;
+/// its bounding box, `2⁻⁴⁰ ≈ 9.1·10⁻¹³`) make a zero-length segment: the same point, up to
+/// the rounding of a few arithmetic steps on the coordinates. Relative to the size, not to
+/// the coordinates: samples 1e-3 apart at 1e12 are distinct points on a curve 1 long, and
+/// every chord that passes keeps its fifth power in the normal range.
+pub const REPEAT_REL: f64 = 1.0 / (1u64 << 40) as f64;
 
 /// The largest `|x_{i+1} − x_i|_∞` that counts as a repeated point on the curve `x`.
 pub fn repeat_floor(x: &[DVec3]) -> f64 {
@@ -153,8 +158,89 @@ pub fn chords_cancellable(
                  consecutive points",
                 (i + 1) % n
             ),
-        )),
+        )
+        .with_kind(ErrorKind::Repeated)),
     }
+}
+
+/// What [`distinct_rows`] finds about each curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum CurveStatus {
+    /// Finite, with enough distinct samples.
+    Valid = 0,
+    /// A NaN or an infinity among its samples.
+    NonFinite = 1,
+    /// Fewer distinct samples than a curve needs (2, or 3 for a closed curve).
+    TooFew = 2,
+}
+
+/// The samples that remain of each curve when consecutive repeats are merged: for every row
+/// `j` (curves `offsets[c]..offsets[c + 1]`), the row it is merged into (`j` itself where it
+/// is kept), and each curve's [`CurveStatus`].
+///
+/// A row is merged into the last kept row before it when they are closer than the curve's
+/// [`repeat_floor`] (`|x_j − x_k|_∞ ≤ 2⁻⁴⁰·extent`, compared with the last *kept* row so a
+/// creep of tiny steps cannot add up to a segment). On a closed curve the last kept row is
+/// merged into the curve's first row when it repeats it. The kept rows then have no chord
+/// at or under the floor of their own (never larger) extent, so the frame and sweep checks
+/// accept them. Curves with a non-finite sample are left as they are (every row kept).
+/// Curves in parallel, each scanned in order; polls `cancel` before every curve (the
+/// result is incomplete once it says stop).
+pub fn distinct_rows(
+    x: &[DVec3],
+    offsets: &[usize],
+    closed: bool,
+    cancel: crate::cancel::Cancel<'_>,
+) -> Result<(Vec<usize>, Vec<CurveStatus>)> {
+    self::offsets(offsets, x.len())?;
+    let mut into = alloc::with_capacity("distinct_rows", x.len())?;
+    into.extend(0..x.len());
+    let min = if closed { 3 } else { 2 };
+    let mut parts: Vec<&mut [usize]> = Vec::with_capacity(offsets.len() - 1);
+    let mut rest = &mut into[..];
+    for w in offsets.windows(2) {
+        let (a, b) = rest.split_at_mut(w[1] - w[0]);
+        parts.push(a);
+        rest = b;
+    }
+    let status = parts
+        .into_par_iter()
+        .enumerate()
+        .map(|(c, rows)| {
+            let (a, b) = (offsets[c], offsets[c + 1]);
+            let xc = &x[a..b];
+            if cancel() {
+                return CurveStatus::Valid;
+            }
+            if xc.iter().any(|p| !p.is_finite()) {
+                return CurveStatus::NonFinite;
+            }
+            let floor = repeat_floor(xc);
+            let mut last = 0;
+            let mut kept = usize::from(!xc.is_empty());
+            for j in 1..xc.len() {
+                if repeated(xc[last], xc[j], floor) {
+                    rows[j] = a + last;
+                } else {
+                    last = j;
+                    kept += 1;
+                }
+            }
+            if closed && last > 0 && repeated(xc[last], xc[0], floor) {
+                for r in rows.iter_mut().skip(last) {
+                    *r = a;
+                }
+                kept -= 1;
+            }
+            if kept < min {
+                CurveStatus::TooFew
+            } else {
+                CurveStatus::Valid
+            }
+        })
+        .collect();
+    Ok((into, status))
 }
 
 /// Refuse segments whose chord `v1(i)` runs against the tangents.
@@ -180,9 +266,9 @@ pub fn aligned(
             what,
             format!(
                 "the segment from row {i} to row {} runs against its tangents (the curve \
-                 reverses there, a cusp, or it is sampled far too coarsely; the tangents \
-                 turn by {:.1}° across it); sample more densely or check the tangent \
-                 orientation",
+                 reverses there, a cusp, or the tangents point backwards; they turn by \
+                 {:.1}° across it); check the tangents' orientation, or let spinal \
+                 estimate them",
                 (i + 1) % n,
                 t[i].dot(t[(i + 1) % n])
                     .clamp(-1.0, 1.0)
@@ -237,6 +323,61 @@ pub fn offsets(offsets: &[usize], rows: usize) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn distinct_rows_merge_repeats_into_the_last_kept_row() {
+        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let e = 1e-13; // under 2⁻⁴⁰ of the size 1 (9.1e-13)
+        let x = [
+            // curve 0: a repeat, then a creep of three tiny steps (adding up past the floor)
+            p(0.0, 0.0),
+            p(0.0, 0.0),
+            p(1.0, 0.0),
+            p(1.0 + e, 0.0),
+            p(1.0 + 2.0 * e, 0.0),
+            p(1.0 + 12.0 * e, 0.0),
+            p(1.0, 1.0),
+            // curve 1: one point twice
+            p(5.0, 5.0),
+            p(5.0, 5.0),
+            // curve 2: a NaN
+            p(0.0, f64::NAN),
+            p(1.0, 1.0),
+        ];
+        let (into, status) =
+            distinct_rows(&x, &[0, 7, 9, 11], false, &crate::cancel::never).expect("valid offsets");
+        assert_eq!(into, [0, 0, 2, 2, 2, 5, 6, 7, 7, 9, 10]);
+        assert_eq!(
+            status,
+            [
+                CurveStatus::Valid,
+                CurveStatus::TooFew,
+                CurveStatus::NonFinite
+            ]
+        );
+        // the kept rows pass the chord check the frames and sweeps make
+        let kept: Vec<DVec3> = (0..7).filter(|&j| into[j] == j).map(|j| x[j]).collect();
+        assert!(chords(&kept, false).is_ok());
+        assert!(chords(&x[..7], false).unwrap_err().kind == ErrorKind::Repeated);
+        // closed: a last row that repeats the first joins it; a triangle with a repeat has
+        // too few distinct points
+        let tri = [
+            p(0.0, 0.0),
+            p(1.0, 0.0),
+            p(1.0, 0.0),
+            p(0.0, 1.0),
+            p(e, 0.0),
+        ];
+        let (into, status) =
+            distinct_rows(&tri, &[0, 5], true, &crate::cancel::never).expect("valid offsets");
+        assert_eq!(
+            (into, status),
+            (vec![0, 1, 1, 3, 0], vec![CurveStatus::Valid])
+        );
+        let (_, status) =
+            distinct_rows(&tri[..3], &[0, 3], true, &crate::cancel::never).expect("valid offsets");
+        assert_eq!(status, [CurveStatus::TooFew]);
+    }
 
     #[test]
     fn offsets_name_the_broken_rule() {

@@ -28,9 +28,17 @@ impl From<InputError> for PyErr {
         match e.kind {
             ErrorKind::Invalid => PyValueError::new_err(e.to_string()),
             ErrorKind::OutOfMemory => PyMemoryError::new_err(e.to_string()),
+            ErrorKind::Repeated => RepeatedPointsError::new_err(e.to_string()),
         }
     }
 }
+
+pyo3::create_exception!(
+    _core,
+    RepeatedPointsError,
+    PyValueError,
+    "Consecutive samples that coincide (a ValueError; the Python layer merges them)."
+);
 
 /// Fails with `MemoryError` naming `call` unless `bytes` more bytes can be allocated now:
 /// a heavy call checks its working memory (estimated from the input sizes) before it starts,
@@ -163,8 +171,12 @@ impl<'a> Ticker<'a> {
 /// The error as a `ValueError` naming `to` where the core named its argument `from` (a
 /// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
 pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {
-    if e.arg == from && e.kind == ErrorKind::Invalid {
-        PyValueError::new_err(format!("{to}: {}", e.msg))
+    if e.arg == from && e.kind != ErrorKind::OutOfMemory {
+        let msg = format!("{to}: {}", e.msg);
+        match e.kind {
+            ErrorKind::Repeated => RepeatedPointsError::new_err(msg),
+            _ => PyValueError::new_err(msg),
+        }
     } else {
         e.into()
     }

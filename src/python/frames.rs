@@ -133,6 +133,30 @@ pub fn frames_analytic<'py>(
     Ok((out, angle))
 }
 
+/// `(into, status)` of [`distinct_rows`].
+type MergePlan<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<u8>>);
+
+/// The rows that remain when consecutive repeats are merged
+/// ([`frames::validate::distinct_rows`]): for every row the row it is merged into, and each
+/// curve's status (0 valid, 1 non-finite, 2 too few distinct samples).
+#[pyfunction]
+pub fn distinct_rows<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    closed: bool,
+) -> PyResult<MergePlan<'py>> {
+    let x = vec3s("points", &points)?;
+    let offs = offsets_of(&offsets)?;
+    let stop = Stop::default();
+    let (into, status) = detach_stoppable(py, &stop, || {
+        frames::validate::distinct_rows(x, &offs, closed, &|| stop.requested())
+    })??;
+    let into: Vec<i64> = into.into_iter().map(|r| r as i64).collect();
+    let status: Vec<u8> = status.into_iter().map(|s| s as u8).collect();
+    Ok((PyArray1::from_vec(py, into), PyArray1::from_vec(py, status)))
+}
+
 /// Unit tangents estimated from points: one curve, or many back to back (`offsets`).
 #[pyfunction]
 #[pyo3(signature = (points, closed, rule, offsets=None))]

@@ -1,0 +1,84 @@
+"""Curves as users hold them: consecutive repeated samples merged, and invalid curves found.
+
+A polyline from a tracker, a GPS log or a simulation often repeats a sample (a pause, a
+rounding). Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size are one
+point: the core refuses them (``RepeatedPointsError``, a ValueError); the functions that take
+curves then merge them (the core's ``distinct_rows`` decides which rows stay) and compute
+again on the rows kept, so clean input pays nothing for this.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _core
+
+#: ``status`` values of :func:`plan`.
+VALID, NON_FINITE, TOO_FEW = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Which rows of curves stored back to back remain when repeats are merged.
+
+    ``into[j]``: the row that row ``j`` is merged into (``j`` where it is kept; a closed
+    curve's last row that repeats its first goes into the first); ``keep``: the rows kept;
+    ``status[c]``: ``VALID``, ``NON_FINITE`` or ``TOO_FEW`` (fewer distinct samples than a
+    curve needs); ``offsets``: the kept rows' curve offsets."""
+
+    into: np.ndarray
+    keep: np.ndarray
+    status: np.ndarray
+    offsets: np.ndarray
+
+    @property
+    def rows(self) -> np.ndarray:
+        """For every given row, its row among the kept rows (the kept row it merged into)."""
+        return (np.cumsum(self.keep) - 1)[self.into]
+
+    @property
+    def merged(self) -> bool:
+        return not bool(self.keep.all())
+
+
+def plan(pts: np.ndarray, offs: np.ndarray, closed: bool) -> Plan:
+    """The :class:`Plan` of the curves ``pts`` (rows ``offs[c]:offs[c+1]``)."""
+    into, status = _core.distinct_rows(pts, np.ascontiguousarray(offs, dtype=np.int64), closed)
+    keep = into == np.arange(len(into))
+    kept = np.concatenate([[0], np.cumsum(keep)])
+    return Plan(into, keep, status, kept[offs].astype(np.int64))
+
+
+def too_few_error(p: Plan, offs: np.ndarray, closed: bool, bundle: bool,
+                  arg: str = "points") -> ValueError | None:
+    """The ValueError for the first curve left with too few distinct samples, or None."""
+    bad = np.flatnonzero(p.status == TOO_FEW)
+    if not bad.size:
+        return None
+    c = int(bad[0])
+    where = f"curve {c} (rows {offs[c]} to {max(offs[c + 1], 1) - 1}): " if bundle else ""
+    need = 3 if closed else 2
+    return ValueError(f"{arg}: {where}a{' closed' if closed else 'n open'} curve needs at "
+                      f"least {need} distinct points, got "
+                      f"{int(p.keep[offs[c]:offs[c + 1]].sum())} (consecutive repeats merged)")
+
+
+def on_rows(call, pts: np.ndarray, offs: np.ndarray, closed: bool, bundle: bool,
+            per_row=(), arg: str = "points"):
+    """``call(pts, offs, *per_row)``, or, where the core finds repeated samples, the same
+    call on the rows kept (``per_row``: other ``(n, …)`` arrays, cut alike, None passed
+    through) with its first result spread back over the rows as given: ``(out, rest…)``."""
+    try:
+        return call(pts, offs, *per_row)
+    except _core.RepeatedPointsError:
+        p = plan(pts, offs, closed)
+        err = too_few_error(p, offs, closed, bundle, arg)
+        if err is not None:
+            raise err from None
+        cut = [None if a is None else np.ascontiguousarray(a[p.keep]) for a in per_row]
+        res = call(np.ascontiguousarray(pts[p.keep]), p.offsets, *cut)
+        out, rest = (res[0], res[1:]) if isinstance(res, tuple) else (res, ())
+        out = out[p.rows]
+        return (out, *rest) if isinstance(res, tuple) else out
