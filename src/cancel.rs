@@ -256,6 +256,7 @@ mod tests {
                 vectors: &up,
                 weight: 1.0,
                 tolerance: 1e-3,
+                axis: false,
             }),
             previous: None,
         };

@@ -134,3 +134,39 @@ def test_tangents_given_against_a_chord_are_still_refused():
     # and out and back twice in a row leaves a segment with no forward tangent
     with pytest.raises(ValueError, match="points: the segment from row 1 to row 2"):
         spinal.frames(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 0], [1, 0, 0]]))
+
+
+def test_repeats_merge_with_guides_previous_and_constraints():
+    """Steered frames merge repeated samples too: a per-row guide and previous are cut alike,
+    a constraint on a repeat applies to the row it repeats, and errors name rows as given."""
+    x = _walks(1, 9, 14, 15)[0]
+    dup = np.insert(x, 5, x[4], axis=0)  # row 5 repeats row 4
+    rows = np.r_[np.arange(5), 4, np.arange(5, len(x))]
+    g = np.tile([0.0, 0, 1], (len(x), 1)) + 0.1 * np.cos(np.arange(len(x)))[:, None]
+    np.testing.assert_array_equal(spinal.frames(dup, guide=g[rows]),
+                                  spinal.frames(x, guide=g)[rows])
+    prev = spinal.frames(x)
+    np.testing.assert_array_equal(spinal.frames(dup, previous=prev[rows], previous_twist=True),
+                                  spinal.frames(x, previous=prev, previous_twist=True)[rows])
+    v = np.cross(spinal.frames(x)[9, :, 2], [0.3, 0.2, 1.0])
+    np.testing.assert_array_equal(spinal.frames(dup, constraints={5: v, 10: v}),
+                                  spinal.frames(x, constraints={4: v, 9: v})[rows])
+    with pytest.raises(ValueError, match="constraints: two constraints of curve 0 fall on one "
+                                         "sample"):
+        spinal.frames(dup, constraints={4: v, 5: v})
+    # a given tangent against its chord after the repeat: the row as given
+    t = spinal.estimate_tangents(dup)
+    t[11:13] *= -1
+    with pytest.raises(ValueError, match=r"points: the segment from row 1[012] to row 1[123] "):
+        spinal.frames(dup, t)
+    # the sweep names the radius' row as given
+    r = np.full(len(dup), 0.1)
+    r[11] = -1
+    with pytest.raises(ValueError, match=r"radius: must be positive and finite, got -1(\.0)? at "
+                                         r"row 11"):
+        spinal.tube(dup, r)
+    # frames in time, one turn per step: repeats merged step by step
+    P = np.stack([dup, dup + 0.01])
+    np.testing.assert_allclose(spinal.frames_in_time(P, previous_twist=False),
+                               spinal.frames_in_time(np.stack([x, x + 0.01]),
+                                                     previous_twist=False)[:, rows], atol=1e-12)

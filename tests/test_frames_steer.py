@@ -270,6 +270,41 @@ def test_one_up_vector_levels_the_frames_and_constraints_win():
     assert np.abs(F[30, :, 0] - v).max() < 1e-12
 
 
+def _strand(n=40):
+    """A β-strand-like zig-zag (3.3 apart along x, ±0.9 across) on a gentle twist, and a
+    smooth field of axes normal to its plane of zig-zag."""
+    i = np.arange(n)
+    a = 0.05 * i  # the strand twists slowly
+    across = np.c_[np.zeros(n), np.cos(a), np.sin(a)]
+    x = np.c_[3.3 * i, np.zeros(n), np.zeros(n)] + 0.9 * (-1.0) ** i[:, None] * across
+    up = np.c_[np.zeros(n), -np.sin(a), np.cos(a)]
+    return x, up
+
+
+def test_free_guide_signs_follow_axes_as_continuous_frames():
+    """guide_sign="free": raw carbonyl-like guides that flip sign at every residue give the
+    frames of the consistently signed guide (the angles unwrapped modulo π); with "follow"
+    they make the frames corkscrew."""
+    x, up = _strand()
+    flips = (-1.0) ** np.arange(len(x))
+    raw = up * flips[:, None]
+    smooth = spinal.frames(x, guide=up)
+    free = spinal.frames(x, guide=raw, guide_sign="free")
+    np.testing.assert_allclose(free, smooth, atol=1e-12)
+    followed = spinal.frames(x, guide=raw)
+    assert rotation_angle(followed, smooth).max() > np.radians(45)
+    # a consistent guide is the same either way; a guide of one vector too
+    np.testing.assert_allclose(spinal.frames(x, guide=up, guide_sign="free"), smooth,
+                               atol=1e-12)
+    np.testing.assert_allclose(spinal.frames(x, guide=[0, 0, 1], guide_sign="free"),
+                               spinal.frames(x, guide=[0, 0, 1]), atol=1e-12)
+    # the first usable row keeps its sign: the flipped guide gives the frames turned by π
+    turned_half = spinal.frames(x, guide=-raw, guide_sign="free")
+    np.testing.assert_allclose(turned_half[:, :, 0], -smooth[:, :, 0], atol=1e-12)
+    with pytest.raises(ValueError, match="guide_sign: unknown value 'axis'"):
+        spinal.frames(x, guide=raw, guide_sign="axis")
+
+
 # ---- time ---------------------------------------------------------------------------------
 
 
@@ -295,7 +330,7 @@ def test_frames_in_time_change_no_more_than_the_curve():
     P = moving_helix()
     b = 0.15 + 0.6 * np.arange(len(P)) / (len(P) - 1)
     holonomy = 6 * np.pi * b / np.sqrt(1 + b**2)
-    F = spinal.frames_in_time(P)
+    F = spinal.frames_in_time(P, previous_twist=False)
     assert F.shape == (100, 200, 3, 3)
     ratios = []
     for k in range(1, len(P)):
@@ -314,7 +349,7 @@ def test_frames_in_time_change_no_more_than_the_curve():
         G.append(spinal.frames(P[k], previous=G[-1]))
     assert np.abs(np.array(G) - F[:5]).max() < 1e-12
     # continuing a sequence
-    again = spinal.frames_in_time(P[50:], previous=F[49])
+    again = spinal.frames_in_time(P[50:], previous=F[49], previous_twist=False)
     assert np.abs(again - F[50:]).max() < 1e-12
 
 
@@ -381,9 +416,15 @@ def test_frames_in_time_bad_input_is_named():
     with pytest.raises(ValueError, match=r"previous: expected shape \(50, 3, 3\)"):
         spinal.frames_in_time(P, previous=np.ones((3, 3, 3)))
     bad = P.copy()
-    bad[1, 10] = bad[1, 9]
-    with pytest.raises(ValueError, match="points_t: time step 1: rows 9 and 10 coincide"):
-        spinal.frames_in_time(bad)
+    bad[1, 10, 2] = np.nan
+    for twist in (True, False):
+        with pytest.raises(ValueError, match="points_t: time step 1: non-finite value .* row "
+                                             "10"):
+            spinal.frames_in_time(bad, previous_twist=twist)
+    with pytest.raises(ValueError, match=r"guide: expected shape \(3,\), \(50, 3\) or"):
+        spinal.frames_in_time(P, guide=np.ones((2, 3)))
+    with pytest.raises(ValueError, match="previous_weight: must be a positive"):
+        spinal.frames_in_time(P, previous_weight=0.0)
 
 
 def test_bundles_take_guides_and_previous_per_curve():
@@ -408,3 +449,69 @@ def test_steered_frames_refuse_tangents_of_another_length():
     x = np.c_[np.cos(np.linspace(0, 1, 5)), np.sin(np.linspace(0, 1, 5)), np.zeros(5)]
     with pytest.raises(ValueError, match="^tangents"):
         spinal.frames(x, np.zeros((0, 3)), turns=[1, 1])
+
+
+def _jittered_chain(steps=30, n=120, seed=0):
+    """A protein-like chain (3.8 apart, turning 70° at every residue about a random axis)
+    jittered by 0.1 per time step: its twist changes from step to step."""
+    rng = np.random.default_rng(seed)
+    d, b, x = np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), [np.zeros(3)]
+    for _ in range(n - 1):
+        x.append(x[-1] + 3.8 * d)
+        a = rng.uniform(0, 2 * np.pi)
+        ax = np.cos(a) * b + np.sin(a) * np.cross(d, b)
+        ax /= np.linalg.norm(ax)
+        d = np.cos(np.radians(70)) * d + np.sin(np.radians(70)) * np.cross(ax, d)
+        d /= np.linalg.norm(d)
+        b = np.cross(d, ax) / np.linalg.norm(np.cross(d, ax))
+    P = [np.array(x)]
+    for _ in range(steps - 1):
+        P.append(P[-1] + rng.normal(scale=0.1, size=P[-1].shape))
+    return np.array(P)
+
+
+def _excess(F):
+    """Per step and sample: how much more the frame turns than its tangent (degrees)."""
+    tangent = np.degrees(np.arccos(np.clip(np.einsum("kni,kni->kn", F[1:, :, :, 2],
+                                                     F[:-1, :, :, 2]), -1, 1)))
+    frame = np.degrees(np.array([rotation_angle(F[k], F[k - 1]) for k in range(1, len(F))]))
+    return frame - tangent
+
+
+def test_frames_in_time_turn_each_sample_no_more_than_its_tangent_by_default():
+    """By default each step follows the step before sample by sample (previous_twist): on a
+    jittered protein-like chain no frame turns more than 1° beyond its tangent, where one
+    turn per step (previous_twist=False) leaves some frames 20° and more beyond theirs."""
+    P = _jittered_chain()
+    F = spinal.frames_in_time(P)
+    assert _excess(F).max() < 1.0, _excess(F).max()
+    one_turn = spinal.frames_in_time(P, previous_twist=False)
+    assert _excess(one_turn).max() > 20
+    # the frames are those of frames(previous=, previous_twist=True) chained
+    G = [spinal.frames(P[0])]
+    for k in range(1, 4):
+        G.append(spinal.frames(P[k], previous=G[-1], previous_twist=True, guide_weight=1000.0))
+    np.testing.assert_array_equal(F[:4], np.array(G))
+    # a bundle: each curve as alone
+    two = np.concatenate([P, P[:, ::-1] + 50], axis=1)
+    B = spinal.frames_in_time(two, lengths=[120, 120])
+    np.testing.assert_allclose(B[:, :120], F, atol=1e-12)
+    # a guide per step: every step follows its own guide
+    up = np.broadcast_to([0.0, 0, 1], P.shape)
+    Fg = spinal.frames_in_time(P, guide=up, guide_weight=10.0)
+    for k in (0, 7):
+        np.testing.assert_array_equal(Fg[k], spinal.frames(P[k], guide=[0, 0, 1],
+                                                           guide_weight=10.0))
+
+
+def test_frames_in_time_of_the_adk_trajectory_do_not_flicker():
+    """MDAnalysisTests' adenylate kinase trajectory (98 frames, CA trace): no residue's
+    frame turns by 45° or more between frames."""
+    mda = pytest.importorskip("MDAnalysis")
+    files = pytest.importorskip("MDAnalysisTests.datafiles")
+    u = mda.Universe(files.PSF, files.DCD)
+    ca = u.select_atoms("name CA")
+    P = np.array([ca.positions.astype(float) for _ in u.trajectory])
+    F = spinal.frames_in_time(P)
+    turns = np.degrees(np.array([rotation_angle(F[k], F[k - 1]) for k in range(1, len(F))]))
+    assert turns.max() < 45, turns.max()

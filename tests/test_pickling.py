@@ -113,3 +113,53 @@ def test_process_pool_sends_them_back(method):
         np.testing.assert_array_equal(w.indices, np.arange(40))
         for name, f in each.items():
             same(f.exception(timeout=120), instance(exception_classes()[name]))
+
+
+def sweep_meshes():
+    """Meshes of tube and sweep as returned, lazy attributes untouched."""
+    rng = np.random.default_rng(5)
+    walks = [np.cumsum(rng.normal(size=(m, 3)), axis=0) for m in (5, 9, 14)]
+    star = [(np.cos(a) * r, np.sin(a) * r) for a, r in
+            zip(np.linspace(0, 2 * np.pi, 10, endpoint=False), [1, 0.45] * 5)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", spinal.FoldOverWarning)
+        return {
+            "tube": spinal.tube(walks[2], 0.1, 8),
+            "bundle": spinal.tube(walks, 0.1, 6, point_data={"c": np.arange(3.0)}),
+            "closed seams": spinal.tube(circle(1, 30), 0.1, 6, closed=True, split_seams=True),
+            "merged rows": spinal.tube(np.r_[walks[1][:4], walks[1][3:]], 0.1, 6),
+            "sweep": spinal.sweep(walks[2], star, scale=0.05),
+            "float32": spinal.tube(walks, 0.1, 6, dtype=np.float32),
+        }
+
+
+def mesh_arrays(m):
+    return {k: getattr(m, k) for k in ("vertices", "faces", "normals", "uv", "fold_over",
+                                       "sample_of", "curve_of", "skipped_curves")}
+
+
+def check_same_mesh(a, b):
+    for k, v in mesh_arrays(a).items():
+        w = getattr(b, k)
+        assert (v is None) == (w is None), k
+        if v is not None:
+            assert v.dtype == w.dtype and np.array_equal(v, w), k
+    assert a.point_data.keys() == b.point_data.keys()
+    for k in a.point_data:
+        np.testing.assert_array_equal(a.point_data[k], b.point_data[k])
+    np.testing.assert_array_equal(a.cell_data.get("curve_id"), b.cell_data.get("curve_id"))
+
+
+def test_sweep_meshes_pickle_as_returned():
+    """T3-03: meshes of tube and sweep pickle before any lazy attribute (sample_of,
+    curve_of, curve ids) is read, and come back equal, also from a spawned process pool."""
+    meshes = sweep_meshes()
+    for name, m in meshes.items():
+        for protocol in range(2, pickle.HIGHEST_PROTOCOL + 1):
+            back = pickle.loads(pickle.dumps(m, protocol=protocol))
+            check_same_mesh(back, sweep_meshes()[name])
+    ctx = multiprocessing.get_context("spawn")
+    with cf.ProcessPoolExecutor(1, mp_context=ctx) as pool:
+        sent = pool.submit(sweep_meshes).result(timeout=300)
+    for name, m in sweep_meshes().items():
+        check_same_mesh(sent[name], m)

@@ -372,7 +372,7 @@ D17_CASES = {
     "frames_in_time": (
         ("n, T = 240_000, 50; s = np.linspace(0, 100, n); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
          "P = np.stack([C * (1 + .01 * k) for k in range(T)])\n"),
-        "spinal.frames_in_time(P)"),
+        "spinal.frames_in_time(P, previous_twist=False)"),
     "estimate_tangents_offsets": (
         ("n = 20_000_000; s = np.linspace(0, 4000, n)\n"
          "X = np.c_[np.cos(s), np.sin(s), .2 * s]\n"),

@@ -456,3 +456,27 @@ def test_steered_frames_of_a_curve_list():
             err_msg=form)
     with pytest.raises(TypeError, match="lengths, offsets: not accepted with a sequence"):
         spinal.frames(curves, lengths=lengths, guide=(0.0, 0.0, 1.0))
+
+
+def test_point_data_as_a_list_of_per_curve_arrays():
+    """A list of one array per curve, as dipy's values_from_volume returns them: one row per
+    point (scalars or (n_c, k) rows), or one value per curve; the same mesh data as the
+    concatenated (stacked) arrays."""
+    rng = np.random.default_rng(4)
+    curves = [np.cumsum(rng.normal(size=(m, 3)), axis=0) for m in (4, 7, 5)]
+    fa = [rng.uniform(size=len(c)) for c in curves]
+    rgb = [rng.integers(0, 255, size=(len(c), 3)).astype(np.uint8) for c in curves]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", spinal.FoldOverWarning)
+        listed = spinal.tube(curves, 0.1, 6, point_data={"fa": fa, "rgb": rgb,
+                                                          "id": [10, 11, 12]})
+        flat = spinal.tube(curves, 0.1, 6, point_data={"fa": np.concatenate(fa),
+                                                        "rgb": np.concatenate(rgb),
+                                                        "id": np.array([10, 11, 12])})
+    for k in ("fa", "rgb", "id"):
+        assert listed.point_data[k].dtype == flat.point_data[k].dtype
+        np.testing.assert_array_equal(listed.point_data[k], flat.point_data[k])
+    np.testing.assert_array_equal(listed.point_data["fa"], np.concatenate(fa)[listed.sample_of])
+    # a list whose arrays do not match the curves' rows is refused, naming the key
+    with pytest.raises(ValueError, match=r"point_data\['fa'\]"):
+        spinal.tube(curves, 0.1, 6, point_data={"fa": [f[:-1] for f in fa]})

@@ -85,6 +85,7 @@ def frames(
     guide_tolerance: float = 1e-3,
     previous: _Array | None = None,
     previous_twist: bool = False,
+    guide_sign: Literal["follow", "free"] = "follow",
 ) -> _F: ...
 def frames_in_time(
     points_t: _Array | None,
@@ -96,6 +97,14 @@ def frames_in_time(
     turns: int = 0,
     reflection: _Reflection = "chord",
     previous: _Array | None = None,
+    previous_twist: bool = True,
+    previous_weight: float = 1000.0,
+    guide: _Array | None = None,
+    guide_weight: float = 1.0,
+    guide_tolerance: float = 1e-3,
+    guide_sign: Literal["follow", "free"] = "follow",
+    lengths: _Ints | None = None,
+    offsets: _Ints | None = None,
 ) -> _F: ...
 def closing_angle(
     points: _Array | Curve | _Curves | None,

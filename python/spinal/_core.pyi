@@ -74,6 +74,7 @@ def frames_steered(
     guide: npt.NDArray[np.float64] | None,
     guide_weight: float,
     guide_tolerance: float,
+    guide_axis: bool,
     previous: npt.NDArray[np.float64] | None,
     points_arg: str = "points",
 ) -> npt.NDArray[np.float64]: ...

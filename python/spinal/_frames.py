@@ -137,7 +137,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
                                     chords_from_tangents, closed, iv, if_, ev, ef, turns,
                                     points_arg)
 
-    if pts is None:
+    if pts is None or chords_from_tangents:  # (the quadrature's grid is the rows as given)
         out, angles = run(pts, offs, tgs)
     else:  # consecutive repeated samples merged
         out, angles = _merge.on_rows(run, pts, offs, closed, bundle, (tgs,), points_arg)
@@ -172,6 +172,7 @@ def frames(
     guide_tolerance: float = 1e-3,
     previous=None,
     previous_twist: bool = False,
+    guide_sign: str = "follow",
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -289,6 +290,13 @@ def frames(
         smooth guide is about ``φ″/guide_weight`` (``φ″`` per sample²).
     guide_tolerance : float
         Angle in radians (in [0, π/2)) from the tangent below which a guide vector is ignored.
+    guide_sign : {"follow", "free"}
+        ``"follow"`` (default): ``r`` follows each guide vector's direction. ``"free"``: each
+        guide row is an axis (``g`` and ``−g`` alike, e.g. raw carbonyl bonds of a β-strand,
+        which alternate): the guide angles ``φ_i`` are unwrapped modulo π instead of 2π, so
+        ``r`` follows whichever of ``±g_i`` continues the frame (the first usable row keeps
+        its sign), as molecular cartoon renderers flip alternate peptide planes. A closed
+        curve still closes: axes that come back reversed after a round spread the half turn.
     previous : array_like (n, 3, 3), optional
         The frames of the same curve at the previous time step (same sample count): the
         result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
@@ -314,13 +322,20 @@ def frames(
     TypeError
         Non-numeric input, wrong argument types.
     ValueError
-        Wrong shapes, fewer than 2 points (3 for a closed curve), NaN/inf, repeated
-        consecutive points (zero-length segments), zero tangents, an exact reversal, a
-        segment whose chord runs against given ``tangents`` (``(x_{i+1} − x_i)·(t_i +
-        t_{i+1}) ≤ 0``; estimated tangents never do, see :func:`estimate_tangents`), an
+        Wrong shapes, fewer than 2 distinct points (3 for a closed curve), NaN/inf, zero
+        tangents, a segment whose chord runs against given ``tangents``
+        (``(x_{i+1} − x_i)·(t_i + t_{i+1}) ≤ 0``; estimated tangents never do short of two
+        reversals in a row, see :func:`estimate_tangents`), an
         ``initial``/``end`` vector parallel to the tangent,
         a constraint row out of range or a constraint parallel to its tangent, a ``guide`` or
-        ``previous`` of the wrong shape. The message names the argument and the row.
+        ``previous`` of the wrong shape, two constraints on samples merged into one. The
+        message names the argument and the row (as given).
+
+    Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times the curve's size are one point:
+    the frames are computed on the curve without the repeats, whose rows get the frame of
+    the row they repeat (a per-row ``tangents``, ``guide`` or ``previous`` is cut alike; a
+    constraint on a repeat applies to the row it repeats). Not with ``reflection="tangents"``
+    (its quadrature needs the rows as given) or an analytic curve, where repeats raise.
 
     Examples
     --------
@@ -341,11 +356,12 @@ def frames(
                          f"{guide_tolerance}")
     if previous_twist and previous is None:
         raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
+    guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
     if (constraints is not None or guide is not None or previous is not None
             or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
         return _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
                         lengths, offsets, constraints, twist_rule, guide, guide_weight,
-                        guide_tolerance, previous, previous_twist)
+                        guide_tolerance, previous, previous_twist, guide_sign)
     out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
                          lengths, offsets)
     return out
@@ -394,12 +410,15 @@ def estimate_tangents(
       bounded by the turn of the last two chords: with ``ĉ`` the end chord and ``φ`` its
       angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than
       ``min(φ, 45°)`` from ``ĉ`` is turned towards ``ĉ`` onto the cone
-      ``∠(t, ĉ) = min(φ, 45°)`` (in the plane of ``ĉ`` and ``t``). On smooth samplings the exact end tangent leans ``κh/2 + O(h²)`` from the
-      end chord, inside the cone, so the estimate stays O(h⁴) there; on coarse samplings
-      (e.g. 20-point streamlines) the one-sided quartic extrapolates the last bends and can
-      lean far past the end chord (chisel-shaped tube ends), which the bound removes. The
-      circle rule's end tangent leans exactly by half the circle's turn, inside the same
-      cone. Interior and closed-curve tangents are those of ``"five_point"``.
+      ``∠(t, ĉ) = min(φ, 45°)`` (in the plane of ``ĉ`` and ``t``). On smooth samplings the
+      exact end tangent leans ``κh/2 + O(h²)`` from the end chord, inside the cone, so the
+      estimate stays O(h⁴) there; on coarse samplings (e.g. 20-point streamlines) the
+      one-sided quartic extrapolates the last bends and can lean far past the end chord
+      (chisel-shaped tube ends), which the bound removes. Where the end chords turn by more
+      than 30° (an end corner), the result is then blended towards ``ĉ`` with the corner
+      weight of the chord guard below: from 60° on the end tangent is the end chord, and a
+      tube's end is cut square to it. The circle rule's end tangent (3 or 4 points) is
+      bounded alike. Interior and closed-curve tangents are those of ``"five_point"``.
     * ``"five_point"``: the derivative at ``x_i`` of the quartic through the five
       samples around it (one-sided at open ends, periodic when ``closed``), parameterised by
       cumulative chord length (Lagrange weights by Fornberg's algorithm). For equal chords
@@ -437,9 +456,10 @@ def estimate_tangents(
        towards ``b̂`` with ``w = min(1, 1 − 2m)``, which leaves a margin of at least
        ``cos(φ/2)/2`` against both chords.
 
-    Both steps are continuous in the points. Then every segment runs along the tangents at
-    its ends (``(x_{i+1} − x_i)·(t_i + t_{i+1}) > 0``) short of an exact reversal, where the
-    tangent is normal to the chord. Samplings that turn by less than 30° per sample with
+    Both steps are continuous in the points, short of reversals: where the chords turn back
+    to within 10⁻⁶ rad of 180°, the bisector is rounding noise and the tangent is normal to
+    the chord instead. Then every segment runs along the tangents at its ends
+    (``(x_{i+1} − x_i)·(t_i + t_{i+1}) > 0``) unless both of its ends reverse. Samplings that turn by less than 30° per sample with
     estimates within 60° of both chords (any reasonably sampled smooth curve) are never
     touched, so the orders above hold there. The unbounded rules' open end tangents
     (``"five_point"``, ``"five_point_uniform"``) are left as their stencils give them.
@@ -449,8 +469,9 @@ def estimate_tangents(
     ``offsets``: many curves back to back, as in :func:`frames` (each curve estimated on
     its own, in parallel; ``closed`` applies to every curve); ``points`` may also be a list
     (any sequence) of ``(n_i, 3)`` arrays, e.g. nibabel's ``ArraySequence``, whose tangents
-    come back to back in one array. Raises ValueError for NaN/inf,
-    repeated consecutive points and exact reversals (the estimate vanishes), naming the row
+    come back to back in one array. Consecutive samples closer than ``2⁻⁴⁰`` of the curve's
+    size are merged: their rows get the tangent of the row they repeat. Raises ValueError
+    for NaN/inf and for curves with fewer than 2 distinct points (3 closed), naming the row
     (and the curve, in a bundle).
     """
     method = as_choice(method, "method", TANGENT_RULES)
@@ -472,7 +493,7 @@ def estimate_tangents(
 
 def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
              offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous,
-             previous_twist=False):
+             previous_twist=False, guide_sign="follow"):
     """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
     ``guide``, ``previous`` or per-interval ``turns``)."""
     method = as_choice(method, "method", METHODS)
@@ -514,9 +535,50 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     if previous_twist:
         guide, previous = _previous_twist_guide(previous, rows), None
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
-                     previous, offs, bundle, rows)
-    return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
-                                reflection == "tangents", closed, iv, if_, ev, ef, *steer)
+                     previous, offs, bundle, rows, guide_sign)
+
+    def run(pts, tgs, offs, steer):
+        return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
+                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer)
+
+    if pts is None or uu is not None or reflection == "tangents":
+        return run(pts, tgs, offs, steer)
+    try:
+        return run(pts, tgs, offs, steer)
+    except _core.RepeatedPointsError as exc:
+        p = _merge.plan(pts, offs, closed)
+        err = _merge.too_few_error(p, offs, closed, bundle)
+        if err is not None:
+            raise err from None
+        if not p.merged:
+            raise ValueError(str(exc)) from None
+    return _steered_merged(run, p, pts, tgs, offs, steer, rows)
+
+
+def _steered_merged(run, p, pts, tgs, offs, steer, rows):
+    """The steered frames on the rows that ``p`` keeps (a per-row guide and previous cut
+    alike, constraint rows moved to the sample they merge into), spread back over the rows
+    as given."""
+    steer = list(steer)  # turns, 5 constraint arrays, rule, guide, weight, tolerance, axis, prev
+    cut = (lambda a: None if a is None else np.ascontiguousarray(a[p.keep]))
+    if steer[7] is not None and len(steer[7]) == rows:
+        steer[7] = cut(steer[7])
+    steer[11] = cut(steer[11])
+    cc, cr = steer[1], steer[2]
+    if cr.size:
+        kept = p.rows[offs[cc] + cr] - p.offsets[cc]
+        key = cc * (rows + 1) + kept
+        if np.unique(key).size < key.size:
+            dup = np.flatnonzero(np.r_[False, np.diff(np.sort(key)) == 0])[0]
+            c = int(np.sort(cc)[dup])
+            raise ValueError(f"constraints: two constraints of curve {c} fall on one sample "
+                             f"(rows that repeat a point are merged into the first); keep one")
+        steer[2] = np.ascontiguousarray(kept, dtype=np.int64)
+    try:
+        out = run(cut(pts), cut(tgs), p.offsets, steer)
+    except ValueError as exc:
+        raise ValueError(_merge.as_given(str(exc), p, offs)) from None
+    return out[p.rows]
 
 
 def _previous_twist_guide(previous, rows: int) -> np.ndarray:
@@ -541,31 +603,63 @@ def frames_in_time(
     turns: int = 0,
     reflection: str = "chord",
     previous=None,
+    previous_twist: bool = True,
+    previous_weight: float = 1000.0,
+    guide=None,
+    guide_weight: float = 1.0,
+    guide_tolerance: float = 1e-3,
+    guide_sign: str = "follow",
+    lengths=None,
+    offsets=None,
 ) -> np.ndarray:
     r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
 
-    ``points_t`` holds ``T`` time steps of the same curve, ``(T, n, 3)`` (same sample count
-    at every step). Every step gets its rotation-minimising frame (computed in parallel over
-    ``T``), turned about the tangents by the one angle ``c`` that brings it closest to the
-    frames of the step before: ``c`` minimises ``Σ_i ‖R_t(c) U_i − P_i‖²`` (Frobenius; every
-    sample counts the same), in closed form ``c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)``.
-    All RMFs of a curve differ only by such a constant turn (Zheng 2008, Cor. 4.1.3), so the
-    frames stay rotation minimising along the curve and change in time only as much as the
-    curve makes them (Ma 1996, §3.5.3, aligns the frames of similar curves by one rotation).
-    Equivalent to calling :func:`frames` with ``previous=`` step by step.
+    ``points_t`` holds ``T`` time steps of the same curve (or bundle, with ``lengths`` /
+    ``offsets``), ``(T, n, 3)`` (same sample count at every step). The first step gets its
+    rotation-minimising frame (from ``initial``, or turned closest to ``previous``); then:
+
+    * ``previous_twist=True`` (default): every step follows the frames of the step before
+      sample by sample: they are :func:`frames` with ``previous=`` the step before and
+      ``previous_twist=True``, i.e. the guide ``previous[:, :, 0]`` (the previous ``r``
+      columns projected on the new normal planes) with the weight ``previous_weight``, so
+      each sample's frame turns between steps by about as much as its tangent does, however
+      the curve's own twist changes (an MD trajectory of a protein backbone, a swimming
+      tail). With the default weight 1000 the frame of a sample is the one closest to its
+      previous frame up to a smoothing bias of about ``φ″/1000`` (see ``guide_weight`` of
+      :func:`frames`). The steps are computed in order.
+    * ``previous_twist=False``: every step gets its rotation-minimising frame (computed in
+      parallel over ``T``), turned about the tangents by the one angle ``c`` that brings it
+      closest to the frames of the step before: ``c`` minimises ``Σ_i ‖R_t(c) U_i − P_i‖²``
+      (Frobenius; every sample counts the same), in closed form
+      ``c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)``. All RMFs of a curve differ only by such
+      a constant turn (Zheng 2008, Cor. 4.1.3), so the frames stay rotation minimising along
+      the curve and change in time only as much as the RMF does (Ma 1996, §3.5.3, aligns the
+      frames of similar curves by one rotation); where the curve's total torsion changes
+      between steps, frames far from the middle turn by that much more than their tangents.
+      Equivalent to calling :func:`frames` with ``previous=`` step by step.
+    * ``guide`` given: every step follows its guide (``(3,)``, ``(n, 3)`` for all steps or
+      ``(T, n, 3)`` one per step; ``guide_weight``, ``guide_tolerance``, ``guide_sign`` as in
+      :func:`frames`), which carries the coherence in time; ``previous_twist`` does not
+      apply then.
 
     Parameters
     ----------
     points_t : array_like (T, n, 3)
-        The curve at ``T`` time steps.
+        The curve (bundle) at ``T`` time steps.
     tangents_t : array_like (T, n, 3), optional
         Tangents at every step (else estimated as in :func:`frames`).
-    method, closed, turns, reflection
+    method, closed, turns, reflection, lengths, offsets
         As in :func:`frames` (a closed curve keeps its closing twist at every step).
     initial : array_like (3,) or (3, 3), optional
         The start of the first step (as in :func:`frames`); not with ``previous``.
     previous : array_like (n, 3, 3), optional
         Frames of the step before the first one (to continue a sequence).
+    previous_twist : bool
+        Follow the previous step sample by sample (default) or by one turn per step.
+    previous_weight : float
+        The weight of the previous step's ``r`` against the twist rate, per sample (> 0).
+    guide, guide_weight, guide_tolerance, guide_sign
+        A guide followed at every step (see above and :func:`frames`).
 
     Returns
     -------
@@ -575,8 +669,15 @@ def frames_in_time(
     ------
     ValueError
         As :func:`frames` (the message names the time step), a ``previous`` of another shape
-        than ``(n, 3, 3)`` or not made of rotations.
+        than ``(n, 3, 3)`` or not made of rotations, a ``guide`` of another shape.
     """
+    previous_twist = as_bool(previous_twist, "previous_twist")
+    chained = previous_twist or guide is not None or lengths is not None or offsets is not None
+    if chained:
+        return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
+                                       reflection, previous, previous_twist, previous_weight,
+                                       guide, guide_weight, guide_tolerance, guide_sign,
+                                       lengths, offsets)
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -595,6 +696,72 @@ def frames_in_time(
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
-    out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
-                               reflection == "tangents", closed, iv, if_, turns, prev)
+    try:
+        out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
+                                   reflection == "tangents", closed, iv, if_, turns, prev)
+    except _core.RepeatedPointsError:
+        if reflection == "tangents":
+            raise
+        # repeated samples: step by step through frames(previous=), which merges them
+        return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
+                                       reflection, previous, False, 1.0, None, 1.0, 1e-3,
+                                       "follow", None, None)
     return out.reshape(steps, n, 3, 3)
+
+
+def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns, reflection,
+                            previous, previous_twist, previous_weight, guide, guide_weight,
+                            guide_tolerance, guide_sign, lengths, offsets) -> np.ndarray:
+    """:func:`frames_in_time` step by step through :func:`frames` (``previous_twist``, a
+    guide, or a bundle)."""
+    p = None if points_t is None else as_float_array(points_t, "points_t")
+    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
+    ref = p if p is not None else tg
+    if ref is None:
+        raise TypeError("points_t: required")
+    for a, name in ((p, "points_t"), (tg, "tangents_t")):
+        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
+            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
+    if p is not None and tg is not None and p.shape != tg.shape:
+        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
+    steps, n = ref.shape[0], ref.shape[1]
+    previous_weight = as_real(previous_weight, "previous_weight")
+    if not 0.0 < previous_weight < np.inf:
+        raise ValueError(f"previous_weight: must be a positive finite number, got "
+                         f"{previous_weight}")
+    g = None
+    if guide is not None:
+        g = as_float_array(guide, "guide")
+        if g.shape not in ((3,), (n, 3), (steps, n, 3)):
+            raise ValueError(f"guide: expected shape (3,), ({n}, 3) or ({steps}, {n}, 3), "
+                             f"got {g.shape}")
+    if previous is not None:
+        previous = previous_frames(previous, n, "the frames of the step before")
+        if initial is not None:
+            raise ValueError("previous: cannot be combined with initial (the previous frames "
+                             "fix the start)")
+    out = np.empty((steps, n, 3, 3))
+    common = {"method": method, "closed": closed, "turns": turns, "reflection": reflection,
+              "lengths": lengths, "offsets": offsets}
+    for k in range(steps):
+        pts = p[k] if p is not None else None
+        tgk = tg[k] if tg is not None else None
+        before = out[k - 1] if k else previous
+        try:
+            if g is not None:
+                gk = g[k] if g.ndim == 3 else g
+                out[k] = frames(pts, tgk, initial=initial, guide=gk, guide_weight=guide_weight,
+                                guide_tolerance=guide_tolerance, guide_sign=guide_sign,
+                                **common)
+            elif before is None:
+                out[k] = frames(pts, tgk, initial=initial, **common)
+            else:
+                out[k] = frames(pts, tgk, previous=before, previous_twist=previous_twist,
+                                guide_weight=previous_weight, **common)
+        except ValueError as exc:
+            msg = str(exc)
+            for arg, name in (("points: ", "points_t"), ("tangents: ", "tangents_t")):
+                if msg.startswith(arg):
+                    raise ValueError(f"{name}: time step {k}: {msg[len(arg):]}") from None
+            raise
+    return out

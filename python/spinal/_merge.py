@@ -9,6 +9,7 @@ again on the rows kept, so clean input pays nothing for this.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,20 +66,56 @@ def too_few_error(p: Plan, offs: np.ndarray, closed: bool, bundle: bool,
                       f"{int(p.keep[offs[c]:offs[c + 1]].sum())} (consecutive repeats merged)")
 
 
+_CURVE = re.compile(r"curve (\d+) \(rows (\d+) to (\d+)\)")
+_ROWS = re.compile(r"\b(rows? )(\d+)(,? (?:and|to) (?:row )?)?(\d+)?")
+
+
+def as_given(msg: str, p: Plan, offs: np.ndarray) -> str:
+    """The message of an error of a call on the rows kept, with its curve's rows and the
+    rows within it (``row 7``, ``rows 4 and 5``, ``from row 4 to row 5``) numbered as given
+    (``offs``: the given curves' offsets)."""
+    m = _CURVE.search(msg)
+    c = int(m.group(1)) if m else 0
+    if m:
+        given = f"curve {c} (rows {offs[c]} to {max(int(offs[c + 1]), 1) - 1})"
+        head, tail = msg[:m.start()] + given, msg[m.end():]
+    else:
+        head, tail = "", msg
+    row_of = np.flatnonzero(p.keep)
+
+    def local(k: str) -> str:
+        j = int(p.offsets[c]) + int(k)
+        return str(int(row_of[j] - offs[c])) if 0 <= j < len(row_of) else k
+
+    def rows(mm: re.Match) -> str:
+        out = mm.group(1) + local(mm.group(2))
+        if mm.group(3) and mm.group(4):
+            out += mm.group(3) + local(mm.group(4))
+        elif mm.group(3):
+            out += mm.group(3)
+        return out
+
+    return head + _ROWS.sub(rows, tail)
+
+
 def on_rows(call, pts: np.ndarray, offs: np.ndarray, closed: bool, bundle: bool,
             per_row=(), arg: str = "points"):
     """``call(pts, offs, *per_row)``, or, where the core finds repeated samples, the same
     call on the rows kept (``per_row``: other ``(n, …)`` arrays, cut alike, None passed
-    through) with its first result spread back over the rows as given: ``(out, rest…)``."""
+    through) with its first result spread back over the rows as given: ``(out, rest…)``.
+    Errors of the second call name the rows as given."""
     try:
         return call(pts, offs, *per_row)
     except _core.RepeatedPointsError:
         p = plan(pts, offs, closed)
-        err = too_few_error(p, offs, closed, bundle, arg)
-        if err is not None:
-            raise err from None
-        cut = [None if a is None else np.ascontiguousarray(a[p.keep]) for a in per_row]
+    err = too_few_error(p, offs, closed, bundle, arg)
+    if err is not None:
+        raise err
+    cut = [None if a is None else np.ascontiguousarray(a[p.keep]) for a in per_row]
+    try:
         res = call(np.ascontiguousarray(pts[p.keep]), p.offsets, *cut)
-        out, rest = (res[0], res[1:]) if isinstance(res, tuple) else (res, ())
-        out = out[p.rows]
-        return (out, *rest) if isinstance(res, tuple) else out
+    except ValueError as exc:
+        raise ValueError(as_given(str(exc), p, offs)) from None
+    out, rest = (res[0], res[1:]) if isinstance(res, tuple) else (res, ())
+    out = out[p.rows]
+    return (out, *rest) if isinstance(res, tuple) else out

@@ -136,10 +136,12 @@ def previous_frames(previous: Any, rows: int, what: str = "the frames of the sam
 
 
 def steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance, previous,
-             offs: np.ndarray, bundle: bool, rows: int):
+             offs: np.ndarray, bundle: bool, rows: int, guide_sign: str = "follow"):
     """The steering arguments of :func:`spinal.frames` as the core takes them: the turns,
-    the five constraint arrays, the rule, the guide, its weight and tolerance, previous."""
+    the five constraint arrays, the rule, the guide, its weight, tolerance and whether its
+    rows are axes (``guide_sign="free"``), previous."""
     twist_rule = as_choice(twist_rule, "twist_rule", TWIST_RULES)
+    axis = as_choice(guide_sign, "guide_sign", ("follow", "free")) == "free"
     return (_turns(turns), *_constraints(constraints, offs, bundle), twist_rule,
             guide_rows(guide, rows), as_real(guide_weight, "guide_weight"),
-            as_real(guide_tolerance, "guide_tolerance"), previous_frames(previous, rows))
+            as_real(guide_tolerance, "guide_tolerance"), axis, previous_frames(previous, rows))

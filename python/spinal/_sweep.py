@@ -166,7 +166,9 @@ def sweep(
         memory and time).
     point_data : dict of str to array_like, optional
         Attributes carried onto the mesh: ``(n,)`` or ``(n, k)`` arrays, one value per spine
-        row (of all curves), or for a bundle ``(C,)`` / ``(C, k)`` per curve. Every vertex of
+        row (of all curves), or for a bundle ``(C,)`` / ``(C, k)`` per curve, or a list of
+        one ``(n_c,)`` / ``(n_c, k)`` array per curve (as dipy's ``values_from_volume``
+        returns them). Every vertex of
         a ring (caps included) gets its sample's (curve's) value, in ``Mesh.point_data``
         with the dtype given.
     on_short : {"raise", "skip"}
@@ -182,7 +184,8 @@ def sweep(
     Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
     bounding box's largest side) are one point: they are merged into the first of them,
     which gets the ring (its ``point_data`` is the ring's; ``sample_of`` names it; the
-    ``scale``/``twist``/``frames`` of the rows merged into it are not used).
+    ``scale``/``twist``/``frames``/``tangents`` of the rows merged into it are not used).
+    Errors name the rows as given.
 
     Returns
     -------
@@ -278,7 +281,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                              f"{tg.shape}")
     sc = _scale_rows(scale, scale_arg, n, lens)
     tw = None if twist is None else as_per_row(twist, "twist", n)
-    pdata = _point_data(point_data, n, curves if bundle else None)
+    pdata = _point_data(point_data, n, curves if bundle else None, lens)
     # curves too short to sweep: refused by the core (on_short="raise") or left out here
     # and curves with NaN/inf or too few distinct points (on_invalid)
     curve_ids, skipped = np.arange(curves), np.zeros(0, dtype=np.int64)
@@ -293,9 +296,11 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 f"points: left out {int(short.sum())} curve(s) with fewer than {need} points "
                 f"(on_short='skip'): {_ranges(np.flatnonzero(short))}; see "
                 f"Mesh.skipped_curves", np.flatnonzero(short)), stacklevel=3)
+    merge = None  # the plan of the rows kept, once made
     if on_invalid == "skip" and counts is not None:
-        status = _merge.plan(pts, offs, closed).status
-        nan, few = status == _merge.NON_FINITE, (status == _merge.TOO_FEW) & ~short
+        merge = _merge.plan(pts, offs, closed)
+        status = merge.status
+        nan, few = (status == _merge.NON_FINITE) & ~short, (status == _merge.TOO_FEW) & ~short
         if (nan | few).any():
             parts = [f"with NaN or inf: {_ranges(np.flatnonzero(nan))}"] if nan.any() else []
             if few.any():
@@ -312,6 +317,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         pts, fr, tg, sc, tw = _cut(keep_rows, pts, fr, tg, sc, tw)
         curve_ids = curve_ids[~short]
         offs = np.concatenate([[0], np.cumsum(counts[~short])]).astype(np.int64)
+        merge = None if merge is None else _merge.plan(pts, offs, closed)
     if offs.size == 1:  # every curve left out
         mesh = Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)),
                     np.zeros((0, 2)), skipped_curves=skipped)
@@ -328,27 +334,43 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
             single, single, want_normals, want_uv, tg,
         )
 
+    def merged(p):
+        # consecutive repeated samples: merged (a ring for the first row of each group)
+        nonlocal pts, fr, tg, sc, tw, offs, keep_rows
+        pts, fr, tg, sc, tw = _cut(p.keep, pts, fr, tg, sc, tw)
+        offs = p.offsets
+        if keep_rows is None:
+            keep_rows = p.keep
+        else:
+            keep_rows[keep_rows] = p.keep
+
     try:
-        try:
-            v, f, nrm, uv, folds, faces_per_curve = core(pts, offs, fr, tg, sc, tw)
-        except _core.RepeatedPointsError:
-            # consecutive repeated samples: merged (a ring for the first row of each group)
-            p = _merge.plan(pts, offs, closed)
-            err = _merge.too_few_error(p, offs, closed, bundle)
-            if err is not None:
-                raise err from None
-            pts, fr, tg, sc, tw = _cut(p.keep, pts, fr, tg, sc, tw)
-            offs = p.offsets
-            if keep_rows is None:
-                keep_rows = p.keep
-            else:
-                keep_rows[keep_rows] = p.keep
-            v, f, nrm, uv, folds, faces_per_curve = core(pts, offs, fr, tg, sc, tw)
+        if merge is not None and merge.merged:  # known already: cut before sweeping
+            before = offs
+            merged(merge)
+        else:
+            try:
+                result = core(pts, offs, fr, tg, sc, tw)
+                merge = None
+            except _core.RepeatedPointsError as exc:
+                merge, before = _merge.plan(pts, offs, closed), offs
+                err = _merge.too_few_error(merge, offs, closed, bundle)
+                if err is not None:
+                    raise err from None
+                if not merge.merged:  # nothing the plan would merge: refused as it is
+                    raise ValueError(str(exc)) from None
+                merged(merge)
+        if merge is not None and merge.merged:
+            try:
+                result = core(pts, offs, fr, tg, sc, tw)
+            except ValueError as exc:  # rows within the curves as given
+                raise ValueError(_merge.as_given(str(exc), merge, before)) from None
     except ValueError as exc:
         if curve_ids.size == curves:
             raise
         # the core numbered the curves that were kept: back to the curves as given
         raise ValueError(_as_given(str(exc), curve_ids, given)) from None
+    v, f, nrm, uv, folds, faces_per_curve = result
     row_of = None if keep_rows is None else np.flatnonzero(keep_rows)
     if folds.size and row_of is not None:  # back to the rows as given
         folds = row_of[folds]
@@ -416,9 +438,29 @@ def _per_row_or_curve(x, name: str, n: int, lens, *, pair: bool) -> np.ndarray:
     return as_per_row(a, name, n, pair=pair)
 
 
-def _point_data(data, n: int, curves: int | None) -> dict:
+def _per_curve_list(v, lens):
+    """A list (any sequence but an array) of one array per curve, as users hold values of
+    streamlines (dipy's ``values_from_volume``): one row per point of each curve,
+    concatenated, or one value (or ``(k,)`` row) per curve, stacked; anything else as
+    given."""
+    if lens is None or isinstance(v, (np.ndarray, str, bytes)) or not hasattr(v, "__len__"):
+        return v
+    if len(v) != len(lens) or not len(v):
+        return v
+    try:
+        parts = [np.asarray(p) for p in v]
+    except (TypeError, ValueError):
+        return v
+    if all(p.ndim in (1, 2) and len(p) == m for p, m in zip(parts, lens)) and \
+            len({p.shape[1:] for p in parts}) == 1:
+        return np.concatenate(parts)
+    return v
+
+
+def _point_data(data, n: int, curves: int | None, lens=None) -> dict:
     """``{name: (array, per_curve)}``: ``(n,)``/``(n, k)`` arrays per spine row, or for a
-    bundle ``(C,)``/``(C, k)`` per curve."""
+    bundle ``(C,)``/``(C, k)`` per curve, or a list of one ``(n_c,)``/``(n_c, k)`` array per
+    curve (``lens``: the curves' row counts)."""
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -430,11 +472,16 @@ def _point_data(data, n: int, curves: int | None) -> dict:
         if isinstance(v, (str, bytes)):
             raise TypeError(f"point_data[{k!r}]: expected a numeric array, got "
                             f"{type(v).__name__}")
-        a = np.asarray(v)
+        per = f"({n},) or ({n}, k) per spine row" + (
+            f", or ({curves},) or ({curves}, k) per curve, or a list of one (n_c,) or "
+            f"(n_c, k) array per curve" if curves is not None else "")
+        try:
+            a = np.asarray(_per_curve_list(v, lens))
+        except ValueError:  # ragged
+            raise ValueError(f"point_data[{k!r}]: expected {per}; got a ragged sequence whose "
+                             f"arrays do not match the curves' rows") from None
         if a.dtype.kind not in "biuf":
             raise TypeError(f"point_data[{k!r}]: expected a numeric array, got dtype {a.dtype}")
-        per = f"({n},) or ({n}, k) per spine row" + (
-            f", or ({curves},) or ({curves}, k) per curve" if curves is not None else "")
         if a.ndim not in (1, 2) or len(a) not in (n, curves):
             raise ValueError(f"point_data[{k!r}]: expected {per}, got shape {a.shape}")
         out[k] = (a, len(a) != n)

@@ -22,9 +22,15 @@
 //! A closed curve's RMF differs across the seam by its closing angle `c`; the seam term is
 //! `(h̄ / h)(α_0 + D − α_{n−1})²` with `D = c + 2πk`, `k` chosen so that the unwrapped guide
 //! angle continues across the seam (plus `2π·turns`).
+//!
+//! A guide of axes (`axis`: a carbonyl bond, a director field, where `g` and `−g` say the
+//! same) is unwrapped modulo π instead (each angle within π/2 of the one before): the frame
+//! follows the sign that continues it, as molecular cartoon renderers flip alternate
+//! peptide planes. The first usable row keeps its sign; a closed curve still closes (the
+//! seam stays modulo 2π: axes that come back reversed after a round spread the half turn).
 
 use glam::DVec3;
-use std::f64::consts::TAU;
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::constraints::wrap;
 use super::geometry::signed_angle;
@@ -39,6 +45,15 @@ pub struct Guide<'a> {
     pub weight: f64,
     /// Angle (radians) between guide and `±t` below which the guide is ignored.
     pub tolerance: f64,
+    /// Each vector is an axis (`±g` alike): the guide angles are unwrapped modulo π, so the
+    /// frame follows whichever sign continues it.
+    pub axis: bool,
+}
+
+/// `a` modulo π, in `(−π/2, π/2]`: the turn to the nearer of `±g`.
+fn wrap_half(a: f64) -> f64 {
+    let w = a.rem_euclid(PI);
+    if w > FRAC_PI_2 { w - PI } else { w }
 }
 
 /// Check the scalar options.
@@ -162,7 +177,11 @@ pub fn twist(
             continue;
         }
         if let Some(p) = prev {
-            *v = p + wrap(*v - p);
+            *v = p + if guide.axis {
+                wrap_half(*v - p)
+            } else {
+                wrap(*v - p)
+            };
         }
         prev = Some(*v);
         first.get_or_insert(i);

@@ -282,7 +282,8 @@ fn cusp_error(i: usize) -> InputError {
 
 /// Unit tangents estimated from points (`closed`: the points form a loop, no repeated end).
 ///
-/// Errors if fewer than 2 points (3 for a loop) or if an estimate vanishes (a cusp).
+/// Errors if fewer than 2 points (3 for a loop) or if an estimate vanishes at an open end
+/// (an interior zero estimate, a symmetric reversal, takes the chord guard's normal).
 /// Points are assumed finite and free of repeated consecutive points (checked by the caller).
 ///
 /// `chords[i] = |x_{i+1} − x_i|` (mod n when closed), as returned by `validate::chords`.
@@ -390,8 +391,8 @@ pub fn estimate_cancellable(
 /// curve with `n ≥ 5` samples: the guarded five-point chord-length tangent, its two end
 /// values bounded by the turn of the end chords ([`bound_end`]); what [`estimate`] returns
 /// there. `h(j)` is the chord length `|x_{j+1} − x_j|` (callers pass a table or compute it on
-/// the fly: the values must be those of `validate::chords`). `None` where the estimate
-/// vanishes (a cusp).
+/// the fly: the values must be those of `validate::chords`). `None` where the estimate is
+/// not finite, or vanishes at an end.
 #[inline(always)]
 pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> Option<DVec3> {
     let u = five_point_unit_unbounded(x, i, h)?;
@@ -504,7 +505,7 @@ pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
 /// `b̂ = (p̂ + q̂)/|p̂ + q̂|` is the tangent of a corner: the normal plane of `b̂` is the plane
 /// in which the straight tubes about the two chords meet, and `b̂·p̂ = b̂·q̂ = cos(φ/2)`, larger
 /// than the smaller dot product of any other unit vector. Two steps, each continuous in the
-/// points:
+/// points short of reversals (below):
 ///
 /// 1. **Corners.** Where the chords turn by more than 30° the samples no longer resolve a
 ///    smooth curve (fewer than 12 samples per turn of a circle), and the estimate, which
@@ -517,10 +518,11 @@ pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
 ///    uneven chords) becomes `normalise((1 − w) u + w b̂)`, `w = min(1, (½ − m)/½)`, whose
 ///    margin against both chords is at least `½ cos(φ/2)`.
 ///
-/// So every segment runs along the tangents of its ends (`ĉ·(t_i + t_{i+1}) > 0`) short of
-/// an exact reversal, and double reflection and the sweep's rings exist on any polyline (a
-/// jagged random walk, a coarse streamline, a hairpin). At an exact reversal (`p̂ = −q̂`) the
-/// result is normal to the chord, the limit of the bisectors of near reversals.
+/// So every segment runs along the tangents of its ends (`ĉ·(t_i + t_{i+1}) > 0`) unless
+/// both of its ends reverse, and double reflection and the sweep's rings exist on any
+/// polyline (a jagged random walk, a coarse streamline, a hairpin). At a reversal (chords
+/// within 10⁻⁶ rad of opposite, where `p̂ + q̂` is rounding noise) the result is normal to the
+/// chord, the limit of the bisectors of near reversals, on the side the estimate leans to.
 ///
 /// A smooth curve sampled with turns under 30° and estimates within 60° of both chords (the
 /// cheap test made first) keeps its 4th-order estimate bit for bit. (Our rule: Wang et al.

@@ -9,8 +9,9 @@
 //!   computes again.
 //! * A segment whose chord runs against its tangents, `v̂₁·(t_i + t_{i+1}) ≤ 10⁻⁶`, is
 //!   refused: double reflection degenerates there (`v₂ → 0`, TOG §4.4) and the rotation
-//!   method meets opposite tangents. Estimated tangents pass it on any polyline short of an
-//!   exact reversal (their chord guard, `tangents::guard_chords`); given tangents (or frames)
+//!   method meets opposite tangents. Estimated tangents pass it on any polyline but where two
+//!   reversals follow each other (their chord guard, `tangents::guard_chords`); given
+//!   tangents (or frames)
 //!   that point backwards along a segment, and the unbounded end tangents of the `FivePoint`
 //!   and `FivePointUniform` rules, can fail it.
 
@@ -181,8 +182,8 @@ pub enum CurveStatus {
 ///
 /// A row is merged into the last kept row before it when they are closer than the curve's
 /// [`repeat_floor`] (`|x_j − x_k|_∞ ≤ 2⁻⁴⁰·extent`, compared with the last *kept* row so a
-/// creep of tiny steps cannot add up to a segment). On a closed curve the last kept row is
-/// merged into the curve's first row when it repeats it. The kept rows then have no chord
+/// creep of tiny steps cannot add up to a segment). On a closed curve the last kept rows
+/// are merged into the curve's first row while they repeat it (or [`coincide`] with it). The kept rows then have no chord
 /// at or under the floor of their own (never larger) extent, so the frame and sweep checks
 /// accept them. Curves with a non-finite sample are left as they are (every row kept).
 /// Curves in parallel, each scanned in order; polls `cancel` before every curve (the
@@ -227,11 +228,17 @@ pub fn distinct_rows(
                     kept += 1;
                 }
             }
-            if closed && last > 0 && repeated(xc[last], xc[0], floor) {
+            // closed: the last kept rows that repeat the first (within the floor, or its
+            // rounding far from the origin, as the core's closing test has it) join it
+            while closed
+                && last > 0
+                && (repeated(xc[last], xc[0], floor) || coincide(xc[last], xc[0]))
+            {
                 for r in rows.iter_mut().skip(last) {
                     *r = a;
                 }
                 kept -= 1;
+                last = rows[last - 1] - a;
             }
             if kept < min {
                 CurveStatus::TooFew
@@ -374,6 +381,13 @@ mod tests {
             (into, status),
             (vec![0, 1, 1, 3, 0], vec![CurveStatus::Valid])
         );
+        // two jittered closing samples, each far enough from the other: both join the first
+        let f = 0.8 * 2.0f64.powi(-40);
+        let jit = [p(0.0, 0.0), p(1.0, 0.0), p(0.0, 1.0), p(f, 0.0), p(-f, 0.0)];
+        let (into, _) =
+            distinct_rows(&jit, &[0, 5], true, &crate::cancel::never).expect("valid offsets");
+        assert_eq!(into, [0, 1, 2, 0, 0]);
+        assert!(chords(&jit[..3], true).is_ok());
         let (_, status) =
             distinct_rows(&tri[..3], &[0, 3], true, &crate::cancel::never).expect("valid offsets");
         assert_eq!(status, [CurveStatus::TooFew]);

@@ -34,7 +34,7 @@ impl From<InputError> for PyErr {
 }
 
 pyo3::create_exception!(
-    _core,
+    spinal._core,
     RepeatedPointsError,
     PyValueError,
     "Consecutive samples that coincide (a ValueError; the Python layer merges them)."

@@ -199,7 +199,8 @@ pub fn estimate_tangents<'py>(
 #[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
                     con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
-                    guide, guide_weight, guide_tolerance, previous, points_arg="points"))]
+                    guide, guide_weight, guide_tolerance, guide_axis, previous,
+                    points_arg="points"))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_steered<'py>(
     py: Python<'py>,
@@ -227,6 +228,7 @@ pub fn frames_steered<'py>(
     guide: Option<PyReadonlyArray2<'py, f64>>,
     guide_weight: f64,
     guide_tolerance: f64,
+    guide_axis: bool,
     previous: Option<PyReadonlyArray3<'py, f64>>,
     points_arg: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
@@ -290,6 +292,7 @@ pub fn frames_steered<'py>(
                     vectors: if g.len() == 1 { g } else { &g[a..b] },
                     weight: guide_weight,
                     tolerance: guide_tolerance,
+                    axis: guide_axis,
                 }),
                 previous: prev.map(|p| &p[a..b]),
             }
