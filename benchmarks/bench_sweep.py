@@ -37,6 +37,8 @@ a first call's time depends on what ran before it.
     python benchmarks/bench_sweep.py --bundle --bundle-first   # first calls, cold memory
     python benchmarks/bench_sweep.py --spikes     # only: non-convex profiles of 10^3 … 10^5
                                                   # packed spikes (star, comb), capped
+    python benchmarks/bench_sweep.py --rough      # only: 2,000 Gaussian random walks and
+                                                  # dipy's bundled tracts (when installed)
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ import json
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 from _timing import best, helix
@@ -262,6 +265,75 @@ def spike_rows(repeat, limit=120.0):
         print(f"| {kind} | " + " | ".join(cells) + f" | {growth} |", flush=True)
 
 
+def rough_sets():
+    """Rough polylines as users have them: 2,000 Gaussian random walks of 3…60 points, and
+    dipy's bundled tracts when dipy is installed (fornix, EuDX small, the minimal bundles,
+    the two cingulum bundles)."""
+    rng = np.random.default_rng(0)
+    yield "2,000 random walks", [np.cumsum(rng.normal(size=(rng.integers(3, 61), 3)), axis=0)
+                                 for _ in range(2000)]
+    try:
+        import glob
+        import os
+        import tempfile
+        import zipfile
+
+        import dipy
+        import dipy.data
+        import nibabel as nib
+    except ImportError:
+        return
+    files = os.path.join(os.path.dirname(dipy.__file__), "data", "files")
+
+    def trk(*paths):
+        return [np.asarray(s, dtype=float) for f in paths
+                for s in nib.streamlines.load(f).streamlines]
+
+    yield "dipy fornix", trk(os.path.join(files, "tracks300.trk"))
+    yield "dipy EuDX small", trk(os.path.join(files, "EuDX_small_25.trk"))
+    with tempfile.TemporaryDirectory() as tmp:
+        with zipfile.ZipFile(os.path.join(files, "minimal_bundles.zip")) as z:
+            z.extractall(tmp)
+        yield "dipy minimal bundles", trk(*sorted(glob.glob(os.path.join(tmp, "**", "*.trk"),
+                                                            recursive=True)))
+    try:
+        cb = dipy.data.two_cingulum_bundles()
+    except (OSError, ValueError) as exc:  # data missing offline
+        print(f"(dipy's two cingulum bundles left out: {exc})")
+        return
+    yield "dipy two cingulum bundles", [np.asarray(s, dtype=float) for b in cb for s in b]
+
+
+def rough_rows(repeat):
+    """One ``spinal.tube`` call per set (8 sides, radius 0.1), every curve tubed: the time,
+    whether the mesh is watertight and wound outwards, and VTK's tube filter on the same
+    polylines (one PolyData)."""
+    import trimesh
+
+    vtk = peers().get("pv")
+    print("| set | curves | points | spinal ms | watertight, outward | VTK strips ms |")
+    print("|---|---|---|---|---|---|")
+    for name, lines in rough_sets():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            t = best(lambda ls=lines: spinal.tube(ls, 0.1, 8), repeat)
+            m = spinal.tube(lines, 0.1, 8)
+        tm = trimesh.Trimesh(m.vertices, m.faces, process=False)
+        ok = tm.is_watertight and tm.is_winding_consistent and m.volume > 0
+        tv = "–"
+        if vtk is not None:
+            import pyvista as pv
+
+            pts = np.concatenate(lines)
+            cells = np.concatenate([np.r_[len(l), o + np.arange(len(l))] for l, o in
+                                    zip(lines, np.r_[0, np.cumsum([len(l) for l in lines])])])
+            poly = pv.PolyData(pts, lines=cells)
+            tube = (lambda p=poly: p.tube(radius=0.1, n_sides=8, capping=True))
+            tv = f"{1e3 * best(tube, repeat):.1f}"
+        print(f"| {name} | {len(lines)} | {sum(len(l) for l in lines)} | {1e3 * t:.1f} | "
+              f"{'yes' if ok else 'NO'} | {tv} |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e6)
@@ -280,7 +352,13 @@ def main():
     ap.add_argument("--spikes", action="store_true",
                     help="only the scaling of a capped sweep of a profile with packed spikes "
                          "(star and comb, m = 10^3, 10^4, 10^5 profile vertices)")
+    ap.add_argument("--rough", action="store_true",
+                    help="only rough polylines: 2,000 random walks and dipy's bundled tracts")
     args = ap.parse_args()
+    if args.rough:
+        print(f"rough polylines tubed in one call each; ms, best of {args.repeat}\n")
+        rough_rows(args.repeat)
+        return
     if args.spikes:
         print(f"capped sweep of a spiky profile along a 3-point straight spine; seconds, best "
               f"of {args.repeat}\n")

@@ -178,3 +178,31 @@ def test_curves_with_nan_or_too_few_distinct_points_are_refused_or_skipped():
     assert len(empty.vertices) == 0 and list(empty.skipped_curves) == [0]
     with pytest.raises(ValueError, match="on_invalid: unknown value .drop.; expected one of"):
         spinal.tube(good[0], 0.1, on_invalid="drop")
+
+
+def test_dipy_bundled_tracts_are_tubed_in_one_call_each():
+    """dipy's bundled tracts (when dipy is installed): every streamline tubed, watertight and
+    wound outwards, no end tilted more than 45° from its end chord."""
+    dipy = pytest.importorskip("dipy")
+    nib = pytest.importorskip("nibabel")
+    import os
+
+    files = os.path.join(os.path.dirname(dipy.__file__), "data", "files")
+    for name in ("tracks300.trk", "EuDX_small_25.trk"):
+        path = os.path.join(files, name)
+        if not os.path.exists(path):
+            pytest.skip(f"{name} not in this dipy")
+        lines = [np.asarray(s, dtype=float) for s in nib.streamlines.load(path).streamlines]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spinal.FoldOverWarning)
+            mesh = spinal.tube(lines, 0.1, 8)
+        tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+        assert tm.is_watertight and tm.is_winding_consistent and mesh.volume > 0, name
+        assert set(mesh.curve_of) == set(range(len(lines)))
+        F = spinal.frames(lines)
+        start = 0
+        for x in lines:
+            for row, chord in ((0, x[1] - x[0]), (len(x) - 1, x[-1] - x[-2])):
+                t = F[start + row, :, 2]
+                assert t @ chord / np.linalg.norm(chord) >= np.cos(np.pi / 4) - 1e-12
+            start += len(x)

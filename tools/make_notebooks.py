@@ -958,7 +958,9 @@ ax.set_xlabel("residue"); ax.set_ylabel("twist from the RMF (rad)"); ax.legend()
 
 A curve waves through a straight position. Started afresh at every time step, its frames depend on the
 principal normal near the start, which turns over when the curve straightens: the tube's stripes jump by
-half a turn. `spinal.frames_in_time` turns each step's RMF by the one angle closest to the step before.""",
+half a turn. `spinal.frames_in_time` follows the step before sample by sample (each frame turns by about
+as much as its tangent); `previous_twist=False` turns each step's RMF by the one angle closest to the step
+before instead.""",
         """T = 8
 xs = np.linspace(0, 6, 120)
 P = np.array([np.c_[xs, a * np.sin(xs), 0.5 * a * np.cos(1.3 * xs) + 0.1 * xs]
