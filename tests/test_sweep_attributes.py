@@ -480,3 +480,22 @@ def test_point_data_as_a_list_of_per_curve_arrays():
     # a list whose arrays do not match the curves' rows is refused, naming the key
     with pytest.raises(ValueError, match=r"point_data\['fa'\]"):
         spinal.tube(curves, 0.1, 6, point_data={"fa": [f[:-1] for f in fa]})
+
+
+def test_tangents_and_frames_as_lists_of_per_curve_arrays():
+    """T3-11: a bundle given as a list of curves takes its tangents and frames as lists too
+    (one array per curve), like spinal.frames; a list that does not match is named."""
+    u = np.linspace(0, 4 * np.pi, 60)
+    H = np.c_[np.cos(u), np.sin(u), 0.2 * u]
+    curves = [H, H[:30] + 3]
+    T = [spinal.estimate_tangents(c) for c in curves]
+    F = [spinal.frames(c) for c in curves]
+    ref_t = spinal.tube(curves, 0.1, 6, tangents=np.concatenate(T))
+    np.testing.assert_array_equal(spinal.tube(curves, 0.1, 6, tangents=T).vertices,
+                                  ref_t.vertices)
+    ref_f = spinal.tube(curves, 0.1, 6, frames=np.concatenate(F))
+    np.testing.assert_array_equal(spinal.tube(curves, 0.1, 6, frames=F).vertices,
+                                  ref_f.vertices)
+    with pytest.raises(ValueError, match=r"tangents: a list of 2 arrays of \[60, 29\] rows "
+                                         r"does not match"):
+        spinal.tube(curves, 0.1, 6, tangents=[T[0], T[1][:-1]])

@@ -272,10 +272,11 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     lens = np.diff(offs) if bundle and (np.diff(offs) >= 0).all() else None
     curves = offs.size - 1
     rule = as_choice(tangent_rule, "tangent_rule", TANGENT_RULES)
-    fr = None if frames is None else as_frames(frames, "frames", rows=n)[0]
+    fr = None if frames is None else as_frames(_joined(frames, "frames", offs, 3), "frames",
+                                               rows=n)[0]
     tg = None
     if tangents is not None:
-        tg = as_points(tangents, "tangents")
+        tg = as_points(_joined(tangents, "tangents", offs, 2), "tangents")
         if tg.shape[0] != n:
             raise ValueError(f"tangents: expected shape ({n}, 3) to match points, got "
                              f"{tg.shape}")
@@ -486,6 +487,27 @@ def _point_data(data, n: int, curves: int | None, lens=None) -> dict:
             raise ValueError(f"point_data[{k!r}]: expected {per}, got shape {a.shape}")
         out[k] = (a, len(a) != n)
     return out
+
+
+def _joined(x, name: str, offs: np.ndarray, ndim: int):
+    """Per-row data given as a list (any sequence but an array) of one array per curve, as
+    ``points`` may be (``ndim``: of each array, 2 for tangents, 3 for frames), back to back;
+    anything else as given."""
+    if isinstance(x, (np.ndarray, str, bytes)) or not hasattr(x, "__len__") or not len(x):
+        return x
+    try:
+        first = np.asarray(x[0])
+    except (TypeError, ValueError, IndexError, KeyError):
+        return x
+    if first.ndim != ndim:
+        return x
+    parts = [as_float_array(a, f"{name}[{c}]") for c, a in enumerate(x)]
+    lens = np.diff(offs)
+    if len(parts) != len(lens) or any(len(a) != m for a, m in zip(parts, lens)):
+        raise ValueError(f"{name}: a list of {len(parts)} arrays of "
+                         f"{[len(a) for a in parts][:8]} rows does not match the curves of "
+                         f"points ({len(lens)} curves of {list(lens[:8])} rows)")
+    return np.concatenate(parts)
 
 
 def _cut(keep, pts, fr, tg, sc, tw):
