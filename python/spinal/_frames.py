@@ -682,17 +682,7 @@ def frames_in_time(
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
     turns = as_int(turns, "turns")
-    p = None if points_t is None else as_float_array(points_t, "points_t")
-    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
-    ref = p if p is not None else tg
-    if ref is None:
-        raise TypeError("points_t: required")
-    for a, name in ((p, "points_t"), (tg, "tangents_t")):
-        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
-            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
-    if p is not None and tg is not None and p.shape != tg.shape:
-        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
-    steps, n = ref.shape[0], ref.shape[1]
+    p, tg, steps, n = _time_steps(points_t, tangents_t)
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
@@ -714,17 +704,7 @@ def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns
                             guide_tolerance, guide_sign, lengths, offsets) -> np.ndarray:
     """:func:`frames_in_time` step by step through :func:`frames` (``previous_twist``, a
     guide, or a bundle)."""
-    p = None if points_t is None else as_float_array(points_t, "points_t")
-    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
-    ref = p if p is not None else tg
-    if ref is None:
-        raise TypeError("points_t: required")
-    for a, name in ((p, "points_t"), (tg, "tangents_t")):
-        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
-            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
-    if p is not None and tg is not None and p.shape != tg.shape:
-        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
-    steps, n = ref.shape[0], ref.shape[1]
+    p, tg, steps, n = _time_steps(points_t, tangents_t)
     previous_weight = as_real(previous_weight, "previous_weight")
     if not 0.0 < previous_weight < np.inf:
         raise ValueError(f"previous_weight: must be a positive finite number, got "
@@ -765,3 +745,19 @@ def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns
                     raise ValueError(f"{name}: time step {k}: {msg[len(arg):]}") from None
             raise
     return out
+
+
+def _time_steps(points_t, tangents_t):
+    """``points_t``, ``tangents_t`` as float arrays ``(T, n, 3)`` (either may be None, not
+    both), and ``T``, ``n``."""
+    p = None if points_t is None else as_float_array(points_t, "points_t")
+    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
+    ref = p if p is not None else tg
+    if ref is None:
+        raise TypeError("points_t: required")
+    for a, name in ((p, "points_t"), (tg, "tangents_t")):
+        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
+            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
+    if p is not None and tg is not None and p.shape != tg.shape:
+        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
+    return p, tg, ref.shape[0], ref.shape[1]
