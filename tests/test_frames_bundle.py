@@ -59,9 +59,15 @@ def test_bundle_per_curve_initial_end_and_closed():
 def test_bundle_error_names_the_curve():
     a = TorusKnot().sample(50)
     bad = a.copy()
-    bad[10] = bad[9]
-    with pytest.raises(ValueError, match=r"points: curve 1 \(rows 50 to 99\): rows 9 and 10"):
+    bad[10, 1] = np.nan
+    with pytest.raises(ValueError, match=r"points: curve 1 \(rows 50 to 99\): non-finite .* "
+                                         r"row 10"):
         spinal.frames(np.concatenate([a, bad]), lengths=[50, 50])
+    # after a merged repeat in curve 0, an error of curve 1 names its rows as given
+    rep = np.insert(a, 10, a[9], axis=0)
+    with pytest.raises(ValueError, match=r"points: curve 1 \(rows 51 to 100\): non-finite .* "
+                                         r"row 10"):
+        spinal.frames(np.concatenate([rep, bad]), lengths=[51, 50])
     with pytest.raises(ValueError, match="lengths"):
         spinal.frames(a, lengths=[20, 20])
     with pytest.raises(ValueError, match="initial"):

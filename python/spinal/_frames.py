@@ -346,14 +346,7 @@ def frames(
     (200, 3, 3)
     """
     previous_twist = as_bool(previous_twist, "previous_twist")
-    # checked even when no guide or previous uses them (the same bounds as the core's)
-    guide_weight = as_real(guide_weight, "guide_weight")
-    if not 0.0 < guide_weight < np.inf:
-        raise ValueError(f"guide_weight: must be a positive finite number, got {guide_weight}")
-    guide_tolerance = as_finite(guide_tolerance, "guide_tolerance", 0.0)
-    if not guide_tolerance < np.pi / 2:
-        raise ValueError(f"guide_tolerance: must be an angle in [0, π/2) radians, got "
-                         f"{guide_tolerance}")
+    guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
     if previous_twist and previous is None:
         raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
@@ -581,6 +574,19 @@ def _steered_merged(run, p, pts, tgs, offs, steer, rows):
     return out[p.rows]
 
 
+def _guide_options(guide_weight, guide_tolerance):
+    """``guide_weight`` and ``guide_tolerance`` as floats, checked even when no guide or
+    previous uses them (the same bounds as the core's)."""
+    guide_weight = as_real(guide_weight, "guide_weight")
+    if not 0.0 < guide_weight < np.inf:
+        raise ValueError(f"guide_weight: must be a positive finite number, got {guide_weight}")
+    guide_tolerance = as_finite(guide_tolerance, "guide_tolerance", 0.0)
+    if not guide_tolerance < np.pi / 2:
+        raise ValueError(f"guide_tolerance: must be an angle in [0, π/2) radians, got "
+                         f"{guide_tolerance}")
+    return guide_weight, guide_tolerance
+
+
 def _previous_twist_guide(previous, rows: int) -> np.ndarray:
     """The ``r`` columns of ``previous`` (checked: one rotation per row) as a guide."""
     prev = previous_frames(previous, rows)
@@ -672,6 +678,8 @@ def frames_in_time(
         than ``(n, 3, 3)`` or not made of rotations, a ``guide`` of another shape.
     """
     previous_twist = as_bool(previous_twist, "previous_twist")
+    guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
+    guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
     chained = previous_twist or guide is not None or lengths is not None or offsets is not None
     if chained:
         return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,

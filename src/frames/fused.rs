@@ -24,7 +24,7 @@ use super::geometry::{any_perpendicular, bounds, rotate_about, signed_angle};
 use super::lanes::{Arith, F4, L, V4};
 use super::rotation::rotation_step;
 use super::tangents::{
-    CHORD_MARGIN, CORNER_COS, OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open,
+    CHORD_MARGIN, CORNER_COS2, OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open,
 };
 use super::transport::{ChunkEnds, Scan, Twist, plan, write_frame};
 use super::validate::{MIN_ALIGNMENT, REPEAT_REL, repeated};
@@ -537,7 +537,7 @@ fn interior_tangents(w: &mut Scratch, blk: &Block, i0: usize, i1: usize) -> u32 
     let (s, lo) = (blk.s, blk.lo);
     let guard2 = F4::splat(OVERSHOOT_COS * OVERSHOOT_COS);
     let margin2 = F4::splat(CHORD_MARGIN * CHORD_MARGIN);
-    let corner = F4::splat(CORNER_COS[0]);
+    let corner2 = F4::splat(CORNER_COS2);
     let zero = F4::splat(0.0);
     let mut bad = 0u32;
     let (p, c) = (refs(&w.p), refs(&w.c));
@@ -566,16 +566,17 @@ fn interior_tangents(w: &mut Scratch, blk: &Block, i0: usize, i1: usize) -> u32 
         // scalar function makes its exact test and may turn the tangent towards the bisector)
         let (ci, co) = (V4::load(&c, k - 1), V4::load(&c, k));
         let (a, b) = (u.dot(ci), u.dot(co));
-        let hh = F4::load(h, k - 1) * F4::load(h, k);
+        let (qi, qo, turn) = (F4::load(q, k - 1), F4::load(q, k), ci.dot(co));
         let good = l.mask(zero, |p, q| p > q)
-            & ci.dot(co).mask(corner * hh, |p, q| p >= q)
+            & turn.mask(zero, |p, q| p >= q)
+            & (turn * turn).mask(corner2 * (qi * qo), |p, q| p >= q)
             & u.finite_mask()
             & d.mask(zero, |p, q| p >= q)
             & (d * d).mask(guard2 * cw.dot(cw), |p, q| p >= q)
             & a.mask(zero, |p, q| p >= q)
             & b.mask(zero, |p, q| p >= q)
-            & (a * a).mask(margin2 * F4::load(q, k - 1), |p, q| p >= q)
-            & (b * b).mask(margin2 * F4::load(q, k), |p, q| p >= q);
+            & (a * a).mask(margin2 * qi, |p, q| p >= q)
+            & (b * b).mask(margin2 * qo, |p, q| p >= q);
         bad |= !good & live(g, i1);
         u.store(&mut t, g - s);
     }

@@ -143,6 +143,11 @@ pub fn circle_normal(
     let d = centre - x[i];
     let perp = d - d.dot(t) * t;
     let kappa = 1.0 / d.length();
+    // the centre seen along the tangent (a tangent along a chord through the centre, as at
+    // an end corner whose chord is a diameter) leaves no normal but rounding
+    if !(perp.length() > 1e-9 * d.length()) {
+        return None;
+    }
     perp.try_normalize().map(|v| (v, kappa))
 }
 
@@ -497,6 +502,9 @@ const REVERSAL: f64 = 1e-6;
 /// of the turn from which the bisector replaces it (60°); see [`guard_chords`].
 pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
 
+/// `cos² 30° = 3/4`, for [`guard_chords`]' test without square roots.
+pub const CORNER_COS2: f64 = 0.75;
+
 /// The unit tangent `u` estimated at a sample between the chords `c_in = x_i − x_{i−1}` and
 /// `c_out = x_{i+1} − x_i`, turned towards their bisector where the polyline turns sharply
 /// there or where `u` points too far from either chord.
@@ -531,11 +539,18 @@ pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
 pub fn guard_chords(c_in: DVec3, c_out: DVec3, u: DVec3) -> DVec3 {
     let (a, b) = (u.dot(c_in), u.dot(c_out));
     let m2 = CHORD_MARGIN * CHORD_MARGIN;
-    if c_in.dot(c_out) >= CORNER_COS[0] * (c_in.length() * c_out.length())
+    let (qi, qo, turn) = (
+        c_in.length_squared(),
+        c_out.length_squared(),
+        c_in.dot(c_out),
+    );
+    // a turn under 30° and within 60° of both chords, without a square root
+    if turn >= 0.0
+        && turn * turn >= CORNER_COS2 * (qi * qo)
         && a >= 0.0
         && b >= 0.0
-        && a * a >= m2 * c_in.length_squared()
-        && b * b >= m2 * c_out.length_squared()
+        && a * a >= m2 * qi
+        && b * b >= m2 * qo
     {
         return u;
     }
