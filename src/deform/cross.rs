@@ -30,52 +30,9 @@
 
 use glam::DVec3;
 
-use super::curl::{Ball, Ring, Shape, ToolShape};
+use super::shape::{Ball, Ring, Shape, ToolShape, blend, speed_factor, translate};
 use super::{Field, Tool, bounded, finite, finite3, positive, reach_or, unit};
 use crate::error::{InputError, Result};
-
-/// `(D, D′)` of the region function at signed distance `d`, reach `rf`.
-#[inline(always)]
-pub(crate) fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
-    let s = d / rf;
-    if !(s > 0.0) {
-        (0.0, 0.0)
-    } else if !(s < 1.0) {
-        (1.0, 0.0)
-    } else if linear {
-        (s, 1.0 / rf)
-    } else {
-        (s * s * s * (4.0 - 3.0 * s), 12.0 * s * s * (1.0 - s) / rf)
-    }
-}
-
-/// The translation field from `d`, `n`, `Y = X − c`, `u` (`None` outside the support).
-#[inline(always)]
-pub(crate) fn translate(d: f64, n: DVec3, y: DVec3, u: DVec3, rf: f64, linear: bool) -> DVec3 {
-    if !(d < rf) {
-        return DVec3::ZERO;
-    }
-    if !(d > 0.0) {
-        return u;
-    }
-    let (b, db) = blend(d, rf, linear);
-    let g = 1.0 - b;
-    (g * g) * u + (g * db) * (y * n.dot(u) - u * n.dot(y))
-}
-
-/// `max_σ [(1 − D)² + (1 − D) D′ L(σ)]` sampled on 2049 distances, `L(σ)` a bound of `|Y|`
-/// (a sampled maximum is low by O(spacing²), immaterial for a step-size rule).
-pub(crate) fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64 {
-    let n = 2048;
-    let mut m: f64 = 1.0;
-    for i in 0..=n {
-        let d = rf * i as f64 / n as f64;
-        let (b, db) = blend(d, rf, linear);
-        let g = 1.0 - b;
-        m = m.max(g * g + g * db * l(d));
-    }
-    m
-}
 
 /// Sphere tool of radius ρ translating with velocity u (von Funck's region translation).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -30,176 +30,12 @@
 //! shape's own frame, `X_b = C + Q(t)ᵀ(X − c(t))`, the gradient turned back, `g = Q g_b`),
 //! a static one keeps it where it was built (a steady field).
 
-use std::sync::Arc;
-
 use glam::{DMat3, DVec3};
 
-use super::grid::GridTool;
-use super::rod::Rod;
+use super::shape::ToolShape;
+pub use super::shape::{Distance, Shape};
 use super::{Tool, bounded, falloff as falloff_power, finite3};
 use crate::error::{InputError, Result};
-
-/// The signed distance of a tool's shape (negative inside), in the shape's own frame.
-pub trait Distance: Send + Sync + std::fmt::Debug {
-    /// `(d, ∇d)` at `x`, or `None` where `|d| ≥ reach` is certain (it may also return a
-    /// distance with `|d| ≥ reach`, which the falloff zeroes). `∇d` must be the exact
-    /// gradient of the `d` returned (it need not be a unit vector).
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)>;
-    /// The reach `R` the shape was built for (the support is `|d| < R`).
-    fn reach(&self) -> f64;
-    /// The tool's centre `C` (the origin of `Y` for a translation).
-    fn center(&self) -> DVec3;
-    /// An upper bound of `|X − C|` over the support `|d| < R`.
-    fn extent(&self) -> f64;
-    /// An upper bound of `|∇d|` over the support (1 for an exact distance).
-    fn gradient_bound(&self) -> f64 {
-        1.0
-    }
-    /// Whether an evaluation reads a table at a place that depends on the point (a grid's
-    /// coefficients, an axis's segments): see [`Tool::wants_locality`].
-    fn wants_locality(&self) -> bool {
-        false
-    }
-    /// Whether [`Self::distance`] is certain to be `None` at every point of the box
-    /// `[lo, hi]` (checked once for a batch of points; `false` when unsure).
-    #[inline(always)]
-    fn misses(&self, _lo: DVec3, _hi: DVec3) -> bool {
-        false
-    }
-    /// Whether [`Self::misses`] is worth a test per batch (then the batch's lanes also run
-    /// in an AVX2 build where the processor has it).
-    fn culls_boxes(&self) -> bool {
-        false
-    }
-}
-
-impl<D: Distance + ?Sized> Distance for Arc<D> {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        (**self).distance(x)
-    }
-    fn reach(&self) -> f64 {
-        (**self).reach()
-    }
-    fn center(&self) -> DVec3 {
-        (**self).center()
-    }
-    fn extent(&self) -> f64 {
-        (**self).extent()
-    }
-    fn gradient_bound(&self) -> f64 {
-        (**self).gradient_bound()
-    }
-    fn wants_locality(&self) -> bool {
-        (**self).wants_locality()
-    }
-    #[inline(always)]
-    fn misses(&self, lo: DVec3, hi: DVec3) -> bool {
-        (**self).misses(lo, hi)
-    }
-    #[inline(always)]
-    fn culls_boxes(&self) -> bool {
-        (**self).culls_boxes()
-    }
-}
-
-/// A ball: `d = |X − c| − ρ`, `∇d = (X − c)/|X − c|` (zero at the centre).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ball {
-    pub center: DVec3,
-    pub radius: f64,
-    pub reach: f64,
-}
-
-impl Distance for Ball {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        let y = x - self.center;
-        let r2 = y.length_squared();
-        let (outer, inner) = (self.radius + self.reach, self.radius - self.reach);
-        if !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner) {
-            return None;
-        }
-        let r = r2.sqrt();
-        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
-        Some((r - self.radius, g))
-    }
-    fn reach(&self) -> f64 {
-        self.reach
-    }
-    fn center(&self) -> DVec3 {
-        self.center
-    }
-    fn extent(&self) -> f64 {
-        self.radius + self.reach
-    }
-}
-
-/// A torus about the unit `axis` through `center` (major radius `R_t`, tube radius `r_t`):
-/// `d = √((ρ − R_t)² + z²) − r_t` with `z = k·Y`, `ρ = |Y − z k|`, `Y = X − center`, and
-/// `∇d = ((ρ − R_t) e_ρ + z k)/√((ρ − R_t)² + z²)` (zero on the core circle). Smooth in the
-/// support `|d| < R` when `r_t + R < R_t` (away from the axis and the core circle's inside).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ring {
-    pub center: DVec3,
-    pub axis: DVec3,
-    pub major: f64,
-    pub minor: f64,
-    pub reach: f64,
-}
-
-impl Distance for Ring {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        let y = x - self.center;
-        let z = self.axis.dot(y);
-        let yp = y - self.axis * z;
-        let rho = yp.length();
-        let dr = rho - self.major;
-        let dist = (dr * dr + z * z).sqrt();
-        let d = dist - self.minor;
-        if !(d.abs() < self.reach) || !(rho > 0.0) {
-            return None;
-        }
-        let g = if dist > 0.0 {
-            (yp * (dr / rho) + self.axis * z) * (1.0 / dist)
-        } else {
-            DVec3::ZERO
-        };
-        Some((d, g))
-    }
-    fn reach(&self) -> f64 {
-        self.reach
-    }
-    fn center(&self) -> DVec3 {
-        self.center
-    }
-    fn extent(&self) -> f64 {
-        self.major + self.minor + self.reach
-    }
-}
-
-impl Distance for GridTool {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        GridTool::distance(self, x)
-    }
-    fn reach(&self) -> f64 {
-        self.reach
-    }
-    fn center(&self) -> DVec3 {
-        self.center
-    }
-    fn extent(&self) -> f64 {
-        self.support_extent()
-    }
-    fn gradient_bound(&self) -> f64 {
-        self.slope_bound()
-    }
-    fn wants_locality(&self) -> bool {
-        true
-    }
-}
 
 /// The falloff factors at distance `d`: `k = e^{p−1}/R^p`, `e = R − |d|` and `p sgn(d)`;
 /// `None` outside the support.
@@ -628,63 +464,14 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     }
 }
 
-/// A tool's shape, for tools that can be posed by keys ([`super::keyframe`]).
-#[derive(Debug, Clone)]
-pub enum Shape {
-    Ball(Ball),
-    Rod(Arc<Rod>),
-    Grid(Arc<GridTool>),
-    Ring(Ring),
-}
-
-impl Shape {
-    /// The shape's centre `C`.
-    pub fn center(&self) -> DVec3 {
-        match self {
-            Shape::Ball(b) => b.center(),
-            Shape::Rod(r) => r.center(),
-            Shape::Grid(g) => Distance::center(&**g),
-            Shape::Ring(r) => r.center(),
-        }
-    }
-}
-
-impl From<Ring> for Shape {
-    fn from(r: Ring) -> Shape {
-        Shape::Ring(r)
-    }
-}
-
-impl From<Ball> for Shape {
-    fn from(b: Ball) -> Shape {
-        Shape::Ball(b)
-    }
-}
-
-impl From<Arc<Rod>> for Shape {
-    fn from(r: Arc<Rod>) -> Shape {
-        Shape::Rod(r)
-    }
-}
-
-impl From<Arc<GridTool>> for Shape {
-    fn from(g: Arc<GridTool>) -> Shape {
-        Shape::Grid(g)
-    }
-}
-
-/// The shape of a built tool and its falloff power (`None` for tools that are not curl
-/// fields: the keyframed tool then needs one).
-#[derive(Debug, Clone)]
-pub struct ToolShape {
-    pub shape: Shape,
-    pub power: Option<u8>,
-}
-
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
     use super::super::Field;
     use super::super::fields::{Rotation, Translation};
+    use super::super::rod::Rod;
+    use super::super::shape::{Ball, Ring};
     use super::*;
 
     fn div(f: impl Fn(DVec3) -> DVec3, x: DVec3) -> f64 {

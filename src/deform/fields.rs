@@ -179,7 +179,7 @@ impl Tool for Translation {
     fn potential_jacobian(&self, x: DVec3, t: f64) -> Option<DMat3> {
         Some(Translation::potential_jacobian(self, x, t))
     }
-    fn shape(&self) -> Option<super::curl::ToolShape> {
+    fn shape(&self) -> Option<super::shape::ToolShape> {
         Some(ball_shape(self.center, self.radius, self.reach, self.power))
     }
     fn rigid_velocity(&self) -> DVec3 {
@@ -298,15 +298,15 @@ impl Tool for Rotation {
     fn length_scale(&self) -> f64 {
         self.reach
     }
-    fn shape(&self) -> Option<super::curl::ToolShape> {
+    fn shape(&self) -> Option<super::shape::ToolShape> {
         Some(ball_shape(self.center, self.radius, self.reach, self.power))
     }
 }
 
 /// The ball of a sphere tool (at its position at t = 0) for keyframed poses.
-fn ball_shape(center: DVec3, radius: f64, reach: f64, power: u8) -> super::curl::ToolShape {
-    super::curl::ToolShape {
-        shape: super::curl::Shape::Ball(super::curl::Ball {
+fn ball_shape(center: DVec3, radius: f64, reach: f64, power: u8) -> super::shape::ToolShape {
+    super::shape::ToolShape {
+        shape: super::shape::Shape::Ball(super::shape::Ball {
             center,
             radius,
             reach,

@@ -28,7 +28,7 @@
 
 use glam::DVec3;
 
-use super::cross::{speed_factor, translate};
+use super::shape::{speed_factor, translate};
 use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
@@ -722,9 +722,9 @@ impl super::Tool for GridTool {
     fn length_scale(&self) -> f64 {
         self.reach
     }
-    fn shape(&self) -> Option<super::curl::ToolShape> {
-        Some(super::curl::ToolShape {
-            shape: super::curl::Shape::Grid(std::sync::Arc::new(self.clone())),
+    fn shape(&self) -> Option<super::shape::ToolShape> {
+        Some(super::shape::ToolShape {
+            shape: super::shape::Shape::Grid(std::sync::Arc::new(self.clone())),
             power: None,
         })
     }

@@ -28,7 +28,8 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use super::curl::{Distance, Falloff, Pose, Shape, ToolShape, rotation_bound};
+use super::curl::{Falloff, Pose, rotation_bound};
+use super::shape::{Distance, Shape, ToolShape};
 use super::{Tool, falloff};
 use crate::alloc;
 use crate::cancel::{self, Cancel};

@@ -20,6 +20,7 @@ pub mod keyframe;
 pub mod path;
 pub mod refine;
 pub mod rod;
+pub mod shape;
 pub mod slip;
 pub mod stamp;
 pub mod tube;
@@ -85,7 +86,7 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
 
     /// The tool's shape (its signed distance, centre and reach) for tools that a
     /// [`keyframe::Keyframed`] tool can pose; `None` for the others.
-    fn shape(&self) -> Option<curl::ToolShape> {
+    fn shape(&self) -> Option<shape::ToolShape> {
         None
     }
 

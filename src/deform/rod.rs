@@ -17,7 +17,7 @@
 
 use glam::DVec3;
 
-use super::curl::Distance;
+use super::shape::Distance;
 use super::tube::{Axis, AxisSample};
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};

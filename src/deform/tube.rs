@@ -45,7 +45,7 @@
 
 use glam::DVec3;
 
-use super::cross::{blend, translate};
+use super::shape::{blend, translate};
 use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
@@ -643,10 +643,10 @@ impl super::Tool for StripAlong {
     }
     /// The rod about the strip's axis (the same axis, checked for the same
     /// `radius + reach`), for keyframed poses.
-    fn shape(&self) -> Option<super::curl::ToolShape> {
+    fn shape(&self) -> Option<super::shape::ToolShape> {
         let rod = super::rod::Rod::with_axis(self.axis.clone(), self.radius, self.reach, None);
-        Some(super::curl::ToolShape {
-            shape: super::curl::Shape::Rod(std::sync::Arc::new(rod)),
+        Some(super::shape::ToolShape {
+            shape: super::shape::Shape::Rod(std::sync::Arc::new(rod)),
             power: None,
         })
     }
