@@ -179,7 +179,9 @@ def sweep(
         What to do with curves (of a bundle, or the one curve) that hold a NaN or an
         infinity or have fewer than 2 (closed: 3) distinct points: refuse them (ValueError
         naming the curve and row) or leave them out like ``on_short="skip"`` (a
-        :class:`SkippedCurvesWarning` naming them and why; ``Mesh.skipped_curves``).
+        :class:`SkippedCurvesWarning` naming them and why; ``Mesh.skipped_curves``). Curves
+        of 0 or 1 rows have fewer than 2 distinct points: ``on_invalid="skip"`` leaves them
+        out too, whatever ``on_short`` says.
 
     Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
     bounding box's largest side) are one point: they are merged into the first of them,
