@@ -529,3 +529,19 @@ def test_many_walkers_equal_one_walker_at_a_time():
     nan[3, 2, 0] = np.nan
     with pytest.raises(ValueError, match="walker 3"):
         Q.walk_mesh_many(V, F, fc, pts, nan)
+
+
+def test_quaternion_and_camera_frames_merge_repeated_samples():
+    """A repeated sample (a pause in a GPS track) gets the quaternion / camera of the row it
+    repeats; the others are those of the track without it (per-row bank cut alike)."""
+    u = np.linspace(0, 6, 60)
+    x = np.c_[np.cos(u), np.sin(u), 0.1 * u]
+    d = np.insert(x, 20, x[19], axis=0)
+    rows = np.r_[np.arange(20), 19, np.arange(20, 60)]
+    np.testing.assert_array_equal(Q.quaternion_frames(d), Q.quaternion_frames(x)[rows])
+    np.testing.assert_array_equal(Q.camera_frames(d), Q.camera_frames(x)[rows])
+    bank = np.arange(61.0) * 0.01
+    np.testing.assert_array_equal(Q.camera_frames(d, mode="up", bank=bank),
+                                  Q.camera_frames(x, mode="up", bank=np.delete(bank, 20))[rows])
+    with pytest.raises(ValueError, match="points: an open curve needs at least 2 distinct"):
+        Q.quaternion_frames(np.zeros((4, 3)))

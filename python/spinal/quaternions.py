@@ -28,7 +28,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import _core
+from . import _core, _merge
 from ._frames import frames
 from ._validate import (
     as_bool,
@@ -198,6 +198,8 @@ def quaternion_frames(
     :func:`spinal.frames`. A closed curve may repeat its first point at the end; that row
     then gets the frame carried once round the loop (after the correction), ``±q₀``: the
     sign tells whether the quaternion curve closes on S³ or ends at the antipode.
+    Consecutive samples closer than ``2⁻⁴⁰`` of the curve's size are merged, as in
+    :func:`spinal.frames`: their rows get the quaternion of the row they repeat.
     """
     method = as_choice(method, "method", ("transport", "frenet"))
     closed = as_bool(closed, "closed")
@@ -207,18 +209,25 @@ def quaternion_frames(
     if method == "frenet":  # the core refuses initial and turns for the Frenet frame
         f = frames(pts, tangents, method="frenet", closed=closed, initial=initial, turns=turns)
         return _from_xyzw(_core.quat_from_frames(f, True), sf)
-    n = len(pts)
-    repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
-    core_pts = pts[:-1] if repeat else pts
     t = None
     if tangents is not None:
         t = as_float_array(tangents, "tangents")
         if t.shape != pts.shape:
             raise ValueError(f"tangents: expected shape {pts.shape} to match points, got {t.shape}")
-        t = np.ascontiguousarray(t[: len(core_pts)])
-    q, _ = _core.quat_transport(np.ascontiguousarray(core_pts), t, _initial_r(initial), closed,
-                                turns, repeat)
-    return _from_xyzw(q, sf)
+    r0 = _initial_r(initial)
+
+    def transport(pts, offs, t):
+        n = len(pts)
+        repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
+        core_pts = pts[:-1] if repeat else pts
+        tc = None if t is None else np.ascontiguousarray(t[: len(core_pts)])
+        return _core.quat_transport(np.ascontiguousarray(core_pts), tc, r0, closed, turns,
+                                    repeat)[0]
+
+    # consecutive repeated samples merged (their rows get the quaternion of the row they
+    # repeat), as in spinal.frames
+    offs = np.array([0, len(pts)], dtype=np.int64)
+    return _from_xyzw(_merge.on_rows(transport, pts, offs, closed, False, (t,)), sf)
 
 
 def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) -> float:
@@ -282,6 +291,8 @@ def camera_frames(
 
     ``bank``: optional roll angles (scalar or ``(n,)``, radians) about the gaze, right-handed
     about the direction of travel: positive turns up towards right (a roll to the right).
+    Consecutive repeated samples (a pause in a track; closer than ``2⁻⁴⁰`` of its size) are
+    merged, as in :func:`spinal.frames`: their rows get the camera of the row they repeat.
     """
     mode = as_choice(mode, "mode", ("transport", "up"))
     closed = as_bool(closed, "closed")
@@ -301,17 +312,24 @@ def camera_frames(
         if b.shape != (n,):
             raise ValueError(f"bank: expected a scalar or shape ({n},), got {b.shape}")
         b = np.ascontiguousarray(b)
-    t, u, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
-                                                  as_finite(singular_angle, "singular_angle",
-                                                            0.0, np.pi / 2))
-    if mode == "transport":
-        init = None if vertical else u
-        f = frames(pts, t, initial=init, closed=closed, turns=as_int(turns, "turns"))
-    else:
-        f = _level_frames(pts, t, u, regular, closed)
-    # spinal frame (r, s, t) = (up, right, gaze), rolled by the bank about the gaze
-    # (up' = cos b up + sin b (t × up)), then reordered to camera (right, up, −gaze)
-    return _core.camera_orient(np.ascontiguousarray(f), b)
+    singular = as_finite(singular_angle, "singular_angle", 0.0, np.pi / 2)
+    turns = as_int(turns, "turns")
+
+    def camera(pts, offs, t, b):
+        t, uu, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
+                                                       singular)
+        if mode == "transport":
+            init = None if vertical else uu
+            f = frames(pts, t, initial=init, closed=closed, turns=turns)
+        else:
+            f = _level_frames(pts, t, uu, regular, closed)
+        # spinal frame (r, s, t) = (up, right, gaze), rolled by the bank about the gaze
+        # (up' = cos b up + sin b (t × up)), then reordered to camera (right, up, −gaze)
+        return _core.camera_orient(np.ascontiguousarray(f), b)
+
+    # consecutive repeated samples (a pause in a GPS track) merged: their rows get the
+    # camera of the row they repeat
+    return _merge.on_rows(camera, pts, np.array([0, n], dtype=np.int64), closed, False, (t, b))
 
 
 def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
