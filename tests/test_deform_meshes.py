@@ -23,9 +23,8 @@ igl = pytest.importorskip("igl")
 pytest.importorskip("igl.predicates")
 
 _NAME = "rocker-arm.obj"
-_CANDIDATES = [Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes" / _NAME,
-               Path("/work/shared/data/meshes") / _NAME]
-PATH = next((p for p in _CANDIDATES if p.exists()), None)
+_CANDIDATE = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes" / _NAME
+PATH = _CANDIDATE if _CANDIDATE.exists() else None
 pytestmark = pytest.mark.skipif(PATH is None, reason=f"shared test mesh {_NAME} not available")
 
 

@@ -434,10 +434,13 @@ def test_extrusion_twist_table():
             assert np.all(coarse / fine > 3.5), (sol, coarse, fine)
 
 
-@pytest.mark.skipif(not os.path.exists("/work/shared/data/meshes/cow.obj"),
-                    reason="shared meshes not available")
+_COW = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data",
+                    "meshes", "cow.obj")
+
+
+@pytest.mark.skipif(not os.path.exists(_COW), reason="shared meshes not available")
 def test_real_mesh_optional():
-    m = trimesh.load("/work/shared/data/meshes/cow.obj", force="mesh", process=True)
+    m = trimesh.load(_COW, force="mesh", process=True)
     if not m.is_watertight:
         pytest.skip("cow.obj is not watertight")
     V = m.vertices - m.vertices.mean(0)

@@ -1,5 +1,5 @@
 """Reproducers of the robustness review (sweeps and meshes, part b), one test per row of
-/work/shared/reviews/robustness-defects.md, each named after its row."""
+../shared/reviews/robustness-defects.md, each named after its row."""
 
 from __future__ import annotations
 
