@@ -9,6 +9,31 @@ import pytest
 import spinal
 
 
+def test_mesh_refuses_non_finite_vertices_normals_and_uv():
+    """T3-06: Mesh() refuses NaN/inf vertices (float64 and float32), normals and uv, naming
+    the array and the row, instead of NaN volumes and areas."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    assert spinal.Mesh(V, F).volume > 0
+    for dtype in (np.float64, np.float32):
+        for bad in (np.nan, np.inf, -np.inf):
+            W = V.astype(dtype)
+            W[3, 0] = bad
+            with pytest.raises(ValueError, match="vertices: non-finite value .* at row 3"):
+                spinal.Mesh(W, F)
+    nrm = V.copy()
+    nrm[2, 1] = np.nan
+    with pytest.raises(ValueError, match="normals: non-finite value .* at row 2"):
+        spinal.Mesh(V, F, normals=nrm)
+    uv = np.zeros((4, 2))
+    uv[1, 0] = np.inf
+    with pytest.raises(ValueError, match="uv: non-finite value .* at row 1"):
+        spinal.Mesh(V, F, uv=uv)
+    # a non-contiguous view is read as it is
+    wide = np.c_[V, np.zeros(4)]
+    assert spinal.Mesh(wide[:, :3], F).volume == spinal.Mesh(V, F).volume
+
+
 def test_D10_mesh_validates_its_arrays():
     """Mesh used to validate nothing: a negative index wrapped (volume from the wrong vertex),
     an out-of-range one raised IndexError from .volume, float faces were truncated and

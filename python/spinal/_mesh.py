@@ -111,6 +111,7 @@ def _rows_or_none(x, name: str, n: int, width: int):
     if a.shape != (n, width):
         raise ValueError(f"{name}: expected shape ({n}, {width}) (one row per vertex), got "
                          f"{a.shape}")
+    _core.mesh_check_finite(np.ascontiguousarray(a), name)
     return a
 
 
@@ -203,6 +204,7 @@ class Mesh:
         V = vertices if single else as_float_array(vertices, "vertices")
         if V.ndim != 2 or V.shape[1] != 3:
             raise ValueError(f"vertices: expected an array of shape (V, 3), got shape {V.shape}")
+        _core.mesh_check_finite(np.ascontiguousarray(V), "vertices")
         n = len(V)
         F = _as_faces(faces, n)
         self.vertices, self.faces = V, F

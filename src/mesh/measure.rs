@@ -86,6 +86,22 @@ pub fn check_faces<I: Index>(f: &[[I; 3]], n: usize) -> Result<()> {
     check_faces_cancellable(f, n, &cancel::never)
 }
 
+/// The first row of `values` (rows of `width` numbers, `f32` or `f64`) that holds a NaN or an
+/// infinity, blocks scanned in parallel; polls `cancel` before each block (a cancelled scan
+/// finds nothing in the blocks it skips, see [`crate::cancel`]).
+pub fn first_non_finite_row<T: Copy + Sync + Into<f64>>(
+    values: &[T],
+    width: usize,
+    cancel: Cancel<'_>,
+) -> Option<usize> {
+    let rows = values.len() / width.max(1);
+    crate::cancel::first_bad_index(rows, cancel, |i| {
+        values[i * width..(i + 1) * width]
+            .iter()
+            .all(|&v| v.into().is_finite())
+    })
+}
+
 /// [`check_faces`] that polls `cancel` before every block of faces; a cancelled check passes
 /// the blocks it skips (the caller discards the result, see [`crate::cancel`]).
 pub fn check_faces_cancellable<I: Index>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<()> {

@@ -184,6 +184,34 @@ pub fn mesh_edges(
     ))
 }
 
+/// Refuse a NaN or an infinity in an `(n, k)` float64 or float32 array of a mesh (vertices,
+/// normals, uv), naming `arg` and the first such row.
+#[pyfunction]
+pub fn mesh_check_finite(py: Python<'_>, values: &Bound<'_, PyAny>, arg: &str) -> PyResult<()> {
+    let stop = Stop::default();
+    let cancel = || stop.requested();
+    let row = if let Ok(a) = values.extract::<numpy::PyReadonlyArray2<'_, f64>>() {
+        let width = a.shape()[1];
+        let v = super::convert::slice_of(arg, &a)?;
+        detach_stoppable(py, &stop, || {
+            measure::first_non_finite_row(v, width, &cancel)
+        })?
+    } else {
+        let a = values.extract::<numpy::PyReadonlyArray2<'_, f32>>()?;
+        let width = a.shape()[1];
+        let v = super::convert::slice_of(arg, &a)?;
+        detach_stoppable(py, &stop, || {
+            measure::first_non_finite_row(v, width, &cancel)
+        })?
+    };
+    match row {
+        Some(i) => Err(super::convert::value_error(format!(
+            "{arg}: non-finite value (NaN or inf) at row {i}"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Refuse face indices outside `0..n` (errors name `faces`).
 #[pyfunction]
 pub fn mesh_check_faces(py: Python<'_>, faces: &Bound<'_, PyAny>, n: usize) -> PyResult<()> {

@@ -73,6 +73,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::mesh_measure, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_edges, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_check_faces, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_check_finite, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::minimal_rotation, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
