@@ -308,6 +308,7 @@ mod tests {
             caps: true,
             miter_limit: 4.0,
             split_seams: true,
+            join: crate::sweep::Join::Round,
         };
         let profile = [DVec2::X, DVec2::Y, -DVec2::X, -DVec2::Y];
         // near unit size, and far from it (the set-up scales the input first)
@@ -412,6 +413,7 @@ mod tests {
             caps: true,
             miter_limit: 4.0,
             split_seams: true,
+            join: crate::sweep::Join::Round,
         };
         let spine = Spine {
             points: &x,

@@ -107,7 +107,7 @@ def test_nonconvex_prism_volume_and_mitred_square_loop(reverse):
     if reverse:
         star = star[::-1]
     square = np.array([(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)], float)
-    loop = spinal.sweep(square, star, closed=True)
+    loop = spinal.sweep(square, star, closed=True, join="miter")
     assert_clean(loop)
     area = abs(0.5 * np.sum(star[:, 0] * np.roll(star[:, 1], -1) - np.roll(star[:, 0], -1) * star[:, 1]))
     for v in volumes(loop):
@@ -276,15 +276,15 @@ def test_fold_over_is_reported_with_spine_rows():
 
 
 def test_corner_is_not_pinched():
-    """At a 90° corner the ring keeps the radius from both legs' axes (VTK's pinch is a
-    ring of radius r·cos 45° there)."""
+    """At a 90° corner the mitred ring keeps the radius from both legs' axes (VTK's pinch is
+    a ring of radius r·cos 45° there)."""
     leg = np.linspace(0, 1, 11)
     x = np.r_[np.c_[leg, 0 * leg, 0 * leg], np.c_[np.ones(10), leg[1:], 0 * leg[1:]]]
-    mesh = spinal.tube(x, 0.05, 8)
+    mesh = spinal.tube(x, 0.05, 8, join="miter")
     ring = mesh.vertices[10 * 8:11 * 8]
     np.testing.assert_allclose(np.hypot(ring[:, 1], ring[:, 2]), 0.05, rtol=1e-12)
     np.testing.assert_allclose(np.hypot(ring[:, 0] - 1, ring[:, 2]), 0.05, rtol=1e-12)
-    flat = spinal.tube(x, 0.05, 8, miter_limit=1.0)
+    flat = spinal.tube(x, 0.05, 8, miter_limit=1.0, join="miter")
     ring = flat.vertices[10 * 8:11 * 8]
     assert np.hypot(ring[:, 1], ring[:, 2]).min() < 0.05 * 0.75
 

@@ -38,7 +38,15 @@ def test_random_sweeps_are_watertight_or_refused(x, profile, size):
         assert str(e).startswith("points"), e
         return
     n, m = len(x), len(profile)
-    assert mesh.vertices.shape == (n * m, 3) and mesh.faces.shape == (2 * (n - 1) * m + 2 * (m - 2), 3)
+    # one ring per sample, then the rings of the corner joins (each at an interior sample);
+    # the faces of a segment or a join band, less those flattened on a join's crease
+    rings = len(mesh.vertices) // m
+    assert mesh.vertices.shape == (rings * m, 3) and rings >= n
+    np.testing.assert_array_equal(mesh.sample_of[:n * m], np.repeat(np.arange(n), m))
+    assert np.all((mesh.sample_of[n * m:] > 0) & (mesh.sample_of[n * m:] < n - 1))
+    full = 2 * (rings - 1) * m + 2 * (m - 2)
+    assert mesh.faces.shape[1] == 3 and (len(mesh.faces) == full) == (rings == n)
+    assert len(mesh.faces) <= full
     for a in (mesh.vertices, mesh.normals, mesh.uv):
         assert np.isfinite(a).all()
     np.testing.assert_allclose(np.linalg.norm(mesh.normals, axis=1), 1, atol=1e-12)
@@ -81,7 +89,7 @@ def test_planar_polyline_tubes_are_exact_prism_chains(x, sides):
     u = c / h[:, None]
     rho = 0.05 * h.min()
     t = np.r_[u[:1], u[:-1] + u[1:], u[-1:]]  # bisector planes at the corners
-    mesh = spinal.tube(x, rho, sides, frames=spinal.frames(x, t), strict=True)
+    mesh = spinal.tube(x, rho, sides, frames=spinal.frames(x, t), strict=True, join="miter")
     tm = trimesh.Trimesh(mesh.vertices - mesh.vertices.mean(axis=0), mesh.faces, process=False)
     assert tm.is_watertight and tm.is_winding_consistent
     area = 0.5 * sides * rho**2 * np.sin(2 * np.pi / sides)

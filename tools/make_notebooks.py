@@ -245,6 +245,60 @@ with tempfile.TemporaryDirectory() as tmp:
 print(back.array_names)
 print("same colours:", np.array_equal(back.point_data["orientation"],
                                        fibres.point_data["orientation"]))""",
+    """md:## Rough curves: sharp corners as joins
+
+Real polylines are rarely smooth: coarse streamlines, GPS tracks and polymer chains turn by
+tens of degrees between samples. At such a corner one ring per sample would cross its
+neighbours on the inner side. `spinal.tube` builds the corner as a join instead, like a 2D
+stroker: the inner side is cut where the two straight tubes meet (in the corner's bisector
+plane), the outer side is a round join (`join="round"`, the default; or `"bevel"`,
+`"miter"`). Below, 40 Gaussian random walks through spinal and through VTK's tube filter
+(PyVista), and the pairs of crossing triangles that libigl's exact predicates find in each.""",
+    """rng = np.random.default_rng(2)
+walks = [np.cumsum(rng.normal(size=(int(rng.integers(5, 25)), 3)), axis=0) for _ in range(40)]
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore", spinal.FoldOverWarning)
+    joined = spinal.tube(walks, 0.08, sides=16)
+print(joined, "watertight:", joined.is_watertight)
+
+try:
+    import igl
+    import igl.predicates
+
+    def crossing_pairs(v, f):
+        v = np.ascontiguousarray(v, dtype=np.float64)
+        f = np.ascontiguousarray(f, dtype=np.int64)
+        return len(igl.predicates.find_self_intersections(v, f)[1])
+
+    # each walk's tube against itself (the walks of a bundle cross each other in space)
+    ours, theirs = [], []
+    for c, w in enumerate(walks):
+        f = joined.faces[joined.cell_data["curve_id"] == c]
+        ours.append(crossing_pairs(joined.vertices, f))
+        vtk = pv.lines_from_points(w).tube(radius=0.08, n_sides=16, capping=True)
+        vtk = vtk.triangulate().clean()
+        theirs.append(crossing_pairs(vtk.points, vtk.faces.reshape(-1, 4)[:, 1:]))
+    ours, theirs = np.array(ours), np.array(theirs)
+    print(f"walks whose tube crosses itself: spinal {np.sum(ours > 0)}, VTK {np.sum(theirs > 0)}")
+    print(f"crossing triangle pairs: spinal {ours.sum()}, VTK {theirs.sum()}")
+except ImportError:
+    print("libigl is not installed: no crossing count")""",
+    """md:The pairs spinal still has are where a walk's tube really meets itself (two segments
+closer than the diameter) or a hairpin tighter than the radius, which a `FoldOverWarning`
+names. One corner of 137° up close, sampled every 0.05: spinal's round join on the left; on
+the right VTK's rings, one per sample: the corner pinches, and the rings next to it fold
+through each other on the inner side.""",
+    """corner = np.r_[np.c_[np.linspace(-1, 0, 21), np.zeros(21), np.zeros(21)],
+               np.linspace(0, 1, 21)[1:, None] * [np.cos(2.4), np.sin(2.4), 0]]
+ours = spinal.tube(corner, 0.1, sides=24).to_pyvista()
+theirs = pv.lines_from_points(corner).tube(radius=0.1, n_sides=24, capping=True)
+pl = pv.Plotter(shape=(1, 2), window_size=(900, 420))
+for i, (m, name) in enumerate([(ours, "spinal, round join"), (theirs, "VTK tube filter")]):
+    pl.subplot(0, i)
+    pl.add_mesh(m, color="lightsteelblue", show_edges=True, edge_color="gray", line_width=0.5)
+    pl.add_text(name, font_size=10)
+    pl.camera_position = [(0.1, -0.5, 1.3), (-0.15, 0.1, 0), (0, 1, 0)]
+pl.show()""",
 ])
 
 knot = nb([

@@ -214,6 +214,7 @@ def sweep(
     point_data: _PointData | None = None,
     on_short: Literal["raise", "skip"] = "raise",
     on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
 ) -> Mesh: ...
 def tube(
     points: _Array | _Curves,
@@ -236,6 +237,7 @@ def tube(
     point_data: _PointData | None = None,
     on_short: Literal["raise", "skip"] = "raise",
     on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------

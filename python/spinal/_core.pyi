@@ -109,11 +109,13 @@ def sweep_mesh(
     normals: bool = True,
     uv: bool = True,
     tangents: npt.NDArray[np.float64] | None = None,
+    join: str = "round",
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],
     npt.NDArray[np.floating] | None,
     npt.NDArray[np.floating] | None,
+    npt.NDArray[np.int64],
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
 ]: ...

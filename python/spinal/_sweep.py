@@ -90,6 +90,7 @@ def sweep(
     point_data=None,
     on_short: str = "raise",
     on_invalid: str = "raise",
+    join: str = "round",
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -102,6 +103,19 @@ def sweep(
     between its chords, the ring is stretched by ``1/cos(φ/2)`` (at most ``miter_limit``)
     along the direction of the turn, so tubes keep their cross-section through corners
     instead of pinching. On smooth, densely sampled spines this is ``1 + κ²h²/8``.
+
+    Sharp corners are built as joins, as a 2D stroker joins two segments: where the chords
+    at a sample turn by 60° or more, by 28° or more between straighter runs, or by 15° or
+    more where the mitred ring would exceed ``miter_limit`` or cross a neighbouring
+    sample's ring (a densely sampled corner), the two straight sweeps meeting there are
+    joined exactly — the inner side cut where they meet
+    (in the bisector plane of the corner; the neighbouring rings' vertices past it are
+    merged into that crease), the outer side a round join (rings turning about the corner,
+    at most ``2π/m`` apart for a profile of ``m`` vertices), a bevel or a mitre (``join``).
+    The extra rings are stored after each curve's rings; ``sample_of`` maps them to the
+    corner's row. Where straight runs on both sides of a corner are longer than
+    ``ρ·tan(φ/2)`` (ρ the profile's reach), no faces cross; shorter ones (a hairpin
+    tighter than the profile) are reported with a :class:`FoldOverWarning`.
 
     Parameters
     ----------
@@ -182,6 +196,12 @@ def sweep(
         :class:`SkippedCurvesWarning` naming them and why; ``Mesh.skipped_curves``). Curves
         of 0 or 1 rows have fewer than 2 distinct points: ``on_invalid="skip"`` leaves them
         out too, whatever ``on_short`` says.
+    join : {"round", "bevel", "miter"}
+        The outer side of the corners that get joins: rings turning about the corner
+        (``"round"``: for a circular profile, the spherical wedge of the union of the two
+        tubes), one flat band (``"bevel"``), or one ring in the bisector plane (``"miter"``,
+        the exact mitre; a bevel where it would exceed ``miter_limit``). Smooth, well
+        sampled spines get no joins, whichever is chosen.
 
     Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
     bounding box's largest side) are one point: they are merged into the first of them,
@@ -223,7 +243,7 @@ def sweep(
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
                        tangents, tangent_rule, dtype, normals, uv, point_data, on_short,
-                       on_invalid)
+                       on_invalid, join)
 
 
 def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
@@ -252,7 +272,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
                 normals=True, uv=True, point_data=None, on_short="raise",
-                on_invalid="raise") -> Mesh:
+                on_invalid="raise", join="round") -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     pts, offs, bundle = as_curves(points, lengths, offsets)
@@ -267,6 +287,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     want_uv = as_bool(uv, "uv")
     on_short = as_choice(on_short, "on_short", ("raise", "skip"))
     on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
+    join = as_choice(join, "join", ("round", "bevel", "miter"))
     miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
@@ -334,7 +355,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         return _core.sweep_mesh(
             pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
             profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
-            single, single, want_normals, want_uv, tg,
+            single, single, want_normals, want_uv, tg, join,
         )
 
     def merged(p):
@@ -373,11 +394,12 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
             raise
         # the core numbered the curves that were kept: back to the curves as given
         raise ValueError(_as_given(str(exc), curve_ids, given)) from None
-    v, f, nrm, uv, folds, faces_per_curve = result
+    v, f, nrm, uv, folds, faces_per_curve, join_rows = result
     row_of = None if keep_rows is None else np.flatnonzero(keep_rows)
     if folds.size and row_of is not None:  # back to the rows as given
         folds = row_of[folds]
-    rings, _ = _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, len(v))
+    rings, _ = _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, len(v),
+                            join_rows)
     if folds.size:
         where = f"spine rows {_ranges(folds)}"
         fold_curves = None
@@ -519,13 +541,14 @@ def _cut(keep, pts, fr, tg, sc, tw):
     return cut(pts), cut(fr), cut(tg), (cut(sc) if sc.shape[0] > 1 else sc), cut(tw)
 
 
-def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv):
+def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv, join_rows=None):
     """The stored rings of a sweep, as the core lays them out: per curve, one ring per
     distinct sample (a closed curve's repeated first point has none; split seams on a
-    closed curve repeat its first ring at the end). ``row_of``: the given row of every row
-    swept (None: the same). Returns a function giving ``(ring_sample, ring_curve, cols)``
-    (given rows and curves; O(rings) memory, so only built when asked for) and the first
-    vertex of every curve ``(C + 1,)``."""
+    closed curve repeat its first ring at the end), then the extra rings of its corner
+    joins (``join_rows``: the swept row of the corner of each, in order). ``row_of``: the
+    given row of every row swept (None: the same). Returns a function giving
+    ``(ring_sample, ring_curve, cols)`` (given rows and curves; O(rings) memory, so only
+    built when asked for) and the first vertex of every curve ``(C + 1,)``."""
     lens = np.diff(offs)
     rings = lens.copy()
     if closed:
@@ -534,25 +557,35 @@ def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv):
         scale = np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1))
         rings -= ((lens >= 2) & (d <= 8 * np.finfo(float).eps * scale)).astype(rings.dtype)
     stored = rings + int(closed and split_seams)
-    total = int(stored.sum())
+    if join_rows is not None and len(join_rows):
+        join_rows = np.asarray(join_rows, dtype=np.int64)
+        extra = np.bincount(np.searchsorted(offs, join_rows, side="right") - 1,
+                            minlength=len(lens))
+    else:
+        join_rows, extra = None, np.zeros_like(stored)
+    total = int((stored + extra).sum())
     cols = nv // total
     if cols * total != nv:
         raise RuntimeError("spinal: the sweep's vertex layout is not one ring per sample")
-    starts = np.concatenate([[0], np.cumsum(stored)])
+    starts = np.concatenate([[0], np.cumsum(stored + extra)])
     per_ring = functools.partial(_per_ring, offs[:-1], stored, rings, starts, row_of,
-                                 curve_ids, cols)
+                                 curve_ids, cols, extra, join_rows)
     return per_ring, starts * cols
 
 
-def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols):
+def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols, extra=None,
+              join_rows=None):
     """``(ring_sample, ring_curve, cols)`` of :func:`_ring_layout` (a module-level function
     bound with :func:`functools.partial`, so meshes that hold it pickle)."""
     total = int(starts[-1])
-    local = np.arange(total) - np.repeat(starts[:-1], stored)
-    sample = np.repeat(row0, stored) + local % np.repeat(rings, stored)
+    per = stored if extra is None else stored + extra
+    local = np.arange(total) - np.repeat(starts[:-1], per)
+    sample = np.repeat(row0, per) + local % np.repeat(rings, per)
+    if join_rows is not None:
+        sample[local >= np.repeat(stored, per)] = join_rows
     if row_of is not None:
         sample = row_of[sample]
-    return (sample.astype(np.int64), np.repeat(curve_ids, stored).astype(np.int64), cols)
+    return (sample.astype(np.int64), np.repeat(curve_ids, per).astype(np.int64), cols)
 
 
 def tube(
@@ -576,6 +609,7 @@ def tube(
     point_data=None,
     on_short: str = "raise",
     on_invalid: str = "raise",
+    join: str = "round",
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -585,8 +619,8 @@ def tube(
     ``radius``: scalar or (n,) positive values (one per spine row), or for a bundle (C,)
     (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
     Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
-    ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``) as in
-    :func:`sweep`.
+    ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``,
+    ``join``) as in :func:`sweep`.
     """
     # the core sees only the polygon built here
     sides = as_int(sides, "sides", 3, MAX_SIDES, out_of_bounds=lambda x: (
@@ -597,4 +631,4 @@ def tube(
     # the core checks the radius' values, naming radius
     return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
-                       dtype, normals, uv, point_data, on_short, on_invalid)
+                       dtype, normals, uv, point_data, on_short, on_invalid, join)

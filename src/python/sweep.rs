@@ -1,8 +1,9 @@
 //! Sweeps and tubes (`spinal.sweep`); the algorithm is in [`crate::sweep`].
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
-use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PySlice;
 
 use super::convert::{
     Stop, detach_stoppable, empty, ensure_memory, frames_of, offsets_of, renamed, slice_mut,
@@ -17,6 +18,7 @@ type MeshArrays<'py> = (
     Option<Bound<'py, PyAny>>,
     Bound<'py, PyArray1<i64>>,
     Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<i64>>,
 );
 
 /// Sweep a profile along one or many spines; see `spinal.sweep`. `frames`: one per row, or
@@ -24,7 +26,9 @@ type MeshArrays<'py> = (
 /// defaults; `tangents` optional), computed spine by spine as the sweep goes. Returns
 /// vertices, faces,
 /// normals (or None), uv (or None), the rows where a miter was folded and the number of
-/// faces of every spine (its faces follow those of the spine before it). Coordinates are
+/// faces of every spine (its faces follow those of the spine before it), and for every ring
+/// stored after a spine's rings for a corner join (`join`: "round", "bevel" or "miter"),
+/// the row of its corner. Coordinates are
 /// float32 with `single` (computed in float64, stored rounded), faces int32 with `index32`
 /// when the vertex count fits (int64 otherwise). Errors about the scale name `scale_arg`
 /// (`spinal.tube` passes its radius as the scale). `scale` may have a single row (the same
@@ -32,7 +36,7 @@ type MeshArrays<'py> = (
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
                     miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
-                    normals=true, uv=true, tangents=None))]
+                    normals=true, uv=true, tangents=None, join="round"))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -53,7 +57,18 @@ pub fn sweep_mesh<'py>(
     normals: bool,
     uv: bool,
     tangents: Option<PyReadonlyArray2<'py, f64>>,
+    join: &str,
 ) -> PyResult<MeshArrays<'py>> {
+    let join = match join {
+        "round" => sweep::Join::Round,
+        "bevel" => sweep::Join::Bevel,
+        "miter" => sweep::Join::Miter,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "join: expected 'round', 'bevel' or 'miter', got {join:?}"
+            )));
+        }
+    };
     let spine = Spine {
         points: vec3s("points", &points)?,
         frames: match &frames {
@@ -87,6 +102,7 @@ pub fn sweep_mesh<'py>(
         caps,
         miter_limit,
         split_seams,
+        join,
     };
     let rename = |e| renamed(e, "scale", scale_arg);
     let stop = Stop::default();
@@ -162,16 +178,21 @@ impl Job<'_> {
             })?
             .map_err(|e| renamed(e, "scale", self.scale_arg))?
         };
-        let folds: Vec<i64> = folds.iter().map(|&i| i as i64).collect();
-        let per_spine = self.prep.faces_per_spine();
-        let per_spine: Vec<i64> = per_spine.iter().map(|&k| k as i64).collect();
+        let written = folds;
+        let as_i64 = |a: &[usize]| a.iter().map(|&i| i as i64).collect::<Vec<i64>>();
+        let mut f = f.into_any();
+        if written.faces < nf {
+            // the faces the joins' welds flattened are left out: a view of the ones kept
+            f = f.get_item(PySlice::new(py, 0, written.faces as isize, 1))?;
+        }
         Ok((
             v.into_any(),
-            f.into_any(),
+            f,
             n.map(Bound::into_any),
             uv.map(Bound::into_any),
-            PyArray1::from_vec(py, folds),
-            PyArray1::from_vec(py, per_spine),
+            PyArray1::from_vec(py, as_i64(&written.folds)),
+            PyArray1::from_vec(py, as_i64(&written.faces_per_spine)),
+            PyArray1::from_vec(py, as_i64(&written.join_rows)),
         ))
     }
 }

@@ -4,6 +4,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::join;
 use super::layout::{Plan, Size};
 use super::{Options, Profile, Spine, columns};
 use crate::cancel::Cancel;
@@ -44,7 +45,7 @@ pub(super) fn check_spine(
     if cancel() {
         return Ok(None);
     }
-    let size = Size::of(s.points, opts, p);
+    let size = Size::of(s, opts, p);
     let rings = size.rings;
     let min = if opts.closed { 3 } else { 2 };
     if rings < min {
@@ -141,7 +142,18 @@ pub(super) fn check_spine(
         acc += *a;
         *a = acc;
     }
-    Ok(Some(Plan { size, arc }))
+    let mut corners = Vec::new();
+    if size.extra > 0 || opts.join == super::Join::Miter {
+        let scale = if s.scale.len() == 1 {
+            s.scale
+        } else {
+            &s.scale[..rings]
+        };
+        join::corners(&s.points[..rings], scale, opts.closed, p, opts, |c| {
+            corners.push(c)
+        });
+    }
+    Ok(Some(Plan { size, arc, corners }))
 }
 
 /// A row of the scale as the user gave it: one number for a radius (both factors equal),

@@ -1,8 +1,9 @@
 //! The size of a sweep's mesh and of every spine's part of it, from the row counts alone, and
 //! the rows of one spine of a bundle.
 
-use glam::DVec3;
+use rayon::prelude::*;
 
+use super::join::{self, Corner};
 use super::{Options, Profile, Spine};
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
@@ -23,18 +24,31 @@ pub(super) struct Size {
     /// Vertices per stored ring (one more than the profile for a closed profile with split
     /// seams).
     pub(super) cols: usize,
+    /// Rings of the corner joins, stored after the spine's rings (see [`super::join`]).
+    pub(super) extra: usize,
 }
 
 impl Size {
     /// The size of the sweep of spine `x` (a spine too short to sweep gets a size, which its
     /// check refuses).
-    pub(super) fn of(x: &[DVec3], opts: &Options, p: &Profile) -> Size {
+    pub(super) fn of(s: &Spine, opts: &Options, p: &Profile) -> Size {
+        let x = s.points;
         let n = x.len();
         let mut rings = n;
         if opts.closed && n >= 2 && validate::coincide(x[0], x[n - 1]) {
             rings -= 1;
         }
+        let scale = if s.scale.len() > 1 {
+            &s.scale[..rings.min(s.scale.len())]
+        } else {
+            s.scale
+        };
+        let extra = match scale.len() == 1 || scale.len() == rings {
+            true => join::extra_rings(&x[..rings], scale, opts.closed, p, opts),
+            false => 0, // refused by the checks
+        };
         Size {
+            extra,
             rings,
             segments: if opts.closed {
                 rings
@@ -47,11 +61,13 @@ impl Size {
         }
     }
     pub(super) fn vertices(&self) -> usize {
-        self.stored_rings * self.cols
+        (self.stored_rings + self.extra) * self.cols
     }
+    /// Faces at most: the side faces, the caps, and the faces of the joins (of which those
+    /// that the joins' welds flatten are left out).
     pub(super) fn faces(&self, p: &Profile) -> usize {
         let edges = if p.closed { p.len() } else { p.len() - 1 };
-        2 * self.segments * edges + if self.caps { 2 * (p.len() - 2) } else { 0 }
+        2 * (self.segments + self.extra) * edges + if self.caps { 2 * (p.len() - 2) } else { 0 }
     }
 }
 
@@ -61,6 +77,8 @@ impl Size {
 pub(super) struct Plan {
     pub(super) size: Size,
     pub(super) arc: Vec<f64>,
+    /// The corners that get joins.
+    pub(super) corners: Vec<Corner>,
 }
 
 impl std::ops::Deref for Plan {
@@ -156,12 +174,23 @@ pub fn layout_cancellable(
         ));
     }
     let mut sizes = crate::alloc::with_capacity("sweep layout", curves)?;
-    for c in 0..curves {
-        if c % BLOCK == 0 && cancel() {
-            return Ok(None);
+    // blocks of curves in parallel (the joins' corners are found from the points)
+    let blocks: Vec<Option<Vec<Size>>> = (0..curves.div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| match cancel() {
+            true => None,
+            false => Some(
+                (b * BLOCK..((b + 1) * BLOCK).min(curves))
+                    .map(|c| Size::of(&part(all, offsets, c), opts, profile))
+                    .collect(),
+            ),
+        })
+        .collect();
+    for b in blocks {
+        match b {
+            Some(b) => sizes.extend(b),
+            None => return Ok(None),
         }
-        let x = &all.points[offsets[c]..offsets[c + 1]];
-        sizes.push(Size::of(x, opts, profile));
     }
     Ok(Some(Layout {
         vertices: sizes.iter().map(Size::vertices).sum(),

@@ -60,6 +60,7 @@
 mod caps;
 mod check;
 mod faces;
+pub mod join;
 mod kernel;
 mod layout;
 mod monotone;
@@ -76,9 +77,10 @@ mod tests;
 
 use glam::{DVec2, DVec3};
 
+pub use join::Join;
 pub use layout::{Layout, indices_fit_i32, layout, layout_cancellable};
 pub use profile::Profile;
-pub use run::{FrameSource, Prepared, sweep_into, sweep_many};
+pub use run::{FrameSource, Prepared, Written, sweep_into, sweep_many};
 pub use scale::{Index, Real};
 
 /// One spine with its per-sample data (all slices have the spine's row count).
@@ -102,6 +104,8 @@ pub struct Options {
     pub miter_limit: f64,
     /// Duplicate the vertices on the texture seams (see [`sweep_many`]).
     pub split_seams: bool,
+    /// The outer side of the corners that get joins ([`join`]).
+    pub join: Join,
 }
 
 /// A triangle mesh.

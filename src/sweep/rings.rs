@@ -85,18 +85,21 @@ fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3]
     }
 }
 
+/// A ring's centre and the images of the profile's axes.
+pub(super) type Axes = (DVec3, DVec3, DVec3);
+
 /// One ring of the smooth swept surface.
 #[derive(Clone, Copy)]
 pub(super) struct Geo {
     /// Spine sample.
     k: usize,
     /// Centre and profile axes of the smooth surface.
-    pub(super) b: (DVec3, DVec3, DVec3),
+    pub(super) b: Axes,
     /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
     /// `x + a_j·ma + b_j·mb`.
     pub(super) ma: DVec3,
     pub(super) mb: DVec3,
-    t: DVec3,
+    pub(super) t: DVec3,
 }
 
 /// One block of rings' share of the outputs (`f`: the faces of its segments): whole rings,
@@ -153,13 +156,13 @@ pub(super) struct Rings<'a> {
 
 impl Rings<'_> {
     #[inline(always)]
-    fn tangent(&self, k: usize) -> DVec3 {
+    pub(super) fn tangent(&self, k: usize) -> DVec3 {
         columns(&self.s.frames[k]).2
     }
 
     /// Ring `k` of the smooth swept surface: centre and the images of the profile axes.
     #[inline(always)]
-    fn base(&self, k: usize) -> (DVec3, DVec3, DVec3) {
+    pub(super) fn base(&self, k: usize) -> (DVec3, DVec3, DVec3) {
         let s = self.s;
         let (r, q, _) = columns(&s.frames[k]);
         let sc = s.scale[if s.scale.len() == 1 { 0 } else { k }];
@@ -178,7 +181,7 @@ impl Rings<'_> {
     /// The unit chord from spine sample `k` to the next ([`unit_chord`]; on a closed spine
     /// the last wraps to the first, on an open one it is zero).
     #[inline(always)]
-    fn chord(&self, k: usize) -> DVec3 {
+    pub(super) fn chord(&self, k: usize) -> DVec3 {
         let n = self.x.len();
         match k + 1 == n {
             false => unit_chord(self.x[k + 1] - self.x[k]),
@@ -189,17 +192,17 @@ impl Rings<'_> {
 
     /// Spine sample `k ± 1` (`k < rings`), wrapping around.
     #[inline(always)]
-    fn after(&self, k: usize) -> usize {
+    pub(super) fn after(&self, k: usize) -> usize {
         if k + 1 == self.x.len() { 0 } else { k + 1 }
     }
 
     #[inline(always)]
-    fn before(&self, k: usize) -> usize {
+    pub(super) fn before(&self, k: usize) -> usize {
         if k == 0 { self.x.len() - 1 } else { k - 1 }
     }
 
     #[inline(always)]
-    fn geo(&self, k: usize) -> Geo {
+    pub(super) fn geo(&self, k: usize) -> Geo {
         self.geo_between(k, self.chord(self.before(k)), self.chord(k))
     }
 
@@ -207,20 +210,34 @@ impl Rings<'_> {
     /// ([`Rings::chord`] of `k − 1` and `k`: a pass along the spine computes each chord
     /// once).
     #[inline(always)]
-    fn geo_between(&self, k: usize, din: DVec3, dout: DVec3) -> Geo {
-        let b = self.base(k);
+    pub(super) fn geo_between(&self, k: usize, din: DVec3, dout: DVec3) -> Geo {
+        self.geo_of(k, din, dout, self.base(k), self.tangent(k))
+    }
+
+    /// Ring `k` of the mitred sweep with the centre and axes `b` and the tangent `t`.
+    #[inline(always)]
+    fn geo_of(&self, k: usize, din: DVec3, dout: DVec3, b: Axes, t: DVec3) -> Geo {
         let end = !self.closed && (k == 0 || k + 1 == self.x.len());
         let (mf, mk) = match end {
             true => (0.0, DVec3::ZERO),
-            false => mitre(din, dout, self.tangent(k), self.miter_limit),
+            false => mitre(din, dout, t, self.miter_limit),
         };
         Geo {
             k,
             b,
             ma: b.1 + (mf * b.1.dot(mk)) * mk,
             mb: b.2 + (mf * b.2.dot(mk)) * mk,
-            t: self.tangent(k),
+            t,
         }
+    }
+
+    /// Ring `k` of the mitred sweep turned to the tangent `t` (its axes turned by the
+    /// minimal rotation from the frame's tangent to `t`).
+    pub(super) fn geo_turned(&self, k: usize, t: DVec3) -> Geo {
+        let (x, a, b) = self.base(k);
+        let turn = crate::math::rotation::minimal_rotation_matrix(self.tangent(k), t);
+        let (din, dout) = (self.chord(self.before(k)), self.chord(k));
+        self.geo_of(k, din, dout, (x, turn * a, turn * b), t)
     }
 
     /// All stored rings and the side faces of their segments, `grain` rings per parallel
@@ -493,9 +510,8 @@ impl Rings<'_> {
                     // a degenerate spine derivative: the normal of the ring plane
                     for (j, n) in rn.iter_mut().enumerate() {
                         if !ring.usable(j) {
-                            let e = column.w[0][j] * cur.b.1 + column.w[1][j] * cur.b.2;
-                            let e = (self.sign * e.cross(cur.t)).try_normalize();
-                            *n = put3(e.unwrap_or(cur.t));
+                            let w = (column.w[0][j], column.w[1][j]);
+                            *n = put3(self.plane_normal(w, (cur.b.1, cur.b.2), cur.t));
                         }
                     }
                 }
@@ -527,6 +543,15 @@ impl Rings<'_> {
             kn = self.after(kn);
         }
         (folds, bad)
+    }
+
+    /// The outward unit normal of a ring's own plane at a column whose profile derivative
+    /// has weights `w` on the ring's axes `(a, b)`: `±(w₀ a + w₁ b) × t` (the tangent `t`
+    /// where that vanishes), the normal of a prism on the ring.
+    #[inline]
+    pub(super) fn plane_normal(&self, w: (f64, f64), (a, b): (DVec3, DVec3), t: DVec3) -> DVec3 {
+        let e = w.0 * a + w.1 * b;
+        (self.sign * e.cross(t)).try_normalize().unwrap_or(t)
     }
 
     /// d/ds of ring `cur` (three-point rule in arc length): the same weights on centres and

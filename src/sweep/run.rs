@@ -8,6 +8,7 @@ use std::sync::OnceLock;
 use super::caps::write_caps;
 use super::check::check_spine;
 use super::faces::FacePattern;
+use super::join::{Corner, write_joins};
 use super::kernel::{Columns, RingScratch};
 use super::layout::{Layout, Plan, in_curve, layout, layout_cancellable, part};
 use super::rings::Rings;
@@ -64,9 +65,17 @@ impl<'a> Shared<'a> {
     }
 }
 
-/// Sweep one spine into its share of the output buffers (`out.faces`: its side faces, then
-/// its caps); returns the rows (global) that start a folded-over segment and the first
-/// vertex (local) out of the output type's range. `ring`: scratch for the rings of a block.
+/// What sweeping one spine wrote: the rows (global) that start a folded-over segment, the
+/// first vertex (local) out of the output type's range, and the faces kept (at the front of
+/// its share of the face buffer).
+struct SpineOut {
+    folds: Vec<usize>,
+    bad: Option<usize>,
+    faces: usize,
+}
+
+/// Sweep one spine into its share of the output buffers (`out.faces`: its side faces, its
+/// caps, then the faces of its joins); `ring`: scratch for the rings of a block.
 #[allow(clippy::too_many_arguments)]
 fn sweep_one<R: Real, I: Index>(
     s: &Spine,
@@ -79,7 +88,7 @@ fn sweep_one<R: Real, I: Index>(
     out: MeshMut<R, I>,
     ring: &mut RingScratch,
     cancel: Cancel<'_>,
-) -> (Vec<usize>, Option<usize>) {
+) -> SpineOut {
     // Rings per parallel task (one poll of `cancel` each): enough work (~4k vertices) to pay
     // for the task, and at most `BLOCK_BYTES` of output, so that a stop waits for little
     // writing even where the writes fault in fresh pages of the output; a ring of more goes
@@ -101,15 +110,19 @@ fn sweep_one<R: Real, I: Index>(
         sign: sh.sign,
         rowbase,
     };
-    let (side, caps) = out.faces.split_at_mut(2 * plan.segments * sh.edges);
-    let side = MeshMut {
-        vertices: out.vertices,
+    let mut out = out;
+    let nv = plan.stored_rings * plan.cols;
+    let n_side = 2 * plan.segments * sh.edges;
+    let n_caps = if plan.caps { sh.tris.len() * 2 } else { 0 };
+    let (side, rest) = out.faces.split_at_mut(n_side);
+    let plain = MeshMut {
+        vertices: &mut out.vertices[..nv],
         faces: side,
-        normals: out.normals,
-        uv: out.uv,
+        normals: out.normals.as_deref_mut().map(|a| &mut a[..nv]),
+        uv: out.uv.as_deref_mut().map(|a| &mut a[..nv]),
     };
-    let res = rings.write(
-        side,
+    let (mut folds, bad) = rings.write(
+        plain,
         &sh.pattern,
         vbase,
         unscale,
@@ -120,9 +133,32 @@ fn sweep_one<R: Real, I: Index>(
     // a stopped sweep writes no caps: they lie apart, and each may be the first write to a
     // fresh page of the output
     if plan.caps && !cancel() {
-        write_caps(caps, plan, &sh.tris, vbase);
+        write_caps(&mut rest[..n_caps], plan, &sh.tris, vbase);
     }
-    res
+    if plan.corners.is_empty() || cancel() {
+        return SpineOut {
+            folds,
+            bad,
+            faces: out.faces.len(),
+        };
+    }
+    let all = sh.column.get_or_init(|| Columns::of(sh.p, plan.cols));
+    let (faces, bad_join) = write_joins(
+        &rings,
+        &plan.corners,
+        &all.view(0..plan.cols),
+        &sh.pattern,
+        out,
+        n_side + n_caps,
+        vbase,
+        unscale,
+        &mut folds,
+    );
+    SpineOut {
+        folds,
+        bad: bad.or(bad_join),
+        faces,
+    }
 }
 
 /// Where the frames of a sweep come from.
@@ -167,10 +203,10 @@ fn rmf_into(
     Ok(())
 }
 
-/// What sweeping one spine gave: its fold-over rows and first vertex out of range, or the
-/// error of its frames or of its checks, or nothing (stopped).
+/// What sweeping one spine gave: what it wrote and its joins' corners, or the error of its
+/// frames or of its checks, or nothing (stopped).
 enum Outcome {
-    Swept(Vec<usize>, Option<usize>),
+    Swept(SpineOut, Vec<Corner>),
     Frames(InputError),
     Checks(InputError),
     Stopped,
@@ -208,11 +244,7 @@ impl Sweep<'_> {
     /// curves, then the sweep's checks, each by curve): a frames error of any curve, else the
     /// first curve's check error, else a vertex beyond the range of the output type
     /// ([`out_of_range`]).
-    fn write<R: Real, I: Index>(
-        &self,
-        out: MeshMut<R, I>,
-        cancel: Cancel<'_>,
-    ) -> Result<Vec<usize>> {
+    fn write<R: Real, I: Index>(&self, out: MeshMut<R, I>, cancel: Cancel<'_>) -> Result<Written> {
         let (nv, nf) = (self.layout.vertices, self.layout.faces);
         assert!(
             out.vertices.len() == nv
@@ -233,7 +265,8 @@ impl Sweep<'_> {
         // Split the buffers per spine.
         let sizes = &self.layout.sizes;
         let mut jobs = crate::alloc::with_capacity("sweep", sizes.len())?;
-        let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, out.faces);
+        let all_faces = out.faces;
+        let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, &mut *all_faces);
         let mut vbase = 0;
         for (c, size) in sizes.iter().enumerate() {
             let (k, kf) = (size.vertices(), size.faces(self.sh.p));
@@ -278,7 +311,7 @@ impl Sweep<'_> {
             match o {
                 Outcome::Frames(e) => return Err(e.clone()),
                 Outcome::Checks(e) if check.is_none() => check = Some(e.clone()),
-                Outcome::Swept(_, b) if bad.is_none() => bad = *b,
+                Outcome::Swept(d, _) if bad.is_none() => bad = d.bad,
                 _ => {}
             }
         }
@@ -288,11 +321,35 @@ impl Sweep<'_> {
         if let Some(i) = bad {
             return Err(out_of_range::<R>(i));
         }
-        let folds = outcomes.into_iter().flat_map(|o| match o {
-            Outcome::Swept(f, _) => f,
-            _ => Vec::new(),
-        });
-        Ok(folds.collect())
+        let mut w = Written {
+            folds: Vec::new(),
+            faces_per_spine: Vec::with_capacity(sizes.len()),
+            faces: 0,
+            join_rows: Vec::new(),
+        };
+        // each spine's faces kept, after those of the spine before it
+        let mut start = 0;
+        for (c, (o, size)) in outcomes.into_iter().zip(sizes).enumerate() {
+            let bound = size.faces(self.sh.p);
+            let kept = match o {
+                Outcome::Swept(d, corners) => {
+                    w.folds.extend(d.folds);
+                    for k in corners {
+                        let row = self.offsets[c] + k.k;
+                        w.join_rows.extend(std::iter::repeat_n(row, k.extra));
+                    }
+                    d.faces
+                }
+                _ => bound,
+            };
+            if w.faces != start {
+                all_faces.copy_within(start..start + kept, w.faces);
+            }
+            w.faces += kept;
+            w.faces_per_spine.push(kept);
+            start += bound;
+        }
+        Ok(w)
     }
 
     /// Spine `c` into its part of the buffers, starting at vertex `vbase`.
@@ -329,10 +386,11 @@ impl Sweep<'_> {
             Err(e) => return Outcome::Checks(in_curve(e, self.offsets, c)),
         };
         let (rowbase, unscale) = (self.offsets[c], self.unscale);
-        let (folds, bad) = sweep_one(
+        let mut done = sweep_one(
             &s, &plan, &self.sh, self.opts, vbase, rowbase, unscale, out, ring, cancel,
         );
-        Outcome::Swept(folds, bad.map(|i| vbase + i))
+        done.bad = done.bad.map(|i| vbase + i);
+        Outcome::Swept(done, plan.corners)
     }
 }
 
@@ -377,10 +435,24 @@ fn first_frames_error(
     errors.into_iter().flatten().next()
 }
 
+/// What a sweep wrote into buffers of the sizes of its [`Layout`].
+#[derive(Debug, Clone, Default)]
+pub struct Written {
+    /// The rows starting a folded-over segment.
+    pub folds: Vec<usize>,
+    /// The faces of every spine, in the order of the spines (they follow one another).
+    pub faces_per_spine: Vec<usize>,
+    /// The faces written, at the front of the face buffer: the layout's count less those
+    /// the joins' welds flattened.
+    pub faces: usize,
+    /// For every ring stored after a spine's rings for a corner join, in order, the row of
+    /// the corner's sample.
+    pub join_rows: Vec<usize>,
+}
+
 /// Sweep `profile` along every spine of a bundle into buffers of the sizes in `layout`
-/// (spines in parallel, each checked as it is swept). Returns the rows starting a
-/// folded-over segment; refuses vertices beyond the range of the output type
-/// ([`out_of_range`]).
+/// (spines in parallel, each checked as it is swept). Refuses vertices beyond the range of
+/// the output type ([`out_of_range`]).
 pub fn sweep_into<R: Real, I: Index>(
     all: &Spine,
     offsets: &[usize],
@@ -388,7 +460,7 @@ pub fn sweep_into<R: Real, I: Index>(
     opts: &Options,
     layout: &Layout,
     out: MeshMut<R, I>,
-) -> Result<Vec<usize>> {
+) -> Result<Written> {
     let caps = layout.sizes.iter().any(|s| s.caps);
     let cols = layout.sizes.first().map_or(profile.len(), |s| s.cols);
     let sweep = Sweep {
@@ -507,16 +579,6 @@ impl<'a> Prepared<'a> {
         }))
     }
 
-    /// The number of faces of every spine's part of the mesh (its side faces, then its
-    /// caps), in the order of the spines: the parts follow one another in the face array.
-    pub fn faces_per_spine(&self) -> Vec<usize> {
-        self.layout
-            .sizes
-            .iter()
-            .map(|s| s.faces(&self.profile))
-            .collect()
-    }
-
     /// The spine the sweep runs on (scaled or as given).
     fn view(&self) -> Spine<'_> {
         match &self.scaled {
@@ -536,7 +598,7 @@ impl<'a> Prepared<'a> {
         &self,
         out: MeshMut<R, I>,
         cancel: Cancel<'_>,
-    ) -> Result<Vec<usize>> {
+    ) -> Result<Written> {
         let sizes = &self.layout.sizes;
         let caps = sizes.iter().any(|s| s.caps);
         let cols = sizes.first().map_or(self.profile.len(), |s| s.cols);
@@ -569,7 +631,7 @@ pub fn sweep_many(
         uv: vec![DVec2::ZERO; lay.vertices],
         folds: Vec::new(),
     };
-    mesh.folds = sweep_into(
+    let w = sweep_into(
         all,
         offsets,
         profile,
@@ -582,5 +644,7 @@ pub fn sweep_many(
             uv: Some(bytemuck::cast_slice_mut(&mut mesh.uv)),
         },
     )?;
+    mesh.faces.truncate(w.faces);
+    mesh.folds = w.folds;
     Ok(mesh)
 }

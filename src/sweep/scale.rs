@@ -127,6 +127,8 @@ pub(super) fn out_of_range<R>(i: usize) -> InputError {
 /// Storage of the face indices: `i64`, or `i32` (the caller checks that they fit).
 pub trait Index: Copy + Send + Sync + 'static {
     fn of(i: usize) -> Self;
+    /// The index as written by [`Index::of`] (every index written is non-negative).
+    fn get(self) -> usize;
 }
 
 impl Index for i64 {
@@ -134,12 +136,20 @@ impl Index for i64 {
     fn of(i: usize) -> i64 {
         i as i64
     }
+    #[inline(always)]
+    fn get(self) -> usize {
+        self as usize
+    }
 }
 
 impl Index for i32 {
     #[inline(always)]
     fn of(i: usize) -> i32 {
         i as i32
+    }
+    #[inline(always)]
+    fn get(self) -> usize {
+        self as usize
     }
 }
 

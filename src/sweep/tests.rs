@@ -58,6 +58,7 @@ fn options(closed: bool, caps: bool, split_seams: bool) -> Options {
         caps,
         miter_limit: 4.0,
         split_seams,
+        join: crate::sweep::Join::Round,
     }
 }
 
@@ -469,7 +470,8 @@ fn written(
         sign: sh.sign,
         rowbase: 7,
     };
-    let nv = plan.vertices();
+    // the rings of the samples (the joins' extra rings are written after them)
+    let nv = plan.stored_rings * plan.cols;
     let (mut v, mut n) = (vec![[0f64; 3]; nv], vec![[0f64; 3]; nv]);
     let mut u = vec![[0f64; 2]; nv];
     let mut f = vec![[0i64; 3]; 2 * plan.segments * sh.edges];
@@ -589,4 +591,78 @@ fn face_formula_equals_table() {
             }
         }
     }
+}
+
+/// Two straight legs meeting at `deg` degrees in the xy plane, `n` chords each of length
+/// `1/n`, with the frames of a plane curve (`r` = z, `t` the chord bisector at the corner).
+fn legs(deg: f64, n: usize) -> (Vec<DVec3>, Vec<[f64; 9]>) {
+    let a = deg.to_radians();
+    let d = DVec3::new(a.cos(), a.sin(), 0.0);
+    let mut x: Vec<DVec3> = (0..=n)
+        .map(|i| DVec3::new(i as f64 / n as f64 - 1.0, 0.0, 0.0))
+        .collect();
+    x.extend((1..=n).map(|i| d * (i as f64 / n as f64)));
+    let frames = (0..x.len())
+        .map(|i| {
+            let t = match i.cmp(&n) {
+                std::cmp::Ordering::Less => DVec3::X,
+                std::cmp::Ordering::Equal => (DVec3::X + d).normalize(),
+                std::cmp::Ordering::Greater => d,
+            };
+            frame(DVec3::Z, t)
+        })
+        .collect();
+    (x, frames)
+}
+
+/// A sharp corner gets a join, a smooth sampling none: the corner's extra rings after the
+/// spine's, a closed and consistently wound mesh whatever the join, faces left out where
+/// the crease welds flatten them, and the round join's outer vertices on the sphere of the
+/// profile's radius about the corner.
+#[test]
+fn corners_get_watertight_joins_and_smooth_spines_none() {
+    let p = Profile::new(&polygon(16), true).expect("a valid profile");
+    let r = DVec2::splat(0.05);
+    for (deg, n) in [(90.0, 20), (150.0, 2), (170.0, 200)] {
+        let (x, frames) = legs(deg, n);
+        for join in [Join::Round, Join::Bevel, Join::Miter] {
+            let opts = Options {
+                join,
+                ..options(false, true, false)
+            };
+            let mut found = Vec::new();
+            super::join::corners(&x, &[r], false, &p, &opts, |c| found.push(c));
+            assert_eq!(found.len(), 1, "{deg}° {join:?}");
+            assert_eq!(found[0].k, n);
+            let m = sweep(&x, &frames, &[r], &p, &opts);
+            assert_watertight(&m.faces);
+            let rings = m.vertices.len() / 16;
+            assert_eq!(rings, x.len() + found[0].extra);
+            let plain = 2 * (rings - 1) * 16 + 2 * 14;
+            // the rings of a round or bevelled join meet on the crease
+            assert!(
+                join == Join::Miter || m.faces.len() < plain,
+                "{deg}° {join:?}: the crease flattens faces"
+            );
+            assert!(m.faces.len() <= plain);
+            if join == Join::Round {
+                let used: std::collections::HashSet<i64> =
+                    m.faces.iter().flatten().copied().collect();
+                for v in x.len() * 16..m.vertices.len() {
+                    if used.contains(&(v as i64)) {
+                        let d = (m.vertices[v] - x[n]).length();
+                        assert!((d - 0.05).abs() < 1e-15, "{deg}°: {d}");
+                    }
+                }
+            }
+        }
+    }
+    // a dense helix: no corner, the plain sweep
+    let (x, frames) = circle(200, 1.0);
+    let opts = options(true, false, false);
+    let mut found = 0;
+    super::join::corners(&x, &[r], true, &p, &opts, |_| found += 1);
+    assert_eq!(found, 0);
+    let m = sweep(&x, &frames, &[r], &p, &opts);
+    assert_eq!(m.vertices.len(), 200 * 16);
 }
