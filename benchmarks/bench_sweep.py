@@ -305,22 +305,25 @@ def rough_sets():
 
 
 def rough_rows(repeat):
-    """One ``spinal.tube`` call per set (8 sides, radius 0.1), every curve tubed: the time,
-    whether the mesh is watertight and wound outwards, and VTK's tube filter on the same
-    polylines (one PolyData)."""
+    """One ``spinal.tube`` call per set (8 sides, radius 0.1), every curve tubed: the time
+    with the default round joins at sharp corners and with mitre joins, whether the mesh is
+    watertight and wound outwards, its vertices, and VTK's tube filter on the same polylines
+    (one PolyData; one ring per sample, no joins)."""
     import trimesh
 
     vtk = peers().get("pv")
-    print("| set | curves | points | spinal ms | watertight, outward | VTK strips ms |")
-    print("|---|---|---|---|---|---|")
+    print("| set | curves | points | spinal ms (round joins) | vertices | spinal ms "
+          "(join='miter') | watertight, outward | VTK strips ms | VTK vertices |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for name, lines in rough_sets():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             t = best(lambda ls=lines: spinal.tube(ls, 0.1, 8), repeat)
+            tm_ = best(lambda ls=lines: spinal.tube(ls, 0.1, 8, join="miter"), repeat)
             m = spinal.tube(lines, 0.1, 8)
         tm = trimesh.Trimesh(m.vertices, m.faces, process=False)
         ok = tm.is_watertight and tm.is_winding_consistent and m.volume > 0
-        tv = "–"
+        tv = nv = "–"
         if vtk is not None:
             import pyvista as pv
 
@@ -330,8 +333,10 @@ def rough_rows(repeat):
             poly = pv.PolyData(pts, lines=cells)
             tube = (lambda p=poly: p.tube(radius=0.1, n_sides=8, capping=True))
             tv = f"{1e3 * best(tube, repeat):.1f}"
+            nv = f"{tube().n_points:,}"
         print(f"| {name} | {len(lines)} | {sum(len(l) for l in lines)} | {1e3 * t:.1f} | "
-              f"{'yes' if ok else 'NO'} | {tv} |", flush=True)
+              f"{len(m.vertices):,} | {1e3 * tm_:.1f} | {'yes' if ok else 'NO'} | {tv} | {nv} |",
+              flush=True)
 
 
 def main():

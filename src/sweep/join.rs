@@ -42,7 +42,29 @@
 //! ring's own plane (their three-point derivative would reach across the corner).
 
 use glam::{DVec2, DVec3};
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A hash of small integer keys (vertex and ring indices): one multiply (Fibonacci
+/// hashing), for the maps of one spine's joins.
+#[derive(Default)]
+struct IndexHasher(u64);
+
+impl Hasher for IndexHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        }
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.0 = (i as u64 ^ self.0).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+}
+
+type HashMap<K, V> = std::collections::HashMap<K, V, BuildHasherDefault<IndexHasher>>;
 
 use super::faces::FacePattern;
 use super::kernel::Cols;
@@ -69,6 +91,9 @@ const MIN_TURN_COS2: f64 = 0.933_012_701_892_219_3;
 /// The smallest turn of a corner between straighter runs that gets a join however long its
 /// legs (28°, in radians): the gentler kinks of a smooth curve keep their mitred ring.
 const LONE_TURN: f64 = 0.488_692_190_558_412_2;
+
+/// No weld (see [`write_joins`]).
+const NONE: usize = usize::MAX;
 
 /// Relative distance from the bisector plane within which a column counts as inner (on the
 /// join's axis: welded rather than turned in place).
@@ -348,12 +373,12 @@ pub(super) fn write_joins<R: Real, I: Index>(
     let split = closed && stored > nr;
     let per_seg = pattern.per_segment();
     let mut bad = None;
-    // vertex (local) → the crease vertex it is welded to
-    let mut weld: HashMap<usize, usize> = HashMap::new();
-    // positions of the vertices written here (swept coordinates)
-    let mut pos: HashMap<usize, DVec3> = HashMap::new();
+    // per ring (slot): the crease vertex (local) each column is welded to, or NONE
+    let mut weld: HashMap<usize, Vec<usize>> = HashMap::default();
+    // per ring written here: its vertices' positions (swept coordinates)
+    let mut pos: HashMap<usize, Vec<DVec3>> = HashMap::default();
     // the tangents of the rings written here, as the end and as the start of a segment
-    let mut tangents: HashMap<usize, (DVec3, DVec3)> = HashMap::new();
+    let mut tangents: HashMap<usize, (DVec3, DVec3)> = HashMap::default();
     // side segments whose faces the welds change → the ring their faces end on
     let mut touched: BTreeMap<usize, usize> = BTreeMap::new();
     // join segments: (first face, from ring, to ring, corner sample)
@@ -369,7 +394,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
     // estimate reaching across the corner would tilt them): tangent to the circle through
     // the ring's sample and its neighbours on that side, or along the chord where the run
     // ends there (a mitre keeps the frames' rings, whose bisector planes it joins)
-    let mut turned: HashMap<usize, Geo> = HashMap::new();
+    let mut turned: HashMap<usize, Geo> = HashMap::default();
     for c in corners.iter().filter(|c| c.extra > 0) {
         for ahead in [false, true] {
             let r = if ahead {
@@ -406,10 +431,10 @@ pub(super) fn write_joins<R: Real, I: Index>(
             }
             if closed || r > 0 {
                 let s = rings.before(r);
-                touched.insert(s, end_slot(s));
+                touched.entry(s).or_insert(end_slot(s));
             }
             if closed || r + 1 < nr {
-                touched.insert(r, end_slot(r));
+                touched.entry(r).or_insert(end_slot(r));
             }
         }
     }
@@ -418,6 +443,10 @@ pub(super) fn write_joins<R: Real, I: Index>(
         turned.get(&k).copied().unwrap_or_else(|| rings.geo(k))
     };
     let (turns, axes) = corner_axes(rings, corners);
+    // per column of the corner at hand: inner?, the outgoing ring B's vertex and normal,
+    // the crease point and normal; the columns welded in the ring before and at hand
+    let (mut inner, mut ring_b, mut crease) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut cur, mut now) = (Vec::new(), Vec::new());
     let (mut next_ring, mut jf) = (stored, side_and_caps);
     for (ci, c) in corners.iter().enumerate() {
         let k = c.k;
@@ -444,9 +473,9 @@ pub(super) fn write_joins<R: Real, I: Index>(
         let m = (din + dout).try_normalize();
         let den = m.map_or(0.0, |m| dout.dot(m));
         // per column: inner?, outgoing vertex, crease point, outgoing and crease normals
-        let mut inner = Vec::with_capacity(cols);
-        let mut ring_b = Vec::with_capacity(cols);
-        let mut crease = Vec::with_capacity(cols);
+        inner.clear();
+        ring_b.clear();
+        crease.clear();
         for j in 0..cols {
             let q = column.px[j] * a1 + column.py[j] * a2;
             let side = m.map_or(0.0, |m| q.dot(m));
@@ -467,6 +496,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
         }
         // the sample's own ring: B (its inner side on the crease), or the mitre
         let kb = k * cols;
+        let mut at_k = Vec::with_capacity(cols);
         for j in 0..cols {
             let v = match c.extra == 0 || inner[j] {
                 true => crease[j],
@@ -475,7 +505,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
             if !put(&mut out, kb + j, v, unscale) && bad.is_none() {
                 bad = Some(kb + j);
             }
-            pos.insert(kb + j, v.0);
+            at_k.push(v.0);
         }
         let into = match closed && k == 0 {
             true => nr - 1,
@@ -493,12 +523,14 @@ pub(super) fn write_joins<R: Real, I: Index>(
                 if !put(&mut out, nr * cols + j, v, unscale) && bad.is_none() {
                     bad = Some(nr * cols + j);
                 }
-                pos.insert(nr * cols + j, v.0);
             }
+            pos.insert(nr, at_k.clone());
             tangents.insert(nr, (if c.extra == 0 { din } else { dout }, dout));
         }
-        touched.insert(k, end_slot(k));
-        touched.insert(into, end_slot(into));
+        pos.insert(k, at_k);
+        // (a segment's end ring already moved to a corner's A stays moved)
+        touched.entry(k).or_insert(end_slot(k));
+        touched.entry(into).or_insert(end_slot(into));
         // the rings turning from A towards B, after the spine's rings
         let first = next_ring;
         let u = match k == 0 && split {
@@ -508,27 +540,30 @@ pub(super) fn write_joins<R: Real, I: Index>(
         for e in 0..c.extra {
             let (slot, ang) = (first + e, phi * e as f64 / c.extra as f64 - phi);
             let t = rodrigues(dout, axis, ang);
+            let (mut to_crease, mut at_e) = (vec![NONE; cols], Vec::with_capacity(cols));
             for j in 0..cols {
                 let li = slot * cols + j;
                 let v = match inner[j] {
                     true => {
-                        weld.insert(li, kb + j);
+                        to_crease[j] = kb + j;
                         crease[j]
                     }
                     false => {
                         let (x, nb) = ring_b[j];
                         let x = cx + rodrigues(x - cx, axis, ang);
-                        pos.insert(li, x);
                         (x, rodrigues(nb, axis, ang))
                     }
                 };
                 if !put(&mut out, li, v, unscale) && bad.is_none() {
                     bad = Some(li);
                 }
+                at_e.push(v.0);
                 if let Some(uv) = out.uv.as_deref_mut() {
                     uv[li] = [unscaled(u, unscale), R::of(column.v[j])];
                 }
             }
+            weld.insert(slot, to_crease);
+            pos.insert(slot, at_e);
             tangents.insert(slot, (t, t));
             let to = if e + 1 < c.extra { slot + 1 } else { k };
             let faces = &mut out.faces[jf..jf + per_seg];
@@ -555,7 +590,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
         // ring before it in the walk has it welded)
         let Some(m) = m else { continue };
         for ahead in [false, true] {
-            let mut cur = inner.clone();
+            cur.clone_from(&inner);
             let mut i = k;
             loop {
                 let nx = if ahead {
@@ -571,13 +606,14 @@ pub(super) fn write_joins<R: Real, I: Index>(
                     break;
                 }
                 let g = geo_at(nx);
-                let mut now = vec![false; cols];
+                now.clear();
+                now.resize(cols, false);
                 for j in (0..cols).filter(|&j| cur[j]) {
                     let x = (g.b.0 + column.px[j] * g.ma) + column.py[j] * g.mb;
                     let past = (x - cx).dot(m);
                     if (ahead && past < 0.0) || (!ahead && past > 0.0) {
                         now[j] = true;
-                        weld.insert(nx * cols + j, kb + j);
+                        weld.entry(nx).or_insert_with(|| vec![NONE; cols])[j] = kb + j;
                         if !put(&mut out, nx * cols + j, crease[j], unscale) && bad.is_none() {
                             bad = Some(nx * cols + j);
                         }
@@ -590,22 +626,40 @@ pub(super) fn write_joins<R: Real, I: Index>(
                 let before = rings.before(nx);
                 touched.entry(nx).or_insert(end_slot(nx));
                 touched.entry(before).or_insert(end_slot(before));
-                (cur, i) = (now, nx);
+                std::mem::swap(&mut cur, &mut now);
+                i = nx;
             }
         }
     }
-    // the welds on the faces they touch, and the faces they flatten
+    // the vertex (local) that the faces use for vertex `l`, column `j` of a ring whose
+    // welds are `w` (its crease vertex where it is welded)
+    let welded = |l: usize, j: usize, w: Option<&Vec<usize>>| match w.map(|w| w[j]) {
+        Some(c) if c != NONE => c,
+        _ => l,
+    };
+    // the welds on the faces they touch (each segment's faces use two rings), and the faces
+    // they flatten
     let ranges = touched
-        .keys()
-        .map(|&s| s * per_seg..(s + 1) * per_seg)
-        .chain(std::iter::once(side_and_caps..jf));
+        .iter()
+        .map(|(&s, &e)| (s * per_seg..(s + 1) * per_seg, s, e))
+        .chain(bands.iter().map(|&(f, a, b, _)| (f..f + per_seg, a, b)));
     let mut dropped = Vec::new();
-    for r in ranges {
+    for (r, a, b) in ranges {
+        let (wa, wb) = (weld.get(&a), weld.get(&b));
+        let (la, lb) = (vbase + a * cols, vbase + b * cols);
         for fi in r {
             let f = &mut out.faces[fi];
-            for i in f.iter_mut() {
-                if let Some(&w) = weld.get(&(i.get() - vbase)) {
-                    *i = I::of(vbase + w);
+            if wa.is_some() || wb.is_some() {
+                for i in f.iter_mut() {
+                    let g = i.get();
+                    let t = match (g.wrapping_sub(la), g.wrapping_sub(lb)) {
+                        (j, _) if j < cols => welded(g - vbase, j, wa),
+                        (_, j) if j < cols => welded(g - vbase, j, wb),
+                        _ => g - vbase,
+                    };
+                    if t + vbase != g {
+                        *i = I::of(vbase + t);
+                    }
                 }
             }
             let [a, b, c] = f.map(|i| i.get());
@@ -617,14 +671,22 @@ pub(super) fn write_joins<R: Real, I: Index>(
     // fold-over on the segments the joins changed, on the vertices as written
     let row = |s: usize| rings.rowbase + s;
     folds.retain(|&r| !touched.contains_key(&(r - rings.rowbase)));
-    let leg_vertex = |l: usize| -> DVec3 {
-        let (g, j) = (geo_at(l / cols), l % cols);
-        (g.b.0 + column.px[j] * g.ma) + column.py[j] * g.mb
-    };
-    let at = |l: usize| -> (usize, DVec3) {
-        let l = weld.get(&l).copied().unwrap_or(l);
-        (l, pos.get(&l).copied().unwrap_or_else(|| leg_vertex(l)))
-    };
+    // a vertex of ring `slot` as the faces use it (its weld) and its position (`w`, `p`,
+    // `g`: the ring's welds, written positions or plain geometry)
+    let at =
+        |slot: usize, j: usize, w: Option<&Vec<usize>>, p: Option<&Vec<DVec3>>, g: &Option<Geo>| {
+            let l = slot * cols + j;
+            let t = welded(l, j, w);
+            let x = match (t == l, p) {
+                (true, Some(p)) => p[j],
+                (false, _) => pos[&(t / cols)][t % cols],
+                (true, None) => {
+                    let g = g.unwrap_or_else(|| geo_at(slot));
+                    (g.b.0 + column.px[j] * g.ma) + column.py[j] * g.mb
+                }
+            };
+            (t, x)
+        };
     let tangent = |slot: usize, start: bool| match tangents.get(&slot) {
         Some(&(t_end, t_start)) => match start {
             true => t_start,
@@ -634,8 +696,15 @@ pub(super) fn write_joins<R: Real, I: Index>(
     };
     let folded = |a: usize, b: usize| {
         let (ta, tb) = (tangent(a, true), tangent(b, false));
+        let plain = |slot: usize| match slot < stored && !tangents.contains_key(&slot) {
+            true => Some(geo_at(slot)),
+            false => None,
+        };
+        let (ga, gb) = (plain(a), plain(b));
+        let (wa, wb, pa, pb) = (weld.get(&a), weld.get(&b), pos.get(&a), pos.get(&b));
         (0..cols).any(|j| {
-            let ((ia, xa), (ib, xb)) = (at(a * cols + j), at(b * cols + j));
+            let (ia, xa) = at(a, j, wa, pa, &ga);
+            let (ib, xb) = at(b, j, wb, pb, &gb);
             let e = xb - xa;
             ia != ib && !(e.dot(ta) > 0.0 && e.dot(tb) > 0.0)
         })
