@@ -515,3 +515,38 @@ def test_frames_in_time_of_the_adk_trajectory_do_not_flicker():
     F = spinal.frames_in_time(P)
     turns = np.degrees(np.array([rotation_angle(F[k], F[k - 1]) for k in range(1, len(F))]))
     assert turns.max() < 45, turns.max()
+
+
+def test_axis_guides_take_their_signs_from_the_previous_frames():
+    """guide= with previous=: each axis row (guide_sign='free') takes the sign that agrees with
+    the previous frames, so a β-strand whose raw carbonyl guides come with the opposite signs
+    at the next time step keeps its frames (alone, the first row's sign would turn them all
+    by 180°); frames_in_time does the same step by step; a direction guide refuses previous."""
+    n, steps = 30, 12
+    rng = np.random.default_rng(4)
+
+    def strand(k):
+        s = np.arange(n) * 3.3
+        return np.c_[s, 0.9 * (-1.0) ** np.arange(n), 0.05 * k * np.sin(s / 10)]
+
+    def carbonyls():
+        return np.c_[np.zeros(n), np.zeros(n), (-1.0) ** np.arange(n)] + rng.normal(0, 0.05, (n, 3))
+
+    def turn(a, b):
+        return np.degrees(np.arccos(np.clip((a[:, :, 0] * b[:, :, 0]).sum(1), -1, 1))).max()
+
+    f0 = spinal.frames(strand(0), guide=carbonyls(), guide_sign="free")
+    flipped = -carbonyls()
+    alone = spinal.frames(strand(1), guide=flipped, guide_sign="free")
+    assert turn(f0, alone) > 170
+    kept = spinal.frames(strand(1), guide=flipped, guide_sign="free", previous=f0)
+    assert turn(f0, kept) < 10
+    # the same frames as the guide signed by hand
+    signs = np.sign((flipped * f0[:, :, 0]).sum(1))[:, None]
+    np.testing.assert_allclose(kept, spinal.frames(strand(1), guide=signs * flipped), atol=1e-12)
+    pts = np.stack([strand(k) for k in range(steps)])
+    gs = np.stack([carbonyls() * (-1) ** k for k in range(steps)])
+    F = spinal.frames_in_time(pts, guide=gs, guide_sign="free")
+    assert max(turn(F[k], F[k + 1]) for k in range(steps - 1)) < 15
+    with pytest.raises(ValueError, match="previous: with guide= the guide fixes"):
+        spinal.frames(strand(1), guide=flipped, previous=f0)

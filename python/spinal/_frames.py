@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from . import _core, _merge
-from ._steer import previous_frames, steering
+from ._steer import guide_rows, previous_frames, steering
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -297,6 +297,10 @@ def frames(
         ``r`` follows whichever of ``±g_i`` continues the frame (the first usable row keeps
         its sign), as molecular cartoon renderers flip alternate peptide planes. A closed
         curve still closes: axes that come back reversed after a round spread the half turn.
+        With ``previous`` too, each row's sign is the one that agrees with the previous
+        frames' ``r`` column (``g·r_prev ≥ 0``): the frames continue those of the previous
+        time step rather than the first row's sign (a β-strand of an MD trajectory does not
+        flip between steps).
     previous : array_like (n, 3, 3), optional
         The frames of the same curve at the previous time step (same sample count): the
         result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
@@ -490,11 +494,18 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
     ``guide``, ``previous`` or per-interval ``turns``)."""
     method = as_choice(method, "method", METHODS)
+    # an axis guide with the previous step's frames: previous picks each row's sign
+    signed_by_previous = guide is not None and previous is not None
+    if signed_by_previous and as_choice(guide_sign, "guide_sign", ("follow", "free")) != "free":
+        raise ValueError("previous: with guide= the guide fixes the frames that previous would "
+                         "choose; pass guide_sign='free' to let previous pick the sign of each "
+                         "guide row (an axis), so that the frames continue the previous ones")
     if previous_twist:
         if method == "frenet":
             raise ValueError("previous: is not used by method='frenet': the Frenet frame is "
                              "fixed by the curve")
-        for other, val in (("constraints", constraints), ("guide", guide),
+        for other, val in (("constraints", constraints),
+                           ("guide", None if signed_by_previous else guide),
                            ("initial", initial), ("end", end)):
             if val is not None:
                 raise ValueError(f"previous: cannot be combined with {other} (they fix the "
@@ -525,7 +536,9 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         # the core names the rule that the lengths/offsets break
         _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE, False, closed, None,
                              None, None, None, 0)
-    if previous_twist:
+    if signed_by_previous:
+        guide, previous, guide_sign = _signed_by(guide, previous, rows), None, "follow"
+    elif previous_twist:
         guide, previous = _previous_twist_guide(previous, rows), None
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
                      previous, offs, bundle, rows, guide_sign)
@@ -587,6 +600,16 @@ def _guide_options(guide_weight, guide_tolerance):
     return guide_weight, guide_tolerance
 
 
+def _signed_by(guide, previous, rows: int) -> np.ndarray:
+    """The axis guide ``guide`` with every row's sign agreeing with the ``r`` column of
+    ``previous`` (checked as :func:`frames` checks it): ``(rows, 3)``."""
+    g = guide_rows(guide, rows)
+    prev = _previous_twist_guide(previous, rows)
+    g = np.broadcast_to(g, (rows, 3))
+    flip = np.einsum("ij,ij->i", g, prev) < 0
+    return np.where(flip[:, None], -g, g)
+
+
 def _previous_twist_guide(previous, rows: int) -> np.ndarray:
     """The ``r`` columns of ``previous`` (checked: one rotation per row) as a guide."""
     prev = previous_frames(previous, rows)
@@ -646,7 +669,9 @@ def frames_in_time(
     * ``guide`` given: every step follows its guide (``(3,)``, ``(n, 3)`` for all steps or
       ``(T, n, 3)`` one per step; ``guide_weight``, ``guide_tolerance``, ``guide_sign`` as in
       :func:`frames`), which carries the coherence in time; ``previous_twist`` does not
-      apply then.
+      apply then. With ``guide_sign="free"`` (axes, such as raw carbonyl bonds) each step's
+      rows take the sign that agrees with the step before (``frames(guide=, previous=)``),
+      so the frames do not flip between steps.
 
     Parameters
     ----------
@@ -737,10 +762,13 @@ def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns
         before = out[k - 1] if k else previous
         try:
             if g is not None:
+                # axes: each row's sign continues the step before (from the second step on)
                 gk = g[k] if g.ndim == 3 else g
-                out[k] = frames(pts, tgk, initial=initial, guide=gk, guide_weight=guide_weight,
+                by = before if guide_sign == "free" else None
+                out[k] = frames(pts, tgk, initial=None if by is not None else initial,
+                                guide=gk, guide_weight=guide_weight,
                                 guide_tolerance=guide_tolerance, guide_sign=guide_sign,
-                                **common)
+                                previous=by, **common)
             elif before is None:
                 out[k] = frames(pts, tgk, initial=initial, **common)
             else:
