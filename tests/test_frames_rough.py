@@ -170,3 +170,33 @@ def test_repeats_merge_with_guides_previous_and_constraints():
     np.testing.assert_allclose(spinal.frames_in_time(P, previous_twist=False),
                                spinal.frames_in_time(np.stack([x, x + 0.01]),
                                                      previous_twist=False)[:, rows], atol=1e-12)
+
+
+def test_invalid_curves_are_skipped_by_frames_and_tangents_on_request():
+    """on_invalid='skip': curves with a NaN or too few distinct points are left out with a
+    SkippedCurvesWarning naming them; their rows are NaN and the other curves get the frames
+    (tangents) of the call without them, per-row and per-curve arguments cut alike."""
+    rng = np.random.default_rng(8)
+    good = [np.cumsum(rng.normal(size=(n, 3)), axis=0) for n in (5, 9, 6)]
+    nan = good[1].copy()
+    nan[4] = np.nan
+    curves = [good[0], nan, good[2], np.ones((3, 3))]
+    rows = np.r_[0, np.cumsum([len(c) for c in curves])]
+    with pytest.raises(ValueError, match="curve 1"):
+        spinal.frames(curves)
+    kept = [good[0], good[2]]
+    for call, ref, kw in (
+        (spinal.frames, spinal.frames(kept, guide=np.tile([0, 0, 1.0], (11, 1))),
+         {"guide": np.tile([0, 0, 1.0], (sum(len(c) for c in curves), 1))}),
+        (spinal.estimate_tangents, spinal.estimate_tangents(kept), {}),
+    ):
+        with pytest.warns(spinal.SkippedCurvesWarning, match="with NaN or inf: 1; with fewer "
+                          "than 2 distinct points: 3") as rec:
+            out = call(curves, on_invalid="skip", **kw)
+        np.testing.assert_array_equal(rec[0].message.curves, [1, 3])
+        np.testing.assert_array_equal(out[rows[0]:rows[1]], ref[:5])
+        np.testing.assert_array_equal(out[rows[2]:rows[3]], ref[5:])
+        assert np.isnan(out[rows[1]:rows[2]]).all() and np.isnan(out[rows[3]:]).all()
+    assert not np.isnan(nan[:4]).any()  # the input is not modified
+    with pytest.raises(TypeError, match="on_invalid: 'skip' does not take constraints"):
+        spinal.frames(curves, on_invalid="skip", constraints=[(0, [1.0, 0, 0])])

@@ -86,6 +86,7 @@ def frames(
     previous: _Array | None = None,
     previous_twist: bool = False,
     guide_sign: Literal["follow", "free"] = "follow",
+    on_invalid: Literal["raise", "skip"] = "raise",
 ) -> _F: ...
 def frames_in_time(
     points_t: _Array | None,
@@ -123,6 +124,7 @@ def estimate_tangents(
     method: _TangentRule = "five_point_bounded",
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    on_invalid: Literal["raise", "skip"] = "raise",
 ) -> _F: ...
 
 # ---- meshes and sweeps --------------------------------------------------------------------

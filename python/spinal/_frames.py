@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -173,6 +174,7 @@ def frames(
     previous=None,
     previous_twist: bool = False,
     guide_sign: str = "follow",
+    on_invalid: str = "raise",
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -301,6 +303,12 @@ def frames(
         frames' ``r`` column (``g·r_prev ≥ 0``): the frames continue those of the previous
         time step rather than the first row's sign (a β-strand of an MD trajectory does not
         flip between steps).
+    on_invalid : {"raise", "skip"}
+        What to do with curves (of a bundle, or the one curve) that hold a NaN or an
+        infinity or have fewer than 2 (closed: 3) distinct points: refuse them (ValueError
+        naming the curve and row) or leave them out, with a :class:`SkippedCurvesWarning`
+        naming them (its ``curves``), their rows NaN in the result (the other curves'
+        frames are those of the call without them). Not with ``constraints``.
     previous : array_like (n, 3, 3), optional
         The frames of the same curve at the previous time step (same sample count): the
         result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
@@ -349,6 +357,27 @@ def frames(
     >>> F.shape
     (200, 3, 3)
     """
+    on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
+    if on_invalid == "skip" and not isinstance(points, Curve):
+        cut = _merge.invalid_curves(points, lengths, offsets, as_bool(closed, "closed"))
+        if cut is not None:
+            if constraints is not None:
+                raise TypeError("on_invalid: 'skip' does not take constraints= (their rows "
+                                "would move); leave the invalid curves out first")
+            pts, offs, keep, kept, bad, nan, few = cut
+            _skipped_warning(nan, few, closed, "their frames are NaN")
+            out = np.full((len(pts), 3, 3), np.nan)
+            if kept[-1]:
+                n, c = len(pts), len(offs) - 1
+                out[keep] = frames(
+                    pts[keep], _cut_rows(tangents, keep, n), method=method,
+                    initial=_cut_curves(initial, bad, c), closed=closed,
+                    end=_cut_curves(end, bad, c), turns=turns, reflection=reflection,
+                    offsets=kept, twist_rule=twist_rule, guide=_cut_rows(guide, keep, n),
+                    guide_weight=guide_weight, guide_tolerance=guide_tolerance,
+                    previous=_cut_rows(previous, keep, n), previous_twist=previous_twist,
+                    guide_sign=guide_sign)
+            return out
     previous_twist = as_bool(previous_twist, "previous_twist")
     guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
     if previous_twist and previous is None:
@@ -400,6 +429,7 @@ def estimate_tangents(
     method: str = DEFAULT_TANGENT_RULE,
     lengths=None,
     offsets=None,
+    on_invalid: str = "raise",
 ) -> np.ndarray:
     r"""Unit tangents estimated from sampled points, ``(n, 3)``.
 
@@ -469,10 +499,21 @@ def estimate_tangents(
     come back to back in one array. Consecutive samples closer than ``2⁻⁴⁰`` of the curve's
     size are merged: their rows get the tangent of the row they repeat. Raises ValueError
     for NaN/inf and for curves with fewer than 2 distinct points (3 closed), naming the row
-    (and the curve, in a bundle).
+    (and the curve, in a bundle); ``on_invalid="skip"`` leaves such curves out instead,
+    with a :class:`SkippedCurvesWarning` naming them, and their rows NaN.
     """
     method = as_choice(method, "method", TANGENT_RULES)
     closed = as_bool(closed, "closed")
+    if as_choice(on_invalid, "on_invalid", ("raise", "skip")) == "skip":
+        cut = _merge.invalid_curves(points, lengths, offsets, closed)
+        if cut is not None:
+            pts, _, keep, kept, _, nan, few = cut
+            _skipped_warning(nan, few, closed, "their tangents are NaN")
+            out = np.full((len(pts), 3), np.nan)
+            if kept[-1]:
+                out[keep] = estimate_tangents(pts[keep], closed=closed, method=method,
+                                              offsets=kept)
+            return out
     if not is_curve_list(points) and lengths is None and offsets is None:
         pts = as_points(points, "points")
         offs, bundle = np.array([0, len(pts)], dtype=np.int64), False
@@ -608,6 +649,34 @@ def _signed_by(guide, previous, rows: int) -> np.ndarray:
     g = np.broadcast_to(g, (rows, 3))
     flip = np.einsum("ij,ij->i", g, prev) < 0
     return np.where(flip[:, None], -g, g)
+
+
+def _skipped_warning(nan, few, closed, what: str) -> None:
+    from ._mesh import SkippedCurvesWarning
+
+    msg = _merge.skipped_message("points", nan, few, bool(closed), what)
+    warnings.warn(SkippedCurvesWarning(msg, np.union1d(nan, few)), stacklevel=3)
+
+
+def _cut_rows(a, keep: np.ndarray, n: int):
+    """A per-row argument (``n`` rows, or a list of one array per curve) on the rows kept;
+    anything else (one vector for all rows, None) as given."""
+    if a is None:
+        return None
+    if not isinstance(a, np.ndarray) and is_curve_list(a):
+        a = np.concatenate([np.asarray(x, dtype=float) for x in a])
+    arr = np.asarray(a, dtype=float)
+    return arr[keep] if arr.ndim >= 2 and arr.shape[0] == n else a
+
+
+def _cut_curves(a, bad: np.ndarray, curves: int):
+    """A per-curve ``initial``/``end`` (``(C, 3)`` or ``(C, 3, 3)``) on the curves kept;
+    one for all curves as given."""
+    if a is None:
+        return None
+    arr = np.asarray(a, dtype=float)
+    per_curve = arr.ndim == 3 or (arr.ndim == 2 and arr.shape != (3, 3))
+    return np.delete(arr, bad, axis=0) if per_curve and arr.shape[0] == curves else a
 
 
 def _previous_twist_guide(previous, rows: int) -> np.ndarray:

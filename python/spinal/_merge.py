@@ -119,3 +119,39 @@ def on_rows(call, pts: np.ndarray, offs: np.ndarray, closed: bool, bundle: bool,
     out, rest = (res[0], res[1:]) if isinstance(res, tuple) else (res, ())
     out = out[p.rows]
     return (out, *rest) if isinstance(res, tuple) else out
+
+
+def invalid_curves(points, lengths, offsets, closed: bool):
+    """The curves of ``points`` (one curve, or a bundle as :func:`spinal.frames` takes it)
+    that hold a NaN or an infinity or have too few distinct samples (2; 3 closed), for
+    ``on_invalid="skip"``: ``None`` when there are none, else ``(pts, offs, keep_rows,
+    kept_offsets, bad, nan, few)`` with the rows ``pts`` and curve offsets ``offs`` as given,
+    the rows kept, the kept curves' offsets among them, and the ids of the curves left out
+    (all, with NaN or inf, with too few points)."""
+    from ._validate import as_curves
+
+    pts, offs, _ = as_curves(points, lengths, offsets)
+    status = plan(pts, offs, closed).status
+    bad = np.flatnonzero(status != VALID)
+    if not bad.size:
+        return None
+    keep_curve = status == VALID
+    keep = np.repeat(keep_curve, np.diff(offs))
+    kept = np.concatenate([[0], np.cumsum(np.diff(offs)[keep_curve])]).astype(np.int64)
+    return (pts, offs, keep, kept, bad, np.flatnonzero(status == NON_FINITE),
+            np.flatnonzero(status == TOO_FEW))
+
+
+def skipped_message(arg: str, nan: np.ndarray, few: np.ndarray, closed: bool, what: str) -> str:
+    """The SkippedCurvesWarning message of ``on_invalid="skip"``."""
+    need = 3 if closed else 2
+    parts = [f"with NaN or inf: {_listed(nan)}"] if nan.size else []
+    if few.size:
+        parts.append(f"with fewer than {need} distinct points: {_listed(few)}")
+    return (f"{arg}: left out {nan.size + few.size} invalid curve(s) (on_invalid='skip'), "
+            f"{what}: {'; '.join(parts)}")
+
+
+def _listed(ids: np.ndarray, most: int = 20) -> str:
+    shown = ", ".join(str(int(i)) for i in ids[:most])
+    return shown + (f" and {ids.size - most} more" if ids.size > most else "")
