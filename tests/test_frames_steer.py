@@ -550,3 +550,22 @@ def test_axis_guides_take_their_signs_from_the_previous_frames():
     assert max(turn(F[k], F[k + 1]) for k in range(steps - 1)) < 15
     with pytest.raises(ValueError, match="previous: with guide= the guide fixes"):
         spinal.frames(strand(1), guide=flipped, previous=f0)
+
+
+def test_guide_is_a_direction_whatever_its_length():
+    """T3-02: guide vectors of length 1e300 or 1e-300 (one for all rows, or per row with half
+    the rows scaled by 1e200) give the frames of the unit guide; a zero row stays no guide."""
+    t = np.linspace(0, 4 * np.pi, 200)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    ref = spinal.frames(h, guide=[0, 0, 1.0])
+    for s in (1e300, 1e155, 1e-160, 1e-300):
+        np.testing.assert_array_equal(spinal.frames(h, guide=[0, 0, s]), ref)
+    g = np.tile([0.3, 0.1, 1.0], (200, 1))
+    scaled = g.copy()
+    scaled[::2] *= 1e200
+    np.testing.assert_allclose(spinal.frames(h, guide=scaled), spinal.frames(h, guide=g),
+                               atol=1e-15)
+    assert not np.isnan(scaled).any() and scaled[0, 2] == 1e200  # the input is kept
+    holes = g.copy()
+    holes[50:60] = 0
+    assert np.isfinite(spinal.frames(h, guide=holes)).all()

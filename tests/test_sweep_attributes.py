@@ -499,3 +499,31 @@ def test_tangents_and_frames_as_lists_of_per_curve_arrays():
     with pytest.raises(ValueError, match=r"tangents: a list of 2 arrays of \[60, 29\] rows "
                                          r"does not match"):
         spinal.tube(curves, 0.1, 6, tangents=[T[0], T[1][:-1]])
+
+
+def test_ply_refuses_non_ascii_attribute_names_and_vtp_keeps_them(tmp_path):
+    """T3-12: a non-ASCII point_data key is a ValueError naming point_data for PLY (whose
+    header is ASCII), not a UnicodeEncodeError; the .vtp writer keeps the name."""
+    mesh = spinal.Mesh(np.eye(3), [[0, 1, 2]], point_data={"é": np.zeros(3)})
+    with pytest.raises(ValueError, match="point_data: the name 'é' is not ASCII"):
+        mesh.save(tmp_path / "a.ply")
+    assert not (tmp_path / "a.ply").exists()
+    mesh.save(tmp_path / "a.vtp")
+    assert "é".encode() in (tmp_path / "a.vtp").read_bytes()
+
+
+def test_concatenate_names_meshes_for_a_bare_mesh_and_mismatched_columns():
+    """T3-13: Mesh.concatenate of one Mesh (not a list) and of point_data arrays of different
+    ranks under one key say what is wrong, naming meshes and the key."""
+    x = np.c_[np.linspace(0, 1, 5), np.zeros(5), np.zeros(5)]
+    m = spinal.tube(x, 0.1, 6)
+    with pytest.raises(TypeError, match="meshes: expected a sequence of spinal.Mesh, got one"):
+        spinal.Mesh.concatenate(m)
+    with pytest.raises(TypeError, match="meshes: expected a sequence of spinal.Mesh, got int"):
+        spinal.Mesh.concatenate(3)
+    a = spinal.tube(x, 0.1, 6, point_data={"t": np.arange(5.0)})
+    b = spinal.tube(x, 0.1, 6, point_data={"t": np.ones((5, 2))})
+    with pytest.raises(ValueError, match=r"meshes: point_data\['t'\] has rows of different"):
+        spinal.Mesh.concatenate([a, b])
+    both = spinal.Mesh.concatenate([a, a])
+    assert both.point_data["t"].shape == (2 * len(a.vertices),)

@@ -351,7 +351,14 @@ class Mesh:
         before (their largest row + 1, or the rows the sweep was given), ``curve_of``,
         ``skipped_curves`` and ``cell_data["curve_id"]`` by their curves, so chunks of a
         bundle swept one by one give the mesh of the whole bundle."""
-        meshes = list(meshes)
+        if isinstance(meshes, Mesh):
+            raise TypeError("meshes: expected a sequence of spinal.Mesh, got one Mesh (pass "
+                            "a list: Mesh.concatenate([a, b, ...]))")
+        try:
+            meshes = list(meshes)
+        except TypeError:
+            raise TypeError(f"meshes: expected a sequence of spinal.Mesh, got "
+                            f"{type(meshes).__name__}") from None
         if not meshes or not all(isinstance(m, Mesh) for m in meshes):
             raise TypeError("meshes: expected a non-empty sequence of spinal.Mesh")
         V = np.concatenate([m.vertices for m in meshes])
@@ -382,6 +389,10 @@ class Mesh:
                 parts = [getattr(m, attr)[k] for m in meshes]
                 if shift_curve and k == "curve_id":
                     parts = [p + s for p, s in zip(parts, curves)]
+                if len({np.shape(p)[1:] for p in parts}) > 1:
+                    raise ValueError(f"meshes: {attr}[{k!r}] has rows of different shapes in "
+                                     f"the meshes ({sorted({np.shape(p)[1:] for p in parts})})"
+                                     f"; give every mesh the same columns under one name")
                 out[k] = np.concatenate(parts)
             return out
 
@@ -542,6 +553,9 @@ def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
     for k, a in data.items():
         a = _plain(a, kinds)
         key = "_".join(k.split()) or "_"
+        if not key.isascii():
+            raise ValueError(f"{what}: the name {k!r} is not ASCII, which PLY property names "
+                             f"must be; rename it, or save as .vtp (UTF-8 names)")
         names = [key] if a.ndim == 1 else [f"{key}_{j}" for j in range(a.shape[1])]
         for j, nm in enumerate(names):
             if nm in taken:

@@ -121,6 +121,11 @@ def guide_rows(guide: Any, rows: int):
     elif g.shape != (rows, 3):
         raise ValueError(f"guide: expected shape (3,) or ({rows}, 3) (one vector per "
                          f"sample), got {g.shape}")
+    # a direction: each row divided by its largest component, so that its length (1e-200 or
+    # 1e300 alike) does not reach the core's squares; zero rows stay zero (no guide there)
+    big = np.abs(g).max(axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        g = np.where((big > 0) & np.isfinite(big), g / np.where(big > 0, big, 1.0), g)
     return np.ascontiguousarray(g)
 
 
