@@ -569,3 +569,21 @@ def test_guide_is_a_direction_whatever_its_length():
     holes = g.copy()
     holes[50:60] = 0
     assert np.isfinite(spinal.frames(h, guide=holes)).all()
+
+
+def test_unsigned_rows_and_turns_that_int64_would_wrap_are_refused():
+    """T3-08, T3-09: a uint64 constraint row or turn of 2**64 − 1 (which int64 wraps to −1,
+    the last row) and a Python int key of 2**70 are ValueErrors naming the argument."""
+    t = np.linspace(0, 4 * np.pi, 50)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    huge = np.array([2**64 - 1], dtype=np.uint64)
+    with pytest.raises(ValueError, match="^constraints: 18446744073709551615 is out of range"):
+        spinal.frames(h, constraints=(huge, np.array([[0, 0, 1.0]])))
+    with pytest.raises(ValueError, match="^turns: 18446744073709551615 is out of range"):
+        spinal.frames(h, turns=huge)
+    for key in (2**70, np.uint64(2**64 - 1)):
+        with pytest.raises(ValueError, match="^constraints: row .* is out of range"):
+            spinal.frames(h, constraints={key: [0, 0, 1.0]})
+    # in range, unsigned rows work
+    ok = spinal.frames(h, constraints=(np.array([3], dtype=np.uint64), np.array([[0, 0, 1.0]])))
+    np.testing.assert_array_equal(ok, spinal.frames(h, constraints={3: [0, 0, 1.0]}))

@@ -48,6 +48,9 @@ def _one_curve(given: Any, rows: int, where: str):
             else:
                 raise ValueError(f"{name}: row {int(key)}: expected a vector (3,) or a frame "
                                  f"(3, 3), got shape {a.shape}{where}")
+            if not -2**63 <= int(key) < 2**63:
+                raise ValueError(f"{name}: row {int(key)} is out of range for a curve of "
+                                 f"{rows} rows{where}")
             keys.append(int(key))
         idx = np.array(keys, dtype=np.int64)
         vec = np.array(vecs, dtype=float).reshape(-1, 3)
@@ -58,6 +61,7 @@ def _one_curve(given: Any, rows: int, where: str):
         if idx.ndim != 1 or (idx.size and idx.dtype.kind not in "iu"):
             raise TypeError(f"{name}: the indices of (indices, vectors) must be a 1-D array of "
                             f"integers{where}")
+        _fits_int64(idx, name, f" for a curve of {rows} rows{where}")
         idx = idx.astype(np.int64)
         vals = as_float_array(given[1], name)
         if vals.shape[:1] != idx.shape:
@@ -107,8 +111,15 @@ def _turns(turns: Any) -> np.ndarray:
         if a.ndim != 1 or (a.size and a.dtype.kind not in "iu"):
             raise TypeError("turns: expected an integer or a 1-D sequence of integers (one per "
                             "twist interval)")
+        _fits_int64(a, "turns", "")
         return np.ascontiguousarray(a, dtype=np.int64)
     return np.array([as_int(turns, "turns")], dtype=np.int64)
+
+
+def _fits_int64(a: np.ndarray, name: str, context: str) -> None:
+    """Refuse unsigned values that int64 would wrap (2**63 and up), naming ``name``."""
+    if a.size and a.dtype.kind == "u" and a.max() > np.iinfo(np.int64).max:
+        raise ValueError(f"{name}: {int(a.max())} is out of range{context}")
 
 
 def guide_rows(guide: Any, rows: int):
