@@ -230,3 +230,15 @@ def test_bad_posed_roll_inputs_are_named():
         spinal.SpineBinding(V, sp[:2], closed=True)
     with pytest.raises(TypeError, match="closed: expected True or False"):
         spinal.SpineBinding(V, sp, closed=1)
+
+
+def test_posed_up_is_a_direction_whatever_its_length():
+    """T3-14: posed_up of length 1e300 or 1e-300 poses the flesh as the unit vector does
+    (it was refused as "parallel to the tangent" or "not a finite non-zero vector")."""
+    rest = np.c_[np.linspace(-1, 1, 41), np.zeros(41), np.zeros(41)]
+    u = np.linspace(-1, 1, 41)
+    posed = np.c_[np.sin(u), 1 - np.cos(u), np.zeros(41)]
+    b = spinal.SpineBinding([[0, 0.1, 0.05], [0.3, -0.05, 0.02]], rest)
+    ref = b.deform(posed, posed_up=[0, 0, 1.0])
+    for s in (1e300, 1e-300, 7.0):
+        np.testing.assert_array_equal(b.deform(posed, posed_up=[0, 0, s]), ref)

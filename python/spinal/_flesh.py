@@ -207,9 +207,13 @@ def _given_roll(frames1, posed_frames, posed_up, at, m: int, closed: bool):
         if u.shape != (m, 3):
             raise ValueError(f"{name}: expected shape (3,) or ({m}, 3) like posed_spine's rows, "
                              f"got {u.shape}")
-        bad = np.flatnonzero(~np.isfinite(u).all(axis=1) | ~(np.linalg.norm(u, axis=1) > 0))
+        # directions: each row divided by its largest component first, so that lengths of
+        # 1e300 or 1e-300 neither overflow nor vanish in the norm
+        big = np.abs(u).max(axis=1, keepdims=True)
+        bad = np.flatnonzero(~np.isfinite(u).all(axis=1) | ~(big[:, 0] > 0))
         if bad.size:
             raise ValueError(f"{name}: row {bad[0]} is not a finite non-zero vector")
+        u = u / big
         vecs, tg = u / np.linalg.norm(u, axis=1, keepdims=True), None
     # the caller's rows around every sample
     k = np.floor(at).astype(np.int64)
