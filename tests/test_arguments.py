@@ -399,3 +399,23 @@ def test_audit_types_and_values_are_named():
         _named((TypeError, ValueError), "p", lambda p=p: curves.TorusKnot(p, 7))
         _named((TypeError, ValueError), "q", lambda p=p: curves.TorusKnot(2, p))
     _named(ValueError, "angle", lambda: curves.Helix().rmf(_u, angle=math.nan))
+
+
+def test_lengths_and_offsets_errors_name_the_argument_given():
+    """T3-10: errors about the bundle layout name the argument the caller passed: uint64
+    lengths that would wrap, decreasing or short offsets."""
+    t = np.linspace(0, 4 * np.pi, 50)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    x = np.r_[h, h]
+    cases = [
+        ({"offsets": [0, 60, 200]}, "^offsets: the last offset is 200 but the input has 100"),
+        ({"offsets": [0, 60, 50, 100]}, "^offsets: must never decrease, got 50 after 60"),
+        ({"offsets": [5, 100]}, "^offsets: must start at 0, got 5"),
+        ({"lengths": np.array([2**64 - 1, 1], np.uint64)}, "^lengths: 18446744073709551615 is"),
+        ({"lengths": [60, 50]}, "^lengths: the curves cover 110 rows but the input has 100"),
+        ({"lengths": [-10, 110]}, "^lengths: must be non-negative, curve 0 has length -10"),
+    ]
+    for call in (spinal.estimate_tangents, spinal.frames, lambda p, **k: spinal.tube(p, 0.1, **k)):
+        for kw, msg in cases:
+            with pytest.raises(ValueError, match=msg):
+                call(x, **kw)

@@ -103,9 +103,30 @@ def as_offsets(rows: int, lengths: Any, offsets: Any) -> tuple[np.ndarray, bool]
     arr = np.asarray(lengths if lengths is not None else offsets)
     if arr.dtype.kind not in "iu" or arr.ndim != 1:
         raise TypeError(f"{name}: expected a 1-D array of integers, got {arr.dtype} {arr.shape}")
+    # the values, named as given (the core checks the offsets it is handed again)
+    if arr.size and arr.dtype.kind == "u" and arr.max() > np.iinfo(np.int64).max:
+        raise ValueError(f"{name}: {int(arr.max())} is out of range")
     arr = arr.astype(np.int64)
     if lengths is not None:
+        neg = np.flatnonzero(arr < 0)
+        if neg.size:
+            raise ValueError(f"{name}: must be non-negative, curve {neg[0]} has length "
+                             f"{arr[neg[0]]}")
+        if int(arr.sum(dtype=object)) != rows:
+            raise ValueError(f"{name}: the curves cover {int(arr.sum(dtype=object))} rows but "
+                             f"the input has {rows}")
         arr = np.concatenate([[0], np.cumsum(arr)]).astype(np.int64)
+    elif arr.size:
+        if arr[0] != 0:
+            raise ValueError(f"{name}: must start at 0, got {arr[0]}")
+        down = np.flatnonzero(np.diff(arr) < 0)
+        if down.size:
+            c = down[0]
+            raise ValueError(f"{name}: must never decrease, got {arr[c + 1]} after {arr[c]} "
+                             f"(curve {c})")
+        if arr[-1] != rows:
+            raise ValueError(f"{name}: the last offset is {arr[-1]} but the input has {rows} "
+                             f"rows")
     return np.ascontiguousarray(arr), True
 
 
