@@ -41,6 +41,8 @@ def instance(cls):
                    np.array([3, 4, 0]))
     if cls is spinal.SkippedCurvesWarning:
         return cls("curves 2, 7 left out", np.array([2, 7]))
+    if cls is spinal.PrecisionWarning:
+        return cls("float32 cannot resolve the profile", 0.0625, 3.9e-5)
     return cls(f"a {cls.__name__}")
 
 

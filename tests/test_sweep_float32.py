@@ -9,6 +9,7 @@ import json
 import subprocess
 import sys
 import textwrap
+import warnings
 
 import numpy as np
 import pytest
@@ -185,3 +186,20 @@ def test_mesh_measures_need_no_big_temporaries(dtype):
     assert got["volume"]["value"] == pytest.approx(octagon * length, rel=1e-6)
     perimeter = 8 * 2 * 0.01 * np.sin(np.pi / 8)
     assert got["area"]["value"] == pytest.approx(perimeter * length + 2 * octagon, rel=1e-6)
+
+
+def test_float32_that_cannot_resolve_the_profile_warns():
+    """T3-15: a tube of radius 1e-4 around a spine at offset 1e6 in float32 (all its vertices
+    round to a few points) warns with a PrecisionWarning pointing at the call; a tube whose
+    profile float32 resolves does not."""
+    t = np.linspace(0, 4 * np.pi, 200)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    with pytest.warns(spinal.PrecisionWarning, match="dtype=float32: the coordinates' rounding") as rec:
+        m = spinal.tube(h * 0.001 + 1e6, 1e-4, dtype=np.float32)
+    assert rec[0].filename == __file__
+    assert rec[0].message.spacing == np.spacing(np.float32(1e6))
+    assert len(np.unique(m.vertices, axis=0)) < len(m.vertices) / 10
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        spinal.tube(h * 1000 + 1e4, 5.0, dtype=np.float32)
+        spinal.sweep(h, [[0, 0], [1, 0], [0, 1]], scale=0.05, dtype=np.float32)

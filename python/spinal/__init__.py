@@ -34,7 +34,7 @@ from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
-from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
+from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._sweep import sweep, tube
 from ._threads import get_num_threads, set_num_threads, threads
 
@@ -42,6 +42,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "PrecisionWarning",
     "RefinementWarning",
     "SkippedCurvesWarning",
     "SpineBinding",

@@ -19,6 +19,7 @@ __all__ = [
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
+    "PrecisionWarning",
     "RefinementWarning",
     "SkippedCurvesWarning",
     "SpineBinding",
@@ -140,6 +141,11 @@ class FoldOverWarning(UserWarning):
 class SkippedCurvesWarning(UserWarning):
     curves: _I
     def __init__(self, message: str, curves: _I) -> None: ...
+
+class PrecisionWarning(UserWarning):
+    spacing: float
+    feature: float
+    def __init__(self, message: str, spacing: float, feature: float) -> None: ...
 
 class Mesh:
     vertices: npt.NDArray[np.float64] | npt.NDArray[np.float32]

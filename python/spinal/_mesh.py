@@ -14,6 +14,22 @@ from ._validate import as_float_array
 __all__ = ["FoldOverWarning", "Mesh", "SkippedCurvesWarning", "mesh_arrays"]
 
 
+class PrecisionWarning(UserWarning):
+    """float32 output cannot resolve the swept profile: the rounding of the coordinates
+    (their float32 spacing at the mesh's largest coordinate) is more than a tenth of the
+    profile's smallest edge as swept, so vertices merge or the cross-section is distorted.
+    ``spacing`` and ``feature`` hold the two lengths."""
+
+    def __init__(self, message: str, spacing: float, feature: float):
+        super().__init__(message)
+        self.spacing = spacing
+        self.feature = feature
+
+    def __reduce__(self):
+        message = self.args[0] if self.args else ""
+        return type(self), (message, self.spacing, self.feature), self.__dict__
+
+
 class FoldOverWarning(UserWarning):
     """The swept profile reaches past the spine's centre of curvature, so the surface folds
     over itself there. ``indices`` holds the spine rows that start the folded segments (rows

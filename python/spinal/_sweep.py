@@ -10,7 +10,7 @@ import numpy as np
 
 from . import _core, _merge
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
-from ._mesh import FoldOverWarning, Mesh, SkippedCurvesWarning
+from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._validate import (
     as_bool,
     as_choice,
@@ -239,6 +239,10 @@ def sweep(
         rows within each curve).
     SkippedCurvesWarning
         ``on_short="skip"`` left curves out.
+    PrecisionWarning
+        ``dtype=float32`` cannot resolve the profile: the coordinates' float32 spacing at the
+        largest coordinate is over a tenth of the profile's smallest edge as swept (a thin
+        tube far from the origin).
     """
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
@@ -416,6 +420,8 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
             raise ValueError(f"points: {msg}")
         local = None if fold_curves is None else folds - _orig_offsets(lens, n)[fold_curves]
         warnings.warn(FoldOverWarning(msg, folds, fold_curves, local), stacklevel=3)
+    if single and len(v):
+        _check_float32(v, prof, sc)
     mesh = Mesh._of_sweep(v, f, nrm, uv, folds, rings, n, curves)
     mesh.skipped_curves = skipped
     if pdata:
@@ -427,6 +433,26 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         small = curves <= np.iinfo(np.int32).max
         mesh._lazy_curve_id(curve_ids.astype(np.int32 if small else np.int64), faces_per_curve)
     return mesh
+
+
+def _check_float32(v: np.ndarray, profile: np.ndarray, scale: np.ndarray) -> None:
+    """Warn (:class:`PrecisionWarning`) where float32 coordinates cannot resolve the profile:
+    their spacing at the largest coordinate over a tenth of the smallest profile edge times
+    the smallest scale."""
+    edges = np.linalg.norm(np.diff(np.r_[profile, profile[:1]], axis=0), axis=1)
+    edges = edges[edges > 0]
+    if not edges.size:
+        return
+    feature = float(edges.min() * np.abs(scale).min())
+    largest = max(abs(float(v.max())), abs(float(v.min())))  # no temporary of v's size
+    spacing = float(np.spacing(np.float32(largest)))
+    if spacing > 0.1 * feature:
+        warnings.warn(PrecisionWarning(
+            f"dtype=float32: the coordinates' rounding ({spacing:.3g} at the largest "
+            f"coordinate, {largest:.3g}) exceeds a tenth of the profile's "
+            f"smallest edge as swept ({feature:.3g}): vertices merge or the cross-section is "
+            f"distorted; use dtype=float64, or move the curves near the origin", spacing,
+            feature), stacklevel=4)
 
 
 def _as_given(msg: str, curve_ids: np.ndarray, starts: np.ndarray) -> str:
