@@ -377,10 +377,10 @@ def test_audit_counts_are_bounded_and_named():
     _named(ValueError, "n_per_segment", lambda: SPLINE.rmf(n_per_segment=10**12))
     _named(ValueError, "n", lambda: curves.Helix().sample(10**12))
     _named(ValueError, "n", lambda: curves.Helix().parameters(1))
-    t = time.perf_counter()
+    t = time.process_time()  # CPU time: a loaded machine does not stretch it
     _named(ValueError, "max_segments",
            lambda: ph.fit(curves.Helix(), tol=1e-300, max_segments=10**9))
-    assert time.perf_counter() - t < 1.0
+    assert time.process_time() - t < 1.0
     _named(ValueError, "max_passes", lambda: spinal.deform(SPHERE, FIELD, 0.01, max_passes=10**12))
 
 

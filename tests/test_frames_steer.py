@@ -587,3 +587,25 @@ def test_unsigned_rows_and_turns_that_int64_would_wrap_are_refused():
     # in range, unsigned rows work
     ok = spinal.frames(h, constraints=(np.array([3], dtype=np.uint64), np.array([[0, 0, 1.0]])))
     np.testing.assert_array_equal(ok, spinal.frames(h, constraints={3: [0, 0, 1.0]}))
+
+
+def test_a_vanishing_guide_weight_tends_to_the_best_constant_turn():
+    """T3-05: as guide_weight → 0⁺ the minimisation's solution tends to the best constant
+    turn of the RMF towards the guide: the mean of the guide angles φ_i weighted by
+    sin²∠(g, t_i) and the samples' half-lengths (computed here from the RMF), at 1e-20 as at
+    1e-300 (a tiny weight once fell back to the plain RMF)."""
+    t = np.linspace(0, 4 * np.pi, 200)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    rmf = spinal.frames(h)
+    g = np.array([0.0, 0, 1])
+    r, s, tt = rmf[:, :, 0], rmf[:, :, 1], rmf[:, :, 2]
+    p = g - (tt @ g)[:, None] * tt
+    phi = np.unwrap(np.arctan2((p * s).sum(1), (p * r).sum(1)))
+    seg = np.linalg.norm(np.diff(h, axis=0), axis=1)
+    mu = 0.5 * (np.r_[0, seg] + np.r_[seg, 0])
+    w = (1 - (tt @ g) ** 2) * mu
+    best = (w * phi).sum() / w.sum()
+    for weight in (1e-20, 1e-50, 1e-300):
+        f = spinal.frames(h, guide=g, guide_weight=weight)
+        turn = np.arctan2((f[:, :, 0] * s).sum(1), (f[:, :, 0] * r).sum(1))
+        np.testing.assert_allclose(np.unwrap(turn), best, atol=1e-12)

@@ -75,9 +75,9 @@ def test_D08_twist_bend_and_path_rates_stay_finite():
 def test_D13_strip_curve_builds_2000_samples_quickly():
     # was: about a minute (a per-row Python loop, O(n²)); now O(n) in Rust
     n = 2000
-    t = time.perf_counter()
+    t = time.process_time()  # CPU time: a loaded machine does not stretch it
     f = fl.strip_curve(np.c_[np.linspace(0, 20, n), np.zeros(n), np.zeros(n)], .1, 1.0)
-    assert time.perf_counter() - t < 5.0  # generous: about 3 ms here
+    assert time.process_time() - t < 5.0  # generous: about 3 ms here
     assert np.isfinite(f.max_speed)
 
 

@@ -60,12 +60,12 @@ def test_construction_is_not_quadratic():
 def test_a_finely_sampled_axis_coming_back_is_still_refused():
     th = np.linspace(0, 5.5, 4000)
     axis = np.c_[np.cos(th), np.sin(th), np.zeros_like(th)]
-    t = time.perf_counter()
+    t = time.process_time()  # CPU time: a loaded machine does not stretch it
     with pytest.raises(ValueError, match=r"^points: the axis comes within 0\.\d+ < "
                        r"2·\(radius \+ reach\) = 0\.8 of itself \(segments 0 and \d+\); the "
                        r"closest point would be ambiguous$"):
         fields.strip_curve(axis, 0.2, 1.0)
-    assert time.perf_counter() - t < 30  # once about 3 minutes
+    assert time.process_time() - t < 30  # once about 3 minutes
     fields.strip_curve(axis, 0.15, 1.0)  # a narrower tube: the ends are 0.76 > 0.6 apart
 
 

@@ -93,6 +93,13 @@ fn thomas(lo: &[f64], d: &[f64], up: &[f64], b: &[f64]) -> Vec<f64> {
     x[0] = b[0] / den;
     for i in 1..n {
         den = d[i] - lo[i] * c[i - 1];
+        if den == 0.0 {
+            // the last pivot of a twist-rate system whose guide weight vanished below the
+            // rounding of its diagonal: the row is the constant mode, which the caller has
+            // already taken out (its right-hand side is rounding), so no correction there
+            (c[i], x[i]) = (0.0, 0.0);
+            continue;
+        }
         c[i] = up[i] / den;
         x[i] = (b[i] - lo[i] * x[i - 1]) / den;
     }
@@ -246,6 +253,7 @@ pub fn twist(
         if c > 0.0 {
             b[i] += c * value[i];
         }
+        weight[i] = c; // the guide's term of the row, for the shift below
     }
     if cancel() {
         return Ok(Vec::new());
@@ -275,11 +283,30 @@ pub fn twist(
     if cancel() {
         return Ok(Vec::new());
     }
-    if closed && !pinned.iter().any(|&p| p) {
-        return Ok(cyclic(&lo, &d, &up, &b));
-    }
-    if !closed {
-        return Ok(thomas(&lo, &d, &up, &b));
+    let any_pin = pinned.iter().any(|&p| p);
+    if !any_pin {
+        // Without pins the twist-rate term has the constants as its null space, and as the
+        // guide's weight goes to 0 the system's condition grows like 1/weight. Solved for the
+        // difference δ = α − ᾱ from the guide's weighted mean ᾱ instead (the same solution:
+        // the twist-rate rows annihilate a constant), the right-hand side is of the weight's
+        // size too, so rounding stays at the level of α and the limit weight → 0⁺ is the best
+        // constant fit, ᾱ.
+        let (mut sw, mut swv) = (0.0, 0.0);
+        for (&c, &v) in weight.iter().zip(&value) {
+            if c > 0.0 {
+                sw += c;
+                swv += c * v;
+            }
+        }
+        let shift = if sw > 0.0 { swv / sw } else { 0.0 };
+        for (bi, &c) in b.iter_mut().zip(&weight) {
+            *bi -= c * shift;
+        }
+        let x = match closed {
+            true => cyclic(&lo, &d, &up, &b),
+            false => thomas(&lo, &d, &up, &b),
+        };
+        return Ok(x.into_iter().map(|v| v + shift).collect());
     }
     // a closed curve with a pin: the corners are gone once a pin sits at row 0; rotate the
     // rows so that it does, solve the open system and rotate back
