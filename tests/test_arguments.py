@@ -170,6 +170,7 @@ NOT_WALKED = {
     "spinal.StampReport": "a result record built by stamp, not an input",
     "spinal.FoldOverWarning": "a warning class raised by the library",
     "spinal.SkippedCurvesWarning": "a warning class raised by the library",
+    "spinal.PrecisionWarning": "a warning class raised by the library",
     "spinal.RefinementWarning": "a warning class raised by the library",
     "spinal.quaternions.WalkResult": "a result record (named tuple)",
     "spinal.quaternions.WalksResult": "a result record (named tuple)",

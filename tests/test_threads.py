@@ -145,3 +145,20 @@ def test_a_call_from_a_progress_callback_does_not_deadlock_one_thread():
         spinal.advect(np.zeros((10, 3)), fl.translation([0, 0, 0.3], 0.6, [0, 0, 1]), 0.1, 4,
                       progress=progress)
     assert seen and all(s == (60, 3, 3) for s in seen)
+
+
+def test_long_single_curves_have_the_same_bits_on_any_thread_count():
+    """T3-04: frames and closing_angle of one curve long enough for the parallel scan
+    (more than 2·2^15 rows: it is cut into chunks whatever the pool size, and one thread
+    scans them in turn) have the same bits on 1, 2, 3 and 5 threads, open and closed."""
+    from spinal.curves import TorusKnot
+
+    x = TorusKnot().sample(150_001)
+    runs = []
+    for n in (1, 2, 3, 5):
+        with spinal.threads(n):
+            runs.append((spinal.frames(x), spinal.frames(x, closed=True),
+                         spinal.closing_angle(x), spinal.tube(x[:70_000], 0.05, 6).vertices))
+    for other in runs[1:]:
+        for a, b in zip(runs[0], other, strict=True):
+            np.testing.assert_array_equal(a, b)

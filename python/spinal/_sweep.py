@@ -421,7 +421,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         local = None if fold_curves is None else folds - _orig_offsets(lens, n)[fold_curves]
         warnings.warn(FoldOverWarning(msg, folds, fold_curves, local), stacklevel=3)
     if single and len(v):
-        _check_float32(v, prof, sc)
+        _check_float32(pts, prof, sc)
     mesh = Mesh._of_sweep(v, f, nrm, uv, folds, rings, n, curves)
     mesh.skipped_curves = skipped
     if pdata:
@@ -435,16 +435,18 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     return mesh
 
 
-def _check_float32(v: np.ndarray, profile: np.ndarray, scale: np.ndarray) -> None:
+def _check_float32(pts: np.ndarray, profile: np.ndarray, scale: np.ndarray) -> None:
     """Warn (:class:`PrecisionWarning`) where float32 coordinates cannot resolve the profile:
-    their spacing at the largest coordinate over a tenth of the smallest profile edge times
-    the smallest scale."""
+    their spacing at the largest coordinate (bounded by the spine's largest coordinate plus
+    the profile's reach, so the vertices need not be read) over a tenth of the smallest
+    profile edge times the smallest scale."""
     edges = np.linalg.norm(np.diff(np.r_[profile, profile[:1]], axis=0), axis=1)
     edges = edges[edges > 0]
-    if not edges.size:
+    if not edges.size or not len(pts):
         return
     feature = float(edges.min() * np.abs(scale).min())
-    largest = max(abs(float(v.max())), abs(float(v.min())))  # no temporary of v's size
+    reach = float(np.abs(profile).max() * np.abs(scale).max())
+    largest = max(abs(float(pts.max())), abs(float(pts.min()))) + reach
     spacing = float(np.spacing(np.float32(largest)))
     if spacing > 0.1 * feature:
         warnings.warn(PrecisionWarning(
