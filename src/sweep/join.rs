@@ -354,7 +354,8 @@ fn put<R: Real>(
 /// part of the buffers; `side_and_caps`: its faces before the joins' faces; `folds`: the
 /// plain sweep's fold-over rows, corrected here). Returns the number of faces kept (the
 /// faces left out are those the welds flatten, the kept ones moved to the front) and the
-/// first vertex (local) out of the output type's range.
+/// first vertex (local) out of the output type's range. Polls `cancel` between blocks of
+/// corners; a stopped call leaves its part of the output incomplete.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_joins<R: Real, I: Index>(
     rings: &Rings,
@@ -366,6 +367,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
     vbase: usize,
     unscale: Option<i32>,
     folds: &mut Vec<usize>,
+    cancel: crate::cancel::Cancel<'_>,
 ) -> (usize, Option<usize>) {
     let plan = rings.plan;
     let (cols, nr, stored) = (plan.cols, plan.rings, plan.stored_rings);
@@ -449,6 +451,11 @@ pub(super) fn write_joins<R: Real, I: Index>(
     let (mut cur, mut now) = (Vec::new(), Vec::new());
     let (mut next_ring, mut jf) = (stored, side_and_caps);
     for (ci, c) in corners.iter().enumerate() {
+        // a long rough spine has a corner at most samples: poll the stop between blocks of
+        // them (a stopped sweep's output is discarded)
+        if ci % 4096 == 0 && cancel() {
+            return (side_and_caps, bad);
+        }
         let k = c.k;
         // how far the crease may run along either leg: half the way to the next corner
         let back = match (ci, closed) {
@@ -644,7 +651,10 @@ pub(super) fn write_joins<R: Real, I: Index>(
         .map(|(&s, &e)| (s * per_seg..(s + 1) * per_seg, s, e))
         .chain(bands.iter().map(|&(f, a, b, _)| (f..f + per_seg, a, b)));
     let mut dropped = Vec::new();
-    for (r, a, b) in ranges {
+    for (si, (r, a, b)) in ranges.enumerate() {
+        if si % 4096 == 0 && cancel() {
+            return (side_and_caps, bad);
+        }
         let (wa, wb) = (weld.get(&a), weld.get(&b));
         let (la, lb) = (vbase + a * cols, vbase + b * cols);
         for fi in r {
@@ -709,17 +719,19 @@ pub(super) fn write_joins<R: Real, I: Index>(
             ia != ib && !(e.dot(ta) > 0.0 && e.dot(tb) > 0.0)
         })
     };
-    let mut new_folds: Vec<usize> = touched
-        .iter()
-        .filter(|&(&s, &b)| folded(s, b))
-        .map(|(&s, _)| row(s))
-        .collect();
-    new_folds.extend(
-        bands
-            .iter()
-            .filter(|&&(_, a, b, _)| folded(a, b))
-            .map(|&(_, _, _, k)| row(k)),
-    );
+    let segments = touched.iter().map(|(&s, &b)| (s, b, s));
+    let mut new_folds = Vec::new();
+    for (i, (a, b, at)) in segments
+        .chain(bands.iter().map(|&(_, a, b, k)| (a, b, k)))
+        .enumerate()
+    {
+        if i % 4096 == 0 && cancel() {
+            return (side_and_caps, bad);
+        }
+        if folded(a, b) {
+            new_folds.push(row(at));
+        }
+    }
     folds.extend(new_folds);
     folds.sort_unstable();
     folds.dedup();

@@ -153,6 +153,7 @@ fn sweep_one<R: Real, I: Index>(
         vbase,
         unscale,
         &mut folds,
+        cancel,
     );
     SpineOut {
         folds,
