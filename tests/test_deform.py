@@ -626,3 +626,46 @@ def test_refinement_from_the_rest_mesh_keeps_a_long_stroke_below_1e_4():
     integration = r.volume / vref - 1
     assert abs(integration) < 1e-6 and abs(r.integration_error) < 1e-6, (r, integration)
     assert abs(r.mesh_error - (vref / rest - 1)) < 0.01 * abs(r.mesh_error), (r, vref / rest - 1)
+
+
+def test_deform_refuses_open_and_inside_out_meshes_unless_told():
+    """T3-07: an open mesh (one face removed) and an inside-out mesh have no meaningful
+    volume, so deform refuses them naming `mesh` (the check fields.mesh_curl makes of its
+    tool); check=False deforms them anyway and moves the vertices exactly as the checked
+    call moves the closed mesh's."""
+    V, F = icosphere(3)
+    tool = fields.translation([0, 0, 1], 0.3, [0, 0, -0.5])
+    closed, _ = spinal.deform((V, F), tool, 1.0, refine=None)
+    for bad, words in (((V, F[:-1]), "mesh: not watertight: edge .* belongs to 1 faces"),
+                       ((V, F[:, ::-1]), "mesh: encloses a non-positive volume")):
+        with pytest.raises(ValueError, match=words + ".*check=False"):
+            spinal.deform(bad, tool, 1.0)
+        with pytest.raises(ValueError, match="mesh: "):
+            fields.mesh_curl(bad, velocity=[0, 0, 1], resolution=8)
+        moved, rep = spinal.deform(bad, tool, 1.0, refine=None, check=False)
+        np.testing.assert_array_equal(moved.vertices, closed.vertices)
+    # faces wound against each other have no consistent sides to refine: refused either way
+    mixed = (V, np.r_[F[:-1], F[-1:, ::-1]])
+    for check in (True, False):
+        with pytest.raises(ValueError, match="mesh: .*consistently"):
+            spinal.deform(mixed, tool, 1.0, check=check)
+    _, rep = spinal.deform((V, F[:, ::-1]), tool, 1.0, refine=None, check=False)
+    assert rep.rest_volume < 0
+    with pytest.raises(TypeError, match="check"):
+        spinal.deform((V, F), tool, 1.0, check="no")
+
+
+@pytest.mark.parametrize("scale", [1e-110, 1e110, 1e150])
+def test_deform_report_is_finite_at_any_scale(scale):
+    """T3-01: the volume report of a mesh whose volume over- or underflows float64
+    (icosphere scaled by 1e±110) compares the volumes on a common power-of-two scale: the
+    relative change equals the unit mesh's (advection is scale invariant), not NaN; the
+    rest volume is inf or 0 as the true value."""
+    V, F = icosphere(3)
+    tool = fields.translation([0, 0, 1], 0.3, [0, 0, -0.5])
+    _, unit = spinal.deform((V, F), tool, 1.0, refine=None, estimate=True)
+    scaled = fields.translation([0, 0, scale], 0.3 * scale, [0, 0, -0.5 * scale])
+    _, rep = spinal.deform((V * scale, F), scaled, 1.0, refine=None, estimate=True)
+    assert rep.relative_change == pytest.approx(unit.relative_change, rel=1e-12)
+    assert rep.integration_error == pytest.approx(unit.integration_error, rel=1e-6)
+    assert rep.rest_volume == (np.inf if scale > 1 else 0.0)

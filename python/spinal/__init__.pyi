@@ -299,6 +299,7 @@ def deform(
     estimate: bool = False,
     progress: _Progress = False,
     max_vertices: int | None = None,
+    check: bool = True,
 ) -> tuple[Mesh, DeformReport]: ...
 @dataclass(frozen=True)
 class StampReport:

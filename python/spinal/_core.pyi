@@ -383,6 +383,7 @@ def deform_mesh(
     max_vertices: int,
     max_passes: int,
     progress: Callable[[int, int], object] | None,
+    check: bool = True,
 ) -> tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],

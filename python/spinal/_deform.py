@@ -30,7 +30,7 @@ import numpy as np
 from . import _core
 from ._advect import MAX_STEPS, _progress_bar
 from ._mesh import Mesh, mesh_arrays
-from ._mesh import signed_volume as _volume
+from ._mesh import volumes_at_scale as _volumes
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
 from .fields import Field
 
@@ -47,6 +47,13 @@ class RefinementWarning(UserWarning):
     """:func:`spinal.deform` stopped refining at its ``max_vertices`` (or ``max_passes``) bound
     with edges still longer than the threshold: the mesh is less resolved than asked for (see
     ``DeformReport.converged`` and ``edges_over_threshold``)."""
+
+
+def _unscaled(volume: float, e: int) -> float:
+    """A volume taken on vertices scaled by ``2**-e``, in the mesh's units (``±inf`` when
+    it exceeds float64)."""
+    with np.errstate(over="ignore", under="ignore"):
+        return float(np.ldexp(volume, 3 * e))
 
 
 @dataclass(frozen=True)
@@ -191,7 +198,7 @@ class DeformReport:
 
 def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: int = 30,
            t0=0.0, estimate: bool = False, progress=False,
-           max_vertices=None) -> tuple[Mesh, DeformReport]:
+           max_vertices=None, check: bool = True) -> tuple[Mesh, DeformReport]:
     """Deform a closed triangle mesh along a divergence-free field and report the volume.
 
     The vertices are advected with RK4 (the steps of :func:`spinal.advect`, default step
@@ -237,6 +244,13 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     progress : bool or callable
         As in :func:`spinal.advect`: a bar, or ``progress(done_steps, total_steps)``. Ctrl-C
         stops the call between steps (``KeyboardInterrupt``).
+    check : bool
+        Refuse (``ValueError`` naming ``mesh``) a mesh that does not bound a solid: an open
+        mesh (an edge in one face), an edge in more than two faces, inconsistently wound faces
+        or a mesh wound inwards (negative enclosed volume). The volume of such a mesh means
+        nothing, so neither does the report's ``relative_change``. ``check=False`` deforms it
+        anyway (the vertices move the same); an edge in more than two faces or two faces
+        running through an edge in the same direction are refused either way.
 
     Returns
     -------
@@ -263,6 +277,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
             raise ValueError(f"max_vertices: must be at least the mesh's {len(V)} vertices, "
                              f"got {max_vertices}")
     estimate = as_bool(estimate, "estimate")
+    check = as_bool(check, "check")
     if not (isinstance(progress, bool) or callable(progress)):
         raise TypeError(f"progress: expected a bool or a callable, got {type(progress).__name__}")
     bar = []  # (update, close) of the progress bar, made when the core reports the step count
@@ -275,15 +290,16 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     try:
         W, Vr, Fr, counts, stats = _core.deform_mesh(
             V, F, field, t0, duration, n, refine, max_vertices, max_passes,
-            tick if progress else None)
+            tick if progress else None, check)
     finally:
         if bar:
             bar[0][1]()
     (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
         (flips, flip_volume, collapses, moves, collapse_volume) = stats
     clock = time.perf_counter()
-    rest, vol = _volume(Vr, Fr), _volume(W, Fr)
+    e, (rest, vol) = _volumes(Fr, Vr, W)
     change = vol / rest - 1 if rest != 0 else float("nan")
+    rest, vol = _unscaled(rest, e), _unscaled(vol, e)
     timings = {"integrate": t_int, "refine": t_ref, "volume": time.perf_counter() - clock,
                "estimate": 0.0}
     integ = mesh_err = None
@@ -293,11 +309,12 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         # their side's velocity; spinal.advect's RK4 stages step across the surface there)
         def rerun(steps):
             return _core.deform_mesh(Vr, Fr, field, t0, duration, steps, None, len(Vr), 0,
-                                     None)[0]
+                                     None, False)[0]
 
         W1 = W if torn == 0 else rerun(n)
         W2 = rerun(2 * n)
-        integ = (_volume(W1, Fr) - _volume(W2, Fr)) / rest * 16 / 15
+        _, (scaled_rest, v1, v2) = _volumes(Fr, Vr, W1, W2)
+        integ = (v1 - v2) / scaled_rest * 16 / 15
         mesh_err = change - integ
         timings["estimate"] = time.perf_counter() - clock
     converged = not bounded
@@ -398,7 +415,8 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     iterations = as_int(iterations, "iterations", 0, MAX_ITERATIONS, out_of_bounds=lambda x: (
         f"must be ≥ 0 and at most {MAX_ITERATIONS}, got {x}"))
     W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations)
-    rest, vol = _volume(V, F), _volume(W, F)
+    e, (rest, vol) = _volumes(F, V, W)
     change = vol / rest - 1 if rest != 0 else float("nan")
+    rest, vol = _unscaled(rest, e), _unscaled(vol, e)
     return Mesh(W, F), StampReport(rest, vol, change, rep[:, 0], rep[:, 1], rep[:, 2],
                                    rep[:, 3].astype(np.int64))

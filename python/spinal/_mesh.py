@@ -71,6 +71,21 @@ def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
                              np.ascontiguousarray(F, dtype=np.int64).reshape(-1, 3))
 
 
+def volumes_at_scale(F: np.ndarray, reference: np.ndarray, *others: np.ndarray
+                     ) -> tuple[int, list[float]]:
+    """``(e, [volume of reference, volume of each other])`` of meshes sharing the faces ``F``,
+    each taken on its vertices times ``2**-e``, the power of two that brings the largest
+    coordinate of ``reference`` into [1, 2). Scaling by a power of two is exact, so ratios and
+    differences of these volumes are those of the true volumes even where the true volumes
+    overflow or underflow float64 (coordinates near 1e±110); ``ldexp(v, 3e)`` gives a volume
+    back in the mesh's units."""
+    largest = float(np.abs(reference).max(initial=0.0))
+    e = int(np.frexp(largest)[1]) - 1 if largest > 0 else 0
+    e = max(-1000, min(1000, e))
+    return e, [signed_volume(np.ldexp(np.asarray(V, dtype=np.float64), -e), F)
+               for V in (reference, *others)]
+
+
 def mesh_arrays(mesh):
     """``(vertices (V, 3) float64, faces (F, 3) int64)`` of a spinal.Mesh, a trimesh.Trimesh or a
     ``(vertices, faces)`` pair, named ``mesh`` in errors."""

@@ -5,6 +5,12 @@
 //!   when the faces are counter-clockwise seen from outside. Any reference point `m` gives
 //!   the same `V` for a closed mesh; the mean vertex keeps the digits of a small mesh far
 //!   from the origin (the terms stay of the size of the mesh, not of its distance).
+//! * **Scale**: both measures are taken on the vertices times a power of two `2^-e` that
+//!   brings the largest coordinate into `[1, 2)` ([`pow2_scale`]) and scaled back by
+//!   `2^(2e)` (area) or `2^(3e)` (volume). Multiplying by a power of two is exact, so the
+//!   result has the same bits as the unscaled sum wherever that one neither overflows nor
+//!   underflows, and stays finite (or `inf` only when the true value is not representable)
+//!   for coordinates anywhere in `1e±300`.
 //! * **Edges**: the undirected edges `{i, j}` (`i < j`, sorted) and, for every face slot `k`
 //!   (the edge `F[k] → F[k+1]`), its edge id; an edge of a closed 2-manifold has exactly two
 //!   slots, a boundary edge one, a non-manifold edge more.
@@ -12,16 +18,43 @@
 use glam::DVec3;
 
 /// Signed volume of the closed triangle mesh `(v, f)`, summed about the mean vertex (0 for
-/// no vertices). Face indices must be valid.
+/// no vertices), on the vertices scaled by [`pow2_scale`]. Face indices must be valid.
 pub fn signed_volume(v: &[DVec3], f: &[[usize; 3]]) -> f64 {
     if v.is_empty() {
         return 0.0;
     }
-    let m = v.iter().sum::<DVec3>() / v.len() as f64;
-    compensated_sum(
-        f.iter()
-            .map(|t| (v[t[0]] - m).dot((v[t[1]] - m).cross(v[t[2]] - m))),
-    ) / 6.0
+    let (s, back) = pow2_scale(v.iter().fold(0.0f64, |a, p| a.max(p.abs().max_element())));
+    let m = v.iter().map(|p| *p * s).sum::<DVec3>() / v.len() as f64;
+    let p = |i: usize| v[i] * s - m;
+    let six = compensated_sum(f.iter().map(|t| p(t[0]).dot(p(t[1]).cross(p(t[2])))));
+    scale_back(six / 6.0, back, 3)
+}
+
+/// The power of two `s = 2^-e` that brings `largest` (the largest absolute coordinate, finite,
+/// ≥ 0) into `[1, 2)`, and its inverse `2^e`; both normal numbers (`e` within ±1022), and
+/// `(1, 1)` for `largest = 0`. Products of coordinates scaled by `s` neither overflow nor
+/// underflow for any mesh whose vertices are distinct in floating point.
+pub fn pow2_scale(largest: f64) -> (f64, f64) {
+    if !(largest > 0.0 && largest.is_finite()) {
+        return (1.0, 1.0);
+    }
+    // the binary exponent of `largest` (of its leading bit for subnormals)
+    let bits = largest.to_bits();
+    let biased = ((bits >> 52) & 0x7ff) as i64;
+    let e = if biased == 0 {
+        -1011 - (bits & ((1u64 << 52) - 1)).leading_zeros() as i64
+    } else {
+        biased - 1023
+    }
+    .clamp(-1022, 1022);
+    let pow = |k: i64| f64::from_bits(((k + 1023) as u64) << 52);
+    (pow(-e), pow(e))
+}
+
+/// `x · back^power`, one factor at a time (each step exact until the true value leaves the
+/// range of `f64`, which then gives `±inf` or `0`, never NaN).
+pub fn scale_back(x: f64, back: f64, power: u32) -> f64 {
+    (0..power).fold(x, |acc, _| acc * back)
 }
 
 /// The sum of `terms` with Neumaier's compensation (Neumaier 1974, "Rundungsfehleranalyse
@@ -141,6 +174,36 @@ pub(crate) mod fixtures {
 mod tests {
     use super::fixtures::cube;
     use super::*;
+
+    #[test]
+    fn pow2_scale_brings_the_largest_coordinate_into_one_two() {
+        for x in [1e-310, 5e-324, 1e-300, 0.75, 1.0, 1.5, 3.0, 1e300, f64::MAX] {
+            let (s, back) = pow2_scale(x);
+            assert_eq!(s * back, 1.0);
+            assert!(s.is_normal() && back.is_normal());
+            if (1e-300..1e300).contains(&x) {
+                assert!((1.0..2.0).contains(&(x * s)), "{x}: {}", x * s);
+            }
+        }
+        assert_eq!(pow2_scale(0.0), (1.0, 1.0));
+        assert_eq!(scale_back(3.0, 2.0, 3), 24.0);
+        assert_eq!(scale_back(1e300, 1e10, 2), f64::INFINITY);
+    }
+
+    #[test]
+    fn signed_volume_is_scale_invariant() {
+        let (v, f) = cube();
+        for k in [-600, -200, 0, 200, 300] {
+            let s = 2f64.powi(k / 2) * 2f64.powi(k - k / 2);
+            let w: Vec<DVec3> = v.iter().map(|p| *p * s).collect();
+            let want = s * s * s;
+            let got = signed_volume(&w, &f);
+            assert!(
+                got == want || (got / want - 1.0).abs() < 1e-15,
+                "2^{k}: {got}"
+            );
+        }
+    }
 
     #[test]
     fn compensated_sum_keeps_the_small_terms() {

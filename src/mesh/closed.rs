@@ -12,9 +12,10 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::measure::{self, BLOCK, Index, Point, corners, face_sum, mean};
+use super::measure::{self, BLOCK, Index, Point, Scaled, corners, face_sum};
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::math::mesh::scale_back;
 
 /// The name of the call in out-of-memory errors.
 pub const CALL: &str = "closed tool";
@@ -58,9 +59,10 @@ pub fn closed_volume_centroid_cancellable<P: Point, I: Index>(
             )),
         };
     }
-    let m = mean(v, cancel);
+    // on the scaled vertices (see `measure`): `vol` and `moment` scaled by `s³` and `s⁴`
+    let sc = Scaled::of(v, true, cancel);
     let six = |[a, b, c]: [usize; 3]| {
-        let (a, b, c) = (v[a].dvec3() - m, v[b].dvec3() - m, v[c].dvec3() - m);
+        let (a, b, c) = (sc.at(v, a), sc.at(v, b), sc.at(v, c));
         (a.dot(b.cross(c)), a + b + c)
     };
     let vol = face_sum(f, n, |t| six(t).0, cancel)? / 6.0;
@@ -70,7 +72,10 @@ pub fn closed_volume_centroid_cancellable<P: Point, I: Index>(
     if !(vol > 0.0) {
         return Err(InputError::new(
             "mesh",
-            format!("encloses a non-positive volume ({vol:.4}); faces must be oriented outwards"),
+            format!(
+                "encloses a non-positive volume ({:.4}); faces must be oriented outwards",
+                scale_back(vol, sc.back, 3)
+            ),
         ));
     }
     let blocks: Vec<DVec3> = f
@@ -86,7 +91,8 @@ pub fn closed_volume_centroid_cancellable<P: Point, I: Index>(
         })
         .collect();
     let moment = blocks.into_iter().sum::<DVec3>();
-    Ok((vol, m + moment / (24.0 * vol)))
+    let centroid = (sc.m + moment / (24.0 * vol)) * sc.back;
+    Ok((scale_back(vol, sc.back, 3), centroid))
 }
 
 /// The error about the first bad edge of a mesh that is not watertight or not consistently
@@ -169,7 +175,7 @@ fn first_bad_edge<I: Index>(
                             "mesh",
                             format!(
                                 "not watertight: edge ({v}, {w}) belongs to {count} faces (a \
-                                 closed tool needs exactly 2)"
+                                 closed surface has exactly 2)"
                             ),
                         )));
                     }

@@ -4,7 +4,10 @@
 //! * **Volume** by the divergence theorem, `V = Σ (a − m)·((b − m) × (c − m)) / 6` about the
 //!   mean vertex `m` (see [`crate::math::mesh::signed_volume`]); **area** `Σ |(b − a) × (c − a)| / 2`.
 //!   Both are summed in fixed blocks of faces with Neumaier's compensation, and the block
-//!   sums again, so the result does not depend on the number of threads.
+//!   sums again, so the result does not depend on the number of threads; both are taken on
+//!   the vertices times the power of two that brings the largest coordinate into `[1, 2)`
+//!   and scaled back ([`crate::math::mesh::pow2_scale`]): the same bits wherever the plain
+//!   sums are finite and normal, and a finite result for coordinates anywhere in `1e±300`.
 //! * **Edges** by distributing the `3F` face slots to buckets on their smaller vertex (Knuth,
 //!   *The Art of Computer Programming* vol. 3, §5.2, "distribution counting"): every vertex
 //!   `v` gets the bucket of the slots `v → w` and `w → v` with `w > v`, stored as
@@ -25,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
-use crate::math::mesh::compensated_sum;
+use crate::math::mesh::{compensated_sum, pow2_scale, scale_back};
 
 /// Faces per block of the compensated sums (fixed, so results do not depend on threads).
 pub(crate) const BLOCK: usize = 1 << 14;
@@ -65,6 +68,14 @@ impl Index for i64 {
     #[inline(always)]
     fn get(self) -> i64 {
         self
+    }
+}
+
+impl Index for usize {
+    /// Indices past `i64::MAX` (never valid) read as `i64::MAX`, which is out of range.
+    #[inline(always)]
+    fn get(self) -> i64 {
+        i64::try_from(self).unwrap_or(i64::MAX)
     }
 }
 
@@ -164,9 +175,54 @@ pub(crate) fn face_sum<I: Index>(
     Ok(compensated_sum(blocks.into_iter().flatten()))
 }
 
-/// The mean of the vertices (zero for none), summed in fixed blocks (polling `cancel`
-/// before each; skipped blocks count as zero).
-pub(crate) fn mean<P: Point>(v: &[P], cancel: Cancel<'_>) -> DVec3 {
+/// The largest absolute coordinate of the vertices (0 for none; NaN rows are skipped),
+/// polling `cancel` before each block.
+pub(crate) fn largest<P: Point>(v: &[P], cancel: Cancel<'_>) -> f64 {
+    v.par_chunks(BLOCK)
+        .map(|b| {
+            if cancel() {
+                return 0.0;
+            }
+            b.iter()
+                .fold(0.0f64, |a, p| a.max(p.dvec3().abs().max_element()))
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
+/// The vertices as the measures read them: times the power of two `s` of
+/// [`pow2_scale`] and, for the volume, about their (scaled) mean `m`.
+#[derive(Clone, Copy)]
+pub(crate) struct Scaled {
+    /// The scale `2^-e` applied to every coordinate.
+    pub s: f64,
+    /// Its inverse `2^e`, to scale results back with [`scale_back`].
+    pub back: f64,
+    /// The mean of the scaled vertices (zero when not asked for).
+    pub m: DVec3,
+}
+
+impl Scaled {
+    /// The scale of `v`, and its scaled mean when `centred`.
+    pub(crate) fn of<P: Point>(v: &[P], centred: bool, cancel: Cancel<'_>) -> Scaled {
+        let (s, back) = pow2_scale(largest(v, cancel));
+        let m = if centred {
+            mean(v, s, cancel)
+        } else {
+            DVec3::ZERO
+        };
+        Scaled { s, back, m }
+    }
+
+    /// Vertex `i` scaled and moved by the mean.
+    #[inline]
+    pub(crate) fn at<P: Point>(&self, v: &[P], i: usize) -> DVec3 {
+        v[i].dvec3() * self.s - self.m
+    }
+}
+
+/// The mean of the vertices times `s` (zero for none), summed in fixed blocks (polling
+/// `cancel` before each; skipped blocks count as zero).
+pub(crate) fn mean<P: Point>(v: &[P], s: f64, cancel: Cancel<'_>) -> DVec3 {
     if v.is_empty() {
         return DVec3::ZERO;
     }
@@ -176,7 +232,7 @@ pub(crate) fn mean<P: Point>(v: &[P], cancel: Cancel<'_>) -> DVec3 {
             if cancel() {
                 return DVec3::ZERO;
             }
-            b.iter().map(|p| p.dvec3()).sum::<DVec3>()
+            b.iter().map(|p| p.dvec3() * s).sum::<DVec3>()
         })
         .collect();
     blocks.into_iter().sum::<DVec3>() / v.len() as f64
@@ -195,17 +251,14 @@ pub fn volume_cancellable<P: Point, I: Index>(
     f: &[[I; 3]],
     cancel: Cancel<'_>,
 ) -> Result<f64> {
-    let m = mean(v, cancel);
-    let s = face_sum(
+    let sc = Scaled::of(v, true, cancel);
+    let six = face_sum(
         f,
         v.len(),
-        |[a, b, c]| {
-            let (a, b, c) = (v[a].dvec3() - m, v[b].dvec3() - m, v[c].dvec3() - m);
-            a.dot(b.cross(c))
-        },
+        |[a, b, c]| sc.at(v, a).dot(sc.at(v, b).cross(sc.at(v, c))),
         cancel,
     )?;
-    Ok(s / 6.0)
+    Ok(scale_back(six / 6.0, sc.back, 3))
 }
 
 /// Total area of the triangles (faces checked, errors name `faces`).
@@ -220,16 +273,17 @@ pub fn area_cancellable<P: Point, I: Index>(
     f: &[[I; 3]],
     cancel: Cancel<'_>,
 ) -> Result<f64> {
-    let s = face_sum(
+    let sc = Scaled::of(v, false, cancel);
+    let twice = face_sum(
         f,
         v.len(),
         |[a, b, c]| {
-            let a = v[a].dvec3();
-            (v[b].dvec3() - a).cross(v[c].dvec3() - a).length()
+            let a = sc.at(v, a);
+            (sc.at(v, b) - a).cross(sc.at(v, c) - a).length()
         },
         cancel,
     )?;
-    Ok(0.5 * s)
+    Ok(scale_back(0.5 * twice, sc.back, 2))
 }
 
 /// Edge statistics of a triangle mesh, from [`edges`].
@@ -676,6 +730,39 @@ mod tests {
         let e = edges(&f, 6).unwrap();
         assert_eq!(e.edges, 12);
         assert!(e.watertight());
+    }
+
+    #[test]
+    fn measures_scale_exactly_with_the_mesh() {
+        // scaling by 2^k scales the area by 4^k and the volume by 8^k bit for bit while the
+        // results are representable; beyond, `inf` or 0 but never NaN
+        let (v, f) = oct();
+        let (a1, v1) = (area(&v, &f).unwrap(), volume(&v, &f).unwrap());
+        for k in [-340i32, -300, -260, -150, -1, 0, 1, 100, 150, 250, 330] {
+            let s = 2f64.powi(k);
+            let w: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| x * s)).collect();
+            let (a, vol) = (area(&w, &f).unwrap(), volume(&w, &f).unwrap());
+            let want_a = a1 * s * s;
+            let want_v = v1 * s * s * s;
+            assert_eq!(
+                a.to_bits(),
+                want_a.to_bits(),
+                "area at 2^{k}: {a} vs {want_a}"
+            );
+            assert_eq!(vol.to_bits(), want_v.to_bits(), "volume at 2^{k}");
+        }
+        // at 1e80 the plain sums overflowed to NaN; at 1e-80 they underflowed to 0
+        for scale in [1e-120, 1e-80, 1e80, 1e102, 1e103] {
+            let w: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| x * scale)).collect();
+            let a = area(&w, &f).unwrap();
+            let vol = volume(&w, &f).unwrap();
+            assert!(
+                (a / (a1 * scale * scale) - 1.0).abs() < 1e-15 || a.is_infinite(),
+                "{a}"
+            );
+            assert!(vol.is_finite() || vol == f64::INFINITY, "{vol}");
+            assert!(!a.is_nan() && !vol.is_nan());
+        }
     }
 
     #[test]

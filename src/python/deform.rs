@@ -116,11 +116,12 @@ type DeformArrays<'py> = (
 /// over the threshold, bounded, integration seconds, refinement seconds, vertices on a slip
 /// surface, vertices at a torn edge's chord midpoint), (flips, their volume change, collapses,
 /// moves, the volume change of the collapses and moves))`. `refine=None`
-/// only advects. Ctrl-C stops it between steps; `progress(done, total)` is called after
-/// every step when given.
+/// only advects. With `check`, a mesh that is open, not edge-manifold, inconsistently wound
+/// or wound inwards is refused first (errors name `mesh`). Ctrl-C stops it between steps;
+/// `progress(done, total)` is called after every step when given.
 #[pyfunction]
 #[pyo3(signature = (vertices, faces, field, t0, duration, steps, refine, max_vertices,
-                    max_passes, progress))]
+                    max_passes, progress, check=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn deform_mesh<'py>(
     py: Python<'py>,
@@ -134,6 +135,7 @@ pub fn deform_mesh<'py>(
     max_vertices: usize,
     max_passes: usize,
     progress: Option<Py<PyAny>>,
+    check: bool,
 ) -> PyResult<DeformArrays<'py>> {
     let field = &field.field;
     let x = vec3s("mesh", &vertices)?;
@@ -153,7 +155,9 @@ pub fn deform_mesh<'py>(
     let mut ticker = Ticker::new(progress, &stop);
     let out = detach_stoppable(py, &stop, || {
         let runs = refine::schedule(field, t0, duration, steps)?;
-        refine::deform(field, x, &f, &runs, opts, &mut |d, n| ticker.tick(d, n))
+        refine::deform(field, x, &f, &runs, opts, check, &mut |d, n| {
+            ticker.tick(d, n)
+        })
     })??;
     ticker.finish()?;
     let d = out.ok_or_else(|| value_error("deform: stopped"))?;

@@ -821,7 +821,7 @@ mod tests {
             max_vertices: 10 * v.len(),
             max_passes: 30,
         };
-        let d = deform(&tool, &v, &f, &runs, Some(opts), &mut |_, _| true)
+        let d = deform(&tool, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
             .unwrap()
             .unwrap();
         assert!(valid(&d.faces, d.vertices.len()));

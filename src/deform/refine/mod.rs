@@ -404,7 +404,10 @@ impl Gen {
 }
 
 /// Advect the closed mesh `(rest, faces)` along `field` through the steps of `runs`,
-/// refining after every step when `refinement` is given (see the module docs). `tick(done,
+/// refining after every step when `refinement` is given (see the module docs). With
+/// `check`, a mesh that does not bound a solid (open, or wound inwards; see
+/// [`crate::mesh::closed`]) is refused naming `mesh`: its volume means nothing. Edges in
+/// more than two faces or traversed twice in one direction are refused either way. `tick(done,
 /// total)` is called after every step; when it returns `false` the deformation stops and
 /// `Ok(None)` is returned.
 pub fn deform(
@@ -413,6 +416,7 @@ pub fn deform(
     faces: &[[usize; 3]],
     runs: &[Run],
     refinement: Option<Refinement>,
+    check: bool,
     tick: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Option<Deformed>> {
     if let Some(r) = refinement
@@ -428,6 +432,16 @@ pub fn deform(
         ));
     }
     let topo = Topology::new(faces, rest.len())?;
+    if check {
+        // one linear pass over the faces before the first step (not polled: it takes about
+        // what one step takes)
+        crate::mesh::closed::closed_volume_centroid(rest, faces).map_err(|mut e| {
+            if e.kind == crate::error::ErrorKind::Invalid {
+                e.msg.push_str("; pass check=False to deform it anyway");
+            }
+            e
+        })?;
+    }
     let edges = topo.twin.iter().enumerate();
     let (sum, count) =
         edges

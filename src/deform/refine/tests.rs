@@ -61,7 +61,10 @@ fn a_two_face_pillow_is_left_alone() {
         max_vertices: 100,
         max_passes: 4,
     };
-    let d = deform(&stretch, &v, &f, &runs, Some(opts), &mut |_, _| true)
+    // it encloses no volume, so only an unchecked call deforms it
+    let e = deform(&stretch, &v, &f, &runs, Some(opts), true, &mut |_, _| true).unwrap_err();
+    assert!(e.arg == "mesh" && e.msg.contains("non-positive volume"), "{e:?}");
+    let d = deform(&stretch, &v, &f, &runs, Some(opts), false, &mut |_, _| true)
         .unwrap()
         .unwrap();
     assert_eq!(d.faces, f);
@@ -106,7 +109,7 @@ fn a_field_that_never_reaches_the_mesh_adds_nothing() {
         max_vertices: 8 * v.len(),
         max_passes: 30,
     };
-    let d = deform(&far, &v, &f, &runs, Some(opts), &mut |_, _| true)
+    let d = deform(&far, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
         .unwrap()
         .unwrap();
     assert_eq!(d.vertices, v);
@@ -125,7 +128,7 @@ fn refined_vertices_are_the_flow_of_their_rest_positions() {
         max_vertices: 8 * v.len(),
         max_passes: 30,
     };
-    let d = deform(&press, &v, &f, &runs, Some(opts), &mut |_, _| true)
+    let d = deform(&press, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
         .unwrap()
         .unwrap();
     assert!(
@@ -163,7 +166,7 @@ fn a_torn_mesh_is_filled_and_converges() {
     // material outside; every edge across the slip is resolved, the volume is kept
     let (v, f, tool, runs, opts) = torn_drag();
     let run = |opts| {
-        let d = deform(&tool, &v, &f, &runs, opts, &mut |_, _| true)
+        let d = deform(&tool, &v, &f, &runs, opts, true, &mut |_, _| true)
             .unwrap()
             .unwrap();
         let change = volume(&d.vertices, &d.faces) / volume(&v, &f) - 1.0;
@@ -225,7 +228,7 @@ fn a_repeating_split_goes_to_the_corner_of_its_path() {
         max_vertices: 8 * v.len(),
         max_passes: 30,
     };
-    let d = deform(&tool, &v, &f, &runs, Some(opts), &mut |_, _| true)
+    let d = deform(&tool, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
         .unwrap()
         .unwrap();
     assert_eq!((d.over_threshold, d.bounded), (0, false));
@@ -260,7 +263,7 @@ fn the_vertex_bound_stops_refinement_and_says_so() {
         max_vertices: v.len() + 50,
         max_passes: 30,
     };
-    let d = deform(&tool, &v, &f, &runs, Some(opts), &mut |_, _| true)
+    let d = deform(&tool, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
         .unwrap()
         .unwrap();
     assert_eq!(d.vertices.len(), v.len() + 50);
@@ -274,7 +277,7 @@ fn tick_can_stop_the_deformation() {
     let tool = drag(DVec3::new(0.0, 0.0, 0.9), 0.9, DVec3::new(0.5, 0.0, 0.0));
     let runs = schedule(&tool, 0.0, 1.0, 20).unwrap();
     let mut seen = 0;
-    let d = deform(&tool, &v, &f, &runs, None, &mut |done, total| {
+    let d = deform(&tool, &v, &f, &runs, None, true, &mut |done, total| {
         assert_eq!(total, 20);
         seen = done;
         done < 3
@@ -378,7 +381,7 @@ fn drag_stats() {
                 max_passes: 30,
             };
             let clock = Instant::now();
-            let d = deform(&tool, &v, &f, &runs, Some(opts), &mut |_, _| true)
+            let d = deform(&tool, &v, &f, &runs, Some(opts), true, &mut |_, _| true)
                 .unwrap()
                 .unwrap();
             let change = volume(&d.vertices, &d.faces) / volume(&v, &f) - 1.0;
@@ -410,8 +413,16 @@ fn refine_below_one_is_refused() {
         max_vertices: 100,
         max_passes: 1,
     };
-    let e = deform(&Field::default(), &v, &f, &[], Some(opts), &mut |_, _| true)
-        .err()
-        .unwrap();
+    let e = deform(
+        &Field::default(),
+        &v,
+        &f,
+        &[],
+        Some(opts),
+        true,
+        &mut |_, _| true,
+    )
+    .err()
+    .unwrap();
     assert_eq!(e.arg, "refine");
 }
