@@ -405,7 +405,7 @@ def test_D17_ctrl_c_within_half_a_second(name):
 
 
 SIGINT_ONCE_CHILD = """
-import hashlib, os, signal, subprocess, sys, time
+import hashlib, os, signal, subprocess, sys, tempfile, time
 import numpy as np, trimesh, spinal
 from spinal import fields as fl, quaternions as Q, ph
 spinal.set_num_threads(2)
@@ -425,35 +425,47 @@ def digest(x, h):
     else:
         h.update(repr(x).encode())
     return h.hexdigest()
-start = time.perf_counter()
+start, cpu = time.perf_counter(), time.process_time()
 result = run()
 full = time.perf_counter() - start  # the call alone: hashing a large result takes seconds
+full_cpu = (time.process_time() - cpu) / 2
 first = digest(result, hashlib.sha256())
 del result
 assert full >= {least}, f'the uninterrupted call takes only {{full:.2f}} s'
 # the signal comes from a shell started now, as Ctrl-C comes from the terminal: a timer
 # thread of this process would need the GIL to send it, and could send it only after a call
-# that holds the GIL (or keeps taking it back) has returned; measured from the planned moment
-sender = subprocess.Popen(["sh", "-c", f"sleep {{{after}:.4f}}; kill -INT {{os.getpid()}}"])
+# that holds the GIL (or keeps taking it back) has returned. The shell first records this
+# process's CPU time (from /proc), so the work done after the signal is measured in CPU
+# time, which a machine loaded by other work does not stretch as it stretches wall time.
+stat = tempfile.NamedTemporaryFile(delete=False).name
+pid = os.getpid()
+sender = subprocess.Popen(["sh", "-c", f"sleep {{{after}:.4f}}; cat /proc/{{pid}}/stat > {{stat}}; "
+                           f"kill -INT {{pid}}"])
 planned = time.perf_counter() + {after}
 try:
     run()
 except KeyboardInterrupt:
-    late = time.perf_counter() - planned
+    late_wall = time.perf_counter() - planned
+    cpu_now = time.process_time()
 else:
     print(f'finished, no KeyboardInterrupt'); sys.exit(3)
 sender.wait()
+fields = open(stat).read().rsplit(")", 1)[1].split()
+os.unlink(stat)
+cpu_sent = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+# per thread of the pool (2); the clock ticks' resolution is 1/CLK_TCK s
+late = max(0.0, cpu_now - cpu_sent) / 2
 # no worker left running: the process stays idle after the interrupt
 cpu = time.process_time(); time.sleep(0.3); busy = time.process_time() - cpu
 same = digest(run(), hashlib.sha256()) == first
-print(f'interrupted {{late:.3f}} s after the signal; {{full:.2f}} s uninterrupted; '
-      f'{{busy:.3f}} s of CPU idle; same after {{same}}')
+print(f'late={{late:.3f}} full={{full_cpu:.3f}} busy={{busy:.3f}} same={{same}} '
+      f'wall_late={{late_wall:.3f}} wall_full={{full:.2f}}')
 """
 
 
 class Interrupted(NamedTuple):
-    late: float  # seconds from the signal to the KeyboardInterrupt
-    full: float  # seconds of the uninterrupted call
+    late: float  # CPU seconds per pool thread from the signal to the KeyboardInterrupt
+    full: float  # CPU seconds per pool thread of the uninterrupted call
     busy: float  # CPU seconds used in 0.3 s of sleep after the interrupt
     same: bool  # whether the run after the interrupt gave the first run's bits
     report: str  # the child's line, for assertion messages
@@ -463,14 +475,16 @@ def interrupt_once(setup: str, call: str, after: float | str = 0.3,
                    least: float = 1.5) -> Interrupted:
     """Run `call` once uninterrupted (it must take at least `least` seconds, so the case
     cannot pass by returning before the signal), once with SIGINT `after` seconds in (a
-    number, or an expression of the uninterrupted time `full`), then again."""
+    number, or an expression of the uninterrupted wall time `full`), then again. Times are
+    CPU time per thread of the pool, which other load on the machine does not stretch."""
     code = SIGINT_ONCE_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after,
                                     least=least)
     r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
                        text=True, timeout=600)
     assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
-    w = r.stdout.split()
-    return Interrupted(float(w[1]), float(w[6]), float(w[9]), w[-1] == "True", r.stdout)
+    w = dict(kv.split("=") for kv in r.stdout.split())
+    return Interrupted(float(w["late"]), float(w["full"]), float(w["busy"]),
+                       w["same"] == "True", r.stdout)
 
 
 # a PH spline of m cubics: the Hermite interpolants of a helix sampled at m + 1 points
