@@ -54,3 +54,74 @@ def test_sweeps_far_from_unit_scale_have_finite_measures():
     assert big.volume == pytest.approx(unit.volume * 1e300, rel=1e-12)
     assert small.area == pytest.approx(unit.area * 1e-200, rel=1e-12)
     assert small.volume / 1e-300 == pytest.approx(unit.volume, rel=1e-12)
+
+
+def _coloured_tube(dtype, uv=False):
+    X = _helix(40)
+    T = np.gradient(X, axis=0)
+    orient = np.abs(T / np.linalg.norm(T, axis=1, keepdims=True))  # floats in [0, 1]
+    if dtype == np.uint8:
+        orient = np.rint(orient * 255).astype(np.uint8)
+    return spinal.tube(X, 0.1, uv=uv, point_data={"colors": orient, "arc": np.arange(40.0)})
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.uint8])
+def test_vertex_colors_open_as_colours_in_trimesh_and_pyvista(tmp_path, dtype):
+    """T3-12 family / item 7: a point_data array `colors` (RGB floats in [0, 1] or uint8) is
+    written as PLY red/green/blue uchar properties, a VTK UInt8 active-scalars array and OBJ
+    vertex colours, which trimesh and pyvista read back as the vertex colours (the other
+    attributes keep their names)."""
+    trimesh = pytest.importorskip("trimesh")
+    pv = pytest.importorskip("pyvista")
+    m = _coloured_tube(dtype)
+    c = m.point_data["colors"]
+    want = c if c.dtype == np.uint8 else np.rint(c * 255).astype(np.uint8)
+    m.save(tmp_path / "t.ply")
+    header = (tmp_path / "t.ply").read_bytes().split(b"end_header")[0].decode()
+    assert "property uchar red\nproperty uchar green\nproperty uchar blue" in header
+    assert "colors_0" not in header and "property double arc" in header
+    t = trimesh.load(tmp_path / "t.ply", process=False)
+    np.testing.assert_array_equal(t.visual.vertex_colors[:, :3], want)
+    p = pv.read(tmp_path / "t.ply")
+    np.testing.assert_array_equal(p.point_data["RGB"], want)
+    m.save(tmp_path / "t.vtp")
+    p = pv.read(tmp_path / "t.vtp")
+    assert p.point_data.active_scalars_name == "colors"
+    assert p.point_data["colors"].dtype == np.uint8
+    np.testing.assert_array_equal(p.point_data["colors"], want)
+    np.testing.assert_array_equal(p.point_data["arc"], m.point_data["arc"])
+    m.save(tmp_path / "t.obj")
+    t = trimesh.load(tmp_path / "t.obj", process=False)
+    np.testing.assert_array_equal(t.visual.vertex_colors[:, :3], want)
+    np.testing.assert_array_equal(m.to_trimesh().visual.vertex_colors[:, :3], want)
+    # with texture coordinates too (trimesh then reads the texture, pyvista both)
+    m = _coloured_tube(dtype, uv=True)
+    m.save(tmp_path / "u.ply")
+    p = pv.read(tmp_path / "u.ply")
+    np.testing.assert_array_equal(p.point_data["RGB"], want)
+    assert p.active_texture_coordinates is not None
+
+
+def test_colors_argument_and_its_errors(tmp_path):
+    """`colors=` names a point_data array or gives the colours (RGBA kept as alpha);
+    anything else is refused naming `colors`."""
+    trimesh = pytest.importorskip("trimesh")
+    m = _coloured_tube(np.float64)
+    n = len(m.vertices)
+    rgba = np.c_[np.zeros((n, 3), np.uint8), np.full(n, 7, np.uint8)]
+    m.save(tmp_path / "a.ply", colors=rgba)
+    t = trimesh.load(tmp_path / "a.ply", process=False)
+    np.testing.assert_array_equal(t.visual.vertex_colors, rgba)
+    # the default `colors` array is then an ordinary attribute
+    header = (tmp_path / "a.ply").read_bytes().split(b"end_header")[0].decode()
+    assert "colors_0" in header and "property uchar alpha" in header
+    m.point_data["paint"] = m.point_data.pop("colors")
+    m.save(tmp_path / "b.ply", colors="paint")
+    assert "paint_0" not in (tmp_path / "b.ply").read_bytes()[:2000].decode("ascii", "replace")
+    for bad, words in (("nope", "no point_data array named 'nope'"),
+                       (np.zeros((n, 2)), r"expected shape \(\d+, 3\) or"),
+                       (np.full((n, 3), 1.5), r"must lie in \[0, 1\]; row 0"),
+                       (np.full((n, 3), np.nan), r"must lie in \[0, 1\]"),
+                       (np.zeros((n, 3), np.int64), "expected uint8")):
+        with pytest.raises(ValueError, match="^colors: .*" + words):
+            m.save(tmp_path / "c.ply", colors=bad)

@@ -442,13 +442,17 @@ class Mesh:
 
     def to_trimesh(self):
         """A ``trimesh.Trimesh`` with the same vertices, faces and normals (no merging or
-        reordering; ``uv`` goes to a ``TextureVisuals`` when present; ``point_data`` and
-        ``cell_data`` to ``vertex_attributes`` and ``face_attributes``)."""
+        reordering; ``uv`` goes to a ``TextureVisuals`` when present, else a ``point_data``
+        array ``"colors"`` (RGB(A), as in :meth:`save`) to the vertex colours; ``point_data``
+        and ``cell_data`` to ``vertex_attributes`` and ``face_attributes``)."""
         import trimesh
 
         visual = None
         if self.uv is not None:
             visual = trimesh.visual.TextureVisuals(uv=self.uv)
+        elif "colors" in self.point_data:
+            rgb, _ = _vertex_colors(self, "colors")
+            visual = trimesh.visual.ColorVisuals(vertex_colors=rgb)
         return trimesh.Trimesh(
             vertices=self.vertices,
             faces=self.faces,
@@ -478,18 +482,32 @@ class Mesh:
             poly.cell_data[k] = v
         return poly
 
-    def save(self, path: str | os.PathLike) -> pathlib.Path:
+    def save(self, path: str | os.PathLike, *, colors=None) -> pathlib.Path:
         """Write the mesh to ``path``; no third-party package is needed. Returns the path.
 
         * ``.ply``: binary little-endian PLY: positions, normals ``nx ny nz`` and texture
-          coordinates ``s t``, then every ``point_data`` array as vertex properties (``name``,
-          or ``name_0 … name_{k-1}`` for ``(V, k)``), faces as int32 vertex lists followed by
-          the ``cell_data`` arrays as face properties.
+          coordinates ``s t``, vertex colours ``red green blue (alpha)`` (uchar), then every
+          other ``point_data`` array as vertex properties (``name``, or ``name_0 …
+          name_{k-1}`` for ``(V, k)``), faces as int32 vertex lists followed by the
+          ``cell_data`` arrays as face properties.
         * ``.vtp``: VTK XML PolyData (appended raw binary, 64-bit headers): points, triangles,
-          point data ``Normals`` and ``uv`` (texture coordinates) and ``point_data``; cell
-          data from ``cell_data``. Read by VTK/pyvista and ParaView.
+          point data ``Normals`` and ``uv`` (texture coordinates), the colours as the active
+          ``UInt8`` scalars ``colors`` and ``point_data``; cell data from ``cell_data``. Read
+          by VTK/pyvista and ParaView.
         * ``.obj``: Wavefront OBJ (``v``, ``vn``, ``vt`` and ``f v/vt/vn`` lines, 17
-          significant digits); attributes are not written.
+          significant digits; colours as ``v x y z r g b`` in [0, 1], the extension that
+          MeshLab, Blender and trimesh read); other attributes are not written.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file; its suffix (``.ply``, ``.vtp``, ``.obj``) picks the format.
+        colors : str or array_like (V, 3) or (V, 4), optional
+            Vertex colours (RGB or RGBA): ``uint8`` in 0 … 255 or floats in [0, 1] (stored
+            as ``round(255 x)``), or the name of a ``point_data`` array holding them. By
+            default the ``point_data`` array ``"colors"`` is used when there is one. The
+            colours replace that array in the file (its other arrays keep their names), so
+            MeshLab, ParaView, Blender and trimesh show them.
         """
         if not isinstance(path, (str, os.PathLike)):
             raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
@@ -497,17 +515,22 @@ class Mesh:
         suffix = path.suffix.lower()
         if suffix not in (".ply", ".obj", ".vtp"):
             raise ValueError(f"path: unknown format {suffix!r}; use .ply, .vtp or .obj")
+        rgb, rest = _vertex_colors(self, colors)
         if suffix == ".vtp":
-            _write_vtp(self, path)
+            _write_vtp(self, path, rgb, rest)
             return path
         if len(self.vertices) >= 2**31:
             raise ValueError("path: PLY/OBJ indices here are 32-bit; the mesh is too large")
         if suffix == ".ply":
-            _write_ply(self, path)
+            _write_ply(self, path, rgb, rest)
             return path
         with open(path, "w") as f:
             f.write("# spinal mesh\n")
-            np.savetxt(f, self.vertices, fmt="v %.17g %.17g %.17g")
+            if rgb is None:
+                np.savetxt(f, self.vertices, fmt="v %.17g %.17g %.17g")
+            else:
+                np.savetxt(f, np.c_[self.vertices, rgb[:, :3] / 255.0],
+                           fmt="v %.17g %.17g %.17g %.6g %.6g %.6g")
             if self.normals is not None:
                 np.savetxt(f, self.normals, fmt="vn %.17g %.17g %.17g")
             if self.uv is not None:
@@ -596,15 +619,52 @@ def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
     return cols
 
 
-def _write_ply(mesh: Mesh, path: pathlib.Path) -> None:
+def _vertex_colors(mesh: Mesh, colors) -> tuple[np.ndarray | None, dict]:
+    """The vertex colours to write, ``(V, 3|4)`` uint8 or None, and the ``point_data``
+    arrays written besides them (all but the one the colours came from)."""
+    rest = dict(mesh.point_data)
+    if colors is None:
+        if "colors" not in rest:
+            return None, rest
+        colors = "colors"
+    name = None
+    if isinstance(colors, str):
+        if colors not in rest:
+            raise ValueError(f"colors: no point_data array named {colors!r} (the mesh has "
+                             f"{sorted(rest) or 'none'})")
+        name, colors = colors, rest.pop(colors)
+    what = "colors" if name is None else f"colors: point_data[{name!r}]"
+    c = np.asarray(colors)
+    if c.ndim != 2 or c.shape[1] not in (3, 4) or len(c) != len(mesh.vertices):
+        raise ValueError(f"{what}: expected shape ({len(mesh.vertices)}, 3) or "
+                         f"({len(mesh.vertices)}, 4) (RGB or RGBA per vertex), got "
+                         f"{c.shape}")
+    if c.dtype == np.uint8:
+        return np.ascontiguousarray(c), rest
+    if c.dtype.kind == "f":
+        inside = (c >= 0) & (c <= 1)  # NaN is outside
+        if not inside.all():
+            row = int(np.argwhere(~inside)[0][0])
+            raise ValueError(f"{what}: float colours must lie in [0, 1]; row {row} is "
+                             f"{c[row].tolist()}")
+        return np.rint(c * 255.0).astype(np.uint8), rest
+    raise ValueError(f"{what}: expected uint8 (0 … 255) or floats in [0, 1], got dtype "
+                     f"{c.dtype}")
+
+
+def _write_ply(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict) -> None:
     V, F = mesh.vertices, mesh.faces
     cols = [(n, V[:, j]) for j, n in enumerate("xyz")]
     if mesh.normals is not None:
         cols += [(n, mesh.normals[:, j]) for j, n in enumerate(("nx", "ny", "nz"))]
     if mesh.uv is not None:
         cols += [(n, mesh.uv[:, j]) for j, n in enumerate("st")]
+    if rgb is not None:
+        cols += [(n, rgb[:, j]) for j, n in enumerate(("red", "green", "blue", "alpha")[
+            :rgb.shape[1]])]
     cols = [(n, _plain(c, _PLY_TYPES)) for n, c in cols]
-    cols += _columns(mesh.point_data, _PLY_TYPES, {n for n, _ in cols}, "point_data")
+    cols += _columns(point_data, _PLY_TYPES, {n for n, _ in cols}, "point_data")
     fcols = _columns(mesh.cell_data, _PLY_TYPES, {"vertex_indices"}, "cell_data")
     vert = np.empty(len(V), dtype=[(n, c.dtype) for n, c in cols])
     for n, c in cols:
@@ -630,7 +690,8 @@ def _write_ply(mesh: Mesh, path: pathlib.Path) -> None:
         f.write(face.tobytes())
 
 
-def _write_vtp(mesh: Mesh, path: pathlib.Path) -> None:
+def _write_vtp(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict) -> None:
     """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
     by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
     Formats", Kitware)."""
@@ -661,7 +722,12 @@ def _write_vtp(mesh: Mesh, path: pathlib.Path) -> None:
     if mesh.uv is not None:
         pdata.append(array(mesh.uv, "uv"))
         active.append('TCoords="uv"')
-    pdata += [array(v, k) for k, v in mesh.point_data.items()]
+    if rgb is not None:
+        if "colors" in point_data:
+            raise ValueError("colors: the name 'colors' is taken by another point_data array")
+        pdata.append(array(rgb, "colors"))
+        active.append('Scalars="colors"')
+    pdata += [array(v, k) for k, v in point_data.items()]
     cdata = [array(v, k) for k, v in mesh.cell_data.items()]
     xml = [
         '<?xml version="1.0"?>',
