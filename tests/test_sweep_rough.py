@@ -1,6 +1,7 @@
 """Tubes of the polylines users have: every random walk, hairpin and exact reversal is
 tubed, watertight and wound outwards, alone or in one bundle call."""
 
+import re
 import warnings
 
 import numpy as np
@@ -211,3 +212,16 @@ def test_dipy_bundled_tracts_are_tubed_in_one_call_each():
                 t = F[start + row, :, 2]
                 assert t @ chord / np.linalg.norm(chord) >= np.cos(np.pi / 4) - 1e-12
             start += len(x)
+
+
+def test_fold_warning_stays_readable_on_a_long_rough_curve():
+    """A tube around a 40,000-step random walk warns about its folds naming the first 20
+    ranges of rows and how many more; the warning still carries every row."""
+    walk = np.cumsum(np.random.default_rng(7).normal(size=(40_000, 3)), 0)
+    with pytest.warns(spinal.FoldOverWarning) as rec:
+        spinal.tube(walk, 0.3, 8)
+    w = rec[0].message
+    assert len(str(w)) < 1000, len(str(w))
+    assert re.search(r"… and [\d,]+ more \([\d,]+ rows in all\)", str(w))
+    total = int(re.search(r"\(([\d,]+) rows in all\)", str(w)).group(1).replace(",", ""))
+    assert total == len(w.indices) > 20

@@ -162,3 +162,50 @@ def test_long_single_curves_have_the_same_bits_on_any_thread_count():
     for other in runs[1:]:
         for a, b in zip(runs[0], other, strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+def every_concept_large():
+    """One call per concept at sizes above every chunk and block threshold of the core
+    (2^15 rows per frames chunk, 2^14 faces per measure block, 1 MB per sweep block, 4,096
+    points per advect block, 2^12 vertices per fleshing block)."""
+    import trimesh
+
+    rng = np.random.default_rng(7)
+    out = {}
+    bundle = np.concatenate([helix(3_000) + i for i in range(30)])  # 90k rows
+    out["frames bundle"] = spinal.frames(bundle, lengths=[3_000] * 30)
+    walk = np.cumsum(rng.normal(size=(40_000, 3)), 0)  # a rough curve: joins everywhere
+    t = spinal.tube(walk, 0.3, 8)
+    out["tube rough"] = (t.vertices, t.faces, t.normals, t.area, t.volume)
+    a = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    star = np.c_[np.cos(a), np.sin(a)] * (1 + 0.3 * (np.arange(24) % 2))[:, None] * 0.05
+    sw = spinal.sweep(helix(40_000), star)
+    out["sweep"] = (sw.vertices, sw.faces, sw.area, sw.volume)
+    field = fl.translation([0, 0, 1.2], 0.5, [0, 0, -1])
+    out["advect"] = spinal.advect(rng.normal(size=(30_000, 3)) * 0.5, field, 0.5, 6)
+    ico = trimesh.creation.icosphere(5)  # 10,242 vertices, 20,480 faces
+    d, rep = spinal.deform(ico, field, 0.8)
+    out["deform"] = (d.vertices, d.faces, rep.volume, rep.relative_change)
+    rest = helix(200)
+    V = rest[rng.integers(0, 200, 20_000)] + rng.normal(size=(20_000, 3)) * 0.05
+    out["flesh"] = spinal.flesh(V, rest, rest * [1.1, 0.9, 1.2])
+    tool = fl.mesh_curl(trimesh.creation.icosphere(3), velocity=[0, 0, 1], resolution=40)
+    out["mesh_curl"] = tool(rng.normal(size=(5_000, 3)), 0.1)
+    return out
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")  # the walk's tight bends
+def test_every_concept_has_the_same_bits_on_1_2_3_and_5_threads():
+    """T3-04: frames of bundles, tubes of rough curves (corner joins), profile sweeps and
+    their measures, advect, deform with refinement, fleshing and a mesh tool give the same
+    bits on 1, 2, 3 and 5 threads (chunk boundaries are fixed, never the pool's size)."""
+    runs = []
+    for n in (1, 2, 3, 5):
+        with spinal.threads(n):
+            runs.append(every_concept_large())
+    for other in runs[1:]:
+        for key, a in runs[0].items():
+            b = other[key]
+            for x, y in zip(a if isinstance(a, tuple) else (a,),
+                            b if isinstance(b, tuple) else (b,), strict=True):
+                np.testing.assert_array_equal(x, y, err_msg=key)

@@ -54,16 +54,19 @@ def _scale_rows(scale, name: str, n: int, lens) -> np.ndarray:
     return np.ascontiguousarray(a if pair else np.stack([a, a], axis=1))
 
 
-def _ranges(rows: np.ndarray) -> str:
-    """'3–7, 12, 20–21' for sorted integer rows."""
-    parts, start, prev = [], None, None
-    for r in list(rows) + [None]:
-        if r is not None and prev is not None and r == prev + 1:
-            prev = r
-            continue
-        if start is not None:
-            parts.append(str(start) if start == prev else f"{start}–{prev}")
-        start = prev = r
+def _ranges(rows: np.ndarray, most: int = 20) -> str:
+    """'3–7, 12, 20–21' for sorted integer rows; past ``most`` ranges, '… and k more
+    (n rows in all)', so a message stays readable on a curve of millions of rows."""
+    rows = np.asarray(rows, dtype=np.int64)
+    if rows.size == 0:
+        return ""
+    # the starts of runs of consecutive rows
+    cut = np.flatnonzero(np.diff(rows) != 1) + 1
+    starts, ends = np.r_[0, cut], np.r_[cut, rows.size] - 1
+    parts = [str(rows[a]) if a == b else f"{rows[a]}–{rows[b]}"
+             for a, b in zip(starts[:most], ends[:most], strict=True)]
+    if len(starts) > most:
+        parts.append(f"… and {len(starts) - most:,} more ({rows.size:,} rows in all)")
     return ", ".join(parts)
 
 
