@@ -11,8 +11,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+import pytest
 import run_all
 
+pytestmark = pytest.mark.slow  # runs the benchmark scripts
 
 def section(text, heading):
     """The report's text under ``## heading...`` up to the next ``## ``."""

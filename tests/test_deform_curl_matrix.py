@@ -55,6 +55,8 @@ from test_deform_tools import C, sphere_grid, torus_mesh
 import spinal
 from spinal import fields
 
+pytestmark = pytest.mark.slow  # a matrix of grid tools
+
 CEN = ARC.mean(axis=0)  # the keyframed rod's centre
 KEY_TIMES = np.array([0.0, 0.4, 1.0])
 KEY_POS = CEN + np.array([[0, 0, 0], [0.1, 0.2, -0.1], [0.3, 0.1, -0.3]])

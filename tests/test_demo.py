@@ -12,6 +12,8 @@ import trimesh
 from spinal.__main__ import main
 from spinal.curves import TorusKnot
 
+pytestmark = pytest.mark.slow  # runs the demo in a subprocess
+
 
 def run_demo(out, capsys):
     assert main(["demo", "--out", str(out)]) == 0

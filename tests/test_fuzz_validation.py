@@ -17,7 +17,8 @@ import pytest
 
 import spinal
 
-pytestmark = pytest.mark.filterwarnings("ignore")  # numpy casts of random input
+# numpy casts of random input; fuzzing runs for SPINAL_FUZZ_SECONDS
+pytestmark = [pytest.mark.filterwarnings("ignore"), pytest.mark.slow]
 
 SECONDS = float(os.environ.get("SPINAL_FUZZ_SECONDS", "10"))
 SEED = int(os.environ.get("SPINAL_FUZZ_SEED", "20261202"))

@@ -24,6 +24,7 @@ import spinal
 from spinal import ph
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and SIGINT: Linux")
+# the subprocess cases (memory limits, Ctrl-C) are marked slow one by one
 
 # address space the child may still map after building its inputs
 HEADROOM = 100 << 20
@@ -187,6 +188,7 @@ D16_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(D16_CASES))
 def test_D16_out_of_memory_raises_memory_error(name):
     setup, call, words = D16_CASES[name]
@@ -196,6 +198,7 @@ def test_D16_out_of_memory_raises_memory_error(name):
     assert f"MemoryError: {words}" in r.stdout, r.stdout
 
 
+@pytest.mark.slow
 def test_D16_memory_error_comes_from_the_core_not_an_abort():
     """The review's reproducer: a 3e7-long move asks for a 2.4 GB crossing path; the walk
     grows its path fallibly and says which call ran out."""
@@ -205,6 +208,7 @@ def test_D16_memory_error_comes_from_the_core_not_an_abort():
     assert r.returncode == 0 and "walk_mesh: out of memory" in r.stdout, (r.stdout, r.stderr)
 
 
+@pytest.mark.slow
 def test_D16_small_calls_unchanged_under_a_limit():
     r = run_limited("", "print(spinal.estimate_tangents(H).shape); raise MemoryError('fine')")
     assert r.returncode == 0 and "(60, 3)" in r.stdout, (r.stdout, r.stderr)
@@ -398,6 +402,7 @@ D17_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_CASES))
 def test_D17_ctrl_c_within_half_a_second(name):
     setup, call = D17_CASES[name]
@@ -543,6 +548,7 @@ D17_ONCE_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_ONCE_CASES))
 def test_D17_ctrl_c_within_half_a_second_inside_one_call(name):
     r = interrupt_once(*D17_ONCE_CASES[name])
@@ -604,6 +610,7 @@ D17_FRACTION_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_FRACTION_CASES))
 def test_D17_ctrl_c_within_a_fraction_of_a_short_call(name):
     r = interrupt_once(*D17_FRACTION_CASES[name], after="full / 6", least=0.3)
@@ -616,6 +623,7 @@ SDF_GRID = ("n = 300; x = np.linspace(-1, 1, n); X, Y, Z = np.meshgrid(x, x, x, 
             "D = np.sqrt(X**2 + Y**2 + Z**2) - .5; del X, Y, Z\n")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("tool", ["sdf_tool(D, [-1, -1, -1], 2 / (n - 1), [1, 0, 0]",
                                   "sdf_curl(D, [-1, -1, -1], 2 / (n - 1), velocity=[1, 0, 0]"])
 def test_D17_distance_grid_tools_stop_within_half_a_second(tool):
@@ -630,6 +638,7 @@ def test_D17_distance_grid_tools_stop_within_half_a_second(tool):
     assert r.same, r.report
 
 
+@pytest.mark.slow
 def test_D17_cold_sweep_stops_promptly():
     """The first sweep of a fresh process writes into output pages never touched before
     (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000
@@ -655,6 +664,7 @@ def test_D17_threads_setting_keeps_results():
     np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.slow
 def test_D17_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
     """A star profile of 2**22 vertices is not convex: the sweep first tests it for
     self-intersection (a sweep line over its 2**23 edge ends, about 4 s here) and then
@@ -668,6 +678,7 @@ def test_D17_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
         assert late_after_sigint(setup, call, after=after) < 0.5
 
 
+@pytest.mark.slow
 def test_D17_sweep_of_a_huge_profile_stops_inside_a_ring():
     """A profile of 2**23 vertices on a two-point spine: two rings of 96 MiB of float32
     vertices and 192 MiB of int32 faces. The writer polls Ctrl-C between pieces of at most

@@ -12,6 +12,8 @@ import pytest
 
 import spinal
 
+pytestmark = pytest.mark.slow  # starts Dask workers
+
 ROOT = pathlib.Path(__file__).parents[1]
 
 
