@@ -420,3 +420,28 @@ def test_lengths_and_offsets_errors_name_the_argument_given():
         for kw, msg in cases:
             with pytest.raises(ValueError, match=msg):
                 call(x, **kw)
+
+
+def test_mesh_objects_where_an_array_is_expected_say_what_to_pass():
+    """Item 4 of the second review: a trimesh.Trimesh, spinal.Mesh or pyvista.PolyData passed
+    where points are expected names the argument, what was passed and which array to pass,
+    instead of numpy's "got dtype object"."""
+    trimesh = pytest.importorskip("trimesh")
+    pv = pytest.importorskip("pyvista")
+    ico = trimesh.creation.icosphere(1)
+    field = spinal.fields.translation([0, 0, 0], 0.1, [0, 0, 1])
+    cases = [
+        (lambda: spinal.frames(ico), r"^points: .*got a trimesh\.Trimesh; pass its vertices"),
+        (lambda: spinal.tube(spinal.Mesh(ico.vertices, ico.faces), 0.1),
+         r"^points: .*got a spinal\.Mesh; pass its vertices"),
+        (lambda: spinal.estimate_tangents(pv.Sphere()),
+         r"^points: .*got a pyvista\.PolyData; pass its points \(data\.points\)"),
+        (lambda: spinal.advect(ico, field, 1.0), r"^vertices: .*trimesh\.Trimesh"),
+    ]
+    for call, words in cases:
+        with pytest.raises(TypeError, match=words):
+            call()
+    # other objects keep the plain message
+    with pytest.raises(TypeError, match=r"^points: expected an array of real numbers, got "
+                                        r"dtype object$"):
+        spinal.frames(object())

@@ -37,10 +37,29 @@ def as_float_array(x: Any, name: str) -> np.ndarray:
             return arr.astype(np.float64)
         except (ValueError, TypeError):
             pass
+        if arr.ndim == 0:
+            hint = _object_hint(x)
+            if hint:
+                raise TypeError(f"{name}: expected an array of real numbers, got a {hint}")
     raise TypeError(
         f"{name}: expected an array of real numbers, got dtype {arr.dtype}"
         + (" (complex values are not accepted)" if arr.dtype.kind == "c" else "")
     )
+
+
+def _object_hint(x: Any) -> str:
+    """For a mesh or polyline object passed where an array is expected: what it is and
+    which of its arrays to pass ('' for other objects)."""
+    kind = f"{type(x).__module__.split('.')[0]}.{type(x).__name__}"
+    if kind in ("trimesh.Trimesh", "spinal.Mesh"):
+        return f"{kind}; pass its vertices (mesh.vertices), or the mesh itself where a " \
+               f"mesh is expected (deform, stamp, fields.mesh_curl)"
+    if kind == "trimesh.Path3D":
+        return f"{kind}; pass the points of one polyline (path.discrete[0])"
+    if kind.startswith(("pyvista.", "vtkmodules.")):
+        return f"{kind}; pass its points (data.points), or for the lines of a PolyData " \
+               f"a list of one (n, 3) array per line"
+    return ""
 
 
 def as_points(x: Any, name: str = "points") -> np.ndarray:
