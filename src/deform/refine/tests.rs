@@ -63,7 +63,10 @@ fn a_two_face_pillow_is_left_alone() {
     };
     // it encloses no volume, so only an unchecked call deforms it
     let e = deform(&stretch, &v, &f, &runs, Some(opts), true, &mut |_, _| true).unwrap_err();
-    assert!(e.arg == "mesh" && e.msg.contains("non-positive volume"), "{e:?}");
+    assert!(
+        e.arg == "mesh" && e.msg.contains("non-positive volume"),
+        "{e:?}"
+    );
     let d = deform(&stretch, &v, &f, &runs, Some(opts), false, &mut |_, _| true)
         .unwrap()
         .unwrap();
