@@ -28,7 +28,7 @@ Threads
 ``python -m spinal demo`` runs a tour that writes its results to a folder.
 """
 
-from . import curves, fields, ph, quaternions
+from . import curves, fields, io, ph, quaternions
 from ._advect import advect
 from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
@@ -60,6 +60,7 @@ __all__ = [
     "frames",
     "frames_in_time",
     "get_num_threads",
+    "io",
     "ph",
     "quaternions",
     "set_num_threads",

@@ -10,6 +10,7 @@ import numpy.typing as npt
 
 from . import curves as curves
 from . import fields as fields
+from . import io as io
 from . import ph as ph
 from . import quaternions as quaternions
 from .curves import Curve
@@ -37,6 +38,7 @@ __all__ = [
     "frames",
     "frames_in_time",
     "get_num_threads",
+    "io",
     "ph",
     "quaternions",
     "set_num_threads",
@@ -193,6 +195,8 @@ class Mesh:
     def save(
         self, path: str | os.PathLike[str], *, colors: str | _Array | None = None
     ) -> pathlib.Path: ...
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Mesh: ...
     def plot(
         self,
         screenshot: str | os.PathLike[str] | None = None,

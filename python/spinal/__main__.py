@@ -1,4 +1,5 @@
-"""Command line: ``python -m spinal`` (help), ``python -m spinal --version`` and
+"""Command line: ``python -m spinal`` (help), ``python -m spinal --version``, the whole-file
+commands ``tube IN OUT``, ``frames IN OUT.npz`` and ``info FILE`` (see ``spinal._cli``), and
 ``python -m spinal demo [--out DIR]``, a small end-to-end run on built-in curves.
 
 The demo computes rotation-minimising frames on the torus knot of Wang et al. (2008) and on a
@@ -22,6 +23,7 @@ import sys
 import numpy as np
 
 import spinal
+from spinal import _cli
 from spinal.curves import Helix, TorusKnot
 
 
@@ -263,9 +265,12 @@ def main(argv=None) -> int:
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
     d = sub.add_parser("demo", help="run the built-in example and write results to a folder")
     d.add_argument("--out", default="spinal-demo", help="output folder (default: spinal-demo)")
+    _cli.add_commands(sub)
     a = ap.parse_args(argv)
     if a.command == "demo":
         return demo(pathlib.Path(a.out))
+    if a.command is not None:
+        return _cli.run(a)
     ap.print_help()
     return 0
 

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
+from . import _core, _files
 from ._validate import as_float_array
 
 __all__ = ["FoldOverWarning", "Mesh", "SkippedCurvesWarning", "mesh_arrays"]
@@ -451,7 +451,7 @@ class Mesh:
         if self.uv is not None:
             visual = trimesh.visual.TextureVisuals(uv=self.uv)
         elif "colors" in self.point_data:
-            rgb, _ = _vertex_colors(self, "colors")
+            rgb, _ = _files.vertex_colors(self, "colors")
             visual = trimesh.visual.ColorVisuals(vertex_colors=rgb)
         return trimesh.Trimesh(
             vertices=self.vertices,
@@ -497,11 +497,16 @@ class Mesh:
         * ``.obj``: Wavefront OBJ (``v``, ``vn``, ``vt`` and ``f v/vt/vn`` lines, 17
           significant digits; colours as ``v x y z r g b`` in [0, 1], the extension that
           MeshLab, Blender and trimesh read); other attributes are not written.
+        * ``.stl``: binary STL (float32 corners and face normals; positions only).
+        * ``.glb``: binary glTF 2.0 (float32 positions, normals, texture coordinates and
+          the colours as ``COLOR_0``; uint32 indices), for Blender, three.js and viewers
+          on the web; other attributes are not written.
 
         Parameters
         ----------
         path : str or os.PathLike
-            The file; its suffix (``.ply``, ``.vtp``, ``.obj``) picks the format.
+            The file; its suffix (``.ply``, ``.vtp``, ``.obj``, ``.stl``, ``.glb``) picks
+            the format.
         colors : str or array_like (V, 3) or (V, 4), optional
             Vertex colours (RGB or RGBA): ``uint8`` in 0 … 255 or floats in [0, 1] (stored
             as ``round(255 x)``), or the name of a ``point_data`` array holding them. By
@@ -509,43 +514,18 @@ class Mesh:
             colours replace that array in the file (its other arrays keep their names), so
             MeshLab, ParaView, Blender and trimesh show them.
         """
-        if not isinstance(path, (str, os.PathLike)):
-            raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
-        path = pathlib.Path(path)
-        suffix = path.suffix.lower()
-        if suffix not in (".ply", ".obj", ".vtp"):
-            raise ValueError(f"path: unknown format {suffix!r}; use .ply, .vtp or .obj")
-        rgb, rest = _vertex_colors(self, colors)
-        if suffix == ".vtp":
-            _write_vtp(self, path, rgb, rest)
-            return path
-        if len(self.vertices) >= 2**31:
-            raise ValueError("path: PLY/OBJ indices here are 32-bit; the mesh is too large")
-        if suffix == ".ply":
-            _write_ply(self, path, rgb, rest)
-            return path
-        with open(path, "w") as f:
-            f.write("# spinal mesh\n")
-            if rgb is None:
-                np.savetxt(f, self.vertices, fmt="v %.17g %.17g %.17g")
-            else:
-                np.savetxt(f, np.c_[self.vertices, rgb[:, :3] / 255.0],
-                           fmt="v %.17g %.17g %.17g %.6g %.6g %.6g")
-            if self.normals is not None:
-                np.savetxt(f, self.normals, fmt="vn %.17g %.17g %.17g")
-            if self.uv is not None:
-                np.savetxt(f, self.uv, fmt="vt %.17g %.17g")
-            k = self.faces + 1
-            if self.normals is not None and self.uv is not None:
-                fmt, data = "f %d/%d/%d %d/%d/%d %d/%d/%d", np.repeat(k, 3, axis=1)
-            elif self.normals is not None:
-                fmt, data = "f %d//%d %d//%d %d//%d", np.repeat(k, 2, axis=1)
-            elif self.uv is not None:
-                fmt, data = "f %d/%d %d/%d %d/%d", np.repeat(k, 2, axis=1)
-            else:
-                fmt, data = "f %d %d %d", k
-            np.savetxt(f, data, fmt=fmt)
-        return path
+        return _files.write(self, path, colors)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Mesh:
+        """Read a triangle mesh: ``.ply``, ``.obj``, ``.stl``, ``.glb``/``.gltf`` and
+        ``.off`` through trimesh, ``.vtp``/``.vtk`` through pyvista (polygons are
+        triangulated). Normals, texture coordinates, vertex colours (as ``point_data
+        ["colors"]``, uint8) and other per-vertex (and, from VTK, per-face) arrays come
+        along where the file has them; vertices are not merged or reordered, so a mesh
+        written by :meth:`save` comes back with the same rows.
+        """
+        return cls(**_files.read(path))
 
     def plot(self, screenshot: str | os.PathLike | None = None, *, window_size=(800, 600),
              **kwargs: Any):
@@ -575,178 +555,6 @@ class Mesh:
         pl.show()
         return None
 
-
-
-# PLY property types by NumPy dtype (int64 is written as int when it fits, else double)
-_PLY_TYPES = {"f8": "double", "f4": "float", "i1": "char", "u1": "uchar", "i2": "short",
-              "u2": "ushort", "i4": "int", "u4": "uint"}
-# VTK XML type names by NumPy dtype
-_VTK_TYPES = {"f8": "Float64", "f4": "Float32", "i1": "Int8", "u1": "UInt8", "i2": "Int16",
-              "u2": "UInt16", "i4": "Int32", "u4": "UInt32", "i8": "Int64", "u8": "UInt64"}
-
-
-def _plain(a: np.ndarray, kinds: dict) -> np.ndarray:
-    """``a`` in a little-endian dtype of ``kinds`` (bools as uint8; int64 as int32 where the
-    format has no 64-bit integers and the values fit, else float64)."""
-    a = np.asarray(a)
-    if a.dtype.kind == "b":
-        a = a.astype(np.uint8)
-    code = f"{a.dtype.kind}{a.dtype.itemsize}"
-    if code not in kinds:
-        fits = a.dtype.kind in "iu" and (a.size == 0 or (
-            a.min() >= np.iinfo(np.int32).min and a.max() <= np.iinfo(np.int32).max))
-        a = a.astype(np.int32 if fits else np.float64)
-        code = f"{a.dtype.kind}{a.dtype.itemsize}"
-    return a.astype(a.dtype.newbyteorder("<"), copy=False)
-
-
-def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
-    """``(property name, 1-D little-endian array)`` of every column of the attribute
-    arrays (``name`` or ``name_0 … name_{k-1}``)."""
-    cols = []
-    for k, a in data.items():
-        a = _plain(a, kinds)
-        key = "_".join(k.split()) or "_"
-        if not key.isascii():
-            raise ValueError(f"{what}: the name {k!r} is not ASCII, which PLY property names "
-                             f"must be; rename it, or save as .vtp (UTF-8 names)")
-        names = [key] if a.ndim == 1 else [f"{key}_{j}" for j in range(a.shape[1])]
-        for j, nm in enumerate(names):
-            if nm in taken:
-                raise ValueError(f"{what}: the name {nm!r} is taken in the PLY file")
-            taken.add(nm)
-            cols.append((nm, a if a.ndim == 1 else a[:, j]))
-    return cols
-
-
-def _vertex_colors(mesh: Mesh, colors) -> tuple[np.ndarray | None, dict]:
-    """The vertex colours to write, ``(V, 3|4)`` uint8 or None, and the ``point_data``
-    arrays written besides them (all but the one the colours came from)."""
-    rest = dict(mesh.point_data)
-    if colors is None:
-        if "colors" not in rest:
-            return None, rest
-        colors = "colors"
-    name = None
-    if isinstance(colors, str):
-        if colors not in rest:
-            raise ValueError(f"colors: no point_data array named {colors!r} (the mesh has "
-                             f"{sorted(rest) or 'none'})")
-        name, colors = colors, rest.pop(colors)
-    what = "colors" if name is None else f"colors: point_data[{name!r}]"
-    c = np.asarray(colors)
-    if c.ndim != 2 or c.shape[1] not in (3, 4) or len(c) != len(mesh.vertices):
-        raise ValueError(f"{what}: expected shape ({len(mesh.vertices)}, 3) or "
-                         f"({len(mesh.vertices)}, 4) (RGB or RGBA per vertex), got "
-                         f"{c.shape}")
-    if c.dtype == np.uint8:
-        return np.ascontiguousarray(c), rest
-    if c.dtype.kind == "f":
-        inside = (c >= 0) & (c <= 1)  # NaN is outside
-        if not inside.all():
-            row = int(np.argwhere(~inside)[0][0])
-            raise ValueError(f"{what}: float colours must lie in [0, 1]; row {row} is "
-                             f"{c[row].tolist()}")
-        return np.rint(c * 255.0).astype(np.uint8), rest
-    raise ValueError(f"{what}: expected uint8 (0 … 255) or floats in [0, 1], got dtype "
-                     f"{c.dtype}")
-
-
-def _write_ply(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
-    V, F = mesh.vertices, mesh.faces
-    cols = [(n, V[:, j]) for j, n in enumerate("xyz")]
-    if mesh.normals is not None:
-        cols += [(n, mesh.normals[:, j]) for j, n in enumerate(("nx", "ny", "nz"))]
-    if mesh.uv is not None:
-        cols += [(n, mesh.uv[:, j]) for j, n in enumerate("st")]
-    if rgb is not None:
-        cols += [(n, rgb[:, j]) for j, n in enumerate(("red", "green", "blue", "alpha")[
-            :rgb.shape[1]])]
-    cols = [(n, _plain(c, _PLY_TYPES)) for n, c in cols]
-    cols += _columns(point_data, _PLY_TYPES, {n for n, _ in cols}, "point_data")
-    fcols = _columns(mesh.cell_data, _PLY_TYPES, {"vertex_indices"}, "cell_data")
-    vert = np.empty(len(V), dtype=[(n, c.dtype) for n, c in cols])
-    for n, c in cols:
-        vert[n] = c
-    face = np.empty(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))]
-                    + [(n, c.dtype) for n, c in fcols])
-    face["n"] = 3
-    face["v"] = F
-    for n, c in fcols:
-        face[n] = c
-    def decl(c):
-        return _PLY_TYPES[f"{c.dtype.kind}{c.dtype.itemsize}"]
-
-    header = ["ply", "format binary_little_endian 1.0", "comment written by spinal",
-              f"element vertex {len(vert)}"]
-    header += [f"property {decl(c)} {n}" for n, c in cols]
-    header += [f"element face {len(face)}", "property list uchar int vertex_indices"]
-    header += [f"property {decl(c)} {n}" for n, c in fcols]
-    header += ["end_header"]
-    with open(path, "wb") as f:
-        f.write(("\n".join(header) + "\n").encode("ascii"))
-        f.write(vert.tobytes())
-        f.write(face.tobytes())
-
-
-def _write_vtp(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
-    """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
-    by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
-    Formats", Kitware)."""
-    from xml.sax.saxutils import quoteattr
-
-    blocks, offset = [], 0
-
-    def array(a, name, extra=""):
-        nonlocal offset
-        a = np.ascontiguousarray(_plain(a, _VTK_TYPES))
-        comps = 1 if a.ndim == 1 else a.shape[1]
-        tag = (f'<DataArray type="{_VTK_TYPES[f"{a.dtype.kind}{a.dtype.itemsize}"]}" '
-               f'Name={quoteattr(name)} NumberOfComponents="{comps}"{extra} '
-               f'format="appended" offset="{offset}"/>')
-        raw = a.tobytes()
-        blocks.append(np.uint64(len(raw)).astype("<u8").tobytes() + raw)
-        offset += 8 + len(raw)
-        return tag
-
-    nv, nf = len(mesh.vertices), len(mesh.faces)
-    points = array(mesh.vertices, "Points")
-    conn = array(mesh.faces.reshape(-1).astype(np.int64), "connectivity")
-    offs = array(3 * np.arange(1, nf + 1, dtype=np.int64), "offsets")
-    pdata, active = [], []
-    if mesh.normals is not None:
-        pdata.append(array(mesh.normals, "Normals"))
-        active.append('Normals="Normals"')
-    if mesh.uv is not None:
-        pdata.append(array(mesh.uv, "uv"))
-        active.append('TCoords="uv"')
-    if rgb is not None:
-        if "colors" in point_data:
-            raise ValueError("colors: the name 'colors' is taken by another point_data array")
-        pdata.append(array(rgb, "colors"))
-        active.append('Scalars="colors"')
-    pdata += [array(v, k) for k, v in point_data.items()]
-    cdata = [array(v, k) for k, v in mesh.cell_data.items()]
-    xml = [
-        '<?xml version="1.0"?>',
-        ('<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
-         'header_type="UInt64">'),
-        "<PolyData>",
-        (f'<Piece NumberOfPoints="{nv}" NumberOfVerts="0" NumberOfLines="0" '
-         f'NumberOfStrips="0" NumberOfPolys="{nf}">'),
-        f"<PointData {' '.join(active)}>", *pdata, "</PointData>",
-        "<CellData>", *cdata, "</CellData>",
-        "<Points>", points, "</Points>",
-        "<Polys>", conn, offs, "</Polys>",
-        "</Piece>", "</PolyData>",
-        '<AppendedData encoding="raw">',
-    ]
-    with open(path, "wb") as f:
-        f.write(("\n".join(xml) + "\n_").encode("utf-8"))
-        f.writelines(blocks)
-        f.write(b"\n</AppendedData>\n</VTKFile>\n")
 
 
 def _has_display() -> bool:
