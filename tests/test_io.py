@@ -274,3 +274,21 @@ def test_cli_errors_exit_1_with_one_line_and_help_has_examples(tmp_path, trk):
     assert r.returncode == 1 and "no data named 'nope' (it has fa, rgb, bundle)" in r.stderr
     r = _spinal("tube", "--help")
     assert r.returncode == 0 and "examples:" in r.stdout and "--radius-from" in r.stdout
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")
+def test_cli_tube_in_blocks_writes_the_one_call_mesh(tmp_path, trk, monkeypatch):
+    """The command tubes a bundle in blocks of whole curves (its progress steps and Ctrl-C
+    points); the blocks' meshes, concatenated, are the mesh of one call on all curves."""
+    from spinal import __main__ as cli
+    from spinal import _cli
+
+    monkeypatch.setattr(_cli, "BLOCK_ROWS", 20)
+    assert cli.main(["tube", str(trk), str(tmp_path / "b.ply"), "--radius", "0.3",
+                     "--color", "fa", "-q"]) == 0
+    s = spinal.io.read_streamlines(trk)
+    one = spinal.tube(s.points, 0.3, 8)
+    got = spinal.Mesh.load(tmp_path / "b.ply")
+    np.testing.assert_array_equal(got.vertices, one.vertices)
+    np.testing.assert_array_equal(got.faces, one.faces)
+    np.testing.assert_array_equal(got.normals, one.normals)
