@@ -292,3 +292,108 @@ def test_cli_tube_in_blocks_writes_the_one_call_mesh(tmp_path, trk, monkeypatch)
     np.testing.assert_array_equal(got.vertices, one.vertices)
     np.testing.assert_array_equal(got.faces, one.faces)
     np.testing.assert_array_equal(got.normals, one.normals)
+
+
+# ------------------------------------------------------------------ streamed tubes
+
+
+def _walks(n=60, seed=5):
+    rng = np.random.default_rng(seed)
+    return [np.cumsum(rng.normal(size=(int(k), 3)) * 0.3, 0) for k in rng.integers(2, 80, n)]
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")  # rough walks
+@pytest.mark.parametrize("suffix", [".ply", ".vtp"])
+def test_tube_file_writes_the_bytes_of_one_call(tmp_path, suffix, trk):
+    """Chunk by chunk (here 100 points per chunk: many chunks) the file has the bytes that
+    Mesh.save writes for one spinal.tube call on all streamlines: from a list (a curve that
+    cannot be swept included: its curve id stays free) and from a .trk read lazily, with
+    orientation colours and a per-point radius."""
+    walks = _walks()
+    walks[9] = np.zeros((4, 3))  # one repeated point: skipped
+    with pytest.warns(spinal.SkippedCurvesWarning):
+        out = spinal.io.tube_file(walks, tmp_path / f"s{suffix}", 0.05, 6,
+                                  chunk_points=100, dtype="float64", colors="orientation")
+    assert out == tmp_path / f"s{suffix}"
+    rgb = np.concatenate([np.abs(spinal.estimate_tangents(w)) if i != 9 else np.zeros((4, 3))
+                          for i, w in enumerate(walks)])
+    with pytest.warns(spinal.SkippedCurvesWarning):
+        one = spinal.tube(walks, 0.05, 6, point_data={"colors": rgb}, on_short="skip",
+                          on_invalid="skip")
+    one.save(tmp_path / f"one{suffix}")
+    assert (tmp_path / f"s{suffix}").read_bytes() == (tmp_path / f"one{suffix}").read_bytes()
+    # a file, read lazily
+    spinal.io.tube_file(trk, tmp_path / f"t{suffix}", "fa", 8, chunk_points=20)
+    s = spinal.io.read_streamlines(trk)
+    with pytest.warns(spinal.FoldOverWarning):
+        one = spinal.tube(s.points, np.concatenate(s.point_data["fa"]), 8, dtype="float32")
+    one.save(tmp_path / f"one_t{suffix}")
+    assert (tmp_path / f"t{suffix}").read_bytes() == (tmp_path / f"one_t{suffix}").read_bytes()
+
+
+def test_tube_file_warns_once_for_the_whole_file(tmp_path):
+    """The chunks' warnings come as one per kind, naming streamlines by their index in src."""
+    walks = _walks(200, seed=6)
+    walks[150] = np.full((3, 3), np.nan)
+    with pytest.warns(spinal.SkippedCurvesWarning, match="1 streamlines .* skipped .*: 150"), \
+            pytest.warns(spinal.FoldOverWarning, match="segments of") as rec:
+        spinal.io.tube_file(walks, tmp_path / "w.ply", 0.2, 6, chunk_points=500)
+    folds = [w.message for w in rec if isinstance(w.message, spinal.FoldOverWarning)]
+    assert len(folds) == 1
+    w = folds[0]
+    starts = np.r_[0, np.cumsum([len(x) for x in walks])]
+    np.testing.assert_array_equal(w.indices, starts[w.curves] + w.rows)
+
+
+def test_tube_file_interrupted_leaves_no_file(tmp_path):
+    """Ctrl-C (here from the streamlines' generator) leaves neither dst nor a temporary
+    file; an existing dst is kept as it was."""
+    def walks():
+        for i, w in enumerate(_walks()):
+            if i == 40:
+                raise KeyboardInterrupt
+            yield w
+
+    with pytest.raises(KeyboardInterrupt):
+        spinal.io.tube_file(walks(), tmp_path / "x.ply", 0.05, chunk_points=50)
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "x.vtp").write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt):
+        spinal.io.tube_file(walks(), tmp_path / "x.vtp", 0.05, chunk_points=50)
+    assert [p.name for p in tmp_path.iterdir()] == ["x.vtp"]
+    assert (tmp_path / "x.vtp").read_bytes() == b"old"
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")  # rough walks
+def test_tube_file_memory_is_that_of_a_chunk(tmp_path):
+    """Python-side peak memory (tracemalloc: NumPy's buffers) of a streamed tube is a small
+    fraction of the one-call tube's: it holds one chunk, not the file."""
+    import tracemalloc
+
+    rng = np.random.default_rng(1)
+    walks = [np.cumsum(rng.normal(size=(200, 3)) * 0.2, 0) for _ in range(400)]
+    tracemalloc.start()
+    try:
+        spinal.io.tube_file(walks, tmp_path / "a.ply", 0.01, 8, chunk_points=4000)
+        streamed = tracemalloc.get_traced_memory()[1]
+        tracemalloc.reset_peak()
+        spinal.tube(walks, 0.01, 8, dtype="float32").save(tmp_path / "b.ply")
+        whole = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert (tmp_path / "a.ply").stat().st_size == (tmp_path / "b.ply").stat().st_size
+    assert streamed < whole / 8, (streamed, whole)
+
+
+def test_tube_file_errors_name_the_argument(tmp_path, trk):
+    with pytest.raises(ValueError, match=r"^dst: streamed meshes are written as \.ply or "):
+        spinal.io.tube_file(_walks(), tmp_path / "a.obj")
+    with pytest.raises(FileNotFoundError, match="^src: no such file"):
+        spinal.io.tube_file(tmp_path / "none.trk", tmp_path / "a.ply")
+    with pytest.raises(ValueError, match="^radius: src has no per-point data named 'r'"):
+        spinal.io.tube_file(trk, tmp_path / "a.ply", "r")
+    with pytest.raises(ValueError, match="^chunk_points: "):
+        spinal.io.tube_file(_walks(), tmp_path / "a.ply", chunk_points=0)
+    with pytest.raises(ValueError, match="^src: no streamline could be swept"):
+        spinal.io.tube_file([np.zeros((3, 3))], tmp_path / "a.ply")
+    assert not (tmp_path / "a.ply").exists()

@@ -373,8 +373,9 @@ def vertex_colors(mesh, colors) -> tuple[np.ndarray | None, dict]:
                      f"{c.dtype}")
 
 
-def _write_ply(mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
+def _ply_chunk(mesh, rgb: np.ndarray | None, point_data: dict, base: int = 0):
+    """The vertex and face records of ``mesh`` as PLY stores them (structured arrays, the
+    property declarations in their dtypes' order); face indices shifted by ``base``."""
     V, F = mesh.vertices, mesh.faces
     cols = [(n, V[:, j]) for j, n in enumerate("xyz")]
     if mesh.normals is not None:
@@ -393,63 +394,73 @@ def _write_ply(mesh, path: pathlib.Path, rgb: np.ndarray | None,
     face = np.empty(len(F), dtype=[("n", "u1"), ("v", "<i4", (3,))]
                     + [(n, c.dtype) for n, c in fcols])
     face["n"] = 3
-    face["v"] = F
+    face["v"] = F if base == 0 else F + base
     for n, c in fcols:
         face[n] = c
-    def decl(c):
-        return _PLY_TYPES[f"{c.dtype.kind}{c.dtype.itemsize}"]
+    return vert, face
+
+
+def _ply_header(vert_dtype: np.dtype, face_dtype: np.dtype, nv: int, nf: int) -> bytes:
+    def decl(dt):
+        return _PLY_TYPES[f"{dt.kind}{dt.itemsize}"]
 
     header = ["ply", "format binary_little_endian 1.0", "comment written by spinal",
-              f"element vertex {len(vert)}"]
-    header += [f"property {decl(c)} {n}" for n, c in cols]
-    header += [f"element face {len(face)}", "property list uchar int vertex_indices"]
-    header += [f"property {decl(c)} {n}" for n, c in fcols]
+              f"element vertex {nv}"]
+    header += [f"property {decl(vert_dtype[n])} {n}" for n in vert_dtype.names]
+    header += [f"element face {nf}", "property list uchar int vertex_indices"]
+    header += [f"property {decl(face_dtype[n])} {n}" for n in face_dtype.names[2:]]
     header += ["end_header"]
+    return ("\n".join(header) + "\n").encode("ascii")
+
+
+def _write_ply(mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict) -> None:
+    vert, face = _ply_chunk(mesh, rgb, point_data)
     with open(path, "wb") as f:
-        f.write(("\n".join(header) + "\n").encode("ascii"))
+        f.write(_ply_header(vert.dtype, face.dtype, len(vert), len(face)))
         f.write(vert.tobytes())
         f.write(face.tobytes())
 
 
-def _write_vtp(mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
-    """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
-    by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
-    Formats", Kitware)."""
-    from xml.sax.saxutils import quoteattr
-
-    blocks, offset = [], 0
-
-    def array(a, name, extra=""):
-        nonlocal offset
-        a = np.ascontiguousarray(_plain(a, _VTK_TYPES))
-        comps = 1 if a.ndim == 1 else a.shape[1]
-        tag = (f'<DataArray type="{_VTK_TYPES[f"{a.dtype.kind}{a.dtype.itemsize}"]}" '
-               f'Name={quoteattr(name)} NumberOfComponents="{comps}"{extra} '
-               f'format="appended" offset="{offset}"/>')
-        raw = a.tobytes()
-        blocks.append(np.uint64(len(raw)).astype("<u8").tobytes() + raw)
-        offset += 8 + len(raw)
-        return tag
-
-    nv, nf = len(mesh.vertices), len(mesh.faces)
-    points = array(mesh.vertices, "Points")
-    conn = array(mesh.faces.reshape(-1).astype(np.int64), "connectivity")
-    offs = array(3 * np.arange(1, nf + 1, dtype=np.int64), "offsets")
-    pdata, active = [], []
+def _vtp_chunk(mesh, rgb: np.ndarray | None, point_data: dict, vbase: int = 0,
+               fbase: int = 0) -> list:
+    """``(section, name, array)`` of every array of ``mesh`` in the order of the appended
+    blocks; connectivity shifted by ``vbase`` vertices, offsets by ``fbase`` faces."""
+    nf = len(mesh.faces)
+    out = [("Points", "Points", mesh.vertices),
+           ("Polys", "connectivity", mesh.faces.reshape(-1).astype(np.int64) + vbase),
+           ("Polys", "offsets", 3 * np.arange(fbase + 1, fbase + nf + 1, dtype=np.int64))]
     if mesh.normals is not None:
-        pdata.append(array(mesh.normals, "Normals"))
-        active.append('Normals="Normals"')
+        out.append(("PointData", "Normals", mesh.normals))
     if mesh.uv is not None:
-        pdata.append(array(mesh.uv, "uv"))
-        active.append('TCoords="uv"')
+        out.append(("PointData", "uv", mesh.uv))
     if rgb is not None:
         if "colors" in point_data:
             raise ValueError("colors: the name 'colors' is taken by another point_data array")
-        pdata.append(array(rgb, "colors"))
-        active.append('Scalars="colors"')
-    pdata += [array(v, k) for k, v in point_data.items()]
-    cdata = [array(v, k) for k, v in mesh.cell_data.items()]
+        out.append(("PointData", "colors", rgb))
+    out += [("PointData", k, v) for k, v in point_data.items()]
+    out += [("CellData", k, v) for k, v in mesh.cell_data.items()]
+    return [(sec, name, np.ascontiguousarray(_plain(a, _VTK_TYPES))) for sec, name, a in out]
+
+
+def _vtp_header(arrays: list, sizes: list, nv: int, nf: int) -> bytes:
+    """The XML of a VTK PolyData file whose appended blocks hold ``arrays`` (as
+    :func:`_vtp_chunk` gives them; only names, dtypes and shapes are read) of ``sizes``
+    bytes each."""
+    from xml.sax.saxutils import quoteattr
+
+    tags = {"Points": [], "Polys": [], "PointData": [], "CellData": []}
+    offset = 0
+    for (sec, name, a), size in zip(arrays, sizes, strict=True):
+        comps = 1 if a.ndim == 1 else a.shape[1]
+        tags[sec].append(
+            f'<DataArray type="{_VTK_TYPES[f"{a.dtype.kind}{a.dtype.itemsize}"]}" '
+            f'Name={quoteattr(name)} NumberOfComponents="{comps}" '
+            f'format="appended" offset="{offset}"/>')
+        offset += 8 + size
+    names = [name for sec, name, _ in arrays if sec == "PointData"]
+    active = [f'{role}="{name}"' for role, name in (("Normals", "Normals"), ("TCoords", "uv"),
+                                                    ("Scalars", "colors")) if name in names]
     xml = [
         '<?xml version="1.0"?>',
         ('<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
@@ -457,14 +468,116 @@ def _write_vtp(mesh, path: pathlib.Path, rgb: np.ndarray | None,
         "<PolyData>",
         (f'<Piece NumberOfPoints="{nv}" NumberOfVerts="0" NumberOfLines="0" '
          f'NumberOfStrips="0" NumberOfPolys="{nf}">'),
-        f"<PointData {' '.join(active)}>", *pdata, "</PointData>",
-        "<CellData>", *cdata, "</CellData>",
-        "<Points>", points, "</Points>",
-        "<Polys>", conn, offs, "</Polys>",
+        f"<PointData {' '.join(active)}>", *tags["PointData"], "</PointData>",
+        "<CellData>", *tags["CellData"], "</CellData>",
+        "<Points>", *tags["Points"], "</Points>",
+        "<Polys>", *tags["Polys"], "</Polys>",
         "</Piece>", "</PolyData>",
         '<AppendedData encoding="raw">',
     ]
+    return ("\n".join(xml) + "\n_").encode("utf-8")
+
+
+_VTP_END = b"\n</AppendedData>\n</VTKFile>\n"
+
+
+def _write_vtp(mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict) -> None:
+    """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
+    by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
+    Formats", Kitware)."""
+    arrays = _vtp_chunk(mesh, rgb, point_data)
     with open(path, "wb") as f:
-        f.write(("\n".join(xml) + "\n_").encode("utf-8"))
-        f.writelines(blocks)
-        f.write(b"\n</AppendedData>\n</VTKFile>\n")
+        f.write(_vtp_header(arrays, [a.nbytes for _, _, a in arrays], len(mesh.vertices),
+                            len(mesh.faces)))
+        for _, _, a in arrays:
+            f.write(np.uint64(a.nbytes).astype("<u8").tobytes())
+            f.write(a.tobytes())
+        f.write(_VTP_END)
+
+
+class Spool:
+    """A mesh file written chunk by chunk in bounded memory: every chunk's records go to
+    temporary files (one per PLY element or VTK array) beside ``path``, and :meth:`finish`
+    writes the header (now that the counts are known) and the spooled bytes to a temporary
+    name that replaces ``path`` only when complete. The bytes equal :meth:`Mesh.save` of
+    the chunks concatenated."""
+
+    def __init__(self, path: pathlib.Path):
+        suffix = path.suffix.lower()
+        if suffix not in (".ply", ".vtp"):
+            raise ValueError(f"dst: streamed meshes are written as .ply or .vtp, got "
+                             f"{suffix!r}")
+        self.path, self.kind = path, suffix
+        self.parts: list = []  # temporary files, one per block of the file
+        self.layout = None  # the dtypes (and names) of the first chunk, kept by the others
+        self.nv = self.nf = 0
+
+    def _files(self, n: int) -> list:
+        import tempfile
+
+        while len(self.parts) < n:
+            # closed by close(), which finish() and the caller's finally call
+            self.parts.append(tempfile.TemporaryFile(dir=self.path.parent))  # noqa: SIM115
+        return self.parts
+
+    def add(self, mesh, rgb: np.ndarray | None, point_data: dict) -> None:
+        """Append ``mesh`` (its faces shifted past the vertices so far)."""
+        if self.kind == ".ply":
+            vert, face = _ply_chunk(mesh, rgb, point_data, self.nv)
+            if self.layout is None:
+                self.layout = (vert.dtype, face.dtype)
+            elif (vert.dtype, face.dtype) != self.layout:
+                vert, face = vert.astype(self.layout[0]), face.astype(self.layout[1])
+            v, f = self._files(2)
+            v.write(vert.tobytes())
+            f.write(face.tobytes())
+        else:
+            arrays = _vtp_chunk(mesh, rgb, point_data, self.nv, self.nf)
+            shape = [(sec, name, a.dtype, a.shape[1:]) for sec, name, a in arrays]
+            if self.layout is None:
+                self.layout = (shape, arrays)
+            elif shape != self.layout[0]:
+                raise ValueError("dst: every chunk must have the same arrays; got "
+                                 f"{[s[:2] for s in shape]} after {[s[:2] for s in self.layout[0]]}")
+            for t, (_, _, a) in zip(self._files(len(arrays)), arrays, strict=True):
+                t.write(a.tobytes())
+        self.nv += len(mesh.vertices)
+        self.nf += len(mesh.faces)
+
+    def finish(self) -> pathlib.Path:
+        """Write the file (to a temporary name, renamed at the end) and drop the spool."""
+        import shutil
+        import tempfile
+
+        if self.layout is None:
+            raise ValueError("src: no streamline could be swept (nothing to write)")
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=self.path.parent)
+        try:
+            with os.fdopen(fd, "wb") as out:
+                sizes = []
+                for t in self.parts:
+                    sizes.append(t.tell())
+                    t.seek(0)
+                if self.kind == ".ply":
+                    out.write(_ply_header(*self.layout, self.nv, self.nf))
+                    for t in self.parts:
+                        shutil.copyfileobj(t, out, 1 << 22)
+                else:
+                    out.write(_vtp_header(self.layout[1], sizes, self.nv, self.nf))
+                    for t, size in zip(self.parts, sizes, strict=True):
+                        out.write(np.uint64(size).astype("<u8").tobytes())
+                        shutil.copyfileobj(t, out, 1 << 22)
+                    out.write(_VTP_END)
+            os.replace(tmp, self.path)
+        except BaseException:
+            os.unlink(tmp)
+            raise
+        finally:
+            self.close()
+        return self.path
+
+    def close(self) -> None:
+        for t in self.parts:
+            t.close()
+        self.parts = []

@@ -15,6 +15,10 @@ per-streamline data of the file. Each reader's package is optional: ``pip instal
 'spinal[io]'`` (from the package index once published; from a clone ``pip install -e
 '.[io]'``) installs nibabel, trx-python and pyvista.
 
+:func:`tube_file` sweeps tubes around the streamlines of a file (or of any iterable of
+arrays) chunk by chunk into a ``.ply`` or ``.vtp`` file in memory bounded by the chunk, so a
+whole-brain tractogram of millions of streamlines becomes one mesh file on a laptop.
+
 Meshes are read by :meth:`spinal.Mesh.load` and written by :meth:`spinal.Mesh.save`.
 """
 
@@ -22,11 +26,12 @@ from __future__ import annotations
 
 import os as _os
 import pathlib as _pathlib
+import warnings as _warnings
 from typing import NamedTuple as _NamedTuple
 
 import numpy as _np
 
-__all__ = ["STREAMLINE_SUFFIXES", "Streamlines", "read_streamlines"]
+__all__ = ["STREAMLINE_SUFFIXES", "Streamlines", "read_streamlines", "tube_file"]
 
 #: The file suffixes :func:`read_streamlines` reads.
 STREAMLINE_SUFFIXES = (".trk", ".tck", ".trx", ".vtp", ".vtk")
@@ -184,3 +189,221 @@ def read_streamlines(path: str | _os.PathLike) -> Streamlines:
     if suffix == ".trx":
         return _read_trx(path)
     return _read_vtk(path)
+
+
+def _lazy_items(path: _pathlib.Path):
+    """``(points (n, 3) float64, {name: per-point values})`` of every streamline of the file,
+    read lazily where the format allows (nibabel's lazy loading of ``.trk``/``.tck``, the
+    memory maps of ``.trx``)."""
+    suffix = path.suffix.lower()
+    if suffix in (".trk", ".tck"):
+        nib = _need("nibabel")
+        lazy = nib.streamlines.load(_os.fspath(path), lazy_load=True).tractogram
+        # `lazy.streamlines` applies the file's affine (RAS+ mm, as the eager loading
+        # gives); the items of iterating `lazy` itself do not all do so
+        keys = list(lazy.data_per_point)
+        for p, *values in zip(lazy.streamlines, *(lazy.data_per_point[k] for k in keys),
+                              strict=False):
+            data = {}
+            for k, v in zip(keys, values, strict=True):
+                v = _np.asarray(v)
+                data[k] = v[:, 0] if v.ndim == 2 and v.shape[1] == 1 else v
+            yield _np.asarray(p, dtype=_np.float64), data
+    elif suffix == ".trx":
+        trx = _need("trx.trx_file_memmap")
+        f = trx.load(_os.fspath(path))
+        try:
+            seq, dpv = f.streamlines, dict(f.data_per_vertex)
+            for i in range(len(seq)):
+                data = {}
+                for k, v in dpv.items():
+                    a = _np.array(v[i])
+                    data[k] = a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
+                yield _np.array(seq[i], dtype=_np.float64), data
+        finally:
+            f.close()
+    else:
+        s = read_streamlines(path)
+        for i, p in enumerate(s.points):
+            yield p, {k: v[i] for k, v in s.point_data.items()}
+
+
+def _orientation(p: _np.ndarray) -> _np.ndarray:
+    """``|unit tangent|`` as RGB in [0, 1] (x red, y green, z blue), the tractography
+    convention; zeros where a curve has fewer than two distinct points."""
+    from ._frames import estimate_tangents
+
+    try:
+        return _np.abs(estimate_tangents(p))
+    except ValueError:
+        return _np.zeros((len(p), 3))
+
+
+def _summarise(folds: list, skipped: list, other: dict) -> None:
+    """One warning per kind for the whole file, naming streamlines by their index in
+    ``src``."""
+    from ._mesh import FoldOverWarning, SkippedCurvesWarning
+
+    if folds:
+        # streamline index in src, row within it, row of all streamlines back to back
+        curves = _np.concatenate([w.curves + first for first, _, w in folds])
+        rows = _np.concatenate([w.rows for _, _, w in folds])
+        indices = _np.concatenate([w.indices + before for _, before, w in folds])
+        firsts = ", ".join(f"streamline {c} row {r}" for c, r in zip(curves[:5], rows[:5],
+                                                                      strict=True))
+        _warnings.warn(FoldOverWarning(
+            f"the profile reaches past the spine's centre of curvature (the surface folds "
+            f"over itself) on {len(rows):,} segments of {len(_np.unique(curves)):,} "
+            f"streamlines ({firsts}{', …' if len(rows) > 5 else ''}); reduce the radius or "
+            f"smooth the streamlines", indices, curves, rows), stacklevel=3)
+    if skipped:
+        ids = _np.concatenate(skipped)
+        _warnings.warn(SkippedCurvesWarning(
+            f"{len(ids):,} streamlines with fewer than two distinct points or with NaN were "
+            f"skipped (the first: {', '.join(map(str, ids[:8]))})", ids), stacklevel=3)
+    for w in other.values():
+        _warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
+              chunk_points: int = 1 << 20, dtype="float32", colors=None, join: str = "round",
+              progress=False) -> _pathlib.Path:
+    """Sweep a tube around every streamline of ``src`` into the mesh file ``dst``, a chunk
+    of streamlines at a time.
+
+    Each chunk of about ``chunk_points`` spine points is read (lazily where the format
+    allows), swept by :func:`spinal.tube` and appended to temporary files beside ``dst``;
+    at the end the header and the spooled blocks are written to a temporary name that
+    then replaces ``dst``. Peak memory is that of one chunk (its points and its mesh), not
+    of the tractogram; the file has the bytes that :meth:`spinal.Mesh.save` writes for one
+    :func:`spinal.tube` call on all streamlines. Ctrl-C (or an error) leaves no file under
+    ``dst``. Streamlines with fewer than two distinct points or with NaN are skipped (their
+    ``curve_id`` is kept free), as ``on_short="skip"`` and ``on_invalid="skip"`` do.
+
+    Parameters
+    ----------
+    src : str, os.PathLike or iterable of array_like (n_i, 3)
+        A streamline file (see :func:`read_streamlines`) or the streamlines themselves (a
+        list, a generator, nibabel's ``ArraySequence``).
+    dst : str or os.PathLike
+        The mesh file: ``.ply`` (binary) or ``.vtp`` (appended binary).
+    radius : float or str
+        The tube radius in the file's units, or the name of per-point data of ``src`` that
+        holds it.
+    sides : int
+        Sides of the tube (3 … 2**20).
+    chunk_points : int
+        Spine points per chunk (at least 1; a streamline is never split).
+    dtype : "float32" or "float64"
+        Of the vertices and normals.
+    colors : None, "orientation" or str
+        Vertex colours: ``"orientation"`` (|tangent| as RGB) or the name of per-point data
+        of ``src`` holding RGB (uint8, or floats in [0, 1]).
+    join : "round", "bevel" or "miter"
+        As in :func:`spinal.tube`.
+    progress : bool or callable
+        ``True``: a bar (tqdm, when installed) counting streamlines; a callable is called
+        as ``progress(streamlines_done)`` after every chunk.
+
+    Returns
+    -------
+    pathlib.Path
+        ``dst``.
+    """
+    from ._files import Spool, vertex_colors
+    from ._mesh import FoldOverWarning, SkippedCurvesWarning
+    from ._sweep import tube
+    from ._validate import as_int
+
+    if not isinstance(dst, (str, _os.PathLike)):
+        raise TypeError(f"dst: expected a str or os.PathLike, got {type(dst).__name__}")
+    chunk_points = as_int(chunk_points, "chunk_points", 1, 1 << 40)
+    if not (isinstance(progress, bool) or callable(progress)):
+        raise TypeError(f"progress: expected a bool or a callable, got "
+                        f"{type(progress).__name__}")
+    if isinstance(src, (str, _os.PathLike)):
+        path = _pathlib.Path(src)
+        if not path.exists():
+            raise FileNotFoundError(f"src: no such file: {_os.fspath(path)!r}")
+        if path.suffix.lower() not in STREAMLINE_SUFFIXES:
+            raise ValueError(f"src: unknown streamline format {path.suffix!r}; use one of "
+                             f"{', '.join(STREAMLINE_SUFFIXES)}")
+        items = _lazy_items(path)
+    else:
+        items = ((p, {}) for p in src)
+    named = [x for x in (radius, colors) if isinstance(x, str) and x != "orientation"]
+    spool = Spool(_pathlib.Path(dst))
+    bar = None
+    if progress is True:
+        try:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(desc="tube_file", unit=" streamlines")
+        except ImportError:
+            bar = None
+
+    def flush(chunk, data, first):
+        r = _np.concatenate(data[radius]) if isinstance(radius, str) else radius
+        point_data = None
+        if colors == "orientation":
+            point_data = {"colors": _np.concatenate([_orientation(p) for p in chunk])}
+        elif colors is not None:
+            point_data = {"colors": _np.concatenate(data[colors])}
+        with _warnings.catch_warnings(record=True) as caught:
+            _warnings.simplefilter("always")
+            m = tube(chunk, r, sides, dtype=dtype, join=join, point_data=point_data,
+                     on_short="skip", on_invalid="skip")
+        for w in caught:
+            if isinstance(w.message, FoldOverWarning):
+                folds.append((first, rows_before[0], w.message))
+            elif isinstance(w.message, SkippedCurvesWarning):
+                skipped.append(_np.asarray(w.message.curves) + first)
+            elif str(w.message) not in other:
+                other[str(w.message)] = w
+        if first and "curve_id" in m.cell_data:
+            m.cell_data["curve_id"] = m.cell_data["curve_id"] + first
+        rgb, rest = vertex_colors(m, None)
+        spool.add(m, rgb, rest)
+        rows_before[0] += sum(len(p) for p in chunk)
+
+    done = 0
+    # the chunks' warnings, given once at the end for the whole file
+    folds, skipped, other = [], [], {}
+    rows_before = [0]  # spine rows of the chunks written
+    try:
+        chunk, data, size = [], {k: [] for k in named}, 0
+        for p, d in items:
+            p = _np.asarray(p, dtype=_np.float64)
+            for k in named:
+                if k not in d:
+                    what = "radius" if k == radius else "colors"
+                    raise ValueError(f"{what}: src has no per-point data named {k!r} (it has "
+                                     f"{', '.join(sorted(d)) or 'none'})")
+                data[k].append(_np.asarray(d[k]))
+            chunk.append(p)
+            size += len(p)
+            if size >= chunk_points:
+                flush(chunk, data, done)
+                done += len(chunk)
+                chunk, data, size = [], {k: [] for k in named}, 0
+                if bar is not None:
+                    bar.update(done - bar.n)
+                elif callable(progress):
+                    progress(done)
+        if chunk:
+            flush(chunk, data, done)
+            done += len(chunk)
+        if bar is not None:
+            bar.update(done - bar.n)
+        elif callable(progress):
+            progress(done)
+        if spool.nv == 0:
+            raise ValueError(f"src: no streamline could be swept ({done:,} read; each needs "
+                             f"two distinct finite points)")
+        out = spool.finish()
+        _summarise(folds, skipped, other)
+        return out
+    finally:
+        spool.close()
+        if bar is not None:
+            bar.close()
