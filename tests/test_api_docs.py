@@ -383,3 +383,16 @@ def test_stubs_are_packaged():
     assert (PKG / "py.typed").exists()
     for path in STUBS.values():
         assert path.parent == PKG
+
+
+@pytest.mark.parametrize("mod", [spinal.curves, spinal.fields, spinal.io, spinal.ph,
+                                 spinal.quaternions], ids=lambda m: m.__name__)
+def test_submodules_show_only_their_public_names(mod):
+    """The public submodules hold their public names and nothing else that looks public
+    (no NumPy, helpers or typing names): the implementation lives in private modules."""
+    shown = sorted(n for n in dir(mod) if not n.startswith("_"))
+    assert shown == sorted(mod.__all__)
+    for name in mod.__all__:
+        obj = getattr(mod, name)
+        if inspect.isclass(obj) or inspect.isfunction(obj):
+            assert obj.__module__ == mod.__name__, name  # documented and pickled here

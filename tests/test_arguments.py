@@ -178,6 +178,7 @@ NOT_WALKED = {
     "spinal.curves.Curve": "the abstract base class (no parameters)",
     "spinal.Mesh.plot": "needs pyvista and a display; its options go to pyvista",
     "spinal.Mesh.save": "path: a str is the valid type (any path-like)",
+    "spinal.Mesh.load": "path: a file (its errors are tested in test_io.py)",
     "spinal.Mesh.to_pyvista": "no parameters",
     "spinal.Mesh.to_trimesh": "no parameters",
 }

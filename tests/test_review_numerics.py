@@ -206,7 +206,7 @@ def test_D25_messages_name_the_argument():
     with pytest.raises(TypeError, match="^path: "):
         spinal.Mesh(np.eye(3), [[0, 1, 2]]).save(5)
     with pytest.raises(ValueError, match="^path: "):
-        spinal.Mesh(np.eye(3), [[0, 1, 2]]).save("mesh.stl")
+        spinal.Mesh(np.eye(3), [[0, 1, 2]]).save("mesh.xyz")
 
 
 # ------------------------------------------------------------- flesh beyond 1e±150

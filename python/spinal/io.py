@@ -22,7 +22,6 @@ whole-brain tractogram of millions of streamlines becomes one mesh file on a lap
 Meshes are read by :meth:`spinal.Mesh.load` and written by :meth:`spinal.Mesh.save`.
 """
 
-from __future__ import annotations
 
 import os as _os
 import pathlib as _pathlib
