@@ -296,7 +296,7 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     dtype : "float32" or "float64"
         Of the vertices and normals.
     colors : None, "orientation" or str
-        Vertex colours: ``"orientation"`` (|tangent| as RGB) or the name of per-point data
+        Vertex colours: ``"orientation"`` (``|tangent|`` as RGB) or the name of per-point data
         of ``src`` holding RGB (uint8, or floats in [0, 1]).
     join : "round", "bevel" or "miter"
         As in :func:`spinal.tube`.
