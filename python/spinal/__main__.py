@@ -132,8 +132,9 @@ def demo(out: pathlib.Path) -> int:
         written += pictures
         picture = None
     except ImportError as e:  # pyvista missing: the demo runs without pictures
-        picture = (f"skipped ({e}; pip install 'spinal[viz]' for the pictures: frames ribbon, "
-                   "knot tube, dent, bent bar)")
+        picture = (f"skipped ({e}; pip install 'spinal[viz]' from the package index once "
+                   "published, or pip install -e '.[viz]' from a clone, for the pictures: "
+                   "frames ribbon, knot tube, dent, bent bar)")
     except Exception as e:  # noqa: BLE001 - no OpenGL: say so and go on
         picture = f"skipped (could not render off-screen: {type(e).__name__}: {e})"
 
