@@ -1,4 +1,7 @@
-"""Measures of spinal.Mesh: area and volume at any scale of the coordinates."""
+"""spinal.Mesh: area and volume at any scale of the coordinates, vertex colours in the
+files, and the faces that cross (against libigl's exact predicates)."""
+
+import pathlib
 
 import numpy as np
 import pytest
@@ -125,3 +128,80 @@ def test_colors_argument_and_its_errors(tmp_path):
                        (np.zeros((n, 3), np.int64), "expected uint8")):
         with pytest.raises(ValueError, match="^colors: .*" + words):
             m.save(tmp_path / "c.ply", colors=bad)
+
+
+# ------------------------------------------------------------------ self-intersections
+
+
+def _pairs_igl(m):
+    igl_pred = pytest.importorskip("igl.predicates")
+    _, pairs, *_ = igl_pred.find_self_intersections(np.asarray(m.vertices, np.float64),
+                                                     np.asarray(m.faces, np.int64))
+    p = np.sort(np.asarray(pairs, np.int64).reshape(-1, 2), axis=1)
+    return p[np.lexsort(p.T[::-1])]
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")
+def test_self_intersections_are_libigls_pairs():
+    """Mesh.self_intersections gives libigl's exact pairs (igl.predicates.
+    find_self_intersections) on tubes of rough random walks (thousands of crossings where
+    hairpins and returns overlap), two overlapping spheres and an embedded sphere."""
+    trimesh = pytest.importorskip("trimesh")
+    rng = np.random.default_rng(0)
+    meshes = [spinal.tube(np.cumsum(rng.normal(size=(200, 3)) * 0.2, 0), 0.05, 8)
+              for _ in range(3)]
+    a = trimesh.creation.icosphere(3)
+    meshes.append(spinal.Mesh(np.r_[a.vertices, a.vertices + [0.7, 0.2, 0.1]],
+                              np.r_[a.faces, a.faces + len(a.vertices)]))
+    meshes.append(spinal.Mesh(a.vertices, a.faces))
+    counts = []
+    for m in meshes:
+        got = m.self_intersections()
+        assert got.dtype == np.int64 and got.ndim == 2 and got.shape[1] == 2
+        assert np.all(got[:, 0] < got[:, 1])
+        np.testing.assert_array_equal(got, _pairs_igl(m))
+        counts.append(len(got))
+    assert min(counts[:3]) > 500 and counts[3] > 100 and counts[4] == 0
+
+
+@pytest.mark.parametrize("name", ["cow.obj", "fandisk.obj", "rocker-arm.obj"])
+def test_self_intersections_of_the_shared_meshes(name):
+    """The shared meshes: the same pairs as libigl (81 on the cow, none on the others)."""
+    trimesh = pytest.importorskip("trimesh")
+    path = pathlib.Path(__file__).resolve().parents[1].parent / "shared/data/meshes" / name
+    if not path.exists():
+        pytest.skip(f"{path} is not available")
+    t = trimesh.load(path, process=False, force="mesh")
+    m = spinal.Mesh(t.vertices, t.faces)
+    np.testing.assert_array_equal(m.self_intersections(), _pairs_igl(m))
+
+
+def test_self_intersection_cases_decided_exactly():
+    """Touching, coplanar and nearly coplanar cases, where a tolerance would guess: a corner
+    touching a face counts, a triangle 1e-300 above another does not, a fold onto a
+    neighbour in its plane counts, a neighbour across the shared edge does not."""
+    V = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0],          # 0-2: a face in z = 0
+                  [0.5, 0.5, 0], [0.5, 0.5, 1], [1.5, 0.5, 1],  # 3-5: a corner on it
+                  [0.2, 0.2, 1e-300], [0.4, 0.2, 1e-300], [0.2, 0.4, 1e-300],  # 6-8: above
+                  [0.3, 0.3, 0], [1, -1, 0.0]])               # 9: folded, 10: across
+    cases = {((0, 1, 2), (3, 4, 5)): 1, ((0, 1, 2), (6, 7, 8)): 0,
+             ((0, 1, 2), (1, 0, 9)): 1, ((0, 1, 2), (1, 0, 10)): 0}
+    for (s, t), n in cases.items():
+        assert len(spinal.Mesh(V, [s, t]).self_intersections()) == n, (s, t)
+
+
+@pytest.mark.filterwarnings("ignore::spinal.FoldOverWarning")
+def test_self_intersections_same_on_any_thread_count_and_limited():
+    walk = np.cumsum(np.random.default_rng(3).normal(size=(900, 3)) * 0.2, 0)
+    m = spinal.tube(walk, 0.05, 8)  # ~29k faces: several blocks of 4,096
+    runs = []
+    for n in (1, 2, 3):
+        with spinal.threads(n):
+            runs.append(m.self_intersections())
+    for r in runs[1:]:
+        np.testing.assert_array_equal(r, runs[0])
+    with pytest.warns(RuntimeWarning, match="stopped at limit=10 pairs"):
+        first = m.self_intersections(limit=10)
+    assert len(first) == 10
+    with pytest.raises(ValueError, match="^limit: "):
+        m.self_intersections(limit=-1)

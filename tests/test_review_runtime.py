@@ -19,6 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pytest
+from conftest import late_after_sigint
 
 import spinal
 from spinal import ph
@@ -221,43 +222,6 @@ def test_D22_fit_segments_is_bounded():
 
 
 # ------------------------------------------------------------------------------ Ctrl-C
-
-SIGINT_CHILD = """
-import os, signal, sys, threading, time
-import numpy as np, trimesh, spinal
-from spinal import fields as fl, quaternions as Q, ph
-spinal.set_num_threads(2)
-# Python installs its Ctrl-C handler only when SIGINT is not ignored at start-up, and a
-# shell starts background jobs with SIGINT ignored: install it here in any case
-signal.signal(signal.SIGINT, signal.default_int_handler)
-{setup}
-sent = []
-def fire():
-    sent.append(time.process_time())
-    os.kill(os.getpid(), signal.SIGINT)
-threading.Timer({after}, fire).start()
-start = time.perf_counter()
-try:
-    for _ in range(100):  # repeated, so a call faster than the timer is still running then
-        {call}
-except KeyboardInterrupt:
-    # the work done after the signal: CPU time of the process (both pool threads) per
-    # thread, so a machine loaded by other work does not stretch it as wall time would
-    late = (time.process_time() - sent[0]) / 2
-    print(f'interrupted {{late:.3f}} s of work per thread after the signal')
-    sys.exit(0)
-print(f'finished after {{time.perf_counter() - start:.1f}} s, no KeyboardInterrupt')
-sys.exit(3)
-"""
-
-
-def late_after_sigint(setup: str, call: str, after: float = 0.5) -> float:
-    code = SIGINT_CHILD.format(setup=textwrap.dedent(setup), call=call, after=after)
-    r = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True,
-                       text=True, timeout=600)
-    assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
-    return float(r.stdout.split()[1])
-
 
 D17_CASES = {
     "advect": (

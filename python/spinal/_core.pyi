@@ -400,6 +400,11 @@ def mesh_measure(
     faces: npt.NDArray[np.int64] | npt.NDArray[np.int32],
     what: str,
 ) -> float: ...
+def mesh_self_intersections(
+    vertices: npt.NDArray[np.float64] | npt.NDArray[np.float32],
+    faces: npt.NDArray[np.int64] | npt.NDArray[np.int32],
+    limit: int,
+) -> tuple[npt.NDArray[np.int64], bool]: ...
 def mesh_edges(
     faces: npt.NDArray[np.int64] | npt.NDArray[np.int32], n: int
 ) -> tuple[int, int, int, int, int]: ...

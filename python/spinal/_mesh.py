@@ -344,6 +344,35 @@ class Mesh:
         keys = ("edges", "boundary", "non_manifold", "inconsistent", "degenerate")
         return dict(zip(keys, _core.mesh_edges(F, len(V))))
 
+    def self_intersections(self, limit: int = 10_000_000) -> np.ndarray:
+        """The pairs of faces that intersect other than along the vertices and edges they
+        share: ``(K, 2)`` int64 face indices ``i < j``, sorted (empty for an embedded mesh).
+
+        Exact: orientation tests with Shewchuk's adaptive-precision predicates, so touching
+        and coplanar overlaps are decided without tolerance. Two faces sharing an edge count
+        when they lie in one plane folded onto each other; sharing a vertex, when they meet
+        anywhere else; duplicate faces count; faces of zero area are left out (see
+        ``edge_stats``). Candidates come from a bounding-volume hierarchy of the faces
+        (``O(F log F)`` for evenly sized faces), in parallel, the same pairs on any thread
+        count; Ctrl-C stops it.
+
+        Parameters
+        ----------
+        limit : int
+            Stop after this many pairs (a ``RuntimeWarning`` says so).
+        """
+        from ._validate import as_int
+
+        limit = as_int(limit, "limit", 0, 1 << 40)
+        pairs, truncated = _core.mesh_self_intersections(*self._arrays(), limit)
+        if truncated:
+            import warnings
+
+            warnings.warn(RuntimeWarning(
+                f"self_intersections: stopped at limit={limit:,} pairs; more faces cross"),
+                stacklevel=2)
+        return pairs
+
     @property
     def is_watertight(self) -> bool:
         """Every edge is shared by exactly two faces that traverse it in opposite directions

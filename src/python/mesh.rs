@@ -1,11 +1,11 @@
 //! Mesh measures (`spinal.Mesh`); the algorithms are in [`crate::math::mesh`].
 
-use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use super::convert::{Stop, detach_stoppable, ensure_memory, triangles, vec3s};
 use crate::mesh::closed::{self, CALL as CLOSED};
-use crate::mesh::measure;
+use crate::mesh::{intersect, measure};
 
 /// Signed volume of a closed triangle mesh, summed about the mean vertex
 /// ([`measure::volume`]).
@@ -146,6 +146,29 @@ pub fn mesh_measure(
             measure::volume_cancellable(v, f, &cancel)
         }
     })??))
+}
+
+/// The pairs of faces that cross (`(K, 2)` int64, sorted; see
+/// [`crate::mesh::intersect`]) and whether the list stopped at `limit` pairs. Ctrl-C stops it
+/// between blocks of faces.
+#[pyfunction]
+pub fn mesh_self_intersections<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+    limit: usize,
+) -> PyResult<(Bound<'py, PyArray2<i64>>, bool)> {
+    let (vs, fs) = (vertices_of(vertices)?, faces_of(faces)?);
+    let stop = Stop::default();
+    let cancel = || stop.requested();
+    let found = with_mesh!(&vs, &fs, |v, f| detach_stoppable(py, &stop, || {
+        intersect::self_intersections(v, f, limit, &cancel)
+    })??);
+    // a stop raised KeyboardInterrupt above; `None` is then not reached
+    let (pairs, truncated) = found.unwrap_or_default();
+    let flat: Vec<i64> = pairs.iter().flatten().map(|&i| i as i64).collect();
+    let n = pairs.len();
+    Ok((PyArray1::from_vec(py, flat).reshape([n, 2])?, truncated))
 }
 
 /// Edge statistics of the faces over `n` vertices: `(edges, boundary, non_manifold,

@@ -72,6 +72,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::mesh_closed_centroid, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_measure, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_edges, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::mesh_self_intersections, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_check_faces, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_check_finite, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::minimal_rotation, m)?)?;

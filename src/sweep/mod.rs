@@ -64,7 +64,6 @@ pub mod join;
 mod kernel;
 mod layout;
 mod monotone;
-mod predicates;
 pub mod profile;
 mod rings;
 mod run;

@@ -20,9 +20,9 @@ use std::collections::BTreeMap;
 
 use glam::DVec2;
 
-use super::predicates::orient;
 use crate::cancel::{self, BLOCK, Cancel};
 use crate::error::Result;
+use crate::math::predicates::orient;
 
 /// Is `a` above `b` in the sweep order (higher, or as high and further left)?
 fn above(a: DVec2, b: DVec2) -> bool {
@@ -397,7 +397,7 @@ pub fn triangulate(q: &[DVec2], cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sweep::predicates::{accurate_area2, accurate_cover2};
+    use crate::math::predicates::{accurate_area2, accurate_cover2};
     use crate::sweep::profile::Profile;
     use crate::sweep::profile::fixtures::{Rng, star_shaped};
     use std::collections::HashMap;

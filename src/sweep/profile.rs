@@ -20,10 +20,10 @@
 
 use glam::DVec2;
 
-use super::predicates::orient;
 use crate::alloc;
 use crate::cancel::{self, BLOCK, Cancel};
 use crate::error::{InputError, Result};
+use crate::math::predicates::orient;
 
 /// A validated profile.
 #[derive(Debug, Clone)]
@@ -612,7 +612,7 @@ pub(crate) mod fixtures {
 mod tests {
     use super::fixtures::{Rng, star_shaped};
     use super::*;
-    use crate::sweep::predicates::{accurate_area2, accurate_cover2};
+    use crate::math::predicates::{accurate_area2, accurate_cover2};
 
     fn area_of(p: &[DVec2], tris: &[[usize; 3]]) -> f64 {
         0.5 * accurate_cover2(p, tris)
