@@ -77,6 +77,7 @@ BASE = {
     "spinal.tube": (spinal.tube, (PTS, 0.1), {}),
     "spinal.Mesh": (spinal.Mesh, (SPHERE.vertices, SPHERE.faces), {}),
     "spinal.Mesh.edge_stats": (MESH.edge_stats, (), {}),
+    "spinal.Mesh.self_intersections": (MESH.self_intersections, (), {"limit": 100}),
     "spinal.Mesh.concatenate": (spinal.Mesh.concatenate, ([MESH, MESH],), {}),
     "spinal.SpineBinding": (spinal.SpineBinding, (CLOUD, REST), {}),
     "spinal.SpineBinding.deform": (SBIND.deform, (BEND,), {}),

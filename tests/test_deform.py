@@ -651,8 +651,10 @@ def test_deform_refuses_open_and_inside_out_meshes_unless_told():
             spinal.deform(mixed, tool, 1.0, check=check)
     _, rep = spinal.deform((V, F[:, ::-1]), tool, 1.0, refine=None, check=False)
     assert rep.rest_volume < 0
-    with pytest.raises(TypeError, match="check"):
+    with pytest.raises(ValueError, match="^check: expected True, False or 'intersections'"):
         spinal.deform((V, F), tool, 1.0, check="no")
+    with pytest.raises(TypeError, match="^check: "):
+        spinal.deform((V, F), tool, 1.0, check=1.5)
 
 
 @pytest.mark.parametrize("scale", [1e-110, 1e110, 1e150])
@@ -669,3 +671,22 @@ def test_deform_report_is_finite_at_any_scale(scale):
     assert rep.relative_change == pytest.approx(unit.relative_change, rel=1e-12)
     assert rep.integration_error == pytest.approx(unit.integration_error, rel=1e-6)
     assert rep.rest_volume == (np.inf if scale > 1 else 0.0)
+
+
+def test_deform_reports_crossing_faces_and_is_then_not_converged():
+    """With check="intersections" the report counts the result's crossing faces (the same
+    count as Mesh.self_intersections) and says not converged, with a RefinementWarning:
+    the drag of a 10k sphere by a translation tool on its surface folds its torn strip
+    (thousands of pairs); the gentle press of the same sphere crosses nothing."""
+    V, F = icosphere(5)
+    drag = fields.translation([0, 0, 1.0], 0.9, [0.5, 0, 0])
+    with pytest.warns(spinal.RefinementWarning, match="pairs of crossing faces"):
+        m, rep = spinal.deform((V, F), drag, 1.0, check="intersections")
+    assert rep.crossing_pairs == len(m.self_intersections()) > 1000
+    assert not rep.converged and rep.degenerate_faces == 0
+    assert "pairs of faces cross" in str(rep)
+    press = fields.translation([0, 0, 1.3], 0.3, [0, 0, -0.2])
+    m, rep = spinal.deform((V, F), press, 1.0, check="intersections")
+    assert rep.crossing_pairs == 0 and rep.converged
+    _, plain = spinal.deform((V, F), press, 1.0)
+    assert plain.crossing_pairs is None and plain.converged

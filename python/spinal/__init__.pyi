@@ -291,6 +291,8 @@ class DeformReport:
     collapses: int = 0
     moves: int = 0
     collapse_volume: float = 0.0
+    degenerate_faces: int = 0
+    crossing_pairs: int | None = None
 
 class RefinementWarning(UserWarning): ...
 
@@ -306,7 +308,7 @@ def deform(
     estimate: bool = False,
     progress: _Progress = False,
     max_vertices: int | None = None,
-    check: bool = True,
+    check: bool | Literal["intersections"] = True,
 ) -> tuple[Mesh, DeformReport]: ...
 @dataclass(frozen=True)
 class StampReport:

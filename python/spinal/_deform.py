@@ -94,9 +94,10 @@ class DeformReport:
         a curl tool's surface, the flow of the material of the side its rest position lies
         on), except the ``slip_vertices`` and ``chord_vertices``.
     converged : bool
-        True when no edge is over the threshold at the end. False when ``max_vertices`` or
-        ``max_passes`` stopped the refinement with edges still too long (a
-        :class:`RefinementWarning` was emitted). Across a tool's slip every edge can be
+        True when no edge is over the threshold at the end, no face has zero area and (with
+        ``check="intersections"``) no faces cross. False when ``max_vertices`` or
+        ``max_passes`` stopped the refinement with edges still too long, or the result has
+        faces of zero area or crossing faces (a :class:`RefinementWarning` was emitted). Across a tool's slip every edge can be
         shortened (see ``torn_vertices``), so a refinement that no bound stops converges.
     edges_over_threshold : int
         Edges longer than the threshold at the end (0 when converged).
@@ -153,6 +154,12 @@ class DeformReport:
         towards the centroid of their neighbours (with the same tests).
     collapse_volume : float
         The change of the volume by the collapses and moves (the sum of what each left).
+    degenerate_faces : int
+        Faces of the result with zero area (the cross product of two of their edges is zero
+        in floating point).
+    crossing_pairs : int or None
+        With ``check="intersections"``: the pairs of faces of the result that cross
+        (:meth:`spinal.Mesh.self_intersections`); else None (not looked for).
     step_vertices : ndarray (steps,) int64 or None
         Vertex count after each integration step (the last one after the collapses).
     timings : dict or None
@@ -182,14 +189,20 @@ class DeformReport:
     collapses: int = 0
     moves: int = 0
     collapse_volume: float = 0.0
+    degenerate_faces: int = 0
+    crossing_pairs: int | None = None
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
              f"(relative change {self.relative_change:+.3e}); {self.steps} RK4 steps; "
              f"{self.vertices_added} vertices added in {self.passes} passes")
-        if not self.converged:
+        if self.edges_over_threshold:
             s += (f"; {self.edges_over_threshold} edges still over the threshold "
                   f"(max_vertices={self.max_vertices})")
+        if self.degenerate_faces:
+            s += f"; {self.degenerate_faces} faces of zero area"
+        if self.crossing_pairs:
+            s += f"; {self.crossing_pairs} pairs of faces cross"
         if self.integration_error is not None:
             s += (f"; integration {self.integration_error:+.2e}, "
                   f"mesh {self.mesh_error:+.2e}")
@@ -244,13 +257,16 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     progress : bool or callable
         As in :func:`spinal.advect`: a bar, or ``progress(done_steps, total_steps)``. Ctrl-C
         stops the call between steps (``KeyboardInterrupt``).
-    check : bool
+    check : bool or "intersections"
         Refuse (``ValueError`` naming ``mesh``) a mesh that does not bound a solid: an open
         mesh (an edge in one face), an edge in more than two faces, inconsistently wound faces
         or a mesh wound inwards (negative enclosed volume). The volume of such a mesh means
         nothing, so neither does the report's ``relative_change``. ``check=False`` deforms it
         anyway (the vertices move the same); an edge in more than two faces or two faces
         running through an edge in the same direction are refused either way.
+        ``"intersections"`` checks the input as ``True`` does and also looks for crossing
+        faces in the result (``DeformReport.crossing_pairs``, an exact test in
+        ``O(F log F)``).
 
     Returns
     -------
@@ -277,7 +293,11 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
             raise ValueError(f"max_vertices: must be at least the mesh's {len(V)} vertices, "
                              f"got {max_vertices}")
     estimate = as_bool(estimate, "estimate")
-    check = as_bool(check, "check")
+    intersections = isinstance(check, str) and check == "intersections"
+    if not intersections:
+        if isinstance(check, str):
+            raise ValueError(f"check: expected True, False or 'intersections', got {check!r}")
+        check = as_bool(check, "check")
     if not (isinstance(progress, bool) or callable(progress)):
         raise TypeError(f"progress: expected a bool or a callable, got {type(progress).__name__}")
     bar = []  # (update, close) of the progress bar, made when the core reports the step count
@@ -290,7 +310,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     try:
         W, Vr, Fr, counts, stats = _core.deform_mesh(
             V, F, field, t0, duration, n, refine, max_vertices, max_passes,
-            tick if progress else None, check)
+            tick if progress else None, bool(check))
     finally:
         if bar:
             bar[0][1]()
@@ -317,17 +337,28 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         integ = (v1 - v2) / scaled_rest * 16 / 15
         mesh_err = change - integ
         timings["estimate"] = time.perf_counter() - clock
-    converged = not bounded
-    if not converged:
+    out = Mesh(W, Fr)
+    tri = W[Fr]
+    degenerate = int(np.count_nonzero(
+        ~np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).any(axis=1)))
+    crossing = len(out.self_intersections()) if intersections else None
+    converged = not bounded and degenerate == 0 and not crossing
+    if bounded:
         warnings.warn(RefinementWarning(
             f"deform: {over} edges are still longer than refine × their rest length (the "
             f"refinement stopped at max_vertices={max_vertices} or max_passes={max_passes} per "
             f"step); raise max_vertices or max_passes"), stacklevel=2)
+    if degenerate or crossing:
+        what = [f"{degenerate} faces of zero area"] if degenerate else []
+        what += [f"{crossing} pairs of crossing faces"] if crossing else []
+        warnings.warn(RefinementWarning(
+            f"deform: the result has {' and '.join(what)} (see Mesh.self_intersections); "
+            f"more steps or a smoother tool may avoid them"), stacklevel=2)
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
                           counts, timings, on_slip, chord, flips, flip_volume, collapses,
-                          moves, collapse_volume)
-    return Mesh(W, Fr), report
+                          moves, collapse_volume, degenerate, crossing)
+    return out, report
 
 
 def _positive(x, name: str) -> float:
