@@ -9,8 +9,6 @@ import numpy as np
 
 from ._validate import MAX_SAMPLES, as_finite, as_float_array, as_int, as_positive
 
-__all__ = ["Bezier", "Curve", "Helix", "Polynomial", "TorusKnot", "Viviani"]
-
 #: The largest winding number of a :class:`TorusKnot` (its third derivative grows as ``q³``).
 _MAX_WINDINGS = 1_000_000
 

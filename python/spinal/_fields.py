@@ -23,27 +23,6 @@ from ._validate import (
     as_vector,
 )
 
-__all__ = [
-    "Field",
-    "along_path",
-    "bend",
-    "capsule",
-    "keyframed",
-    "mesh_curl",
-    "mesh_tool",
-    "rod",
-    "rotation",
-    "sdf_curl",
-    "sdf_tool",
-    "sphere",
-    "strip",
-    "strip_curve",
-    "sum",
-    "torus",
-    "translation",
-    "twist",
-]
-
 
 def _recorded(ctor):
     """The constructor, with the call remembered by the field it returns: a field pickles as

@@ -25,14 +25,22 @@ WRITES = (".ply", ".vtp", ".obj", ".stl", ".glb")
 READS = (".ply", ".obj", ".stl", ".glb", ".gltf", ".off", ".vtp", ".vtk")
 
 
-def write(mesh, path, colors=None) -> pathlib.Path:
-    """Write ``mesh`` (a :class:`spinal.Mesh`) to ``path`` in the format of its suffix."""
+def _path(path, formats: tuple, kind: str) -> tuple[pathlib.Path, str]:
+    """``path`` as a Path and its lower-case suffix, one of ``formats`` (errors name
+    ``path``)."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
-    if suffix not in WRITES:
-        raise ValueError(f"path: unknown format {suffix!r}; use one of {', '.join(WRITES)}")
+    if suffix not in formats:
+        raise ValueError(f"path: unknown {kind}format {suffix!r}; use one of "
+                         f"{', '.join(formats)}")
+    return path, suffix
+
+
+def write(mesh, path, colors=None) -> pathlib.Path:
+    """Write ``mesh`` (a :class:`spinal.Mesh`) to ``path`` in the format of its suffix."""
+    path, suffix = _path(path, WRITES, "")
     rgb, rest = vertex_colors(mesh, colors)
     if suffix == ".vtp":
         _write_vtp(mesh, path, rgb, rest)
@@ -148,12 +156,7 @@ def read(path) -> dict:
     """The arrays of the mesh file ``path``: ``vertices``, ``faces`` and, where the file has
     them, ``normals``, ``uv``, ``point_data`` (vertex colours as ``"colors"``) and
     ``cell_data``; the keyword arguments of :class:`spinal.Mesh`."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
-    path = pathlib.Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in READS:
-        raise ValueError(f"path: unknown mesh format {suffix!r}; use one of {', '.join(READS)}")
+    path, suffix = _path(path, READS, "mesh ")
     if not path.exists():
         raise FileNotFoundError(f"path: no such file: {os.fspath(path)!r}")
     if suffix in (".vtp", ".vtk"):

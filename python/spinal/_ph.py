@@ -11,19 +11,6 @@ import numpy as np
 from . import _core
 from ._validate import MAX_SAMPLES, as_bool, as_finite, as_float_array, as_int, as_positive, as_real
 
-__all__ = [
-    "PHSpline",
-    "angle_fit",
-    "evaluate",
-    "fit",
-
-    "from_quaternions",
-    "hermite",
-    "invariants",
-    "is_ph",
-    "preimage",
-]
-
 
 def _finite(a: np.ndarray, name: str) -> np.ndarray:
     """Finite values, for the inputs of Python-side computations (the core checks its own)."""

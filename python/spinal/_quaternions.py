@@ -20,22 +20,6 @@ from ._validate import (
     as_vector,
 )
 
-__all__ = [
-    "WalkResult",
-    "WalksResult",
-    "camera_frames",
-    "from_quaternions",
-    "make_continuous",
-    "quaternion_frames",
-    "quaternion_length",
-    "slerp",
-    "slerp_frames",
-    "spin",
-    "to_quaternions",
-    "walk_mesh",
-    "walk_mesh_many",
-]
-
 
 def _to_xyzw(q: np.ndarray, scalar_first: bool) -> np.ndarray:
     return np.ascontiguousarray(q[..., [1, 2, 3, 0]] if scalar_first else q)
