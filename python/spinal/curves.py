@@ -24,6 +24,7 @@ from ._curves import (
     TorusKnot,
     Viviani,
 )
+from ._public import publish as _publish
 
 __all__ = [
     "Bezier",
@@ -34,9 +35,4 @@ __all__ = [
     "Viviani",
 ]
 
-# documented, pickled and shown under this module's name
-for _name in __all__:
-    _obj = globals()[_name]
-    if getattr(_obj, "__module__", None) == "spinal._curves":
-        _obj.__module__ = __name__
-del _name, _obj
+_publish(globals())  # documented, pickled and shown under this module's name

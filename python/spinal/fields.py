@@ -73,6 +73,7 @@ from ._fields import (  # noqa: F401
     translation,
     twist,
 )
+from ._public import publish as _publish
 
 __all__ = [
     "Field",
@@ -95,9 +96,4 @@ __all__ = [
     "twist",
 ]
 
-# documented, pickled and shown under this module's name
-for _name in __all__:
-    _obj = globals()[_name]
-    if getattr(_obj, "__module__", None) == "spinal._fields":
-        _obj.__module__ = __name__
-del _name, _obj
+_publish(globals())  # documented, pickled and shown under this module's name

@@ -174,13 +174,9 @@ def read_streamlines(path: str | _os.PathLike) -> Streamlines:
     >>> s = spinal.io.read_streamlines("bundle.trk")              # doctest: +SKIP
     >>> mesh = spinal.tube(s.points, 0.2, 8, dtype="float32")   # doctest: +SKIP
     """
-    if not isinstance(path, (str, _os.PathLike)):
-        raise TypeError(f"path: expected a str or os.PathLike, got {type(path).__name__}")
-    path = _pathlib.Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in STREAMLINE_SUFFIXES:
-        raise ValueError(f"path: unknown streamline format {suffix!r}; use one of "
-                         f"{', '.join(STREAMLINE_SUFFIXES)}")
+    from ._files import _path
+
+    path, suffix = _path(path, STREAMLINE_SUFFIXES, "streamline ")
     if not path.exists():
         raise FileNotFoundError(f"path: no such file: {_os.fspath(path)!r}")
     if suffix in (".trk", ".tck"):

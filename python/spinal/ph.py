@@ -51,6 +51,7 @@ from ._ph import (
     is_ph,
     preimage,
 )
+from ._public import publish as _publish
 
 __all__ = [
     "PHSpline",
@@ -64,9 +65,4 @@ __all__ = [
     "preimage",
 ]
 
-# documented, pickled and shown under this module's name
-for _name in __all__:
-    _obj = globals()[_name]
-    if getattr(_obj, "__module__", None) == "spinal._ph":
-        _obj.__module__ = __name__
-del _name, _obj
+_publish(globals())  # documented, pickled and shown under this module's name

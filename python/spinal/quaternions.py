@@ -22,6 +22,7 @@ unit quaternion ``q``; ``q`` and ``−q`` give the same frame. Quaternion arrays
 * :func:`walk_mesh` — a walker with a frame on a triangle mesh, rotated across every edge.
 """
 
+from ._public import publish as _publish
 from ._quaternions import (
     WalkResult,
     WalksResult,
@@ -54,9 +55,4 @@ __all__ = [
     "walk_mesh_many",
 ]
 
-# documented, pickled and shown under this module's name
-for _name in __all__:
-    _obj = globals()[_name]
-    if getattr(_obj, "__module__", None) == "spinal._quaternions":
-        _obj.__module__ = __name__
-del _name, _obj
+_publish(globals())  # documented, pickled and shown under this module's name
