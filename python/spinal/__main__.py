@@ -236,7 +236,11 @@ def render_pictures(out, x, F, alpha, tube, ring, dented, report, tool_end, bar,
                 f"{report.integration_error:+.0e}, mesh {report.mesh_error:+.0e})\n"
                 f"{report.steps} RK4 steps, +{report.vertices_added} vertices by refinement",
                 position="upper_left", font_size=10)
+    # the view direction of the dent, then the camera moved until the whole ring and the
+    # tool fit below the caption
     pl.camera_position = [(3.2, -2.2, 1.9), (0.6, 0.0, 0.0), (0, 0, 1)]
+    pl.reset_camera()  # fits the bounding sphere: generous for a flat ring
+    pl.camera.zoom(1.5)
     finish(pl, "dented_ring.png")
 
     # 4. the bar bent with its spine: uncorrected and radial correction, side by side
