@@ -378,6 +378,7 @@ pl.add_arrows(knot[i][None], -back[None], mag=0.8, color="crimson")   # and wher
 pl.camera.position = knot[i] + 4.0 * back + 2.5 * up
 pl.camera.focal_point = knot[i] - 1.0 * back
 pl.camera.up = up
+pl.reset_camera()                # the same direction, moved back until the whole knot fits
 pl.show()""",
     """md:## Pythagorean-hodograph cubics: rational frames
 
