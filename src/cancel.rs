@@ -343,7 +343,7 @@ mod tests {
                     uv: None,
                 };
                 // a stopped sweep's result is discarded, whatever it holds
-                let folds = p.write_into(out, c);
+                let folds = p.write_into(out, c, None);
                 (folds, v.concat(), f)
             };
             let plain = Prepared::new(spine, &offsets, &profile, true, opts).expect("valid");
@@ -434,7 +434,7 @@ mod tests {
                     uv: None,
                 };
                 // a stopped sweep's result is discarded, whatever it holds
-                let done = p.write_into(out, c).is_ok();
+                let done = p.write_into(out, c, None).is_ok();
                 (done, v.concat(), f)
             })
         };

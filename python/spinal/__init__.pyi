@@ -90,6 +90,7 @@ def frames(
     previous_twist: bool = False,
     guide_sign: Literal["follow", "free"] = "follow",
     on_invalid: Literal["raise", "skip"] = "raise",
+    progress: _Progress = False,
 ) -> _F: ...
 def frames_in_time(
     points_t: _Array | None,
@@ -109,6 +110,7 @@ def frames_in_time(
     guide_sign: Literal["follow", "free"] = "follow",
     lengths: _Ints | None = None,
     offsets: _Ints | None = None,
+    progress: _Progress = False,
 ) -> _F: ...
 def closing_angle(
     points: _Array | Curve | _Curves | None,
@@ -230,6 +232,7 @@ def sweep(
     on_short: Literal["raise", "skip"] = "raise",
     on_invalid: Literal["raise", "skip"] = "raise",
     join: Literal["round", "bevel", "miter"] = "round",
+    progress: _Progress = False,
 ) -> Mesh: ...
 def tube(
     points: _Array | _Curves,
@@ -253,6 +256,7 @@ def tube(
     on_short: Literal["raise", "skip"] = "raise",
     on_invalid: Literal["raise", "skip"] = "raise",
     join: Literal["round", "bevel", "miter"] = "round",
+    progress: _Progress = False,
 ) -> Mesh: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------
@@ -329,6 +333,7 @@ def stamp(
     reach: float | None = None,
     frames: int = 10,
     iterations: int = 2,
+    progress: _Progress = False,
 ) -> tuple[Mesh, StampReport]: ...
 
 # ---- fleshing -----------------------------------------------------------------------------

@@ -7,39 +7,14 @@ import itertools
 import numpy as np
 
 from . import _core
-from ._validate import as_bool, as_choice, as_finite, as_int, as_points
+from ._progress import Progress, checked
+from ._validate import as_choice, as_finite, as_int, as_points
 from .fields import Field
 
 __all__ = ["advect"]
 
 # the most steps a call takes (the default step rule refuses more too)
 MAX_STEPS = 100_000_000
-
-
-def _progress_bar(total: int, progress):
-    """A callable ``update(done)`` and ``close()`` for ``progress`` (True: tqdm if installed,
-    else a line on stderr; a callable: called as ``progress(done, total)``)."""
-    if callable(progress):
-        return (lambda done: progress(done, total)), (lambda: None)
-    try:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=total, unit="step", desc="advect")
-        state = {"n": 0}
-
-        def update(done):
-            bar.update(done - state["n"])
-            state["n"] = done
-
-        return update, bar.close
-    except ImportError:
-        import sys
-
-        def update(done):
-            sys.stderr.write(f"\radvect: {done}/{total} steps")
-            sys.stderr.flush()
-
-        return update, (lambda: sys.stderr.write("\n"))
 
 
 def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
@@ -94,8 +69,7 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
     duration = as_finite(duration, "duration")
     t0 = as_finite(t0, "t0")
     method = as_choice(method, "method", ("rk4", "euler", "split"))
-    if not callable(progress):
-        progress = as_bool(progress, "progress")
+    progress = checked(progress)
     if steps is None:
         steps = field.steps(duration)
     else:
@@ -114,22 +88,17 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         ns = [max(1, int(np.ceil(steps * abs(b - a) / abs(duration) - 1e-9)))
               for a, b in itertools.pairwise(ts)]
         runs = [(float(a), float(b - a) / n, n) for a, b, n in zip(ts[:-1], ts[1:], ns)]
-        if not progress:
+        if progress is False:
             # one core call: the points are put in their spatial order once for all the runs
             return _core.advect_runs(x, field, runs, method)
         total = sum(ns)
-        update, close = _progress_bar(total, progress)
-        try:
+        with Progress(progress, total, "advect", "step") as bar:
             return _core.advect_runs(x, field, runs, method,
-                                     lambda done, total: update(done), max(1, total // 100))
-        finally:
-            close()
+                                     lambda done, total: bar.update(done), max(1, total // 100))
     h = duration / steps
-    if not progress:
+    if progress is False:
         return _core.advect(x, field, t0, h, steps, method)
-    update, close = _progress_bar(steps, progress)
-    try:  # one call: the core reports every 1/100 of the steps (same bits as without)
+    # one call: the core reports every 1/100 of the steps (same bits as without)
+    with Progress(progress, steps, "advect", "step") as bar:
         return _core.advect(x, field, t0, h, steps, method,
-                            lambda done, total: update(done), max(1, steps // 100))
-    finally:
-        close()
+                            lambda done, total: bar.update(done), max(1, steps // 100))

@@ -15,8 +15,12 @@ import time
 
 import numpy as np
 
-#: Spine rows per block of a bundle's tube (a progress step; Ctrl-C stops between blocks).
+#: Spine rows per chunk of a bundle streamed to a file (a progress step; Ctrl-C stops
+#: between chunks).
 BLOCK_ROWS = 1 << 18
+
+#: Mesh formats written chunk by chunk (the others are written from one mesh in memory).
+STREAMED = (".ply", ".vtp")
 
 TUBE_EXAMPLES = """examples:
   python -m spinal tube fornix.trk fornix.vtp --radius 0.3 --color orientation
@@ -27,25 +31,29 @@ TUBE_EXAMPLES = """examples:
 
 
 class _Progress:
-    """A bar (tqdm, when installed and stderr is a terminal), else nothing; ``--quiet``
-    silences the summary lines too."""
+    """A bar (tqdm, when installed and stderr is a terminal) showing a count of ``total``
+    (None: not known), else nothing; ``--quiet`` silences the summary lines too."""
 
-    def __init__(self, total: int, what: str, quiet: bool):
+    def __init__(self, total: int | None, what: str, quiet: bool):
         self.bar = None
         if not quiet and sys.stderr.isatty():
             try:
                 from tqdm import tqdm
 
-                self.bar = tqdm(total=total, desc=what, unit="pt", unit_scale=True,
-                                file=sys.stderr, leave=False)
+                self.bar = tqdm(total=total, desc=what, unit="pt" if total else " curves",
+                                unit_scale=True, file=sys.stderr, leave=False)
             except ImportError:
                 pass
 
-    def step(self, n: int) -> None:
+    def step(self, done: int) -> None:
+        """Show ``done`` so far."""
         if self.bar is not None:
-            self.bar.update(n)
+            self.bar.update(done - self.bar.n)
 
-    def close(self) -> None:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
         if self.bar is not None:
             self.bar.close()
 
@@ -140,41 +148,56 @@ def _check_paths(a, output_suffixes=None) -> None:
 def tube(a) -> int:
     import spinal
 
+    from . import io
     from ._files import WRITES
 
     _check_paths(a, WRITES)
     if a.radius_from is None and not a.radius > 0:
         raise ValueError(f"--radius: must be positive, got {a.radius}")
+    dtype = np.float32 if a.float32 else np.float64
+    out = pathlib.Path(a.output)
     t0 = time.perf_counter()
+    if out.suffix.lower() in STREAMED and a.radius_from is None and a.color in (None,
+                                                                                "orientation"):
+        # nothing needs the whole bundle: read and tubed a block at a time, written as
+        # it goes (memory of one block)
+        src = pathlib.Path(a.input)
+        if src.suffix.lower() not in io.STREAMLINE_SUFFIXES:
+            src = read_curves(src).points
+        with _Progress(None, "tube", a.quiet) as bar:
+            io.tube_file(src, out, a.radius, a.sides, chunk_points=BLOCK_ROWS, dtype=dtype,
+                         colors=a.color, join=a.join,
+                         progress=(lambda done: bar.step(done)) if bar.bar else False)
+        _say(a.quiet, f"wrote {a.output} ({out.stat().st_size / 1e6:,.1f} MB, "
+                      f"{time.perf_counter() - t0:.2f} s)")
+        return 0
     s = read_curves(pathlib.Path(a.input))
     rows = sum(len(p) for p in s.points)
     _say(a.quiet, f"read {len(s.points):,} curve(s), {rows:,} points from {a.input} "
                   f"({time.perf_counter() - t0:.2f} s)")
     radius = _per_point(s, a.radius_from, "--radius-from") if a.radius_from else None
     colors = _colors(s, a.color) if a.color else None
-    dtype = np.float32 if a.float32 else np.float64
-    # blocks of whole curves: a bar moves and Ctrl-C stops between them; the meshes of the
-    # blocks, concatenated, are the one call's mesh (every curve is swept on its own)
-    blocks, start, size = [], 0, 0
-    for i, p in enumerate(s.points):
-        size += len(p)
-        if size >= BLOCK_ROWS or i == len(s.points) - 1:
-            blocks.append((start, i + 1))
-            start, size = i + 1, 0
-    progress = _Progress(rows, "tube", a.quiet)
-    meshes = []
     t1 = time.perf_counter()
-    try:
-        for lo, hi in blocks:
-            pts = s.points[lo:hi]
-            r = a.radius if radius is None else np.concatenate(radius[lo:hi]).astype(float)
-            data = None if colors is None else {"colors": np.concatenate(colors[lo:hi])}
-            meshes.append(spinal.tube(pts, r, a.sides, dtype=dtype, join=a.join,
-                                      point_data=data, on_short="skip", on_invalid="skip"))
-            progress.step(sum(len(p) for p in pts))
-    finally:
-        progress.close()
-    mesh = meshes[0] if len(meshes) == 1 else spinal.Mesh.concatenate(meshes)
+    if out.suffix.lower() in STREAMED:
+        # per-point radius and colours computed over the whole bundle, then streamed out
+        data = [{} for _ in s.points]
+        for name, values in (("radius", radius), ("colors", colors)):
+            for d, v in zip(data, values or ()):
+                d[name] = v
+        with _Progress(None, "tube", a.quiet) as bar:
+            io.tube_file(zip(s.points, data), out, "radius" if radius else a.radius,
+                         a.sides, chunk_points=BLOCK_ROWS, dtype=dtype,
+                         colors="colors" if colors else None, join=a.join,
+                         progress=(lambda done: bar.step(done)) if bar.bar else False)
+        _say(a.quiet, f"wrote {a.output} ({out.stat().st_size / 1e6:,.1f} MB, "
+                      f"{time.perf_counter() - t1:.2f} s)")
+        return 0
+    r = a.radius if radius is None else np.concatenate(radius).astype(float)
+    data = None if colors is None else {"colors": np.concatenate(colors)}
+    with _Progress(rows, "tube", a.quiet) as bar:
+        mesh = spinal.tube(s.points, r, a.sides, dtype=dtype, join=a.join, point_data=data,
+                           on_short="skip", on_invalid="skip",
+                           progress=(lambda done, total: bar.step(done)) if bar.bar else False)
     _say(a.quiet, f"tube: {len(mesh.vertices):,} vertices, {len(mesh.faces):,} faces "
                   f"({time.perf_counter() - t1:.2f} s)")
     mesh.save(a.output)

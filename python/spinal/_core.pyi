@@ -22,6 +22,7 @@ def frames_sampled(
     end_frames: npt.NDArray[np.float64] | None,
     turns: int,
     points_arg: str = "points",
+    progress: Callable[[int, int], object] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def frames_analytic(
     points: npt.NDArray[np.float64],
@@ -110,6 +111,7 @@ def sweep_mesh(
     uv: bool = True,
     tangents: npt.NDArray[np.float64] | None = None,
     join: str = "round",
+    progress: Callable[[int, int], object] | None = None,
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],
@@ -458,6 +460,7 @@ def stamp(
     reach: float,
     frames: int,
     iterations: int,
+    progress: Callable[[int, int], object] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 
 # ---- worker threads (spinal._threads) ---------------------------------------------------------

@@ -28,9 +28,10 @@ from dataclasses import field as _dc_field
 import numpy as np
 
 from . import _core
-from ._advect import MAX_STEPS, _progress_bar
+from ._advect import MAX_STEPS
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import volumes_at_scale as _volumes
+from ._progress import Progress, checked
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
 from .fields import Field
 
@@ -298,22 +299,21 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         if isinstance(check, str):
             raise ValueError(f"check: expected True, False or 'intersections', got {check!r}")
         check = as_bool(check, "check")
-    if not (isinstance(progress, bool) or callable(progress)):
-        raise TypeError(f"progress: expected a bool or a callable, got {type(progress).__name__}")
-    bar = []  # (update, close) of the progress bar, made when the core reports the step count
+    progress = checked(progress)
+    bar = []  # the progress report, made when the core reports the step count
 
     def tick(done, total):
         if not bar:
-            bar.append(_progress_bar(total, progress))
-        bar[0][0](done)
+            bar.append(Progress(progress, total, "deform", "step"))
+        bar[0].update(done)
 
     try:
         W, Vr, Fr, counts, stats = _core.deform_mesh(
             V, F, field, t0, duration, n, refine, max_vertices, max_passes,
-            tick if progress else None, bool(check))
+            None if progress is False else tick, bool(check))
     finally:
         if bar:
-            bar[0][1]()
+            bar[0].close()
     (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
         (flips, flip_volume, collapses, moves, collapse_volume) = stats
     clock = time.perf_counter()
@@ -400,7 +400,7 @@ class StampReport:
 
 
 def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
-          iterations: int = 2) -> tuple[Mesh, StampReport]:
+          iterations: int = 2, progress=False) -> tuple[Mesh, StampReport]:
     """Press a sphere into a closed mesh in contact only (thesis §11.2.6, the "stamper"),
     giving the dented volume back as a protrusion around the contact.
 
@@ -427,6 +427,10 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
     reach : R > 0 of the protrusion field (default ``radius``).
     frames : number of moves, 1 … 1,000,000.
     iterations : secant corrections per frame, 0 … 1000.
+    progress : bool or callable
+        Report the frames done: True shows a bar (tqdm when installed, in a terminal or a
+        notebook) or a line on stderr; a callable is called as ``progress(done, frames)``
+        after every frame.
 
     Ctrl-C stops it between frames (``KeyboardInterrupt``). A tool that swallows every vertex
     of the mesh or touches every triangle in a frame raises ``ValueError`` naming ``radius``;
@@ -445,7 +449,10 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
         f"must be at least 1 and at most {MAX_FRAMES:,}, got {x}"))
     iterations = as_int(iterations, "iterations", 0, MAX_ITERATIONS, out_of_bounds=lambda x: (
         f"must be ≥ 0 and at most {MAX_ITERATIONS}, got {x}"))
-    W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations)
+    progress = checked(progress)
+    with Progress(progress, frames, "stamp", "frame") as bar:
+        W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations,
+                             (lambda done, total: bar.update(done)) if bar else None)
     e, (rest, vol) = _volumes(F, V, W)
     change = vol / rest - 1 if rest != 0 else float("nan")
     rest, vol = _unscaled(rest, e), _unscaled(vol, e)

@@ -12,6 +12,7 @@ import numpy as np
 from . import _core
 from ._core import Field
 from ._mesh import mesh_arrays
+from ._progress import Progress, checked
 from ._validate import (
     as_bool,
     as_finite,
@@ -30,7 +31,9 @@ def _recorded(ctor):
 
     @functools.wraps(ctor)
     def build(*args, **kwargs):
-        return ctor(*args, **kwargs)._with_recipe(ctor.__name__, args, kwargs)
+        # a progress report does not change the field: not part of its recipe
+        kept = {k: v for k, v in kwargs.items() if k != "progress"}
+        return ctor(*args, **kwargs)._with_recipe(ctor.__name__, args, kept)
 
     return build
 
@@ -342,6 +345,9 @@ def _sdf_samples(grid, origin, spacing):
     return np.array(a, dtype=np.float64), o, h
 
 
+#: Grid nodes per slab of a mesh's sampled distance (whole planes; at least one plane).
+SLAB_NODES = 1 << 16
+
 # cells per reach that the blend region needs (the core refuses coarser grids, naming
 # `spacing`; `mesh_tool` chooses its spacing and names `resolution`)
 MIN_CELLS_PER_REACH = 4
@@ -357,7 +363,7 @@ def _closed_mesh(mesh):
 
 @_recorded
 def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
-              blend: str = "c1", moving: bool = True) -> Field:
+              blend: str = "c1", moving: bool = True, progress=False) -> Field:
     """A free-form tool given as a closed triangle mesh, translating with ``velocity``: the
     field of :func:`sdf_tool` with the mesh's signed distance sampled on a grid.
 
@@ -377,14 +383,21 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
         ``reach/4`` (``ValueError`` naming ``resolution`` otherwise).
     center : (3,) the tool's centre C (default: the centroid of the enclosed volume).
     blend, moving : as for :func:`sdf_tool`.
+    progress : bool or callable
+        Report the grid nodes sampled (the long part at high resolution: 250³ nodes take
+        minutes): ``True`` shows a bar (tqdm when installed, in a terminal or a notebook)
+        or a line on stderr at every tenth; a callable is called as ``progress(done,
+        nodes)``. The distances are sampled in slabs of grid planes, between which Ctrl-C
+        stops the call, with or without ``progress``.
     """
-    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center)
+    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
     return _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
 
 
-def _mesh_samples(mesh, reach, resolution, center):
+def _mesh_samples(mesh, reach, resolution, center, progress):
     """The signed distance of a closed mesh sampled on the grid of :func:`mesh_tool`:
     samples, origin, spacing, centre and reach."""
+    progress = checked(progress)
     V, F, centroid = _closed_mesh(mesh)
     c = centroid if center is None else as_vector(center, "center")
     rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else as_real(reach, "reach")
@@ -412,9 +425,21 @@ def _mesh_samples(mesh, reach, resolution, center):
     origin = lo - rf - pad * h
     shape = np.ceil((hi - lo + 2 * (rf + pad * h)) / h).astype(int) + 1
     axes = [origin[i] + h * np.arange(shape[i]) for i in range(3)]
-    P = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    d = igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0]
-    return np.ascontiguousarray(d.reshape(tuple(shape))), origin, h, c, rf
+    # slabs of whole x planes of at least SLAB_NODES nodes: each point's distance is its
+    # own, so the slabs give the one call's values; Ctrl-C and reports come between them
+    d = np.empty(tuple(shape))
+    plane = int(shape[1] * shape[2])
+    per = max(1, SLAB_NODES // plane)
+    yz = np.stack(np.meshgrid(axes[1], axes[2], indexing="ij"), axis=-1).reshape(-1, 2)
+    with Progress(progress, d.size, "distance grid", "node") as bar:
+        for i0 in range(0, int(shape[0]), per):
+            xs = axes[0][i0:i0 + per]
+            P = np.column_stack([np.repeat(xs, plane), np.tile(yz, (len(xs), 1))])
+            d[i0:i0 + len(xs)] = igl.signed_distance(
+                P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0].reshape(
+                    len(xs), shape[1], shape[2])
+            bar.update((i0 + len(xs)) * plane)
+    return d, origin, h, c, rf
 
 
 def sum(fields: Iterable[Field]) -> Field:
@@ -542,11 +567,11 @@ def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, piv
 @_recorded
 def mesh_curl(mesh, *, velocity=None, angular_velocity=None, pivot=None, reach=None,
               resolution: int = 64, center=None, falloff_power: int = 2,
-              moving: bool = True) -> Field:
+              moving: bool = True, progress=False) -> Field:
     """A curl tool whose shape is a closed triangle mesh: its signed distance sampled on the
-    grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``; needs
-    libigl), then :func:`sdf_curl`."""
-    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center)
+    grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``,
+    ``progress``; needs libigl), then :func:`sdf_curl`."""
+    values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
     return _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
                       falloff_power, moving, "mesh_curl")
 

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from . import _core, _merge
+from ._progress import Progress, Reported, checked
 from ._steer import guide_rows, previous_frames, steering
 from ._validate import (
     MAX_SAMPLES,
@@ -30,6 +31,9 @@ METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
+
+#: Rows per block of a bundle's frames (or of a time series) computed with ``progress``.
+BLOCK_ROWS = 1 << 18
 
 
 def _orientation(x: Any, name: str, curves: int, bundle: bool):
@@ -105,7 +109,7 @@ def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"
 
 
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-             lengths, offsets, points_arg="points"):
+             lengths, offsets, points_arg="points", report=None):
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -121,6 +125,8 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         iv, if_ = _orientation(initial, "initial", 1, False)
         ev, ef = _orientation(end, "end", 1, False)
         out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns)
+        if report is not None:
+            report(len(out), len(out))
         return out, np.array([angle]), False
     if u is not None:
         raise TypeError("u: only used with an analytic curve from spinal.curves")
@@ -136,7 +142,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     def run(pts, offs, tgs):
         return _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE,
                                     chords_from_tangents, closed, iv, if_, ev, ef, turns,
-                                    points_arg)
+                                    points_arg, report)
 
     if pts is None or chords_from_tangents:  # (the quadrature's grid is the rows as given)
         out, angles = run(pts, offs, tgs)
@@ -175,6 +181,7 @@ def frames(
     previous_twist: bool = False,
     guide_sign: str = "follow",
     on_invalid: str = "raise",
+    progress=False,
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -309,6 +316,13 @@ def frames(
         naming the curve and row) or leave them out, with a :class:`SkippedCurvesWarning`
         naming them (its ``curves``), their rows NaN in the result (the other curves'
         frames are those of the call without them). Not with ``constraints``.
+    progress : bool or callable
+        Report the rows done (those of the curves done, in any order): ``True`` shows a bar
+        (tqdm when installed, in a terminal or a notebook) or a line on stderr at every
+        tenth; a callable is called as ``progress(rows_done, rows)`` from the calling
+        thread, about every 20 ms while the count moves and once at the end. The work only
+        counts (the same frames, bit for bit). With ``constraints``, ``guide``,
+        ``previous``, ``twist_rule`` or per-interval ``turns``, one report at the end.
     previous : array_like (n, 3, 3), optional
         The frames of the same curve at the previous time step (same sample count): the
         result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
@@ -358,6 +372,7 @@ def frames(
     (200, 3, 3)
     """
     on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
+    progress = checked(progress)
     if on_invalid == "skip" and not isinstance(points, Curve):
         cut = _merge.invalid_curves(points, lengths, offsets, as_bool(closed, "closed"))
         if cut is not None:
@@ -376,7 +391,7 @@ def frames(
                     offsets=kept, twist_rule=twist_rule, guide=_cut_rows(guide, keep, n),
                     guide_weight=guide_weight, guide_tolerance=guide_tolerance,
                     previous=_cut_rows(previous, keep, n), previous_twist=previous_twist,
-                    guide_sign=guide_sign)
+                    guide_sign=guide_sign, progress=progress)
             return out
     previous_twist = as_bool(previous_twist, "previous_twist")
     guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
@@ -385,11 +400,15 @@ def frames(
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
     if (constraints is not None or guide is not None or previous is not None
             or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
-        return _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
-                        lengths, offsets, constraints, twist_rule, guide, guide_weight,
-                        guide_tolerance, previous, previous_twist, guide_sign)
-    out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-                         lengths, offsets)
+        out = _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
+                       lengths, offsets, constraints, twist_rule, guide, guide_weight,
+                       guide_tolerance, previous, previous_twist, guide_sign)
+        with Progress(progress, len(out), "frames", "row") as bar:
+            bar.update(len(out))
+        return out
+    with Reported(progress, "frames", "row") as report:
+        out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection,
+                             u, lengths, offsets, report=report.callback)
     return out
 
 
@@ -709,6 +728,7 @@ def frames_in_time(
     guide_sign: str = "follow",
     lengths=None,
     offsets=None,
+    progress=False,
 ) -> np.ndarray:
     r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
 
@@ -760,6 +780,10 @@ def frames_in_time(
         The weight of the previous step's ``r`` against the twist rate, per sample (> 0).
     guide, guide_weight, guide_tolerance, guide_sign
         A guide followed at every step (see above and :func:`frames`).
+    progress : bool or callable
+        Report the time steps done: ``True`` shows a bar (tqdm when installed, in a
+        terminal or a notebook) or a line on stderr at every tenth; a callable is called as
+        ``progress(steps_done, T)``. The same frames, bit for bit.
 
     Returns
     -------
@@ -774,12 +798,13 @@ def frames_in_time(
     previous_twist = as_bool(previous_twist, "previous_twist")
     guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
+    progress = checked(progress)
     chained = previous_twist or guide is not None or lengths is not None or offsets is not None
     if chained:
         return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
                                        reflection, previous, previous_twist, previous_weight,
                                        guide, guide_weight, guide_tolerance, guide_sign,
-                                       lengths, offsets)
+                                       lengths, offsets, progress)
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -788,24 +813,49 @@ def frames_in_time(
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
+    # with progress: blocks of steps, each continuing the frames of the block before (the
+    # core's step k continues step k − 1 in the same way, so the bits are the one call's)
+    per = steps if progress is False else max(1, BLOCK_ROWS // max(n, 1))
+    out = np.empty((steps, n, 3, 3)) if per < steps else None
     try:
-        out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
-                                   reflection == "tangents", closed, iv, if_, turns, prev)
+        with Progress(progress, steps, "frames_in_time", "step") as bar:
+            for k0 in range(0, steps, per):
+                k1 = min(steps, k0 + per)
+                cut = (lambda a, k0=k0, k1=k1: None if a is None else a[k0:k1])
+                got = _core.frames_in_time(flat(cut(p)), flat(cut(tg)), k1 - k0, method,
+                                           DEFAULT_TANGENT_RULE, reflection == "tangents",
+                                           closed, iv if k0 == 0 else None,
+                                           if_ if k0 == 0 else None, turns,
+                                           prev if k0 == 0 else out[k0 - 1])
+                if out is None:
+                    out = got.reshape(steps, n, 3, 3)
+                else:
+                    out[k0:k1] = got.reshape(k1 - k0, n, 3, 3)
+                bar.update(k1)
     except _core.RepeatedPointsError:
         if reflection == "tangents":
             raise
         # repeated samples: step by step through frames(previous=), which merges them
         return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
                                        reflection, previous, False, 1.0, None, 1.0, 1e-3,
-                                       "follow", None, None)
-    return out.reshape(steps, n, 3, 3)
+                                       "follow", None, None, progress)
+    except ValueError as exc:
+        if per >= steps:
+            raise
+        # a later block: the message names the step within it; the one call names it in all
+        del exc
+        out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
+                                   reflection == "tangents", closed, iv, if_, turns, prev)
+        return out.reshape(steps, n, 3, 3)
+    return out
 
 
 def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns, reflection,
                             previous, previous_twist, previous_weight, guide, guide_weight,
-                            guide_tolerance, guide_sign, lengths, offsets) -> np.ndarray:
+                            guide_tolerance, guide_sign, lengths, offsets,
+                            progress=False) -> np.ndarray:
     """:func:`frames_in_time` step by step through :func:`frames` (``previous_twist``, a
-    guide, or a bundle)."""
+    guide, or a bundle), with a ``progress`` report after every step."""
     p, tg, steps, n = _time_steps(points_t, tangents_t)
     previous_weight = as_real(previous_weight, "previous_weight")
     if not 0.0 < previous_weight < np.inf:
@@ -825,31 +875,40 @@ def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns
     out = np.empty((steps, n, 3, 3))
     common = {"method": method, "closed": closed, "turns": turns, "reflection": reflection,
               "lengths": lengths, "offsets": offsets}
-    for k in range(steps):
-        pts = p[k] if p is not None else None
-        tgk = tg[k] if tg is not None else None
-        before = out[k - 1] if k else previous
-        try:
-            if g is not None:
-                # axes: each row's sign continues the step before (from the second step on)
-                gk = g[k] if g.ndim == 3 else g
-                by = before if guide_sign == "free" else None
-                out[k] = frames(pts, tgk, initial=None if by is not None else initial,
-                                guide=gk, guide_weight=guide_weight,
-                                guide_tolerance=guide_tolerance, guide_sign=guide_sign,
-                                previous=by, **common)
-            elif before is None:
-                out[k] = frames(pts, tgk, initial=initial, **common)
-            else:
-                out[k] = frames(pts, tgk, previous=before, previous_twist=previous_twist,
-                                guide_weight=previous_weight, **common)
-        except ValueError as exc:
-            msg = str(exc)
-            for arg, name in (("points: ", "points_t"), ("tangents: ", "tangents_t")):
-                if msg.startswith(arg):
-                    raise ValueError(f"{name}: time step {k}: {msg[len(arg):]}") from None
-            raise
+    with Progress(progress, steps, "frames_in_time", "step") as bar:
+        for k in range(steps):
+            _frames_step(k, p, tg, g, out, previous, guide_sign, initial, guide_weight,
+                         guide_tolerance, previous_twist, previous_weight, common)
+            bar.update(k + 1)
     return out
+
+
+def _frames_step(k, p, tg, g, out, previous, guide_sign, initial, guide_weight,
+                 guide_tolerance, previous_twist, previous_weight, common) -> None:
+    """Step ``k`` of :func:`_frames_in_time_chained` into ``out[k]``."""
+    pts = p[k] if p is not None else None
+    tgk = tg[k] if tg is not None else None
+    before = out[k - 1] if k else previous
+    try:
+        if g is not None:
+            # axes: each row's sign continues the step before (from the second step on)
+            gk = g[k] if g.ndim == 3 else g
+            by = before if guide_sign == "free" else None
+            out[k] = frames(pts, tgk, initial=None if by is not None else initial,
+                            guide=gk, guide_weight=guide_weight,
+                            guide_tolerance=guide_tolerance, guide_sign=guide_sign,
+                            previous=by, **common)
+        elif before is None:
+            out[k] = frames(pts, tgk, initial=initial, **common)
+        else:
+            out[k] = frames(pts, tgk, previous=before, previous_twist=previous_twist,
+                            guide_weight=previous_weight, **common)
+    except ValueError as exc:
+        msg = str(exc)
+        for arg, name in (("points: ", "points_t"), ("tangents: ", "tangents_t")):
+            if msg.startswith(arg):
+                raise ValueError(f"{name}: time step {k}: {msg[len(arg):]}") from None
+        raise
 
 
 def _time_steps(points_t, tangents_t):

@@ -11,6 +11,7 @@ import numpy as np
 from . import _core, _merge
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
+from ._progress import Reported, checked
 from ._validate import (
     as_bool,
     as_choice,
@@ -27,6 +28,7 @@ __all__ = ["sweep", "tube"]
 
 #: Most sides of a :func:`tube` (a 2**20-gon is round to 5e-12 of its radius).
 MAX_SIDES = 2**20
+
 
 
 def _dtype(dtype) -> bool:
@@ -94,6 +96,7 @@ def sweep(
     on_short: str = "raise",
     on_invalid: str = "raise",
     join: str = "round",
+    progress=False,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -205,6 +208,13 @@ def sweep(
         tubes), one flat band (``"bevel"``), or one ring in the bisector plane (``"miter"``,
         the exact mitre; a bevel where it would exceed ``miter_limit``). Smooth, well
         sampled spines get no joins, whichever is chosen.
+    progress : bool or callable
+        Report the spine rows swept (those of the spines done, in any order, after repeats
+        are merged and skipped curves left out): ``True`` shows a bar (tqdm when installed,
+        in a terminal or a notebook) or a line on stderr at every tenth; a callable is
+        called as ``progress(rows_done, rows)`` from the calling thread, about every 20 ms
+        while the count moves and once at the end. The work only counts (the same mesh, bit
+        for bit, at the same speed).
 
     Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
     bounding box's largest side) are one point: they are merged into the first of them,
@@ -250,7 +260,7 @@ def sweep(
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
                        tangents, tangent_rule, dtype, normals, uv, point_data, on_short,
-                       on_invalid, join)
+                       on_invalid, join, progress)
 
 
 def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
@@ -279,9 +289,10 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
                 normals=True, uv=True, point_data=None, on_short="raise",
-                on_invalid="raise", join="round") -> Mesh:
+                on_invalid="raise", join="round", progress=False) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
+    progress = checked(progress)
     pts, offs, bundle = as_curves(points, lengths, offsets)
     n = pts.shape[0]
     closed = as_bool(closed, "closed")
@@ -357,13 +368,16 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         return mesh
     given = _orig_offsets(lens, n)
 
+    report = Reported(progress, "tube" if scale_arg == "radius" else "sweep", "row")
+
     def core(pts, offs, fr, tg, sc, tw):
         fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
-        return _core.sweep_mesh(
-            pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
-            profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
-            single, single, want_normals, want_uv, tg, join,
-        )
+        with report:
+            return _core.sweep_mesh(
+                pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
+                profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
+                single, single, want_normals, want_uv, tg, join, report.callback,
+            )
 
     def merged(p):
         # consecutive repeated samples: merged (a ring for the first row of each group)
@@ -641,6 +655,7 @@ def tube(
     on_short: str = "raise",
     on_invalid: str = "raise",
     join: str = "round",
+    progress=False,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -651,7 +666,7 @@ def tube(
     (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
     Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
     ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``,
-    ``join``) as in :func:`sweep`.
+    ``join``, ``progress``) as in :func:`sweep`.
     """
     # the core sees only the polygon built here
     sides = as_int(sides, "sides", 3, MAX_SIDES, out_of_bounds=lambda x: (
@@ -662,4 +677,4 @@ def tube(
     # the core checks the radius' values, naming radius
     return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
-                       dtype, normals, uv, point_data, on_short, on_invalid, join)
+                       dtype, normals, uv, point_data, on_short, on_invalid, join, progress)

@@ -1,4 +1,4 @@
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Literal, TypeAlias
 
 import numpy as np
@@ -157,6 +157,7 @@ def mesh_tool(
     center: _Array | None = None,
     blend: _Blend = "c1",
     moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
 ) -> Field: ...
 def sdf_curl(
     grid: _Array,
@@ -182,6 +183,7 @@ def mesh_curl(
     center: _Array | None = None,
     falloff_power: _Power = 2,
     moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
 ) -> Field: ...
 def rod(
     points: _Array,

@@ -223,6 +223,11 @@ def _lazy_items(path: _pathlib.Path):
             yield p, {k: v[i] for k, v in s.point_data.items()}
 
 
+def _is_pair(x) -> bool:
+    """Whether an item of ``tube_file``'s ``src`` is a ``(points, data)`` pair."""
+    return isinstance(x, tuple) and len(x) == 2 and isinstance(x[1], dict)
+
+
 def _orientation(p: _np.ndarray) -> _np.ndarray:
     """``|unit tangent|`` as RGB in [0, 1] (x red, y green, z blue), the tractography
     convention; zeros where a curve has fewer than two distinct points."""
@@ -279,7 +284,9 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     ----------
     src : str, os.PathLike or iterable of array_like (n_i, 3)
         A streamline file (see :func:`read_streamlines`) or the streamlines themselves (a
-        list, a generator, nibabel's ``ArraySequence``).
+        list, a generator, nibabel's ``ArraySequence``); an item may also be a pair
+        ``(points, data)`` with ``data`` a dict of per-point arrays that ``radius`` and
+        ``colors`` can name.
     dst : str or os.PathLike
         The mesh file: ``.ply`` (binary) or ``.vtp`` (appended binary).
     radius : float or str
@@ -297,8 +304,9 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     join : "round", "bevel" or "miter"
         As in :func:`spinal.tube`.
     progress : bool or callable
-        ``True``: a bar (tqdm, when installed) counting streamlines; a callable is called
-        as ``progress(streamlines_done)`` after every chunk.
+        ``True``: a bar counting streamlines (tqdm when installed, in a terminal or a
+        notebook), else a line on stderr after every chunk; a callable is called as
+        ``progress(streamlines_done)`` after every chunk.
 
     Returns
     -------
@@ -307,6 +315,7 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     """
     from ._files import Spool, vertex_colors
     from ._mesh import FoldOverWarning, SkippedCurvesWarning
+    from ._progress import Progress
     from ._sweep import tube
     from ._validate import as_int
 
@@ -325,17 +334,10 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
                              f"{', '.join(STREAMLINE_SUFFIXES)}")
         items = _lazy_items(path)
     else:
-        items = ((p, {}) for p in src)
+        items = (x if _is_pair(x) else (x, {}) for x in src)
     named = [x for x in (radius, colors) if isinstance(x, str) and x != "orientation"]
     spool = Spool(_pathlib.Path(dst))
-    bar = None
-    if progress is True:
-        try:
-            from tqdm.auto import tqdm
-
-            bar = tqdm(desc="tube_file", unit=" streamlines")
-        except ImportError:
-            bar = None
+    bar = Progress(progress is True, None, "tube_file", "streamline")
 
     def flush(chunk, data, first):
         r = _np.concatenate(data[radius]) if isinstance(radius, str) else radius
@@ -381,16 +383,14 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
                 flush(chunk, data, done)
                 done += len(chunk)
                 chunk, data, size = [], {k: [] for k in named}, 0
-                if bar is not None:
-                    bar.update(done - bar.n)
-                elif callable(progress):
+                bar.update(done)
+                if callable(progress):
                     progress(done)
         if chunk:
             flush(chunk, data, done)
             done += len(chunk)
-        if bar is not None:
-            bar.update(done - bar.n)
-        elif callable(progress):
+            bar.update(done)
+        if callable(progress):
             progress(done)
         if spool.nv == 0:
             raise ValueError(f"src: no streamline could be swept ({done:,} read; each needs "
@@ -400,5 +400,4 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
         return out
     finally:
         spool.close()
-        if bar is not None:
-            bar.close()
+        bar.close()

@@ -555,10 +555,19 @@ pub fn compute_many(
     end: &[Orientation],
     out: &mut [f64],
 ) -> Result<Vec<f64>> {
-    compute_many_cancellable(template, offsets, initial, end, out, &crate::cancel::never)
+    compute_many_cancellable(
+        template,
+        offsets,
+        initial,
+        end,
+        out,
+        &crate::cancel::never,
+        None,
+    )
 }
 
-/// [`compute_many`] that polls `cancel` before each curve (see [`crate::cancel`]).
+/// [`compute_many`] that polls `cancel` before each curve (see [`crate::cancel`]) and adds
+/// each curve's row count to `done` once its frames are written (a progress count).
 pub fn compute_many_cancellable(
     template: &Request,
     offsets: &[usize],
@@ -566,6 +575,7 @@ pub fn compute_many_cancellable(
     end: &[Orientation],
     out: &mut [f64],
     cancel: crate::cancel::Cancel<'_>,
+    done: Option<&std::sync::atomic::AtomicUsize>,
 ) -> Result<Vec<f64>> {
     let curves = offsets.len().saturating_sub(1);
     let slices = bundle_slices(template, offsets, initial, end, out)?;
@@ -585,13 +595,17 @@ pub fn compute_many_cancellable(
                 end: pick(end, c),
                 ..*template
             };
-            compute_into_cancellable(&req, buf, cancel).map_err(|e| {
+            let angle = compute_into_cancellable(&req, buf, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {
                     e
                 }
-            })
+            });
+            if let Some(d) = done {
+                d.fetch_add(b - a, std::sync::atomic::Ordering::Relaxed);
+            }
+            angle
         })
         .collect();
     results.into_iter().collect()

@@ -8,7 +8,7 @@ use numpy::{
     Element, PyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray, PyReadonlyArray1,
     PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray, PyUntypedArrayMethods,
 };
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
@@ -82,14 +82,73 @@ pub fn detach_stoppable<T: Send>(
     stop: &Stop,
     op: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    detach_reporting(py, stop, None, op)
+}
+
+/// A count of work that a heavy call adds to as it goes (rows, spines), reported by the
+/// calling thread as `progress(done, total)` while it waits ([`detach_reporting`]).
+pub struct Report {
+    pub done: AtomicUsize,
+    pub total: usize,
+    pub progress: Py<PyAny>,
+}
+
+impl Report {
+    /// A report of `total` units to `progress`, or `None` without a callback.
+    pub fn new(progress: Option<Py<PyAny>>, total: usize) -> Option<Report> {
+        progress.map(|progress| Report {
+            done: AtomicUsize::new(0),
+            total,
+            progress,
+        })
+    }
+
+    /// The counter that the work adds to, if any.
+    pub fn counter(report: &Option<Report>) -> Option<&AtomicUsize> {
+        report.as_ref().map(|r| &r.done)
+    }
+
+    fn call(&self, py: Python<'_>, done: usize) -> PyResult<()> {
+        self.progress.bind(py).call1((done, self.total)).map(drop)
+    }
+}
+
+/// [`detach_stoppable`] that also calls `report`'s callback from the calling thread, at
+/// most every [`SIGNAL_INTERVAL`] while the count moves and once at the end with the final
+/// count (the work itself never calls into Python, so reports cost it one atomic add per
+/// unit). An error raised by the callback stops the work like Ctrl-C and is returned.
+pub fn detach_reporting<T: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    report: Option<&Report>,
+    op: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    let (out, shown) = detach_waiting(py, stop, report, op)?;
+    if let Some(r) = report {
+        let done = r.done.load(Ordering::Relaxed);
+        if done != shown || done == 0 {
+            r.call(py, done)?;
+        }
+    }
+    Ok(out)
+}
+
+/// The work's result, and the count last reported.
+fn detach_waiting<T: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    report: Option<&Report>,
+    op: impl FnOnce() -> T + Send,
+) -> PyResult<(T, usize)> {
     let pool = threads::current_pool()?;
     if pool.current_thread_index().is_some() {
         // a call from inside the pool (a progress callback): blocking this worker to wait
         // for another could deadlock a pool of one thread, so run here
-        return Ok(py.detach(op));
+        return Ok((py.detach(op), 0));
     }
     py.detach(|| {
         let (tx, rx) = mpsc::channel();
+        let mut shown = 0;
         pool.in_place_scope(|scope| {
             scope.spawn(move |_| {
                 // the receiver outlives the scope, so this send cannot fail
@@ -97,12 +156,28 @@ pub fn detach_stoppable<T: Send>(
             });
             loop {
                 match rx.recv_timeout(SIGNAL_INTERVAL) {
-                    Ok(v) => return Ok(v),
+                    Ok(v) => return Ok((v, shown)),
                     Err(RecvTimeoutError::Timeout) => {
-                        if let Err(e) = Python::attach(|py| py.check_signals()) {
-                            stop.0.store(true, Ordering::Relaxed);
-                            let _ = rx.recv();
-                            return Err(e);
+                        let polled = Python::attach(|py| {
+                            py.check_signals()?;
+                            match report {
+                                Some(r) => {
+                                    let done = r.done.load(Ordering::Relaxed);
+                                    match done != shown {
+                                        true => r.call(py, done).map(|()| done),
+                                        false => Ok(shown),
+                                    }
+                                }
+                                None => Ok(shown),
+                            }
+                        });
+                        match polled {
+                            Ok(done) => shown = done,
+                            Err(e) => {
+                                stop.0.store(true, Ordering::Relaxed);
+                                let _ = rx.recv();
+                                return Err(e);
+                            }
                         }
                     }
                     // the work panicked; the scope raises the panic again when it ends

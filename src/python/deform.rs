@@ -194,8 +194,10 @@ pub fn deform_mesh<'py>(
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Contact stamper (see `deform::stamp`): a new vertex array and per-frame rows
-/// `(dent, time, residual, contact)`. Ctrl-C stops it between frames.
+/// `(dent, time, residual, contact)`. Ctrl-C stops it between frames, after each of which
+/// `progress(done, frames)` is called when given.
 #[pyfunction]
+#[pyo3(signature = (vertices, faces, start, end, radius, reach, frames, iterations, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn stamp<'py>(
     py: Python<'py>,
@@ -207,6 +209,7 @@ pub fn stamp<'py>(
     reach: f64,
     frames: usize,
     iterations: usize,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<StampArrays<'py>> {
     let x = vec3s("vertices", &vertices)?;
     // negative indices become out of range, which the stamper reports
@@ -218,7 +221,7 @@ pub fn stamp<'py>(
     )?;
     let mut v = alloc::copied("stamp", x)?;
     let stop = Stop::default();
-    let mut ticker = Ticker::new(None, &stop);
+    let mut ticker = Ticker::new(progress, &stop);
     let rep = detach_stoppable(py, &stop, || {
         deform::stamp::stamp(
             &mut v,

@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, detach_stoppable, empty, ensure_memory, offsets_of, orientations, renamed, slice_mut,
-    slice_of, value_error, vec3_array, vec3s,
+    Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, offsets_of,
+    orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
@@ -20,11 +20,12 @@ const PROBE_BYTES_PER_ROW: usize = 72 + frames::WORKING_BYTES_PER_ROW;
 pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
-/// the points name `points_arg` (the argument the caller's user passed them as).
+/// the points name `points_arg` (the argument the caller's user passed them as);
+/// `progress(done, rows)` is called from the waiting thread as curves are done.
 #[pyfunction]
 #[pyo3(signature = (points, tangents, offsets, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
-                    points_arg="points"))]
+                    points_arg="points", progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_sampled<'py>(
     py: Python<'py>,
@@ -41,6 +42,7 @@ pub fn frames_sampled<'py>(
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
     turns: i64,
     points_arg: &str,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<FramesAndAngles<'py>> {
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
@@ -70,9 +72,13 @@ pub fn frames_sampled<'py>(
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
         let stop = Stop::default();
-        detach_stoppable(py, &stop, || {
+        let report = Report::new(progress, rows);
+        let done = Report::counter(&report);
+        detach_reporting(py, &stop, report.as_ref(), || {
             let cancel = || stop.requested();
-            frames::compute_many_cancellable(&template, &offsets, &initial, &end, buf, &cancel)
+            frames::compute_many_cancellable(
+                &template, &offsets, &initial, &end, buf, &cancel, done,
+            )
         })?
         .map_err(|e| renamed(e, "points", points_arg))?
     };

@@ -6,8 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::PySlice;
 
 use super::convert::{
-    Stop, detach_stoppable, empty, ensure_memory, frames_of, offsets_of, renamed, slice_mut,
-    slice_of, vec2s, vec3s,
+    Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, frames_of, offsets_of,
+    renamed, slice_mut, slice_of, vec2s, vec3s,
 };
 use crate::sweep::{self, FrameSource, Options, Prepared, Spine};
 
@@ -32,11 +32,12 @@ type MeshArrays<'py> = (
 /// float32 with `single` (computed in float64, stored rounded), faces int32 with `index32`
 /// when the vertex count fits (int64 otherwise). Errors about the scale name `scale_arg`
 /// (`spinal.tube` passes its radius as the scale). `scale` may have a single row (the same
-/// scale at every sample).
+/// scale at every sample). `progress(done, rows)` is called from the waiting thread as the
+/// spines are swept (rows of the spines done) and once at the end.
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
                     miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
-                    normals=true, uv=true, tangents=None, join="round"))]
+                    normals=true, uv=true, tangents=None, join="round", progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -58,6 +59,7 @@ pub fn sweep_mesh<'py>(
     uv: bool,
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     join: &str,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<MeshArrays<'py>> {
     let join = match join {
         "round" => sweep::Join::Round,
@@ -122,6 +124,7 @@ pub fn sweep_mesh<'py>(
         normals,
         uv,
         scale_arg,
+        report: Report::new(progress, offsets.last().copied().unwrap_or(0)),
     };
     match (single, index32) {
         (false, false) => job.run::<f64, i64>(py),
@@ -137,6 +140,8 @@ struct Job<'a> {
     normals: bool,
     uv: bool,
     scale_arg: &'a str,
+    /// The spine rows swept, reported to the caller's `progress(done, total)`.
+    report: Option<Report>,
 }
 
 impl Job<'_> {
@@ -173,8 +178,9 @@ impl Job<'_> {
                 },
             };
             let stop = Stop::default();
-            detach_stoppable(py, &stop, || {
-                self.prep.write_into(out, &|| stop.requested())
+            let done = Report::counter(&self.report);
+            detach_reporting(py, &stop, self.report.as_ref(), || {
+                self.prep.write_into(out, &|| stop.requested(), done)
             })?
             .map_err(|e| renamed(e, "scale", self.scale_arg))?
         };

@@ -4,6 +4,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::caps::write_caps;
 use super::check::check_spine;
@@ -245,7 +246,12 @@ impl Sweep<'_> {
     /// curves, then the sweep's checks, each by curve): a frames error of any curve, else the
     /// first curve's check error, else a vertex beyond the range of the output type
     /// ([`out_of_range`]).
-    fn write<R: Real, I: Index>(&self, out: MeshMut<R, I>, cancel: Cancel<'_>) -> Result<Written> {
+    fn write<R: Real, I: Index>(
+        &self,
+        out: MeshMut<R, I>,
+        cancel: Cancel<'_>,
+        done: Option<&AtomicUsize>,
+    ) -> Result<Written> {
         let (nv, nf) = (self.layout.vertices, self.layout.faces);
         assert!(
             out.vertices.len() == nv
@@ -304,7 +310,13 @@ impl Sweep<'_> {
                     frames: Vec::new(),
                     ring: RingScratch::new(0),
                 },
-                |sc, (c, vbase, mine)| self.spine(c, vbase, mine, sc, cancel),
+                |sc, (c, vbase, mine)| {
+                    let o = self.spine(c, vbase, mine, sc, cancel);
+                    if let Some(d) = done {
+                        d.fetch_add(self.offsets[c + 1] - self.offsets[c], Ordering::Relaxed);
+                    }
+                    o
+                },
             )
             .collect();
         let (mut check, mut bad) = (None, None);
@@ -474,7 +486,7 @@ pub fn sweep_into<R: Real, I: Index>(
         sh: Shared::new(profile, cols, caps, &cancel::never)?,
         unscale: None,
     };
-    sweep.write(out, &cancel::never)
+    sweep.write(out, &cancel::never, None)
 }
 
 /// A sweep checked and sized, to be written into buffers of a chosen precision: the input
@@ -594,11 +606,13 @@ impl<'a> Prepared<'a> {
 
     /// Every spine swept into buffers of the sizes in `self.layout` (see
     /// [`sweep_into`]; with computed frames, each spine's frames first), polling `cancel`
-    /// before every spine and every block of rings within them (see [`crate::cancel`]).
+    /// before every spine and every block of rings within them (see [`crate::cancel`]),
+    /// and adding each spine's row count to `done` once it is swept (a progress count).
     pub fn write_into<R: Real, I: Index>(
         &self,
         out: MeshMut<R, I>,
         cancel: Cancel<'_>,
+        done: Option<&AtomicUsize>,
     ) -> Result<Written> {
         let sizes = &self.layout.sizes;
         let caps = sizes.iter().any(|s| s.caps);
@@ -613,7 +627,7 @@ impl<'a> Prepared<'a> {
             sh: Shared::new(&self.profile, cols, caps, cancel)?,
             unscale: self.scaled.as_ref().map(|s| s.k),
         };
-        sweep.write(out, cancel)
+        sweep.write(out, cancel, done)
     }
 }
 
