@@ -110,7 +110,8 @@ w = 0.04
 pts = np.empty((2 * len(x), 3)); pts[0::2] = x - w * F[:, :, 0]; pts[1::2] = x + w * F[:, :, 0]
 ribbon = pv.StructuredGrid(pts[:, 0].reshape(-1, 2), pts[:, 1].reshape(-1, 2), pts[:, 2].reshape(-1, 2))
 pl = pv.Plotter(window_size=(500, 400))
-pl.add_mesh(ribbon, scalars=np.repeat(np.arange(len(x)), 2), cmap="viridis", show_scalar_bar=False)
+pl.add_mesh(ribbon, scalars=np.tile(np.arange(len(x)), 2), cmap="viridis",  # grid order: edge by edge
+            scalar_bar_args={"title": "sample index", "n_labels": 2, "fmt": "%.0f"})
 if os.environ.get("SPINAL_WRITE_IMAGES"):  # refresh the README picture
     pl.screenshot(os.path.join("..", "docs", "images", "ribbon.png"))
 pl.show()""",
@@ -164,7 +165,8 @@ gets its sample's value, so the flow speed colours the tubes without index arith
     """mesh = spinal.tube(points, radius, sides=10, lengths=lengths, point_data={"speed": speed})
 poly = mesh.to_pyvista()
 pl = pv.Plotter(window_size=(640, 480))
-pl.add_mesh(poly, scalars="speed", cmap="magma", smooth_shading=True, show_scalar_bar=False)
+pl.add_mesh(poly, scalars="speed", cmap="magma", smooth_shading=True,
+            scalar_bar_args={"title": "flow speed", "n_labels": 2, "fmt": "%.2f"})
 pl.view_isometric()
 pl.camera.zoom(1.2)
 if IMAGES:
@@ -759,7 +761,8 @@ pl.camera_position = [(1.0, -3.2, 3.2), (0, 0, 0.4), (0, 0, 1)]
 pl.subplot(0, 1)
 longitude = np.sin(5 * np.arctan2(V0[:, 1], V0[:, 0]))
 pl.add_mesh(pv.wrap(trimesh.Trimesh(carried, F, process=False)), scalars=longitude,
-            cmap="copper", show_scalar_bar=False, smooth_shading=True)
+            cmap="copper", smooth_shading=True,
+            scalar_bar_args={"title": "sin(5 x start longitude)", "n_labels": 2, "fmt": "%.1f"})
 pl.camera_position = [(2.5, -3.0, 3.5), (0, 0, 0.0), (0, 0, 1)]
 pl.show()""",
     ]
