@@ -155,8 +155,9 @@ BASE = {
     "spinal.curves.Polynomial": (curves.Polynomial, (PTS[:3],), {}),
     "spinal.curves.TorusKnot": (curves.TorusKnot, (), {}),
     "spinal.curves.Viviani": (curves.Viviani, (), {}),
+    "spinal.curves.Spline": (curves.Spline, (PTS,), {}),  # domain [0, 2.06] holds _u
 }
-for _cls in ("Bezier", "Helix", "Polynomial", "TorusKnot", "Viviani", "Curve"):
+for _cls in ("Bezier", "Helix", "Polynomial", "TorusKnot", "Viviani", "Spline", "Curve"):
     _obj = curves.Helix() if _cls == "Curve" else BASE[f"spinal.curves.{_cls}"][0](
         *BASE[f"spinal.curves.{_cls}"][1])
     for _m in ("curvature", "d1", "d2", "d3", "frenet", "point", "speed", "tangent", "torsion"):
@@ -164,11 +165,16 @@ for _cls in ("Bezier", "Helix", "Polynomial", "TorusKnot", "Viviani", "Curve"):
     BASE[f"spinal.curves.{_cls}.parameters"] = (_obj.parameters, (5,), {})
     BASE[f"spinal.curves.{_cls}.sample"] = (_obj.sample, (5,), {})
 BASE["spinal.curves.Helix.rmf"] = (curves.Helix().rmf, (_u,), {})
+_spline = curves.Spline(PTS)
+BASE["spinal.curves.Spline.arc_length_parameters"] = (_spline.arc_length_parameters, (5,), {})
+BASE["spinal.curves.Spline.sample_arc_length"] = (_spline.sample_arc_length, (5,), {})
+BASE["spinal.compensate_volume"] = (spinal.compensate_volume, (SPHERE, 4.0), {})
 
 #: Callables that take no user arguments worth walking, with the reason.
 NOT_WALKED = {
     "spinal.DeformReport": "a result record built by deform, not an input",
     "spinal.StampReport": "a result record built by stamp, not an input",
+    "spinal.CompensationReport": "a result record built by compensate_volume, not an input",
     "spinal.FoldOverWarning": "a warning class raised by the library",
     "spinal.SkippedCurvesWarning": "a warning class raised by the library",
     "spinal.PrecisionWarning": "a warning class raised by the library",

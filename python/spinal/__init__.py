@@ -13,7 +13,8 @@ Sweeps
 Deformation
     Divergence-free velocity fields in :mod:`spinal.fields`; :func:`advect` (RK4, splitting),
     :func:`deform` (advection with refinement and a volume report, :class:`DeformReport`),
-    :func:`stamp` (contact stamper, :class:`StampReport`).
+    :func:`stamp` (contact stamper, :class:`StampReport`), :func:`compensate_volume` (a
+    target volume by one normal offset, :class:`CompensationReport`).
 Fleshing
     :func:`flesh`, :class:`SpineBinding` (bending along a spine with local volume
     correction), :func:`flesh_surface`, :class:`SurfaceBinding` (spine surfaces).
@@ -30,6 +31,7 @@ Threads
 
 from . import curves, fields, io, ph, quaternions
 from ._advect import advect
+from ._compensate import CompensationReport, compensate_volume
 from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
@@ -39,6 +41,7 @@ from ._sweep import sweep, tube
 from ._threads import get_num_threads, set_num_threads, threads
 
 __all__ = [
+    "CompensationReport",
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
@@ -51,6 +54,7 @@ __all__ = [
     "__version__",
     "advect",
     "closing_angle",
+    "compensate_volume",
     "curves",
     "deform",
     "estimate_tangents",

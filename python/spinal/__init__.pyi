@@ -17,6 +17,7 @@ from .curves import Curve
 from .fields import Field
 
 __all__ = [
+    "CompensationReport",
     "DeformReport",
     "FoldOverWarning",
     "Mesh",
@@ -29,6 +30,7 @@ __all__ = [
     "__version__",
     "advect",
     "closing_angle",
+    "compensate_volume",
     "curves",
     "deform",
     "estimate_tangents",
@@ -335,6 +337,16 @@ def stamp(
     iterations: int = 2,
     progress: _Progress = False,
 ) -> tuple[Mesh, StampReport]: ...
+@dataclass(frozen=True)
+class CompensationReport:
+    offset: float
+    volume_before: float
+    volume_after: float
+    target: float
+    steiner_offset: float
+    iterations: int
+
+def compensate_volume(mesh: _AnyMesh, target: float) -> tuple[Mesh, CompensationReport]: ...
 
 # ---- fleshing -----------------------------------------------------------------------------
 

@@ -12,6 +12,10 @@ tangents to the other methods, and serve as references in tests:
 * :class:`Viviani` – ``a (1 + cos u, sin u, 2 sin(u/2))`` on the sphere of radius ``2a``
   about the origin (a spherical curve: double reflection is exact on it).
 * :class:`Polynomial` – ``Σ c_j u^j``; :class:`Bezier` – Bernstein form on ``[0, 1]``.
+* :class:`Spline` – a piecewise cubic spine through control points: the C¹ non-uniform
+  Catmull–Rom spline or the C² natural/periodic cubic spline at chord-length knots, or the
+  clamped/periodic uniform cubic B-spline; exact derivatives, arc length and samples equally
+  spaced in arc length (:meth:`Spline.sample_arc_length`).
 
 Lengths are in the units of the coordinates, angles in radians.
 """
@@ -21,6 +25,7 @@ from ._curves import (
     Curve,
     Helix,
     Polynomial,
+    Spline,
     TorusKnot,
     Viviani,
 )
@@ -31,6 +36,7 @@ __all__ = [
     "Curve",
     "Helix",
     "Polynomial",
+    "Spline",
     "TorusKnot",
     "Viviani",
 ]

@@ -1,9 +1,9 @@
-from typing import TypeAlias
+from typing import Literal, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Bezier", "Curve", "Helix", "Polynomial", "TorusKnot", "Viviani"]
+__all__ = ["Bezier", "Curve", "Helix", "Polynomial", "Spline", "TorusKnot", "Viviani"]
 
 _Array: TypeAlias = npt.ArrayLike
 _F: TypeAlias = npt.NDArray[np.float64]
@@ -52,3 +52,19 @@ class Polynomial(Curve):
 class Bezier(Polynomial):
     control_points: _F
     def __init__(self, control_points: _Array) -> None: ...
+
+class Spline(Curve):
+    points: _F
+    kind: Literal["catmull_rom", "natural_cubic", "bspline"]
+    closed: bool
+    knots: _F
+    def __init__(
+        self,
+        points: _Array,
+        kind: Literal["catmull_rom", "natural_cubic", "bspline"] = "catmull_rom",
+        closed: bool = False,
+    ) -> None: ...
+    @property
+    def length(self) -> float: ...
+    def arc_length_parameters(self, n: int) -> _F: ...
+    def sample_arc_length(self, n: int) -> _F: ...

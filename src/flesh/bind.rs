@@ -23,6 +23,8 @@ use super::spine::SpineModel;
 use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::Result;
+use crate::math::bvh::{Aabb, Bvh};
+use crate::math::scale::Pow2;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -98,69 +100,149 @@ fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
     out
 }
 
-/// Register one vertex: `(k, a, τ)`.
-fn locate(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
+/// The rest spine's edges in a hierarchy of boxes. Edge `k`'s curve is
+/// `C(a) = C_k + a E_k + h (h10(a) d_k + h11(a) d_{k+1})` (the Hermite form with slopes
+/// `h t`, `h = |E_k|`, `d_j = t_j − E_k/h`, since `h01 + h10 + h11 = a`), so it stays within
+/// `ρ_k = (4/27) h (|d_k| + |d_{k+1}|)` of its chord (`|h10|, |h11| ≤ 4/27` on `[0, 1]`):
+/// the distance from `P` to the chord minus `ρ_k` bounds the distance to the curve from
+/// below. The boxes are the chords' widened by `ρ_k`; they hold both samples.
+struct Edges {
+    bvh: Bvh,
+    /// `ρ_k`, slightly enlarged against round-off.
+    reach: Vec<f64>,
+}
+
+impl Edges {
+    fn new(sp: &SpineModel) -> Result<Edges> {
+        let n = sp.len();
+        let reach: Vec<f64> = alloc::collect(
+            "SpineBinding",
+            (0..n - 1).map(|k| {
+                let e = sp.c[k + 1] - sp.c[k];
+                let h = e.length();
+                let u = e / h;
+                let rho = 4.0 / 27.0 * h * ((sp.t[k] - u).length() + (sp.t[k + 1] - u).length());
+                rho * (1.0 + 1e-9) + 1e-12 * h
+            }),
+        )?;
+        let boxes: Vec<Aabb> = alloc::collect(
+            "SpineBinding",
+            (0..n - 1).map(|k| {
+                let (a, b) = (sp.c[k], sp.c[k + 1]);
+                let r = DVec3::splat(reach[k]);
+                Aabb {
+                    lo: a.min(b) - r,
+                    hi: a.max(b) + r,
+                }
+            }),
+        )?;
+        Ok(Edges {
+            bvh: Bvh::build(&boxes),
+            reach,
+        })
+    }
+
+    /// A lower bound of the squared distance from `p` to edge `k`'s curve.
+    fn lower_bound(&self, sp: &SpineModel, k: usize, p: DVec3) -> f64 {
+        let (a, e) = (sp.c[k], sp.c[k + 1] - sp.c[k]);
+        let s = ((p - a).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+        let lo = (p - (a + s * e)).length() - self.reach[k];
+        // a margin for the round-off of the distances computed from the curve
+        if lo > 0.0 {
+            lo * lo * (1.0 - 1e-9)
+        } else {
+            0.0
+        }
+    }
+
+    /// The sample nearest to `p` (the first of equally near ones). `hint`: a sample that is
+    /// probably near (the answer for the vertex before), whose distance bounds the search
+    /// from the start; the answer does not depend on it.
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, hint: usize) -> usize {
+        let hint = hint.min(sp.len() - 1);
+        let mut best = ((p - sp.c[hint]).length_squared(), hint);
+        self.bvh.nearest(p, best.0, |k| {
+            for j in [k, k + 1] {
+                let d = (p - sp.c[j]).length_squared();
+                if d < best.0 || (d == best.0 && j < best.1) {
+                    best = (d, j);
+                }
+            }
+            best.0
+        });
+        best.1
+    }
+}
+
+/// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
+/// edge's roots, the first found winning ties in the order: the start's extension, the
+/// end's, the two edges at the sample nearest to `P`, then the other edges by index; the
+/// edges are searched nearest first in the hierarchy, skipping those whose ball lies
+/// farther than the best so far (`O(log n)` edges for a vertex near the spine).
+fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, hint: &mut usize) -> (usize, f64, f64) {
     let n = sp.len();
-    let mut best = (f64::INFINITY, 0usize, 0.0f64, 0.0f64);
+    // (squared distance, rank in the order above, edge, a, τ)
+    let mut best = (f64::INFINITY, i64::MIN, 0usize, 0.0f64, 0.0f64);
     // straight extensions past both ends (a loop has none)
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
     if tau < 0.0 && !sp.closed {
-        best = ((w - tau * sp.t[0]).length_squared(), 0, 0.0, tau);
+        best = ((w - tau * sp.t[0]).length_squared(), -2, 0, 0.0, tau);
     }
     let w = p - sp.c[n - 1];
     let tau = w.dot(sp.t[n - 1]);
     if tau > 0.0 && !sp.closed {
         let d2 = (w - tau * sp.t[n - 1]).length_squared();
         if d2 < best.0 {
-            best = (d2, n - 2, 1.0, tau);
+            best = (d2, -1, n - 2, 1.0, tau);
         }
     }
-    // the edges next to the nearest sample first: a good bound prunes almost all others
-    let near =
-        sp.c.iter()
-            .enumerate()
-            .fold((0, f64::INFINITY), |acc, (i, c)| {
-                let d = (p - *c).length_squared();
-                if d < acc.1 { (i, d) } else { acc }
-            })
-            .0;
+    let near = edges.nearest_sample(sp, p, *hint);
+    *hint = near;
     let first = near.saturating_sub(1);
-    let order =
-        (first..(near + 1).min(n - 1)).chain((0..n - 1).filter(|&k| k + 1 < near || k > near));
-    for k in order {
-        let w = p - sp.c[k];
-        let e = sp.c[k + 1] - sp.c[k];
-        // every point of the edge's curve (within 1.5 chords of C_k) is at least this far
-        let lo = w.length() - 1.5 * e.length();
-        if lo > 0.0 && lo * lo > best.0 {
-            continue;
+    let end = (near + 1).min(n - 1);
+    let rank = |k: usize| match (first..end).contains(&k) {
+        true => (k - first) as i64,
+        false => 2 + k as i64,
+    };
+    let edge = |k: usize, best: &mut (f64, i64, usize, f64, f64)| {
+        // every point of the edge's curve is at least this far
+        if edges.lower_bound(sp, k, p) > best.0 {
+            return;
         }
+        let r = rank(k);
         for a in edge_roots(sp, k, p) {
             if !(-1e-12..=1.0 + 1e-12).contains(&a) {
                 continue;
             }
             let a = a.clamp(0.0, 1.0);
             let d2 = (p - sp.c_at(k, a)).length_squared();
-            if d2 < best.0 {
-                best = (d2, k, a, 0.0);
+            if d2 < best.0 || (d2 == best.0 && r < best.1) {
+                *best = (d2, r, k, a, 0.0);
             }
         }
+    };
+    // the edges next to the nearest sample first: a good bound prunes almost all others
+    for k in first..end {
+        edge(k, &mut best);
     }
+    edges.bvh.nearest(p, best.0, |k| {
+        if !(first..end).contains(&k) {
+            edge(k, &mut best);
+        }
+        best.0
+    });
     if best.0.is_infinite() {
         // cannot happen for finite input (the plane signs change somewhere); keep a
         // defined answer anyway: the nearest sample
-        let (k, _) =
-            sp.c.iter()
-                .enumerate()
-                .fold((0, f64::INFINITY), |acc, (i, c)| {
-                    let d = (p - *c).length_squared();
-                    if d < acc.1 { (i, d) } else { acc }
-                });
-        let (k, a) = if k + 1 < n { (k, 0.0) } else { (n - 2, 1.0) };
+        let (k, a) = if near + 1 < n {
+            (near, 0.0)
+        } else {
+            (n - 2, 1.0)
+        };
         return (k, a, 0.0);
     }
-    (best.1, best.2, best.3)
+    (best.2, best.3, best.4)
 }
 
 /// Register `vertices` on the rest spine.
@@ -176,6 +258,7 @@ pub fn bind_cancellable(
 ) -> Result<Binding> {
     super::check_vertices(vertices, rest.scale, "spine")?;
     let (to_model, to_input) = (rest.scale, rest.scale.inverse());
+    let edges = Edges::new(rest)?;
     let nv = vertices.len();
     let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
     let mut coords = alloc::filled(
@@ -183,35 +266,58 @@ pub fn bind_cancellable(
         alloc::product("SpineBinding", COORDS, nv, 8)?,
         0.0,
     )?;
-    edge.par_iter_mut()
-        .zip(coords.par_chunks_mut(COORDS))
-        .zip(vertices.par_iter())
-        .for_each(|((e, c), &p)| {
+    // blocks of consecutive vertices (often neighbours on the mesh): each vertex's search
+    // starts from the sample nearest to the vertex before
+    edge.par_chunks_mut(BLOCK)
+        .zip(coords.par_chunks_mut(COORDS * BLOCK))
+        .zip(vertices.par_chunks(BLOCK))
+        .for_each(|((eb, cb), vb)| {
             if cancel() {
                 return;
             }
-            let p = to_model.of3(p);
-            let (k, a, tau) = locate(rest, p);
-            let l = rest.eval(k, a);
-            let d = p - l.q - tau * l.t;
-            let sk = if tau != 0.0 {
-                DVec2::ZERO
-            } else {
-                l.kappa * l.sigma
-            };
-            let len = |x: f64| to_input.of(x);
-            *e = k as i64;
-            c.copy_from_slice(&[
-                a,
-                len(tau),
-                len(d.dot(l.u)),
-                len(d.dot(l.v)),
-                len(l.sigma),
-                sk.x,
-                sk.y,
-            ]);
+            let mut hint = 0;
+            for ((e, c), &p) in eb.iter_mut().zip(cb.chunks_mut(COORDS)).zip(vb) {
+                bind_one(rest, &edges, to_model, to_input, p, &mut hint, e, c);
+            }
         });
     Ok(Binding { edge, coords })
+}
+
+/// Vertices per block of the registration (a Ctrl-C poll each).
+const BLOCK: usize = 256;
+
+/// The binding of vertex `p` (input units) into `e` and `c` (see the module notes).
+#[allow(clippy::too_many_arguments)]
+fn bind_one(
+    rest: &SpineModel,
+    edges: &Edges,
+    to_model: Pow2,
+    to_input: Pow2,
+    p: DVec3,
+    hint: &mut usize,
+    e: &mut i64,
+    c: &mut [f64],
+) {
+    let p = to_model.of3(p);
+    let (k, a, tau) = locate(rest, edges, p, hint);
+    let l = rest.eval(k, a);
+    let d = p - l.q - tau * l.t;
+    let sk = if tau != 0.0 {
+        DVec2::ZERO
+    } else {
+        l.kappa * l.sigma
+    };
+    let len = |x: f64| to_input.of(x);
+    *e = k as i64;
+    c.copy_from_slice(&[
+        a,
+        len(tau),
+        len(d.dot(l.u)),
+        len(d.dot(l.v)),
+        len(l.sigma),
+        sk.x,
+        sk.y,
+    ]);
 }
 
 #[cfg(test)]
@@ -233,6 +339,93 @@ mod tests {
             frames.extend_from_slice(&[r.x, q.x, t.x, r.y, q.y, t.y, r.z, q.z, t.z]);
         }
         (pts, frames)
+    }
+
+    /// The scan over every edge that the hierarchy replaced (the reference of the test
+    /// below): extensions, then the edges at the nearest sample, then all others by index,
+    /// each replacing the best only when strictly closer.
+    fn locate_by_scan(sp: &SpineModel, p: DVec3) -> (usize, f64, f64) {
+        let n = sp.len();
+        let mut best = (f64::INFINITY, 0usize, 0.0f64, 0.0f64);
+        let w = p - sp.c[0];
+        let tau = w.dot(sp.t[0]);
+        if tau < 0.0 && !sp.closed {
+            best = ((w - tau * sp.t[0]).length_squared(), 0, 0.0, tau);
+        }
+        let w = p - sp.c[n - 1];
+        let tau = w.dot(sp.t[n - 1]);
+        if tau > 0.0 && !sp.closed {
+            let d2 = (w - tau * sp.t[n - 1]).length_squared();
+            if d2 < best.0 {
+                best = (d2, n - 2, 1.0, tau);
+            }
+        }
+        let near = (0..n)
+            .map(|i| ((p - sp.c[i]).length_squared(), i))
+            .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+            .1;
+        let first = near.saturating_sub(1);
+        let order =
+            (first..(near + 1).min(n - 1)).chain((0..n - 1).filter(|&k| k + 1 < near || k > near));
+        for k in order {
+            for a in edge_roots(sp, k, p) {
+                if !(-1e-12..=1.0 + 1e-12).contains(&a) {
+                    continue;
+                }
+                let a = a.clamp(0.0, 1.0);
+                let d2 = (p - sp.c_at(k, a)).length_squared();
+                if d2 < best.0 {
+                    best = (d2, k, a, 0.0);
+                }
+            }
+        }
+        (best.1, best.2, best.3)
+    }
+
+    #[test]
+    fn the_hierarchy_finds_the_sections_of_the_scan_bit_for_bit() {
+        // a wavy open spine and a closed circle; points near and far, on sample planes and
+        // at samples (ties between two edges' ends)
+        let n = 300;
+        let pts: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let u = i as f64 * 0.05;
+                DVec3::new(u, (2.0 * u).sin() * 0.5, (0.7 * u).cos() * 0.3)
+            })
+            .collect();
+        let req = crate::frames::Request {
+            points: Some(&pts),
+            ..Default::default()
+        };
+        let mut frames = vec![0.0; 9 * n];
+        crate::frames::compute_into(&req, &mut frames).unwrap();
+        let sp = SpineModel::new("rest_spine", &pts, &frames, false).unwrap();
+        let (cpts, cframes) = circle(64);
+        let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true).unwrap();
+        for (model, count) in [(&sp, 4000), (&loop_sp, 2000)] {
+            let edges = Edges::new(model).unwrap();
+            for q in 0..count {
+                let x = q as f64 * 0.618_033_988_7;
+                let mut p = DVec3::new(
+                    (x * 3.1).sin() * 8.0 + 7.0,
+                    (x * 1.7).cos() * 1.5,
+                    (x * 0.9).sin() * 1.2,
+                );
+                if model.closed {
+                    p = DVec3::new((x * 3.1).sin() * 1.6, (x * 1.7).cos() * 1.6, x.sin() * 0.4);
+                }
+                if q % 10 == 0 {
+                    p = model.c[q % model.len()]; // on a sample
+                }
+                let got = locate(model, &edges, p, &mut (q * 7 % model.len()));
+                let want = locate_by_scan(model, p);
+                assert_eq!(
+                    (got.0, got.1.to_bits(), got.2.to_bits()),
+                    (want.0, want.1.to_bits(), want.2.to_bits()),
+                    "{p}"
+                );
+            }
+        }
     }
 
     #[test]

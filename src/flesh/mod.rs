@@ -32,7 +32,8 @@
 //! it for a straight spine) can come from the caller — a rigid motion's frames give a rigid
 //! result, a rig's frames roll the shape — without changing the volume element.
 //!
-//! Registration (bind) is brute force over the edges with pruning, `O(V n)`; deformation is
+//! Registration (bind) searches the edges nearest first in a bounding-volume hierarchy
+//! (`O(V log n)` for vertices near the spine, [`crate::math::bvh`]); deformation is
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
 
 pub mod bind;

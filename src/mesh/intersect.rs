@@ -3,7 +3,7 @@
 //! meshes of evenly sized faces.
 //!
 //! * **Candidates** from a bounding-volume hierarchy over the faces' boxes (median splits
-//!   of the face centroids along the longest axis, leaves of at most [`LEAF`] faces): every
+//!   of the face centroids along the longest axis, [`crate::math::bvh`]): every
 //!   face descends the hierarchy with its box and meets the faces after it whose boxes
 //!   overlap its own (closed intervals of exact coordinates: no tolerance).
 //! * **Two faces with no common vertex** intersect exactly when an edge of one meets the
@@ -31,135 +31,14 @@ use rayon::prelude::*;
 use super::measure::{Index, Point, corners};
 use crate::cancel::Cancel;
 use crate::error::{InputError, Result};
+use crate::math::bvh::{Aabb, Bvh};
 use crate::math::predicates::{orient, orient3d};
 
-/// Faces per leaf of the hierarchy.
-pub const LEAF: usize = 8;
 /// Faces per block of the candidate search (a Ctrl-C poll each).
 const BLOCK: usize = 1 << 12;
 
 /// The name of the call in out-of-memory errors.
 pub const CALL: &str = "self_intersections";
-
-#[derive(Clone, Copy)]
-struct Aabb {
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl Aabb {
-    fn of(t: &[DVec3; 3]) -> Aabb {
-        Aabb {
-            lo: t[0].min(t[1]).min(t[2]),
-            hi: t[0].max(t[1]).max(t[2]),
-        }
-    }
-    fn union(self, o: Aabb) -> Aabb {
-        Aabb {
-            lo: self.lo.min(o.lo),
-            hi: self.hi.max(o.hi),
-        }
-    }
-    fn overlaps(&self, o: &Aabb) -> bool {
-        self.lo.cmple(o.hi).all() && o.lo.cmple(self.hi).all()
-    }
-}
-
-/// A node: a box and either two children or a range of `order`.
-struct Node {
-    bound: Aabb,
-    /// children `(left, right)` for an inner node; `(start, end)` in `order` for a leaf
-    kids: (usize, usize),
-    leaf: bool,
-}
-
-struct Bvh {
-    nodes: Vec<Node>,
-    order: Vec<usize>,
-}
-
-impl Bvh {
-    fn build(boxes: &[Aabb]) -> Bvh {
-        let mut order: Vec<usize> = (0..boxes.len()).collect();
-        let mut nodes = Vec::with_capacity(2 * boxes.len() / LEAF + 1);
-        if !boxes.is_empty() {
-            Self::split(boxes, &mut order, 0, boxes.len(), &mut nodes);
-        }
-        Bvh { nodes, order }
-    }
-
-    /// The node over `order[lo..hi]` (its index); children first split at the median of
-    /// the centroids along the longest axis of their bounds.
-    fn split(
-        boxes: &[Aabb],
-        order: &mut [usize],
-        lo: usize,
-        hi: usize,
-        nodes: &mut Vec<Node>,
-    ) -> usize {
-        let bound = order[lo..hi]
-            .iter()
-            .map(|&f| boxes[f])
-            .reduce(Aabb::union)
-            .unwrap_or(Aabb {
-                lo: DVec3::ZERO,
-                hi: DVec3::ZERO,
-            });
-        let me = nodes.len();
-        nodes.push(Node {
-            bound,
-            kids: (lo, hi),
-            leaf: true,
-        });
-        if hi - lo <= LEAF {
-            return me;
-        }
-        let centre = |f: usize| boxes[f].lo + boxes[f].hi;
-        let (clo, chi) = order[lo..hi].iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(a, b), &f| (a.min(centre(f)), b.max(centre(f))),
-        );
-        let ext = chi - clo;
-        let axis = if ext.x >= ext.y && ext.x >= ext.z {
-            0
-        } else if ext.y >= ext.z {
-            1
-        } else {
-            2
-        };
-        let mid = (lo + hi) / 2;
-        order[lo..hi].select_nth_unstable_by(mid - lo, |&a, &b| {
-            centre(a)[axis].total_cmp(&centre(b)[axis]).then(a.cmp(&b))
-        });
-        let left = Self::split(boxes, order, lo, mid, nodes);
-        let right = Self::split(boxes, order, mid, hi, nodes);
-        nodes[me].kids = (left, right);
-        nodes[me].leaf = false;
-        me
-    }
-
-    /// Calls `hit(j)` for every face `j` whose box overlaps `b`.
-    fn query(&self, b: &Aabb, mut hit: impl FnMut(usize)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = vec![0usize];
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n];
-            if !node.bound.overlaps(b) {
-                continue;
-            }
-            if node.leaf {
-                for &j in &self.order[node.kids.0..node.kids.1] {
-                    hit(j);
-                }
-            } else {
-                stack.push(node.kids.0);
-                stack.push(node.kids.1);
-            }
-        }
-    }
-}
 
 /// The pairs of faces of `(v, f)` that intersect other than along shared vertices and
 /// edges (see the module documentation), sorted, and whether the list stopped at `limit`
@@ -174,7 +53,8 @@ pub fn self_intersections<P: Point, I: Index>(
     let tri: Vec<[usize; 3]> = crate::alloc::collect(CALL, f.iter().map(corners))?;
     let at = |i: usize| v[i].dvec3();
     let pts = |t: &[usize; 3]| [at(t[0]), at(t[1]), at(t[2])];
-    let boxes: Vec<Aabb> = crate::alloc::collect(CALL, tri.iter().map(|t| Aabb::of(&pts(t))))?;
+    let boxes: Vec<Aabb> =
+        crate::alloc::collect(CALL, tri.iter().map(|t| Aabb::of_points(&pts(t))))?;
     if cancel() {
         return Ok(None);
     }
