@@ -158,10 +158,10 @@ impl Edges {
     /// The sample nearest to `p` (the first of equally near ones). `hint`: a sample that is
     /// probably near (the answer for the vertex before), whose distance bounds the search
     /// from the start; the answer does not depend on it.
-    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, hint: usize) -> usize {
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, hint: usize, s: &mut Scratch) -> usize {
         let hint = hint.min(sp.len() - 1);
         let mut best = ((p - sp.c[hint]).length_squared(), hint);
-        self.bvh.nearest(p, best.0, |k| {
+        self.bvh.nearest(p, best.0, &mut s.stack, |k| {
             for j in [k, k + 1] {
                 let d = (p - sp.c[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
@@ -174,12 +174,19 @@ impl Edges {
     }
 }
 
+/// Working state of a run of vertices: the sample nearest to the vertex before (where the
+/// next one's search starts) and the hierarchy's stack.
+struct Scratch {
+    hint: usize,
+    stack: Vec<(usize, f64)>,
+}
+
 /// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
 /// edge's roots, the first found winning ties in the order: the start's extension, the
 /// end's, the two edges at the sample nearest to `P`, then the other edges by index; the
 /// edges are searched nearest first in the hierarchy, skipping those whose ball lies
 /// farther than the best so far (`O(log n)` edges for a vertex near the spine).
-fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, hint: &mut usize) -> (usize, f64, f64) {
+fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
     let n = sp.len();
     // (squared distance, rank in the order above, edge, a, τ)
     let mut best = (f64::INFINITY, i64::MIN, 0usize, 0.0f64, 0.0f64);
@@ -197,8 +204,8 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, hint: &mut usize) -> (usize,
             best = (d2, -1, n - 2, 1.0, tau);
         }
     }
-    let near = edges.nearest_sample(sp, p, *hint);
-    *hint = near;
+    let near = edges.nearest_sample(sp, p, s.hint, s);
+    s.hint = near;
     let first = near.saturating_sub(1);
     let end = (near + 1).min(n - 1);
     let rank = |k: usize| match (first..end).contains(&k) {
@@ -222,11 +229,16 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, hint: &mut usize) -> (usize,
             }
         }
     };
-    // the edges next to the nearest sample first: a good bound prunes almost all others
-    for k in first..end {
+    // the edges next to the nearest sample first (the one with the nearer chord first): a
+    // good bound prunes almost all others
+    let mut two = [first, end - 1];
+    if edges.lower_bound(sp, two[1], p) < edges.lower_bound(sp, two[0], p) {
+        two.swap(0, 1);
+    }
+    for k in two.into_iter().take(end - first) {
         edge(k, &mut best);
     }
-    edges.bvh.nearest(p, best.0, |k| {
+    edges.bvh.nearest(p, best.0, &mut s.stack, |k| {
         if !(first..end).contains(&k) {
             edge(k, &mut best);
         }
@@ -275,9 +287,12 @@ pub fn bind_cancellable(
             if cancel() {
                 return;
             }
-            let mut hint = 0;
+            let mut s = Scratch {
+                hint: 0,
+                stack: Vec::with_capacity(64),
+            };
             for ((e, c), &p) in eb.iter_mut().zip(cb.chunks_mut(COORDS)).zip(vb) {
-                bind_one(rest, &edges, to_model, to_input, p, &mut hint, e, c);
+                bind_one(rest, &edges, to_model, to_input, p, &mut s, e, c);
             }
         });
     Ok(Binding { edge, coords })
@@ -294,12 +309,12 @@ fn bind_one(
     to_model: Pow2,
     to_input: Pow2,
     p: DVec3,
-    hint: &mut usize,
+    s: &mut Scratch,
     e: &mut i64,
     c: &mut [f64],
 ) {
     let p = to_model.of3(p);
-    let (k, a, tau) = locate(rest, edges, p, hint);
+    let (k, a, tau) = locate(rest, edges, p, s);
     let l = rest.eval(k, a);
     let d = p - l.q - tau * l.t;
     let sk = if tau != 0.0 {
@@ -417,7 +432,11 @@ mod tests {
                 if q % 10 == 0 {
                     p = model.c[q % model.len()]; // on a sample
                 }
-                let got = locate(model, &edges, p, &mut (q * 7 % model.len()));
+                let mut s = Scratch {
+                    hint: q * 7 % model.len(),
+                    stack: Vec::new(),
+                };
+                let got = locate(model, &edges, p, &mut s);
                 let want = locate_by_scan(model, p);
                 assert_eq!(
                     (got.0, got.1.to_bits(), got.2.to_bits()),

@@ -162,18 +162,20 @@ impl Bvh {
     /// returns the bound from then on (the squared distance of the best answer so far).
     /// Items whose boxes are all farther than the final bound may be skipped; an item whose
     /// box is at exactly the bound is visited (so ties can be decided by the caller).
-    pub fn nearest(&self, p: DVec3, mut bound: f64, mut visit: impl FnMut(usize) -> f64) {
+    /// `stack`: scratch space that a caller making many queries passes each time.
+    pub fn nearest(
+        &self,
+        p: DVec3,
+        mut bound: f64,
+        stack: &mut Vec<(usize, f64)>,
+        mut visit: impl FnMut(usize) -> f64,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
-        // a median split halves the items, so the depth is at most log2(items) + 1 and
-        // the stack holds at most one pending sibling per level: no allocation per query
-        let mut stack = [(0usize, 0.0f64); 2 * (usize::BITS as usize) + 2];
-        stack[0] = (0, self.nodes[0].bound.distance_squared(p));
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let (n, d) = stack[top];
+        stack.clear();
+        stack.push((0, self.nodes[0].bound.distance_squared(p)));
+        while let Some((n, d)) = stack.pop() {
             if d > bound {
                 continue;
             }
@@ -190,14 +192,11 @@ impl Bvh {
                 self.nodes[b].bound.distance_squared(p),
             );
             // the nearer child is popped first
-            let (near, far) = if da <= db {
-                ((a, da), (b, db))
+            if da <= db {
+                stack.extend([(b, db), (a, da)]);
             } else {
-                ((b, db), (a, da))
-            };
-            stack[top] = far;
-            stack[top + 1] = near;
-            top += 2;
+                stack.extend([(a, da), (b, db)]);
+            }
         }
     }
 }
@@ -232,7 +231,7 @@ mod tests {
                 .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
             let mut best = (f64::INFINITY, usize::MAX);
             let mut visited = 0;
-            bvh.nearest(p, f64::INFINITY, |j| {
+            bvh.nearest(p, f64::INFINITY, &mut Vec::new(), |j| {
                 visited += 1;
                 let d = (p - pts[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
