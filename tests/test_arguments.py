@@ -81,6 +81,7 @@ BASE = {
     "spinal.Mesh.concatenate": (spinal.Mesh.concatenate, ([MESH, MESH],), {}),
     "spinal.SpineBinding": (spinal.SpineBinding, (CLOUD, REST), {}),
     "spinal.SpineBinding.deform": (SBIND.deform, (BEND,), {}),
+    "spinal.SpineBinding.animate": (SBIND.animate, (np.stack([BEND, BEND]),), {}),
     "spinal.SpineBinding.posed_spine": (SBIND.posed_spine, (BEND,), {}),
     "spinal.SurfaceBinding": (spinal.SurfaceBinding, (SHEET_PTS, SHEET), {}),
     "spinal.SurfaceBinding.deform": (SURF.deform, (SHEET2,), {}),
@@ -195,7 +196,7 @@ ARRAYS = {
     "points", "tangents", "initial", "end", "u", "lengths", "offsets", "constraints", "guide",
     "previous", "vertices", "faces", "normals", "uv", "fold_over", "point_data", "cell_data",
     "sample_of", "curve_of", "skipped_curves", "meshes", "mesh", "field", "rest_spine",
-    "posed_spine", "posed_frames", "posed_up", "twist", "rest_surface", "posed_surface",
+    "posed_spine", "posed_spines_t", "posed_frames", "posed_up", "twist", "rest_surface", "posed_surface",
     "points_t", "tangents_t", "profile", "frames", "scale", "start", "center", "axis",
     "velocity", "angular_velocity", "pivot", "grid", "origin", "tool", "times", "positions",
     "orientations", "fields", "quaternions", "q", "q0", "q1", "new_u", "key_u", "a", "b",
@@ -232,6 +233,9 @@ KINDS = {
 #: (callable, parameter) -> {bad value label: reason it is legitimately accepted}.
 ACCEPTED = {
     ("*", "turns"): {"-1": "a negative number of turns is a turn the other way"},
+    ("spinal.SpineBinding.animate", "slide"): {"[1, 2]": "one slide per pose (two here)",
+                                               "-1": "a slide backwards along the spine"},
+    ("spinal.SpineBinding.deform", "slide"): {"-1": "a slide backwards along the spine"},
     ("spinal.frames", "turns"): {"-1": "a turn the other way",
                                  "[1, 2]": "a sequence: the turns per steered interval"},
     ("*", "reach"): {"inf": "an infinite reach: the field reaches everywhere"},

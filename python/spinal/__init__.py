@@ -34,7 +34,8 @@ from ._advect import advect
 from ._compensate import CompensationReport, compensate_volume
 from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
-from ._flesh import SpineBinding, SurfaceBinding, flesh, flesh_surface
+from ._flesh import SpineBinding, flesh
+from ._flesh_surface import SurfaceBinding, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._sweep import sweep, tube

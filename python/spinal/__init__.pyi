@@ -377,6 +377,7 @@ class SpineBinding:
         return_clamped: Literal[False] = False,
         posed_frames: _Array | None = None,
         posed_up: _Array | None = None,
+        slide: float = 0.0,
     ) -> _F: ...
     @overload
     def deform(
@@ -390,6 +391,7 @@ class SpineBinding:
         return_clamped: Literal[True],
         posed_frames: _Array | None = None,
         posed_up: _Array | None = None,
+        slide: float = 0.0,
     ) -> tuple[_F, _I]: ...
     @overload
     def deform(
@@ -403,7 +405,19 @@ class SpineBinding:
         return_clamped: bool = False,
         posed_frames: _Array | None = None,
         posed_up: _Array | None = None,
+        slide: float = 0.0,
     ) -> _F | tuple[_F, _I]: ...
+    def animate(
+        self,
+        posed_spines_t: _Array,
+        *,
+        solution: _SpineSolution = "radial",
+        stretchable: bool = False,
+        twist: float | _Array | None = None,
+        slide: float | _Array = 0.0,
+        previous_weight: float = 1000.0,
+        progress: _Progress = False,
+    ) -> _F: ...
 
 @overload
 def flesh(
