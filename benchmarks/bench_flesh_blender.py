@@ -110,7 +110,7 @@ BLENDER = textwrap.dedent("""
 
 
 def blender_times(python: str, n: int, repeat: int, tmp: str) -> dict:
-    V, F, rest, arc = shapes(n)
+    V, F, _, arc = shapes(n)
     src, dst = os.path.join(tmp, "in.npz"), os.path.join(tmp, "out.npy")
     np.savez(src, V=V, F=F, arc=arc, repeat=repeat)
     script = os.path.join(tmp, "curve_modifier.py")
