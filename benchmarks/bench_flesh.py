@@ -90,7 +90,7 @@ def volume_table() -> None:
         for sol in ("none", "radial"):
             W = spinal.flesh(V, rest, posed, solution=sol)
             row.append(spinal.Mesh(W, F).volume / v0 - 1)
-        comp, rep = spinal.compensate_volume((W, F), v0)
+        _, rep = spinal.compensate_volume((W, F), v0)
         row.append(rep.volume_after / v0 - 1)
         size = float(np.linalg.norm(np.ptp(V, axis=0)))
         print(f"| {name} | {len(V):,} | {row[0]:+.2%} | {row[1]:+.1e} | {row[2]:+.1e} | "

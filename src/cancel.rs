@@ -851,8 +851,10 @@ mod tests {
         for previous in [None, Some(&prev[..])] {
             let run = |c: super::Cancel<'_>| {
                 let mut out = vec![0.0; 9 * x.len()];
-                time::frames_in_time_cancellable(&req, steps, rows, None, previous, &mut out, c)
-                    .expect("valid");
+                time::frames_in_time_cancellable(
+                    &req, steps, rows, None, previous, &mut out, c, None,
+                )
+                .expect("valid");
                 out
             };
             let (out, _) = stop_everywhere(run);

@@ -145,3 +145,22 @@ def test_animate_crawls_with_a_slide_per_pose_and_checks_its_input():
     bad[3, 5] = np.nan
     with pytest.raises(ValueError, match="^posed_spines_t: pose 3: "):
         b.animate(bad)
+
+
+def test_slides_per_pose_must_be_finite_and_clamp_warnings_point_at_the_caller():
+    V, _ = tube_shape(rings=20, sides=6)
+    b = spinal.SpineBinding(V, line(11, start=0.0, stop=4.0))
+    posed = np.repeat(line(50, start=0.0, stop=8.0)[None], 3, axis=0)
+    with pytest.raises(ValueError, match="^slide: the slide of pose 1 is not finite"):
+        b.animate(posed, slide=[0.0, np.nan, 0.0])
+    # points 0.9 off the spine, bent to radius 1 towards them: past the fold limit
+    W = np.c_[np.linspace(0, 4, 50), np.full(50, 0.9), np.zeros(50)]
+    rest = line(21, start=0.0, stop=4.0)
+    c = spinal.SpineBinding(W, rest)
+    th = np.linspace(0, 4, 21)
+    tight = np.c_[np.sin(th), 1 - np.cos(th), 0 * th]
+    for call in (lambda: c.deform(tight), lambda: c.animate(tight[None]),
+                 lambda: spinal.flesh(W, rest, tight)):
+        with pytest.warns(spinal.FoldOverWarning) as rec:
+            call()
+        assert rec[0].filename == __file__

@@ -397,3 +397,19 @@ def test_tube_file_errors_name_the_argument(tmp_path, trk):
     with pytest.raises(ValueError, match="^src: no streamline could be swept"):
         spinal.io.tube_file([np.zeros((3, 3))], tmp_path / "a.ply")
     assert not (tmp_path / "a.ply").exists()
+
+
+def test_tube_file_pairs_carry_data_of_their_own_length_and_files_get_normal_permissions(
+        tmp_path):
+    """Per-point data given with each streamline must have one row per point (a mismatch
+    would shift radii onto the next streamline); the written file has the permissions a
+    plain open() gives, not the temporary file's private ones."""
+    a, b = np.c_[np.arange(5.0), np.zeros((5, 2))], np.c_[np.arange(5.0), np.ones((5, 2))]
+    with pytest.raises(ValueError, match="^src: streamline 0: its 'r' data has 6 rows for 5"):
+        spinal.io.tube_file([(a, {"r": np.full(6, 0.1)}), (b, {"r": np.full(4, 0.1)})],
+                            tmp_path / "a.ply", "r")
+    out = spinal.io.tube_file([(a, {"r": np.full(5, 0.1)}), (b, {"r": np.full(5, 0.2)})],
+                              tmp_path / "a.ply", "r")
+    with open(tmp_path / "plain", "w"):
+        pass
+    assert (out.stat().st_mode & 0o777) == ((tmp_path / "plain").stat().st_mode & 0o777)

@@ -8,13 +8,7 @@ import numpy as np
 import pytest
 
 import spinal
-from spinal import _fields, _frames, fields
-
-
-@pytest.fixture
-def small_blocks(monkeypatch):
-    """Time series in blocks of a few thousand rows, so that small inputs take many."""
-    monkeypatch.setattr(_frames, "BLOCK_ROWS", 3000)
+from spinal import _fields, fields
 
 
 def walks(count=1200, seed=3):
@@ -118,7 +112,7 @@ def test_frames_of_a_bundle_with_progress_are_the_one_call():
     assert np.array_equal(F, spinal.frames(w[0])) and calls == [(len(w[0]), len(w[0]))]
 
 
-def test_frames_in_time_report_every_step_with_the_same_frames(small_blocks):
+def test_frames_in_time_report_every_step_with_the_same_frames():
     rng = np.random.default_rng(2)
     base = np.c_[np.cos(np.linspace(0, 6, 400)), np.sin(np.linspace(0, 6, 400)),
                  np.linspace(0, 3, 400)]
@@ -128,7 +122,7 @@ def test_frames_in_time_report_every_step_with_the_same_frames(small_blocks):
         calls = Calls()
         steps = spinal.frames_in_time(pts, progress=calls, **kw)
         assert np.array_equal(one, steps), kw
-        assert_reports(calls, 30, 30 if not kw else 30 * 400 // 3000)
+        assert_reports(calls, 30, 30 if not kw else 1)
 
 
 def test_stamp_reports_every_frame():
@@ -151,6 +145,7 @@ def test_mesh_tool_samples_in_slabs_with_the_same_field(monkeypatch):
     x = np.random.default_rng(4).uniform(-1, 1, (200, 3))
     one = fields.mesh_tool(box, [0, 0, 1], resolution=24)
     monkeypatch.setattr(_fields, "SLAB_NODES", 1000)  # a few planes per slab
+    monkeypatch.setattr(_fields, "SLAB_PER_FACE", 0)
     calls = Calls()
     slabs = fields.mesh_tool(box, [0, 0, 1], resolution=24, progress=calls)
     assert np.array_equal(one(x), slabs(x))
@@ -226,3 +221,27 @@ def test_reports_come_while_a_long_sweep_runs():
         assert len(calls) >= 2 and calls[0][0] < 300_000
     F = spinal.frames(np.concatenate(w), lengths=[200] * 1500, progress=calls)
     assert calls[-1] == (300_000, 300_000) and np.isfinite(F).all()
+
+
+def test_frames_in_time_without_previous_twist_reports_steps_with_the_same_frames():
+    rng = np.random.default_rng(5)
+    u = np.linspace(0, 6, 300)
+    base = np.c_[np.cos(u), np.sin(u), 0.3 * u]
+    pts = base + np.cumsum(rng.normal(scale=0.002, size=(40, 300, 3)), 0)
+    for kw in ({}, {"initial": [0.3, -1, 0.7]}, {"closed": True}):
+        one = spinal.frames_in_time(pts, previous_twist=False, **kw)
+        calls = Calls()
+        got = spinal.frames_in_time(pts, previous_twist=False, progress=calls, **kw)
+        assert np.array_equal(one, got), kw
+        assert_reports(calls, 40)
+
+    def fails(done, total):
+        raise ValueError("stop here")
+
+    with pytest.raises(ValueError, match="stop here"):
+        spinal.frames_in_time(pts, previous_twist=False, progress=fails)
+
+
+def test_a_numpy_bool_is_a_bool():
+    assert spinal.frames(np.eye(3), progress=np.True_).shape == (3, 3, 3)
+    assert spinal.tube(np.eye(3), 0.1, progress=np.False_).is_watertight

@@ -91,6 +91,7 @@ def frames_in_time(
     initial_frames: npt.NDArray[np.float64] | None,
     turns: int,
     previous: npt.NDArray[np.float64] | None,
+    progress: Callable[[int, int], object] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def sweep_mesh(
     points: npt.NDArray[np.float64],

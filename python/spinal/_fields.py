@@ -345,8 +345,10 @@ def _sdf_samples(grid, origin, spacing):
     return np.array(a, dtype=np.float64), o, h
 
 
-#: Grid nodes per slab of a mesh's sampled distance (whole planes; at least one plane).
+#: Grid nodes per slab of a mesh's sampled distance with progress reports (whole planes;
+#: at least one plane), and at least this many per face of the mesh.
 SLAB_NODES = 1 << 16
+SLAB_PER_FACE = 32
 
 # cells per reach that the blend region needs (the core refuses coarser grids, naming
 # `spacing`; `mesh_tool` chooses its spacing and names `resolution`)
@@ -387,8 +389,10 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
         Report the grid nodes sampled (the long part at high resolution: 250³ nodes take
         minutes): ``True`` shows a bar (tqdm when installed, in a terminal or a notebook)
         or a line on stderr at every tenth; a callable is called as ``progress(done,
-        nodes)``. The distances are sampled in slabs of grid planes, between which Ctrl-C
-        stops the call, with or without ``progress``.
+        nodes)``. The distances are then sampled in slabs of grid planes (at least 2¹⁶
+        nodes and 32 per face), between which reports come and Ctrl-C stops the call;
+        without ``progress`` they are sampled in one call to libigl, which Ctrl-C cannot
+        stop.
     """
     values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
     return _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
@@ -425,11 +429,14 @@ def _mesh_samples(mesh, reach, resolution, center, progress):
     origin = lo - rf - pad * h
     shape = np.ceil((hi - lo + 2 * (rf + pad * h)) / h).astype(int) + 1
     axes = [origin[i] + h * np.arange(shape[i]) for i in range(3)]
-    # slabs of whole x planes of at least SLAB_NODES nodes: each point's distance is its
-    # own, so the slabs give the one call's values; Ctrl-C and reports come between them
+    # with progress: slabs of whole x planes of at least SLAB_NODES nodes, and of at least
+    # SLAB_PER_FACE nodes per face (libigl builds its tree of the faces again for every
+    # call; this keeps that under a few per cent); each point's distance is its own, so the
+    # slabs give the one call's values. Reports (and Ctrl-C) come between them.
     d = np.empty(tuple(shape))
     plane = int(shape[1] * shape[2])
-    per = max(1, SLAB_NODES // plane)
+    per = int(shape[0]) if progress is False else max(
+        1, max(SLAB_NODES, SLAB_PER_FACE * len(F)) // plane)
     yz = np.stack(np.meshgrid(axes[1], axes[2], indexing="ij"), axis=-1).reshape(-1, 2)
     with Progress(progress, d.size, "distance grid", "node") as bar:
         for i0 in range(0, int(shape[0]), per):

@@ -572,6 +572,8 @@ class Spool:
                         out.write(np.uint64(size).astype("<u8").tobytes())
                         shutil.copyfileobj(t, out, 1 << 22)
                     out.write(_VTP_END)
+            # mkstemp made it private (0600): the permissions an open() would have given
+            os.chmod(tmp, 0o666 & ~_umask())
             os.replace(tmp, self.path)
         except BaseException:
             os.unlink(tmp)
@@ -584,3 +586,10 @@ class Spool:
         for t in self.parts:
             t.close()
         self.parts = []
+
+
+def _umask() -> int:
+    """The process's file-creation mask (read by setting it and putting it back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask

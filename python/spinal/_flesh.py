@@ -512,6 +512,13 @@ class SpineBinding:
         They are also stored in ``self.clamped`` and reported by a
         :class:`spinal.FoldOverWarning` (``indices`` attribute).
         """
+        return self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+                            posed_frames, posed_up, slide)
+
+    def _deform(self, posed_spine, solution, stretchable, twist, strict, return_clamped,
+                posed_frames, posed_up, slide):
+        """:meth:`deform` (also of :func:`flesh`: either is two frames above this one, so
+        a clamp warning points at the caller's line)."""
         solution = as_choice(solution, "solution", SOLUTIONS)
         strict = as_bool(strict, "strict")
         return_clamped = as_bool(return_clamped, "return_clamped")
@@ -526,12 +533,13 @@ class SpineBinding:
         if given:
             frames1 = _spine_frames(posed, "posed_spine", closed=self._closed)
             frames1 = _given_roll(frames1, posed_frames, posed_up, at, m, self._closed)
-        out, _ = self._apply(posed, frames1, solution, twist, strict)
+        out, _ = self._apply(posed, frames1, solution, twist, strict, level=5)
         return (out, self.clamped) if return_clamped else out
 
-    def _apply(self, posed, frames1, solution, twist, strict):
+    def _apply(self, posed, frames1, solution, twist, strict, level):
         """The shape on the used posed spine ``posed`` with the frames ``frames1`` (None: the
-        default posed frames): the deformed vertices and the frames used."""
+        default posed frames): the deformed vertices and the frames used. A clamp warning
+        points ``level`` frames up from the warning."""
         if frames1 is None:
             frames1 = self._posed_frames(posed)
         tw = None if twist is None else _twist(twist, len(self._rest))
@@ -543,7 +551,7 @@ class SpineBinding:
             tw = _loop(tw, c)
         out, flags = _core.flesh_deform(_loop(posed, c), _loop(frames1, c), self._edge,
                                         self._coords, sol, tw, c)
-        self.clamped = _report_clamped(flags, strict)
+        self.clamped = _report_clamped(flags, strict, level)
         if self._dim == 2:
             out = np.ascontiguousarray(out[:, :2])
         return out, frames1
@@ -612,8 +620,9 @@ def _twist(twist, n: int) -> np.ndarray:
     return np.ascontiguousarray(tw)
 
 
-def _report_clamped(flags: np.ndarray, strict: bool) -> np.ndarray:
-    """Indices of the clamped vertices; warned about (raised with ``strict``)."""
+def _report_clamped(flags: np.ndarray, strict: bool, level: int = 3) -> np.ndarray:
+    """Indices of the clamped vertices; warned about (raised with ``strict``), the warning
+    pointing ``level`` frames up."""
     clamped = np.flatnonzero(flags).astype(np.int64)
     if clamped.size:
         msg = (
@@ -622,7 +631,7 @@ def _report_clamped(flags: np.ndarray, strict: bool) -> np.ndarray:
         )
         if strict:
             raise ValueError(msg)
-        warnings.warn(FoldOverWarning(msg, clamped), stacklevel=3)
+        warnings.warn(FoldOverWarning(msg, clamped), stacklevel=level)
     return clamped
 
 
@@ -662,13 +671,5 @@ def flesh(
         binding = SpineBinding(vertices, rest_spine, closed=closed)
     except MemoryError as e:
         raise MemoryError(f"flesh: {e}") from None
-    return binding.deform(
-        posed_spine,
-        solution=solution,
-        stretchable=stretchable,
-        twist=twist,
-        strict=strict,
-        return_clamped=return_clamped,
-        posed_frames=posed_frames,
-        posed_up=posed_up,
-    )
+    return binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+                           posed_frames, posed_up, 0.0)

@@ -32,8 +32,6 @@ REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
 
-#: Rows per block of a bundle's frames (or of a time series) computed with ``progress``.
-BLOCK_ROWS = 1 << 18
 
 
 def _orientation(x: Any, name: str, curves: int, bundle: bool):
@@ -813,25 +811,11 @@ def frames_in_time(
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
-    # with progress: blocks of steps, each continuing the frames of the block before (the
-    # core's step k continues step k − 1 in the same way, so the bits are the one call's)
-    per = steps if progress is False else max(1, BLOCK_ROWS // max(n, 1))
-    out = np.empty((steps, n, 3, 3)) if per < steps else None
     try:
-        with Progress(progress, steps, "frames_in_time", "step") as bar:
-            for k0 in range(0, steps, per):
-                k1 = min(steps, k0 + per)
-                cut = (lambda a, k0=k0, k1=k1: None if a is None else a[k0:k1])
-                got = _core.frames_in_time(flat(cut(p)), flat(cut(tg)), k1 - k0, method,
-                                           DEFAULT_TANGENT_RULE, reflection == "tangents",
-                                           closed, iv if k0 == 0 else None,
-                                           if_ if k0 == 0 else None, turns,
-                                           prev if k0 == 0 else out[k0 - 1])
-                if out is None:
-                    out = got.reshape(steps, n, 3, 3)
-                else:
-                    out[k0:k1] = got.reshape(k1 - k0, n, 3, 3)
-                bar.update(k1)
+        with Reported(progress, "frames_in_time", "step") as report:
+            out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
+                                       reflection == "tangents", closed, iv, if_, turns, prev,
+                                       report.callback)
     except _core.RepeatedPointsError:
         if reflection == "tangents":
             raise
@@ -839,15 +823,7 @@ def frames_in_time(
         return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
                                        reflection, previous, False, 1.0, None, 1.0, 1e-3,
                                        "follow", None, None, progress)
-    except ValueError as exc:
-        if per >= steps:
-            raise
-        # a later block: the message names the step within it; the one call names it in all
-        del exc
-        out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
-                                   reflection == "tangents", closed, iv, if_, turns, prev)
-        return out.reshape(steps, n, 3, 3)
-    return out
+    return out.reshape(steps, n, 3, 3)
 
 
 def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns, reflection,

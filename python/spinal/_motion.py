@@ -103,12 +103,15 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
         if sl.shape != (steps,):
             raise ValueError(f"slide: expected a number or one per pose ({steps}), got shape "
                              f"{sl.shape}")
+        bad = np.flatnonzero(~np.isfinite(sl))
+        if bad.size:
+            raise ValueError(f"slide: the slide of pose {bad[0]} is not finite ({sl[bad[0]]})")
     out = np.empty((steps, len(binding), binding._dim))
     prev = None
     with Progress(progress, steps, "animate", "pose") as bar:
         for t in range(steps):
             try:
-                posed, _, _ = binding._posed(P[t], stretchable, as_slide(sl[t]))
+                posed, _, _ = binding._posed(P[t], stretchable, float(sl[t]))
             except ValueError as e:
                 raise ValueError(f"posed_spines_t: pose {t}: {str(e).split(': ', 1)[-1]}") \
                     from None
@@ -117,6 +120,6 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
             else:
                 fr = frames(posed, previous=prev, previous_twist=True,
                             guide_weight=previous_weight, closed=binding._closed)
-            out[t], prev = binding._apply(posed, fr, solution, twist, False)
+            out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5)
             bar.update(t + 1)
     return out

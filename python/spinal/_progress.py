@@ -1,11 +1,14 @@
 """Progress reports of long calls: the ``progress=`` argument that they share.
 
 ``progress`` is ``False`` (silent, the default), ``True`` (a bar) or a callable called as
-``progress(done, total)`` after every block of work, in the calling thread. The bar is
+``progress(done, total)`` as the work goes, with the GIL held: from the calling thread
+while it waits for the work (sweeps, frames, ``frames_in_time``; about every 20 ms while
+the count moves and once at the end), or from the worker running a sequential loop between
+its steps (``advect``, ``deform``, ``stamp``). The bar is
 tqdm's (``tqdm.auto``: a widget in a notebook) where tqdm is installed and the output is a
 terminal or a notebook; otherwise a plain line on stderr at every tenth of the work, which
-reads well in a log file. Reports come between the same blocks at which Ctrl-C is polled,
-so they cost nothing beside the work; an exception raised by a callable stops the call and
+reads well in a log file. The work itself only counts (an atomic add per curve or step), so
+reports cost nothing beside it; an exception raised by a callable stops the call and
 propagates.
 """
 
@@ -14,13 +17,17 @@ from __future__ import annotations
 import sys
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 if TYPE_CHECKING:  # Python 3.11+ at run time
     from typing import Self
 
 
 def checked(progress, name: str = "progress"):
-    """``progress`` if it is a bool or a callable, else ``TypeError`` naming it."""
-    if isinstance(progress, bool) or callable(progress):
+    """``progress`` as a bool (NumPy's too) or the callable, else ``TypeError`` naming it."""
+    if isinstance(progress, (bool, np.bool_)):
+        return bool(progress)
+    if callable(progress):
         return progress
     raise TypeError(f"{name}: expected a bool or a callable, got {type(progress).__name__}")
 
@@ -122,16 +129,3 @@ class Reported:
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-def blocks(lengths, rows_per_block: int) -> list[tuple[int, int]]:
-    """Runs ``[lo, hi)`` of whole curves (given their row counts) of about
-    ``rows_per_block`` rows each, in order, covering every curve."""
-    out, lo, size = [], 0, 0
-    n = len(lengths)
-    for i, k in enumerate(lengths):
-        size += int(k)
-        if size >= rows_per_block or i == n - 1:
-            out.append((lo, i + 1))
-            lo, size = i + 1, 0
-    return out

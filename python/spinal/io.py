@@ -369,14 +369,19 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     rows_before = [0]  # spine rows of the chunks written
     try:
         chunk, data, size = [], {k: [] for k in named}, 0
-        for p, d in items:
+        for i, (p, d) in enumerate(items):
             p = _np.asarray(p, dtype=_np.float64)
             for k in named:
                 if k not in d:
                     what = "radius" if k == radius else "colors"
                     raise ValueError(f"{what}: src has no per-point data named {k!r} (it has "
                                      f"{', '.join(sorted(d)) or 'none'})")
-                data[k].append(_np.asarray(d[k]))
+                v = _np.asarray(d[k])
+                if v.ndim == 0 or len(v) != len(p):
+                    raise ValueError(f"src: streamline {i}: its {k!r} data has "
+                                     f"{v.shape[0] if v.ndim else 'no'} rows for {len(p)} "
+                                     f"points")
+                data[k].append(v)
             chunk.append(p)
             size += len(p)
             if size >= chunk_points:

@@ -122,7 +122,10 @@ impl Edges {
                 let h = e.length();
                 let u = e / h;
                 let rho = 4.0 / 27.0 * h * ((sp.t[k] - u).length() + (sp.t[k + 1] - u).length());
-                rho * (1.0 + 1e-9) + 1e-12 * h
+                // round-off of the curve's evaluation (power form about the origin) and of
+                // this bound, relative to the coordinates' size, not only the edge's
+                let size = sp.c[k].abs().max_element() + sp.c[k + 1].abs().max_element() + h;
+                rho * (1.0 + 1e-9) + 1e-12 * h + 64.0 * f64::EPSILON * size
             }),
         )?;
         let boxes: Vec<Aabb> = alloc::collect(
@@ -146,7 +149,9 @@ impl Edges {
     fn lower_bound(&self, sp: &SpineModel, k: usize, p: DVec3) -> f64 {
         let (a, e) = (sp.c[k], sp.c[k + 1] - sp.c[k]);
         let s = ((p - a).dot(e) / e.length_squared()).clamp(0.0, 1.0);
-        let lo = (p - (a + s * e)).length() - self.reach[k];
+        // the round-off of the chord point and of the distance, relative to p's size
+        let slack = 16.0 * f64::EPSILON * (p.abs().max_element() + a.abs().max_element());
+        let lo = (p - (a + s * e)).length() - self.reach[k] - slack;
         // a margin for the round-off of the distances computed from the curve
         if lo > 0.0 {
             lo * lo * (1.0 - 1e-9)
@@ -417,7 +422,25 @@ mod tests {
         let sp = SpineModel::new("rest_spine", &pts, &frames, false).unwrap();
         let (cpts, cframes) = circle(64);
         let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true).unwrap();
-        for (model, count) in [(&sp, 4000), (&loop_sp, 2000)] {
+        // far from the origin with short edges: the round-off of positions of size 1e4
+        // exceeds the edges' own scale, which the bounds must allow for
+        let far: Vec<DVec3> = (0..n)
+            .map(|i| {
+                DVec3::new(
+                    1e4 + i as f64 * 0.01,
+                    1e4 + (i as f64 * 0.02).sin() * 0.01,
+                    1e4,
+                )
+            })
+            .collect();
+        let req = crate::frames::Request {
+            points: Some(&far),
+            ..Default::default()
+        };
+        let mut far_frames = vec![0.0; 9 * n];
+        crate::frames::compute_into(&req, &mut far_frames).unwrap();
+        let far_sp = SpineModel::new("rest_spine", &far, &far_frames, false).unwrap();
+        for (model, count) in [(&sp, 4000), (&loop_sp, 2000), (&far_sp, 4000)] {
             let edges = Edges::new(model).unwrap();
             for q in 0..count {
                 let x = q as f64 * 0.618_033_988_7;
@@ -428,6 +451,12 @@ mod tests {
                 );
                 if model.closed {
                     p = DVec3::new((x * 3.1).sin() * 1.6, (x * 1.7).cos() * 1.6, x.sin() * 0.4);
+                }
+                if std::ptr::eq(model, &far_sp) {
+                    // within 1e-6 … 1e-2 of the spine (model units), often on sample planes
+                    let j = 1 + q % (n - 2);
+                    let off = 10f64.powf(-6.0 + 4.0 * (x * 7.3).sin().abs());
+                    p = model.c[j] + DVec3::new(0.0, off * (x * 2.1).cos(), off * (x * 2.1).sin());
                 }
                 if q % 10 == 0 {
                     p = model.c[q % model.len()]; // on a sample

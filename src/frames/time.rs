@@ -136,12 +136,15 @@ pub fn frames_in_time(
         previous,
         out,
         &crate::cancel::never,
+        None,
     )
 }
 
 /// [`frames_in_time`] that polls `cancel` before every time step, inside each step's frames
 /// ([`super::compute_into_cancellable`]) and before every block of rows of the turns, and
-/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]); adds 1
+/// to `done` as each step's frames are computed (a progress count).
+#[allow(clippy::too_many_arguments)]
 pub fn frames_in_time_cancellable(
     template: &Request,
     steps: usize,
@@ -150,6 +153,7 @@ pub fn frames_in_time_cancellable(
     previous: Option<&[[f64; 9]]>,
     out: &mut [f64],
     cancel: Cancel<'_>,
+    done: Option<&std::sync::atomic::AtomicUsize>,
 ) -> Result<()> {
     if template.end.is_some() {
         return Err(InputError::new(
@@ -193,9 +197,13 @@ pub fn frames_in_time_cancellable(
                 end: None,
                 ..*template
             };
-            compute_into_cancellable(&req, buf, cancel)
+            let step = compute_into_cancellable(&req, buf, cancel)
                 .map(|_| ())
-                .map_err(|e| e.context(&format!("time step {k}")))
+                .map_err(|e| e.context(&format!("time step {k}")));
+            if let Some(d) = done {
+                d.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+            step
         })
         .collect::<Result<()>>()?; // no buffer: the first error or `()`
     if cancel() {

@@ -353,10 +353,11 @@ pub fn frames_steered<'py>(
 }
 
 /// Frames of a curve moving in time, `(T, n, 3)` points (and tangents) flattened to
-/// `(T·n, 3)`: each step's RMF, turned to be closest to the step before.
+/// `(T·n, 3)`: each step's RMF, turned to be closest to the step before. `progress(done,
+/// steps)` is called from the waiting thread as the steps' frames are computed.
 #[pyfunction]
 #[pyo3(signature = (points, tangents, steps, method, tangent_rule, tangent_chords, closed,
-                    initial_vectors, initial_frames, turns, previous))]
+                    initial_vectors, initial_frames, turns, previous, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_in_time<'py>(
     py: Python<'py>,
@@ -371,6 +372,7 @@ pub fn frames_in_time<'py>(
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
     turns: i64,
     previous: Option<PyReadonlyArray3<'py, f64>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
@@ -407,7 +409,9 @@ pub fn frames_in_time<'py>(
         let mut rw = out.readwrite();
         let buf = slice_mut(&mut rw)?;
         let stop = Stop::default();
-        detach_stoppable(py, &stop, || {
+        let report = Report::new(progress, steps);
+        let done = Report::counter(&report);
+        detach_reporting(py, &stop, report.as_ref(), || {
             frames::time::frames_in_time_cancellable(
                 &template,
                 steps,
@@ -416,6 +420,7 @@ pub fn frames_in_time<'py>(
                 prev,
                 buf,
                 &|| stop.requested(),
+                done,
             )
         })?
         .map_err(|e| match e.arg {
