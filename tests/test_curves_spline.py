@@ -470,3 +470,21 @@ def test_a_million_evaluations_take_well_under_a_second():
         best = min(best, time.perf_counter() - t0)
     assert x.shape == (1_000_000, 3)
     assert best < 0.5, best
+
+
+def test_spline_lengths_at_extreme_scales_are_exact_or_refused_by_name():
+    """A B-spline's length scales with its control points from 1e-170 to 1e170 (no
+    overflow or underflow in the speed); an interpolating spline, whose pieces hold the
+    chord lengths cubed, refuses chords outside 1e-100 … 1e100 by naming the points and is
+    exact inside that range."""
+    P = np.random.default_rng(11).normal(size=(8, 3))
+    ref = Spline(P, "bspline").length
+    for sc in (1e-170, 1e170):
+        assert abs(Spline(P * sc, "bspline").length / (ref * sc) - 1) < 1e-12
+    for kind in ("natural_cubic", "catmull_rom"):
+        ref = Spline(P, kind).length
+        for sc in (1e-90, 1e90):
+            assert abs(Spline(P * sc, kind).length / (ref * sc) - 1) < 1e-12
+        for sc in (1e-170, 1e170):
+            with pytest.raises(ValueError, match="^points: chords from .* leave the range"):
+                Spline(P * sc, kind)

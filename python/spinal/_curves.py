@@ -19,6 +19,7 @@ from ._spline import (
     invert_arc_length,
     natural_pieces,
     periodic_bspline,
+    row_norms,
 )
 from ._validate import (
     MAX_SAMPLES,
@@ -418,6 +419,9 @@ class Spline(Curve):
         lo, hi = self.domain
         if self.closed:
             u = lo + np.mod(u - lo, hi - lo)
+            # a whole number of periods that rounds to just short of one is the seam (the
+            # start of the first piece), as it is in exact arithmetic
+            u = np.where(u - lo > (hi - lo) * (1 - 4 * np.finfo(float).eps), lo, u)
         else:
             slack = 1e-12 * max(hi - lo, abs(lo), abs(hi))
             out = (u < lo - slack) | (u > hi + slack)
@@ -430,7 +434,7 @@ class Spline(Curve):
 
     def _speed(self, piece, s):
         """``|x′|`` on ``piece`` at the local parameter ``s``."""
-        return np.linalg.norm(horner(self._coef[1], piece, s), axis=1)
+        return row_norms(horner(self._coef[1], piece, s))
 
     def _arc_table(self):
         if self._table is None:

@@ -61,13 +61,28 @@ def horner(c: np.ndarray, piece: np.ndarray, s: np.ndarray) -> np.ndarray:
 # ------------------------------------------------------------- interpolating splines
 
 
+#: Chord lengths an interpolating spline can be built from (its coefficients hold h±³).
+_CHORDS = (1e-100, 1e100)
+
+
+def row_norms(d: np.ndarray) -> np.ndarray:
+    """Lengths of the rows of ``d`` (n, 3) without overflow or underflow in the squares
+    (``hypot``), so splines of any size have finite, non-zero chords and speeds."""
+    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+
+
 def chords(p: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Chord vectors ``Δ_i = p_{i+1} − p_i`` (closed: with the chord back to ``p_0``), their
     lengths ``h_i`` (the knot spacings of the chord-length parametrisation) and the divided
     differences ``δ_i = Δ_i / h_i`` (unit vectors). Raises on a chord of length 0."""
     d = np.diff(np.vstack([p, p[:1]]) if closed else p, axis=0)
-    h = np.linalg.norm(d, axis=1)
+    h = row_norms(d)
     zero = np.flatnonzero(~(h > 0))
+    if not zero.size and not (_CHORDS[0] <= h.min() and h.max() <= _CHORDS[1]):
+        # the pieces' coefficients hold h³ and 1/h³ (the chord-length parameter is a length)
+        raise ValueError(f"points: chords from {h.min():.3g} to {h.max():.3g} leave the range "
+                         f"1e-100 … 1e100 where the chord-length pieces stay finite; rescale "
+                         f"the points (the spline is the same in any unit)")
     if zero.size:
         i = int(zero[0])
         j = (i + 1) % len(p)
@@ -273,6 +288,8 @@ def arc_length_table(speed, h: np.ndarray):
         if scale is None:
             scale = float(halves.sum())
         ok = np.abs(whole - halves) <= 1e-13 * halves + 1e-15 * scale
+        # an integral that is not finite cannot be refined by halving
+        ok |= ~(np.isfinite(whole) & np.isfinite(halves))
         if level == _MAX_LEVELS:
             ok[:] = True
         kept.append((piece[ok], a[ok], b[ok], halves[ok]))
