@@ -402,6 +402,17 @@ mod tests {
         (best.1, best.2, best.3)
     }
 
+    /// The model of an open spine through `pts` with its default frames.
+    fn open_model(pts: &[DVec3]) -> SpineModel {
+        let req = crate::frames::Request {
+            points: Some(pts),
+            ..Default::default()
+        };
+        let mut frames = vec![0.0; 9 * pts.len()];
+        crate::frames::compute_into(&req, &mut frames).unwrap();
+        SpineModel::new("rest_spine", pts, &frames, false).unwrap()
+    }
+
     #[test]
     fn the_hierarchy_finds_the_sections_of_the_scan_bit_for_bit() {
         // a wavy open spine and a closed circle; points near and far, on sample planes and
@@ -413,13 +424,7 @@ mod tests {
                 DVec3::new(u, (2.0 * u).sin() * 0.5, (0.7 * u).cos() * 0.3)
             })
             .collect();
-        let req = crate::frames::Request {
-            points: Some(&pts),
-            ..Default::default()
-        };
-        let mut frames = vec![0.0; 9 * n];
-        crate::frames::compute_into(&req, &mut frames).unwrap();
-        let sp = SpineModel::new("rest_spine", &pts, &frames, false).unwrap();
+        let sp = open_model(&pts);
         let (cpts, cframes) = circle(64);
         let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true).unwrap();
         // far from the origin with short edges: the round-off of positions of size 1e4
@@ -433,13 +438,7 @@ mod tests {
                 )
             })
             .collect();
-        let req = crate::frames::Request {
-            points: Some(&far),
-            ..Default::default()
-        };
-        let mut far_frames = vec![0.0; 9 * n];
-        crate::frames::compute_into(&req, &mut far_frames).unwrap();
-        let far_sp = SpineModel::new("rest_spine", &far, &far_frames, false).unwrap();
+        let far_sp = open_model(&far);
         for (model, count) in [(&sp, 4000), (&loop_sp, 2000), (&far_sp, 4000)] {
             let edges = Edges::new(model).unwrap();
             for q in 0..count {
