@@ -28,7 +28,7 @@ from dataclasses import field as _dc_field
 import numpy as np
 
 from . import _core
-from ._advect import MAX_STEPS
+from ._advect import MAX_STEPS, default_steps
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import volumes_at_scale as _volumes
 from ._progress import Progress, checked
@@ -279,7 +279,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
     duration = as_finite(duration, "duration")
     t0 = as_finite(t0, "t0")
-    n = field.steps(duration) if steps is None else as_int(steps, "steps")
+    n = default_steps(field, duration, V, t0) if steps is None else as_int(steps, "steps")
     if not 1 <= n <= MAX_STEPS:
         raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {n}")
     if refine is not None:

@@ -349,6 +349,43 @@ pub fn advect_steps(
         });
 }
 
+/// RK4 on `points` in place over the equal steps of `run` (in their spatial order when a
+/// tool benefits from it), returning the largest distance (max norm) a point moved in one
+/// step; `None` when `cancel` stopped it between chunks of points (they are then partly
+/// advected). The positions are those of [`advect_in_place`].
+pub fn advect_measuring(
+    field: &Field,
+    points: &mut [DVec3],
+    run: Run,
+    cancel: Cancel<'_>,
+) -> Option<f64> {
+    if field.tools.is_empty() || run.count == 0 || run.h == 0.0 {
+        return Some(0.0);
+    }
+    with_locality(field, points, |points| {
+        points
+            .par_chunks_mut(CHUNK)
+            .map(|c| {
+                if cancel() {
+                    return None;
+                }
+                let mut most = 0.0f64;
+                for b in c.chunks_mut(LANES) {
+                    let mut before = [DVec3::ZERO; LANES];
+                    for s in 0..run.count {
+                        before[..b.len()].copy_from_slice(b);
+                        integrate_batch(field, b, run.t0, run.h, s..s + 1, Method::Rk4);
+                        for (x, y) in b.iter().zip(&before) {
+                            most = most.max((*x - *y).abs().max_element());
+                        }
+                    }
+                }
+                Some(most)
+            })
+            .try_reduce(|| 0.0, |a, b| Some(a.max(b)))
+    })
+}
+
 /// `Ok` if `field` can be integrated by `m` (the splitting needs curl potentials).
 pub fn check_method(field: &Field, m: Method) -> crate::error::Result<()> {
     if m == Method::Split && !field.has_potential() {

@@ -434,6 +434,19 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
     fn potential_jacobian(&self, x: DVec3, t: f64) -> Option<DMat3> {
         Some(CurlTool::potential_jacobian(self, x, t))
     }
+    /// The shape's own motion: `|u|` for a moving translation, `|Ω| (arm + extent)` for a
+    /// moving rotation (the farthest point of the support); 0 for a steady field.
+    fn support_speed(&self) -> f64 {
+        if !self.moving {
+            return 0.0;
+        }
+        match self.motion {
+            Motion::Translate(u) => u.length(),
+            Motion::Rotate { omega, pivot } => {
+                omega.length() * ((self.shape.center() - pivot).length() + self.shape.extent())
+            }
+        }
+    }
     fn rigid_velocity(&self) -> DVec3 {
         match self.motion {
             Motion::Translate(u) if self.moving => u,

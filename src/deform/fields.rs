@@ -173,6 +173,14 @@ impl Tool for Translation {
     fn max_speed(&self) -> f64 {
         Translation::max_speed(self)
     }
+    /// The ball's own motion: `|u|` when it moves, else 0.
+    fn support_speed(&self) -> f64 {
+        if self.moving {
+            self.velocity.length()
+        } else {
+            0.0
+        }
+    }
     fn length_scale(&self) -> f64 {
         self.reach
     }
@@ -295,6 +303,11 @@ impl Tool for Rotation {
     fn max_speed(&self) -> f64 {
         Rotation::max_speed(self)
     }
+    /// The ball's centre orbiting the pivot: `ω |c − o|` (a ball turning about its centre
+    /// stays where it is).
+    fn support_speed(&self) -> f64 {
+        self.omega.length() * (self.center - self.pivot).length()
+    }
     fn length_scale(&self) -> f64 {
         self.reach
     }
@@ -414,6 +427,10 @@ impl Tool for Swirl {
     }
     fn max_speed(&self) -> f64 {
         Swirl::max_speed(self)
+    }
+    /// A swirl stays where it is.
+    fn support_speed(&self) -> f64 {
+        0.0
     }
     fn length_scale(&self) -> f64 {
         self.reach

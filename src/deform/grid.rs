@@ -722,6 +722,14 @@ impl super::Tool for GridTool {
     fn length_scale(&self) -> f64 {
         self.reach
     }
+    /// The grid's own motion: `|velocity|` when it moves with the tool, else 0.
+    fn support_speed(&self) -> f64 {
+        if self.moving {
+            self.velocity.length()
+        } else {
+            0.0
+        }
+    }
     fn shape(&self) -> Option<super::shape::ToolShape> {
         Some(super::shape::ToolShape {
             shape: super::shape::Shape::Grid(std::sync::Arc::new(self.clone())),

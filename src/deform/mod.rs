@@ -23,6 +23,7 @@ pub mod rod;
 pub mod shape;
 pub mod slip;
 pub mod stamp;
+pub mod steps;
 pub mod tube;
 
 use std::ops::Range;
@@ -60,6 +61,15 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
     /// splitting scheme; `None` for tools without one.
     fn potential_jacobian(&self, _x: DVec3, _t: f64) -> Option<DMat3> {
         None
+    }
+
+    /// A bound of the speed at which the region where the tool acts moves (its support
+    /// swept by its motion): 0 for a tool at rest. The measured step rule
+    /// ([`steps::measured_steps`]) takes at least `8 |T| w / ℓ` steps with this `w`, so no
+    /// point can miss the tool between two samples of time. The default, [`Tool::max_speed`],
+    /// keeps the a priori rule for tools that do not say.
+    fn support_speed(&self) -> f64 {
+        self.max_speed()
     }
 
     /// The velocity with which the whole tool translates (its field is steady in a frame
@@ -299,6 +309,11 @@ impl Field {
             .try_fold(0.0, |m: f64, e| e.support_radius(about).map(|r| m.max(r)))
     }
 
+    /// Sum of the tools' [`Tool::support_speed`]s.
+    pub fn support_speed(&self) -> f64 {
+        self.tools.iter().map(|e| e.support_speed()).sum()
+    }
+
     /// Sum of the tools' speed bounds.
     pub fn max_speed(&self) -> f64 {
         self.tools.iter().map(|e| e.max_speed()).sum()
@@ -325,13 +340,20 @@ impl Field {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The step rule for `steps=None`: a step moves a point by at most 1/8 of the field's
+    /// `⌈8 |duration| max_speed / length_scale⌉` (NaN for the zero field over no time): the
+    /// steps of [`Self::default_steps`] before its floor of 4 and its cap.
+    pub fn step_bound(&self, duration: f64) -> f64 {
+        (duration.abs() * 8.0 * self.max_speed() / self.length_scale()).ceil()
+    }
+
+    /// The a priori step rule (the default for `steps=None` without points, see
+    /// [`steps::measured_steps`] for the rule measured on them): a step moves a point by at most 1/8 of the field's
     /// length scale, `h = ℓ / (8 v_max)`, and never fewer than 4 steps. More than
     /// [`MAX_STEPS`] is refused (the caller must then choose the steps).
     pub fn default_steps(&self, duration: f64) -> Result<usize> {
         let v = self.max_speed();
         let l = self.length_scale();
-        let n = (duration.abs() * 8.0 * v / l).ceil();
+        let n = self.step_bound(duration);
         if !(n <= MAX_STEPS as f64) {
             return Err(InputError::new(
                 "steps",
