@@ -251,14 +251,32 @@ def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None
                     closed: bool = False, profile_closed: bool = False) -> ProfileSurface:
     r"""Normals, principal curvatures, parabolic lines, singular points and convexity of the
     profile (moulding) surface ``X(u, v) = x(u) + a(v) r(u) + b(v) s(u)`` swept with the
-    rotation-minimising frame (Mäurer & Jüttler 1999, §2.2–2.3; the formulas are in
-    :mod:`spinal._profile`'s docstring and in :class:`ProfileSurface`).
+    rotation-minimising frame (RMF) ``(r, s, t)`` (Mäurer & Jüttler 1999, "MJ", §2.2–2.3).
 
     The surface is the one :func:`spinal.sweep` meshes from the same spine, profile and
     frames (without its mitre stretch at corners). Everything is evaluated on the grid of
-    spine samples × profile samples; the only spine data needed are the RMF and the
-    curvature vector ``κn = k₁ r + k₂ s`` (no derivative of the curvature: the patch is
-    principal, MJ Prop. 3), the only profile data its unit tangent and signed curvature.
+    spine samples × profile samples. ``u`` runs along the spine and ``v`` along the profile
+    (as in the sweeps' texture coordinates; MJ name them the other way round). With the
+    curvature vector ``κn = k₁ r + k₂ s`` of the spine (1/length; the RMF relations
+    ``t′ = σ(k₁ r + k₂ s)``, ``r′ = −σk₁ t``, ``s′ = −σk₂ t``, ``σ = |x′|``), the profile's
+    unit tangent ``T = (T_a, T_b)`` and signed curvature ``κ_c`` (1/length)::
+
+        X_u = σ μ t,   μ = 1 − k₁ a − k₂ b,   X_u · X_v = 0         (MJ Prop. 3)
+        N   = T_b r − T_a s                                         (MJ (10))
+        κ_u = (k₁ T_b − k₂ T_a)/μ = κ cos ϑ/μ,   κ_v = −κ_c         (MJ (11)–(12))
+        K   = κ_u κ_v = −κ_c κ cos ϑ/μ,   H = (κ_u + κ_v)/2         (MJ (13))
+
+    The patch is principal (the ``u`` and ``v`` lines are lines of curvature); ``N`` is the
+    outward normal of a counter-clockwise profile; curvatures are signed by
+    ``II = X_ij · N``; MJ print (13) without its sign and the ``1/μ``.
+
+    ``cos ϑ = N · n``. Parabolic lines (``K = 0``) are where ``κ_c = 0`` (profile
+    inflections), ``κ = 0`` (spine inflections) or ``cos ϑ = 0`` (MJ (14)); singular points
+    where ``μ = 0`` (the profile meets the curvature axis; MJ Cor. 7: ``μ > 0``, i.e.
+    ``κ(a cos Ω − b sin Ω) < 1`` with ``Ω`` the angle from ``n`` to ``r``, excludes them).
+    No derivative of the curvature is needed, so sampled spines need only the RMF and
+    ``κn``, and profiles only ``T`` and ``κ_c``. The convexity fields follow MJ Prop. 8 and
+    Cor. 9 (see :class:`ProfileSurface`).
 
     Parameters
     ----------
