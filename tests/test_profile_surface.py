@@ -187,6 +187,29 @@ def test_sampled_profile_converges_at_second_order_ends_included():
     assert np.all(orders > 1.8), (errs, orders)
 
 
+def test_closed_spine_uses_the_rmf_not_the_closed_up_frames():
+    """A torus knot (closing angle −2.88): closed=True drops the repeated first point (equal
+    up to rounding), estimates across the seam and uses the RMF from row 0; frames that
+    spread the closing angle (spinal.frames(..., closed=True)) twist, and are refused."""
+    knot = curves.TorusKnot().sample(1025)
+    assert not np.array_equal(knot[0], knot[-1])  # the same point up to rounding
+    a = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    prof = 0.02 * np.c_[np.cos(a), np.sin(a)]
+    ps = spinal.profile_surface(knot, prof, closed=True, profile_closed=True)
+    assert ps.u.shape == (1024,) and ps.singularity_free
+    F = spinal.frames(knot[:-1], spinal.estimate_tangents(knot[:-1], closed=True))
+    np.testing.assert_allclose(ps.frames, F, atol=1e-15)
+    # the seam: the curvature there comes from the neighbours across it, like everywhere
+    kn = np.linalg.norm(ps.spine_curvature, axis=1)
+    exact = curves.TorusKnot().curvature(np.linspace(0, 2 * np.pi, 1025)[:-1])
+    err = np.abs(kn / exact - 1)
+    assert err.max() < 2.5e-4  # 1.7e-4 measured: 2nd order in a non-uniform spacing
+    assert err[[0, -1]].max() < 1e-4  # 3.8e-5 (an open spine's ends: 4.1e-4, extrapolated)
+    with pytest.raises(ValueError, match="^frames: not rotation-minimising"):
+        spinal.profile_surface(knot, prof, closed=True, profile_closed=True,
+                               frames=spinal.frames(knot[:-1], closed=True))
+
+
 def test_twisted_frames_are_refused():
     helix, u, v, prof, _ = _ribbon()
     frenet = helix.frenet(u)  # columns (N, B, T): it turns about t at the torsion's rate

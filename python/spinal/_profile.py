@@ -388,16 +388,15 @@ def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None
         x = as_points(spine, "spine")
         if not np.all(np.isfinite(x)):
             raise ValueError("spine: contains non-finite values")
-        if closed and len(x) > 1 and np.array_equal(x[0], x[-1]):
+        floor = _repeat_floor(x)
+        if closed and len(x) > 1 and np.abs(x[-1] - x[0]).max() <= floor:
             x = x[:-1]
         if len(x) < 3:
             raise ValueError(f"spine: expected at least 3 samples, got {len(x)}")
-        h = np.linalg.norm(np.diff(x, axis=0), axis=1)
-        if np.any(h == 0):
-            rows = np.flatnonzero(h == 0)
+        rows = np.flatnonzero(np.abs(np.diff(x, axis=0)).max(axis=1) <= floor)
+        if rows.size:
             raise ValueError(f"spine: repeated consecutive points at rows {rows[:10].tolist()}")
-        if closed and np.array_equal(x[0], x[-1]):
-            raise ValueError("spine: repeated consecutive points at the seam")
+        h = np.linalg.norm(np.diff(x, axis=0), axis=1)
         uu = np.r_[0.0, np.cumsum(h)]
         kn = _circle_curvature(x, closed)
         spine_size = _size(x)
@@ -474,6 +473,12 @@ def _size(p: np.ndarray) -> float:
     return d if d > 0 else 1.0
 
 
+def _repeat_floor(p: np.ndarray) -> float:
+    """The largest coordinate difference that counts as a repeated point: ``2⁻⁴⁰`` of the
+    bounding box's largest side, the rule of :func:`spinal.frames` and :func:`spinal.sweep`."""
+    return float(np.max(p.max(axis=0) - p.min(axis=0))) * 2.0**-40
+
+
 def _count_or_values(x, name: str, domain: tuple[float, float], default: int) -> np.ndarray:
     if x is None:
         x = default
@@ -539,15 +544,16 @@ def _profile(profile, v, profile_closed: bool):
     if not np.all(np.isfinite(c)):
         raise ValueError("profile: contains non-finite values")
     c = np.array(c, dtype=float)
-    if profile_closed and len(c) > 1 and np.array_equal(c[0], c[-1]):
+    floor = _repeat_floor(c)
+    if profile_closed and len(c) > 1 and np.abs(c[-1] - c[0]).max() <= floor:
         c = c[:-1]
     if len(c) < 3:
         raise ValueError(f"profile: expected at least 3 samples, got {len(c)}")
     e = np.diff(np.vstack([c, c[:1]]) if profile_closed else c, axis=0)
+    rows = np.flatnonzero(np.abs(e).max(axis=1) <= floor)
+    if rows.size:
+        raise ValueError(f"profile: repeated consecutive points at rows {rows[:10].tolist()}")
     h = np.hypot(e[:, 0], e[:, 1])
-    if np.any(h == 0):
-        raise ValueError(f"profile: repeated consecutive points at rows "
-                         f"{np.flatnonzero(h == 0)[:10].tolist()}")
     vv = np.r_[0.0, np.cumsum(h[: len(c) - 1])]
     T, kc = _circle_2d(c, profile_closed, vv)
     return c, T, kc, vv, _size(c), (float(vv[-1] + h[-1]) if profile_closed else None)
