@@ -210,6 +210,17 @@ def test_closed_spine_uses_the_rmf_not_the_closed_up_frames():
                                frames=spinal.frames(knot[:-1], closed=True))
 
 
+def test_analytic_spine_default_rk4_frames_converge_at_fourth_order():
+    errs = []
+    for n in (41, 81, 161):
+        helix, u, v, prof, F = _ribbon(n_u=n)
+        exact = spinal.profile_surface(helix, prof, u=u, v=v, frames=F)
+        rk4 = spinal.profile_surface(helix, prof, u=u, v=v)
+        errs.append(np.abs(rk4.mean - exact.mean).max())
+    orders = np.log2(np.array(errs[:-1]) / errs[1:])
+    assert np.all(orders > 3.7), (errs, orders)
+
+
 def test_twisted_frames_are_refused():
     helix, u, v, prof, _ = _ribbon()
     frenet = helix.frenet(u)  # columns (N, B, T): it turns about t at the torsion's rate
@@ -459,6 +470,11 @@ def test_convex_profile_turned_into_the_interval_is_convex():
     assert not anti.convex and np.all(anti.gaussian < 0)  # Ω₀ + π: K < 0 everywhere
     outside = spinal.profile_surface(pts, _arc(1.5, turn=hi + 0.2))
     assert not outside.convex and np.any(outside.gaussian > 0)
+    # the profile run clockwise (κ_c < 0 and N reversed) is the same surface: same turns
+    cw = spinal.profile_surface(pts, _arc(1.5)[::-1])
+    assert cw.convexity_criterion and np.all(cw.profile_curvature < 0)
+    np.testing.assert_allclose(cw.convex_turns, base.convex_turns, atol=1e-9)
+    np.testing.assert_allclose(cw.gaussian, base.gaussian[:, ::-1], rtol=1e-9)
 
 
 def test_non_convex_profiles_are_not_convex_for_any_turn():
