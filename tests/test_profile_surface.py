@@ -98,6 +98,25 @@ def test_torus_analytic_spine_and_profile_closed_form():
     assert len(m.vertices) == 60 * 48 and len(m.faces) == 2 * 59 * 48
 
 
+def test_spindle_torus_poles_are_singular_points_not_parabolic_lines():
+    """R < r: the profile crosses the curvature axis (the torus' axis) where
+    R + r cos θ = 0; K has poles there (sign change through ∞), its zeros stay θ = ±π/2."""
+    Rs, rs = 1.0, 1.5
+    v = np.linspace(0, 2 * np.pi, 61, endpoint=False) + 0.01
+    ps = spinal.profile_surface(curves.Helix(a=Rs, b=0.0), curves.Helix(a=rs, b=0.0),
+                                u=40, v=v, profile_closed=True)
+    th = np.pi - v
+    np.testing.assert_allclose(ps.gaussian[0], np.cos(th) / (rs * (Rs + rs * np.cos(th))),
+                               rtol=1e-10)
+    assert not ps.singularity_free
+    sing = ps.singular_points
+    assert len(sing) == 2 * 40  # two crossings of the axis on every ring
+    np.testing.assert_allclose(np.cos(np.pi - sing[:, 1]), -Rs / rs, atol=1e-3)  # 6.6e-4
+    lines = ps.parabolic_lines()
+    assert len(lines) == 2
+    np.testing.assert_allclose(np.cos(np.concatenate(lines)[:, 1]), 0, atol=1e-4)  # 1.6e-5
+
+
 def test_torus_from_samples_is_exact_on_circles():
     """Sampled spine and profile: the circle through three samples is exact on circles."""
     u = np.linspace(0, 2 * np.pi, 90, endpoint=False)

@@ -181,12 +181,13 @@ class ProfileSurface:
     def parabolic_lines(self, space: str = "parameters") -> list[np.ndarray]:
         """The parabolic lines (``K = 0``, MJ (14) and §2.3) as polylines.
 
-        Marching squares on the sample grid of ``K`` (with the factors of
-        :attr:`parabolic_sign` below their threshold set to 0): a line crosses each grid
-        edge whose ends have ``K > 0`` and ``K ≤ 0``, at the zero of ``K`` interpolated
-        linearly along the edge (2nd order in the sample spacing); a cell crossed four
-        times is resolved by the mean of its corners. The lines separate ``K > 0`` from
-        ``K ≤ 0``: on a developable part (``K ≡ 0``) there is none. Across a closed
+        Marching squares on the sample grid of ``K μ = −κ_c κ cos ϑ`` (the zeros of ``K``
+        without its poles where the profile crosses the curvature axis, ``μ = 0``; with
+        the factors of :attr:`parabolic_sign` below their threshold set to 0): a line
+        crosses each grid edge whose ends have ``K μ > 0`` and ``K μ ≤ 0``, at the zero
+        interpolated linearly along the edge (2nd order in the sample spacing); a cell
+        crossed four times is resolved by the mean of its corners. On a developable part
+        (``K ≡ 0``) there is none. Across a closed
         profile's seam the lines continue; a closed spine's seam is not joined (the RMF
         generally does not close, :func:`spinal.closing_angle`).
 
@@ -202,7 +203,11 @@ class ProfileSurface:
             One polyline per line; a closed line repeats its first vertex at the end.
         """
         space = as_choice(space, "space", ("parameters", "points"))
-        field = np.where(self.parabolic_sign == 0, 0.0, self.gaussian)
+        # K μ = −κ_c κ cos ϑ: the zeros of K without its poles on the singular curve
+        k, T = self.spine_curvature, self.profile_tangents
+        kcos = k[:, :1] * T[None, :, 1] - k[:, 1:] * T[None, :, 0]
+        num = -self.profile_curvature[None, :] * kcos
+        field = np.where(self.parabolic_sign == 0, 0.0, num)
         lines = _contours(field, self.profile_closed)
         nu = field.shape[0]
         out = []
@@ -380,6 +385,8 @@ def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None
         if frames is None:
             F = _frames(spine, u=uu, method="rk4", initial=init)
         else:
+            if init is not None:
+                raise TypeError("initial: only for the default frames (turn the frames given)")
             F = _checked_frames(frames, x, uu, kn, spine_size, spine.tangent(uu))
     else:
         if u is not None:
@@ -668,8 +675,8 @@ def _checked_frames(frames, x, uu, kn, size, tangents) -> np.ndarray:
     length = float(h.sum())
     kmax = float(np.linalg.norm(kn, axis=1).max())
     limit = _TWIST_TOL * max(kmax, 1.0 / length if length > 0 else 0.0)
-    if np.any(rate > limit):
-        i = int(np.argmax(rate))
+    if not np.all(rate <= limit):  # NaN: a tangent reversed between neighbours
+        i = int(np.argmax(np.where(np.isnan(rate), np.inf, rate)))
         raise ValueError(f"frames: not rotation-minimising: they turn about the tangent by "
                          f"{twist[i]:.3g} rad between rows {i} and {i + 1} ({rate[i]:.3g} "
                          f"rad per length; at most {limit:.3g} is accepted)")
