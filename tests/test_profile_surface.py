@@ -496,6 +496,20 @@ def test_convex_profile_turned_into_the_interval_is_convex():
     np.testing.assert_allclose(cw.gaussian, base.gaussian[:, ::-1], rtol=1e-9)
 
 
+def test_ph_cubic_frame_turning_is_the_closed_form_angle_change():
+    """For a PH cubic Ω is monotone, so Ω_max − Ω_min of MJ Cor. 9 is |Ω(1) − Ω(0)| of the
+    closed form (MJ (30)); the criterion and the interval then follow for a short arc."""
+    sp = ph.PHSpline(_ph_spline().control_points[:1])
+    ps = spinal.profile_surface(sp, SECTION, u=np.linspace(0, 1, 33), v=20)
+    om = sp.angle([0.0, 1.0], exact=True)
+    np.testing.assert_allclose(ps.frame_turning, abs(om[1] - om[0]), rtol=1e-12)
+    arc = spinal.profile_surface(sp, _arc(0.5), u=np.linspace(0, 1, 33))
+    assert arc.convexity_criterion
+    turned = spinal.profile_surface(sp, _arc(0.5, turn=arc.convex_turns.mean()),
+                                    u=np.linspace(0, 1, 33))
+    assert turned.convex and turned.singularity_free
+
+
 def test_non_convex_profiles_are_not_convex_for_any_turn():
     pts = _short_helix()
     s_curve = np.r_[_arc(1.0, start=-np.pi / 2)[:-1],
