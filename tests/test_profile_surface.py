@@ -117,6 +117,25 @@ def test_spindle_torus_poles_are_singular_points_not_parabolic_lines():
     np.testing.assert_allclose(np.cos(np.concatenate(lines)[:, 1]), 0, atol=1e-4)  # 1.6e-5
 
 
+def test_sign_field_is_point_data_of_the_sweep_of_the_same_samples():
+    u = np.linspace(0, 4 * np.pi, 200)
+    pts = np.c_[np.cos(u), np.sin(u), 0.2 * u]
+    a = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    prof = 0.1 * np.c_[np.cos(a), 0.5 * np.sin(a)]
+    for closed_prof, p in ((True, prof), (False, prof[:13])):
+        ps = spinal.profile_surface(pts, p, profile_closed=closed_prof)
+        swept = spinal.sweep(pts, p, frames=ps.frames, caps=False, miter_limit=1.0,
+                             profile_closed=closed_prof)
+        np.testing.assert_allclose(swept.vertices, ps.points.reshape(-1, 3), atol=1e-15)
+        swept.point_data["parabolic_sign"] = ps.parabolic_sign.ravel()
+        grid = ps.mesh()
+        np.testing.assert_array_equal(grid.vertices, ps.points.reshape(-1, 3))
+        assert grid.is_watertight is False and len(grid.faces) == len(swept.faces)
+        V, Fc = grid.vertices, grid.faces
+        fn = np.cross(V[Fc[:, 1]] - V[Fc[:, 0]], V[Fc[:, 2]] - V[Fc[:, 0]])
+        assert np.all(np.einsum("ij,ij->i", fn, grid.normals[Fc].sum(axis=1)) > 0)
+
+
 def test_torus_from_samples_is_exact_on_circles():
     """Sampled spine and profile: the circle through three samples is exact on circles."""
     u = np.linspace(0, 2 * np.pi, 90, endpoint=False)

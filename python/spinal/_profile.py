@@ -122,7 +122,10 @@ class ProfileSurface:
         The sign of ``K`` (−1, 0, +1) as the product of the signs of its factors
         ``−κ_c``, ``κ cos ϑ`` and ``μ``, a factor counting as 0 when the curvature it
         carries is below ``1e-10`` per size of the profile (``κ_c``) or of the spine
-        (``κ cos ϑ``): ready for ``Mesh.point_data`` (see :meth:`mesh`).
+        (``κ cos ϑ``). ``parabolic_sign.ravel()`` is per vertex of :meth:`mesh`, and of
+        ``spinal.sweep(points, profile, frames=ps.frames, caps=False, miter_limit=1.0,
+        profile_closed=...)`` on the same samples when the sweep adds no joins (a smooth
+        spine): ``mesh.point_data["parabolic_sign"] = ps.parabolic_sign.ravel()``.
     singular_points : ndarray (k, 2)
         ``(u, v)`` where ``μ = 0`` (MJ Cor. 7): per spine sample, the profile parameters
         where ``μ`` changes sign between neighbouring profile samples (linear
