@@ -32,7 +32,7 @@ the normal curvatures of the two parameter directions (1/length)::
     K   = κ_u κ_v = −κ_c κ cos ϑ / μ,   H = (κ_u + κ_v)/2                               (13)
 
 ``cos ϑ = N · n``. MJ's (13) is printed without the sign and the ``1/μ``; the zero set, and
-so every statement about parabolic lines, is the same (MJ spec erratum A-8). ``K`` vanishes
+so every statement about parabolic lines, is the same. ``K`` vanishes
 (parabolic points) where ``κ_c = 0`` (an inflection of the profile: a line ``v = const``),
 ``κ = 0`` (an inflection of the spine: ``u = const``) or ``cos ϑ = 0`` (``N ∥ b``, MJ (14)).
 The surface is singular where ``X_u = 0``, i.e. ``μ = 0``: the profile meets the curvature
