@@ -170,12 +170,18 @@ _spline = curves.Spline(PTS)
 BASE["spinal.curves.Spline.arc_length_parameters"] = (_spline.arc_length_parameters, (5,), {})
 BASE["spinal.curves.Spline.sample_arc_length"] = (_spline.sample_arc_length, (5,), {})
 BASE["spinal.compensate_volume"] = (spinal.compensate_volume, (SPHERE, 4.0), {})
+PROFILE_OPEN = 0.1 * np.c_[np.cos(np.linspace(0, 1, 8)), np.sin(np.linspace(0, 1, 8))]
+PSURF = spinal.profile_surface(PTS, PROFILE_OPEN)
+BASE["spinal.profile_surface"] = (spinal.profile_surface, (PTS, PROFILE_OPEN), {})
+BASE["spinal.ProfileSurface.parabolic_lines"] = (PSURF.parabolic_lines, (), {})
+BASE["spinal.ProfileSurface.mesh"] = (PSURF.mesh, (), {})
 
 #: Callables that take no user arguments worth walking, with the reason.
 NOT_WALKED = {
     "spinal.DeformReport": "a result record built by deform, not an input",
     "spinal.StampReport": "a result record built by stamp, not an input",
     "spinal.CompensationReport": "a result record built by compensate_volume, not an input",
+    "spinal.ProfileSurface": "a result record built by profile_surface, not an input",
     "spinal.FoldOverWarning": "a warning class raised by the library",
     "spinal.SkippedCurvesWarning": "a warning class raised by the library",
     "spinal.PrecisionWarning": "a warning class raised by the library",
@@ -202,7 +208,7 @@ ARRAYS = {
     "orientations", "fields", "quaternions", "q", "q0", "q1", "new_u", "key_u", "a", "b",
     "face", "point", "moves", "direction", "directions", "control_points", "knots", "s", "v",
     "section_ctrl", "section_weights", "curve", "domain", "A0", "A1", "p0", "t0", "p1", "t1",
-    "coefficients", "up", "bank", "kwargs",
+    "coefficients", "up", "bank", "kwargs", "spine",
 }
 
 #: Parameters whose kind is not in the annotation/default: name -> kind, per callable

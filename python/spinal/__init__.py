@@ -9,7 +9,9 @@ Frames
     :func:`estimate_tangents`; analytic curves in :mod:`spinal.curves`.
 Sweeps
     :func:`tube`, :func:`sweep` return a watertight :class:`Mesh` with normals and texture
-    coordinates (``.save``, ``.to_trimesh``, ``.to_pyvista``, ``.plot``).
+    coordinates (``.save``, ``.to_trimesh``, ``.to_pyvista``, ``.plot``);
+    :func:`profile_surface` (:class:`ProfileSurface`) analyses a profile sweep: normals,
+    principal and Gaussian curvatures, parabolic lines, singular points, convexity.
 Deformation
     Divergence-free velocity fields in :mod:`spinal.fields`; :func:`advect` (RK4, splitting),
     :func:`deform` (advection with refinement and a volume report, :class:`DeformReport`),
@@ -38,6 +40,7 @@ from ._flesh import SpineBinding, flesh
 from ._flesh_surface import SurfaceBinding, flesh_surface
 from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
+from ._profile import ProfileSurface, profile_surface
 from ._sweep import sweep, tube
 from ._threads import get_num_threads, set_num_threads, threads
 
@@ -47,6 +50,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "PrecisionWarning",
+    "ProfileSurface",
     "RefinementWarning",
     "SkippedCurvesWarning",
     "SpineBinding",
@@ -67,6 +71,7 @@ __all__ = [
     "get_num_threads",
     "io",
     "ph",
+    "profile_surface",
     "quaternions",
     "set_num_threads",
     "stamp",

@@ -15,6 +15,7 @@ from . import ph as ph
 from . import quaternions as quaternions
 from .curves import Curve
 from .fields import Field
+from .ph import PHSpline
 
 __all__ = [
     "CompensationReport",
@@ -22,6 +23,7 @@ __all__ = [
     "FoldOverWarning",
     "Mesh",
     "PrecisionWarning",
+    "ProfileSurface",
     "RefinementWarning",
     "SkippedCurvesWarning",
     "SpineBinding",
@@ -42,6 +44,7 @@ __all__ = [
     "get_num_threads",
     "io",
     "ph",
+    "profile_surface",
     "quaternions",
     "set_num_threads",
     "stamp",
@@ -260,6 +263,52 @@ def tube(
     join: Literal["round", "bevel", "miter"] = "round",
     progress: _Progress = False,
 ) -> Mesh: ...
+
+# ---- profile (moulding) surfaces -----------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class ProfileSurface:
+    u: _F
+    v: _F
+    points: _F
+    normals: _F
+    frames: _F
+    spine_curvature: _F
+    profile_tangents: _F
+    profile_curvature: _F
+    mu: _F
+    curvature_u: _F
+    curvature_v: _F
+    k1: _F
+    k2: _F
+    d1: _F
+    d2: _F
+    gaussian: _F
+    mean: _F
+    parabolic_sign: npt.NDArray[np.int8]
+    singular_points: _F
+    singularity_free: bool
+    convex: bool
+    profile_turning: float
+    frame_turning: float
+    convexity_criterion: bool
+    convex_turns: _F | None
+    closed: bool
+    profile_closed: bool
+    def parabolic_lines(self, space: Literal["parameters", "points"] = "parameters") -> list[_F]: ...
+    def mesh(self) -> Mesh: ...
+
+def profile_surface(
+    spine: _Array | Curve | PHSpline,
+    profile: _Array | Curve,
+    u: int | _Array | None = None,
+    v: int | _Array | None = None,
+    *,
+    frames: _Array | None = None,
+    initial: _Array | None = None,
+    closed: bool = False,
+    profile_closed: bool = False,
+) -> ProfileSurface: ...
 
 # ---- deformation by divergence-free fields ------------------------------------------------
 
