@@ -65,7 +65,7 @@ _Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
 _TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
-_SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
+_SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "blend", "none"]
 _SurfaceSolution: TypeAlias = Literal["offset", "none"]
 
 # ---- frames -------------------------------------------------------------------------------
@@ -371,6 +371,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -385,6 +386,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -399,6 +401,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -412,6 +415,7 @@ class SpineBinding:
         posed_spines_t: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         slide: float | _Array = 0.0,
@@ -426,6 +430,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,
@@ -441,6 +446,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,
@@ -456,6 +462,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,

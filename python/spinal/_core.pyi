@@ -435,6 +435,8 @@ def flesh_deform(
     solution: str,
     twist: npt.NDArray[np.float64] | None,
     closed: bool = False,
+    blend: float | None = None,
+    planar: bool = False,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]

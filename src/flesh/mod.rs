@@ -37,6 +37,7 @@
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
 
 pub mod bind;
+pub mod blend;
 pub mod pose;
 pub mod solve;
 pub mod spine;

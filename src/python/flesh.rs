@@ -49,8 +49,11 @@ pub fn flesh_bind<'py>(
 }
 
 /// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
+/// `blend` is the weight of `solution="blend"` (refused with the other solutions);
+/// `planar`: the shape lies in the spine's plane, where every corrected solution is the
+/// planar quadratic (the normal solution).
 #[pyfunction]
-#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false))]
+#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false, blend=None, planar=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn flesh_deform<'py>(
     py: Python<'py>,
@@ -61,7 +64,13 @@ pub fn flesh_deform<'py>(
     solution: Solution,
     twist: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
+    blend: Option<f64>,
+    planar: bool,
 ) -> PyResult<FleshPose<'py>> {
+    let mut solution = solution.with_blend(blend)?;
+    if planar && solution != Solution::None {
+        solution = Solution::Normal;
+    }
     let (pts, fr) = spine_arrays("posed_spine", &posed_points, &posed_frames)?;
     let edge = slice_of("edge", &edge)?;
     let coords = slice_of("coords", &coords)?;
