@@ -474,8 +474,14 @@ def flesh(
 
 class SurfaceBinding:
     clamped: _I
-    def __init__(self, vertices: _Array, rest_surface: _Array) -> None: ...
+    def __init__(
+        self, vertices: _Array, rest_surface: _Array | Mesh | tuple[_Array, _Array]
+    ) -> None: ...
     def __len__(self) -> int: ...
+    @property
+    def face(self) -> _I: ...
+    @property
+    def barycentric(self) -> _F: ...
     @property
     def uv(self) -> _F: ...
     @property
@@ -519,7 +525,7 @@ class SurfaceBinding:
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",
@@ -531,7 +537,7 @@ def flesh_surface(
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",
@@ -543,7 +549,7 @@ def flesh_surface(
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",

@@ -42,6 +42,7 @@ pub mod pose;
 pub mod solve;
 pub mod spine;
 pub mod surface;
+pub mod trisurf;
 
 pub use bind::{Binding, COORDS, bind, bind_cancellable};
 pub use pose::{deform, deform_cancellable};
