@@ -265,3 +265,15 @@ def test_seams_across_edges_shrink_with_refinement():
         b = spinal.flesh_surface(P + [1e-9, 0, 0], tri(g), cylinder_grid(n).reshape(-1, 3))
         assert np.abs(a - b).max() < 1e-8
     assert jumps[0] > 1e-3 and jumps[0] / jumps[1] > 1.8 and jumps[1] / jumps[2] > 1.8, jumps
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1e-30, 1e30, 1e200])
+def test_any_scale_gives_the_scaled_result(scale):
+    rng = np.random.default_rng(0)
+    g = plane_grid(11)
+    sv, F = tri(g)
+    V = points(rng, 50)
+    posed = bent_stretched(g).reshape(-1, 3)
+    ref = spinal.flesh_surface(V, (sv, F), posed)
+    out = spinal.flesh_surface(V * scale, (sv * scale, F), posed * scale)
+    assert np.abs(out / scale - ref).max() < 1e-14
