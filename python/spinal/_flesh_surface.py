@@ -144,7 +144,9 @@ class SurfaceBinding:
     vertices : array_like (V, 3)
     rest_surface : array_like (nu, nv, 3), nu, nv ≥ 2, or a triangle mesh
         ``(surface_vertices (n, 3), faces (F, 3))``, a :class:`spinal.Mesh` or a
-        ``trimesh.Trimesh`` (faces in range, not degenerate, consistently oriented).
+        ``trimesh.Trimesh`` (faces in range, not degenerate, consistently oriented). A
+        2-tuple whose second item has an integer dtype is read as ``(vertices, faces)``; give
+        a grid as one array.
     """
 
     def __init__(self, vertices, rest_surface):
