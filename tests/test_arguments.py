@@ -220,7 +220,7 @@ KINDS = {
           "steps": "count", "max_vertices": "count", "refine": "real", "progress": "bool",
           "angular_speed": "finite", "spacing": "finite", "speed": "finite", "major": "finite",
           "minor": "finite", "tol": "real", "segments": "count", "phi": "finite",
-          "falloff_power": "count", "n": "count", "dtype": "str"},
+          "falloff_power": "count", "n": "count", "dtype": "str", "blend": "finite"},
     "spinal.advect": {"t0": "finite"},
     "spinal.deform": {"t0": "finite"},
     "spinal.fields.along_path": {"t0": "finite"},

@@ -31,7 +31,7 @@ def test_option_strings_name_the_argument_and_list_the_choices():
                        r"'euler' or 'split'"):
         _core.advect(PTS, spinal.fields.translation([0, 0, 0], 1, [1, 0, 0]), 0.0, 0.1, 1, "x")
     with pytest.raises(ValueError, match=r"^solution: unknown value \"x\"; expected 'none', "
-                       r"'normal', 'binormal' or 'radial'"):
+                       r"'normal', 'binormal', 'radial' or 'blend'"):
         _core.flesh_deform(PTS, np.zeros((4, 3, 3)), np.zeros(0, dtype=np.int64),
                            np.zeros((0, 3)), "x", None)
     with pytest.raises(TypeError):

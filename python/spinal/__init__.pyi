@@ -68,7 +68,7 @@ _Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
 _TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]
 _Progress: TypeAlias = bool | Callable[[int, int], object]
 _AnyMesh: TypeAlias = Mesh | Any | tuple[_Array, _Array]  # Any: a trimesh.Trimesh
-_SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "none"]
+_SpineSolution: TypeAlias = Literal["radial", "normal", "binormal", "blend", "none"]
 _SurfaceSolution: TypeAlias = Literal["offset", "none"]
 
 # ---- frames -------------------------------------------------------------------------------
@@ -420,6 +420,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -434,6 +435,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -448,6 +450,7 @@ class SpineBinding:
         posed_spine: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         strict: bool = False,
@@ -461,6 +464,7 @@ class SpineBinding:
         posed_spines_t: _Array,
         *,
         solution: _SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
         twist: float | _Array | None = None,
         slide: float | _Array = 0.0,
@@ -475,6 +479,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,
@@ -490,6 +495,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,
@@ -505,6 +511,7 @@ def flesh(
     posed_spine: _Array,
     *,
     solution: _SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
     twist: float | _Array | None = None,
     strict: bool = False,
@@ -516,8 +523,14 @@ def flesh(
 
 class SurfaceBinding:
     clamped: _I
-    def __init__(self, vertices: _Array, rest_surface: _Array) -> None: ...
+    def __init__(
+        self, vertices: _Array, rest_surface: _Array | Mesh | tuple[_Array, _Array]
+    ) -> None: ...
     def __len__(self) -> int: ...
+    @property
+    def face(self) -> _I: ...
+    @property
+    def barycentric(self) -> _F: ...
     @property
     def uv(self) -> _F: ...
     @property
@@ -561,7 +574,7 @@ class SurfaceBinding:
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",
@@ -573,7 +586,7 @@ def flesh_surface(
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",
@@ -585,7 +598,7 @@ def flesh_surface(
 @overload
 def flesh_surface(
     vertices: _Array,
-    rest_surface: _Array,
+    rest_surface: _Array | Mesh | tuple[_Array, _Array],
     posed_surface: _Array,
     *,
     solution: _SurfaceSolution = "offset",

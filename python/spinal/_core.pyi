@@ -435,6 +435,8 @@ def flesh_deform(
     solution: str,
     twist: npt.NDArray[np.float64] | None,
     closed: bool = False,
+    blend: float | None = None,
+    planar: bool = False,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
@@ -442,6 +444,19 @@ def flesh_resample(
 def flesh_surface_bind(
     rest_points: npt.NDArray[np.float64], nu: int, nv: int, vertices: npt.NDArray[np.float64]
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], int]: ...
+def flesh_trisurface_bind(
+    rest_points: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    vertices: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], int]: ...
+def flesh_trisurface_deform(
+    posed_points: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    face: npt.NDArray[np.int64],
+    coords: npt.NDArray[np.float64],
+    rest_exp: int,
+    corrected: bool,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_surface_deform(
     posed_points: npt.NDArray[np.float64],
     nu: int,

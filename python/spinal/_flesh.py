@@ -15,9 +15,9 @@ import numpy as np
 from . import _core, _motion
 from ._frames import _spine_frames
 from ._mesh import FoldOverWarning
-from ._validate import as_bool, as_choice, as_float_array
+from ._validate import as_bool, as_choice, as_float_array, as_real
 
-SOLUTIONS = ("radial", "normal", "binormal", "none")
+SOLUTIONS = ("radial", "normal", "binormal", "blend", "none")
 
 
 def _spine(x, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
@@ -400,6 +400,7 @@ class SpineBinding:
         posed_spine,
         *,
         solution: str = "radial",
+        blend=None,
         stretchable: bool = False,
         twist=None,
         strict: bool = False,
@@ -423,6 +424,21 @@ class SpineBinding:
             (quadratic; the planar solution, Eq. 2/7).
         ``"binormal"``
             coordinate ``y`` along the binormal: ``(1 − κx) y`` is carried over (linear).
+        ``"blend"``
+            between the two, with the weight ``blend = w ∈ [0, 1]`` of the normal solution
+            (``w = 1`` is ``"normal"``, ``w = 0`` is ``"binormal"``). Zhuo's Ch. VIII shows
+            that treating the two coordinates as independent (Eq. 44,
+            ``(x1 − ½κ1x1²) y1 = (x0 − ½κ0x0²) y0``) or moving along a fixed direction
+            (Eq. 45–48) does not keep the volume, and that a cascade of the two solutions
+            does. This is such a cascade, through virtual spines whose curvature is ``w``
+            times the real one: on the posed side the normal bend into ``wκ1`` (with the
+            stretch ``λ^w``), ``x1 − ½wκ1x1² = x/λ^w``, then the binormal unbend at ``wκ1``
+            and the binormal bend into ``κ1`` (with the stretch ``λ^(1−w)``),
+            ``y1 = y (1 − wκ1x1) / (λ^(1−w) (1 − κ1x1))``; on the rest side the mirror image
+            (``y* = y0 (1 − κ0x0)/(1 − wκ0x0)``, ``x* = x0 (1 − ½wκ0x0)``). Every stage carries
+            the volume element ``σ (1 − κx)`` of one spine onto the next, so the map has
+            Jacobian determinant 1 for every ``w``. Fold-over is clamped as for the two
+            solutions (focal point ``1/(wκ1)``, binormal factors capped at ``1e-3``).
         ``"none"``
             the uncorrected map (same local offset in the posed frame), as industry curve
             deformers do; not volume preserving — for comparison.
@@ -472,8 +488,11 @@ class SpineBinding:
         Parameters
         ----------
         posed_spine : array_like (m, 3) or (m, 2)
-        solution : "radial", "normal", "binormal" or "none"
+        solution : "radial", "normal", "binormal", "blend" or "none"
             In 2D every corrected solution is the planar quadratic (Eq. 2/7).
+        blend : float, optional
+            With ``solution="blend"`` (and only then; required there): the weight
+            ``w ∈ [0, 1]`` of the normal solution.
         stretchable : bool
         twist : float or array_like (n,), optional
             Extra rotation (rad, right-handed about the posed tangent) of the cross-section
@@ -513,13 +532,14 @@ class SpineBinding:
         :class:`spinal.FoldOverWarning` (``indices`` attribute).
         """
         return self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
-                            posed_frames, posed_up, slide)
+                            posed_frames, posed_up, slide, blend)
 
     def _deform(self, posed_spine, solution, stretchable, twist, strict, return_clamped,
-                posed_frames, posed_up, slide):
+                posed_frames, posed_up, slide, blend=None):
         """:meth:`deform` (also of :func:`flesh`: either is two frames above this one, so
         a clamp warning points at the caller's line)."""
         solution = as_choice(solution, "solution", SOLUTIONS)
+        blend = _blend(blend)
         strict = as_bool(strict, "strict")
         return_clamped = as_bool(return_clamped, "return_clamped")
         given = posed_frames is not None or posed_up is not None
@@ -533,32 +553,31 @@ class SpineBinding:
         if given:
             frames1 = _spine_frames(posed, "posed_spine", closed=self._closed)
             frames1 = _given_roll(frames1, posed_frames, posed_up, at, m, self._closed)
-        out, _ = self._apply(posed, frames1, solution, twist, strict, level=5)
+        out, _ = self._apply(posed, frames1, solution, twist, strict, level=5, blend=blend)
         return (out, self.clamped) if return_clamped else out
 
-    def _apply(self, posed, frames1, solution, twist, strict, level):
+    def _apply(self, posed, frames1, solution, twist, strict, level, blend=None):
         """The shape on the used posed spine ``posed`` with the frames ``frames1`` (None: the
         default posed frames): the deformed vertices and the frames used. A clamp warning
         points ``level`` frames up from the warning."""
         if frames1 is None:
             frames1 = self._posed_frames(posed)
         tw = None if twist is None else _twist(twist, len(self._rest))
-        sol = solution
-        if self._dim == 2 and sol != "none":
-            sol = "normal"
         c = self._closed
         if tw is not None:
             tw = _loop(tw, c)
+        # in the plane every corrected solution is the planar quadratic (the core checks
+        # `blend` first)
         out, flags = _core.flesh_deform(_loop(posed, c), _loop(frames1, c), self._edge,
-                                        self._coords, sol, tw, c)
+                                        self._coords, solution, tw, c, blend, self._dim == 2)
         self.clamped = _report_clamped(flags, strict, level)
         if self._dim == 2:
             out = np.ascontiguousarray(out[:, :2])
         return out, frames1
 
-    def animate(self, posed_spines_t, *, solution: str = "radial", stretchable: bool = False,
-                twist=None, slide=0.0, previous_weight: float = 1000.0,
-                progress=False) -> np.ndarray:
+    def animate(self, posed_spines_t, *, solution: str = "radial", blend=None,
+                stretchable: bool = False, twist=None, slide=0.0,
+                previous_weight: float = 1000.0, progress=False) -> np.ndarray:
         r"""The shape posed on a sequence of posed spines, with frames that follow each
         other in time: ``(T, V, 3)`` (or ``(T, V, 2)`` in the plane).
 
@@ -575,7 +594,7 @@ class SpineBinding:
         ----------
         posed_spines_t : array_like (T, m, 3) or (T, m, 2)
             One posed spine per pose (the same row count ``m`` at every pose).
-        solution, stretchable, twist
+        solution, blend, stretchable, twist
             As in :meth:`deform`, for every pose.
         slide : float or array_like (T,)
             Arc length to slide the shape along each pose's spine (see :meth:`deform`): one
@@ -592,8 +611,9 @@ class SpineBinding:
         holds those of the last pose.
         """
         solution = as_choice(solution, "solution", SOLUTIONS)
+        blend = _blend(blend)
         return _motion.animate(self, posed_spines_t, solution, stretchable, twist, slide,
-                               previous_weight, progress)
+                               previous_weight, progress, blend)
 
     def _posed_frames(self, posed: np.ndarray) -> np.ndarray:
         """The frames of the posed spine: its RMF started from the reference vector of
@@ -607,6 +627,12 @@ class SpineBinding:
         frames1 = _spine_frames(posed, "posed_spine", closed=self._closed)
         init = _posed_initial(self._rest, self._frames[0], posed, frames1[0][:, 2])
         return _roll_to(frames1, init, "posed_spine")
+
+
+def _blend(blend) -> float | None:
+    """``blend`` as a Python float (or ``None``); the core checks its value and that it
+    comes with ``solution="blend"``."""
+    return None if blend is None else as_real(blend, "blend")
 
 
 def _twist(twist, n: int) -> np.ndarray:
@@ -641,6 +667,7 @@ def flesh(
     posed_spine,
     *,
     solution: str = "radial",
+    blend=None,
     stretchable: bool = False,
     twist=None,
     strict: bool = False,
@@ -653,8 +680,8 @@ def flesh(
 
     One-shot form of ``SpineBinding(vertices, rest_spine).deform(posed_spine, ...)``; see
     :class:`SpineBinding` for the registration and :meth:`SpineBinding.deform` for the
-    solutions (``"radial"``, ``"normal"``, ``"binormal"``, and ``"none"`` the uncorrected
-    map), ``stretchable`` (without it the posed spine is resampled to the rest spine's
+    solutions (``"radial"``, ``"normal"``, ``"binormal"``, ``"blend"`` between the last two
+    with the weight ``blend``, and ``"none"`` the uncorrected map), ``stretchable`` (without it the posed spine is resampled to the rest spine's
     length), ``twist``, ``posed_frames``/``posed_up`` (the roll of the posed spine, e.g.
     driven by a rig), fold-over clamping and errors; ``closed`` for loops (rings).
     2-column input is the planar case.
@@ -672,4 +699,4 @@ def flesh(
     except MemoryError as e:
         raise MemoryError(f"flesh: {e}") from None
     return binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
-                           posed_frames, posed_up, 0.0)
+                           posed_frames, posed_up, 0.0, blend)

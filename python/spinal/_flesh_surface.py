@@ -1,5 +1,5 @@
-r"""Fleshing with a spine surface: a shape bound to a grid surface keeps its volume locally
-when the surface moves (Zhuo 2014 Ch. VI). See :class:`SurfaceBinding` and
+r"""Fleshing with a spine surface: a shape bound to a grid surface or a triangle mesh keeps
+its volume locally when the surface moves (Zhuo 2014 Ch. VI). See :class:`SurfaceBinding` and
 :func:`flesh_surface`.
 """
 
@@ -21,6 +21,32 @@ def _grid(x, name: str) -> np.ndarray:
         raise ValueError(f"{name}: expected a grid of shape (nu, nv, 3), nu, nv ≥ 2, got "
                          f"{arr.shape}")
     return np.ascontiguousarray(arr)
+
+
+def _is_mesh(x) -> bool:
+    """A triangulated surface: ``(vertices, faces)`` with integer faces, or an object with
+    ``vertices`` and ``faces`` (spinal.Mesh, trimesh.Trimesh)."""
+    if isinstance(x, tuple) and len(x) == 2:
+        return np.asarray(x[1]).dtype.kind in "iu"
+    return hasattr(x, "vertices") and hasattr(x, "faces")
+
+
+def _mesh(x, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """``(vertices (n, 3) float64, faces (F, 3) int64)`` of a triangulated surface; the core
+    checks the values (finite, indices in range, no degenerate faces)."""
+    V, F = x if isinstance(x, tuple) else (x.vertices, x.faces)
+    V = as_float_array(V, name)
+    if V.ndim != 2 or V.shape[1] != 3:
+        raise ValueError(f"{name}: expected vertices of shape (n, 3), got {V.shape}")
+    F = np.asarray(F)
+    if F.dtype.kind not in "iu":
+        raise TypeError(f"{name}: expected integer faces, got dtype {F.dtype}")
+    if F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
+        raise ValueError(f"{name}: expected faces of shape (F, 3), F ≥ 1, got {F.shape}")
+    if F.dtype.kind == "u" and F.max() > np.iinfo(np.int64).max:
+        raise ValueError(f"{name}: face index {F.max()} out of range ({len(V)} vertices)")
+    return (np.ascontiguousarray(V, dtype=np.float64),
+            np.ascontiguousarray(F, dtype=np.int64))
 
 
 def _surface_frames(g: np.ndarray) -> np.ndarray:
@@ -90,17 +116,55 @@ class SurfaceBinding:
     (``B = −2mA``, ``C = gA``), so the map's Jacobian determinant is 1. Where no fold-free
     root exists, ``h1`` is clamped to the largest fold-free offset ``1/k_max`` (§6.2).
 
+    **Triangulated surfaces.** ``rest_surface`` may instead be a triangle mesh
+    ``(surface_vertices, faces)`` (or a :class:`spinal.Mesh` / ``trimesh.Trimesh``), posed by
+    moving its vertices (:meth:`deform` takes the posed vertex array, same faces). Every face
+    is flat; the normal is the barycentric interpolation of the unit angle-weighted vertex
+    normals, made unit (the normal side is the one the faces' winding gives). A vertex is
+    registered by its face, barycentric coordinates and offset along that interpolated
+    normal (``P = S + h N``; the face is searched around the closest point of the mesh,
+    found with a bounding-volume hierarchy). The volume element of this model is
+    ``A + B h + C h²`` exactly as above, with ``S_u, S_v`` the face's edges and
+    ``N_u = (I − NNᵀ)(n_b − n_a)/|M|`` (``M`` the interpolated, not yet unit, normal): the
+    faces are flat and all the curvature ``m = −B/(2A)``, ``g = C/A`` lies in the
+    interpolated normals. :meth:`deform` solves the same equation with the face's own ``A, B,
+    C`` at the foot, so the Jacobian determinant is 1 inside the normal prism of every face.
+    ``A, B, C`` jump across edges (they are derivatives of a piecewise-linear surface), and
+    so does the corrected offset: the map is continuous across faces only where the pose
+    keeps them (the identity, or an affine map of a flat surface in its plane); elsewhere the
+    jump is first order in the edge length, and a shape that crosses edges gains or loses
+    thin slivers there, which shrink as the surface is refined. On a flat grid posed by an affine map of its plane (rigid motion, stretch,
+    shear) the triangulated grid gives the grid model's result (both are exact there:
+    ``h1 = h0 A0/A1``); on a bent grid the two models differ by their discretisation errors
+    (the grid's bicubic cells against flat faces with interpolated normals), and the
+    difference falls as the grid is refined (first order in the grid step).
+
     Parameters
     ----------
     vertices : array_like (V, 3)
-    rest_surface : array_like (nu, nv, 3), nu, nv ≥ 2
+    rest_surface : array_like (nu, nv, 3), nu, nv ≥ 2, or a triangle mesh
+        ``(surface_vertices (n, 3), faces (F, 3))``, a :class:`spinal.Mesh` or a
+        ``trimesh.Trimesh`` (faces in range, not degenerate, consistently oriented). A
+        2-tuple whose second item has an integer dtype is read as ``(vertices, faces)``; give
+        a grid as one array.
     """
 
     def __init__(self, vertices, rest_surface):
-        g = _grid(rest_surface, "rest_surface")
         v = as_float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
+        if _is_mesh(rest_surface):
+            sv, faces = _mesh(rest_surface, "rest_surface")
+            self._faces = faces
+            self._shape = None
+            self._rest_frames = None
+            self._cell, self._coords, self._exp = _core.flesh_trisurface_bind(
+                sv, faces, np.ascontiguousarray(v, dtype=np.float64))
+            self._nverts = len(sv)
+            self.clamped = np.zeros(0, dtype=np.int64)
+            return
+        self._faces = None
+        g = _grid(rest_surface, "rest_surface")
         self._shape = g.shape[:2]
         self._rest_frames = _surface_frames(g)
         self._cell, self._coords, self._exp = _core.flesh_surface_bind(
@@ -112,8 +176,28 @@ class SurfaceBinding:
         return len(self._cell)
 
     @property
+    def face(self) -> np.ndarray:
+        """``(V,)`` int64: the face of each foot (triangulated surfaces only)."""
+        self._only("face", triangles=True)
+        return self._cell.copy()
+
+    @property
+    def barycentric(self) -> np.ndarray:
+        """``(V, 3)`` barycentric coordinates of the feet on their faces (triangulated
+        surfaces only)."""
+        self._only("barycentric", triangles=True)
+        u, v = self._coords[:, 0], self._coords[:, 1]
+        return np.c_[1 - u - v, u, v]
+
+    def _only(self, name: str, triangles: bool) -> None:
+        if (self._faces is not None) != triangles:
+            kind = "a triangulated" if triangles else "a grid"
+            raise TypeError(f"{name}: only for {kind} rest_surface")
+
+    @property
     def uv(self) -> np.ndarray:
-        """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet."""
+        """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet (grids only)."""
+        self._only("uv", triangles=False)
         i, j = np.divmod(self._cell, self._shape[1])
         return np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
 
@@ -132,7 +216,8 @@ class SurfaceBinding:
 
     def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
                return_clamped: bool = False, posed_frames=None, posed_up=None):
-        """The shape on ``posed_surface`` (same grid shape): ``(V, 3)``.
+        """The shape on ``posed_surface`` (same grid shape; for a triangulated rest surface
+        the posed vertex array ``(n, 3)``, or a mesh with the same faces): ``(V, 3)``.
 
         ``solution="offset"`` (default) corrects the offset (volume preserving);
         ``"none"`` keeps ``h1 = h0`` (the uncorrected map). Clamped vertices (no fold-free
@@ -161,11 +246,19 @@ class SurfaceBinding:
 
         Both must lie on the normal's side of the surface and not in it (refused where the
         cosine with the sample normal is 1e-3 or less, or where the interpolated direction
-        reaches the surface's plane inside a cell).
+        reaches the surface's plane inside a cell). Grids only.
         """
         solution = as_choice(solution, "solution", ("offset", "none"))
         strict = as_bool(strict, "strict")
         return_clamped = as_bool(return_clamped, "return_clamped")
+        if self._faces is not None:
+            if posed_frames is not None or posed_up is not None:
+                name = "posed_frames" if posed_frames is not None else "posed_up"
+                raise TypeError(f"{name}: only with a grid rest_surface")
+            out, flags = _core.flesh_trisurface_deform(
+                self._posed_vertices(posed_surface), self._faces, self._cell, self._coords,
+                self._exp, solution == "offset")
+            return self._report(out, flags, strict, return_clamped)
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:
             raise ValueError(f"posed_surface: expected the rest grid's shape "
@@ -174,6 +267,23 @@ class SurfaceBinding:
         out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
                                                 self._cell, self._coords, self._exp,
                                                 solution == "offset", dirs)
+        return self._report(out, flags, strict, return_clamped)
+
+    def _posed_vertices(self, posed_surface) -> np.ndarray:
+        """The posed vertices of a triangulated binding (an array, or a mesh whose faces
+        are the rest faces)."""
+        if _is_mesh(posed_surface):
+            pv, faces = _mesh(posed_surface, "posed_surface")
+            if not np.array_equal(faces, self._faces):
+                raise ValueError("posed_surface: its faces differ from rest_surface's")
+        else:
+            pv = as_float_array(posed_surface, "posed_surface")
+        if pv.shape != (self._nverts, 3):
+            raise ValueError(f"posed_surface: expected the rest surface's {self._nverts} "
+                             f"vertices, shape ({self._nverts}, 3), got {pv.shape}")
+        return np.ascontiguousarray(pv, dtype=np.float64)
+
+    def _report(self, out, flags, strict, return_clamped):
         clamped = np.flatnonzero(flags).astype(np.int64)
         self.clamped = clamped
         if clamped.size:
@@ -181,7 +291,7 @@ class SurfaceBinding:
                    f"outside the surface and were clamped, e.g. vertex {clamped[0]}")
             if strict:
                 raise ValueError(msg)
-            warnings.warn(FoldOverWarning(msg, clamped), stacklevel=2)
+            warnings.warn(FoldOverWarning(msg, clamped), stacklevel=3)
         return (out, clamped) if return_clamped else out
 
 

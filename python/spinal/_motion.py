@@ -81,7 +81,7 @@ def positions(at_q: np.ndarray, q: np.ndarray, back, posed: np.ndarray, closed: 
 
 
 def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previous_weight,
-            progress) -> np.ndarray:
+            progress, blend=None) -> np.ndarray:
     """:meth:`spinal.SpineBinding.animate` (see there)."""
     from ._frames import frames
     from ._validate import as_float_array, as_real
@@ -120,6 +120,7 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
             else:
                 fr = frames(posed, previous=prev, previous_twist=True,
                             guide_weight=previous_weight, closed=binding._closed)
-            out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5)
+            out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5,
+                                          blend=blend)
             bar.update(t + 1)
     return out

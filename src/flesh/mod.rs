@@ -37,10 +37,12 @@
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
 
 pub mod bind;
+pub mod blend;
 pub mod pose;
 pub mod solve;
 pub mod spine;
 pub mod surface;
+pub mod trisurf;
 
 pub use bind::{Binding, COORDS, bind, bind_cancellable};
 pub use pose::{deform, deform_cancellable};

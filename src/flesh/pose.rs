@@ -73,18 +73,19 @@ pub fn deform_cancellable(
             ),
         ));
     }
-    let run = match sol {
-        Solution::None => batch::<0>,
-        Solution::Normal => batch::<1>,
-        Solution::Binormal => batch::<2>,
-        Solution::Radial => batch::<3>,
+    let (run, w) = match sol {
+        Solution::None => (batch::<0> as Batch, 0.0),
+        Solution::Normal => (batch::<1> as Batch, 0.0),
+        Solution::Binormal => (batch::<2> as Batch, 0.0),
+        Solution::Radial => (batch::<3> as Batch, 0.0),
+        Solution::Blend(w) => (batch::<4> as Batch, super::blend::check_weight(w)?),
     };
     out.par_chunks_mut(TASK)
         .zip(flags.par_chunks_mut(TASK))
         .zip(edge.par_chunks(TASK).zip(coords.par_chunks(COORDS * TASK)))
         .for_each(|((o, f), (e, c))| {
             if !cancel() {
-                run(posed, twist, e, c, o, f)
+                run(posed, w, twist, e, c, o, f)
             }
         });
     if posed.scale.exp() != 0 {
@@ -112,19 +113,26 @@ const TASK: usize = 1024;
 /// Vertices evaluated together (see [`SpineModel::eval_lanes`]).
 const LANES: usize = 4;
 
-const fn solution(s: u8) -> Solution {
+/// One task's vertices (see [`batch`]).
+type Batch = fn(&SpineModel, f64, &[f64], &[i64], &[f64], &mut [DVec3], &mut [u8]);
+
+/// The solution of instance `S` (`w`: the blend weight, used by `S = 4` only).
+#[inline(always)]
+const fn solution(s: u8, w: f64) -> Solution {
     match s {
         0 => Solution::None,
         1 => Solution::Normal,
         2 => Solution::Binormal,
-        _ => Solution::Radial,
+        3 => Solution::Radial,
+        _ => Solution::Blend(w),
     }
 }
 
 /// One task's vertices, `LANES` at a time; the solution is a constant of the instance, so
-/// its branch leaves the loop.
+/// its branch leaves the loop (`w`: the blend weight of [`Solution::Blend`]).
 fn batch<const S: u8>(
     posed: &SpineModel,
+    w: f64,
     twist: &[f64],
     edge: &[i64],
     coords: &[f64],
@@ -135,6 +143,7 @@ fn batch<const S: u8>(
     while i + LANES <= out.len() {
         lanes::<S, LANES>(
             posed,
+            w,
             twist,
             &edge[i..],
             &coords[COORDS * i..],
@@ -146,6 +155,7 @@ fn batch<const S: u8>(
     while i < out.len() {
         lanes::<S, 1>(
             posed,
+            w,
             twist,
             &edge[i..],
             &coords[COORDS * i..],
@@ -159,13 +169,14 @@ fn batch<const S: u8>(
 #[inline(always)]
 fn lanes<const S: u8, const L: usize>(
     posed: &SpineModel,
+    w: f64,
     twist: &[f64],
     edge: &[i64],
     coords: &[f64],
     out: &mut [DVec3],
     flags: &mut [u8],
 ) {
-    let sol = solution(S);
+    let sol = solution(S, w);
     // lengths of the binding (input units) to the posed model's units and back
     let (to_model, to_input) = (posed.scale, posed.scale.inverse());
     let k: [usize; L] = std::array::from_fn(|l| edge[l] as usize);

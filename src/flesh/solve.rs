@@ -18,6 +18,9 @@
 //!   minimum of `f(m) = α m³ + m² − 1` at `m = 1` and says "if α > 0, λ2 > 0"; as
 //!   `f'(m) = m(3αm + 2)` the minimum is at `m = 0` and the condition is `α < 0`.)
 //!
+//! * blend (Ch. VIII): a cascade of normal and binormal stages weighted by `w`, exact for
+//!   every `w` (see [`super::blend`]).
+//!
 //! Existence (§3.1.2, §4.3): the thesis only says that no valid solution exists past the
 //! limits; a choice of ours: where no fold-free root exists the offset is clamped to the
 //! largest safe one (normal: the focal point `1/κ1`; radial: `r1 = 1/(κ1 cosθ1)`, the local
@@ -29,7 +32,7 @@
 use glam::DVec2;
 
 /// Which offset correction to apply.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solution {
     /// The uncorrected map: the same local offset in the posed frame (the industry baseline).
     None,
@@ -39,6 +42,30 @@ pub enum Solution {
     Binormal,
     /// Only the distance from the spine changes, the angle is kept (cubic, Eq. 13/25).
     Radial,
+    /// The cascade of normal and binormal stages with the weight `w ∈ [0, 1]` of the
+    /// normal solution (Ch. VIII; see [`super::blend`]): `w = 1` is [`Solution::Normal`],
+    /// `w = 0` is [`Solution::Binormal`].
+    Blend(f64),
+}
+
+impl Solution {
+    /// The solution with the blend weight `blend` (given only with [`Solution::Blend`],
+    /// whose weight it sets; checked to be in `[0, 1]`); errors name `blend`.
+    pub fn with_blend(self, blend: Option<f64>) -> crate::error::Result<Solution> {
+        use crate::error::InputError;
+        match (self, blend) {
+            (Solution::Blend(_), Some(w)) => Ok(Solution::Blend(super::blend::check_weight(w)?)),
+            (Solution::Blend(_), None) => Err(InputError::new(
+                "blend",
+                "solution=\"blend\" needs the weight of the normal solution, a number in [0, 1]",
+            )),
+            (_, Some(_)) => Err(InputError::new(
+                "blend",
+                "only with solution=\"blend\" (the other solutions take no weight)",
+            )),
+            (s, None) => Ok(s),
+        }
+    }
 }
 
 /// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
@@ -102,6 +129,7 @@ pub fn unbend(sol: Solution, d: DVec2, k0: DVec2, flags: &mut u8) -> DVec2 {
             }
             d * (1.0 - (2.0 / 3.0) * c).sqrt()
         }
+        Solution::Blend(w) => super::blend::unbend_blend(w, d, k0, flags),
     }
 }
 
@@ -149,6 +177,7 @@ pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVe
             }
             d * (s * m)
         }
+        Solution::Blend(w) => super::blend::bend_blend(w, d, k1, lam, flags),
     }
 }
 

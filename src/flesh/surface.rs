@@ -101,7 +101,7 @@ impl SurfLocal {
     }
 
     /// A local orthonormal frame (e1 along S_u, e2, N).
-    fn frame(&self) -> (DVec3, DVec3) {
+    pub fn frame(&self) -> (DVec3, DVec3) {
         let e1 = (self.su - self.n * self.n.dot(self.su)).normalize();
         (e1, self.n.cross(e1))
     }
@@ -350,11 +350,22 @@ fn eval_raw(
 
 /// Solve `S(u,v) + h N(u,v) = p` in cell `(i, j)` by Newton from the cell centre.
 fn foot(sf: &Surface, i: usize, j: usize, p: DVec3) -> Option<(f64, f64, f64)> {
-    let (mut u, mut v) = (0.5, 0.5);
-    let mut h = (p - sf.eval(i, j, u, v).s).dot(sf.eval(i, j, u, v).n);
+    newton_foot(|u, v| sf.eval(i, j, u, v), (0.5, 0.5), p)
+}
+
+/// Solve `S(u,v) + h N(u,v) = p` by Newton's method from `(u, v) = start` (`eval`: the
+/// surface at a parameter); `None` if it does not converge or leaves `|u|, |v| < 10`.
+pub(super) fn newton_foot(
+    eval: impl Fn(f64, f64) -> SurfLocal,
+    start: (f64, f64),
+    p: DVec3,
+) -> Option<(f64, f64, f64)> {
+    let (mut u, mut v) = start;
+    let l = eval(u, v);
+    let mut h = (p - l.s).dot(l.n);
     let mut polish = false;
     for _ in 0..40 {
-        let l = sf.eval(i, j, u, v);
+        let l = eval(u, v);
         let r = l.s + h * l.n - p;
         let c0 = l.su + h * l.nu;
         let c1 = l.sv + h * l.nv;
@@ -587,21 +598,8 @@ pub fn deform_surface_cancellable(
             format!("vertex {i} is bound to a cell the posed grid does not have"),
         ));
     }
-    // lengths of the binding to the posed model's units, and its output back to the input's
     let q = posed.scale.exp();
-    let (Some(d), Some(d2)) = (
-        q.checked_sub(rest_exp),
-        q.checked_sub(rest_exp).and_then(|d| d.checked_mul(2)),
-    ) else {
-        return Err(InputError::new("coords", "inconsistent scale exponent"));
-    };
-    let units = Units {
-        to_model: posed.scale,
-        to_input: posed.scale.inverse(),
-        // rest model lengths (B0) and areas (A0) in the posed model's units
-        len1: Pow2::new(d),
-        area1: Pow2::new(d2),
-    };
+    let units = Units::new(posed.scale, rest_exp)?;
     out.par_chunks_mut(DEFORM_BLOCK)
         .zip(flags.par_chunks_mut(DEFORM_BLOCK))
         .zip(cell.par_chunks(DEFORM_BLOCK))
@@ -612,7 +610,8 @@ pub fn deform_surface_cancellable(
             }
             let rows = o.iter_mut().zip(f.iter_mut()).zip(c);
             for (((o, f), &c), x) in rows.zip(x.chunks_exact(SURFACE_COORDS)) {
-                deform_vertex(posed, corrected, &units, o, f, c, x);
+                let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
+                deform_vertex(posed.eval(i, j, x[0], x[1]), corrected, &units, o, f, x);
             }
         });
     if (q != 0 || rest_exp != 0) && !cancel() {
@@ -633,20 +632,17 @@ pub fn deform_surface_cancellable(
     Ok(())
 }
 
-/// One registered vertex (cell `c`, coordinates `x`) onto the posed surface: its position
-/// `o` and clamp flag `f`.
+/// One registered vertex (coordinates `x`) onto the posed surface `l` at its foot: its
+/// position `o` and clamp flag `f`.
 #[inline]
-fn deform_vertex(
-    posed: &Surface,
+pub(super) fn deform_vertex(
+    l: SurfLocal,
     corrected: bool,
     u: &Units,
     o: &mut DVec3,
     f: &mut u8,
-    c: i64,
     x: &[f64],
 ) {
-    let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
-    let l = posed.eval(i, j, x[0], x[1]);
     let resid = DVec3::new(x[6], x[7], x[8]);
     if resid != DVec3::ZERO {
         let resid = u.to_model.of3(resid);
@@ -672,7 +668,7 @@ fn deform_vertex(
 }
 
 /// The powers of two between a binding's stored numbers and the posed model's units.
-struct Units {
+pub(super) struct Units {
     /// Input lengths to the posed model's units.
     to_model: Pow2,
     /// The posed model's lengths back to the input's units.
@@ -681,6 +677,28 @@ struct Units {
     len1: Pow2,
     /// Rest model areas (the stored `A0`) to the posed model's units.
     area1: Pow2,
+}
+
+impl Units {
+    /// From the posed model's scale and the exponent of the rest model's.
+    pub(super) fn new(posed: Pow2, rest_exp: i32) -> Result<Units> {
+        // lengths of the binding to the posed model's units, and its output back to the
+        // input's
+        let q = posed.exp();
+        let (Some(d), Some(d2)) = (
+            q.checked_sub(rest_exp),
+            q.checked_sub(rest_exp).and_then(|d| d.checked_mul(2)),
+        ) else {
+            return Err(InputError::new("coords", "inconsistent scale exponent"));
+        };
+        Ok(Units {
+            to_model: posed,
+            to_input: posed.inverse(),
+            // rest model lengths (B0) and areas (A0) in the posed model's units
+            len1: Pow2::new(d),
+            area1: Pow2::new(d2),
+        })
+    }
 }
 
 #[cfg(test)]

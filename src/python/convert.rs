@@ -605,6 +605,8 @@ impl FromPyObject<'_, '_> for flesh::Solution {
                 ("normal", S::Normal),
                 ("binormal", S::Binormal),
                 ("radial", S::Radial),
+                // the weight is set from the `blend` argument (Solution::with_blend)
+                ("blend", S::Blend(f64::NAN)),
             ],
         )
     }

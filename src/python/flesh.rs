@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 
 use super::convert::{Stop, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s};
 use crate::alloc;
-use crate::flesh::{self, Solution, surface};
+use crate::flesh::{self, Solution, surface, trisurf};
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
 type SurfaceFleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>, i32);
@@ -49,8 +49,11 @@ pub fn flesh_bind<'py>(
 }
 
 /// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
+/// `blend` is the weight of `solution="blend"` (refused with the other solutions);
+/// `planar`: the shape lies in the spine's plane, where every corrected solution is the
+/// planar quadratic (the normal solution).
 #[pyfunction]
-#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false))]
+#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false, blend=None, planar=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn flesh_deform<'py>(
     py: Python<'py>,
@@ -61,7 +64,13 @@ pub fn flesh_deform<'py>(
     solution: Solution,
     twist: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
+    blend: Option<f64>,
+    planar: bool,
 ) -> PyResult<FleshPose<'py>> {
+    let mut solution = solution.with_blend(blend)?;
+    if planar && solution != Solution::None {
+        solution = Solution::Normal;
+    }
     let (pts, fr) = spine_arrays("posed_spine", &posed_points, &posed_frames)?;
     let edge = slice_of("edge", &edge)?;
     let coords = slice_of("coords", &coords)?;
@@ -189,6 +198,71 @@ pub fn flesh_surface_deform<'py>(
             let cancel = || stop.requested();
             surface::deform_surface_cancellable(
                 &posed, rest_exp, cell, coords, corrected, buf, &mut flags, &cancel,
+            )
+        })??;
+    }
+    Ok((out, PyArray1::from_vec(py, flags)))
+}
+
+/// Register vertices on a rest spine surface given as a triangle mesh (`faces` (F, 3));
+/// see `spinal.SurfaceBinding`. Returns the face and coordinates of every vertex and the
+/// exponent of the rest surface's normalisation, which [`flesh_trisurface_deform`] takes back.
+#[pyfunction]
+pub fn flesh_trisurface_bind<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    vertices: PyReadonlyArray2<'py, f64>,
+) -> PyResult<SurfaceFleshBinding<'py>> {
+    let pts = vec3s("rest_surface", &rest_points)?;
+    let fs = slice_of("rest_surface", &faces)?;
+    let v = vec3s("vertices", &vertices)?;
+    let stop = Stop::default();
+    let (face, coords, exp) = detach_stoppable(py, &stop, || {
+        let rest = trisurf::TriSurface::new("rest_surface", pts, fs)?;
+        let (face, coords) = trisurf::bind_trisurface_cancellable(&rest, v, &|| stop.requested())?;
+        Ok::<_, crate::error::InputError>((face, coords, rest.scale.exp()))
+    })??;
+    let n = face.len();
+    let coords = PyArray1::from_vec(py, coords).reshape([n, surface::SURFACE_COORDS])?;
+    Ok((PyArray1::from_vec(py, face), coords, exp))
+}
+
+/// Deform vertices registered on a triangle-mesh spine surface; see
+/// `spinal.SurfaceBinding.deform`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn flesh_trisurface_deform<'py>(
+    py: Python<'py>,
+    posed_points: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    face: PyReadonlyArray1<'py, i64>,
+    coords: PyReadonlyArray2<'py, f64>,
+    rest_exp: i32,
+    corrected: bool,
+) -> PyResult<FleshPose<'py>> {
+    let pts = vec3s("posed_surface", &posed_points)?;
+    let fs = slice_of("posed_surface", &faces)?;
+    let face = slice_of("face", &face)?;
+    let coords = slice_of("coords", &coords)?;
+    let n = face.len();
+    let out = empty::<f64, numpy::Ix2>(py, "SurfaceBinding.deform", &[n, 3])?;
+    let mut flags = alloc::filled("flesh_surface", n, 0u8)?;
+    {
+        let mut w = out.readwrite();
+        let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
+        let stop = Stop::default();
+        detach_stoppable(py, &stop, || {
+            let posed = trisurf::TriSurface::new("posed_surface", pts, fs)?;
+            trisurf::deform_trisurface_cancellable(
+                &posed,
+                rest_exp,
+                face,
+                coords,
+                corrected,
+                buf,
+                &mut flags,
+                &|| stop.requested(),
             )
         })??;
     }
