@@ -56,6 +56,8 @@ pub struct GridTool {
     /// `y_max[b]`: largest `|X − C|` over the cells whose smallest coefficient is below
     /// `(b + 1) R_f / BUCKETS` (a point at distance `d` lies in a cell with minimum `≤ d`).
     y_max: [f64; BUCKETS],
+    /// [`GridTool::slope_bound`], computed once (a pass over every coefficient).
+    slope: f64,
 }
 
 const BUCKETS: usize = 64;
@@ -260,12 +262,14 @@ impl GridTool {
         for b in 1..BUCKETS {
             y_max[b] = y_max[b].max(y_max[b - 1]);
         }
+        let slope = slope_bound(&coef, n, spacing);
         Ok(GridTool {
             origin,
             spacing,
             n,
             coef,
             cell_min,
+            slope,
             inv_spacing: 1.0 / spacing,
             top: n.map(|k| (k - 1) as f64),
             last: n.map(|k| k as i64 - 2),
@@ -747,26 +751,30 @@ impl GridTool {
 
     /// An upper bound of `|∇d|`: each partial derivative of the B-spline is a spline of one
     /// degree less whose coefficients are the differences `Δc/h` along that axis (a convex
-    /// combination of them), so `|∂d/∂x_a| ≤ max |Δ_a c|/h`.
+    /// combination of them), so `|∂d/∂x_a| ≤ max |Δ_a c|/h` (computed when the tool is built).
     pub fn slope_bound(&self) -> f64 {
-        let p = [self.n[0] + 2, self.n[1] + 2, self.n[2] + 2];
-        let stride = [p[1] * p[2], p[2], 1];
-        let mut m = [0.0f64; 3];
-        for i in 0..p[0] {
-            for j in 0..p[1] {
-                for k in 0..p[2] {
-                    let at = i * stride[0] + j * stride[1] + k;
-                    for (a, idx) in [i, j, k].into_iter().enumerate() {
-                        if idx + 1 < p[a] {
-                            let diff = (self.coef[at + stride[a]] - self.coef[at]).abs();
-                            m[a] = m[a].max(diff);
-                        }
+        self.slope
+    }
+}
+
+/// [`GridTool::slope_bound`] of the coefficients `coef` (`n + 2` per axis) at `spacing`.
+fn slope_bound(coef: &[f64], n: [usize; 3], spacing: f64) -> f64 {
+    let p = [n[0] + 2, n[1] + 2, n[2] + 2];
+    let stride = [p[1] * p[2], p[2], 1];
+    let mut m = [0.0f64; 3];
+    for i in 0..p[0] {
+        for j in 0..p[1] {
+            for k in 0..p[2] {
+                let at = i * stride[0] + j * stride[1] + k;
+                for (a, idx) in [i, j, k].into_iter().enumerate() {
+                    if idx + 1 < p[a] {
+                        m[a] = m[a].max((coef[at + stride[a]] - coef[at]).abs());
                     }
                 }
             }
         }
-        DVec3::from(m).length() / self.spacing
     }
+    DVec3::from(m).length() / spacing
 }
 
 #[cfg(test)]
