@@ -27,7 +27,7 @@ from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
-METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
+METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
@@ -220,6 +220,10 @@ def frames(
           not apply. (The Frenet frame itself turns by π across an inflection.)
         * ``"rk4"``: classical Runge–Kutta on the RMF ODE ``r′ = (x′ × x″)/|x′|² × r``
           with the normal-plane projection after each step; analytic curves only. 4th order.
+        * ``"rk4_phi"``: classical Runge–Kutta on the equivalent form ``r′ = −(r·t′) t``
+          without projection, the variant whose errors Wang et al. (2008) tabulate (Table
+          III); the frame written is the normal part of the state, normalised. Analytic
+          curves only; 4th order, about 1.5× the error of ``"rk4"``. For comparisons.
     initial : array_like (3,) or (3, 3), optional
         Reference vector at the first sample (projected onto the normal plane and
         normalised), or a whole frame (rotation matrix, columns r, s, t; its r is used and its

@@ -95,12 +95,19 @@ fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
 
 /// The method, the tangents-only chords, the input they need and the end condition.
 fn check_options(req: &Request) -> Result<()> {
-    if req.method == Method::Rk4 && req.analytic.is_none() {
+    if matches!(req.method, Method::Rk4 | Method::Rk4Phi) && req.analytic.is_none() {
+        let name = if req.method == Method::Rk4 {
+            "rk4"
+        } else {
+            "rk4_phi"
+        };
         return Err(InputError::new(
             "method",
-            "'rk4' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass a \
-             spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), u=200, \
-             method='rk4')",
+            format!(
+                "'{name}' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass \
+                 a spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), \
+                 u=200, method='{name}')"
+            ),
         ));
     }
     if req.tangent_chords && req.method != Method::DoubleReflection && req.method != Method::Frenet
@@ -159,7 +166,7 @@ pub(super) fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
 pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()> {
     let (t, closed) = (dr.t, dr.closed);
     let n = t.len();
-    if req.method != Method::Rk4 {
+    if !matches!(req.method, Method::Rk4 | Method::Rk4Phi) {
         let what = if req.tangent_chords {
             "tangents"
         } else {

@@ -420,6 +420,12 @@ fn transport_frames(
                 cancel,
             )
         }
+        Method::Rk4Phi => {
+            let a = req
+                .analytic
+                .ok_or_else(|| InputError::new("method", "rk4_phi"))?;
+            ctx.run(&rk4::Rk4Phi::new(a.u, a.d1, a.d2, t), out, cancel)
+        }
         Method::Frenet => unreachable!("frenet_frames handles it"),
     }
 }

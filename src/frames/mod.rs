@@ -9,6 +9,7 @@
 //! | rotation (Bloomenthal, discrete parallel transport) | [`rotation`] | 2 | |
 //! | projection (Klok) | [`projection`] | 2 | depends on the initial vector |
 //! | RK4 on the RMF ODE | [`rk4`] | 4 | analytic curves (needs x′, x″) |
+//! | RK4, unprojected φ-form (Wang et al.'s Table III) | [`rk4`] | 4 | analytic curves; for comparisons |
 //! | Frenet | [`frenet`] | exact where κ ≠ 0 | continuous fill at κ ≈ 0 |
 //!
 //! Boundary conditions (closed curves, a prescribed end vector) add a twist linear in arc

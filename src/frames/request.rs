@@ -15,6 +15,8 @@ pub enum Method {
     Rotation,
     Frenet,
     Rk4,
+    /// RK4 on the φ-form `r′ = −(r·t′) t` without projection (Wang et al.'s Table III).
+    Rk4Phi,
 }
 
 /// A prescribed orientation: a reference vector (projected onto the normal plane) or a

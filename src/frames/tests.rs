@@ -127,6 +127,7 @@ fn helix_rmf_matches_the_closed_form_at_the_method_order() {
         (Method::Rotation, false, false, 2, 40),
         (Method::Projection, true, false, 2, 40),
         (Method::Rk4, false, true, 4, 40),
+        (Method::Rk4Phi, false, true, 4, 40),
     ] {
         let (e1, t1) = helix_errors(method, given, analytic, n);
         let (e2, t2) = helix_errors(method, given, analytic, 2 * n - 1);
