@@ -36,6 +36,7 @@ def frames_analytic(
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
     turns: int,
+    d3: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 class RepeatedPointsError(ValueError): ...
 

@@ -27,7 +27,7 @@ from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
-METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi")
+METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi", "torsion")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
@@ -122,7 +122,14 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         pts, uu, d1, d2 = _analytic(points, u)
         iv, if_ = _orientation(initial, "initial", 1, False)
         ev, ef = _orientation(end, "end", 1, False)
-        out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns)
+        # x‴ at the same rows, for the torsion integral only
+        d3 = None
+        if method == "torsion":
+            full = np.empty(2 * uu.size - 1)
+            full[0::2], full[1::2] = uu, 0.5 * (uu[:-1] + uu[1:])
+            d3 = np.ascontiguousarray(points.d3(full))
+        out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns,
+                                           d3)
         if report is not None:
             report(len(out), len(out))
         return out, np.array([angle]), False
@@ -224,6 +231,12 @@ def frames(
           without projection, the variant whose errors Wang et al. (2008) tabulate (Table
           III); the frame written is the normal part of the state, normalised. Analytic
           curves only; 4th order, about 1.5× the error of ``"rk4"``. For comparisons.
+        * ``"torsion"``: the Frenet frame turned about ``t`` by ``θ = −∫τ ds`` (Simpson's
+          rule on ``τ|x′|`` with the exact ``x′, x″, x‴``; Wang et al. 2008 Eq. 3, Zheng's
+          thesis §2.4), the RMF where the Frenet frame exists: exact on a circular helix,
+          4th order in general. Analytic curves only; a curve whose curvature vanishes at a
+          sample or midpoint is refused (the Frenet frame and the torsion are undefined
+          there; near an inflection the torsion is unbounded). For comparisons.
     initial : array_like (3,) or (3, 3), optional
         Reference vector at the first sample (projected onto the normal plane and
         normalised), or a whole frame (rotation matrix, columns r, s, t; its r is used and its

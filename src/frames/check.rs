@@ -5,7 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::double_reflection::DoubleReflection;
-use super::request::{Analytic, Method, Request};
+use super::request::{Analytic, Method, Request, STRAIGHT_TOL};
 use super::validate;
 use crate::error::{InputError, Result};
 
@@ -32,7 +32,48 @@ pub(super) fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
         check_analytic(&a, rows)?;
     }
     check_options(req)?;
+    if req.method == Method::Torsion {
+        check_torsion(req)?;
+    }
     Ok(rows)
+}
+
+/// The torsion method needs `x‴` and a curvature that vanishes nowhere (at the samples and
+/// midpoints its quadrature reads): there the Frenet frame and the torsion are undefined.
+fn check_torsion(req: &Request) -> Result<()> {
+    let Some(a) = req.analytic else {
+        return Ok(());
+    };
+    if a.d3.len() != a.d1.len() {
+        return Err(InputError::new(
+            "method",
+            "'torsion' needs the third derivative x‴ of an analytic curve (a spinal.curves \
+             object with u=...)",
+        ));
+    }
+    validate::finite("points", a.d3)?;
+    let diag = super::geometry::scale_and_diagonal(req.points.unwrap_or(&[])).1;
+    let flat = |k: usize| {
+        let (d1, d2) = (a.d1[k], a.d2[k]);
+        let c = d1.cross(d2).length();
+        !(c > 64.0 * f64::EPSILON * d1.length() * d2.length()
+            && c / d1.length().powi(3) * diag > STRAIGHT_TOL)
+    };
+    if let Some(k) = (0..a.d1.len()).into_par_iter().position_first(flat) {
+        let u = if k % 2 == 0 {
+            a.u[k / 2]
+        } else {
+            0.5 * (a.u[k / 2] + a.u[k / 2 + 1])
+        };
+        return Err(InputError::new(
+            "method",
+            format!(
+                "'torsion' turns the Frenet frame, which is undefined where the curvature \
+                 vanishes (at u = {u}); use method='double_reflection'"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Row counts of the sample arrays and the output buffer, and finite samples.
@@ -95,11 +136,13 @@ fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
 
 /// The method, the tangents-only chords, the input they need and the end condition.
 fn check_options(req: &Request) -> Result<()> {
-    if matches!(req.method, Method::Rk4 | Method::Rk4Phi) && req.analytic.is_none() {
-        let name = if req.method == Method::Rk4 {
-            "rk4"
-        } else {
-            "rk4_phi"
+    if matches!(req.method, Method::Rk4 | Method::Rk4Phi | Method::Torsion)
+        && req.analytic.is_none()
+    {
+        let name = match req.method {
+            Method::Rk4 => "rk4",
+            Method::Rk4Phi => "rk4_phi",
+            _ => "torsion",
         };
         return Err(InputError::new(
             "method",
@@ -166,7 +209,7 @@ pub(super) fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
 pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()> {
     let (t, closed) = (dr.t, dr.closed);
     let n = t.len();
-    if !matches!(req.method, Method::Rk4 | Method::Rk4Phi) {
+    if !matches!(req.method, Method::Rk4 | Method::Rk4Phi | Method::Torsion) {
         let what = if req.tangent_chords {
             "tangents"
         } else {

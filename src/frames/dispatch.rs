@@ -9,7 +9,7 @@ use super::double_reflection::DoubleReflection;
 use super::geometry::{self, any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 use super::request::{Analytic, Method, Orientation, Request, STRAIGHT_TOL, pick, resolve};
 use super::transport::{Step, Twist, transport_into_cancellable};
-use super::{frenet, fused, projection, rk4, rotation, tangents, validate};
+use super::{frenet, fused, projection, rk4, rotation, tangents, torsion, validate};
 use crate::error::{InputError, Result};
 
 /// Where the principal normal comes from.
@@ -148,6 +148,7 @@ struct Normalised {
     points: Vec<DVec3>,
     d1: Vec<DVec3>,
     d2: Vec<DVec3>,
+    d3: Vec<DVec3>,
 }
 
 fn normalised(req: &Request) -> Result<Option<Normalised>> {
@@ -163,6 +164,7 @@ fn normalised(req: &Request) -> Result<Option<Normalised>> {
         points: scaled(p)?,
         d1: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d1))?,
         d2: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d2))?,
+        d3: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d3))?,
     }))
 }
 
@@ -174,6 +176,7 @@ impl Normalised {
                 u: a.u,
                 d1: &self.d1,
                 d2: &self.d2,
+                d3: &self.d3,
             }),
             ..*req
         }
@@ -425,6 +428,16 @@ fn transport_frames(
                 .analytic
                 .ok_or_else(|| InputError::new("method", "rk4_phi"))?;
             ctx.run(&rk4::Rk4Phi::new(a.u, a.d1, a.d2, t), out, cancel)
+        }
+        Method::Torsion => {
+            let a = req
+                .analytic
+                .ok_or_else(|| InputError::new("method", "torsion"))?;
+            ctx.run(
+                &torsion::Torsion::new(a.u, a.d1, a.d2, a.d3, t),
+                out,
+                cancel,
+            )
         }
         Method::Frenet => unreachable!("frenet_frames handles it"),
     }

@@ -17,6 +17,8 @@ pub enum Method {
     Rk4,
     /// RK4 on the φ-form `r′ = −(r·t′) t` without projection (Wang et al.'s Table III).
     Rk4Phi,
+    /// The Frenet frame turned by `−∫τ ds` (analytic curves with `x‴`, `κ ≠ 0`).
+    Torsion,
 }
 
 /// A prescribed orientation: a reference vector (projected onto the normal plane) or a
@@ -36,6 +38,8 @@ pub struct Analytic<'a> {
     pub d1: &'a [DVec3],
     /// Second derivative `x″(u)` at the samples and midpoints (2m + 1 rows).
     pub d2: &'a [DVec3],
+    /// Third derivative `x‴(u)` at the same rows, or empty (only the torsion method reads it).
+    pub d3: &'a [DVec3],
 }
 
 /// Everything one frame computation needs. Arrays have one row per input sample.

@@ -98,6 +98,7 @@ fn helix_errors(method: Method, given: bool, analytic: bool, n: usize) -> (f64, 
             u: &u,
             d1: &d1,
             d2: &d2,
+            d3: &[],
         }),
         method,
         ..Default::default()
@@ -443,6 +444,7 @@ fn errors_name_the_argument() {
         u: &u,
         d1: &d,
         d2: &d,
+        d3: &[],
     };
     let mut nan = x.clone();
     nan[4].z = f64::NAN;

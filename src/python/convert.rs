@@ -521,6 +521,7 @@ impl FromPyObject<'_, '_> for Method {
                 ("frenet", Method::Frenet),
                 ("rk4", Method::Rk4),
                 ("rk4_phi", Method::Rk4Phi),
+                ("torsion", Method::Torsion),
             ],
         )
     }
