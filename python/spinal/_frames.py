@@ -27,7 +27,8 @@ from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
-METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi", "torsion")
+METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi", "torsion",
+           "bisector")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
@@ -216,6 +217,12 @@ def frames(
           (Bloomenthal 1990; discrete parallel transport / Bishop frame). 2nd order.
         * ``"projection"``: the RMF by projecting along each chord (Klok 1986). 2nd order,
           depends on ``initial``.
+        * ``"bisector"``: Klok's projection for polygons given as points only (Klok 1986;
+          Zheng's thesis §2.3): the tangent at a vertex is the normal of the plane through
+          the bisector of its two segments, ``t_i ∝ d̂_{i−1} + d̂_i`` (the end segment's
+          direction at an open end), and ``r`` is projected along each segment onto the next
+          such plane. No twist on a planar polygon; 2nd order at the interior vertices of a
+          sampled curve, 1st order at the ends. ``tangents`` are not accepted.
         * ``"frenet"``: the Frenet frame ``r = N`` (towards the centre of curvature),
           ``s = B``; exact on analytic curves, from sampled points ``N`` points to the centre
           of the circle through each sample and its neighbours (2nd order; 1st order at the

@@ -153,6 +153,22 @@ fn check_options(req: &Request) -> Result<()> {
             ),
         ));
     }
+    if req.method == Method::Bisector {
+        if req.analytic.is_some() {
+            return Err(InputError::new(
+                "method",
+                "'bisector' is Klok's projection for polygons given as points; an analytic \
+                 curve has exact tangents: use method='projection' or 'double_reflection'",
+            ));
+        }
+        if req.tangents.is_some() {
+            return Err(InputError::new(
+                "tangents",
+                "not used by method='bisector': its tangents are the normals of the polygon's \
+                 bisector planes (use method='projection' with given tangents)",
+            ));
+        }
+    }
     if req.tangent_chords && req.method != Method::DoubleReflection && req.method != Method::Frenet
     {
         return Err(InputError::new(
@@ -217,7 +233,7 @@ pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()>
         };
         validate::aligned(t, closed, |i| dr.chord(i), what)?;
     }
-    if req.method == Method::Projection {
+    if matches!(req.method, Method::Projection | Method::Bisector) {
         let m = if closed { n } else { n - 1 };
         if let Some(i) = (0..m).into_par_iter().position_first(|i| {
             let d = dr.chord(i);

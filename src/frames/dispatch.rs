@@ -280,6 +280,16 @@ fn unit_tangents(
             InputError::new("points", format!("cannot normalise the tangent at row {i}"))
         })?;
         t
+    } else if req.method == Method::Bisector {
+        projection::bisector_tangents(x, req.closed).map_err(|i| {
+            InputError::new(
+                "points",
+                format!(
+                    "the polygon turns back on itself at row {i} (the segments there are \
+                     opposite), so the bisector plane is undefined"
+                ),
+            )
+        })?
     } else if let Some(tg) = req.tangents {
         let mut t = tg[..n].to_vec();
         tangents::normalize_all(&mut t).map_err(|i| {
@@ -403,7 +413,9 @@ fn transport_frames(
     match req.method {
         Method::DoubleReflection => ctx.run(dr, out, cancel),
         Method::Rotation => ctx.run(&rotation::Rotation { t }, out, cancel),
-        Method::Projection => ctx.run(&projection::Projection { x: dr.x, t }, out, cancel),
+        Method::Projection | Method::Bisector => {
+            ctx.run(&projection::Projection { x: dr.x, t }, out, cancel)
+        }
         Method::Rk4 => {
             let a = req
                 .analytic

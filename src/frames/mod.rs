@@ -8,6 +8,7 @@
 //! | double reflection | [`double_reflection`] | 4 | exact on lines, planes and spheres |
 //! | rotation (Bloomenthal, discrete parallel transport) | [`rotation`] | 2 | |
 //! | projection (Klok) | [`projection`] | 2 | depends on the initial vector |
+//! | bisector planes (Klok's polygon variant) | [`projection`] | 2 (1 at the ends) | points only; its own tangents |
 //! | RK4 on the RMF ODE | [`rk4`] | 4 | analytic curves (needs x′, x″) |
 //! | RK4, unprojected φ-form (Wang et al.'s Table III) | [`rk4`] | 4 | analytic curves; for comparisons |
 //! | Frenet | [`frenet`] | exact where κ ≠ 0 | continuous fill at κ ≈ 0 |

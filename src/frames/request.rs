@@ -19,6 +19,8 @@ pub enum Method {
     Rk4Phi,
     /// The Frenet frame turned by `−∫τ ds` (analytic curves with `x‴`, `κ ≠ 0`).
     Torsion,
+    /// Klok's projection onto the bisector planes of a polygon (points only).
+    Bisector,
 }
 
 /// A prescribed orientation: a reference vector (projected onto the normal plane) or a

@@ -522,6 +522,7 @@ impl FromPyObject<'_, '_> for Method {
                 ("rk4", Method::Rk4),
                 ("rk4_phi", Method::Rk4Phi),
                 ("torsion", Method::Torsion),
+                ("bisector", Method::Bisector),
             ],
         )
     }
