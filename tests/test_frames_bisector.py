@@ -3,7 +3,10 @@ Klok 1986, Zheng's thesis §2.3), see docs/references.md."""
 
 import numpy as np
 import pytest
-from conftest import angle_between
+from conftest import angle_between, orthonormality_error
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
 
 import spinal
 from spinal.curves import Helix
@@ -82,3 +85,35 @@ def test_bisector_arguments_and_bundles():
     both = spinal.frames([x, y], method="bisector")
     np.testing.assert_array_equal(both[: len(x)], spinal.frames(x, method="bisector"))
     np.testing.assert_array_equal(both[len(x):], spinal.frames(y, method="bisector"))
+
+
+def test_rigid_motion_scale_and_reversal():
+    from scipy.spatial.transform import Rotation
+
+    from spinal.curves import TorusKnot
+
+    x = TorusKnot().sample(400)
+    R = Rotation.from_rotvec([0.7, -0.2, 1.9]).as_matrix()
+    F = spinal.frames(x, method="bisector")  # default initial frame
+    G = spinal.frames(3.5 * x @ R.T + [10.0, -4.0, 2.0], method="bisector")
+    assert np.abs(R @ F - G).max() < 1e-11
+    # the projection between two planes along a segment is the same both ways
+    B = spinal.frames(x[::-1], method="bisector", initial=F[-1][:, 0])[::-1]
+    assert np.abs(B[:, :, 0] - F[:, :, 0]).max() < 1e-12
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    arrays(np.float64, st.tuples(st.integers(0, 12), st.integers(2, 4)),
+           elements=st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                              st.sampled_from([0.0, 1.0, -1.0]))),
+    st.booleans(),
+)
+def test_garbage_never_panics_or_returns_nan(a, closed):
+    try:
+        F = spinal.frames(a, method="bisector", closed=closed)
+    except (ValueError, TypeError) as e:
+        assert str(e).split(":")[0] in {"points", "tangents", "initial", "end"}
+    else:
+        assert np.all(np.isfinite(F))
+        assert orthonormality_error(F) < 1e-9
