@@ -98,6 +98,12 @@ def test_torsion_method_helix_closed_form_and_fourth_order(torus_knot_reference)
         gap = angle_between(T[:, :, 0], D[:, :, 0]).max()
         assert abs(gap / e_dr - 1) < 0.05, (kk, gap, e_dr)
     assert abs(spinal.closing_angle(k, u=2049, method="torsion") + 2.875711997866) < 1e-11
+    # steering passes x‴ on: a constraint at the first row is the initial vector
+    u = np.linspace(0, 10, 41)
+    v = [0.3, 0.2, 1.0]
+    np.testing.assert_allclose(spinal.frames(helix, u=u, method="torsion", constraints={0: v}),
+                               spinal.frames(helix, u=u, method="torsion", initial=v),
+                               atol=1e-14)
 
 
 def test_torsion_method_refuses_vanishing_curvature():

@@ -79,6 +79,15 @@ def _analytic(curve: Curve, u: Any):
     )
 
 
+def _third(curve: Curve, uu: np.ndarray, method: str):
+    """``x‴`` at the samples and midpoints for the torsion method (None for the others)."""
+    if method != "torsion":
+        return None
+    full = np.empty(2 * uu.size - 1)
+    full[0::2], full[1::2] = uu, 0.5 * (uu[:-1] + uu[1:])
+    return np.ascontiguousarray(curve.d3(full))
+
+
 def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"):
     """Sampled points and tangents as the core takes them: ``(pts, tgs, offs, bundle)``, rows
     ``(N, 3)`` float64 (either may be ``None``), CSR offsets ``(C + 1,)`` and whether the
@@ -123,12 +132,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         pts, uu, d1, d2 = _analytic(points, u)
         iv, if_ = _orientation(initial, "initial", 1, False)
         ev, ef = _orientation(end, "end", 1, False)
-        # x‴ at the same rows, for the torsion integral only
-        d3 = None
-        if method == "torsion":
-            full = np.empty(2 * uu.size - 1)
-            full[0::2], full[1::2] = uu, 0.5 * (uu[:-1] + uu[1:])
-            d3 = np.ascontiguousarray(points.d3(full))
+        d3 = _third(points, uu, method)
         out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns,
                                            d3)
         if report is not None:
@@ -594,7 +598,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
                                  f"frames that previous would choose)")
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
-    d1 = d2 = uu = tgs = None
+    d1 = d2 = d3 = uu = tgs = None
     if isinstance(points, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (its exact tangents "
@@ -604,6 +608,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         if reflection != "chord":
             raise ValueError("reflection: 'tangents' applies to sampled curves only")
         pts, uu, d1, d2 = _analytic(points, u)
+        d3 = _third(points, uu, method)
     else:
         if u is not None:
             raise TypeError("u: only used with an analytic curve from spinal.curves")
@@ -627,7 +632,8 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
 
     def run(pts, tgs, offs, steer):
         return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
-                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer)
+                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer,
+                                    d3=d3)
 
     if pts is None or uu is not None or reflection == "tangents":
         return run(pts, tgs, offs, steer)

@@ -207,13 +207,13 @@ pub fn estimate_tangents<'py>(
 /// (`spinal.frames` with `constraints=`, `twist_rule=`, `guide=` or `previous=`). The
 /// constraints of all curves come flattened: curve `con_curves[k]`, local row `con_rows[k]`,
 /// the vector `con_vectors[k]` or, where `con_is_frame[k]`, the frame `con_frames[k]`. An
-/// analytic curve (one) passes `u`, `d1`, `d2` as in [`frames_analytic`].
+/// analytic curve (one) passes `u`, `d1`, `d2` (and `d3`) as in [`frames_analytic`].
 #[pyfunction]
 #[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
                     con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
                     guide, guide_weight, guide_tolerance, guide_axis, previous,
-                    points_arg="points"))]
+                    points_arg="points", d3=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_steered<'py>(
     py: Python<'py>,
@@ -244,6 +244,7 @@ pub fn frames_steered<'py>(
     guide_axis: bool,
     previous: Option<PyReadonlyArray3<'py, f64>>,
     points_arg: &str,
+    d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     use crate::frames::constraints::TwistRule;
     use crate::frames::guide::Guide;
@@ -335,7 +336,10 @@ pub fn frames_steered<'py>(
                     u: slice_of("u", u)?,
                     d1: vec3s("points.d1", d1)?,
                     d2: vec3s("points.d2", d2)?,
-                    d3: &[],
+                    d3: match &d3 {
+                        Some(d) => vec3s("points.d3", d)?,
+                        None => &[],
+                    },
                 }),
                 initial: frames::pick(&initial, 0),
                 end: frames::pick(&end, 0),
