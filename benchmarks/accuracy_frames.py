@@ -23,14 +23,14 @@ def main():
 
     ref = solve_ivp(rhs, (0, 2 * np.pi), [-1.0, 0, 0], method="DOP853", t_eval=u_ref,
                     rtol=1e-13, atol=1e-15).y.T
-    print("| segments | double_reflection | rk4 | rotation | projection |")
-    print("|---|---|---|---|---|")
+    print("| segments | double_reflection | rk4 | rk4_phi | rotation | projection |")
+    print("|---|---|---|---|---|---|")
     for e in range(6, 12):
         step = 2 ** (11 - e)
         u = u_ref[::step]
         row = []
-        for m in ("double_reflection", "rk4", "rotation", "projection"):
-            F = (spinal.frames(k, u=u, method=m, initial=[-1.0, 0, 0]) if m == "rk4" else
+        for m in ("double_reflection", "rk4", "rk4_phi", "rotation", "projection"):
+            F = (spinal.frames(k, u=u, method=m, initial=[-1.0, 0, 0]) if m.startswith("rk4") else
                  spinal.frames(k.point(u), k.d1(u), method=m, initial=[-1.0, 0, 0]))
             r = F[:, :, 0]
             err = np.arctan2(np.linalg.norm(np.cross(r, ref[::step]), axis=1),

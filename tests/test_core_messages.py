@@ -19,7 +19,8 @@ def sampled(method="double_reflection", rule="five_point", offsets=(0, 4), end_f
 
 def test_option_strings_name_the_argument_and_list_the_choices():
     with pytest.raises(ValueError, match=r"^method: unknown method \"dr\"; expected "
-                       r"'double_reflection', 'projection', 'rotation', 'frenet' or 'rk4'"):
+                       r"'double_reflection', 'projection', 'rotation', 'frenet', 'rk4', "
+                       r"'rk4_phi', 'torsion' or 'bisector'"):
         sampled(method="dr")
     with pytest.raises(ValueError, match=r"^method: unknown tangent estimate \"x\"; expected "
                        r"'five_point', 'five_point_uniform' or 'circle'"):

@@ -91,6 +91,8 @@ def test_bad_options():
         spinal.frames(GOOD, method=3)
     with pytest.raises(ValueError, match="method: 'rk4'.*analytic curve"):
         spinal.frames(GOOD, method="rk4")
+    with pytest.raises(ValueError, match="method: 'rk4_phi'.*analytic curve"):
+        spinal.frames(GOOD, method="rk4_phi")
     with pytest.raises(TypeError, match="closed: expected True or False"):
         spinal.frames(GOOD, closed=1)
     with pytest.raises(TypeError, match="turns: expected an integer"):
@@ -149,6 +151,8 @@ def test_analytic_curve_errors():
     cusp = Polynomial([[0, 0, 0], [0, 0, 0], [1, 0, 0], [0, 1, 0]], domain=(-1, 1))
     with pytest.raises(ValueError, match="derivative vanishes at u = 0"):
         spinal.frames(cusp, u=np.linspace(-1, 1, 11), method="rk4")
+    with pytest.raises(ValueError, match="derivative vanishes at u = 0"):
+        spinal.frames(cusp, u=np.linspace(-1, 1, 11), method="rk4_phi")
 
 
 def test_tangent_estimation_errors():

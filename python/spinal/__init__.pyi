@@ -62,7 +62,8 @@ _Ints: TypeAlias = Sequence[int] | npt.NDArray[np.integer]
 # a bundle as users hold it: a list (any sequence, e.g. nibabel's ArraySequence) of (n_i, 3)
 _Curves: TypeAlias = Sequence[_Array] | Any
 _PointData: TypeAlias = dict[str, _Array]
-_Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4"]
+_Method: TypeAlias = Literal["double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi",
+                              "torsion", "bisector"]
 _Reflection: TypeAlias = Literal["chord", "tangents"]
 _Constraints: TypeAlias = dict[int, _Array] | tuple[_Array, _Array]
 _TangentRule: TypeAlias = Literal["five_point_bounded", "five_point", "five_point_uniform", "circle"]

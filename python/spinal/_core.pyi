@@ -36,6 +36,7 @@ def frames_analytic(
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
     turns: int,
+    d3: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 class RepeatedPointsError(ValueError): ...
 
@@ -78,6 +79,7 @@ def frames_steered(
     guide_axis: bool,
     previous: npt.NDArray[np.float64] | None,
     points_arg: str = "points",
+    d3: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def frames_in_time(
     points: npt.NDArray[np.float64] | None,

@@ -27,7 +27,8 @@ from .curves import Curve
 
 __all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
 
-METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4")
+METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi", "torsion",
+           "bisector")
 REFLECTIONS = ("chord", "tangents")
 TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
 DEFAULT_TANGENT_RULE = "five_point_bounded"
@@ -78,6 +79,15 @@ def _analytic(curve: Curve, u: Any):
     )
 
 
+def _third(curve: Curve, uu: np.ndarray, method: str):
+    """``x‴`` at the samples and midpoints for the torsion method (None for the others)."""
+    if method != "torsion":
+        return None
+    full = np.empty(2 * uu.size - 1)
+    full[0::2], full[1::2] = uu, 0.5 * (uu[:-1] + uu[1:])
+    return np.ascontiguousarray(curve.d3(full))
+
+
 def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"):
     """Sampled points and tangents as the core takes them: ``(pts, tgs, offs, bundle)``, rows
     ``(N, 3)`` float64 (either may be ``None``), CSR offsets ``(C + 1,)`` and whether the
@@ -122,7 +132,9 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         pts, uu, d1, d2 = _analytic(points, u)
         iv, if_ = _orientation(initial, "initial", 1, False)
         ev, ef = _orientation(end, "end", 1, False)
-        out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns)
+        d3 = _third(points, uu, method)
+        out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns,
+                                           d3)
         if report is not None:
             report(len(out), len(out))
         return out, np.array([angle]), False
@@ -209,6 +221,12 @@ def frames(
           (Bloomenthal 1990; discrete parallel transport / Bishop frame). 2nd order.
         * ``"projection"``: the RMF by projecting along each chord (Klok 1986). 2nd order,
           depends on ``initial``.
+        * ``"bisector"``: Klok's projection for polygons given as points only (Klok 1986;
+          Zheng's thesis §2.3): the tangent at a vertex is the normal of the plane through
+          the bisector of its two segments, ``t_i ∝ d̂_{i−1} + d̂_i`` (the end segment's
+          direction at an open end), and ``r`` is projected along each segment onto the next
+          such plane. No twist on a planar polygon; 2nd order at the interior vertices of a
+          sampled curve, 1st order at the ends. ``tangents`` are not accepted.
         * ``"frenet"``: the Frenet frame ``r = N`` (towards the centre of curvature),
           ``s = B``; exact on analytic curves, from sampled points ``N`` points to the centre
           of the circle through each sample and its neighbours (2nd order; 1st order at the
@@ -220,6 +238,16 @@ def frames(
           not apply. (The Frenet frame itself turns by π across an inflection.)
         * ``"rk4"``: classical Runge–Kutta on the RMF ODE ``r′ = (x′ × x″)/|x′|² × r``
           with the normal-plane projection after each step; analytic curves only. 4th order.
+        * ``"rk4_phi"``: classical Runge–Kutta on the equivalent form ``r′ = −(r·t′) t``
+          without projection, the variant whose errors Wang et al. (2008) tabulate (Table
+          III); the frame written is the normal part of the state, normalised. Analytic
+          curves only; 4th order, about 1.5× the error of ``"rk4"``. For comparisons.
+        * ``"torsion"``: the Frenet frame turned about ``t`` by ``θ = −∫τ ds`` (Simpson's
+          rule on ``τ|x′|`` with the exact ``x′, x″, x‴``; Wang et al. 2008 Eq. 3, Zheng's
+          thesis §2.4), the RMF where the Frenet frame exists: exact on a circular helix,
+          4th order in general. Analytic curves only; a curve whose curvature vanishes at a
+          sample or midpoint is refused (the Frenet frame and the torsion are undefined
+          there; near an inflection the torsion is unbounded). For comparisons.
     initial : array_like (3,) or (3, 3), optional
         Reference vector at the first sample (projected onto the normal plane and
         normalised), or a whole frame (rotation matrix, columns r, s, t; its r is used and its
@@ -570,7 +598,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
                                  f"frames that previous would choose)")
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
-    d1 = d2 = uu = tgs = None
+    d1 = d2 = d3 = uu = tgs = None
     if isinstance(points, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (its exact tangents "
@@ -580,6 +608,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         if reflection != "chord":
             raise ValueError("reflection: 'tangents' applies to sampled curves only")
         pts, uu, d1, d2 = _analytic(points, u)
+        d3 = _third(points, uu, method)
     else:
         if u is not None:
             raise TypeError("u: only used with an analytic curve from spinal.curves")
@@ -603,7 +632,8 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
 
     def run(pts, tgs, offs, steer):
         return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
-                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer)
+                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer,
+                                    d3=d3)
 
     if pts is None or uu is not None or reflection == "tangents":
         return run(pts, tgs, offs, steer)

@@ -5,7 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::double_reflection::DoubleReflection;
-use super::request::{Analytic, Method, Request};
+use super::request::{Analytic, Method, Request, STRAIGHT_TOL};
 use super::validate;
 use crate::error::{InputError, Result};
 
@@ -32,7 +32,48 @@ pub(super) fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
         check_analytic(&a, rows)?;
     }
     check_options(req)?;
+    if req.method == Method::Torsion {
+        check_torsion(req)?;
+    }
     Ok(rows)
+}
+
+/// The torsion method needs `x‴` and a curvature that vanishes nowhere (at the samples and
+/// midpoints its quadrature reads): there the Frenet frame and the torsion are undefined.
+fn check_torsion(req: &Request) -> Result<()> {
+    let Some(a) = req.analytic else {
+        return Ok(());
+    };
+    if a.d3.len() != a.d1.len() {
+        return Err(InputError::new(
+            "method",
+            "'torsion' needs the third derivative x‴ of an analytic curve (a spinal.curves \
+             object with u=...)",
+        ));
+    }
+    validate::finite("points", a.d3)?;
+    let diag = super::geometry::scale_and_diagonal(req.points.unwrap_or(&[])).1;
+    let flat = |k: usize| {
+        let (d1, d2) = (a.d1[k], a.d2[k]);
+        let c = d1.cross(d2).length();
+        !(c > 64.0 * f64::EPSILON * d1.length() * d2.length()
+            && c / d1.length().powi(3) * diag > STRAIGHT_TOL)
+    };
+    if let Some(k) = (0..a.d1.len()).into_par_iter().position_first(flat) {
+        let u = if k % 2 == 0 {
+            a.u[k / 2]
+        } else {
+            0.5 * (a.u[k / 2] + a.u[k / 2 + 1])
+        };
+        return Err(InputError::new(
+            "method",
+            format!(
+                "'torsion' turns the Frenet frame, which is undefined where the curvature \
+                 vanishes (at u = {u}); use method='double_reflection'"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Row counts of the sample arrays and the output buffer, and finite samples.
@@ -95,13 +136,38 @@ fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
 
 /// The method, the tangents-only chords, the input they need and the end condition.
 fn check_options(req: &Request) -> Result<()> {
-    if req.method == Method::Rk4 && req.analytic.is_none() {
+    if matches!(req.method, Method::Rk4 | Method::Rk4Phi | Method::Torsion)
+        && req.analytic.is_none()
+    {
+        let name = match req.method {
+            Method::Rk4 => "rk4",
+            Method::Rk4Phi => "rk4_phi",
+            _ => "torsion",
+        };
         return Err(InputError::new(
             "method",
-            "'rk4' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass a \
-             spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), u=200, \
-             method='rk4')",
+            format!(
+                "'{name}' integrates the RMF ODE and needs an analytic curve (x′ and x″): pass \
+                 a spinal.curves object with u=..., e.g. frames(spinal.curves.Helix(), \
+                 u=200, method='{name}')"
+            ),
         ));
+    }
+    if req.method == Method::Bisector {
+        if req.analytic.is_some() {
+            return Err(InputError::new(
+                "method",
+                "'bisector' is Klok's projection for polygons given as points; an analytic \
+                 curve has exact tangents: use method='projection' or 'double_reflection'",
+            ));
+        }
+        if req.tangents.is_some() {
+            return Err(InputError::new(
+                "tangents",
+                "not used by method='bisector': its tangents are the normals of the polygon's \
+                 bisector planes (use method='projection' with given tangents)",
+            ));
+        }
     }
     if req.tangent_chords && req.method != Method::DoubleReflection && req.method != Method::Frenet
     {
@@ -159,7 +225,7 @@ pub(super) fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
 pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()> {
     let (t, closed) = (dr.t, dr.closed);
     let n = t.len();
-    if req.method != Method::Rk4 {
+    if !matches!(req.method, Method::Rk4 | Method::Rk4Phi | Method::Torsion) {
         let what = if req.tangent_chords {
             "tangents"
         } else {
@@ -167,7 +233,7 @@ pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()>
         };
         validate::aligned(t, closed, |i| dr.chord(i), what)?;
     }
-    if req.method == Method::Projection {
+    if matches!(req.method, Method::Projection | Method::Bisector) {
         let m = if closed { n } else { n - 1 };
         if let Some(i) = (0..m).into_par_iter().position_first(|i| {
             let d = dr.chord(i);

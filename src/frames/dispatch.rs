@@ -9,7 +9,7 @@ use super::double_reflection::DoubleReflection;
 use super::geometry::{self, any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 use super::request::{Analytic, Method, Orientation, Request, STRAIGHT_TOL, pick, resolve};
 use super::transport::{Step, Twist, transport_into_cancellable};
-use super::{frenet, fused, projection, rk4, rotation, tangents, validate};
+use super::{frenet, fused, projection, rk4, rotation, tangents, torsion, validate};
 use crate::error::{InputError, Result};
 
 /// Where the principal normal comes from.
@@ -148,6 +148,7 @@ struct Normalised {
     points: Vec<DVec3>,
     d1: Vec<DVec3>,
     d2: Vec<DVec3>,
+    d3: Vec<DVec3>,
 }
 
 fn normalised(req: &Request) -> Result<Option<Normalised>> {
@@ -163,6 +164,7 @@ fn normalised(req: &Request) -> Result<Option<Normalised>> {
         points: scaled(p)?,
         d1: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d1))?,
         d2: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d2))?,
+        d3: req.analytic.map_or(Ok(Vec::new()), |a| scaled(a.d3))?,
     }))
 }
 
@@ -174,6 +176,7 @@ impl Normalised {
                 u: a.u,
                 d1: &self.d1,
                 d2: &self.d2,
+                d3: &self.d3,
             }),
             ..*req
         }
@@ -277,6 +280,16 @@ fn unit_tangents(
             InputError::new("points", format!("cannot normalise the tangent at row {i}"))
         })?;
         t
+    } else if req.method == Method::Bisector {
+        projection::bisector_tangents(x, req.closed).map_err(|i| {
+            InputError::new(
+                "points",
+                format!(
+                    "the polygon turns back on itself at row {i} (the segments there are \
+                     opposite), so the bisector plane is undefined"
+                ),
+            )
+        })?
     } else if let Some(tg) = req.tangents {
         let mut t = tg[..n].to_vec();
         tangents::normalize_all(&mut t).map_err(|i| {
@@ -400,7 +413,9 @@ fn transport_frames(
     match req.method {
         Method::DoubleReflection => ctx.run(dr, out, cancel),
         Method::Rotation => ctx.run(&rotation::Rotation { t }, out, cancel),
-        Method::Projection => ctx.run(&projection::Projection { x: dr.x, t }, out, cancel),
+        Method::Projection | Method::Bisector => {
+            ctx.run(&projection::Projection { x: dr.x, t }, out, cancel)
+        }
         Method::Rk4 => {
             let a = req
                 .analytic
@@ -416,6 +431,22 @@ fn transport_frames(
                     omega: &omega,
                     t,
                 },
+                out,
+                cancel,
+            )
+        }
+        Method::Rk4Phi => {
+            let a = req
+                .analytic
+                .ok_or_else(|| InputError::new("method", "rk4_phi"))?;
+            ctx.run(&rk4::Rk4Phi::new(a.u, a.d1, a.d2, t), out, cancel)
+        }
+        Method::Torsion => {
+            let a = req
+                .analytic
+                .ok_or_else(|| InputError::new("method", "torsion"))?;
+            ctx.run(
+                &torsion::Torsion::new(a.u, a.d1, a.d2, a.d3, t),
                 out,
                 cancel,
             )

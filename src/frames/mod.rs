@@ -8,8 +8,11 @@
 //! | double reflection | [`double_reflection`] | 4 | exact on lines, planes and spheres |
 //! | rotation (Bloomenthal, discrete parallel transport) | [`rotation`] | 2 | |
 //! | projection (Klok) | [`projection`] | 2 | depends on the initial vector |
+//! | bisector planes (Klok's polygon variant) | [`projection`] | 2 (1 at the ends) | points only; its own tangents |
 //! | RK4 on the RMF ODE | [`rk4`] | 4 | analytic curves (needs x′, x″) |
+//! | RK4, unprojected φ-form (Wang et al.'s Table III) | [`rk4`] | 4 | analytic curves; for comparisons |
 //! | Frenet | [`frenet`] | exact where κ ≠ 0 | continuous fill at κ ≈ 0 |
+//! | Frenet turned by −∫τ ds | [`torsion`] | 4 (exact on helices) | analytic curves (needs x‴), κ ≠ 0 |
 //!
 //! Boundary conditions (closed curves, a prescribed end vector) add a twist linear in arc
 //! length ([`transport`]). [`steer`] turns the RMF about its tangents to meet constraints at
@@ -35,6 +38,7 @@ pub mod rotation;
 pub mod steer;
 pub mod tangents;
 pub mod time;
+pub mod torsion;
 pub mod transport;
 pub mod validate;
 

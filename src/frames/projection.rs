@@ -4,6 +4,14 @@
 //!
 //! The projection is not an isometry of the normal plane, so the result depends on the
 //! initial vector; 2nd-order accurate. Defined when `d·t_{i+1} ≠ 0` (checked by the caller).
+//!
+//! Klok's polygon variant (Klok 1986; Zheng's thesis §2.3) needs no tangents: the plane at
+//! an interior vertex contains the bisector of the angle between the two segments there
+//! and is ⟂ to their plane, so its normal, taken as the frame's tangent, is the sum of the
+//! two unit segment directions, `t_i ∝ d̂_{i−1} + d̂_i`; at an open end it is the end
+//! segment's direction ([`bisector_tangents`]). The same projection along each segment then
+//! carries `r` from plane to plane. Each step moves `r` along `d_i`, so a component of `r`
+//! normal to a planar polygon is kept exactly: on a planar polygon the frames do not twist.
 
 use glam::DVec3;
 
@@ -33,4 +41,24 @@ impl Step for Projection<'_> {
     fn is_rotation(&self) -> bool {
         false
     }
+}
+
+/// The normals of Klok's bisector planes at the vertices `x` (see the module notes), or the
+/// first vertex where the two segments turn back on each other (`d̂_{i−1} + d̂_i = 0`). The
+/// vertices must be distinct in turn (checked by the caller).
+pub fn bisector_tangents(x: &[DVec3], closed: bool) -> Result<Vec<DVec3>, usize> {
+    let n = x.len();
+    let unit = |i: usize| (x[(i + 1) % n] - x[i]).normalize();
+    (0..n)
+        .map(|i| {
+            let (before, after) = match (i, closed) {
+                (0, false) => (DVec3::ZERO, unit(0)),
+                (i, false) if i + 1 == n => (unit(i - 1), DVec3::ZERO),
+                (i, _) => (unit((i + n - 1) % n), unit(i)),
+            };
+            let s = before + after;
+            let l = s.length();
+            if l > 1e-12 { Ok(s / l) } else { Err(i) }
+        })
+        .collect()
 }

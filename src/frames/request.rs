@@ -15,6 +15,12 @@ pub enum Method {
     Rotation,
     Frenet,
     Rk4,
+    /// RK4 on the φ-form `r′ = −(r·t′) t` without projection (Wang et al.'s Table III).
+    Rk4Phi,
+    /// The Frenet frame turned by `−∫τ ds` (analytic curves with `x‴`, `κ ≠ 0`).
+    Torsion,
+    /// Klok's projection onto the bisector planes of a polygon (points only).
+    Bisector,
 }
 
 /// A prescribed orientation: a reference vector (projected onto the normal plane) or a
@@ -34,6 +40,8 @@ pub struct Analytic<'a> {
     pub d1: &'a [DVec3],
     /// Second derivative `x″(u)` at the samples and midpoints (2m + 1 rows).
     pub d2: &'a [DVec3],
+    /// Third derivative `x‴(u)` at the same rows, or empty (only the torsion method reads it).
+    pub d3: &'a [DVec3],
 }
 
 /// Everything one frame computation needs. Arrays have one row per input sample.

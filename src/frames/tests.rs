@@ -98,6 +98,7 @@ fn helix_errors(method: Method, given: bool, analytic: bool, n: usize) -> (f64, 
             u: &u,
             d1: &d1,
             d2: &d2,
+            d3: &[],
         }),
         method,
         ..Default::default()
@@ -127,6 +128,7 @@ fn helix_rmf_matches_the_closed_form_at_the_method_order() {
         (Method::Rotation, false, false, 2, 40),
         (Method::Projection, true, false, 2, 40),
         (Method::Rk4, false, true, 4, 40),
+        (Method::Rk4Phi, false, true, 4, 40),
     ] {
         let (e1, t1) = helix_errors(method, given, analytic, n);
         let (e2, t2) = helix_errors(method, given, analytic, 2 * n - 1);
@@ -442,6 +444,7 @@ fn errors_name_the_argument() {
         u: &u,
         d1: &d,
         d2: &d,
+        d3: &[],
     };
     let mut nan = x.clone();
     nan[4].z = f64::NAN;

@@ -520,6 +520,9 @@ impl FromPyObject<'_, '_> for Method {
                 ("rotation", Method::Rotation),
                 ("frenet", Method::Frenet),
                 ("rk4", Method::Rk4),
+                ("rk4_phi", Method::Rk4Phi),
+                ("torsion", Method::Torsion),
+                ("bisector", Method::Bisector),
             ],
         )
     }

@@ -86,10 +86,11 @@ pub fn frames_sampled<'py>(
 }
 
 /// Frames of one analytic curve from exact derivatives at the samples and midpoints. The
-/// user passes the curve as `points` (with `u`); `d1`, `d2` come from its `d1`, `d2`.
+/// user passes the curve as `points` (with `u`); `d1`, `d2` (and `d3`, read by the torsion
+/// method only) come from its `d1`, `d2`, `d3`.
 #[pyfunction]
 #[pyo3(signature = (points, u, d1, d2, method, closed, initial_vectors, initial_frames,
-                    end_vectors, end_frames, turns))]
+                    end_vectors, end_frames, turns, d3=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_analytic<'py>(
     py: Python<'py>,
@@ -104,11 +105,16 @@ pub fn frames_analytic<'py>(
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
     turns: i64,
+    d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, f64)> {
     let pts = vec3s("points", &points)?;
     let us = slice_of("u", &u)?;
     let d1s = vec3s("points.d1", &d1)?;
     let d2s = vec3s("points.d2", &d2)?;
+    let d3s = match &d3 {
+        Some(d) => vec3s("points.d3", d)?,
+        None => &[],
+    };
     let initial = orientations("initial", initial_vectors, initial_frames)?;
     let end = orientations("end", end_vectors, end_frames)?;
     let req = Request {
@@ -117,6 +123,7 @@ pub fn frames_analytic<'py>(
             u: us,
             d1: d1s,
             d2: d2s,
+            d3: d3s,
         }),
         closed,
         method,
@@ -200,13 +207,13 @@ pub fn estimate_tangents<'py>(
 /// (`spinal.frames` with `constraints=`, `twist_rule=`, `guide=` or `previous=`). The
 /// constraints of all curves come flattened: curve `con_curves[k]`, local row `con_rows[k]`,
 /// the vector `con_vectors[k]` or, where `con_is_frame[k]`, the frame `con_frames[k]`. An
-/// analytic curve (one) passes `u`, `d1`, `d2` as in [`frames_analytic`].
+/// analytic curve (one) passes `u`, `d1`, `d2` (and `d3`) as in [`frames_analytic`].
 #[pyfunction]
 #[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
                     con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
                     guide, guide_weight, guide_tolerance, guide_axis, previous,
-                    points_arg="points"))]
+                    points_arg="points", d3=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_steered<'py>(
     py: Python<'py>,
@@ -237,6 +244,7 @@ pub fn frames_steered<'py>(
     guide_axis: bool,
     previous: Option<PyReadonlyArray3<'py, f64>>,
     points_arg: &str,
+    d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     use crate::frames::constraints::TwistRule;
     use crate::frames::guide::Guide;
@@ -328,6 +336,10 @@ pub fn frames_steered<'py>(
                     u: slice_of("u", u)?,
                     d1: vec3s("points.d1", d1)?,
                     d2: vec3s("points.d2", d2)?,
+                    d3: match &d3 {
+                        Some(d) => vec3s("points.d3", d)?,
+                        None => &[],
+                    },
                 }),
                 initial: frames::pick(&initial, 0),
                 end: frames::pick(&end, 0),
