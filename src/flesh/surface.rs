@@ -614,9 +614,14 @@ pub fn deform_surface_cancellable(
                 deform_vertex(posed.eval(i, j, x[0], x[1]), corrected, &units, o, f, x);
             }
         });
+    in_range(out, q, rest_exp, cancel)
+}
+
+/// `Ok` unless a posed position `out` left the finite numbers: a binding (size exponent
+/// `rest_exp`) and a pose (`q`) whose sizes differ by more than the range of f64 between
+/// them, or a result past the largest float. Only looked for when a size was rescaled.
+pub(super) fn in_range(out: &[DVec3], q: i32, rest_exp: i32, cancel: Cancel<'_>) -> Result<()> {
     if (q != 0 || rest_exp != 0) && !cancel() {
-        // a binding and a pose whose sizes differ by more than the range of f64 between
-        // them, or a result past the largest float
         if let Some(i) = out.par_iter().position_first(|p| !p.is_finite()) {
             return Err(InputError::new(
                 "posed_surface",

@@ -395,20 +395,7 @@ pub fn deform_trisurface_cancellable(
             }
         });
     let q = posed.scale.exp();
-    if (q != 0 || rest_exp != 0) && !cancel() {
-        if let Some(i) = out.par_iter().position_first(|p| !p.is_finite()) {
-            return Err(InputError::new(
-                "posed_surface",
-                format!(
-                    "vertex {i}: the posed position is out of range of float64 (the change \
-                     of area between the rest surface and the posed surface at size {:e} is \
-                     out of range)",
-                    scale::ldexp(1.0, -q)
-                ),
-            ));
-        }
-    }
-    Ok(())
+    super::surface::in_range(out, q, rest_exp, cancel)
 }
 
 #[cfg(test)]
