@@ -1,10 +1,11 @@
 """``spinal.deform``: carry a closed triangle mesh along a divergence-free field, refining the
-edges that the flow stretches while it integrates (Rust core, ``src/deform/refine.rs``).
+edges that the flow stretches while it integrates (Rust core, ``src/deform/refine/``).
 
 Refinement (Zheng's thesis §13.2, with the smoother variant's placement): after every
 integration step, an edge longer than ``refine × max(its rest length, mean rest edge)`` is
-split — the longest edge of both its triangles first (Rivara's longest-edge bisection), both
-triangles bisected (conforming, watertight) — and the new vertex is the rest midpoint carried
+refined by Rivara's longest-edge bisection — the edge that ends its longest-edge propagation
+path (the longest edge of both its triangles) is split, both triangles bisected (conforming,
+watertight, no angle below half of the one it came from) — and the new vertex is the rest midpoint carried
 by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow tears an edge
 apart (the tangential slip at the surface of a curl tool) the body's boundary runs along the
 tool's surface between the two torn sides: the new vertex goes halfway along that path, onto

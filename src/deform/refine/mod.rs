@@ -13,9 +13,16 @@
 //!   `W` the current and `X` the rest positions, `ℓ̄` the mean rest edge length and
 //!   `τ = refine ≥ 1`. An edge that is long already at rest is split only where the flow
 //!   stretches it, and a mesh the field never moves is never split;
-//! * **longest-edge bisection** (Rivara 1984) — an edge is split only when it is the longest
-//!   edge of both its triangles (a shorter over-long edge waits for the longest edge of its
-//!   neighbour), so a split never makes a triangle thinner than its parent;
+//! * **longest-edge bisection** (Rivara 1984, 1997) — an edge over the threshold is refined
+//!   through its longest-edge propagation path: from its triangle to the neighbour across
+//!   that triangle's longest edge, until an edge is the longest of both its triangles (the
+//!   terminal edge), which is split, whether or not it is over the threshold itself. A
+//!   split only ever halves triangles across their longest edge, so no angle falls below half
+//!   the smallest angle it came from and the splits end. Splitting the over-long edge
+//!   itself where a longer edge of its triangle is not over the threshold (a long rest
+//!   edge, whose threshold is higher) can cycle: two such splits in turn converge to a fixed
+//!   point and stack copies of one vertex (a rocker arm's long CAD triangles under a
+//!   fandisk-shaped tool got 39, with 150 faces of zero area);
 //! * **placement** — the rest midpoint `m = (X_a + X_b)/2` is integrated through the steps
 //!   taken so far, which gives the bits of advecting `m` from the start (the refined mesh is
 //!   `Φ(rest)` vertex by vertex);

@@ -153,17 +153,49 @@ impl Refiner<'_> {
         t != NONE && self.topo.faces[h / 3][(h + 2) % 3] == self.topo.faces[t / 3][(t + 2) % 3]
     }
 
-    /// Whether `h` is the longest of the over-threshold edges of its triangle (ties
-    /// allowed). The longest edge of a triangle is usually over the threshold when any edge
-    /// is; where it is not (a long rest edge, whose threshold is higher), the longest edge
-    /// that is over is split, so the refinement cannot stall.
-    fn longest_in_face(&self, w: &[DVec3], h: usize) -> bool {
-        let f = h / 3;
-        let l = len2(&self.topo, w, h);
-        (0..3).all(|k| {
-            let e = 3 * f + k;
-            len2(&self.topo, w, e) <= l || !self.over(w, e)
-        })
+    /// The undirected edge of half-edge `h`: the smaller of `h` and its twin.
+    fn edge(&self, h: usize) -> usize {
+        let t = self.topo.twin[h];
+        if t == NONE { h } else { h.min(t) }
+    }
+
+    /// The longest edge of face `f` at positions `w`, as the half-edge in `f`: the largest
+    /// `(squared length, undirected edge)`, a strict order, so that a path of longest edges
+    /// cannot cycle.
+    fn longest_of(&self, w: &[DVec3], f: usize) -> usize {
+        let key = |h: usize| (len2(&self.topo, w, h), self.edge(h));
+        let mut best = 3 * f;
+        for h in 3 * f + 1..3 * f + 3 {
+            let (l, e) = key(h);
+            let (bl, be) = key(best);
+            if l > bl || (l == bl && e > be) {
+                best = h;
+            }
+        }
+        best
+    }
+
+    /// The terminal edge of the longest-edge propagation path from half-edge `h` (Rivara
+    /// 1997): from a face to the neighbour across its longest edge until that edge is the
+    /// longest of both its faces (or lies on the boundary). Bisecting terminal edges only
+    /// halves triangles across their longest edge, so no angle falls below half the
+    /// smallest angle of the triangles it came from and the refinement ends; splitting a
+    /// shorter edge instead can cycle towards a fixed point and stack copies of one vertex.
+    fn terminal(&self, w: &[DVec3], h: usize) -> usize {
+        let mut e = self.longest_of(w, h / 3);
+        // the (length, edge) key grows strictly along the path: at most one visit per face
+        for _ in 0..self.topo.faces.len() {
+            let t = self.topo.twin[e];
+            if t == NONE {
+                return e;
+            }
+            let next = self.longest_of(w, t / 3);
+            if next == t {
+                return self.edge(e);
+            }
+            e = next;
+        }
+        self.edge(e)
     }
 
     /// Room for the vertices, faces and half-edges `new` splits add (each adds a vertex,
@@ -190,17 +222,18 @@ impl Refiner<'_> {
                 self.bounded = true;
                 return Ok(());
             }
-            // terminal edges: the longest of both their triangles, longest first
-            let mut pick: Vec<(f64, usize)> = alloc::with_capacity(CALL, over.len())?;
-            pick.extend(
-                over.into_iter()
-                    .filter(|&h| {
-                        let t = self.topo.twin[h];
-                        self.longest_in_face(w, h) && (t == NONE || self.longest_in_face(w, t))
-                    })
-                    .map(|h| (len2(&self.topo, w, h), h)),
-            );
+            // the terminal edges of the over-threshold edges' longest-edge paths (from both
+            // faces of each), longest first, each once
+            let mut pick: Vec<(f64, usize)> = alloc::with_capacity(CALL, 2 * over.len())?;
+            for h in over {
+                let t = self.topo.twin[h];
+                for g in [Some(h), (t != NONE).then_some(t)].into_iter().flatten() {
+                    let e = self.terminal(w, g);
+                    pick.push((len2(&self.topo, w, e), e));
+                }
+            }
             pick.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+            pick.dedup_by_key(|p| p.1);
             let mut used = alloc::filled(CALL, self.topo.faces.len(), false)?;
             let mut chosen = alloc::with_capacity(CALL, room.min(pick.len()))?;
             for &(_, h) in &pick {
