@@ -47,9 +47,9 @@ def pressing(target, tool, frac=0.25, gap=0.005, depth=0.06, reach=0.1):
 def crossing_pairs(V, F):
     import igl.predicates
 
-    r = igl.predicates.find_self_intersections(np.ascontiguousarray(V, dtype=np.float64),
-                                               np.ascontiguousarray(F, dtype=np.int64))
-    return int(r[0])
+    _, pairs, _ = igl.predicates.find_self_intersections(
+        np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64))
+    return len(pairs)
 
 
 def assert_healthy(mesh, rep, rest_volume):
@@ -79,3 +79,53 @@ def test_rocker_arm_pressed_by_the_fandisk_keeps_healthy_faces():
     out, rep = spinal.deform(m, f, 1.0, check="intersections")
     change = assert_healthy(out, rep, m.volume)
     assert abs(change) <= 5e-4
+
+
+@shared("homer.obj", "fandisk.obj")
+def test_homer_pressed_by_the_fandisk_has_no_crossing_faces():
+    """Plain advection folds flat faces over their neighbours where the flow bends them by
+    ~45° across one edge (9 crossing pairs, unchanged by 4x the steps or one uniform
+    subdivision); the bending splits resolve the bend at Φ of rest midpoints."""
+    m = trimesh.load(MESHES / "homer.obj", force="mesh")
+    f = pressing(m, trimesh.load(MESHES / "fandisk.obj", force="mesh"))
+    V, F = np.asarray(m.vertices), np.asarray(m.faces)
+    assert crossing_pairs(spinal.advect(V, f, 1.0), F) > 0
+    out, rep = spinal.deform(m, f, 1.0, check="intersections")
+    change = assert_healthy(out, rep, m.volume)
+    assert abs(change) <= 5e-4
+    assert rep.vertices_added > 0 and rep.edges_over_threshold == 0
+
+
+def fan_capped_sphere():
+    """An icosphere(3) with its top (face centres above z = 0.8) cut off and closed by a
+    fan of long thin triangles from one vertex, the ring's mean, like a CAD cap."""
+    s = trimesh.creation.icosphere(3)
+    F = s.faces[s.vertices[s.faces][:, :, 2].mean(1) <= 0.8]
+    E = np.r_[F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]
+    have = set(map(tuple, E))
+    rim = [(a, b) for a, b in E if (b, a) not in have]
+    c = len(s.vertices)
+    V = np.r_[s.vertices, [[0, 0, s.vertices[[a for a, _ in rim], 2].mean()]]]
+    m = trimesh.Trimesh(V, np.r_[F, [[b, a, c] for a, b in rim]])
+    m.remove_unreferenced_vertices()
+    assert m.is_watertight and m.is_winding_consistent and m.volume > 0
+    return m
+
+
+def test_a_cone_pressed_into_a_fan_cap_is_refined_where_it_bends():
+    """A cone's tip pressed into the middle of a fan of long triangles bends them without
+    stretching an edge past the threshold: split by length alone the flat faces lose 1.4e-3
+    of the volume. The bending splits put new vertices at Φ of rest midpoints, and every
+    vertex stays the flow of its rest point (spinal.advect, bit for bit)."""
+    m = fan_capped_sphere()
+    cone = trimesh.creation.cone(0.3, 0.6, sections=24)
+    cone.apply_transform(trimesh.transformations.rotation_matrix(np.pi, [1, 0, 0]))
+    cone.apply_translation([0.1, 0.05, m.vertices[:, 2].max() + 0.01 - cone.vertices[:, 2].min()])
+    f = fields.mesh_curl(cone, velocity=[0, 0, -0.15], reach=0.25, resolution=48)
+    out, rep = spinal.deform(m, f, 1.0, check="intersections")
+    change = assert_healthy(out, rep, m.volume)
+    assert abs(change) <= 5e-4
+    assert rep.vertices_added > 0 and rep.edges_over_threshold == 0
+    assert rep.slip_vertices == 0 and rep.chord_vertices == 0
+    np.testing.assert_array_equal(spinal.advect(rep.rest_vertices, f, 1.0, rep.steps),
+                                  np.asarray(out.vertices))

@@ -349,6 +349,8 @@ class DeformReport:
     collapse_volume: float = 0.0
     degenerate_faces: int = 0
     crossing_pairs: int | None = None
+    bent_edges: int = 0
+    bend_vertices: int = 0
 
 class RefinementWarning(UserWarning): ...
 

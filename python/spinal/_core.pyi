@@ -396,7 +396,7 @@ def deform_mesh(
     npt.NDArray[np.int64],
     tuple[
         tuple[int, int, int, bool, float, float, int, int],
-        tuple[int, float, int, int, float],
+        tuple[int, float, int, int, float, int, int],
     ],
 ]: ...
 def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...

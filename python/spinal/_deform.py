@@ -99,8 +99,9 @@ class DeformReport:
         True when no edge is over the threshold at the end, no face has zero area and (with
         ``check="intersections"``) no faces cross. False when ``max_vertices`` or
         ``max_passes`` stopped the refinement with edges still too long, or the result has
-        faces of zero area or crossing faces (a :class:`RefinementWarning` was emitted). Across a tool's slip every edge can be
-        shortened (see ``torn_vertices``), so a refinement that no bound stops converges.
+        faces of zero area or crossing faces (a :class:`RefinementWarning` was emitted).
+        Across a tool's slip every edge can be shortened (see ``torn_vertices``), so a
+        refinement that no bound stops converges.
     edges_over_threshold : int
         Edges longer than the threshold at the end (0 when converged).
     max_vertices : int or None
@@ -162,6 +163,18 @@ class DeformReport:
     crossing_pairs : int or None
         With ``check="intersections"``: the pairs of faces of the result that cross
         (:meth:`spinal.Mesh.self_intersections`); else None (not looked for).
+    bent_edges : int
+        Edges the flow still bends at the end: ``Φ`` of the rest midpoint farther than 0.06
+        of the edge from its chord midpoint (the flat faces then miss the deformed surface
+        by about as much). After the integration such edges longer than a quarter of the
+        mean rest edge are split — the terminal edge of their longest-edge path, at ``Φ`` of
+        its rest midpoint — in rounds, until a round splits nothing, for at most
+        ``max_passes`` rounds and within ``max_vertices``. An edge stays bent
+        where its path ends at an edge whose ``Φ(rest midpoint)`` is torn away from the
+        chord (more than a quarter of the edge: a flow the steps do not resolve there), or
+        where a bound stopped the rounds. Not part of ``converged``.
+    bend_vertices : int
+        Vertices those bending splits added (part of ``vertices_added``).
     step_vertices : ndarray (steps,) int64 or None
         Vertex count after each integration step (the last one after the collapses).
     timings : dict or None
@@ -193,6 +206,8 @@ class DeformReport:
     collapse_volume: float = 0.0
     degenerate_faces: int = 0
     crossing_pairs: int | None = None
+    bent_edges: int = 0
+    bend_vertices: int = 0
 
     def __str__(self) -> str:
         s = (f"volume {self.rest_volume:.6g} → {self.volume:.6g} "
@@ -316,7 +331,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         if bar:
             bar[0].close()
     (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
-        (flips, flip_volume, collapses, moves, collapse_volume) = stats
+        (flips, flip_volume, collapses, moves, collapse_volume, bent, bent_added) = stats
     clock = time.perf_counter()
     e, (rest, vol) = _volumes(Fr, Vr, W)
     change = vol / rest - 1 if rest != 0 else float("nan")
@@ -358,7 +373,8 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     report = DeformReport(rest, vol, change, n, len(Vr) - len(V), passes, integ, mesh_err, Vr,
                           converged, over, max_vertices if refine is not None else None, torn,
                           counts, timings, on_slip, chord, flips, flip_volume, collapses,
-                          moves, collapse_volume, degenerate, crossing)
+                          moves, collapse_volume, degenerate, crossing, bent,
+                          bent_added)
     return out, report
 
 

@@ -107,7 +107,7 @@ type DeformArrays<'py> = (
     Bound<'py, PyArray1<i64>>,
     (
         (usize, usize, usize, bool, f64, f64, usize, usize),
-        (usize, f64, usize, usize, f64),
+        (usize, f64, usize, usize, f64, usize, usize),
     ),
 );
 
@@ -186,6 +186,8 @@ pub fn deform_mesh<'py>(
                 d.collapses,
                 d.moves,
                 d.collapse_volume,
+                d.bent,
+                d.bend_splits,
             ),
         ),
     ))

@@ -99,6 +99,10 @@
 //!   centroid (Hoppe et al., "Mesh optimization", SIGGRAPH 1993; see `refine/collapse.rs`). On the
 //!   10k-vertex drag the band's slivers go from 32% to 1.3%, the vertices from 2.34× to
 //!   1.90×, the volume change from −4.18e-5 to −4.22e-5;
+//! * **bending** — after the integration, edges the flow bends (`Φ` of the rest midpoint
+//!   farther than 0.06 of the edge from the chord) are split the same way, in rounds
+//!   (`refine/bend.rs`): lengths alone miss a press into a long face or a sharp bend that
+//!   folds flat faces over their neighbours;
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
 //!   When edges remain over the threshold at the end — a bound stopped the refinement — the
 //!   result says so (`bounded`, and the number of those edges).
@@ -108,7 +112,8 @@
 //! closed surface by `O(ℓ² |∇²v|)` per unit area: keeping every edge below `τ ℓ̄` keeps the
 //! mesh error at the resolution of the rest mesh.
 //!
-//! The splits (threshold, bisection, placement) are in `refine/split.rs`, the flips in
+//! The splits (threshold, bisection, placement) are in `refine/split.rs`, the bending splits
+//! in `refine/bend.rs`, the flips in
 //! `refine/flip.rs`, the collapses in `refine/collapse.rs`; this file holds the mesh, the
 //! refinement state and the integration loop ([`deform`]).
 
@@ -123,6 +128,7 @@ use super::slip::{self, Carry};
 use crate::alloc;
 use crate::error::{InputError, Result};
 
+mod bend;
 mod collapse;
 mod flip;
 mod split;
@@ -235,6 +241,10 @@ pub struct Deformed {
     pub slip_vertices: usize,
     /// Edges still over the threshold at the end (0 when the refinement converged).
     pub over_threshold: usize,
+    /// Edges still bent beyond the bending bound at the end (see `refine/bend.rs`).
+    pub bent: usize,
+    /// Vertices added by the bending splits after the integration (see `refine/bend.rs`).
+    pub bend_splits: usize,
     /// Whether edges remain over the threshold at the end (a bound, `max_vertices` or
     /// `max_passes`, stopped the refinement).
     pub bounded: bool,
@@ -382,6 +392,12 @@ struct Refiner<'a> {
     moves: usize,
     /// The input's vertex count (its vertices are never collapsed away).
     inputs: usize,
+    /// The vertices placed at a chord midpoint instead of `Φ(rest)`, in increasing order.
+    chords: Vec<usize>,
+    /// Edges still bent beyond [`bend::BEND`] after the bending splits.
+    bent: usize,
+    /// Vertices added by the bending splits.
+    bend_splits: usize,
 }
 
 /// A point of the generalized rest mesh (see the module docs): a material rest point, or a
@@ -483,6 +499,9 @@ pub fn deform(
         collapse_volume: 0.0,
         moves: 0,
         inputs: rest.len(),
+        chords: Vec::new(),
+        bent: 0,
+        bend_splits: 0,
     };
     r.carry = alloc::collect(CALL, rest.iter().map(|&x| r.carry_of(Gen::Material(x))))?;
     let mut w = alloc::copied(CALL, rest)?;
@@ -509,6 +528,7 @@ pub fn deform(
     }
     if refinement.is_some() {
         let clock = Instant::now();
+        r.split_bends(&mut w, done)?;
         // the strip goes on shearing after a step's flips: a last round over all of it
         let mut touched = alloc::with_capacity(CALL, r.topo.faces.len())?;
         touched.extend((0..r.topo.faces.len()).filter(|&f| {
@@ -535,6 +555,8 @@ pub fn deform(
     // not converged whenever edges remain over the threshold: a bound stopped the refinement
     // (every edge, torn ones too, is shortened by its split; see the module docs)
     out.bounded = out.over_threshold > 0;
+    out.bent = r.bent;
+    out.bend_splits = r.bend_splits;
     out.passes = r.passes;
     out.torn = r.torn;
     out.fallback = r.fallback;

@@ -11,7 +11,7 @@ use crate::error::Result;
 
 /// A placement farther than this fraction of its edge from the chord midpoint marks the edge
 /// as torn by the flow (see the module docs).
-const TORN: f64 = 0.25;
+pub(super) const TORN: f64 = 0.25;
 
 /// A torn edge's halfway point closer than this fraction of the edge to a third vertex of
 /// its triangles lands on that vertex (see the module docs: corners).
@@ -154,7 +154,7 @@ impl Refiner<'_> {
     }
 
     /// The undirected edge of half-edge `h`: the smaller of `h` and its twin.
-    fn edge(&self, h: usize) -> usize {
+    pub(super) fn edge(&self, h: usize) -> usize {
         let t = self.topo.twin[h];
         if t == NONE { h } else { h.min(t) }
     }
@@ -214,54 +214,69 @@ impl Refiner<'_> {
     pub(super) fn refine(&mut self, w: &mut Vec<DVec3>, done: usize, t: f64) -> Result<()> {
         for _ in 0..self.opts.max_passes {
             let over = self.over_edges(w)?;
-            if over.is_empty() {
+            if over.is_empty() || self.split_terminals(w, &over, done, t, true)? == 0 {
                 return Ok(());
             }
-            let room = self.opts.max_vertices.saturating_sub(w.len());
-            if room == 0 {
-                self.bounded = true;
-                return Ok(());
-            }
-            // the terminal edges of the over-threshold edges' longest-edge paths (from both
-            // faces of each), longest first, each once
-            let mut pick: Vec<(f64, usize)> = alloc::with_capacity(CALL, 2 * over.len())?;
-            for h in over {
-                let t = self.topo.twin[h];
-                for g in [Some(h), (t != NONE).then_some(t)].into_iter().flatten() {
-                    let e = self.terminal(w, g);
-                    pick.push((len2(&self.topo, w, e), e));
-                }
-            }
-            pick.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
-            pick.dedup_by_key(|p| p.1);
-            let mut used = alloc::filled(CALL, self.topo.faces.len(), false)?;
-            let mut chosen = alloc::with_capacity(CALL, room.min(pick.len()))?;
-            for &(_, h) in &pick {
-                if chosen.len() == room {
-                    self.bounded = true;
-                    break;
-                }
-                let t = self.topo.twin[h];
-                if used[h / 3] || (t != NONE && used[t / 3]) || self.folded(h) {
-                    continue;
-                }
-                used[h / 3] = true;
-                if t != NONE {
-                    used[t / 3] = true;
-                }
-                chosen.push(h);
-            }
-            if chosen.is_empty() {
-                return Ok(());
-            }
-            self.reserve_splits(w, chosen.len())?;
-            self.place_and_split(w, &chosen, done, t);
-            self.passes += 1;
         }
         if !self.over_edges(w)?.is_empty() {
             self.bounded = true;
         }
         Ok(())
+    }
+
+    /// One pass of splits for the edges `triggers` (half-edges): the terminal edges of
+    /// their longest-edge paths (from both faces of each), longest first, each once, as many
+    /// as share no triangle and `max_vertices` leaves room for (`bounded` is set when it
+    /// leaves too little). With `chords` false, an edge of one side's material whose
+    /// `Φ(rest midpoint)` is torn away from its chord is left unsplit instead of split at the
+    /// chord midpoint. Returns how many were split.
+    pub(super) fn split_terminals(
+        &mut self,
+        w: &mut Vec<DVec3>,
+        triggers: &[usize],
+        done: usize,
+        t: f64,
+        chords: bool,
+    ) -> Result<usize> {
+        let room = self.opts.max_vertices.saturating_sub(w.len());
+        if room == 0 {
+            self.bounded = true;
+            return Ok(0);
+        }
+        let mut pick: Vec<(f64, usize)> = alloc::with_capacity(CALL, 2 * triggers.len())?;
+        for &h in triggers {
+            let t = self.topo.twin[h];
+            for g in [Some(h), (t != NONE).then_some(t)].into_iter().flatten() {
+                let e = self.terminal(w, g);
+                pick.push((len2(&self.topo, w, e), e));
+            }
+        }
+        pick.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        pick.dedup_by_key(|p| p.1);
+        let mut used = alloc::filled(CALL, self.topo.faces.len(), false)?;
+        let mut chosen = alloc::with_capacity(CALL, room.min(pick.len()))?;
+        for &(_, h) in &pick {
+            if chosen.len() == room {
+                self.bounded = true;
+                break;
+            }
+            let t = self.topo.twin[h];
+            if used[h / 3] || (t != NONE && used[t / 3]) || self.folded(h) {
+                continue;
+            }
+            used[h / 3] = true;
+            if t != NONE {
+                used[t / 3] = true;
+            }
+            chosen.push(h);
+        }
+        let mut split = 0;
+        if !chosen.is_empty() {
+            self.reserve_splits(w, chosen.len())?;
+            split = self.place_and_split(w, &chosen, done, t, chords);
+            self.passes += usize::from(split > 0);
+        }
+        Ok(split)
     }
 
     /// Whether splitting half-edge `h` at position `p` (rest point `x`) would repeat an
@@ -301,7 +316,7 @@ impl Refiner<'_> {
 
     /// The deformed positions of generalized rest points after `done` steps: `Φ` of the
     /// material ones, `Ψ` of the slip ones.
-    fn image(&self, gens: &[Gen], done: usize) -> Vec<DVec3> {
+    pub(super) fn image(&self, gens: &[Gen], done: usize) -> Vec<DVec3> {
         let mut out: Vec<DVec3> = gens.iter().map(|g| g.rest()).collect();
         let carry: Vec<Carry> = gens.iter().map(|&g| self.carry_of(g)).collect();
         slip::flow(self.field, &mut out, &carry, self.runs, done);
@@ -312,7 +327,17 @@ impl Refiner<'_> {
     /// one side gets `Φ(rest midpoint)` (the chord midpoint where that is torn away); an edge
     /// along a slip surface gets the point halfway along its generalized path, measured by
     /// the chords between the images of the path's points.
-    fn place_and_split(&mut self, w: &mut Vec<DVec3>, chosen: &[usize], done: usize, t: f64) {
+    /// Returns how many were split (all of `chosen` unless `chords` is false: see
+    /// [`Refiner::split_terminals`]).
+    fn place_and_split(
+        &mut self,
+        w: &mut Vec<DVec3>,
+        chosen: &[usize],
+        done: usize,
+        t: f64,
+        chords: bool,
+    ) -> usize {
+        let mut split = 0;
         let paths: Vec<Option<Vec<Gen>>> = chosen
             .iter()
             .map(|&h| {
@@ -401,8 +426,12 @@ impl Refiner<'_> {
                 Gen::Slip(_, s) => (p, Carry::Surface(s)),
                 // `!(d <= ...)` also catches a NaN placement
                 Gen::Material(_) if path.is_none() && !(p.distance(chord) <= TORN * l) => {
+                    if !chords {
+                        continue;
+                    }
                     self.fallback += 1;
                     self.torn += 1;
+                    self.chords.push(w.len());
                     (self.on_slip(chord, l, t), Carry::Free)
                 }
                 Gen::Material(x) => (p, self.carry_of(Gen::Material(x))),
@@ -421,7 +450,9 @@ impl Refiner<'_> {
                 self.touched.push(tw / 3);
             }
             self.touched.extend(n..self.topo.faces.len());
+            split += 1;
         }
+        split
     }
 }
 

@@ -324,6 +324,9 @@ fn over_edges_of_the_drag() {
         collapse_volume: 0.0,
         moves: 0,
         inputs: v.len(),
+        chords: Vec::new(),
+        bent: 0,
+        bend_splits: 0,
     };
     r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
     let mut w = v.clone();

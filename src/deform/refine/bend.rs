@@ -1,0 +1,143 @@
+//! Splits where the flow bends an edge, not only where it stretches it.
+//!
+//! A flat face between vertices that follow the flow `Φ` exactly misses the deformed surface
+//! `Φ(rest face)` by about the deviation of `Φ` from its chords: for an edge `(a, b)` with
+//! rest midpoint `m`,
+//!
+//! `δ = |Φ(m) − (Φ(a) + Φ(b))/2| ≈ ℓ² |∂²Φ/∂s²| / 8`,
+//!
+//! `ℓ` the edge's rest length and `s` arc length along it. Lengths alone do not see it: a
+//! tool pressing into the middle of a long flat face, a shear or a twist bends faces
+//! without stretching their edges much, and the flat faces then lose volume (a long
+//! triangle fan pressed by a cube lost 0.9 % of a sphere's volume with no edge over the
+//! threshold) or fold over their neighbours. Zheng's thesis (§13.2) places a new vertex at
+//! `Φ(m)` so that the refined mesh follows the curved image; the same deviation, relative to
+//! the edge, measures where the mesh needs it:
+//!
+//! * after the integration, every edge of one side's material (no slip surface between its
+//!   ends, both ends at `Φ(rest)`) longer than [`SHORTEST`] × `ℓ̄` whose `δ` exceeds
+//!   [`BEND`] × `|Φ(a) − Φ(b)|` is refined like an edge over the length threshold: the
+//!   terminal edge of its longest-edge propagation path (Rivara 1997) is split at `Φ` of its
+//!   rest midpoint. A new vertex is `Φ(rest)` whether it is made during the integration or
+//!   after it, so splitting afterwards gives the vertices that splitting during it would;
+//! * the edges of the faces a round split, and the bent edges it left, are tested in the
+//!   next, until a round splits nothing, for at most `max_passes` rounds (and within
+//!   `max_vertices`). A bent edge whose path ends at an
+//!   edge whose `Φ(rest midpoint)` is torn away from the chord (a flow the steps do not
+//!   resolve) is left unsplit: the chord midpoint would resolve nothing. Halving an edge divides its `δ/ℓ` by about two, so
+//!   a smooth flow is resolved in a few rounds; the edges still bent at the end are counted
+//!   ([`super::Deformed::bent`]).
+
+use glam::DVec3;
+
+use super::split::TORN;
+use super::{CALL, Gen, Refiner};
+use crate::alloc;
+use crate::deform::slip::Carry;
+use crate::error::Result;
+
+/// An edge is bent when `Φ` of its rest midpoint lies farther than this fraction of the edge
+/// from the chord midpoint: the flat face then misses the surface by about `BEND · ℓ`.
+pub(super) const BEND: f64 = 0.06;
+
+/// Edges shorter than this fraction of the mean rest edge `ℓ̄` are not split for bending.
+const SHORTEST: f64 = 0.25;
+
+impl Refiner<'_> {
+    /// Whether vertex `v` sits at `Φ` of its rest point (material, not a chord midpoint).
+    fn at_flow(&self, v: usize) -> bool {
+        !matches!(self.carry[v], Carry::Surface(_)) && self.chords.binary_search(&v).is_err()
+    }
+
+    /// The half-edges (one per undirected edge) among the edges of `faces` that are bent
+    /// at positions `w` after `done` steps.
+    fn bent_edges(&self, w: &[DVec3], faces: &[usize], done: usize) -> Result<Vec<usize>> {
+        let shortest2 = SHORTEST * SHORTEST * self.mean2;
+        let mut cand = alloc::with_capacity(CALL, 3 * faces.len())?;
+        cand.extend(
+            faces
+                .iter()
+                .flat_map(|&f| 3 * f..3 * f + 3)
+                .filter_map(|h| {
+                    let e = self.edge(h);
+                    let (a, b) = self.topo.ends(e);
+                    (self.at_flow(a)
+                        && self.at_flow(b)
+                        && w[a].distance_squared(w[b]) > shortest2
+                        && self.path(a, b).is_none())
+                    .then_some(e)
+                }),
+        );
+        cand.sort_unstable();
+        cand.dedup();
+        let mids: Vec<Gen> = alloc::collect(
+            CALL,
+            cand.iter().map(|&e| {
+                let (a, b) = self.topo.ends(e);
+                Gen::Material(0.5 * (self.rest[a] + self.rest[b]))
+            }),
+        )?;
+        // a rest midpoint across a curved slip surface from its edge's ends (both on one
+        // side) is not tested: the edge is not the image of one side's material
+        let keep: Vec<bool> = alloc::collect(
+            CALL,
+            mids.iter()
+                .zip(&cand)
+                .map(|(&m, &e)| self.carry_of(m) == self.carry[self.topo.ends(e).0]),
+        )?;
+        let at = self.image(&mids, done);
+        let mut bent = alloc::with_capacity(CALL, cand.len())?;
+        bent.extend(cand.iter().zip(at).zip(keep).filter_map(|((&e, p), keep)| {
+            if !keep {
+                return None;
+            }
+            let (a, b) = self.topo.ends(e);
+            let l2 = w[a].distance_squared(w[b]);
+            // bent, but not torn away from the chord (a flow the steps do not resolve, whose
+            // split would fall back to the chord midpoint and resolve nothing)
+            let d2 = p.distance_squared(0.5 * (w[a] + w[b]));
+            (d2 > BEND * BEND * l2 && d2 <= TORN * TORN * l2).then_some(e)
+        }));
+        Ok(bent)
+    }
+
+    /// The bending splits after the integration (`done` steps; see the module docs), in
+    /// at most `max_passes` rounds.
+    pub(super) fn split_bends(&mut self, w: &mut Vec<DVec3>, done: usize) -> Result<()> {
+        let end = self
+            .runs
+            .last()
+            .map_or(self.start, |l| l.t0 + l.h * l.count as f64);
+        let mut faces: Vec<usize> = alloc::collect(CALL, 0..self.topo.faces.len())?;
+        for _ in 0..self.opts.max_passes {
+            let bent = self.bent_edges(w, &faces, done)?;
+            self.bent = bent.len();
+            if bent.is_empty() {
+                return Ok(());
+            }
+            // the faces of the bent edges keep their indices through the splits: those not
+            // split this round are tested again with the faces the splits made or changed
+            faces.clear();
+            alloc::reserve(CALL, &mut faces, 2 * bent.len())?;
+            for &h in &bent {
+                faces.push(h / 3);
+                let t = self.topo.twin[h];
+                if t != super::NONE {
+                    faces.push(t / 3);
+                }
+            }
+            let from = self.touched.len();
+            let split = self.split_terminals(w, &bent, done, end, false)?;
+            if split == 0 {
+                return Ok(());
+            }
+            self.bend_splits += split;
+            alloc::reserve(CALL, &mut faces, self.touched.len() - from)?;
+            faces.extend_from_slice(&self.touched[from..]);
+            faces.sort_unstable();
+            faces.dedup();
+        }
+        self.bent = self.bent_edges(w, &faces, done)?.len();
+        Ok(())
+    }
+}
