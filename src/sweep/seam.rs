@@ -133,3 +133,52 @@ pub fn no_corners<C>(corners: &[C]) -> Result<()> {
         )),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    fn polygon(m: usize, a: f64, b: f64, off: f64) -> Profile {
+        let pts: Vec<DVec2> = (0..m)
+            .map(|j| {
+                let u = std::f64::consts::TAU * j as f64 / m as f64;
+                DVec2::new(off + a * u.cos(), b * u.sin())
+            })
+            .collect();
+        Profile::new(&pts, true).expect("a simple polygon")
+    }
+
+    #[test]
+    fn half_turns_shift_symmetric_profiles_by_half_their_vertices() {
+        let p = polygon(12, 1.0, 0.4, 0.0);
+        assert_eq!(shift(&p, true, 0.0).ok(), Some(0));
+        assert_eq!(shift(&p, true, 2.0).ok(), Some(0));
+        assert_eq!(shift(&p, true, 0.5).ok(), Some(6));
+        assert_eq!(shift(&p, true, -1.5).ok(), Some(6));
+        let arg = |r: Result<usize>| r.err().map(|e| e.arg);
+        assert_eq!(arg(shift(&p, true, 0.25)), Some("turns"));
+        assert_eq!(arg(shift(&p, false, 0.5)), Some("turns"));
+        assert_eq!(
+            arg(shift(&polygon(12, 1.0, 0.4, 0.1), true, 0.5)),
+            Some("profile")
+        );
+        assert_eq!(
+            arg(shift(&polygon(11, 1.0, 0.4, 0.0), true, 0.5)),
+            Some("profile")
+        );
+    }
+
+    #[test]
+    fn given_frames_must_close_up_to_a_half_turn() {
+        // frames about e_z at two rows: r = e_x, then r turned by `a`
+        let frame = |a: f64| {
+            let (s, c) = a.sin_cos();
+            [c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0]
+        };
+        assert!(check_given(&[frame(0.0), frame(3.0)], 2).is_ok());
+        assert!(check_given(&[frame(0.0), frame(-2.0)], 2).is_ok());
+        let e = check_given(&[frame(0.0), frame(0.3)], 2).err();
+        assert_eq!(e.map(|e| e.arg), Some("frames"));
+    }
+}
