@@ -239,3 +239,18 @@ def test_given_frames_that_close_up_to_a_half_turn():
                      turns=0.5)
     with pytest.raises(TypeError, match="turns: with frames= only a half number"):
         spinal.sweep(x, ellipse, frames=f, closed=True, turns=1)
+
+
+def test_bundle_and_float32_sweeps_with_a_half_turn():
+    a, b = 1.0, 0.5
+    rect = np.array([[a, b], [-a, b], [-a, -b], [a, -b]])
+    one = spinal.sweep(circle(64), rect, closed=True, turns=0.5)
+    both = spinal.sweep(np.r_[circle(64), circle(64) + [0.0, 0.0, 5.0]], rect, closed=True,
+                        turns=0.5, lengths=[64, 64])
+    mesh = trimesh.Trimesh(both.vertices, both.faces, process=False)
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    assert np.isclose(mesh.volume, 2 * one.volume, rtol=1e-12)
+    assert np.array_equal(both.faces[: len(one.faces)], one.faces)
+    single = spinal.sweep(circle(64), rect, closed=True, turns=0.5, dtype=np.float32)
+    assert np.array_equal(single.faces, one.faces)
+    assert np.abs(single.vertices - one.vertices).max() < 1e-6
