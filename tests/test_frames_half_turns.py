@@ -254,3 +254,20 @@ def test_bundle_and_float32_sweeps_with_a_half_turn():
     single = spinal.sweep(circle(64), rect, closed=True, turns=0.5, dtype=np.float32)
     assert np.array_equal(single.faces, one.faces)
     assert np.abs(single.vertices - one.vertices).max() < 1e-6
+
+
+def test_quaternion_frames_take_half_turns_like_frames():
+    from scipy.spatial.transform import Rotation
+
+    from spinal import quaternions
+
+    x = torus_knot(300)
+    q = quaternions.quaternion_frames(x, closed=True, turns=0.5)
+    # an independent recurrence: the rotation-method frames with the same spread
+    f = spinal.frames(x, closed=True, method="rotation", turns=0.5)
+    assert np.abs(Rotation.from_quat(q).as_matrix() - f).max() < 1e-12
+    assert f[-1][:, 0] @ f[0][:, 0] < -0.9
+    with pytest.raises(ValueError, match="turns: a half number of turns"):
+        quaternions.quaternion_frames(x, turns=0.5)
+    with pytest.raises(ValueError, match="turns: expected a whole or half number"):
+        quaternions.quaternion_frames(x, closed=True, turns=0.3)

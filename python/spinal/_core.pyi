@@ -156,7 +156,7 @@ def quat_transport(
     tangents: npt.NDArray[np.float64] | None,
     initial: npt.NDArray[np.float64] | None,
     closed: bool,
-    turns: int,
+    turns: float,
     closing_row: bool,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 def walk_mesh_many(
