@@ -262,7 +262,8 @@ def frames(
         first frame again). Tangents are estimated periodically, the closing segment is
         included, and the RMF's closing angle ``α`` (see :func:`closing_angle`) plus
         ``2π·turns`` is distributed linearly in arc length, ``α s/L``, so the frames meet
-        across the seam (up to a half turn for half-integer ``turns``). Linear in arc length is the minimiser of ``∫(κ² + α′²) ds`` (Wang et
+        across the seam (up to a half turn for half-integer ``turns``; a repeated first
+        point still gets the first frame). Linear in arc length is the minimiser of ``∫(κ² + α′²) ds`` (Wang et
         al. §6.3).
     end : array_like (3,) or (3, 3), optional
         A prescribed reference vector (or frame) at the last sample; the angle from the RMF to

@@ -149,7 +149,8 @@ def sweep(
         towards s).
     closed : bool
         The spine is a loop (a repeated first point at the end is accepted): the last ring
-        is joined to the first; no caps.
+        is joined to the first (column to column, or with the half-turn shift of
+        ``turns``); no caps.
     caps : bool
         Close the ends of an open spine with the triangulated profile (on its own
         vertices, so non-convex profiles work; O(m log m) in the profile's vertices); the
