@@ -309,6 +309,7 @@ mod tests {
             miter_limit: 4.0,
             split_seams: true,
             join: crate::sweep::Join::Round,
+            turns: 0.0,
         };
         let profile = [DVec2::X, DVec2::Y, -DVec2::X, -DVec2::Y];
         // near unit size, and far from it (the set-up scales the input first)
@@ -414,6 +415,7 @@ mod tests {
             miter_limit: 4.0,
             split_seams: true,
             join: crate::sweep::Join::Round,
+            turns: 0.0,
         };
         let spine = Spine {
             points: &x,

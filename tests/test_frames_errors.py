@@ -95,8 +95,10 @@ def test_bad_options():
         spinal.frames(GOOD, method="rk4_phi")
     with pytest.raises(TypeError, match="closed: expected True or False"):
         spinal.frames(GOOD, closed=1)
-    with pytest.raises(TypeError, match="turns: expected an integer"):
-        spinal.frames(GOOD, closed=True, turns=1.5)
+    with pytest.raises(ValueError, match="turns: expected a whole or half number"):
+        spinal.frames(GOOD, closed=True, turns=1.25)
+    with pytest.raises(TypeError, match="turns: expected a whole or half number"):
+        spinal.frames(GOOD, closed=True, turns="1")
     with pytest.raises(ValueError, match="end: cannot be combined with closed=True"):
         spinal.frames(GOOD, closed=True, end=[1.0, 0, 0])
     with pytest.raises(ValueError, match="initial: is not used by method='frenet'"):

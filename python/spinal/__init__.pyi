@@ -82,7 +82,7 @@ def frames(
     initial: _Array | None = None,
     closed: bool = False,
     end: _Array | None = None,
-    turns: int = 0,
+    turns: float = 0,
     reflection: _Reflection = "chord",
     u: int | _Array | None = None,
     lengths: _Ints | None = None,
@@ -105,7 +105,7 @@ def frames_in_time(
     method: _Method = "double_reflection",
     initial: _Array | None = None,
     closed: bool = False,
-    turns: int = 0,
+    turns: float = 0,
     reflection: _Reflection = "chord",
     previous: _Array | None = None,
     previous_twist: bool = True,
@@ -239,6 +239,7 @@ def sweep(
     on_invalid: Literal["raise", "skip"] = "raise",
     join: Literal["round", "bevel", "miter"] = "round",
     progress: _Progress = False,
+    turns: float = 0,
 ) -> Mesh: ...
 def tube(
     points: _Array | _Curves,
@@ -263,6 +264,7 @@ def tube(
     on_invalid: Literal["raise", "skip"] = "raise",
     join: Literal["round", "bevel", "miter"] = "round",
     progress: _Progress = False,
+    turns: float = 0,
 ) -> Mesh: ...
 
 # ---- profile (moulding) surfaces -----------------------------------------------------------

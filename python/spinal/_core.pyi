@@ -20,7 +20,7 @@ def frames_sampled(
     initial_frames: npt.NDArray[np.float64] | None,
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
-    turns: int,
+    turns: float,
     points_arg: str = "points",
     progress: Callable[[int, int], object] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
@@ -35,7 +35,7 @@ def frames_analytic(
     initial_frames: npt.NDArray[np.float64] | None,
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
-    turns: int,
+    turns: float,
     d3: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 class RepeatedPointsError(ValueError): ...
@@ -66,7 +66,7 @@ def frames_steered(
     initial_frames: npt.NDArray[np.float64] | None,
     end_vectors: npt.NDArray[np.float64] | None,
     end_frames: npt.NDArray[np.float64] | None,
-    turns: npt.NDArray[np.int64],
+    turns: npt.NDArray[np.float64],
     con_curves: npt.NDArray[np.int64],
     con_rows: npt.NDArray[np.int64],
     con_vectors: npt.NDArray[np.float64],
@@ -91,7 +91,7 @@ def frames_in_time(
     closed: bool,
     initial_vectors: npt.NDArray[np.float64] | None,
     initial_frames: npt.NDArray[np.float64] | None,
-    turns: int,
+    turns: float,
     previous: npt.NDArray[np.float64] | None,
     progress: Callable[[int, int], object] | None = None,
 ) -> npt.NDArray[np.float64]: ...
@@ -115,6 +115,7 @@ def sweep_mesh(
     tangents: npt.NDArray[np.float64] | None = None,
     join: str = "round",
     progress: Callable[[int, int], object] | None = None,
+    turns: float = 0.0,
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],
@@ -155,7 +156,7 @@ def quat_transport(
     tangents: npt.NDArray[np.float64] | None,
     initial: npt.NDArray[np.float64] | None,
     closed: bool,
-    turns: int,
+    turns: float,
     closing_row: bool,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 def walk_mesh_many(

@@ -21,6 +21,7 @@ from ._validate import (
     as_offsets,
     as_points,
     as_real,
+    as_turns,
     is_curve_list,
 )
 from .curves import Curve
@@ -121,7 +122,7 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
-    turns = as_int(turns, "turns")
+    turns = as_turns(turns, "turns")
     if isinstance(points, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (its exact tangents are used)")
@@ -177,7 +178,7 @@ def frames(
     initial=None,
     closed: bool = False,
     end=None,
-    turns: int = 0,
+    turns: float = 0,
     reflection: str = "chord",
     u=None,
     lengths=None,
@@ -261,14 +262,28 @@ def frames(
         first frame again). Tangents are estimated periodically, the closing segment is
         included, and the RMF's closing angle ``α`` (see :func:`closing_angle`) plus
         ``2π·turns`` is distributed linearly in arc length, ``α s/L``, so the frames meet
-        across the seam. Linear in arc length is the minimiser of ``∫(κ² + α′²) ds`` (Wang et
+        across the seam (up to a half turn for half-integer ``turns``; a repeated first
+        point still gets the first frame). Linear in arc length is the minimiser of ``∫(κ² + α′²) ds`` (Wang et
         al. §6.3).
     end : array_like (3,) or (3, 3), optional
         A prescribed reference vector (or frame) at the last sample; the angle from the RMF to
         it (in (−π, π], plus ``2π·turns``) is distributed linearly in arc length, so the last
         frame meets it exactly.
-    turns : int
-        Extra full turns added to the closing or end twist (``k`` in ``α + 2πk``).
+    turns : int or float
+        Extra turns added to the closing or end twist (``k`` in ``α + 2πk``, radians). A
+        whole number (an int, or a float such as ``2.0``: the int's frames bit for bit), or,
+        for the closing twist of a closed curve, a half number ``k = j + ½`` (``0.5``,
+        ``-0.5``, ``1.5``): the total spread is then ``α + 2πk = α + π + 2πj``, so the last
+        frame carried across the closing segment is the first one turned by π about the
+        tangent (``r → −r``, ``s → −s``): the frames close up to a half turn. A profile that
+        maps onto itself under that half turn still closes (``spinal.sweep(...,
+        closed=True, turns=0.5)``; Ma 1996, Fig. G.1c, adds multiples of π to the twist of a
+        closed ribbon for this reason; Zheng's eq. 7.3 takes ``2kπ``, whole turns).
+        Half numbers work with ``twist_rule`` (the closing interval), ``guide`` (the guide
+        followed up to the half turn across the seam) and ``previous`` (also in
+        :func:`frames_in_time`); with ``end`` or ``constraints`` (met exactly, so whole turns
+        between them) and per-interval counts they raise ValueError naming ``turns``, as do
+        other fractions.
     reflection : {"chord", "tangents"}
         ``"tangents"``: double reflection with the chords replaced by the 4th-order quadrature
         ``13(t_i + t_{i+1}) − (t_{i−1} + t_{i+2})`` of the tangents (TOG §6.2; Adams–Moulton
@@ -425,7 +440,7 @@ def frames(
         raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
     if (constraints is not None or guide is not None or previous is not None
-            or twist_rule != "arc_length" or not isinstance(turns, (int, np.integer))):
+            or twist_rule != "arc_length" or isinstance(turns, (list, tuple, np.ndarray))):
         out = _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
                        lengths, offsets, constraints, twist_rule, guide, guide_weight,
                        guide_tolerance, previous, previous_twist, guide_sign)
@@ -745,7 +760,7 @@ def frames_in_time(
     method: str = "double_reflection",
     initial=None,
     closed: bool = False,
-    turns: int = 0,
+    turns: float = 0,
     reflection: str = "chord",
     previous=None,
     previous_twist: bool = True,
@@ -836,7 +851,7 @@ def frames_in_time(
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
-    turns = as_int(turns, "turns")
+    turns = as_turns(turns, "turns")
     p, tg, steps, n = _time_steps(points_t, tangents_t)
     iv, if_ = _orientation(initial, "initial", 1, False)
     prev = previous_frames(previous, n, "the frames of the step before")

@@ -17,6 +17,7 @@ from ._validate import (
     as_frames,
     as_int,
     as_points,
+    as_turns,
     as_vector,
 )
 
@@ -137,7 +138,7 @@ def quaternion_frames(
     method: str = "transport",
     initial=None,
     closed: bool = False,
-    turns: int = 0,
+    turns: float = 0,
     scalar_first: bool = False,
 ) -> np.ndarray:
     r"""Frames along a sampled curve as a sign-continuous quaternion curve ``(n, 4)``.
@@ -151,7 +152,9 @@ def quaternion_frames(
       2π in the limit) plus ``2π·turns`` is spread linearly in arc length by body
       rotations about the tangent, ``Q_i ← Q_i (cos(a_i/2), 0, 0, sin(a_i/2))`` with
       ``a_i = α L_i/L``, so the frames close. (Ma's text applies the mismatch angle with the
-      opposite sign, which doubles it.)
+      opposite sign, which doubles it.) A half number of ``turns`` (``0.5``, ``-1.5``;
+      closed curves only) leaves them closing up to a half turn about the tangent, as in
+      :func:`spinal.frames`.
     * ``method="frenet"``: the Frenet frame ``(N, B, T)`` of ``spinal.frames(points,
       method="frenet")`` (with its continuous fill at inflections and straight runs) as
       quaternions.
@@ -167,7 +170,7 @@ def quaternion_frames(
     method = as_choice(method, "method", ("transport", "frenet"))
     closed = as_bool(closed, "closed")
     sf = as_bool(scalar_first, "scalar_first")
-    turns = as_int(turns, "turns")
+    turns = as_turns(turns, "turns")
     pts = as_points(points, "points")
     if method == "frenet":  # the core refuses initial and turns for the Frenet frame
         f = frames(pts, tangents, method="frenet", closed=closed, initial=initial, turns=turns)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ._validate import as_choice, as_float_array, as_int, as_real
+from ._validate import as_choice, as_float_array, as_real, as_turns
 
 TWIST_RULES = ("arc_length", "min_angular_speed")
 
@@ -112,8 +112,9 @@ def _turns(turns: Any) -> np.ndarray:
             raise TypeError("turns: expected an integer or a 1-D sequence of integers (one per "
                             "twist interval)")
         _fits_int64(a, "turns", "")
-        return np.ascontiguousarray(a, dtype=np.int64)
-    return np.array([as_int(turns, "turns")], dtype=np.int64)
+        return np.ascontiguousarray(a, dtype=np.float64)
+    # one count: whole, or half (the closing twist of a closed curve; the core checks where)
+    return np.array([as_turns(turns, "turns")], dtype=np.float64)
 
 
 def _fits_int64(a: np.ndarray, name: str, context: str) -> None:

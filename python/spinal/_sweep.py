@@ -22,6 +22,7 @@ from ._validate import (
     as_per_row,
     as_points,
     as_real,
+    as_turns,
 )
 
 __all__ = ["sweep", "tube"]
@@ -97,6 +98,7 @@ def sweep(
     on_invalid: str = "raise",
     join: str = "round",
     progress=False,
+    turns: float = 0,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -147,7 +149,8 @@ def sweep(
         towards s).
     closed : bool
         The spine is a loop (a repeated first point at the end is accepted): the last ring
-        is joined to the first; no caps.
+        is joined to the first (column to column, or with the half-turn shift of
+        ``turns``); no caps.
     caps : bool
         Close the ends of an open spine with the triangulated profile (on its own
         vertices, so non-convex profiles work; O(m log m) in the profile's vertices); the
@@ -208,6 +211,30 @@ def sweep(
         tubes), one flat band (``"bevel"``), or one ring in the bisector plane (``"miter"``,
         the exact mitre; a bevel where it would exceed ``miter_limit``). Smooth, well
         sampled spines get no joins, whichever is chosen.
+    turns : int or float
+        With ``closed=True``: extra turns of the default frames, those of
+        ``spinal.frames(points, closed=True, turns=turns)`` (the closing twist ``α +
+        2π·turns`` spread along the loop). A half number (``0.5``, ``-0.5``, ``1.5``, …)
+        leaves the frames closing up to a half turn about the tangent, ``(r, s) → (−r, −s)``,
+        which takes profile vertex ``p_j`` to ``−p_j``: the sweep still closes when the
+        profile maps onto itself under that half turn, ``p_{j+m/2} = −p_j`` (a closed profile
+        of an even number ``m`` of vertices, point symmetric about the spine to 1e-9 of its
+        reach: an ellipse or rectangle centred on it, a tube of an even number of sides).
+        The seam then joins column ``j`` of the last ring to column ``j + m/2 (mod m)`` of
+        the first, every vertex shared: the mesh stays watertight and wound outwards (a
+        torus; an open profile would close into a Möbius band and is refused), and the
+        normals and the fold-over test see the ring across the seam turned by π, so they
+        are those of the surface there as anywhere. ``u`` of ``uv`` jumps at the seam as it
+        always does; with ``split_seams`` the copy of the first ring at ``u = L`` is that
+        ring turned by π (its column ``j`` on the first ring's column ``j + m/2``), so
+        every face's ``uv`` is continuous. A profile without the symmetry raises ValueError
+        naming ``profile`` (a tube of an odd number of sides: ``turns``), as does a spine
+        with corner joins (their rings are laid out column by column across the seam;
+        sample the spine more densely). With ``frames=`` the frames carry their own twist:
+        ``turns`` is 0 (they are joined column to column, as given) or a half number, which
+        says that they close up to a half turn: the last frame, carried to the first
+        tangent by the minimal rotation, must then be within π/2 of the first turned by π
+        (else ValueError naming ``frames``); nonzero whole numbers raise TypeError.
     progress : bool or callable
         Report the spine rows swept (those of the spines done, in any order, after repeats
         are merged and skipped curves left out): ``True`` shows a bar (tqdm when installed,
@@ -260,7 +287,7 @@ def sweep(
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
                        tangents, tangent_rule, dtype, normals, uv, point_data, on_short,
-                       on_invalid, join, progress)
+                       on_invalid, join, progress, turns)
 
 
 def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
@@ -289,7 +316,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
                 normals=True, uv=True, point_data=None, on_short="raise",
-                on_invalid="raise", join="round", progress=False) -> Mesh:
+                on_invalid="raise", join="round", progress=False, turns=0) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     progress = checked(progress)
@@ -307,6 +334,10 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
     join = as_choice(join, "join", ("round", "bevel", "miter"))
     miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
+    turns = as_turns(turns, "turns")  # the core checks where it applies and the profile
+    if frames is not None and turns == int(turns) and turns != 0:
+        raise TypeError("turns: with frames= only a half number is used (it says the frames "
+                        "close up to a half turn); the given frames carry their whole turns")
     prof = as_float_array(profile, "profile")
     if prof.ndim != 2 or prof.shape[1] != 2:
         raise ValueError(f"profile: expected an array of shape (m, 2), got shape {prof.shape}")
@@ -377,6 +408,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
                 profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
                 single, single, want_normals, want_uv, tg, join, report.callback,
+                float(turns),
             )
 
     def merged(p):
@@ -656,6 +688,7 @@ def tube(
     on_invalid: str = "raise",
     join: str = "round",
     progress=False,
+    turns: float = 0,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -666,15 +699,23 @@ def tube(
     (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
     Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
     ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``,
-    ``join``, ``progress``) as in :func:`sweep`.
+    ``join``, ``progress``, ``turns``) as in :func:`sweep`. The polygon of an even number of
+    sides maps onto itself under a half turn (vertex ``j`` to ``j + sides/2``), so a closed
+    tube takes half-integer ``turns`` (an odd number of sides raises ValueError naming
+    ``turns``).
     """
     # the core sees only the polygon built here
     sides = as_int(sides, "sides", 3, MAX_SIDES, out_of_bounds=lambda x: (
         f"a tube needs at least 3 sides, got {x}" if x < 3
         else f"at most {MAX_SIDES:,} (2**20) sides, got {x:,}"))
+    if as_turns(turns, "turns") != int(turns) and sides % 2:
+        raise ValueError(f"turns: a half number of turns ({turns}) needs a tube of an even "
+                         f"number of sides (its polygon turned by π maps onto itself), got "
+                         f"sides={sides}")
     a = 2 * np.pi * np.arange(sides) / sides
     profile = np.stack([np.cos(a), np.sin(a)], axis=1)
     # the core checks the radius' values, naming radius
     return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
-                       dtype, normals, uv, point_data, on_short, on_invalid, join, progress)
+                       dtype, normals, uv, point_data, on_short, on_invalid, join, progress,
+                       turns)

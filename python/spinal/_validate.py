@@ -258,6 +258,23 @@ def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = 
     return x
 
 
+def as_turns(x: Any, name: str = "turns") -> int | float:
+    """A whole or half number of turns: an int for whole numbers (``2.0`` becomes ``2``, so
+    whole numbers give the results of the int, bit for bit), a float ``k + 0.5`` for half
+    numbers. Where a half number applies (the closing twist of a closed curve) is checked by
+    the core; anything else raises, naming ``name``."""
+    if isinstance(x, numbers.Integral) and not isinstance(x, (bool, np.bool_)):
+        return as_int(x, name)
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
+        raise TypeError(f"{name}: expected a whole or half number of turns (e.g. 1, 0.5, "
+                        f"-1.5), got {type(x).__name__}")
+    v = float(x)
+    if not np.isfinite(v) or 2 * v != round(2 * v) or abs(v) > 1e15:
+        raise ValueError(f"{name}: expected a whole or half number of turns (e.g. 1, 0.5, "
+                         f"-1.5), got {v!r}")
+    return int(v) if v == round(v) else v
+
+
 def as_bool(x: Any, name: str) -> bool:
     if not isinstance(x, (bool, np.bool_)):
         raise TypeError(f"{name}: expected True or False, got {type(x).__name__}")

@@ -37,7 +37,7 @@ def quaternion_frames(
     method: Literal["transport", "frenet"] = "transport",
     initial: _Array | None = None,
     closed: bool = False,
-    turns: int = 0,
+    turns: float = 0,
     scalar_first: bool = False,
 ) -> _F: ...
 def quaternion_length(q: _Array, *, closed: bool = False, scalar_first: bool = False) -> float: ...

@@ -38,6 +38,44 @@ pub(super) fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
     Ok(rows)
 }
 
+/// Is `turns` a whole number (within `f64`)?
+pub fn whole(turns: f64) -> bool {
+    turns == turns.round()
+}
+
+/// `turns` (see [`Request::turns`]) is finite and a whole or half number of turns; a half
+/// number only on a closed curve without an `end`, where it is the closing twist
+/// `α + 2π·turns` = `α + π·(2·turns)`: the frames then close up to a half turn about the
+/// tangent (`r_n = −r_0`), which only a profile symmetric under that half turn absorbs
+/// (`spinal.sweep(..., turns=0.5)`). Without a twist to add it to (an open curve without
+/// `end`), turns must be 0; the Frenet frame takes none.
+pub fn turns(req: &Request) -> Result<()> {
+    let t = req.turns;
+    if !t.is_finite() || !whole(2.0 * t) || t.abs() > 1e15 {
+        return Err(InputError::new(
+            "turns",
+            format!("expected a whole or half number of turns (e.g. 1, 0.5, -1.5), got {t}"),
+        ));
+    }
+    if t != 0.0 && !req.closed && req.end.is_none() && req.method != Method::Frenet {
+        return Err(InputError::new(
+            "turns",
+            "applies to a closed curve (closed=True) or with a prescribed end; an open curve \
+             without end has no twist to add turns to",
+        ));
+    }
+    if !whole(t) && (!req.closed || req.end.is_some()) {
+        return Err(InputError::new(
+            "turns",
+            format!(
+                "a half number of turns ({t}) applies only to the closing twist of a closed \
+                 curve: a prescribed end is met exactly, so its twist takes whole turns"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The torsion method needs `x‴` and a curvature that vanishes nowhere (at the samples and
 /// midpoints its quadrature reads): there the Frenet frame and the torsion are undefined.
 fn check_torsion(req: &Request) -> Result<()> {

@@ -80,9 +80,9 @@ pub fn intervals(pins: usize, closed: bool) -> usize {
 }
 
 /// The extra turns of interval `j`: one count for all, or one per interval.
-fn turns_of(turns: &[i64], j: usize, count: usize) -> Result<i64> {
+fn turns_of(turns: &[f64], j: usize, count: usize) -> Result<f64> {
     match turns.len() {
-        0 => Ok(0),
+        0 => Ok(0.0),
         1 => Ok(turns[0]),
         k if k == count => Ok(turns[j]),
         k => Err(InputError::new(
@@ -107,7 +107,7 @@ pub fn twist(
     closing: f64,
     pins: &[(usize, DVec3)],
     rule: TwistRule,
-    turns: &[i64],
+    turns: &[f64],
 ) -> Result<Vec<f64>> {
     let n = t.len();
     // per-row (and per-pin, pins ≤ rows) working vectors, within
@@ -136,7 +136,15 @@ pub fn twist(
             // closed: round the seam to the first constraint
             (pins[0].0 + n, a[0] + closing)
         };
-        let total = wrap(a1 - a0) + TAU * turns_of(turns, j, count)? as f64;
+        let extra = turns_of(turns, j, count)?;
+        let total = wrap(a1 - a0) + TAU * extra;
+        // round the seam to the first pin again: a whole number of turns lands on its own
+        // value (up to whole turns); a half number (the closing twist only) lands a half turn
+        // off it, and the pinned row keeps its value (the frames close up to a half turn)
+        let last = match k1 >= n && extra != extra.round() {
+            true => k1 - 1,
+            false => k1,
+        };
         let w = if rule == TwistRule::MinAngularSpeed
             && at(&turn, k1) - at(&turn, k0) > STRAIGHT_TURN
         {
@@ -145,7 +153,7 @@ pub fn twist(
             &arc
         };
         let (w0, span) = (at(w, k0), at(w, k1) - at(w, k0));
-        for e in k0..=k1 {
+        for e in k0..=last {
             let f = if span > 0.0 {
                 (at(w, e) - w0) / span
             } else {
@@ -211,7 +219,7 @@ mod tests {
             0.0,
             &pins,
             TwistRule::ArcLength,
-            &[1, 2, 3],
+            &[1.0, 2.0, 3.0],
         );
         assert_eq!(e.map_err(|e| e.arg), Err("turns"));
     }

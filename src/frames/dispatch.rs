@@ -120,13 +120,7 @@ pub fn compute_into_cancellable(
     out: &mut [f64],
     cancel: crate::cancel::Cancel<'_>,
 ) -> Result<f64> {
-    if req.turns != 0 && !req.closed && req.end.is_none() && req.method != Method::Frenet {
-        return Err(InputError::new(
-            "turns",
-            "applies to a closed curve (closed=True) or with a prescribed end; an open curve \
-             without end has no twist to add turns to",
-        ));
-    }
+    super::check::turns(req)?;
     let owned = normalised(req)?;
     let req = match &owned {
         Some(o) => &o.request(req),
@@ -359,7 +353,7 @@ fn frenet_frames(
     out: &mut [f64],
     cancel: crate::cancel::Cancel<'_>,
 ) -> Result<f64> {
-    if req.initial.is_some() || req.end.is_some() || req.turns != 0 {
+    if req.initial.is_some() || req.end.is_some() || req.turns != 0.0 {
         return Err(InputError::new(
             if req.initial.is_some() {
                 "initial"
@@ -538,7 +532,7 @@ pub(crate) fn rmf_parts(
 ) -> Result<RmfParts> {
     let base = Request {
         end: None,
-        turns: 0,
+        turns: 0.0,
         ..*req
     };
     let closing = compute_into_cancellable(&base, out, cancel)?;

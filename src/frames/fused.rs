@@ -734,7 +734,7 @@ mod tests {
                         points: Some(&x),
                         initial,
                         end,
-                        turns: 1,
+                        turns: 1.0,
                         method,
                         ..Default::default()
                     };

@@ -21,7 +21,11 @@
 //!
 //! A closed curve's RMF differs across the seam by its closing angle `c`; the seam term is
 //! `(h̄ / h)(α_0 + D − α_{n−1})²` with `D = c + 2πk`, `k` chosen so that the unwrapped guide
-//! angle continues across the seam (plus `2π·turns`).
+//! angle continues across the seam (plus `2π·turns`). A half number of turns `k + ½` asks for
+//! frames that close up to a half turn: then the guide angle plus π continues across the
+//! seam (`D = c + π + 2πk′`, the unwrapping done about the half turn, so a guide that itself
+//! comes back reversed, such as the `r` of frames that closed that way, is followed), plus
+//! `2π·k`.
 //!
 //! A guide of axes (`axis`: a carbonyl bond, a director field, where `g` and `−g` say the
 //! same) is unwrapped modulo π instead (each angle within π/2 of the one before): the frame
@@ -143,7 +147,7 @@ pub fn twist(
     closing: f64,
     guide: &Guide,
     pins: &[(usize, DVec3)],
-    turns: i64,
+    turns: f64,
     cancel: crate::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     check(guide)?;
@@ -197,7 +201,7 @@ pub fn twist(
         // no usable guide and no pin: the RMF (a closed curve with its closing twist)
         let mut alpha = vec![0.0; n];
         if closed {
-            let total = wrap(closing) + TAU * turns as f64;
+            let total = wrap(closing) + TAU * turns;
             let length: f64 = seg.iter().sum();
             let mut arc = 0.0;
             for (i, a) in alpha.iter_mut().enumerate() {
@@ -212,9 +216,12 @@ pub fn twist(
     // seam offset: the first value seen again after one round, unwrapped after the last
     let seam = if closed {
         let last = prev.unwrap_or(value[first]);
-        let again = value[first] + closing;
+        // a half turn at the seam (turns = k + ½): unwrapped about it, the whole turns after
+        let whole = turns.floor();
+        let half = if whole == turns { 0.0 } else { PI };
+        let again = value[first] + closing + half;
         let again = last + wrap(again - last);
-        again - value[first] + TAU * turns as f64
+        again - value[first] + TAU * if half == 0.0 { turns } else { whole }
     } else {
         0.0
     };

@@ -57,7 +57,10 @@ pub struct Request<'a> {
     pub tangent_rule: TangentRule,
     pub initial: Option<Orientation>,
     pub end: Option<Orientation>,
-    pub turns: i64,
+    /// Extra turns of the closing (or end) twist: `2π·turns` is added to it. A whole
+    /// number, or on a closed curve without `end` also a half-integer (see
+    /// [`super::check::turns`]).
+    pub turns: f64,
 }
 
 impl Default for Request<'_> {
@@ -72,7 +75,7 @@ impl Default for Request<'_> {
             tangent_rule: TangentRule::FivePointBounded,
             initial: None,
             end: None,
-            turns: 0,
+            turns: 0.0,
         }
     }
 }

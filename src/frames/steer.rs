@@ -28,11 +28,37 @@ pub struct Constraint {
 pub struct Steering<'a> {
     pub constraints: &'a [Constraint],
     pub rule: TwistRule,
-    /// Extra turns: none (the request's `turns`), one for every interval, or one per interval.
-    pub turns: &'a [i64],
+    /// Extra turns: none (the request's `turns`), one for every interval, or one per interval
+    /// (whole numbers; one half number is the closing twist of a closed curve, see
+    /// [`super::check::turns`]).
+    pub turns: &'a [f64],
     pub guide: Option<Guide<'a>>,
     /// Frames of the same curve at the previous time step (one per row).
     pub previous: Option<&'a [[f64; 9]]>,
+}
+
+/// `turns` are whole numbers, or (`closing`: the one closing twist of a closed curve) half
+/// numbers; an error naming `turns` otherwise.
+fn half_turns(turns: &[f64], closing: bool) -> Result<()> {
+    for &t in turns {
+        if !t.is_finite() || !super::check::whole(2.0 * t) {
+            return Err(InputError::new(
+                "turns",
+                format!("expected a whole or half number of turns, got {t}"),
+            ));
+        }
+        if !closing && !super::check::whole(t) {
+            return Err(InputError::new(
+                "turns",
+                format!(
+                    "a half number of turns ({t}) applies only to the closing twist of a \
+                     closed curve without constraints, end or guide (those are met exactly, \
+                     so the twist between them takes whole turns)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn col(f: &[f64], k: usize) -> DVec3 {
@@ -168,6 +194,7 @@ pub fn compute_steered_cancellable(
         return Ok(());
     }
     let alpha = if let Some(g) = &st.guide {
+        half_turns(st.turns, req.closed && req.end.is_none())?;
         let turns = match st.turns {
             [] => req.turns,
             [k] => *k,
@@ -196,6 +223,9 @@ pub fn compute_steered_cancellable(
         } else {
             st.turns
         };
+        // a half turn only as the closing twist: one interval, from row 0 round the seam
+        let closing = req.closed && req.end.is_none() && pins.len() == 1 && pins[0].0 == 0;
+        half_turns(turns, closing && turns.len() == 1)?;
         constraints::twist(
             &r,
             &t,

@@ -273,7 +273,7 @@ fn closed_curve_frames_meet_at_the_seam() {
     let h: Vec<f64> = (0..n).map(|i| (x[(i + 1) % n] - x[i]).length()).collect();
     let length: f64 = h.iter().sum();
     for method in [Method::DoubleReflection, Method::Rotation] {
-        for turns in [0, 1, -2] {
+        for turns in [0.0, 1.0, -2.0] {
             let (out, raw) = frames(&Request {
                 points: Some(&x),
                 closed: true,
@@ -295,7 +295,7 @@ fn closed_curve_frames_meet_at_the_seam() {
                 };
                 step_angles(&dr, &out, n, true)
             };
-            let total = raw + TAU * turns as f64;
+            let total = raw + TAU * turns;
             for (i, a) in angles.iter().enumerate() {
                 let want = wrap(total * h[i] / length);
                 assert!(
@@ -344,7 +344,7 @@ fn open_curve_meets_initial_and_end() {
     let h: Vec<f64> = (0..n - 1).map(|i| (x[i + 1] - x[i]).length()).collect();
     let length: f64 = h.iter().sum();
     let (v0, v1) = (DVec3::new(0.3, -1.0, 2.0), DVec3::new(1.0, 0.5, -0.2));
-    for turns in [0, 3] {
+    for turns in [0.0, 3.0] {
         let (out, raw) = frames(&Request {
             points: Some(&x),
             initial: Some(Orientation::Vector(v0)),
@@ -363,7 +363,7 @@ fn open_curve_meets_initial_and_end() {
             closed: false,
             tangent_chords: false,
         };
-        let total = raw + TAU * turns as f64;
+        let total = raw + TAU * turns;
         for (i, a) in step_angles(&dr, &out, n, false).iter().enumerate() {
             assert!((a - wrap(total * h[i] / length)).abs() < 1e-10, "step {i}");
         }
@@ -393,7 +393,7 @@ fn compute_many_equals_each_curve_alone() {
             let template = Request {
                 points: Some(&x),
                 method,
-                turns: 1,
+                turns: 1.0,
                 ..Default::default()
             };
             let mut all = vec![0.0; 9 * x.len()];
@@ -645,7 +645,7 @@ fn errors_name_the_argument() {
             "turns",
             Request {
                 method: Method::Frenet,
-                turns: 1,
+                turns: 1.0,
                 ..base
             },
             30,

@@ -38,9 +38,9 @@ pub enum Twist {
     /// No condition: the plain transported frames.
     None,
     /// Closed curve: the frame after the closing segment must equal the first one.
-    Closed { turns: i64 },
+    Closed { turns: f64 },
     /// The reference vector at the last sample must be `target` (unit, ⟂ last tangent).
-    End { target: DVec3, turns: i64 },
+    End { target: DVec3, turns: f64 },
 }
 
 /// A curve is split across threads only from `2·PAR_CHUNK` frames on.
@@ -268,11 +268,11 @@ where
             Twist::None => (0.0, 0.0),
             Twist::Closed { turns } => {
                 let a = signed_angle(end_r, self.r0, tt(0));
-                (a, a + std::f64::consts::TAU * turns as f64)
+                (a, a + std::f64::consts::TAU * turns)
             }
             Twist::End { target, turns } => {
                 let a = signed_angle(end_r, target, tt(n - 1));
-                (a, a + std::f64::consts::TAU * turns as f64)
+                (a, a + std::f64::consts::TAU * turns)
             }
         };
         if !turn_now {
@@ -514,11 +514,11 @@ mod tests {
             Twist::None => (0.0, 0.0),
             Twist::Closed { turns } => {
                 let a = signed_angle(end, r0, t[0]);
-                (a, a + TAU * turns as f64)
+                (a, a + TAU * turns)
             }
             Twist::End { target, turns } => {
                 let a = signed_angle(end, target, t[n - 1]);
-                (a, a + TAU * turns as f64)
+                (a, a + TAU * turns)
             }
         };
         let length: f64 = seg[..ext - 1].iter().sum();
@@ -564,11 +564,11 @@ mod tests {
                 let twists = if closed {
                     vec![
                         Twist::None,
-                        Twist::Closed { turns: 0 },
-                        Twist::Closed { turns: -2 },
+                        Twist::Closed { turns: 0.0 },
+                        Twist::Closed { turns: -2.0 },
                     ]
                 } else {
-                    vec![Twist::None, Twist::End { target, turns: 1 }]
+                    vec![Twist::None, Twist::End { target, turns: 1.0 }]
                 };
                 for twist in twists {
                     for rows in [n, n + usize::from(closed)] {
@@ -662,7 +662,7 @@ mod tests {
             Request {
                 points: Some(&x),
                 closed: true,
-                turns: 1,
+                turns: 1.0,
                 ..Default::default()
             },
             // the rotation method with an end condition

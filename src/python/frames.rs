@@ -40,7 +40,7 @@ pub fn frames_sampled<'py>(
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: i64,
+    turns: f64,
     points_arg: &str,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<FramesAndAngles<'py>> {
@@ -104,7 +104,7 @@ pub fn frames_analytic<'py>(
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: i64,
+    turns: f64,
     d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, f64)> {
     let pts = vec3s("points", &points)?;
@@ -231,7 +231,7 @@ pub fn frames_steered<'py>(
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: PyReadonlyArray1<'py, i64>,
+    turns: PyReadonlyArray1<'py, f64>,
     con_curves: PyReadonlyArray1<'py, i64>,
     con_rows: PyReadonlyArray1<'py, i64>,
     con_vectors: PyReadonlyArray2<'py, f64>,
@@ -322,7 +322,7 @@ pub fn frames_steered<'py>(
         tangent_rule,
         initial: None,
         end: None,
-        turns: 0,
+        turns: 0.0,
     };
     // the output, the rotation-minimising frames, the tangents and the twist solve
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
@@ -382,7 +382,7 @@ pub fn frames_in_time<'py>(
     closed: bool,
     initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: i64,
+    turns: f64,
     previous: Option<PyReadonlyArray3<'py, f64>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {

@@ -152,7 +152,7 @@ pub fn quat_transport<'py>(
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     initial: Option<PyReadonlyArray1<'py, f64>>,
     closed: bool,
-    turns: i64,
+    turns: f64,
     closing_row: bool,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, f64)> {
     let x = vec3s("points", &points)?;

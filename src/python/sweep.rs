@@ -33,11 +33,14 @@ type MeshArrays<'py> = (
 /// when the vertex count fits (int64 otherwise). Errors about the scale name `scale_arg`
 /// (`spinal.tube` passes its radius as the scale). `scale` may have a single row (the same
 /// scale at every sample). `progress(done, rows)` is called from the waiting thread as the
-/// spines are swept (rows of the spines done) and once at the end.
+/// spines are swept (rows of the spines done) and once at the end. `turns`: extra turns of
+/// a closed spine's computed frames; a half number joins the seam with a half turn (with
+/// given frames: they close that way; see `sweep::seam`).
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
                     miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
-                    normals=true, uv=true, tangents=None, join="round", progress=None))]
+                    normals=true, uv=true, tangents=None, join="round", progress=None,
+                    turns=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -60,6 +63,7 @@ pub fn sweep_mesh<'py>(
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     join: &str,
     progress: Option<Py<PyAny>>,
+    turns: f64,
 ) -> PyResult<MeshArrays<'py>> {
     let join = match join {
         "round" => sweep::Join::Round,
@@ -105,6 +109,7 @@ pub fn sweep_mesh<'py>(
         miter_limit,
         split_seams,
         join,
+        turns,
     };
     let rename = |e| renamed(e, "scale", scale_arg);
     let stop = Stop::default();

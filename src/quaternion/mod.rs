@@ -455,7 +455,8 @@ fn default_reference(
 ///   must be finite and not parallel to `t[0]`); `None`: the reference vector of the
 ///   rotation-method frames ([`frames::compute_into`]);
 /// * `closed`: the samples form a loop (no repeated end point); the closing angle is then
-///   spread linearly in arc length (plus `2π·turns`) so the frames close.
+///   spread linearly in arc length (plus `2π·turns`) so the frames close; a half number
+///   of turns leaves them closing up to a half turn about the tangent.
 ///
 /// Writes `n` quaternions (sign-continuous, `out[0]` canonical), and for a closed curve with
 /// `out.len() == n + 1` also the frame carried once round the loop, corrected (`±q₀`: the
@@ -466,7 +467,7 @@ pub fn transport(
     t: Option<&[DVec3]>,
     initial: Option<DVec3>,
     closed: bool,
-    turns: i64,
+    turns: f64,
     out: &mut [DQuat],
 ) -> Result<f64> {
     transport_cancellable(x, t, initial, closed, turns, out, &crate::cancel::never)
@@ -481,10 +482,25 @@ pub fn transport_cancellable(
     t: Option<&[DVec3]>,
     initial: Option<DVec3>,
     closed: bool,
-    turns: i64,
+    turns: f64,
     out: &mut [DQuat],
     cancel: crate::cancel::Cancel<'_>,
 ) -> Result<f64> {
+    if !turns.is_finite() || 2.0 * turns != (2.0 * turns).round() {
+        return Err(InputError::new(
+            "turns",
+            format!("expected a whole or half number of turns (e.g. 1, 0.5, -1.5), got {turns}"),
+        ));
+    }
+    if turns != turns.round() && !closed {
+        return Err(InputError::new(
+            "turns",
+            format!(
+                "a half number of turns ({turns}) applies only to the closing twist of a \
+                 closed curve (closed=True)"
+            ),
+        ));
+    }
     let t = &unit_tangents_cancellable(x, t, closed, cancel)?;
     if cancel() {
         return Ok(0.0);
@@ -529,7 +545,7 @@ pub fn transport_cancellable(
     let q_end = (step(n - 1)? * out[n - 1]).normalize();
     let r_end = q_end * DVec3::X;
     let alpha = rotation::signed_angle(r_end, r0, t[0]);
-    let total = alpha + std::f64::consts::TAU * turns as f64;
+    let total = alpha + std::f64::consts::TAU * turns;
     let mut arc = alloc::with_capacity("quaternion_frames", n + 1)?;
     let mut acc = 0.0;
     arc.push(0.0);
@@ -652,7 +668,7 @@ mod tests {
             .collect();
         let mut out = vec![DQuat::IDENTITY; x.len()];
         let mut run = |x: &[DVec3], t: Option<&[DVec3]>, r: Option<DVec3>| {
-            transport(x, t, r, false, 0, &mut out[..x.len()])
+            transport(x, t, r, false, 0.0, &mut out[..x.len()])
         };
         assert_eq!(arg_of(run(&x[..1], None, None)), "points");
         assert_eq!(arg_of(run(&x[..1], Some(&x[..1]), None)), "points");

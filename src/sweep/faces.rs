@@ -18,6 +18,9 @@ pub(super) struct FacePattern {
     /// The tables (empty for a large profile).
     pub(super) ac: Vec<[usize; 3]>,
     pub(super) bd: Vec<[usize; 3]>,
+    /// The column shift at a closed spine's seam (`m/2` for a half turn, else 0; see
+    /// [`super::seam`]).
+    pub(super) seam: usize,
 }
 
 impl FacePattern {
@@ -42,6 +45,40 @@ impl FacePattern {
             flip,
             ac,
             bd,
+            seam: 0,
+        }
+    }
+
+    /// The faces of edges `e0..` of the closing segment of a closed spine, from the last
+    /// ring (at vertex `b0`) to the first (at `b1`), whose column `j` meets column
+    /// `j + seam (mod cols)` of the first ring; [`FacePattern::write`] without a shift.
+    pub(super) fn write_seam<I: Index>(
+        &self,
+        out: &mut [[I; 3]],
+        bd: bool,
+        b0: usize,
+        b1: usize,
+        e0: usize,
+    ) {
+        if self.seam == 0 {
+            return self.write(out, bd, b0, b1, e0);
+        }
+        let cols = self.cols;
+        let on_first = |j: usize| b1 + (j + self.seam) % cols;
+        for (k, f) in out.chunks_exact_mut(2).enumerate() {
+            let j = e0 + k;
+            let jn = if j + 1 == cols { 0 } else { j + 1 };
+            let (a, b, c, d) = (b0 + j, b0 + jn, on_first(jn), on_first(j));
+            let (t0, t1) = match bd {
+                false => ([a, b, c], [a, c, d]),
+                true => ([a, b, d], [b, c, d]),
+            };
+            let wind = |t: [usize; 3]| match self.flip {
+                false => [I::of(t[0]), I::of(t[1]), I::of(t[2])],
+                true => [I::of(t[0]), I::of(t[2]), I::of(t[1])],
+            };
+            f[0] = wind(t0);
+            f[1] = wind(t1);
         }
     }
 

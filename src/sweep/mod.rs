@@ -68,6 +68,7 @@ pub mod profile;
 mod rings;
 mod run;
 mod scale;
+pub mod seam;
 
 #[cfg(test)]
 mod proptests;
@@ -105,6 +106,10 @@ pub struct Options {
     pub split_seams: bool,
     /// The outer side of the corners that get joins ([`join`]).
     pub join: Join,
+    /// Extra turns of a closed spine's computed frames (`2π·turns` added to the closing
+    /// twist); a half number joins the seam with a half turn ([`seam`]; with given frames,
+    /// it says they close up to a half turn).
+    pub turns: f64,
 }
 
 /// A triangle mesh.

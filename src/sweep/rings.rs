@@ -152,6 +152,9 @@ pub(super) struct Rings<'a> {
     pub(super) sign: f64,
     /// Global row of spine sample 0 (for the fold reports).
     pub(super) rowbase: usize,
+    /// The column shift at a closed spine's seam (0, or `m/2` for a half turn: the rings
+    /// across the seam are then seen turned by π, [`Rings::across`]).
+    pub(super) seam: usize,
 }
 
 impl Rings<'_> {
@@ -199,6 +202,22 @@ impl Rings<'_> {
     #[inline(always)]
     pub(super) fn before(&self, k: usize) -> usize {
         if k == 0 { self.x.len() - 1 } else { k - 1 }
+    }
+
+    /// Ring `g` as seen from a ring on the other side of a seam with a half turn
+    /// (`crossed`): its axes turned by π about the tangent, so that its column `j` is the
+    /// neighbour of the other ring's column `j` (see [`super::seam`]); else as it is.
+    #[inline(always)]
+    pub(super) fn across(&self, g: Geo, crossed: bool) -> Geo {
+        match crossed && self.seam > 0 {
+            false => g,
+            true => Geo {
+                b: (g.b.0, -g.b.1, -g.b.2),
+                ma: -g.ma,
+                mb: -g.mb,
+                ..g
+            },
+        }
     }
 
     #[inline(always)]
@@ -350,7 +369,8 @@ impl Rings<'_> {
             .map(|t| {
                 let (i, c) = (2 * (t / pieces) + 1, t % pieces);
                 let e = (c * piece).min(edges)..((c + 1) * piece).min(edges);
-                !cancel() && self.twisted(&self.geo(i), &self.geo(self.after(i)), e)
+                let next = self.across(self.geo(self.after(i)), i + 1 >= self.plan.rings);
+                !cancel() && self.twisted(&self.geo(i), &next, e)
             })
             .collect();
         if cancel() {
@@ -493,13 +513,16 @@ impl Rings<'_> {
         let k0 = if i0 >= r_n { i0 - r_n } else { i0 };
         let (kp, kn) = (self.before(k0), self.after(k0));
         let (cp, mut cc) = (self.chord(kp), self.chord(k0));
-        let mut prev = self.geo_between(kp, self.chord(self.before(kp)), cp);
-        let mut cur = self.geo_between(k0, cp, cc);
+        // stored ring i is sample i mod r_n; rings before 0 and from r_n on (a split seam's
+        // copy of ring 0) lie across the seam
+        let prev = self.geo_between(kp, self.chord(self.before(kp)), cp);
+        let mut prev = self.across(prev, i0 == 0 || i0 > r_n);
+        let mut cur = self.across(self.geo_between(k0, cp, cc), i0 >= r_n);
         let mut kn = kn;
         for (di, rv) in bv.chunks_mut(width).enumerate() {
             let i = i0 + di;
             let cn = self.chord(kn);
-            let next = self.geo_between(kn, cc, cn);
+            let next = self.across(self.geo_between(kn, cc, cn), i + 1 >= r_n);
             let span = di * width..(di + 1) * width;
             ring.vertices(column, &cur);
             ring.put_vertices(rv, unscale);
@@ -534,10 +557,15 @@ impl Rings<'_> {
                     Some(bd) => bd[i],
                     None => i % 2 == 1 && self.twisted_ring(&cur, &next, column, pattern.edges),
                 };
-                let i1 = if i + 1 == stored { 0 } else { i + 1 };
                 let faces = &mut bf[di * per_segment..(di + 1) * per_segment];
-                let (b0, b1) = (vbase + i * cols, vbase + i1 * cols);
-                pattern.write(faces, bd, b0, b1, edges.start);
+                match i + 1 == stored {
+                    // the closing segment, to ring 0 (with the seam's column shift)
+                    true => pattern.write_seam(faces, bd, vbase + i * cols, vbase, edges.start),
+                    false => {
+                        let (b0, b1) = (vbase + i * cols, vbase + (i + 1) * cols);
+                        pattern.write(faces, bd, b0, b1, edges.start);
+                    }
+                }
             }
             (prev, cur, cc) = (cur, next, cn);
             kn = self.after(kn);

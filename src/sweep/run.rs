@@ -46,16 +46,19 @@ impl<'a> Shared<'a> {
         p: &'a Profile,
         cols: usize,
         caps: bool,
+        opts: &Options,
         cancel: Cancel<'_>,
     ) -> Result<Shared<'a>> {
         // Winding: normals to the right of the profile's direction, outward for closed
         // profiles.
         let sign = if p.closed && p.area < 0.0 { -1.0 } else { 1.0 };
         let edges = if p.closed { p.len() } else { p.len() - 1 };
+        let mut pattern = FacePattern::of(cols, edges, sign);
+        pattern.seam = super::seam::shift(p, opts.closed, opts.turns)?;
         Ok(Shared {
             p,
             column: OnceLock::new(),
-            pattern: FacePattern::of(cols, edges, sign),
+            pattern,
             tris: match caps {
                 true => p.triangulate_cancellable(cancel)?,
                 false => Vec::new(),
@@ -110,6 +113,7 @@ fn sweep_one<R: Real, I: Index>(
         miter_limit: opts.miter_limit,
         sign: sh.sign,
         rowbase,
+        seam: sh.pattern.seam,
     };
     let mut out = out;
     let nv = plan.stored_rings * plan.cols;
@@ -184,7 +188,7 @@ fn rmf_into(
     tangents: Option<&[DVec3]>,
     offsets: &[usize],
     c: usize,
-    closed: bool,
+    (closed, turns): (bool, f64),
     buf: &mut Vec<[f64; 9]>,
     cancel: Cancel<'_>,
 ) -> Result<()> {
@@ -199,6 +203,7 @@ fn rmf_into(
         points: Some(&points[a..b]),
         tangents: tangents.map(|t| &t[a..b]),
         closed,
+        turns,
         ..crate::frames::Request::default()
     };
     crate::frames::compute_into_cancellable(&req, buf[..n].as_flattened_mut(), cancel)?;
@@ -382,8 +387,8 @@ impl Sweep<'_> {
         let given = match self.frames {
             FrameSource::Given => true,
             FrameSource::Rmf { tangents } => {
-                let (o, closed) = (self.offsets, self.opts.closed);
-                if let Err(e) = rmf_into(self.points, tangents, o, c, closed, frames, cancel) {
+                let (o, ct) = (self.offsets, (self.opts.closed, self.opts.turns));
+                if let Err(e) = rmf_into(self.points, tangents, o, c, ct, frames, cancel) {
                     return Outcome::Frames(in_curve(e, o, c));
                 }
                 if cancel() {
@@ -398,6 +403,17 @@ impl Sweep<'_> {
             Ok(None) => return Outcome::Stopped,
             Err(e) => return Outcome::Checks(in_curve(e, self.offsets, c)),
         };
+        if self.sh.pattern.seam > 0 {
+            // a half turn at the seam: given frames must close that way, and no corner join
+            // may reach across the seam's column shift
+            let seam = match given {
+                true => super::seam::check_given(s.frames, plan.size.rings),
+                false => Ok(()),
+            };
+            if let Err(e) = seam.and_then(|_| super::seam::no_corners(&plan.corners)) {
+                return Outcome::Checks(in_curve(e, self.offsets, c));
+            }
+        }
         let (rowbase, unscale) = (self.offsets[c], self.unscale);
         let mut done = sweep_one(
             &s, &plan, &self.sh, self.opts, vbase, rowbase, unscale, out, ring, cancel,
@@ -432,7 +448,7 @@ fn first_frames_error(
     points: &[DVec3],
     tangents: Option<&[DVec3]>,
     offsets: &[usize],
-    closed: bool,
+    closed: (bool, f64),
     cancel: Cancel<'_>,
 ) -> Option<InputError> {
     let curves = offsets.len().saturating_sub(1);
@@ -483,7 +499,7 @@ pub fn sweep_into<R: Real, I: Index>(
         offsets,
         opts,
         layout,
-        sh: Shared::new(profile, cols, caps, &cancel::never)?,
+        sh: Shared::new(profile, cols, caps, opts, &cancel::never)?,
         unscale: None,
     };
     sweep.write(out, &cancel::never, None)
@@ -556,6 +572,7 @@ impl<'a> Prepared<'a> {
             ..spine
         };
         let set_up = Profile::new_cancellable(prof, profile_closed, cancel).and_then(|p| {
+            super::seam::shift(&p, opts.closed, opts.turns)?;
             let lay = layout_cancellable(&view, offsets, &p, &opts, cancel)?;
             Ok(lay.map(|l| (p, l)))
         });
@@ -571,7 +588,7 @@ impl<'a> Prepared<'a> {
             }
             (Err(e), FrameSource::Rmf { tangents }) => {
                 validate::offsets(offsets, spine.points.len())?;
-                let (x, closed) = (spine.points, opts.closed);
+                let (x, closed) = (spine.points, (opts.closed, opts.turns));
                 if let Some(fe) = first_frames_error(x, tangents, offsets, closed, cancel) {
                     return Err(fe);
                 }
@@ -624,7 +641,7 @@ impl<'a> Prepared<'a> {
             offsets: self.offsets,
             opts: &self.opts,
             layout: &self.layout,
-            sh: Shared::new(&self.profile, cols, caps, cancel)?,
+            sh: Shared::new(&self.profile, cols, caps, &self.opts, cancel)?,
             unscale: self.scaled.as_ref().map(|s| s.k),
         };
         sweep.write(out, cancel, done)

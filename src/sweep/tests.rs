@@ -59,6 +59,7 @@ fn options(closed: bool, caps: bool, split_seams: bool) -> Options {
         miter_limit: 4.0,
         split_seams,
         join: crate::sweep::Join::Round,
+        turns: 0.0,
     }
 }
 
@@ -401,6 +402,7 @@ fn avx2_block_equals_baseline_block() {
         miter_limit: 4.0,
         sign: 1.0,
         rowbase: 0,
+        seam: 0,
     };
     let pattern = FacePattern::of(plan.cols, p.len(), 1.0);
     type Out = (Vec<[u32; 3]>, Vec<[u32; 3]>, Vec<[u32; 2]>, Vec<[i32; 3]>);
@@ -458,7 +460,14 @@ fn written(
     let plan = check_spine(spine, opts, p, true, &cancel::never)
         .expect("a valid sweep")
         .expect("not stopped");
-    let sh = Shared::new(p, plan.cols, false, &cancel::never).unwrap();
+    let sh = Shared::new(
+        p,
+        plan.cols,
+        false,
+        &options(false, false, false),
+        &cancel::never,
+    )
+    .unwrap();
     let rings = Rings {
         s: spine,
         x: &spine.points[..plan.rings],
@@ -469,6 +478,7 @@ fn written(
         miter_limit: opts.miter_limit,
         sign: sh.sign,
         rowbase: 7,
+        seam: 0,
     };
     // the rings of the samples (the joins' extra rings are written after them)
     let nv = plan.stored_rings * plan.cols;
@@ -628,6 +638,7 @@ fn corners_get_watertight_joins_and_smooth_spines_none() {
         for join in [Join::Round, Join::Bevel, Join::Miter] {
             let opts = Options {
                 join,
+                turns: 0.0,
                 ..options(false, true, false)
             };
             let mut found = Vec::new();
