@@ -24,7 +24,6 @@ use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::Result;
 use crate::math::bvh::{Aabb, Bvh};
-use crate::math::scale::Pow2;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -43,23 +42,36 @@ pub struct Binding {
 /// values round to the same sign.
 fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
     let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
-    let on_plane = |a: f64, fa: f64| {
-        let c = sp.c_at(k, a);
-        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * sp.m_at(k, a).length()
+    // f at a grid point with the curve point and tangent it used
+    let fcm = |a: f64| {
+        let (c, m) = (sp.c_at(k, a), sp.m_at(k, a));
+        ((p - c).dot(m), c, m)
+    };
+    let on_plane = |fa: f64, c: DVec3, m: DVec3| {
+        // a bound of the threshold first (1-norms bound the lengths; below 1e150 their
+        // squares do not overflow), which rules out almost every point without square roots
+        let l1 = |x: DVec3| x.abs().element_sum();
+        let (lpc, lm) = (l1(p) + l1(c), l1(m));
+        let cheap = 16.0 * f64::EPSILON * lpc * lm * (1.0 + 1e-6);
+        if lpc < 1e150 && lm < 1e150 && fa.abs() > cheap {
+            return false;
+        }
+        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * m.length()
     };
     let mut out = [f64::NAN; 4];
-    let mut prev = (0.0, f(0.0));
+    let (f0, c0, m0) = fcm(0.0);
+    let mut prev = (0.0, f0);
     for (i, slot) in out.iter_mut().enumerate() {
         let b = (i + 1) as f64 / 4.0;
-        let fb = f(b);
+        let (fb, cb, mb) = fcm(b);
         let (mut a0, mut f0) = prev;
         prev = (b, fb);
-        if f0 == 0.0 || (i == 0 && on_plane(0.0, f0)) {
+        if f0 == 0.0 || (i == 0 && on_plane(f0, c0, m0)) {
             *slot = a0;
             continue;
         }
         if (f0 > 0.0) == (fb > 0.0) {
-            if i == 3 && on_plane(1.0, fb) {
+            if i == 3 && on_plane(fb, cb, mb) {
                 *slot = 1.0;
             }
             continue;
@@ -110,7 +122,14 @@ struct Edges {
     bvh: Bvh,
     /// `ρ_k`, slightly enlarged against round-off.
     reach: Vec<f64>,
+    /// Per edge: its box (the hierarchy's items), a first cheap test before
+    /// [`Edges::lower_bound`].
+    boxes: Vec<Aabb>,
 }
+
+/// Relative margin on squared distances from boxes: a box nearer than the best answer by
+/// less than this may still hold it once both are rounded (kept, never pruned).
+const BOX_MARGIN: f64 = 1e-9;
 
 impl Edges {
     fn new(sp: &SpineModel) -> Result<Edges> {
@@ -142,6 +161,7 @@ impl Edges {
         Ok(Edges {
             bvh: Bvh::build(&boxes),
             reach,
+            boxes,
         })
     }
 
@@ -160,98 +180,136 @@ impl Edges {
         }
     }
 
-    /// The sample nearest to `p` (the first of equally near ones). `hint`: a sample that is
-    /// probably near (the answer for the vertex before), whose distance bounds the search
-    /// from the start; the answer does not depend on it.
-    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, hint: usize, s: &mut Scratch) -> usize {
-        let hint = hint.min(sp.len() - 1);
-        let mut best = ((p - sp.c[hint]).length_squared(), hint);
-        self.bvh.nearest(p, best.0, &mut s.stack, |k| {
+    /// The sample nearest to `p` (the first of equally near ones).
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, stack: &mut Vec<(usize, f64)>) -> usize {
+        let mut best = (f64::INFINITY, 0);
+        self.bvh.nearest(p, best.0, stack, |k| {
             for j in [k, k + 1] {
                 let d = (p - sp.c[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
                     best = (d, j);
                 }
             }
-            best.0
+            best.0 * (1.0 + BOX_MARGIN)
         });
         best.1
     }
 }
 
-/// Working state of a run of vertices: the sample nearest to the vertex before (where the
-/// next one's search starts) and the hierarchy's stack.
+/// Working state of a run of vertices: the edge of the vertex before (where the next one's
+/// search starts) and the hierarchy's stack.
 struct Scratch {
     hint: usize,
     stack: Vec<(usize, f64)>,
 }
 
+/// The best candidate of [`locate`] so far: squared distance, who (`-2` the start's
+/// extension, `-1` the end's, `k ≥ 0` edge `k`, `i64::MIN` none yet), edge, `a`, `τ`.
+#[derive(Clone, Copy)]
+struct Best {
+    d2: f64,
+    who: i64,
+    k: usize,
+    a: f64,
+    tau: f64,
+}
+
 /// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
 /// edge's roots, the first found winning ties in the order: the start's extension, the
-/// end's, the two edges at the sample nearest to `P`, then the other edges by index; the
-/// edges are searched nearest first in the hierarchy, skipping those whose ball lies
-/// farther than the best so far (`O(log n)` edges for a vertex near the spine).
+/// end's, the two edges at the sample nearest to `P`, then the other edges by index (the
+/// nearest sample is searched only when two edges tie). The edge of the vertex before
+/// (`s.hint`, often the answer: consecutive vertices are often neighbours) is solved first,
+/// then the others nearest first in the hierarchy, skipping those whose box or ball lies
+/// farther than the best so far (`O(log n)` edges for a vertex near the spine). The answer
+/// is the least candidate in that order whatever the hint.
 fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
     let n = sp.len();
-    // (squared distance, rank in the order above, edge, a, τ)
-    let mut best = (f64::INFINITY, i64::MIN, 0usize, 0.0f64, 0.0f64);
+    let mut best = Best {
+        d2: f64::INFINITY,
+        who: i64::MIN,
+        k: 0,
+        a: 0.0,
+        tau: 0.0,
+    };
     // straight extensions past both ends (a loop has none)
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
     if tau < 0.0 && !sp.closed {
-        best = ((w - tau * sp.t[0]).length_squared(), -2, 0, 0.0, tau);
+        best = Best {
+            d2: (w - tau * sp.t[0]).length_squared(),
+            who: -2,
+            k: 0,
+            a: 0.0,
+            tau,
+        };
     }
     let w = p - sp.c[n - 1];
     let tau = w.dot(sp.t[n - 1]);
     if tau > 0.0 && !sp.closed {
         let d2 = (w - tau * sp.t[n - 1]).length_squared();
-        if d2 < best.0 {
-            best = (d2, -1, n - 2, 1.0, tau);
+        if d2 < best.d2 {
+            best = Best {
+                d2,
+                who: -1,
+                k: n - 2,
+                a: 1.0,
+                tau,
+            };
         }
     }
-    let near = edges.nearest_sample(sp, p, s.hint, s);
-    s.hint = near;
-    let first = near.saturating_sub(1);
-    let end = (near + 1).min(n - 1);
-    let rank = |k: usize| match (first..end).contains(&k) {
-        true => (k - first) as i64,
-        false => 2 + k as i64,
-    };
-    let edge = |k: usize, best: &mut (f64, i64, usize, f64, f64)| {
+    // the sample nearest to p, searched when first needed (ties between edges)
+    let mut near: Option<usize> = None;
+    // the nearest sample's search stack (rarely used: allocated then only)
+    let mut inner = Vec::new();
+    let mut edge = |k: usize, best: &mut Best, stack: &mut Vec<(usize, f64)>| {
         // every point of the edge's curve is at least this far
-        if edges.lower_bound(sp, k, p) > best.0 {
+        if edges.lower_bound(sp, k, p) > best.d2 {
             return;
         }
-        let r = rank(k);
         for a in edge_roots(sp, k, p) {
             if !(-1e-12..=1.0 + 1e-12).contains(&a) {
                 continue;
             }
             let a = a.clamp(0.0, 1.0);
             let d2 = (p - sp.c_at(k, a)).length_squared();
-            if d2 < best.0 || (d2 == best.0 && r < best.1) {
-                *best = (d2, r, k, a, 0.0);
+            let wins = d2 < best.d2
+                || (d2 == best.d2 && best.who >= 0 && best.who != k as i64 && {
+                    // ranks: the edges at the nearest sample first, then by index
+                    let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, stack));
+                    let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
+                    let rank = |k: usize| match (first..end).contains(&k) {
+                        true => (k - first) as i64,
+                        false => 2 + k as i64,
+                    };
+                    rank(k) < rank(best.who as usize)
+                });
+            if wins {
+                *best = Best {
+                    d2,
+                    who: k as i64,
+                    k,
+                    a,
+                    tau: 0.0,
+                };
             }
         }
     };
-    // the edges next to the nearest sample first (the one with the nearer chord first): a
-    // good bound prunes almost all others
-    let mut two = [first, end - 1];
-    if edges.lower_bound(sp, two[1], p) < edges.lower_bound(sp, two[0], p) {
-        two.swap(0, 1);
-    }
-    for k in two.into_iter().take(end - first) {
-        edge(k, &mut best);
-    }
-    edges.bvh.nearest(p, best.0, &mut s.stack, |k| {
-        if !(first..end).contains(&k) {
-            edge(k, &mut best);
-        }
-        best.0
-    });
-    if best.0.is_infinite() {
+    let hint = s.hint.min(n - 2);
+    edge(hint, &mut best, &mut inner);
+    let mut search = std::mem::take(&mut s.stack);
+    edges
+        .bvh
+        .nearest(p, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
+            if k != hint && edges.boxes[k].distance_squared(p) <= best.d2 * (1.0 + BOX_MARGIN) {
+                edge(k, &mut best, &mut inner);
+            }
+            best.d2 * (1.0 + BOX_MARGIN)
+        });
+    s.stack = search;
+    if best.d2.is_infinite() {
         // cannot happen for finite input (the plane signs change somewhere); keep a
         // defined answer anyway: the nearest sample
+        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, &mut inner));
         let (k, a) = if near + 1 < n {
             (near, 0.0)
         } else {
@@ -259,7 +317,8 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
         };
         return (k, a, 0.0);
     }
-    (best.2, best.3, best.4)
+    s.hint = best.k;
+    (best.k, best.a, best.tau)
 }
 
 /// Register `vertices` on the rest spine.
@@ -274,7 +333,6 @@ pub fn bind_cancellable(
     cancel: Cancel<'_>,
 ) -> Result<Binding> {
     super::check_vertices(vertices, rest.scale, "spine")?;
-    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
     let edges = Edges::new(rest)?;
     let nv = vertices.len();
     let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
@@ -284,7 +342,7 @@ pub fn bind_cancellable(
         0.0,
     )?;
     // blocks of consecutive vertices (often neighbours on the mesh): each vertex's search
-    // starts from the sample nearest to the vertex before
+    // starts from the edge of the vertex before
     edge.par_chunks_mut(BLOCK)
         .zip(coords.par_chunks_mut(COORDS * BLOCK))
         .zip(vertices.par_chunks(BLOCK))
@@ -296,9 +354,7 @@ pub fn bind_cancellable(
                 hint: 0,
                 stack: Vec::with_capacity(64),
             };
-            for ((e, c), &p) in eb.iter_mut().zip(cb.chunks_mut(COORDS)).zip(vb) {
-                bind_one(rest, &edges, to_model, to_input, p, &mut s, e, c);
-            }
+            bind_run(rest, &edges, vb, &mut s, eb, cb);
         });
     Ok(Binding { edge, coords })
 }
@@ -306,38 +362,79 @@ pub fn bind_cancellable(
 /// Vertices per block of the registration (a Ctrl-C poll each).
 const BLOCK: usize = 256;
 
-/// The binding of vertex `p` (input units) into `e` and `c` (see the module notes).
-#[allow(clippy::too_many_arguments)]
-fn bind_one(
+/// Vertices whose spine points are evaluated together (see [`SpineModel::eval_lanes`]).
+const LANES: usize = 4;
+
+/// The bindings of a run of vertices (input units) into `e` and `c` (see the module notes):
+/// each located in turn (the next search starts from the edge found), then the spine
+/// evaluated at `LANES` of them at a time.
+fn bind_run(
     rest: &SpineModel,
     edges: &Edges,
-    to_model: Pow2,
-    to_input: Pow2,
-    p: DVec3,
+    vb: &[DVec3],
     s: &mut Scratch,
-    e: &mut i64,
-    c: &mut [f64],
+    eb: &mut [i64],
+    cb: &mut [f64],
 ) {
-    let p = to_model.of3(p);
-    let (k, a, tau) = locate(rest, edges, p, s);
-    let l = rest.eval(k, a);
-    let d = p - l.q - tau * l.t;
-    let sk = if tau != 0.0 {
-        DVec2::ZERO
-    } else {
-        l.kappa * l.sigma
-    };
+    let mut i = 0;
+    while i + LANES <= vb.len() {
+        bind_lanes::<LANES>(
+            rest,
+            edges,
+            &vb[i..],
+            s,
+            &mut eb[i..],
+            &mut cb[COORDS * i..],
+        );
+        i += LANES;
+    }
+    while i < vb.len() {
+        bind_lanes::<1>(
+            rest,
+            edges,
+            &vb[i..],
+            s,
+            &mut eb[i..],
+            &mut cb[COORDS * i..],
+        );
+        i += 1;
+    }
+}
+
+/// The bindings of the first `L` vertices of `vb` (see [`bind_run`]).
+#[inline(always)]
+fn bind_lanes<const L: usize>(
+    rest: &SpineModel,
+    edges: &Edges,
+    vb: &[DVec3],
+    s: &mut Scratch,
+    eb: &mut [i64],
+    cb: &mut [f64],
+) {
+    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
+    let p: [DVec3; L] = std::array::from_fn(|l| to_model.of3(vb[l]));
+    let found: [(usize, f64, f64); L] = std::array::from_fn(|l| locate(rest, edges, p[l], s));
+    let loc = rest.eval_lanes(&found.map(|f| f.0), &found.map(|f| f.1));
     let len = |x: f64| to_input.of(x);
-    *e = k as i64;
-    c.copy_from_slice(&[
-        a,
-        len(tau),
-        len(d.dot(l.u)),
-        len(d.dot(l.v)),
-        len(l.sigma),
-        sk.x,
-        sk.y,
-    ]);
+    for l in 0..L {
+        let ((k, a, tau), l0) = (found[l], &loc[l]);
+        let d = p[l] - l0.q - tau * l0.t;
+        let sk = if tau != 0.0 {
+            DVec2::ZERO
+        } else {
+            l0.kappa * l0.sigma
+        };
+        eb[l] = k as i64;
+        cb[COORDS * l..COORDS * (l + 1)].copy_from_slice(&[
+            a,
+            len(tau),
+            len(d.dot(l0.u)),
+            len(d.dot(l0.v)),
+            len(l0.sigma),
+            sk.x,
+            sk.y,
+        ]);
+    }
 }
 
 #[cfg(test)]
