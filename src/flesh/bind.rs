@@ -19,6 +19,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::section::{MAX_LANES, edge_roots, edge_roots_lanes};
 use super::spine::SpineModel;
 use crate::alloc;
 use crate::cancel::{self, Cancel};
@@ -33,83 +34,6 @@ pub const COORDS: usize = 7;
 pub struct Binding {
     pub edge: Vec<i64>,
     pub coords: Vec<f64>,
-}
-
-/// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
-/// steps, each refined by the Illinois variant of regula falsi to full precision. A point
-/// on the section plane of a sample (`f` zero at `a = 0` or `a = 1` up to the round-off of
-/// its evaluation) is a root there, so that it is not lost between two edges whose end
-/// values round to the same sign.
-fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
-    let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
-    // f at a grid point with the curve point and tangent it used
-    let fcm = |a: f64| {
-        let (c, m) = (sp.c_at(k, a), sp.m_at(k, a));
-        ((p - c).dot(m), c, m)
-    };
-    let on_plane = |fa: f64, c: DVec3, m: DVec3| {
-        // a bound of the threshold first (1-norms bound the lengths; below 1e150 their
-        // squares do not overflow), which rules out almost every point without square roots
-        let l1 = |x: DVec3| x.abs().element_sum();
-        let (lpc, lm) = (l1(p) + l1(c), l1(m));
-        let cheap = 16.0 * f64::EPSILON * lpc * lm * (1.0 + 1e-6);
-        if lpc < 1e150 && lm < 1e150 && fa.abs() > cheap {
-            return false;
-        }
-        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * m.length()
-    };
-    let mut out = [f64::NAN; 4];
-    let (f0, c0, m0) = fcm(0.0);
-    let mut prev = (0.0, f0);
-    for (i, slot) in out.iter_mut().enumerate() {
-        let b = (i + 1) as f64 / 4.0;
-        let (fb, cb, mb) = fcm(b);
-        let (mut a0, mut f0) = prev;
-        prev = (b, fb);
-        if f0 == 0.0 || (i == 0 && on_plane(f0, c0, m0)) {
-            *slot = a0;
-            continue;
-        }
-        if (f0 > 0.0) == (fb > 0.0) {
-            if i == 3 && on_plane(fb, cb, mb) {
-                *slot = 1.0;
-            }
-            continue;
-        }
-        let (mut a1, mut f1) = (b, fb);
-        let mut side = 0i8;
-        for _ in 0..200 {
-            let x = (a0 * f1 - a1 * f0) / (f1 - f0);
-            let x = if x > a0.min(a1) && x < a0.max(a1) {
-                x
-            } else {
-                0.5 * (a0 + a1)
-            };
-            let fx = f(x);
-            if fx == 0.0 || (a1 - a0).abs() <= 1e-15 {
-                a0 = x;
-                a1 = x;
-                break;
-            }
-            if (fx > 0.0) == (f1 > 0.0) {
-                a1 = x;
-                f1 = fx;
-                if side == -1 {
-                    f0 *= 0.5;
-                }
-                side = -1;
-            } else {
-                a0 = x;
-                f0 = fx;
-                if side == 1 {
-                    f1 *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        *slot = 0.5 * (a0 + a1);
-    }
-    out
 }
 
 /// The rest spine's edges in a hierarchy of boxes. Edge `k`'s curve is
@@ -214,15 +138,8 @@ struct Best {
     tau: f64,
 }
 
-/// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
-/// edge's roots, the first found winning ties in the order: the start's extension, the
-/// end's, the two edges at the sample nearest to `P`, then the other edges by index (the
-/// nearest sample is searched only when two edges tie). The edge of the vertex before
-/// (`s.hint`, often the answer: consecutive vertices are often neighbours) is solved first,
-/// then the others nearest first in the hierarchy, skipping those whose box or ball lies
-/// farther than the best so far (`O(log n)` edges for a vertex near the spine). The answer
-/// is the least candidate in that order whatever the hint.
-fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
+/// The best candidate past the spine's ends: the straight extensions (a loop has none).
+fn ends(sp: &SpineModel, p: DVec3) -> Best {
     let n = sp.len();
     let mut best = Best {
         d2: f64::INFINITY,
@@ -231,7 +148,6 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
         a: 0.0,
         tau: 0.0,
     };
-    // straight extensions past both ends (a loop has none)
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
     if tau < 0.0 && !sp.closed {
@@ -257,16 +173,48 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
             };
         }
     }
+    best
+}
+
+/// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
+/// edge's roots, the first found winning ties in the order: the start's extension, the
+/// end's, the two edges at the sample nearest to `P`, then the other edges by index (the
+/// nearest sample is searched only when two edges tie). The edge `s.hint` (the edge of the
+/// vertex before, often the answer: consecutive vertices are often neighbours) is solved
+/// first, then the others nearest first in the hierarchy, skipping those whose box or ball
+/// lies farther than the best so far (`O(log n)` edges for a vertex near the spine). The
+/// answer is the least candidate in that order whatever the hint.
+#[cfg(test)]
+fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
+    let hint = s.hint.min(sp.len() - 2);
+    locate_from(sp, edges, p, hint, &edge_roots(sp, hint, p), s)
+}
+
+/// [`locate`] with the roots `roots` of the hint edge `hint` given.
+fn locate_from(
+    sp: &SpineModel,
+    edges: &Edges,
+    p: DVec3,
+    hint: usize,
+    roots: &[f64; 4],
+    s: &mut Scratch,
+) -> (usize, f64, f64) {
+    let n = sp.len();
+    let mut best = ends(sp, p);
     // the sample nearest to p, searched when first needed (ties between edges)
     let mut near: Option<usize> = None;
     // the nearest sample's search stack (rarely used: allocated then only)
     let mut inner = Vec::new();
-    let mut edge = |k: usize, best: &mut Best, stack: &mut Vec<(usize, f64)>| {
+    let mut edge = |k: usize, roots: Option<&[f64; 4]>, best: &mut Best| {
         // every point of the edge's curve is at least this far
         if edges.lower_bound(sp, k, p) > best.d2 {
             return;
         }
-        for a in edge_roots(sp, k, p) {
+        let roots = match roots {
+            Some(r) => *r,
+            None => edge_roots(sp, k, p),
+        };
+        for a in roots {
             if !(-1e-12..=1.0 + 1e-12).contains(&a) {
                 continue;
             }
@@ -275,7 +223,7 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
             let wins = d2 < best.d2
                 || (d2 == best.d2 && best.who >= 0 && best.who != k as i64 && {
                     // ranks: the edges at the nearest sample first, then by index
-                    let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, stack));
+                    let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, &mut inner));
                     let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
                     let rank = |k: usize| match (first..end).contains(&k) {
                         true => (k - first) as i64,
@@ -294,14 +242,13 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
             }
         }
     };
-    let hint = s.hint.min(n - 2);
-    edge(hint, &mut best, &mut inner);
+    edge(hint, Some(roots), &mut best);
     let mut search = std::mem::take(&mut s.stack);
     edges
         .bvh
         .nearest(p, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
             if k != hint && edges.boxes[k].distance_squared(p) <= best.d2 * (1.0 + BOX_MARGIN) {
-                edge(k, &mut best, &mut inner);
+                edge(k, None, &mut best);
             }
             best.d2 * (1.0 + BOX_MARGIN)
         });
@@ -309,7 +256,7 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
     if best.d2.is_infinite() {
         // cannot happen for finite input (the plane signs change somewhere); keep a
         // defined answer anyway: the nearest sample
-        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, &mut inner));
+        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, &mut Vec::new()));
         let (k, a) = if near + 1 < n {
             (near, 0.0)
         } else {
@@ -362,12 +309,13 @@ pub fn bind_cancellable(
 /// Vertices per block of the registration (a Ctrl-C poll each).
 const BLOCK: usize = 256;
 
-/// Vertices whose spine points are evaluated together (see [`SpineModel::eval_lanes`]).
-const LANES: usize = 4;
+/// Vertices registered together: the roots on their hint edge refined together (see
+/// [`edge_roots_lanes`]), the spine evaluated at their sections together (see
+/// [`SpineModel::eval_lanes`]).
+const LANES: usize = MAX_LANES;
 
 /// The bindings of a run of vertices (input units) into `e` and `c` (see the module notes):
-/// each located in turn (the next search starts from the edge found), then the spine
-/// evaluated at `LANES` of them at a time.
+/// `LANES` at a time, each search starting from the edge found for the vertex before them.
 fn bind_run(
     rest: &SpineModel,
     edges: &Edges,
@@ -412,9 +360,20 @@ fn bind_lanes<const L: usize>(
     cb: &mut [f64],
 ) {
     let (to_model, to_input) = (rest.scale, rest.scale.inverse());
-    let p: [DVec3; L] = std::array::from_fn(|l| to_model.of3(vb[l]));
-    let found: [(usize, f64, f64); L] = std::array::from_fn(|l| locate(rest, edges, p[l], s));
-    let loc = rest.eval_lanes(&found.map(|f| f.0), &found.map(|f| f.1));
+    let mut p = [DVec3::ZERO; L];
+    for l in 0..L {
+        p[l] = to_model.of3(vb[l]);
+    }
+    // the edge of the run's vertex before, for all L
+    let hint = s.hint.min(rest.len() - 2);
+    let roots = edge_roots_lanes(rest, &[hint; L], &p);
+    let mut found = [(0usize, 0.0, 0.0); L];
+    let (mut ks, mut as_) = ([0usize; L], [0.0; L]);
+    for l in 0..L {
+        found[l] = locate_from(rest, edges, p[l], hint, &roots[l], s);
+        (ks[l], as_[l]) = (found[l].0, found[l].1);
+    }
+    let loc = rest.eval_lanes(&ks, &as_);
     let len = |x: f64| to_input.of(x);
     for l in 0..L {
         let ((k, a, tau), l0) = (found[l], &loc[l]);
@@ -538,6 +497,7 @@ mod tests {
         let far_sp = open_model(&far);
         for (model, count) in [(&sp, 4000), (&loop_sp, 2000), (&far_sp, 4000)] {
             let edges = Edges::new(model).unwrap();
+            let mut run = Vec::new();
             for q in 0..count {
                 let x = q as f64 * 0.618_033_988_7;
                 let mut p = DVec3::new(
@@ -568,8 +528,68 @@ mod tests {
                     (want.0, want.1.to_bits(), want.2.to_bits()),
                     "{p}"
                 );
+                run.push((p, want));
+            }
+            // the same points registered as one run (hints from the vertex before, four
+            // at a time), in input units
+            let to_input = model.scale.inverse();
+            let pts: Vec<DVec3> = run.iter().map(|r| to_input.of3(r.0)).collect();
+            let b = bind(model, &pts).unwrap();
+            for (i, (p, want)) in run.iter().enumerate() {
+                let got = (
+                    b.edge[i] as usize,
+                    b.coords[COORDS * i],
+                    b.coords[COORDS * i + 1],
+                );
+                assert_eq!(
+                    (got.0, got.1.to_bits(), got.2.to_bits()),
+                    (want.0, want.1.to_bits(), to_input.of(want.2).to_bits()),
+                    "{p}"
+                );
             }
         }
+    }
+
+    #[test]
+    fn a_tube_about_a_straight_spine_binds_as_the_scan_does() {
+        // rings of vertices about a straight spine (the vertex before is on the same edge
+        // but at the sample planes), rings on the sample planes themselves (ties between
+        // the two edges of a sample, decided by the nearest sample), and past both ends
+        let n = 26;
+        let pts: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new(i as f64 * 0.16, 0.0, 0.0))
+            .collect();
+        let sp = open_model(&pts);
+        let mut verts = Vec::new();
+        for ring in 0..300 {
+            let x = if ring % 5 == 0 {
+                0.16 * (ring / 5) as f64 // on a sample plane
+            } else {
+                -0.2 + 4.4 * ring as f64 / 300.0
+            };
+            for j in 0..37 {
+                let ang = std::f64::consts::TAU * j as f64 / 37.0;
+                verts.push(DVec3::new(x, 0.3 * ang.cos(), 0.3 * ang.sin()));
+            }
+        }
+        let b = bind(&sp, &verts).unwrap();
+        let mut ties = 0;
+        for (i, &p) in verts.iter().enumerate() {
+            let want = locate_by_scan(&sp, p);
+            let got = (
+                b.edge[i] as usize,
+                b.coords[COORDS * i],
+                b.coords[COORDS * i + 1],
+            );
+            assert_eq!(
+                (got.0, got.1.to_bits(), got.2.to_bits()),
+                (want.0, want.1.to_bits(), want.2.to_bits()),
+                "{p}"
+            );
+            // on a sample plane inside the spine (the first edge of the tie wins)
+            ties += usize::from((want.1 == 0.0 || want.1 == 1.0) && want.2 == 0.0);
+        }
+        assert!(ties > 100, "{ties}");
     }
 
     #[test]

@@ -39,6 +39,7 @@
 pub mod bind;
 pub mod blend;
 pub mod pose;
+pub mod section;
 pub mod solve;
 pub mod spine;
 pub mod surface;
