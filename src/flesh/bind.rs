@@ -24,7 +24,8 @@ use super::spine::SpineModel;
 use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::Result;
-use crate::math::bvh::{Aabb, Bvh};
+use crate::math::bvh::Aabb;
+use crate::math::chain::ChainBoxes;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -36,19 +37,16 @@ pub struct Binding {
     pub coords: Vec<f64>,
 }
 
-/// The rest spine's edges in a hierarchy of boxes. Edge `k`'s curve is
+/// The rest spine's edges in a hierarchy of boxes ([`ChainBoxes`]). Edge `k`'s curve is
 /// `C(a) = C_k + a E_k + h (h10(a) d_k + h11(a) d_{k+1})` (the Hermite form with slopes
 /// `h t`, `h = |E_k|`, `d_j = t_j − E_k/h`, since `h01 + h10 + h11 = a`), so it stays within
 /// `ρ_k = (4/27) h (|d_k| + |d_{k+1}|)` of its chord (`|h10|, |h11| ≤ 4/27` on `[0, 1]`):
 /// the distance from `P` to the chord minus `ρ_k` bounds the distance to the curve from
 /// below. The boxes are the chords' widened by `ρ_k`; they hold both samples.
 struct Edges {
-    bvh: Bvh,
+    tree: ChainBoxes,
     /// `ρ_k`, slightly enlarged against round-off.
     reach: Vec<f64>,
-    /// Per edge: its box (the hierarchy's items), a first cheap test before
-    /// [`Edges::lower_bound`].
-    boxes: Vec<Aabb>,
 }
 
 /// Relative margin on squared distances from boxes: a box nearer than the best answer by
@@ -83,9 +81,8 @@ impl Edges {
             }),
         )?;
         Ok(Edges {
-            bvh: Bvh::build(&boxes),
+            tree: ChainBoxes::build(&boxes),
             reach,
-            boxes,
         })
     }
 
@@ -105,9 +102,9 @@ impl Edges {
     }
 
     /// The sample nearest to `p` (the first of equally near ones).
-    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, stack: &mut Vec<(usize, f64)>) -> usize {
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, stack: &mut Stack) -> usize {
         let mut best = (f64::INFINITY, 0);
-        self.bvh.nearest(p, best.0, stack, |k| {
+        self.tree.nearest_from(p, 0, best.0, stack, |k| {
             for j in [k, k + 1] {
                 let d = (p - sp.c[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
@@ -124,8 +121,11 @@ impl Edges {
 /// search starts) and the hierarchy's stack.
 struct Scratch {
     hint: usize,
-    stack: Vec<(usize, f64)>,
+    stack: Stack,
 }
+
+/// The search stack of [`ChainBoxes::nearest_from`].
+type Stack = Vec<(usize, usize, f64)>;
 
 /// The best candidate of [`locate`] so far: squared distance, who (`-2` the start's
 /// extension, `-1` the end's, `k ≥ 0` edge `k`, `i64::MIN` none yet), edge, `a`, `τ`.
@@ -181,9 +181,9 @@ fn ends(sp: &SpineModel, p: DVec3) -> Best {
 /// end's, the two edges at the sample nearest to `P`, then the other edges by index (the
 /// nearest sample is searched only when two edges tie). The edge `s.hint` (the edge of the
 /// vertex before, often the answer: consecutive vertices are often neighbours) is solved
-/// first, then the others nearest first in the hierarchy, skipping those whose box or ball
-/// lies farther than the best so far (`O(log n)` edges for a vertex near the spine). The
-/// answer is the least candidate in that order whatever the hint.
+/// first, then the others climbing the hierarchy of boxes from it, skipping those whose box
+/// or ball lies farther than the best so far (`O(log n)` box tests for a vertex near the
+/// hint's edge). The answer is the least candidate in that order whatever the hint.
 #[cfg(test)]
 fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
     let hint = s.hint.min(sp.len() - 2);
@@ -242,14 +242,12 @@ fn locate_from(
             }
         }
     };
-    edge(hint, Some(roots), &mut best);
     let mut search = std::mem::take(&mut s.stack);
     edges
-        .bvh
-        .nearest(p, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
-            if k != hint && edges.boxes[k].distance_squared(p) <= best.d2 * (1.0 + BOX_MARGIN) {
-                edge(k, None, &mut best);
-            }
+        .tree
+        .nearest_from(p, hint, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
+            // the hint edge's roots are known
+            edge(k, (k == hint).then_some(roots), &mut best);
             best.d2 * (1.0 + BOX_MARGIN)
         });
     s.stack = search;
