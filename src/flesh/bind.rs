@@ -101,10 +101,11 @@ impl Edges {
         }
     }
 
-    /// The sample nearest to `p` (the first of equally near ones).
-    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, stack: &mut Stack) -> usize {
+    /// The sample nearest to `p` (the first of equally near ones), searched from edge
+    /// `start` (the answer does not depend on it).
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, start: usize, stack: &mut Stack) -> usize {
         let mut best = (f64::INFINITY, 0);
-        self.tree.nearest_from(p, 0, best.0, stack, |k| {
+        self.tree.nearest_from(p, start, best.0, stack, |k| {
             for j in [k, k + 1] {
                 let d = (p - sp.c[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
@@ -187,74 +188,127 @@ fn ends(sp: &SpineModel, p: DVec3) -> Best {
 #[cfg(test)]
 fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
     let hint = s.hint.min(sp.len() - 2);
-    locate_from(sp, edges, p, hint, &edge_roots(sp, hint, p), s)
+    let roots = between_planes(sp, hint, p).then(|| edge_roots(sp, hint, p));
+    locate_from(sp, edges, p, hint, roots.as_ref(), s)
 }
 
-/// [`locate`] with the roots `roots` of the hint edge `hint` given.
+/// Edge `k`'s roots for `p` (`roots` when they are known) as candidates against `best`
+/// (see [`locate`]); `near` caches the sample nearest to `p` (searched with the stack
+/// `inner` when two edges tie).
+#[allow(clippy::too_many_arguments)]
+fn consider(
+    sp: &SpineModel,
+    edges: &Edges,
+    p: DVec3,
+    k: usize,
+    roots: Option<&[f64; 4]>,
+    best: &mut Best,
+    near: &mut Option<usize>,
+    inner: &mut Stack,
+) {
+    let n = sp.len();
+    // every point of the edge's curve is at least this far
+    if edges.lower_bound(sp, k, p) > best.d2 {
+        return;
+    }
+    let roots = match roots {
+        Some(r) => *r,
+        None => edge_roots(sp, k, p),
+    };
+    for a in roots {
+        if !(-1e-12..=1.0 + 1e-12).contains(&a) {
+            continue;
+        }
+        let a = a.clamp(0.0, 1.0);
+        let d2 = (p - sp.c_at(k, a)).length_squared();
+        let wins = d2 < best.d2
+            || (d2 == best.d2 && best.who >= 0 && best.who != k as i64 && {
+                // ranks: the edges at the nearest sample first, then by index
+                let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, k, inner));
+                let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
+                let rank = |k: usize| match (first..end).contains(&k) {
+                    true => (k - first) as i64,
+                    false => 2 + k as i64,
+                };
+                rank(k) < rank(best.who as usize)
+            });
+        if wins {
+            *best = Best {
+                d2,
+                who: k as i64,
+                k,
+                a,
+                tau: 0.0,
+            };
+        }
+    }
+}
+
+/// [`locate`] with the roots `roots` of the hint edge `hint` given, or `None` when the hint
+/// is not worth solving first (`p` outside its end planes). When the hint edge gives no
+/// candidate, the two edges at the sample nearest to `p` are solved first instead and the
+/// search climbs from there.
 fn locate_from(
     sp: &SpineModel,
     edges: &Edges,
     p: DVec3,
     hint: usize,
-    roots: &[f64; 4],
+    roots: Option<&[f64; 4]>,
     s: &mut Scratch,
 ) -> (usize, f64, f64) {
     let n = sp.len();
     let mut best = ends(sp, p);
-    // the sample nearest to p, searched when first needed (ties between edges)
+    // the sample nearest to p, searched when first needed
     let mut near: Option<usize> = None;
-    // the nearest sample's search stack (rarely used: allocated then only)
+    // the nearest sample's search stack (allocated when first used)
     let mut inner = Vec::new();
-    let mut edge = |k: usize, roots: Option<&[f64; 4]>, best: &mut Best| {
-        // every point of the edge's curve is at least this far
-        if edges.lower_bound(sp, k, p) > best.d2 {
-            return;
+    // edges solved before the climb
+    let mut done = [usize::MAX; 3];
+    if let Some(r) = roots {
+        consider(
+            sp,
+            edges,
+            p,
+            hint,
+            Some(r),
+            &mut best,
+            &mut near,
+            &mut inner,
+        );
+        done[0] = hint;
+    }
+    let start = if best.who == hint as i64 {
+        hint
+    } else {
+        let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, hint, &mut inner));
+        let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
+        // the one with the nearer chord first: a good bound prunes almost all others
+        let mut two = [first, end - 1];
+        if edges.lower_bound(sp, two[1], p) < edges.lower_bound(sp, two[0], p) {
+            two.swap(0, 1);
         }
-        let roots = match roots {
-            Some(r) => *r,
-            None => edge_roots(sp, k, p),
-        };
-        for a in roots {
-            if !(-1e-12..=1.0 + 1e-12).contains(&a) {
-                continue;
-            }
-            let a = a.clamp(0.0, 1.0);
-            let d2 = (p - sp.c_at(k, a)).length_squared();
-            let wins = d2 < best.d2
-                || (d2 == best.d2 && best.who >= 0 && best.who != k as i64 && {
-                    // ranks: the edges at the nearest sample first, then by index
-                    let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, &mut inner));
-                    let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
-                    let rank = |k: usize| match (first..end).contains(&k) {
-                        true => (k - first) as i64,
-                        false => 2 + k as i64,
-                    };
-                    rank(k) < rank(best.who as usize)
-                });
-            if wins {
-                *best = Best {
-                    d2,
-                    who: k as i64,
-                    k,
-                    a,
-                    tau: 0.0,
-                };
+        for (i, &k) in two.iter().take(end - first).enumerate() {
+            if !done.contains(&k) {
+                consider(sp, edges, p, k, None, &mut best, &mut near, &mut inner);
+                done[1 + i] = k;
             }
         }
+        two[0]
     };
     let mut search = std::mem::take(&mut s.stack);
     edges
         .tree
-        .nearest_from(p, hint, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
-            // the hint edge's roots are known
-            edge(k, (k == hint).then_some(roots), &mut best);
+        .nearest_from(p, start, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
+            if !done.contains(&k) {
+                consider(sp, edges, p, k, None, &mut best, &mut near, &mut inner);
+            }
             best.d2 * (1.0 + BOX_MARGIN)
         });
     s.stack = search;
     if best.d2.is_infinite() {
         // cannot happen for finite input (the plane signs change somewhere); keep a
         // defined answer anyway: the nearest sample
-        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, &mut Vec::new()));
+        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, hint, &mut inner));
         let (k, a) = if near + 1 < n {
             (near, 0.0)
         } else {
@@ -264,6 +318,12 @@ fn locate_from(
     }
     s.hint = best.k;
     (best.k, best.a, best.tau)
+}
+
+/// Whether `p` lies between the end planes of edge `k` (where its section probably is:
+/// then the hint is solved first).
+fn between_planes(sp: &SpineModel, k: usize, p: DVec3) -> bool {
+    (p - sp.c[k]).dot(sp.t[k]) >= 0.0 && (p - sp.c[k + 1]).dot(sp.t[k + 1]) <= 0.0
 }
 
 /// Register `vertices` on the rest spine.
@@ -364,11 +424,26 @@ fn bind_lanes<const L: usize>(
     }
     // the edge of the run's vertex before, for all L
     let hint = s.hint.min(rest.len() - 2);
-    let roots = edge_roots_lanes(rest, &[hint; L], &p);
+    let mut inside = [false; L];
+    for l in 0..L {
+        inside[l] = between_planes(rest, hint, p[l]);
+    }
+    let roots = if inside.iter().all(|&b| b) {
+        edge_roots_lanes(rest, &[hint; L], &p)
+    } else {
+        let mut r = [[f64::NAN; 4]; L];
+        for l in 0..L {
+            if inside[l] {
+                r[l] = edge_roots(rest, hint, p[l]);
+            }
+        }
+        r
+    };
     let mut found = [(0usize, 0.0, 0.0); L];
     let (mut ks, mut as_) = ([0usize; L], [0.0; L]);
     for l in 0..L {
-        found[l] = locate_from(rest, edges, p[l], hint, &roots[l], s);
+        let r = inside[l].then_some(&roots[l]);
+        found[l] = locate_from(rest, edges, p[l], hint, r, s);
         (ks[l], as_[l]) = (found[l].0, found[l].1);
     }
     let loc = rest.eval_lanes(&ks, &as_);

@@ -1,5 +1,6 @@
 //! A hierarchy of boxes over the consecutive items of a chain (the edges of a polyline):
-//! level 0 holds the items' boxes, level `l + 1` the unions of pairs of level `l` (the
+//! level 0 holds the boxes of blocks of [`LEAF`] consecutive items, level `l + 1` the
+//! unions of pairs of level `l` (the
 //! layout of a segment tree, Bentley 1977; de Berg et al., "Computational Geometry", 3rd
 //! ed., §10.3). [`ChainBoxes::nearest_from`] is the branch-and-bound nearest search of
 //! [`super::bvh::Bvh::nearest`] started at a leaf instead of the root: after the start item
@@ -9,38 +10,57 @@
 
 use super::bvh::Aabb;
 
+/// Items per leaf (consecutive items: a leaf's are tested one by one).
+pub const LEAF: usize = 8;
+
 /// The levels of boxes over a chain of items (see the module notes).
 pub struct ChainBoxes {
+    items: Vec<Aabb>,
+    /// level 0: the leaves (blocks of [`LEAF`] items); level `l + 1`: pairs of level `l`
     levels: Vec<Vec<Aabb>>,
 }
 
 impl ChainBoxes {
     pub fn build(boxes: &[Aabb]) -> ChainBoxes {
-        let mut levels = vec![boxes.to_vec()];
+        let union = |c: &[Aabb]| c.iter().copied().reduce(Aabb::union).unwrap_or(c[0]);
+        let mut levels = vec![boxes.chunks(LEAF).map(union).collect::<Vec<_>>()];
         while levels[levels.len() - 1].len() > 1 {
-            let last = &levels[levels.len() - 1];
-            let up = last
-                .chunks(2)
-                .map(|c| c.iter().copied().reduce(Aabb::union).unwrap_or(c[0]))
-                .collect();
+            let up = levels[levels.len() - 1].chunks(2).map(union).collect();
             levels.push(up);
         }
-        ChainBoxes { levels }
+        ChainBoxes {
+            items: boxes.to_vec(),
+            levels,
+        }
     }
 
-    /// The box of item `j`.
+    /// Calls `visit` for the items of leaf `leaf` whose box lies within `bound` (but
+    /// `skip`); returns the bound from then on.
     #[inline]
-    pub fn item(&self, j: usize) -> &Aabb {
-        &self.levels[0][j]
+    fn leaf(
+        &self,
+        p: glam::DVec3,
+        leaf: usize,
+        skip: usize,
+        mut bound: f64,
+        visit: &mut impl FnMut(usize) -> f64,
+    ) -> f64 {
+        let end = (LEAF * leaf + LEAF).min(self.items.len());
+        for j in LEAF * leaf..end {
+            if j != skip && self.items[j].distance_squared(p) <= bound {
+                bound = visit(j);
+            }
+        }
+        bound
     }
 
     /// Branch and bound about `p` from item `start`: calls `visit(j)` for every item whose
     /// box lies within squared distance `bound` of `p` (an item at exactly the bound
-    /// included) — `start` first, then the sibling subtrees of its ancestors nearest first,
-    /// nearer children first — where `visit` returns the bound from then on (the
-    /// squared distance of the best answer so far). Items whose boxes are all farther than
-    /// the final bound may be skipped. `stack`: scratch space that a caller making many
-    /// queries passes each time.
+    /// included) — `start` first, then the other items of its leaf, then the sibling
+    /// subtrees of its ancestors nearest first, nearer children first — where `visit`
+    /// returns the bound from then on (the squared distance of the best answer so far).
+    /// Items whose boxes are all farther than the final bound may be skipped. `stack`:
+    /// scratch space that a caller making many queries passes each time.
     pub fn nearest_from(
         &self,
         p: glam::DVec3,
@@ -49,18 +69,18 @@ impl ChainBoxes {
         stack: &mut Vec<(usize, usize, f64)>,
         mut visit: impl FnMut(usize) -> f64,
     ) {
-        let items = &self.levels[0];
-        if start >= items.len() {
+        if start >= self.items.len() {
             return;
         }
-        if items[start].distance_squared(p) <= bound {
+        if self.items[start].distance_squared(p) <= bound {
             bound = visit(start);
         }
+        bound = self.leaf(p, start / LEAF, start, bound, &mut visit);
         // the sibling subtrees of the start's ancestors, the nearest popped first (a
         // start far from the answer, whose own candidates set no bound, then finds it
         // nearest first as from the root)
         stack.clear();
-        let mut idx = start;
+        let mut idx = start / LEAF;
         for (l, level) in self.levels.iter().enumerate() {
             let sib = idx ^ 1;
             if sib < level.len() {
@@ -79,7 +99,7 @@ impl ChainBoxes {
                 continue;
             }
             if lv == 0 {
-                bound = visit(i);
+                bound = self.leaf(p, i, usize::MAX, bound, &mut visit);
                 continue;
             }
             let below = &self.levels[lv - 1];
