@@ -1,8 +1,8 @@
 //! A hierarchy of boxes over the consecutive items of a chain (the edges of a polyline):
 //! level 0 holds the boxes of blocks of [`LEAF`] consecutive items, level `l + 1` the
-//! unions of pairs of level `l` (the
-//! layout of a segment tree, Bentley 1977; de Berg et al., "Computational Geometry", 3rd
-//! ed., §10.3). [`ChainBoxes::nearest_from`] is the branch-and-bound nearest search of
+//! unions of pairs of level `l` (the layout of a segment tree: de Berg et al.,
+//! "Computational Geometry", 3rd ed., §10.3). [`ChainBoxes::nearest_from`] is the
+//! branch-and-bound nearest search (Friedman, Bentley & Finkel 1977) of
 //! [`super::bvh::Bvh::nearest`] started at a leaf instead of the root: after the start item
 //! it searches the sibling subtrees of the start's ancestors, nearest first, each only when
 //! its box lies within the bound, so a query whose answer is near the start (a vertex bound
