@@ -19,12 +19,13 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::section::{MAX_LANES, edge_roots, edge_roots_lanes};
 use super::spine::SpineModel;
 use crate::alloc;
 use crate::cancel::{self, Cancel};
 use crate::error::Result;
-use crate::math::bvh::{Aabb, Bvh};
-use crate::math::scale::Pow2;
+use crate::math::bvh::Aabb;
+use crate::math::chain::ChainBoxes;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -36,81 +37,21 @@ pub struct Binding {
     pub coords: Vec<f64>,
 }
 
-/// Roots in `[0, 1]` of `f(a) = (P − C(a))·m(a)` (degree 6): sign changes on a grid of 4
-/// steps, each refined by the Illinois variant of regula falsi to full precision. A point
-/// on the section plane of a sample (`f` zero at `a = 0` or `a = 1` up to the round-off of
-/// its evaluation) is a root there, so that it is not lost between two edges whose end
-/// values round to the same sign.
-fn edge_roots(sp: &SpineModel, k: usize, p: DVec3) -> [f64; 4] {
-    let f = |a: f64| (p - sp.c_at(k, a)).dot(sp.m_at(k, a));
-    let on_plane = |a: f64, fa: f64| {
-        let c = sp.c_at(k, a);
-        fa.abs() <= 16.0 * f64::EPSILON * (p.length() + c.length()) * sp.m_at(k, a).length()
-    };
-    let mut out = [f64::NAN; 4];
-    let mut prev = (0.0, f(0.0));
-    for (i, slot) in out.iter_mut().enumerate() {
-        let b = (i + 1) as f64 / 4.0;
-        let fb = f(b);
-        let (mut a0, mut f0) = prev;
-        prev = (b, fb);
-        if f0 == 0.0 || (i == 0 && on_plane(0.0, f0)) {
-            *slot = a0;
-            continue;
-        }
-        if (f0 > 0.0) == (fb > 0.0) {
-            if i == 3 && on_plane(1.0, fb) {
-                *slot = 1.0;
-            }
-            continue;
-        }
-        let (mut a1, mut f1) = (b, fb);
-        let mut side = 0i8;
-        for _ in 0..200 {
-            let x = (a0 * f1 - a1 * f0) / (f1 - f0);
-            let x = if x > a0.min(a1) && x < a0.max(a1) {
-                x
-            } else {
-                0.5 * (a0 + a1)
-            };
-            let fx = f(x);
-            if fx == 0.0 || (a1 - a0).abs() <= 1e-15 {
-                a0 = x;
-                a1 = x;
-                break;
-            }
-            if (fx > 0.0) == (f1 > 0.0) {
-                a1 = x;
-                f1 = fx;
-                if side == -1 {
-                    f0 *= 0.5;
-                }
-                side = -1;
-            } else {
-                a0 = x;
-                f0 = fx;
-                if side == 1 {
-                    f1 *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        *slot = 0.5 * (a0 + a1);
-    }
-    out
-}
-
-/// The rest spine's edges in a hierarchy of boxes. Edge `k`'s curve is
+/// The rest spine's edges in a hierarchy of boxes ([`ChainBoxes`]). Edge `k`'s curve is
 /// `C(a) = C_k + a E_k + h (h10(a) d_k + h11(a) d_{k+1})` (the Hermite form with slopes
 /// `h t`, `h = |E_k|`, `d_j = t_j − E_k/h`, since `h01 + h10 + h11 = a`), so it stays within
 /// `ρ_k = (4/27) h (|d_k| + |d_{k+1}|)` of its chord (`|h10|, |h11| ≤ 4/27` on `[0, 1]`):
 /// the distance from `P` to the chord minus `ρ_k` bounds the distance to the curve from
 /// below. The boxes are the chords' widened by `ρ_k`; they hold both samples.
 struct Edges {
-    bvh: Bvh,
+    tree: ChainBoxes,
     /// `ρ_k`, slightly enlarged against round-off.
     reach: Vec<f64>,
 }
+
+/// Relative margin on squared distances from boxes: a box nearer than the best answer by
+/// less than this may still hold it once both are rounded (kept, never pruned).
+const BOX_MARGIN: f64 = 1e-9;
 
 impl Edges {
     fn new(sp: &SpineModel) -> Result<Edges> {
@@ -140,7 +81,7 @@ impl Edges {
             }),
         )?;
         Ok(Edges {
-            bvh: Bvh::build(&boxes),
+            tree: ChainBoxes::build(&boxes),
             reach,
         })
     }
@@ -160,98 +101,214 @@ impl Edges {
         }
     }
 
-    /// The sample nearest to `p` (the first of equally near ones). `hint`: a sample that is
-    /// probably near (the answer for the vertex before), whose distance bounds the search
-    /// from the start; the answer does not depend on it.
-    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, hint: usize, s: &mut Scratch) -> usize {
-        let hint = hint.min(sp.len() - 1);
-        let mut best = ((p - sp.c[hint]).length_squared(), hint);
-        self.bvh.nearest(p, best.0, &mut s.stack, |k| {
+    /// The sample nearest to `p` (the first of equally near ones), searched from edge
+    /// `start` (the answer does not depend on it).
+    fn nearest_sample(&self, sp: &SpineModel, p: DVec3, start: usize, stack: &mut Stack) -> usize {
+        let mut best = (f64::INFINITY, 0);
+        self.tree.nearest_from(p, start, best.0, stack, |k| {
             for j in [k, k + 1] {
                 let d = (p - sp.c[j]).length_squared();
                 if d < best.0 || (d == best.0 && j < best.1) {
                     best = (d, j);
                 }
             }
-            best.0
+            best.0 * (1.0 + BOX_MARGIN)
         });
         best.1
     }
 }
 
-/// Working state of a run of vertices: the sample nearest to the vertex before (where the
-/// next one's search starts) and the hierarchy's stack.
+/// Working state of a run of vertices: the edge of the vertex before (where the next one's
+/// search starts) and the hierarchy's stack.
 struct Scratch {
     hint: usize,
-    stack: Vec<(usize, f64)>,
+    stack: Stack,
 }
 
-/// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
-/// edge's roots, the first found winning ties in the order: the start's extension, the
-/// end's, the two edges at the sample nearest to `P`, then the other edges by index; the
-/// edges are searched nearest first in the hierarchy, skipping those whose ball lies
-/// farther than the best so far (`O(log n)` edges for a vertex near the spine).
-fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
+/// The search stack of [`ChainBoxes::nearest_from`].
+type Stack = Vec<(usize, usize, f64)>;
+
+/// The best candidate of [`locate`] so far: squared distance, who (`-2` the start's
+/// extension, `-1` the end's, `k ≥ 0` edge `k`, `i64::MIN` none yet), edge, `a`, `τ`.
+#[derive(Clone, Copy)]
+struct Best {
+    d2: f64,
+    who: i64,
+    k: usize,
+    a: f64,
+    tau: f64,
+}
+
+/// The best candidate past the spine's ends: the straight extensions (a loop has none).
+fn ends(sp: &SpineModel, p: DVec3) -> Best {
     let n = sp.len();
-    // (squared distance, rank in the order above, edge, a, τ)
-    let mut best = (f64::INFINITY, i64::MIN, 0usize, 0.0f64, 0.0f64);
-    // straight extensions past both ends (a loop has none)
+    let mut best = Best {
+        d2: f64::INFINITY,
+        who: i64::MIN,
+        k: 0,
+        a: 0.0,
+        tau: 0.0,
+    };
     let w = p - sp.c[0];
     let tau = w.dot(sp.t[0]);
     if tau < 0.0 && !sp.closed {
-        best = ((w - tau * sp.t[0]).length_squared(), -2, 0, 0.0, tau);
+        best = Best {
+            d2: (w - tau * sp.t[0]).length_squared(),
+            who: -2,
+            k: 0,
+            a: 0.0,
+            tau,
+        };
     }
     let w = p - sp.c[n - 1];
     let tau = w.dot(sp.t[n - 1]);
     if tau > 0.0 && !sp.closed {
         let d2 = (w - tau * sp.t[n - 1]).length_squared();
-        if d2 < best.0 {
-            best = (d2, -1, n - 2, 1.0, tau);
+        if d2 < best.d2 {
+            best = Best {
+                d2,
+                who: -1,
+                k: n - 2,
+                a: 1.0,
+                tau,
+            };
         }
     }
-    let near = edges.nearest_sample(sp, p, s.hint, s);
-    s.hint = near;
-    let first = near.saturating_sub(1);
-    let end = (near + 1).min(n - 1);
-    let rank = |k: usize| match (first..end).contains(&k) {
-        true => (k - first) as i64,
-        false => 2 + k as i64,
+    best
+}
+
+/// Register one vertex: `(k, a, τ)`. The closest point over the end extensions and every
+/// edge's roots, the first found winning ties in the order: the start's extension, the
+/// end's, the two edges at the sample nearest to `P`, then the other edges by index (the
+/// nearest sample is searched only when two edges tie). The edge `s.hint` (the edge of the
+/// vertex before, often the answer: consecutive vertices are often neighbours) is solved
+/// first, then the others climbing the hierarchy of boxes from it, skipping those whose box
+/// or ball lies farther than the best so far (`O(log n)` box tests for a vertex near the
+/// hint's edge). The answer is the least candidate in that order whatever the hint.
+#[cfg(test)]
+fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, f64, f64) {
+    let hint = s.hint.min(sp.len() - 2);
+    let roots = between_planes(sp, hint, p).then(|| edge_roots(sp, hint, p));
+    locate_from(sp, edges, p, hint, roots.as_ref(), s)
+}
+
+/// Edge `k`'s roots for `p` (`roots` when they are known) as candidates against `best`
+/// (see [`locate`]); `near` caches the sample nearest to `p` (searched with the stack
+/// `inner` when two edges tie).
+#[allow(clippy::too_many_arguments)]
+fn consider(
+    sp: &SpineModel,
+    edges: &Edges,
+    p: DVec3,
+    k: usize,
+    roots: Option<&[f64; 4]>,
+    best: &mut Best,
+    near: &mut Option<usize>,
+    inner: &mut Stack,
+) {
+    let n = sp.len();
+    // every point of the edge's curve is at least this far
+    if edges.lower_bound(sp, k, p) > best.d2 {
+        return;
+    }
+    let roots = match roots {
+        Some(r) => *r,
+        None => edge_roots(sp, k, p),
     };
-    let edge = |k: usize, best: &mut (f64, i64, usize, f64, f64)| {
-        // every point of the edge's curve is at least this far
-        if edges.lower_bound(sp, k, p) > best.0 {
-            return;
+    for a in roots {
+        if !(-1e-12..=1.0 + 1e-12).contains(&a) {
+            continue;
         }
-        let r = rank(k);
-        for a in edge_roots(sp, k, p) {
-            if !(-1e-12..=1.0 + 1e-12).contains(&a) {
-                continue;
-            }
-            let a = a.clamp(0.0, 1.0);
-            let d2 = (p - sp.c_at(k, a)).length_squared();
-            if d2 < best.0 || (d2 == best.0 && r < best.1) {
-                *best = (d2, r, k, a, 0.0);
+        let a = a.clamp(0.0, 1.0);
+        let d2 = (p - sp.c_at(k, a)).length_squared();
+        let wins = d2 < best.d2
+            || (d2 == best.d2 && best.who >= 0 && best.who != k as i64 && {
+                // ranks: the edges at the nearest sample first, then by index
+                let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, k, inner));
+                let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
+                let rank = |k: usize| match (first..end).contains(&k) {
+                    true => (k - first) as i64,
+                    false => 2 + k as i64,
+                };
+                rank(k) < rank(best.who as usize)
+            });
+        if wins {
+            *best = Best {
+                d2,
+                who: k as i64,
+                k,
+                a,
+                tau: 0.0,
+            };
+        }
+    }
+}
+
+/// [`locate`] with the roots `roots` of the hint edge `hint` given, or `None` when the hint
+/// is not worth solving first (`p` outside its end planes). When the hint edge gives no
+/// candidate, the two edges at the sample nearest to `p` are solved first instead and the
+/// search climbs from there.
+fn locate_from(
+    sp: &SpineModel,
+    edges: &Edges,
+    p: DVec3,
+    hint: usize,
+    roots: Option<&[f64; 4]>,
+    s: &mut Scratch,
+) -> (usize, f64, f64) {
+    let n = sp.len();
+    let mut best = ends(sp, p);
+    // the sample nearest to p, searched when first needed
+    let mut near: Option<usize> = None;
+    // the nearest sample's search stack (allocated when first used)
+    let mut inner = Vec::new();
+    // edges solved before the climb
+    let mut done = [usize::MAX; 3];
+    if let Some(r) = roots {
+        consider(
+            sp,
+            edges,
+            p,
+            hint,
+            Some(r),
+            &mut best,
+            &mut near,
+            &mut inner,
+        );
+        done[0] = hint;
+    }
+    let start = if best.who == hint as i64 {
+        hint
+    } else {
+        let j = *near.get_or_insert_with(|| edges.nearest_sample(sp, p, hint, &mut inner));
+        let (first, end) = (j.saturating_sub(1), (j + 1).min(n - 1));
+        // the one with the nearer chord first: a good bound prunes almost all others
+        let mut two = [first, end - 1];
+        if edges.lower_bound(sp, two[1], p) < edges.lower_bound(sp, two[0], p) {
+            two.swap(0, 1);
+        }
+        for (i, &k) in two.iter().take(end - first).enumerate() {
+            if !done.contains(&k) {
+                consider(sp, edges, p, k, None, &mut best, &mut near, &mut inner);
+                done[1 + i] = k;
             }
         }
+        two[0]
     };
-    // the edges next to the nearest sample first (the one with the nearer chord first): a
-    // good bound prunes almost all others
-    let mut two = [first, end - 1];
-    if edges.lower_bound(sp, two[1], p) < edges.lower_bound(sp, two[0], p) {
-        two.swap(0, 1);
-    }
-    for k in two.into_iter().take(end - first) {
-        edge(k, &mut best);
-    }
-    edges.bvh.nearest(p, best.0, &mut s.stack, |k| {
-        if !(first..end).contains(&k) {
-            edge(k, &mut best);
-        }
-        best.0
-    });
-    if best.0.is_infinite() {
+    let mut search = std::mem::take(&mut s.stack);
+    edges
+        .tree
+        .nearest_from(p, start, best.d2 * (1.0 + BOX_MARGIN), &mut search, |k| {
+            if !done.contains(&k) {
+                consider(sp, edges, p, k, None, &mut best, &mut near, &mut inner);
+            }
+            best.d2 * (1.0 + BOX_MARGIN)
+        });
+    s.stack = search;
+    if best.d2.is_infinite() {
         // cannot happen for finite input (the plane signs change somewhere); keep a
         // defined answer anyway: the nearest sample
+        let near = near.unwrap_or_else(|| edges.nearest_sample(sp, p, hint, &mut inner));
         let (k, a) = if near + 1 < n {
             (near, 0.0)
         } else {
@@ -259,7 +316,14 @@ fn locate(sp: &SpineModel, edges: &Edges, p: DVec3, s: &mut Scratch) -> (usize, 
         };
         return (k, a, 0.0);
     }
-    (best.2, best.3, best.4)
+    s.hint = best.k;
+    (best.k, best.a, best.tau)
+}
+
+/// Whether `p` lies between the end planes of edge `k` (where its section probably is:
+/// then the hint is solved first).
+fn between_planes(sp: &SpineModel, k: usize, p: DVec3) -> bool {
+    (p - sp.c[k]).dot(sp.t[k]) >= 0.0 && (p - sp.c[k + 1]).dot(sp.t[k + 1]) <= 0.0
 }
 
 /// Register `vertices` on the rest spine.
@@ -274,7 +338,6 @@ pub fn bind_cancellable(
     cancel: Cancel<'_>,
 ) -> Result<Binding> {
     super::check_vertices(vertices, rest.scale, "spine")?;
-    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
     let edges = Edges::new(rest)?;
     let nv = vertices.len();
     let mut edge = alloc::filled("SpineBinding", nv, 0i64)?;
@@ -284,7 +347,7 @@ pub fn bind_cancellable(
         0.0,
     )?;
     // blocks of consecutive vertices (often neighbours on the mesh): each vertex's search
-    // starts from the sample nearest to the vertex before
+    // starts from the edge of the vertex before
     edge.par_chunks_mut(BLOCK)
         .zip(coords.par_chunks_mut(COORDS * BLOCK))
         .zip(vertices.par_chunks(BLOCK))
@@ -296,9 +359,7 @@ pub fn bind_cancellable(
                 hint: 0,
                 stack: Vec::with_capacity(64),
             };
-            for ((e, c), &p) in eb.iter_mut().zip(cb.chunks_mut(COORDS)).zip(vb) {
-                bind_one(rest, &edges, to_model, to_input, p, &mut s, e, c);
-            }
+            bind_run(rest, &edges, vb, &mut s, eb, cb);
         });
     Ok(Binding { edge, coords })
 }
@@ -306,38 +367,106 @@ pub fn bind_cancellable(
 /// Vertices per block of the registration (a Ctrl-C poll each).
 const BLOCK: usize = 256;
 
-/// The binding of vertex `p` (input units) into `e` and `c` (see the module notes).
-#[allow(clippy::too_many_arguments)]
-fn bind_one(
+/// Vertices registered together: the roots on their hint edge refined together (see
+/// [`edge_roots_lanes`]), the spine evaluated at their sections together (see
+/// [`SpineModel::eval_lanes`]).
+const LANES: usize = MAX_LANES;
+
+/// The bindings of a run of vertices (input units) into `e` and `c` (see the module notes):
+/// `LANES` at a time, each search starting from the edge found for the vertex before them.
+fn bind_run(
     rest: &SpineModel,
     edges: &Edges,
-    to_model: Pow2,
-    to_input: Pow2,
-    p: DVec3,
+    vb: &[DVec3],
     s: &mut Scratch,
-    e: &mut i64,
-    c: &mut [f64],
+    eb: &mut [i64],
+    cb: &mut [f64],
 ) {
-    let p = to_model.of3(p);
-    let (k, a, tau) = locate(rest, edges, p, s);
-    let l = rest.eval(k, a);
-    let d = p - l.q - tau * l.t;
-    let sk = if tau != 0.0 {
-        DVec2::ZERO
+    let mut i = 0;
+    while i + LANES <= vb.len() {
+        bind_lanes::<LANES>(
+            rest,
+            edges,
+            &vb[i..],
+            s,
+            &mut eb[i..],
+            &mut cb[COORDS * i..],
+        );
+        i += LANES;
+    }
+    while i < vb.len() {
+        bind_lanes::<1>(
+            rest,
+            edges,
+            &vb[i..],
+            s,
+            &mut eb[i..],
+            &mut cb[COORDS * i..],
+        );
+        i += 1;
+    }
+}
+
+/// The bindings of the first `L` vertices of `vb` (see [`bind_run`]).
+#[inline(always)]
+fn bind_lanes<const L: usize>(
+    rest: &SpineModel,
+    edges: &Edges,
+    vb: &[DVec3],
+    s: &mut Scratch,
+    eb: &mut [i64],
+    cb: &mut [f64],
+) {
+    let (to_model, to_input) = (rest.scale, rest.scale.inverse());
+    let mut p = [DVec3::ZERO; L];
+    for l in 0..L {
+        p[l] = to_model.of3(vb[l]);
+    }
+    // the edge of the run's vertex before, for all L
+    let hint = s.hint.min(rest.len() - 2);
+    let mut inside = [false; L];
+    for l in 0..L {
+        inside[l] = between_planes(rest, hint, p[l]);
+    }
+    let roots = if inside.iter().all(|&b| b) {
+        edge_roots_lanes(rest, &[hint; L], &p)
     } else {
-        l.kappa * l.sigma
+        let mut r = [[f64::NAN; 4]; L];
+        for l in 0..L {
+            if inside[l] {
+                r[l] = edge_roots(rest, hint, p[l]);
+            }
+        }
+        r
     };
+    let mut found = [(0usize, 0.0, 0.0); L];
+    let (mut ks, mut as_) = ([0usize; L], [0.0; L]);
+    for l in 0..L {
+        let r = inside[l].then_some(&roots[l]);
+        found[l] = locate_from(rest, edges, p[l], hint, r, s);
+        (ks[l], as_[l]) = (found[l].0, found[l].1);
+    }
+    let loc = rest.eval_lanes(&ks, &as_);
     let len = |x: f64| to_input.of(x);
-    *e = k as i64;
-    c.copy_from_slice(&[
-        a,
-        len(tau),
-        len(d.dot(l.u)),
-        len(d.dot(l.v)),
-        len(l.sigma),
-        sk.x,
-        sk.y,
-    ]);
+    for l in 0..L {
+        let ((k, a, tau), l0) = (found[l], &loc[l]);
+        let d = p[l] - l0.q - tau * l0.t;
+        let sk = if tau != 0.0 {
+            DVec2::ZERO
+        } else {
+            l0.kappa * l0.sigma
+        };
+        eb[l] = k as i64;
+        cb[COORDS * l..COORDS * (l + 1)].copy_from_slice(&[
+            a,
+            len(tau),
+            len(d.dot(l0.u)),
+            len(d.dot(l0.v)),
+            len(l0.sigma),
+            sk.x,
+            sk.y,
+        ]);
+    }
 }
 
 #[cfg(test)]
@@ -441,6 +570,7 @@ mod tests {
         let far_sp = open_model(&far);
         for (model, count) in [(&sp, 4000), (&loop_sp, 2000), (&far_sp, 4000)] {
             let edges = Edges::new(model).unwrap();
+            let mut run = Vec::new();
             for q in 0..count {
                 let x = q as f64 * 0.618_033_988_7;
                 let mut p = DVec3::new(
@@ -471,8 +601,68 @@ mod tests {
                     (want.0, want.1.to_bits(), want.2.to_bits()),
                     "{p}"
                 );
+                run.push((p, want));
+            }
+            // the same points registered as one run (hints from the vertex before, four
+            // at a time), in input units
+            let to_input = model.scale.inverse();
+            let pts: Vec<DVec3> = run.iter().map(|r| to_input.of3(r.0)).collect();
+            let b = bind(model, &pts).unwrap();
+            for (i, (p, want)) in run.iter().enumerate() {
+                let got = (
+                    b.edge[i] as usize,
+                    b.coords[COORDS * i],
+                    b.coords[COORDS * i + 1],
+                );
+                assert_eq!(
+                    (got.0, got.1.to_bits(), got.2.to_bits()),
+                    (want.0, want.1.to_bits(), to_input.of(want.2).to_bits()),
+                    "{p}"
+                );
             }
         }
+    }
+
+    #[test]
+    fn a_tube_about_a_straight_spine_binds_as_the_scan_does() {
+        // rings of vertices about a straight spine (the vertex before is on the same edge
+        // but at the sample planes), rings on the sample planes themselves (ties between
+        // the two edges of a sample, decided by the nearest sample), and past both ends
+        let n = 26;
+        let pts: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new(i as f64 * 0.16, 0.0, 0.0))
+            .collect();
+        let sp = open_model(&pts);
+        let mut verts = Vec::new();
+        for ring in 0..300 {
+            let x = if ring % 5 == 0 {
+                0.16 * (ring / 5) as f64 // on a sample plane
+            } else {
+                -0.2 + 4.4 * ring as f64 / 300.0
+            };
+            for j in 0..37 {
+                let ang = std::f64::consts::TAU * j as f64 / 37.0;
+                verts.push(DVec3::new(x, 0.3 * ang.cos(), 0.3 * ang.sin()));
+            }
+        }
+        let b = bind(&sp, &verts).unwrap();
+        let mut ties = 0;
+        for (i, &p) in verts.iter().enumerate() {
+            let want = locate_by_scan(&sp, p);
+            let got = (
+                b.edge[i] as usize,
+                b.coords[COORDS * i],
+                b.coords[COORDS * i + 1],
+            );
+            assert_eq!(
+                (got.0, got.1.to_bits(), got.2.to_bits()),
+                (want.0, want.1.to_bits(), want.2.to_bits()),
+                "{p}"
+            );
+            // on a sample plane inside the spine (the first edge of the tie wins)
+            ties += usize::from((want.1 == 0.0 || want.1 == 1.0) && want.2 == 0.0);
+        }
+        assert!(ties > 100, "{ties}");
     }
 
     #[test]

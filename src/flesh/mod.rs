@@ -32,13 +32,16 @@
 //! it for a straight spine) can come from the caller — a rigid motion's frames give a rigid
 //! result, a rig's frames roll the shape — without changing the volume element.
 //!
-//! Registration (bind) searches the edges nearest first in a bounding-volume hierarchy
-//! (`O(V log n)` for vertices near the spine, [`crate::math::bvh`]); deformation is
+//! Registration (bind) starts from the edge of the vertex before and climbs a hierarchy of
+//! boxes over the edges ([`crate::math::chain`]: `O(log n)` box tests per vertex whose
+//! section is near the one before; results do not depend on where the search starts);
+//! deformation is
 //! `O(V + n)`, per vertex independent and run in parallel with rayon.
 
 pub mod bind;
 pub mod blend;
 pub mod pose;
+pub mod section;
 pub mod solve;
 pub mod spine;
 pub mod surface;

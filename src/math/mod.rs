@@ -15,13 +15,16 @@
 //! * [`mesh`]: signed volume of a closed triangle mesh and its undirected edges (for
 //!   manifold checks and adjacency).
 //! * [`bvh`]: a bounding-volume hierarchy over boxes, with overlap and nearest-first
-//!   queries (face pairs of the self-intersection test, the rest spine's edges in
-//!   registration).
+//!   queries (face pairs of the self-intersection test, the faces of a rest surface
+//!   mesh in registration).
+//! * [`chain`]: a hierarchy of boxes over the consecutive items of a chain, searched
+//!   nearest first from a start item (the rest spine's edges in registration).
 //! * [`predicates`]: exact orientation tests in the plane and in space (Shewchuk's
 //!   orient2d and orient3d: a floating-point filter, then exact expansions), for the profile
 //!   triangulation and the self-intersection test of meshes.
 
 pub mod bvh;
+pub mod chain;
 pub mod cubic;
 pub mod mesh;
 pub mod predicates;
