@@ -89,9 +89,9 @@ def frame(m):
 
 
 def top(V, c, flank, across, half_width):
-    """The height (along ``flank``) of the highest vertex within ``half_width`` of the line
-    through ``c`` along ``flank``, widened by the longest edge, in the rectangle spanned by
-    ``across`` (two unit vectors with their half widths)."""
+    """The largest height (coordinate along ``flank``) of the vertices in the column over
+    ``c``: those whose offsets from ``c`` along the unit vectors ``across`` are within
+    ``half_width``."""
     inside = np.ones(len(V), bool)
     for a, w in zip(across, half_width, strict=True):
         inside &= np.abs((V - c) @ a) <= w
