@@ -11,6 +11,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+import numpy as np
 import pytest
 import run_all
 
@@ -93,3 +94,71 @@ def test_summary_reads_tables_with_pipes_in_headers():
     # a table the summary cannot read is reported, not skipped silently
     _, unreadable = run_all.summary_table({"bench_sweep.py": "no table here\n"})
     assert unreadable == ["bench_sweep.py"]
+
+
+def test_deform_table_quick():
+    """bench_deform_table.py --quick: the cow (skipped and named when the shared meshes are
+    absent) and a small icosphere. The volumes are the meshes' (trimesh here), the relative
+    change is after/before − 1, the rest crossing pairs are libigl's count, every missed case
+    has its diagnosis row, and the thesis's Table 13.1 is printed beside it."""
+    import bench_deform_table as table
+
+    r = subprocess.run([sys.executable, "benchmarks/bench_deform_table.py", "--quick"],
+                       check=False, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    main, *rest = run_all.md_tables(r.stdout)
+    cow = table.MESHES / "cow.obj"
+    expect = ([("cow", "press"), ("cow", "twist")] if cow.exists() else []) + [
+        ("icosphere(3)", "drag")]
+    assert [(row["mesh"], row["tool"]) for row in main] == expect
+    if not cow.exists():
+        assert f"skipped cow: {cow} not found" in r.stdout
+    for row in main:
+        mesh = table.load(row["mesh"], table.MESHES)
+        before, after = float(row["volume before"]), float(row["volume after"])
+        assert abs(before / mesh.volume - 1) < 1e-5  # 6 significant digits
+        assert abs(float(row["relative change"]) - (after / before - 1)) < 2e-5
+        faces, out = (int(x.replace(",", "")) for x in row["faces"].split(" → "))
+        assert faces == len(mesh.faces) and out >= faces
+        rest_pairs = int(row["crossing pairs"].split(" → ")[0].replace(",", ""))
+        if row["mesh"] == "cow":
+            import igl.predicates
+
+            hit = igl.predicates.find_self_intersections(
+                np.ascontiguousarray(mesh.vertices, dtype=np.float64),
+                np.ascontiguousarray(mesh.faces, dtype=np.int64))
+            assert rest_pairs == len(hit[1]) > 0
+        else:
+            assert rest_pairs == 0
+        assert row["target"] == ("met" if abs(float(row["relative change"])) <= 5e-4
+                                 else "missed")
+    missed = [(row["mesh"], row["tool"]) for row in main if row["target"] == "missed"]
+    thesis = rest[-1]
+    assert [row["relative change"] for row in thesis][3] == "-0.70%"  # rocker-arm (C)
+    if missed:
+        diagnosis = rest[0]
+        assert [(row["mesh"], row["tool"]) for row in diagnosis] == missed
+        for row in diagnosis:  # the flat-face error falls with the edge: one subdivision
+            default = abs(run_all.num(row["default"]))
+            sub = abs(run_all.num(row["subdivided rest mesh"]))
+            assert sub < default / 2, row
+
+
+def test_deform_table_twist_turns_up_to_its_angle():
+    """The benchmark's curl twist turns every sphere about the centroid rigidly by
+    ``κ z (1 − r/R)(1 − 3r/(2R))``: the largest angle an advected vertex turns about the long
+    axis is the 1.5 rad the script asks for (RK4 with many steps for the exact flow)."""
+    import bench_deform_table as table
+
+    import spinal
+
+    m = table.load("icosphere(3)", table.MESHES)
+    m.apply_scale([1.0, 1.6, 0.7])  # a long axis (y) and a flank (z)
+    f, T = table.tool("twist", m)
+    c, axis, _, _ = table.frame(m)
+    assert np.array_equal(axis, [0, 1, 0])
+    V = np.asarray(m.vertices)
+    W = spinal.advect(V, f, T, 64)  # RK4 error ~1e-9 (7e-5 at the default 4 steps)
+    a, b = (V - c)[:, [2, 0]], (W - c)[:, [2, 0]]  # turned about +y: z, x
+    turned = np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], np.einsum("ij,ij->i", a, b))
+    assert abs(np.abs(turned).max() - 1.5) < 1e-6
