@@ -176,7 +176,7 @@ class DeformReport:
     bend_vertices : int
         Vertices those bending splits added (part of ``vertices_added``).
     step_vertices : ndarray (steps,) int64 or None
-        Vertex count after each integration step (the last one after the collapses).
+        Vertex count after each integration step (the last one after the bending splits and the collapses).
     timings : dict or None
         Wall time in seconds of each phase: ``"integrate"`` (the mesh's vertices),
         ``"refine"`` (edge tests, new vertices, splits), ``"volume"``, ``"estimate"``.

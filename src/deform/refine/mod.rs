@@ -226,7 +226,8 @@ pub struct Deformed {
     pub faces: Vec<[usize; 3]>,
     /// Refinement passes that split at least one edge.
     pub passes: usize,
-    /// Vertex count after each step (length = the number of steps taken).
+    /// Vertex count after each step (length = the number of steps taken; the last one after
+    /// the bending splits and the collapses).
     pub step_vertices: Vec<usize>,
     /// New vertices of edges along a slip surface (placed on their generalized path).
     pub torn: usize,
@@ -529,6 +530,9 @@ pub fn deform(
     if refinement.is_some() {
         let clock = Instant::now();
         r.split_bends(&mut w, done)?;
+        if let Some(last) = out.step_vertices.last_mut() {
+            *last = w.len();
+        }
         // the strip goes on shearing after a step's flips: a last round over all of it
         let mut touched = alloc::with_capacity(CALL, r.topo.faces.len())?;
         touched.extend((0..r.topo.faces.len()).filter(|&f| {
