@@ -57,6 +57,7 @@ use crate::math::bvh::{Aabb, Bvh};
 use crate::math::scale::{self, Pow2};
 
 /// A triangulated spine surface (model units, see [`super::surface::Surface::scale`]).
+#[derive(Clone, Debug)]
 pub struct TriSurface {
     /// Input units to model units.
     pub scale: Pow2,
@@ -580,5 +581,32 @@ mod tests {
             assert!(b.0 >= c[2].abs() - 1e-12, "{k}: {} < {}", b.0, c[2].abs());
         }
         assert!(inside > 200, "{inside}");
+    }
+
+    #[test]
+    fn given_directions_and_frames() {
+        // the bent plate: its own normals given back reproduce it; a constant "up" gives
+        // A = (S_u × S_v)·z and B = C = 0; the frames are rotations with the vertex normals
+        let (pts, f) = bent(6);
+        let sf = TriSurface::new("s", &pts, &f).unwrap();
+        let same = TriSurface::with_directions("s", &pts, &f, "d", &sf.n).unwrap();
+        let (a, b) = (sf.eval(7, 0.3, 0.2), same.eval(7, 0.3, 0.2));
+        let (x, y) = (a.abc(), b.abc());
+        assert!((a.n - b.n).length() < 1e-15, "{:?}", a.n - b.n);
+        assert!((x.0 - y.0).abs() + (x.1 - y.1).abs() + (x.2 - y.2).abs() < 1e-13);
+        let up = vec![DVec3::Z * 3.0; pts.len()];
+        let l = TriSurface::with_directions("s", &pts, &f, "d", &up)
+            .unwrap()
+            .eval(11, 0.25, 0.5);
+        let (a, b, c) = l.abc();
+        let ex = l.su.cross(l.sv).z;
+        assert!((a - ex).abs() < 1e-15 && b.abs() < 1e-15 && c.abs() < 1e-15);
+        let err = TriSurface::with_directions("s", &pts, &f, "d", &vec![DVec3::NEG_Z; pts.len()])
+            .unwrap_err();
+        assert!(err.to_string().starts_with("d: vertex 0:"), "{err}");
+        for (fr, n) in sf.frames("t").unwrap().iter().zip(&sf.n) {
+            assert!(fr[2] == *n && fr[0].dot(*n).abs() < 1e-15);
+            assert!((fr[0].cross(fr[1]).dot(fr[2]) - 1.0).abs() < 1e-15);
+        }
     }
 }
