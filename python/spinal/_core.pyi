@@ -452,6 +452,9 @@ def flesh_trisurface_bind(
     faces: npt.NDArray[np.int64],
     vertices: npt.NDArray[np.float64],
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], int]: ...
+def flesh_trisurface_frames(
+    rest_points: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]
+) -> npt.NDArray[np.float64]: ...
 def flesh_trisurface_deform(
     posed_points: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
@@ -459,6 +462,7 @@ def flesh_trisurface_deform(
     coords: npt.NDArray[np.float64],
     rest_exp: int,
     corrected: bool,
+    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_surface_deform(
     posed_points: npt.NDArray[np.float64],

@@ -69,31 +69,36 @@ def _surface_frames(g: np.ndarray) -> np.ndarray:
 
 
 def _surface_directions(posed_frames, posed_up, shape):
-    """The ``(name, (nu·nv, 3) directions)`` the core lays the offsets along, or ``None``."""
+    """The ``(name, (rows, 3) directions)`` the core lays the offsets along, or ``None``;
+    ``shape`` is the grid's ``(nu, nv)`` or the triangulated surface's ``(n,)``."""
     if posed_frames is None and posed_up is None:
         return None
     if posed_frames is not None and posed_up is not None:
         raise TypeError("posed_frames, posed_up: pass one of them, not both")
-    nu, nv = shape
+    shape = tuple(shape)
+    dims = ", ".join(map(str, shape))
+    like = "posed_surface's grid" if len(shape) == 2 else "posed_surface's vertices"
+    where = "grid point" if len(shape) == 2 else "vertex"
     if posed_frames is not None:
         f = as_float_array(posed_frames, "posed_frames")
-        if f.shape != (nu, nv, 3, 3):
-            raise ValueError(f"posed_frames: expected shape ({nu}, {nv}, 3, 3) like "
-                             f"posed_surface's grid, got {f.shape}")
+        if f.shape != (*shape, 3, 3):
+            raise ValueError(f"posed_frames: expected shape ({dims}, 3, 3) like "
+                             f"{like}, got {f.shape}")
         err = np.abs(np.swapaxes(f, -1, -2) @ f - np.eye(3)).max(axis=(-2, -1))
         bad = np.argwhere(~(err < 1e-6) | ~(np.linalg.det(f) > 0))
         if bad.size:
-            i, j = bad[0]
-            raise ValueError(f"posed_frames: grid point ({i}, {j}) is not a rotation (expected "
+            at = ", ".join(map(str, bad[0]))
+            at = f"({at})" if len(shape) == 2 else at
+            raise ValueError(f"posed_frames: {where} {at} is not a rotation (expected "
                              f"orthonormal columns (S_u direction, in-surface perpendicular, "
                              f"normal) with det +1, like SurfaceBinding.rest_frames)")
         return "posed_frames", np.ascontiguousarray(f[..., 2].reshape(-1, 3))
     u = as_float_array(posed_up, "posed_up")
     if u.shape == (3,):
-        u = np.broadcast_to(u, (nu, nv, 3))
-    if u.shape != (nu, nv, 3):
-        raise ValueError(f"posed_up: expected shape (3,) or ({nu}, {nv}, 3) like "
-                         f"posed_surface's grid, got {u.shape}")
+        u = np.broadcast_to(u, (*shape, 3))
+    if u.shape != (*shape, 3):
+        raise ValueError(f"posed_up: expected shape (3,) or ({dims}, 3) like {like}, got "
+                         f"{u.shape}")
     return "posed_up", np.ascontiguousarray(u.reshape(-1, 3))
 
 
@@ -133,7 +138,8 @@ class SurfaceBinding:
     so does the corrected offset: the map is continuous across faces only where the pose
     keeps them (the identity, or an affine map of a flat surface in its plane); elsewhere the
     jump is first order in the edge length, and a shape that crosses edges gains or loses
-    thin slivers there, which shrink as the surface is refined. On a flat grid posed by an affine map of its plane (rigid motion, stretch,
+    thin slivers there, which shrink as the surface is refined. :attr:`rest_frames` and
+    the ``posed_frames``/``posed_up`` of :meth:`deform` are per vertex. On a flat grid posed by an affine map of its plane (rigid motion, stretch,
     shear) the triangulated grid gives the grid model's result (both are exact there:
     ``h1 = h0 A0/A1``); on a bent grid the two models differ by their discretisation errors
     (the grid's bicubic cells against flat faces with interpolated normals), and the
@@ -157,7 +163,7 @@ class SurfaceBinding:
             sv, faces = _mesh(rest_surface, "rest_surface")
             self._faces = faces
             self._shape = None
-            self._rest_frames = None
+            self._rest_frames = _core.flesh_trisurface_frames(sv, faces)
             self._cell, self._coords, self._exp = _core.flesh_trisurface_bind(
                 sv, faces, np.ascontiguousarray(v, dtype=np.float64))
             self._nverts = len(sv)
@@ -211,7 +217,16 @@ class SurfaceBinding:
         """``(nu, nv, 3, 3)`` frames of the rest surface at its samples, columns ``(e1, e2,
         N)``: ``e1`` the direction of ``S_u``, ``e2 = N × e1`` in the surface, ``N`` the
         normal (all by the central differences the binding uses). ``R @ rest_frames`` are
-        the ``posed_frames`` of the surface moved by ``x ↦ Rx + c``."""
+        the ``posed_frames`` of the surface moved by ``x ↦ Rx + c``.
+
+        For a triangulated rest surface: ``(n, 3, 3)`` frames at its vertices, ``N`` the
+        unit angle-weighted vertex normal the binding uses, ``e1`` the first edge
+        ``S_b − S_a`` (the face's ``S_u``) of the lowest-numbered face ``(a, b, c)`` around
+        the vertex, projected on the plane normal to ``N`` and made unit, ``e2 = N × e1``
+        (the identity at vertices no face uses). On a grid triangulated with the faces
+        ``(a, a + (1, 0), a + (1, 1))`` listed before ``(a, a + (1, 1), a + (0, 1))`` these
+        are the grid's frames, except ``e1, e2`` at the corner sample ``(0, nv − 1)``, which
+        only the second kind of face uses."""
         return self._rest_frames.copy()
 
     def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
@@ -231,33 +246,40 @@ class SurfaceBinding:
         across the surface, so ``"offset"`` still keeps the volume (Jacobian determinant 1);
         with a constant ``D`` it is ``(S_u × S_v)·D`` and ``h1 = h0 A0/A1``.
 
+        On a triangulated surface the directions are given at the posed vertices and
+        interpolated over the faces as the vertex normals are (barycentric, made unit); the
+        face's volume element ``det[S_u + h D_u, S_v + h D_v, D]`` (``D_u = (I − DDᵀ)(d_b −
+        d_a)/|M|``) is solved for, so ``"offset"`` keeps the Jacobian determinant 1 inside
+        every face's prism.
+
         Parameters
         ----------
-        posed_frames : array_like (nu, nv, 3, 3), optional
-            Frames at the posed samples, columns ``(S_u direction, in-surface perpendicular,
-            normal)`` like :attr:`rest_frames`; proper rotations (so the first two columns
-            are orthogonal to the third). Only the normal column is used: it carries the
-            normal segment there. ``R @ binding.rest_frames`` with the surface moved by
-            ``x ↦ Rx + c`` moves the shape rigidly; a rig can tilt the segments.
-        posed_up : array_like (3,) or (nu, nv, 3), optional
+        posed_frames : array_like (nu, nv, 3, 3) or, triangulated, (n, 3, 3), optional
+            Frames at the posed samples (vertices), columns ``(S_u direction, in-surface
+            perpendicular, normal)`` like :attr:`rest_frames`; proper rotations (so the
+            first two columns are orthogonal to the third). Only the normal column is used:
+            it carries the normal segment there. ``R @ binding.rest_frames`` with the
+            surface moved by ``x ↦ Rx + c`` moves the shape rigidly; a rig can tilt the
+            segments.
+        posed_up : array_like (3,), (nu, nv, 3) or, triangulated, (n, 3), optional
             Instead of ``posed_frames``: directions (one for all samples, or one per sample;
             made unit) along which the offset is laid instead of the normal, e.g. a constant
             "up" keeps a skin's thickness vertical on a sheared surface.
 
         Both must lie on the normal's side of the surface and not in it (refused where the
-        cosine with the sample normal is 1e-3 or less, or where the interpolated direction
-        reaches the surface's plane inside a cell). Grids only.
+        cosine with the sample's or vertex's normal is 1e-3 or less, or where the
+        interpolated direction reaches the surface's plane inside a cell; on a
+        triangulated surface, where a face's corner direction is not on the face's side).
         """
         solution = as_choice(solution, "solution", ("offset", "none"))
         strict = as_bool(strict, "strict")
         return_clamped = as_bool(return_clamped, "return_clamped")
         if self._faces is not None:
-            if posed_frames is not None or posed_up is not None:
-                name = "posed_frames" if posed_frames is not None else "posed_up"
-                raise TypeError(f"{name}: only with a grid rest_surface")
+            pv = self._posed_vertices(posed_surface)
+            dirs = _surface_directions(posed_frames, posed_up, (self._nverts,))
             out, flags = _core.flesh_trisurface_deform(
-                self._posed_vertices(posed_surface), self._faces, self._cell, self._coords,
-                self._exp, solution == "offset")
+                pv, self._faces, self._cell, self._coords, self._exp, solution == "offset",
+                dirs)
             return self._report(out, flags, strict, return_clamped)
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:

@@ -31,6 +31,12 @@
 //! gains or loses the slivers between them (a discretisation error of the piecewise-linear
 //! surface; the grid model's C¹ bicubic cells have none).
 //!
+//! **Given directions.** The posed offset may be laid along directions given per vertex
+//! ([`TriSurface::with_directions`]: a rig's frames, a constant "up") instead of the vertex
+//! normals, interpolated the same way; the volume element keeps its form with `D` for `N`,
+//! so the same correction keeps the volume. [`TriSurface::frames`] gives the frames at the
+//! vertices (the vertex normal and the projected `S_u` edge of the vertex's first face).
+//!
 //! **Registration.** The closest point of the triangle mesh (branch and bound over the
 //! faces' boxes in a bounding-volume hierarchy, [`crate::math::bvh`]; exact point–triangle
 //! distance by Voronoi regions, Ericson, Real-Time Collision Detection §5.1.5), then the foot
@@ -51,6 +57,7 @@ use crate::math::bvh::{Aabb, Bvh};
 use crate::math::scale::{self, Pow2};
 
 /// A triangulated spine surface (model units, see [`super::surface::Surface::scale`]).
+#[derive(Clone, Debug)]
 pub struct TriSurface {
     /// Input units to model units.
     pub scale: Pow2,
@@ -156,6 +163,95 @@ impl TriSurface {
             n,
             faces: fs,
         })
+    }
+
+    /// The surface with the offset laid along the given directions `dirs` (one per vertex,
+    /// named `dir_arg`, made unit) instead of the vertex normals, interpolated over the faces
+    /// exactly as the normals are (barycentric, then made unit). The volume element
+    /// `det[S_u + hD_u, S_v + hD_v, D]` and so the offset correction hold for any unit
+    /// direction field `D` transverse to the faces. A direction at 1e-3 or less in cosine
+    /// from its vertex normal is refused, and so is a face whose corner direction is not on
+    /// its side (`n_f·D > 0` over the face iff it holds at the corners, the interpolation
+    /// being linear before the normalisation).
+    pub fn with_directions(
+        arg: &'static str,
+        points: &[DVec3],
+        faces: &[i64],
+        dir_arg: &'static str,
+        dirs: &[DVec3],
+    ) -> Result<TriSurface> {
+        let mut sf = TriSurface::new(arg, points, faces)?;
+        if dirs.len() != sf.s.len() {
+            return Err(InputError::new(
+                dir_arg,
+                format!(
+                    "expected {} directions like the surface's vertices, got {}",
+                    sf.s.len(),
+                    dirs.len()
+                ),
+            ));
+        }
+        let mut d = alloc::with_capacity("SurfaceBinding.deform", dirs.len())?;
+        for (i, (&g, &normal)) in dirs.iter().zip(&sf.n).enumerate() {
+            let Some(g) = scale::normalize(g) else {
+                return Err(InputError::new(
+                    dir_arg,
+                    format!("vertex {i}: not a finite non-zero vector"),
+                ));
+            };
+            let c = g.dot(normal);
+            if normal != DVec3::ZERO && !(c > 1e-3) {
+                return Err(InputError::new(
+                    dir_arg,
+                    format!(
+                        "vertex {i}: the direction is {:.1}° from the surface normal: \
+                         parallel to the surface or on its other side",
+                        c.clamp(-1.0, 1.0).acos().to_degrees()
+                    ),
+                ));
+            }
+            d.push(g);
+        }
+        for (k, t) in sf.faces.iter().enumerate() {
+            let nf = (sf.s[t[1]] - sf.s[t[0]]).cross(sf.s[t[2]] - sf.s[t[0]]);
+            if let Some(&i) = t.iter().find(|&&i| !(nf.dot(d[i]) > 0.0)) {
+                return Err(InputError::new(
+                    dir_arg,
+                    format!(
+                        "face {k}: the direction of vertex {i} is not on the face's normal \
+                         side, so the interpolated direction reaches the face's plane"
+                    ),
+                ));
+            }
+        }
+        sf.n = d;
+        Ok(sf)
+    }
+
+    /// Orthonormal frames `[e1, e2, n]` at the vertices: `n` the vertex normal, `e1` the
+    /// first edge `S_b − S_a` (the face's `S_u`) of the lowest-numbered face around the
+    /// vertex, projected on the normal plane and made unit, `e2 = n × e1` (the identity at
+    /// vertices no face uses). On a grid triangulated with the `S_u` edge first this is the
+    /// grid model's frame (`e1` along `S_u`).
+    pub fn frames(&self, call: &'static str) -> Result<Vec<[DVec3; 3]>> {
+        let mut first = alloc::filled(call, self.s.len(), usize::MAX)?;
+        for (k, t) in self.faces.iter().enumerate().rev() {
+            for &i in t {
+                first[i] = k;
+            }
+        }
+        alloc::collect(
+            call,
+            first.iter().zip(&self.n).map(|(&k, &n)| {
+                if k == usize::MAX {
+                    return [DVec3::X, DVec3::Y, DVec3::Z];
+                }
+                let [a, b, _] = self.faces[k];
+                let t = self.s[b] - self.s[a];
+                let e1 = (t - n * n.dot(t)).normalize();
+                [e1, n.cross(e1), n]
+            }),
+        )
     }
 
     /// The surface in face `f` at the barycentric coordinates `(1 − u − v, u, v)`.
@@ -485,5 +581,32 @@ mod tests {
             assert!(b.0 >= c[2].abs() - 1e-12, "{k}: {} < {}", b.0, c[2].abs());
         }
         assert!(inside > 200, "{inside}");
+    }
+
+    #[test]
+    fn given_directions_and_frames() {
+        // the bent plate: its own normals given back reproduce it; a constant "up" gives
+        // A = (S_u × S_v)·z and B = C = 0; the frames are rotations with the vertex normals
+        let (pts, f) = bent(6);
+        let sf = TriSurface::new("s", &pts, &f).unwrap();
+        let same = TriSurface::with_directions("s", &pts, &f, "d", &sf.n).unwrap();
+        let (a, b) = (sf.eval(7, 0.3, 0.2), same.eval(7, 0.3, 0.2));
+        let (x, y) = (a.abc(), b.abc());
+        assert!((a.n - b.n).length() < 1e-15, "{:?}", a.n - b.n);
+        assert!((x.0 - y.0).abs() + (x.1 - y.1).abs() + (x.2 - y.2).abs() < 1e-13);
+        let up = vec![DVec3::Z * 3.0; pts.len()];
+        let l = TriSurface::with_directions("s", &pts, &f, "d", &up)
+            .unwrap()
+            .eval(11, 0.25, 0.5);
+        let (a, b, c) = l.abc();
+        let ex = l.su.cross(l.sv).z;
+        assert!((a - ex).abs() < 1e-15 && b.abs() < 1e-15 && c.abs() < 1e-15);
+        let err = TriSurface::with_directions("s", &pts, &f, "d", &vec![DVec3::NEG_Z; pts.len()])
+            .unwrap_err();
+        assert!(err.to_string().starts_with("d: vertex 0:"), "{err}");
+        for (fr, n) in sf.frames("t").unwrap().iter().zip(&sf.n) {
+            assert!(fr[2] == *n && fr[0].dot(*n).abs() < 1e-15);
+            assert!((fr[0].cross(fr[1]).dot(fr[2]) - 1.0).abs() < 1e-15);
+        }
     }
 }

@@ -228,9 +228,38 @@ pub fn flesh_trisurface_bind<'py>(
     Ok((PyArray1::from_vec(py, face), coords, exp))
 }
 
-/// Deform vertices registered on a triangle-mesh spine surface; see
-/// `spinal.SurfaceBinding.deform`.
+/// Orthonormal frames `(n, 3, 3)`, columns `(e1, e2, normal)`, at the vertices of a
+/// triangle-mesh spine surface; see `spinal.SurfaceBinding.rest_frames`.
 #[pyfunction]
+pub fn flesh_trisurface_frames<'py>(
+    py: Python<'py>,
+    rest_points: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+    let pts = vec3s("rest_surface", &rest_points)?;
+    let fs = slice_of("rest_surface", &faces)?;
+    let n = pts.len();
+    let frames = py.detach(|| {
+        let rest = trisurf::TriSurface::new("rest_surface", pts, fs)?;
+        rest.frames("SurfaceBinding")
+    })?;
+    // row-major (vertex, row, column): column c of vertex i is frames[i][c]
+    let mut flat = alloc::filled("SurfaceBinding", 9 * n, 0.0)?;
+    for (out, f) in flat.chunks_exact_mut(9).zip(&frames) {
+        for r in 0..3 {
+            for c in 0..3 {
+                out[3 * r + c] = f[c][r];
+            }
+        }
+    }
+    PyArray1::from_vec(py, flat).reshape([n, 3, 3])
+}
+
+/// Deform vertices registered on a triangle-mesh spine surface; see
+/// `spinal.SurfaceBinding.deform`. `directions` (one per vertex, with the name of the
+/// argument they came from) replace the vertex normals as the offset directions.
+#[pyfunction]
+#[pyo3(signature = (posed_points, faces, face, coords, rest_exp, corrected, directions=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn flesh_trisurface_deform<'py>(
     py: Python<'py>,
@@ -240,9 +269,21 @@ pub fn flesh_trisurface_deform<'py>(
     coords: PyReadonlyArray2<'py, f64>,
     rest_exp: i32,
     corrected: bool,
+    directions: Option<(String, PyReadonlyArray2<'py, f64>)>,
 ) -> PyResult<FleshPose<'py>> {
     let pts = vec3s("posed_surface", &posed_points)?;
     let fs = slice_of("posed_surface", &faces)?;
+    let dirs = match &directions {
+        Some((name, d)) => {
+            let arg: &'static str = if name == "posed_up" {
+                "posed_up"
+            } else {
+                "posed_frames"
+            };
+            Some((arg, vec3s(arg, d)?))
+        }
+        None => None,
+    };
     let face = slice_of("face", &face)?;
     let coords = slice_of("coords", &coords)?;
     let n = face.len();
@@ -253,7 +294,12 @@ pub fn flesh_trisurface_deform<'py>(
         let buf: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            let posed = trisurf::TriSurface::new("posed_surface", pts, fs)?;
+            let posed = match dirs {
+                Some((arg, d)) => {
+                    trisurf::TriSurface::with_directions("posed_surface", pts, fs, arg, d)?
+                }
+                None => trisurf::TriSurface::new("posed_surface", pts, fs)?,
+            };
             trisurf::deform_trisurface_cancellable(
                 &posed,
                 rest_exp,

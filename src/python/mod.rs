@@ -80,6 +80,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(flesh::flesh_deform, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_trisurface_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_trisurface_deform, m)?)?;
+    m.add_function(wrap_pyfunction!(flesh::flesh_trisurface_frames, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_resample, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_surface_bind, m)?)?;
     m.add_function(wrap_pyfunction!(flesh::flesh_surface_deform, m)?)?;
