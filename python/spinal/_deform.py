@@ -5,8 +5,12 @@ Refinement (Zheng's thesis §13.2, with the smoother variant's placement): after
 integration step, an edge longer than ``refine × max(its rest length, mean rest edge)`` is
 refined by Rivara's longest-edge bisection — the edge that ends its longest-edge propagation
 path (the longest edge of both its triangles) is split, both triangles bisected (conforming,
-watertight, no angle below half of the one it came from) — and the new vertex is the rest midpoint carried
-by the same steps (``Φ(rest)``), then carried on with the mesh. Where the flow tears an edge
+watertight, no angle below half of the one it came from) — and the new vertex is the rest
+midpoint carried by the same steps (``Φ(rest)``), then carried on with the mesh. After the
+integration, edges that the flow bends without stretching them (``Φ`` of the rest midpoint
+more than 0.06 of the edge from the chord: a press into a long face, a sharp bend that
+folds flat faces over their neighbours) are split the same way
+(``DeformReport.bend_vertices``). Where the flow tears an edge
 apart (the tangential slip at the surface of a curl tool) the body's boundary runs along the
 tool's surface between the two torn sides: the new vertex goes halfway along that path, onto
 the material of one side or onto the tool's surface, where it moves with a blend of the two
