@@ -170,13 +170,19 @@ class DeformReport:
     bent_edges : int
         Edges the flow still bends at the end: ``Φ`` of the rest midpoint farther than 0.06
         of the edge from its chord midpoint (the flat faces then miss the deformed surface
-        by about as much). After the integration such edges longer than a quarter of the
-        mean rest edge are split — the terminal edge of their longest-edge path, at ``Φ`` of
-        its rest midpoint — in rounds, until a round splits nothing, for at most
-        ``max_passes`` rounds and within ``max_vertices``. An edge stays bent
-        where its path ends at an edge whose ``Φ(rest midpoint)`` is torn away from the
-        chord (more than a quarter of the edge: a flow the steps do not resolve there), or
-        where a bound stopped the rounds. Not part of ``converged``.
+        by about as much), or, with both ends away from any slip surface, a deviation
+        ``δ`` that accounts for more than 2e-3 of the rest volume per input edge
+        (``|δ · n| / 6``, ``n`` the sum of the edge's two face cross products
+        ``(y − x) × (z − x)``: the volume between the flat faces and the quadratic patch
+        through their corners and ``Φ`` of the edge midpoints is ``Σ δ · n / 6``; a twist
+        loses volume this way while shearing each face by less than 0.06). After the
+        integration such edges longer than a quarter of the mean rest edge are split — the
+        terminal edge of their longest-edge path, at ``Φ`` of its rest midpoint — in
+        rounds, until a round splits nothing, for at most ``max_passes`` rounds and within
+        ``max_vertices``. An edge stays bent where its path ends at an edge whose
+        ``Φ(rest midpoint)`` is torn away from the chord (more than a quarter of the edge: a
+        flow the steps do not resolve there), or where a bound stopped the rounds. Not part
+        of ``converged``.
     bend_vertices : int
         Vertices those bending splits added (part of ``vertices_added``).
     step_vertices : ndarray (steps,) int64 or None

@@ -6,7 +6,11 @@
 //!
 //! `δ = |Φ(m) − (Φ(a) + Φ(b))/2| ≈ ℓ² |∂²Φ/∂s²| / 8`,
 //!
-//! `ℓ` the edge's rest length and `s` arc length along it. Lengths alone do not see it: a
+//! `ℓ` the edge's rest length and `s` arc length along it. The quadratic patch through a
+//! face's corners and edge midpoints `Φ(m)` encloses, beyond the flat faces, the volume
+//! `Σ_e δ_e · n_e / 6` (`δ_e` the vector deviation, `n_e` the sum of the unnormalised normals
+//! `(y − x) × (z − x)` of the edge's two faces), so `|δ · n| / 6` is the volume an edge
+//! accounts for. Lengths alone do not see it: a
 //! tool pressing into the middle of a long flat face, a shear or a twist bends faces
 //! without stretching their edges much, and the flat faces then lose volume (a long
 //! triangle fan pressed by a cube lost 0.9 % of a sphere's volume with no edge over the
@@ -16,7 +20,11 @@
 //!
 //! * after the integration, every edge of one side's material (no slip surface between its
 //!   ends, both ends at `Φ(rest)`) longer than [`SHORTEST`] × `ℓ̄` whose `δ` exceeds
-//!   [`BEND`] × `|Φ(a) − Φ(b)|` is refined like an edge over the length threshold: the
+//!   [`BEND`] × `|Φ(a) − Φ(b)|`, or, where both ends are carried by the field (no slip
+//!   surface near them: [`Carry::Free`]), whose `δ` accounts for more than [`VOLUME`] × the
+//!   rest volume `V` per input edge (`E` edges), is refined like an edge over the length
+//!   threshold (`|δ · n| / 6 > VOLUME · |V| / E`; a twist shears faces by less than
+//!   [`BEND`] per edge yet loses volume over the whole mesh): the
 //!   terminal edge of its longest-edge propagation path (Rivara 1997) is split at `Φ` of its
 //!   rest midpoint. A new vertex is `Φ(rest)` whether it is made during the integration or
 //!   after it, so splitting afterwards gives the vertices that splitting during it would;
@@ -40,6 +48,10 @@ use crate::error::Result;
 /// from the chord midpoint: the flat face then misses the surface by about `BEND · ℓ`.
 pub(super) const BEND: f64 = 0.06;
 
+/// An edge whose deviation accounts for more than this fraction of the rest volume per
+/// input edge is bent (where the flow is smooth: both ends carried by the field).
+pub(super) const VOLUME: f64 = 2e-3;
+
 /// Edges shorter than this fraction of the mean rest edge `ℓ̄` are not split for bending.
 const SHORTEST: f64 = 0.25;
 
@@ -47,6 +59,24 @@ impl Refiner<'_> {
     /// Whether vertex `v` sits at `Φ` of its rest point (material, not a chord midpoint).
     fn at_flow(&self, v: usize) -> bool {
         !matches!(self.carry[v], Carry::Surface(_)) && self.chords.binary_search(&v).is_err()
+    }
+
+    /// `|δ · n| / 6`: the volume between the two faces of half-edge `e` and the quadratic
+    /// patch that the deviation `d` of its midpoint accounts for (`n` the sum of the faces'
+    /// unnormalised normals at `w`).
+    fn share_of(&self, w: &[DVec3], e: usize, d: DVec3) -> f64 {
+        let normal = |h: usize| {
+            let [x, y, z] = self.topo.faces[h / 3];
+            (w[y] - w[x]).cross(w[z] - w[x])
+        };
+        let t = self.topo.twin[e];
+        let n = normal(e)
+            + if t == super::NONE {
+                DVec3::ZERO
+            } else {
+                normal(t)
+            };
+        d.dot(n).abs() / 6.0
     }
 
     /// The half-edges (one per undirected edge) among the edges of `faces` that are bent
@@ -95,8 +125,13 @@ impl Refiner<'_> {
             let l2 = w[a].distance_squared(w[b]);
             // bent, but not torn away from the chord (a flow the steps do not resolve, whose
             // split would fall back to the chord midpoint and resolve nothing)
-            let d2 = p.distance_squared(0.5 * (w[a] + w[b]));
-            (d2 > BEND * BEND * l2 && d2 <= TORN * TORN * l2).then_some(e)
+            let d = p - 0.5 * (w[a] + w[b]);
+            let d2 = d.length_squared();
+            let bent = d2 > BEND * BEND * l2
+                || (matches!(self.carry[a], Carry::Free)
+                    && matches!(self.carry[b], Carry::Free)
+                    && self.share_of(w, e, d) > self.share);
+            (bent && d2 <= TORN * TORN * l2).then_some(e)
         }));
         Ok(bent)
     }

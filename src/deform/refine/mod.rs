@@ -100,9 +100,10 @@
 //!   10k-vertex drag the band's slivers go from 32% to 1.3%, the vertices from 2.34× to
 //!   1.90×, the volume change from −4.18e-5 to −4.22e-5;
 //! * **bending** — after the integration, edges the flow bends (`Φ` of the rest midpoint
-//!   farther than 0.06 of the edge from the chord) are split the same way, in rounds
-//!   (`refine/bend.rs`): lengths alone miss a press into a long face or a sharp bend that
-//!   folds flat faces over their neighbours;
+//!   farther than 0.06 of the edge from the chord, or, away from slip surfaces, its
+//!   deviation accounting for more than 2e-3 of the rest volume per input edge) are split
+//!   the same way, in rounds (`refine/bend.rs`): lengths alone miss a press into a long
+//!   face, a twist, or a sharp bend that folds flat faces over their neighbours;
 //! * **bounds** — at most `max_passes` passes per step and `max_vertices` vertices in all.
 //!   When edges remain over the threshold at the end — a bound stopped the refinement — the
 //!   result says so (`bounded`, and the number of those edges).
@@ -395,10 +396,13 @@ struct Refiner<'a> {
     inputs: usize,
     /// The vertices placed at a chord midpoint instead of `Φ(rest)`, in increasing order.
     chords: Vec<usize>,
-    /// Edges still bent beyond [`bend::BEND`] after the bending splits.
+    /// Edges still bent (see `refine/bend.rs`) after the bending splits.
     bent: usize,
     /// Vertices added by the bending splits.
     bend_splits: usize,
+    /// The volume an edge's deviation may account for before it is split
+    /// ([`bend::VOLUME`] × |rest volume| / the input's edge count).
+    share: f64,
 }
 
 /// A point of the generalized rest mesh (see the module docs): a material rest point, or a
@@ -503,6 +507,11 @@ pub fn deform(
         chords: Vec::new(),
         bent: 0,
         bend_splits: 0,
+        share: if count > 0 {
+            bend::VOLUME * crate::math::mesh::signed_volume(rest, faces).abs() / count as f64
+        } else {
+            0.0
+        },
     };
     r.carry = alloc::collect(CALL, rest.iter().map(|&x| r.carry_of(Gen::Material(x))))?;
     let mut w = alloc::copied(CALL, rest)?;
