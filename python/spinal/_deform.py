@@ -102,8 +102,9 @@ class DeformReport:
     converged : bool
         True when no edge is over the threshold at the end, no face has zero area and (with
         ``check="intersections"``) no faces cross. False when ``max_vertices`` or
-        ``max_passes`` stopped the refinement with edges still too long, or the result has
-        faces of zero area or crossing faces (a :class:`RefinementWarning` was emitted).
+        ``max_passes`` stopped the refinement with edges still too long or still bent (see
+        ``bent_edges``), or the result has faces of zero area or crossing faces (a
+        :class:`RefinementWarning` was emitted).
         Across a tool's slip every edge can be shortened (see ``torn_vertices``), so a
         refinement that no bound stops converges.
     edges_over_threshold : int
@@ -179,10 +180,13 @@ class DeformReport:
         integration such edges longer than a quarter of the mean rest edge are split — the
         terminal edge of their longest-edge path, at ``Φ`` of its rest midpoint — in
         rounds, until a round splits nothing, for at most ``max_passes`` rounds and within
-        ``max_vertices``. An edge stays bent where its path ends at an edge whose
-        ``Φ(rest midpoint)`` is torn away from the chord (more than a quarter of the edge: a
-        flow the steps do not resolve there), or where a bound stopped the rounds. Not part
-        of ``converged``.
+        ``max_vertices``. Where the field is smooth (both ends and the rest midpoint away
+        from any slip surface) an edge is split at ``Φ`` of its rest midpoint however far that
+        lies from the chord (a twist turns a long edge's midpoint far off it). Near a slip
+        surface an edge stays bent where its path ends at an edge whose ``Φ(rest midpoint)``
+        is torn away from the chord (more than a quarter of the edge: a flow the steps do
+        not resolve there); such edges are not part of ``converged``. Edges left bent
+        because a bound stopped the rounds make ``converged`` false.
     bend_vertices : int
         Vertices those bending splits added (part of ``vertices_added``).
     step_vertices : ndarray (steps,) int64 or None
@@ -369,11 +373,16 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         ~np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).any(axis=1)))
     crossing = len(out.self_intersections()) if intersections else None
     converged = not bounded and degenerate == 0 and not crossing
-    if bounded:
+    if bounded and over:
         warnings.warn(RefinementWarning(
             f"deform: {over} edges are still longer than refine × their rest length (the "
             f"refinement stopped at max_vertices={max_vertices} or max_passes={max_passes} per "
             f"step); raise max_vertices or max_passes"), stacklevel=2)
+    elif bounded:
+        warnings.warn(RefinementWarning(
+            f"deform: {bent} edges are still bent by the flow (the bending splits stopped at "
+            f"max_vertices={max_vertices} or after max_passes={max_passes} rounds); raise "
+            f"max_vertices or max_passes"), stacklevel=2)
     if degenerate or crossing:
         what = [f"{degenerate} faces of zero area"] if degenerate else []
         what += [f"{crossing} pairs of crossing faces"] if crossing else []

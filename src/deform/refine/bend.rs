@@ -30,9 +30,13 @@
 //!   after it, so splitting afterwards gives the vertices that splitting during it would;
 //! * the edges of the faces a round split, and the bent edges it left, are tested in the
 //!   next, until a round splits nothing, for at most `max_passes` rounds (and within
-//!   `max_vertices`). A bent edge whose path ends at an
-//!   edge whose `Φ(rest midpoint)` is torn away from the chord (a flow the steps do not
-//!   resolve) is left unsplit: the chord midpoint would resolve nothing. Halving an edge divides its `δ/ℓ` by about two, so
+//!   `max_vertices`; bent edges left by either bound make the result not converged). Near a
+//!   slip surface, a bent edge whose path ends at an edge whose `Φ(rest midpoint)` is torn
+//!   away from the chord (a flow the steps do not resolve) is left unsplit: the chord
+//!   midpoint would resolve nothing. Where the field is smooth (both ends and the rest
+//!   midpoint [`Carry::Free`]) the steps resolve `Φ(m)` however far it lies from the chord
+//!   (a twist turns the midpoint of a long edge of a coarse capsule by 0.4 of the edge off
+//!   it), so such an edge is split there: leaving them lost 11 % of the capsule's volume. Halving an edge divides its `δ/ℓ` by about two, so
 //!   a smooth flow is resolved in a few rounds; the edges still bent at the end are counted
 //!   ([`super::Deformed::bent`]).
 
@@ -59,6 +63,16 @@ impl Refiner<'_> {
     /// Whether vertex `v` sits at `Φ` of its rest point (material, not a chord midpoint).
     fn at_flow(&self, v: usize) -> bool {
         !matches!(self.carry[v], Carry::Surface(_)) && self.chords.binary_search(&v).is_err()
+    }
+
+    /// Whether the edge `(a, b)` with rest midpoint `m` lies where the field is smooth: both
+    /// ends and the midpoint carried by the field, no slip surface near them. `Φ(m)` is then
+    /// resolved by the steps however far it lies from the chord (a twist turns a long edge's
+    /// midpoint far from it), so a bent edge is split there.
+    pub(super) fn smooth(&self, a: usize, b: usize, m: DVec3) -> bool {
+        matches!(self.carry[a], Carry::Free)
+            && matches!(self.carry[b], Carry::Free)
+            && matches!(self.carry_of(Gen::Material(m)), Carry::Free)
     }
 
     /// `|δ · n| / 6`: the volume between the two faces of half-edge `e` and the quadratic
@@ -117,22 +131,28 @@ impl Refiner<'_> {
         )?;
         let at = self.image(&mids, done);
         let mut bent = alloc::with_capacity(CALL, cand.len())?;
-        bent.extend(cand.iter().zip(at).zip(keep).filter_map(|((&e, p), keep)| {
-            if !keep {
-                return None;
-            }
-            let (a, b) = self.topo.ends(e);
-            let l2 = w[a].distance_squared(w[b]);
-            // bent, but not torn away from the chord (a flow the steps do not resolve, whose
-            // split would fall back to the chord midpoint and resolve nothing)
-            let d = p - 0.5 * (w[a] + w[b]);
-            let d2 = d.length_squared();
-            let bent = d2 > BEND * BEND * l2
-                || (matches!(self.carry[a], Carry::Free)
-                    && matches!(self.carry[b], Carry::Free)
-                    && self.share_of(w, e, d) > self.share);
-            (bent && d2 <= TORN * TORN * l2).then_some(e)
-        }));
+        bent.extend(cand.iter().zip(&mids).zip(at).zip(keep).filter_map(
+            |(((&e, &m), p), keep)| {
+                let Gen::Material(m) = m else {
+                    return None;
+                };
+                if !keep {
+                    return None;
+                }
+                let (a, b) = self.topo.ends(e);
+                let l2 = w[a].distance_squared(w[b]);
+                // bent, but not torn away from the chord (a flow the steps do not resolve, whose
+                // split would fall back to the chord midpoint and resolve nothing)
+                let d = p - 0.5 * (w[a] + w[b]);
+                let d2 = d.length_squared();
+                let bent = d2 > BEND * BEND * l2
+                    || (matches!(self.carry[a], Carry::Free)
+                        && matches!(self.carry[b], Carry::Free)
+                        && self.share_of(w, e, d) > self.share);
+                (bent && (d2 <= TORN * TORN * l2 || (d2.is_finite() && self.smooth(a, b, m))))
+                    .then_some(e)
+            },
+        ));
         Ok(bent)
     }
 
@@ -148,6 +168,7 @@ impl Refiner<'_> {
             let bent = self.bent_edges(w, &faces, done)?;
             self.bent = bent.len();
             if bent.is_empty() {
+                self.bend_bounded = false;
                 return Ok(());
             }
             // the faces of the bent edges keep their indices through the splits: those not
@@ -162,7 +183,11 @@ impl Refiner<'_> {
                 }
             }
             let from = self.touched.len();
+            let was = std::mem::replace(&mut self.bounded, false);
             let split = self.split_terminals(w, &bent, done, end, false)?;
+            // `max_vertices` left too little room for this round's splits
+            self.bend_bounded = self.bounded;
+            self.bounded |= was;
             if split == 0 {
                 return Ok(());
             }
@@ -173,6 +198,8 @@ impl Refiner<'_> {
             faces.dedup();
         }
         self.bent = self.bent_edges(w, &faces, done)?.len();
+        // the rounds ran out with edges left to split
+        self.bend_bounded |= self.bent > 0;
         Ok(())
     }
 }

@@ -400,6 +400,9 @@ struct Refiner<'a> {
     bent: usize,
     /// Vertices added by the bending splits.
     bend_splits: usize,
+    /// Whether a bound (`max_vertices`, or `max_passes` rounds) stopped the bending splits
+    /// with bent edges left that they would have split.
+    bend_bounded: bool,
     /// The volume an edge's deviation may account for before it is split
     /// ([`bend::VOLUME`] × |rest volume| / the input's edge count).
     share: f64,
@@ -507,6 +510,7 @@ pub fn deform(
         chords: Vec::new(),
         bent: 0,
         bend_splits: 0,
+        bend_bounded: false,
         share: if count > 0 {
             bend::VOLUME * crate::math::mesh::signed_volume(rest, faces).abs() / count as f64
         } else {
@@ -565,9 +569,10 @@ pub fn deform(
     if refinement.is_some() {
         out.over_threshold = r.over_edges(&w)?.len();
     }
-    // not converged whenever edges remain over the threshold: a bound stopped the refinement
-    // (every edge, torn ones too, is shortened by its split; see the module docs)
-    out.bounded = out.over_threshold > 0;
+    // not converged whenever edges remain over the threshold, or bent where the bending
+    // splits would split them: a bound stopped the refinement (every edge, torn ones too, is
+    // shortened by its split; see the module docs)
+    out.bounded = out.over_threshold > 0 || r.bend_bounded;
     out.bent = r.bent;
     out.bend_splits = r.bend_splits;
     out.passes = r.passes;

@@ -425,7 +425,11 @@ impl Refiner<'_> {
             let (p, carry) = match g {
                 Gen::Slip(_, s) => (p, Carry::Surface(s)),
                 // `!(d <= ...)` also catches a NaN placement
-                Gen::Material(_) if path.is_none() && !(p.distance(chord) <= TORN * l) => {
+                Gen::Material(x)
+                    if path.is_none()
+                        && !(p.distance(chord) <= TORN * l)
+                        && !(p.is_finite() && !chords && self.smooth(a, b, x)) =>
+                {
                     if !chords {
                         continue;
                     }

@@ -327,6 +327,7 @@ fn over_edges_of_the_drag() {
         chords: Vec::new(),
         bent: 0,
         bend_splits: 0,
+        bend_bounded: false,
         share: f64::INFINITY,
     };
     r.carry = v.iter().map(|&x| r.carry_of(Gen::Material(x))).collect();
