@@ -8,6 +8,12 @@ double-reflection loop is timed at small n as the peer a user would otherwise wr
 
     python benchmarks/bench_frames.py            # up to 10^7 points
     python benchmarks/bench_frames.py --max 1e6  # quicker
+    python benchmarks/bench_frames.py --max 1e6 --method double_reflection --load 3
+
+``--load N`` starts N busy-loop processes beside the whole run (both the threaded and the
+one-thread measurement), to see how the threads fare when the machine has more runnable
+jobs than cores; ``--method`` restricts the methods timed. Each time cell is then the best
+of ``--repeat`` calls with the median in brackets.
 
 A second table times bundles of many short curves (``lengths=``), 10⁶ points in all (or
 ``--max``).
@@ -16,8 +22,10 @@ A second table times bundles of many short curves (``lengths=``), 10⁶ points i
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -29,6 +37,18 @@ import spinal
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]
 
+
+@contextlib.contextmanager
+def busy(n):
+    """``n`` busy-loop processes running for the duration of the block."""
+    procs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+    try:
+        yield
+    finally:
+        for p in procs:
+            p.kill()
+        for p in procs:
+            p.wait()
 
 
 def helix(n):
@@ -56,7 +76,8 @@ def numpy_double_reflection(x, t):
 
 def best_with_floor(f, n, repeat):
     """Best times of ``f()`` and of the write floor, measured alternately in the same window
-    (a burst of load from elsewhere on a shared machine then hits both alike)."""
+    (a burst of load from elsewhere on a shared machine then hits both alike), and the
+    median time of ``f()``."""
     tf, tw = [], []
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -66,10 +87,10 @@ def best_with_floor(f, n, repeat):
         t2 = time.perf_counter()
         tw.append(t1 - t0)
         tf.append(t2 - t1)
-    return min(tf), min(tw)
+    return min(tf), min(tw), statistics.median(tf)
 
 
-def measure(sizes, repeat):
+def measure(sizes, repeat, methods=METHODS):
     rows = []
     for n in sizes:
         x, t = helix(n)
@@ -78,14 +99,14 @@ def measure(sizes, repeat):
         row0 = {"n": n, "method": "numpy write floor", "tangents": "-", "s": floor,
                 "floor": floor}
         rows.append(row0)
-        for method in METHODS:
+        for method in methods:
             for given in (False, True):
                 args = (x, t) if given else (x,)
-                s, fl = best_with_floor(lambda a=args, m=method: spinal.frames(*a, method=m),
-                                        n, rep)
+                s, fl, med = best_with_floor(
+                    lambda a=args, m=method: spinal.frames(*a, method=m), n, rep)
                 row0["s"] = row0["floor"] = min(row0["s"], fl)
                 rows.append({"n": n, "method": method, "tangents": "given" if given else
-                             "estimated", "s": s, "floor": fl})
+                             "estimated", "s": s, "floor": fl, "median": med})
         if n <= 10_000:
             s = best(numpy_double_reflection, 1, x, t)
             rows.append({"n": n, "method": "numpy loop (DR)", "tangents": "given", "s": s,
@@ -104,7 +125,7 @@ def bundles(total, repeat):
         piece = np.c_[np.cos(u), np.sin(u), 0.1 * u]
         pts = (piece[None] + rng.normal(size=(m, 1, 3))).reshape(-1, 3)
         lengths = np.full(m, length)
-        s, fl = best_with_floor(lambda p=pts, c=lengths: spinal.frames(p, lengths=c),
+        s, fl, _ = best_with_floor(lambda p=pts, c=lengths: spinal.frames(p, lengths=c),
                                 len(pts), repeat)
         rows.append({"curves": m, "length": length, "s": s, "floor": fl})
     return rows
@@ -114,29 +135,48 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e7)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--method", action="append", choices=METHODS,
+                    help="time this method only (repeatable; default: all)")
+    ap.add_argument("--load", type=int, default=0,
+                    help="busy-loop processes to run beside the measurement")
     ap.add_argument("--json", action="store_true", help="print raw rows as JSON (internal)")
     a = ap.parse_args()
+    methods = a.method or METHODS
     sizes = [n for n in (10**3, 10**4, 10**5, 10**6, 10**7) if n <= a.max]
-    rows = measure(sizes, a.repeat)
     if a.json:
-        print(json.dumps(rows))
+        print(json.dumps(measure(sizes, a.repeat, methods)))
         return
+    with busy(a.load):
+        run(a, sizes, methods)
+
+
+def run(a, sizes, methods):
+    rows = measure(sizes, a.repeat, methods)
     env = dict(os.environ, RAYON_NUM_THREADS="1")
+    flags = [f"--method={m}" for m in methods]
     single = json.loads(subprocess.run(
-        [sys.executable, __file__, "--max", str(a.max), "--repeat", str(a.repeat), "--json"],
-        env=env, check=True, capture_output=True, text=True).stdout)
-    one = {(r["n"], r["method"], r["tangents"]): r["s"] for r in single}
+        [sys.executable, __file__, "--max", str(a.max), "--repeat", str(a.repeat), "--json",
+         *flags], env=env, check=True, capture_output=True, text=True).stdout)
+    one = {(r["n"], r["method"], r["tangents"]): r for r in single}
     cores = os.cpu_count()
-    print(f"spinal {spinal.__version__}, {cores} cores; best of {a.repeat}; helix samples; "
-          "× write floor: against NumPy's np.full of the (n, 3, 3) output timed alternately "
-          "with each call\n")
+    print(f"spinal {spinal.__version__}, {cores} cores, {spinal.get_num_threads()} threads "
+          f"(all), {a.load} busy processes beside; best of {a.repeat}"
+          f"{' (median)' if a.load else ''}; helix samples; × write floor: against NumPy's "
+          "np.full of the (n, 3, 3) output timed alternately with each call\n")
     print("| n | method | tangents | ms, 1 thread | ms, all cores | Mframes/s (all) "
           "| × write floor (all) | speed-up |")
     print("|---|---|---|---|---|---|---|---|")
+    def cell(r):
+        if r is None:
+            return "nan"
+        med = f" ({1e3 * r['median']:.3f})" if a.load and "median" in r else ""
+        return f"{1e3 * r['s']:.3f}{med}"
+
     for r in rows:
         n, s = r["n"], r["s"]
-        s1 = one.get((n, r["method"], r["tangents"]), float("nan"))
-        print(f"| {n:,} | {r['method']} | {r['tangents']} | {1e3 * s1:.3f} | {1e3 * s:.3f} | "
+        r1 = one.get((n, r["method"], r["tangents"]))
+        s1 = r1["s"] if r1 else float("nan")
+        print(f"| {n:,} | {r['method']} | {r['tangents']} | {cell(r1)} | {cell(r)} | "
               f"{n / s / 1e6:.1f} | {s / r['floor']:.2f} | {s1 / s:.2f} |")
     dr = [r for r in rows if r["n"] == 10**6 and r["method"] == "double_reflection"
           and r["tangents"] == "estimated"]
