@@ -10,10 +10,14 @@ double-reflection loop is timed at small n as the peer a user would otherwise wr
     python benchmarks/bench_frames.py --max 1e6  # quicker
     python benchmarks/bench_frames.py --max 1e6 --method double_reflection --load 3
 
+    python benchmarks/bench_frames.py --alternate 1e6 --repeat 21 --load 3
+
 ``--load N`` starts N busy-loop processes beside the whole run (both the threaded and the
 one-thread measurement), to see how the threads fare when the machine has more runnable
 jobs than cores; ``--method`` restricts the methods timed. Each time cell is then the best
-of ``--repeat`` calls with the median in brackets.
+of ``--repeat`` calls with the median in brackets. ``--alternate n`` times only
+``spinal.frames`` of an n-point helix (double reflection, tangents estimated) on 1 and on 2
+threads, call after call in turn, so that both see the same load from elsewhere.
 
 A second table times bundles of many short curves (``lengths=``), 10⁶ points in all (or
 ``--max``).
@@ -131,6 +135,19 @@ def bundles(total, repeat):
     return rows
 
 
+def alternate(n, repeat):
+    """Best and median times of ``spinal.frames`` on 1 and on 2 threads, called in turn."""
+    x, _ = helix(n)
+    times = {1: [], 2: []}
+    for _ in range(repeat):
+        for threads, ts in times.items():
+            with spinal.threads(threads):
+                t0 = time.perf_counter()
+                spinal.frames(x)
+                ts.append(time.perf_counter() - t0)
+    return {k: (min(v), statistics.median(v)) for k, v in times.items()}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e7)
@@ -139,8 +156,18 @@ def main():
                     help="time this method only (repeatable; default: all)")
     ap.add_argument("--load", type=int, default=0,
                     help="busy-loop processes to run beside the measurement")
+    ap.add_argument("--alternate", type=float, default=0,
+                    help="only time n points on 1 and 2 threads, call after call in turn")
     ap.add_argument("--json", action="store_true", help="print raw rows as JSON (internal)")
     a = ap.parse_args()
+    if a.alternate:
+        with busy(a.load):
+            t = alternate(int(a.alternate), a.repeat)
+        print(f"{int(a.alternate):,} points, {a.load} busy processes beside, {a.repeat} calls "
+              f"each: 1 thread {1e3 * t[1][0]:.1f} ms (median {1e3 * t[1][1]:.1f}), 2 threads "
+              f"{1e3 * t[2][0]:.1f} ms (median {1e3 * t[2][1]:.1f}); 1 thread / 2 threads: "
+              f"{t[1][0] / t[2][0]:.2f} (medians {t[1][1] / t[2][1]:.2f})")
+        return
     methods = a.method or METHODS
     sizes = [n for n in (10**3, 10**4, 10**5, 10**6, 10**7) if n <= a.max]
     if a.json:
