@@ -373,7 +373,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     turns = as_turns(turns, "turns")  # the core checks where it applies and the profile
     buffers = _out_buffers(out, want_normals, want_uv, [
-        ("points", points), ("profile", profile), ("frames", frames), ("scale", scale),
+        ("points", points), ("profile", profile), ("frames", frames), (scale_arg, scale),
         ("twist", twist), ("tangents", tangents), ("lengths", lengths),
         ("offsets", offsets)])
     if frames is not None and turns == int(turns) and turns != 0:
