@@ -17,7 +17,8 @@ one-thread measurement), to see how the threads fare when the machine has more r
 jobs than cores; ``--method`` restricts the methods timed. Each time cell is then the best
 of ``--repeat`` calls with the median in brackets. ``--alternate n`` times only
 ``spinal.frames`` of an n-point helix (double reflection, tangents estimated) on 1 and on 2
-threads, call after call in turn, so that both see the same load from elsewhere.
+threads, call after call in turn, so that both see the same load from elsewhere; with
+``--out`` every call writes into one array allocated (and paged in) once, ``out=``.
 
 A second table times bundles of many short curves (``lengths=``), 10⁶ points in all (or
 ``--max``).
@@ -135,15 +136,17 @@ def bundles(total, repeat):
     return rows
 
 
-def alternate(n, repeat):
-    """Best and median times of ``spinal.frames`` on 1 and on 2 threads, called in turn."""
+def alternate(n, repeat, reuse=False):
+    """Best and median times of ``spinal.frames`` on 1 and on 2 threads, called in turn
+    (``reuse``: into one output array)."""
     x, _ = helix(n)
+    out = np.full((n, 3, 3), 0.0) if reuse else None
     times = {1: [], 2: []}
     for _ in range(repeat):
         for threads, ts in times.items():
             with spinal.threads(threads):
                 t0 = time.perf_counter()
-                spinal.frames(x)
+                spinal.frames(x, out=out)
                 ts.append(time.perf_counter() - t0)
     return {k: (min(v), statistics.median(v)) for k, v in times.items()}
 
@@ -158,12 +161,15 @@ def main():
                     help="busy-loop processes to run beside the measurement")
     ap.add_argument("--alternate", type=float, default=0,
                     help="only time n points on 1 and 2 threads, call after call in turn")
+    ap.add_argument("--out", action="store_true",
+                    help="with --alternate: every call writes into one array (out=)")
     ap.add_argument("--json", action="store_true", help="print raw rows as JSON (internal)")
     a = ap.parse_args()
     if a.alternate:
         with busy(a.load):
-            t = alternate(int(a.alternate), a.repeat)
-        print(f"{int(a.alternate):,} points, {a.load} busy processes beside, {a.repeat} calls "
+            t = alternate(int(a.alternate), a.repeat, a.out)
+        into = " into one out= array" if a.out else ""
+        print(f"{int(a.alternate):,} points{into}, {a.load} busy processes beside, {a.repeat} calls "
               f"each: 1 thread {1e3 * t[1][0]:.1f} ms (median {1e3 * t[1][1]:.1f}), 2 threads "
               f"{1e3 * t[2][0]:.1f} ms (median {1e3 * t[2][1]:.1f}); 1 thread / 2 threads: "
               f"{t[1][0] / t[2][0]:.2f} (medians {t[1][1] / t[2][1]:.2f})")
