@@ -8,6 +8,17 @@ double-reflection loop is timed at small n as the peer a user would otherwise wr
 
     python benchmarks/bench_frames.py            # up to 10^7 points
     python benchmarks/bench_frames.py --max 1e6  # quicker
+    python benchmarks/bench_frames.py --max 1e6 --method double_reflection --load 3
+
+    python benchmarks/bench_frames.py --alternate 1e6 --repeat 21 --load 3
+
+``--load N`` starts N busy-loop processes beside the whole run (both the threaded and the
+one-thread measurement), to see how the threads fare when the machine has more runnable
+jobs than cores; ``--method`` restricts the methods timed. Each time cell is then the best
+of ``--repeat`` calls with the median in brackets. ``--alternate n`` times only
+``spinal.frames`` of an n-point helix (double reflection, tangents estimated) on 1 and on 2
+threads, call after call in turn, so that both see the same load from elsewhere; with
+``--out`` every call writes into one array allocated (and paged in) once, ``out=``.
 
 A second table times bundles of many short curves (``lengths=``), 10⁶ points in all (or
 ``--max``).
@@ -16,8 +27,10 @@ A second table times bundles of many short curves (``lengths=``), 10⁶ points i
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -29,6 +42,18 @@ import spinal
 
 METHODS = ["double_reflection", "rotation", "projection", "frenet"]
 
+
+@contextlib.contextmanager
+def busy(n):
+    """``n`` busy-loop processes running for the duration of the block."""
+    procs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+    try:
+        yield
+    finally:
+        for p in procs:
+            p.kill()
+        for p in procs:
+            p.wait()
 
 
 def helix(n):
@@ -56,7 +81,8 @@ def numpy_double_reflection(x, t):
 
 def best_with_floor(f, n, repeat):
     """Best times of ``f()`` and of the write floor, measured alternately in the same window
-    (a burst of load from elsewhere on a shared machine then hits both alike)."""
+    (a burst of load from elsewhere on a shared machine then hits both alike), and the
+    median time of ``f()``."""
     tf, tw = [], []
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -66,10 +92,10 @@ def best_with_floor(f, n, repeat):
         t2 = time.perf_counter()
         tw.append(t1 - t0)
         tf.append(t2 - t1)
-    return min(tf), min(tw)
+    return min(tf), min(tw), statistics.median(tf)
 
 
-def measure(sizes, repeat):
+def measure(sizes, repeat, methods=METHODS):
     rows = []
     for n in sizes:
         x, t = helix(n)
@@ -78,14 +104,14 @@ def measure(sizes, repeat):
         row0 = {"n": n, "method": "numpy write floor", "tangents": "-", "s": floor,
                 "floor": floor}
         rows.append(row0)
-        for method in METHODS:
+        for method in methods:
             for given in (False, True):
                 args = (x, t) if given else (x,)
-                s, fl = best_with_floor(lambda a=args, m=method: spinal.frames(*a, method=m),
-                                        n, rep)
+                s, fl, med = best_with_floor(
+                    lambda a=args, m=method: spinal.frames(*a, method=m), n, rep)
                 row0["s"] = row0["floor"] = min(row0["s"], fl)
                 rows.append({"n": n, "method": method, "tangents": "given" if given else
-                             "estimated", "s": s, "floor": fl})
+                             "estimated", "s": s, "floor": fl, "median": med})
         if n <= 10_000:
             s = best(numpy_double_reflection, 1, x, t)
             rows.append({"n": n, "method": "numpy loop (DR)", "tangents": "given", "s": s,
@@ -104,39 +130,86 @@ def bundles(total, repeat):
         piece = np.c_[np.cos(u), np.sin(u), 0.1 * u]
         pts = (piece[None] + rng.normal(size=(m, 1, 3))).reshape(-1, 3)
         lengths = np.full(m, length)
-        s, fl = best_with_floor(lambda p=pts, c=lengths: spinal.frames(p, lengths=c),
+        s, fl, _ = best_with_floor(lambda p=pts, c=lengths: spinal.frames(p, lengths=c),
                                 len(pts), repeat)
         rows.append({"curves": m, "length": length, "s": s, "floor": fl})
     return rows
+
+
+def alternate(n, repeat, reuse=False):
+    """Best and median times of ``spinal.frames`` on 1 and on 2 threads, called in turn
+    (``reuse``: into one output array)."""
+    x, _ = helix(n)
+    out = np.full((n, 3, 3), 0.0) if reuse else None
+    times = {1: [], 2: []}
+    for _ in range(repeat):
+        for threads, ts in times.items():
+            with spinal.threads(threads):
+                t0 = time.perf_counter()
+                spinal.frames(x, out=out)
+                ts.append(time.perf_counter() - t0)
+    return {k: (min(v), statistics.median(v)) for k, v in times.items()}
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max", type=float, default=1e7)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--method", action="append", choices=METHODS,
+                    help="time this method only (repeatable; default: all)")
+    ap.add_argument("--load", type=int, default=0,
+                    help="busy-loop processes to run beside the measurement")
+    ap.add_argument("--alternate", type=float, default=0,
+                    help="only time n points on 1 and 2 threads, call after call in turn")
+    ap.add_argument("--out", action="store_true",
+                    help="with --alternate: every call writes into one array (out=)")
     ap.add_argument("--json", action="store_true", help="print raw rows as JSON (internal)")
     a = ap.parse_args()
-    sizes = [n for n in (10**3, 10**4, 10**5, 10**6, 10**7) if n <= a.max]
-    rows = measure(sizes, a.repeat)
-    if a.json:
-        print(json.dumps(rows))
+    if a.alternate:
+        with busy(a.load):
+            t = alternate(int(a.alternate), a.repeat, a.out)
+        into = " into one out= array" if a.out else ""
+        print(f"{int(a.alternate):,} points{into}, {a.load} busy processes beside, {a.repeat} calls "
+              f"each: 1 thread {1e3 * t[1][0]:.1f} ms (median {1e3 * t[1][1]:.1f}), 2 threads "
+              f"{1e3 * t[2][0]:.1f} ms (median {1e3 * t[2][1]:.1f}); 1 thread / 2 threads: "
+              f"{t[1][0] / t[2][0]:.2f} (medians {t[1][1] / t[2][1]:.2f})")
         return
+    methods = a.method or METHODS
+    sizes = [n for n in (10**3, 10**4, 10**5, 10**6, 10**7) if n <= a.max]
+    if a.json:
+        print(json.dumps(measure(sizes, a.repeat, methods)))
+        return
+    with busy(a.load):
+        run(a, sizes, methods)
+
+
+def run(a, sizes, methods):
+    rows = measure(sizes, a.repeat, methods)
     env = dict(os.environ, RAYON_NUM_THREADS="1")
+    flags = [f"--method={m}" for m in methods]
     single = json.loads(subprocess.run(
-        [sys.executable, __file__, "--max", str(a.max), "--repeat", str(a.repeat), "--json"],
-        env=env, check=True, capture_output=True, text=True).stdout)
-    one = {(r["n"], r["method"], r["tangents"]): r["s"] for r in single}
+        [sys.executable, __file__, "--max", str(a.max), "--repeat", str(a.repeat), "--json",
+         *flags], env=env, check=True, capture_output=True, text=True).stdout)
+    one = {(r["n"], r["method"], r["tangents"]): r for r in single}
     cores = os.cpu_count()
-    print(f"spinal {spinal.__version__}, {cores} cores; best of {a.repeat}; helix samples; "
-          "× write floor: against NumPy's np.full of the (n, 3, 3) output timed alternately "
-          "with each call\n")
+    print(f"spinal {spinal.__version__}, {cores} cores, {spinal.get_num_threads()} threads "
+          f"(all), {a.load} busy processes beside; best of {a.repeat}"
+          f"{' (median)' if a.load else ''}; helix samples; × write floor: against NumPy's "
+          "np.full of the (n, 3, 3) output timed alternately with each call\n")
     print("| n | method | tangents | ms, 1 thread | ms, all cores | Mframes/s (all) "
           "| × write floor (all) | speed-up |")
     print("|---|---|---|---|---|---|---|---|")
+    def cell(r):
+        if r is None:
+            return "nan"
+        med = f" ({1e3 * r['median']:.3f})" if a.load and "median" in r else ""
+        return f"{1e3 * r['s']:.3f}{med}"
+
     for r in rows:
         n, s = r["n"], r["s"]
-        s1 = one.get((n, r["method"], r["tangents"]), float("nan"))
-        print(f"| {n:,} | {r['method']} | {r['tangents']} | {1e3 * s1:.3f} | {1e3 * s:.3f} | "
+        r1 = one.get((n, r["method"], r["tangents"]))
+        s1 = r1["s"] if r1 else float("nan")
+        print(f"| {n:,} | {r['method']} | {r['tangents']} | {cell(r1)} | {cell(r)} | "
               f"{n / s / 1e6:.1f} | {s / r['floor']:.2f} | {s1 / s:.2f} |")
     dr = [r for r in rows if r["n"] == 10**6 and r["method"] == "double_reflection"
           and r["tangents"] == "estimated"]

@@ -208,7 +208,7 @@ ARRAYS = {
     "orientations", "fields", "quaternions", "q", "q0", "q1", "new_u", "key_u", "a", "b",
     "face", "point", "moves", "direction", "directions", "control_points", "knots", "s", "v",
     "section_ctrl", "section_weights", "curve", "domain", "A0", "A1", "p0", "t0", "p1", "t1",
-    "coefficients", "up", "bank", "kwargs", "spine",
+    "coefficients", "up", "bank", "kwargs", "spine", "out",
 }
 
 #: Parameters whose kind is not in the annotation/default: name -> kind, per callable

@@ -97,6 +97,7 @@ def frames(
     guide_sign: Literal["follow", "free"] = "follow",
     on_invalid: Literal["raise", "skip"] = "raise",
     progress: _Progress = False,
+    out: npt.NDArray[np.float64] | None = None,
 ) -> _F: ...
 def frames_in_time(
     points_t: _Array | None,
@@ -240,6 +241,7 @@ def sweep(
     join: Literal["round", "bevel", "miter"] = "round",
     progress: _Progress = False,
     turns: float = 0,
+    out: Mesh | None = None,
 ) -> Mesh: ...
 def tube(
     points: _Array | _Curves,
@@ -265,6 +267,7 @@ def tube(
     join: Literal["round", "bevel", "miter"] = "round",
     progress: _Progress = False,
     turns: float = 0,
+    out: Mesh | None = None,
 ) -> Mesh: ...
 
 # ---- profile (moulding) surfaces -----------------------------------------------------------
@@ -324,6 +327,7 @@ def advect(
     method: Literal["rk4", "euler", "split"] = "rk4",
     t0: float = 0.0,
     progress: _Progress = False,
+    out: npt.NDArray[np.float64] | None = None,
 ) -> _F: ...
 @dataclass(frozen=True)
 class DeformReport:

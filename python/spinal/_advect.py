@@ -8,7 +8,7 @@ import numpy as np
 
 from . import _core
 from ._progress import Progress, checked
-from ._validate import as_choice, as_finite, as_int, as_points
+from ._validate import as_choice, as_finite, as_int, as_out, as_points
 from .fields import Field
 
 __all__ = ["advect"]
@@ -18,7 +18,7 @@ MAX_STEPS = 100_000_000
 
 
 def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
-           t0=0.0, progress=False) -> np.ndarray:
+           t0=0.0, progress=False, out=None) -> np.ndarray:
     """Move points along a velocity field for ``duration``: integrate ``dX/dt = v(X, t)``
     from ``t0`` to ``t0 + duration`` for every point, independently and in parallel.
 
@@ -62,11 +62,19 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
     progress : bool or callable
         Report progress for long animations: True shows a tqdm bar (notebook-aware) or a
         line on stderr; a callable is called as ``progress(done_steps, total_steps)``.
+    out : ndarray (n, 3) float64, optional
+        An array to write the moved points into (and return), for callers that reuse one
+        buffer across animation frames: exactly shape ``(n, 3)``, dtype float64, C-contiguous
+        and writeable, sharing no memory with ``vertices`` (else a ValueError naming
+        ``out``). The core integrates in it directly; the points are those of the call
+        without ``out``, bit for bit. If the call raises (or is interrupted by Ctrl-C), the
+        contents of ``out`` are unspecified.
 
     Returns
     -------
-    (n, 3) float64 array of the moved points.
+    (n, 3) float64 array of the moved points (``out`` itself when given).
     """
+    out = as_out(out, [("vertices", vertices)])
     x = as_points(vertices, "vertices")
     if not isinstance(field, Field):
         raise TypeError(f"field: expected a spinal.fields.Field, got {type(field).__name__}")
@@ -81,7 +89,7 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         if not 1 <= steps <= MAX_STEPS:
             raise ValueError(f"steps: must be in 1 … {MAX_STEPS}, got {steps}")
     if duration == 0.0:  # an unchanged copy (the core still checks the points)
-        return _core.advect(x, field, t0, 0.0, 1, method)
+        return _core.advect(x, field, t0, 0.0, 1, method, out=out)
     bp = field.breakpoints()
     t1 = t0 + duration
     cuts = bp[(bp > min(t0, t1)) & (bp < max(t0, t1))]
@@ -94,18 +102,20 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         runs = [(float(a), float(b - a) / n, n) for a, b, n in zip(ts[:-1], ts[1:], ns)]
         if progress is False:
             # one core call: the points are put in their spatial order once for all the runs
-            return _core.advect_runs(x, field, runs, method)
+            return _core.advect_runs(x, field, runs, method, out=out)
         total = sum(ns)
         with Progress(progress, total, "advect", "step") as bar:
             return _core.advect_runs(x, field, runs, method,
-                                     lambda done, total: bar.update(done), max(1, total // 100))
+                                     lambda done, total: bar.update(done), max(1, total // 100),
+                                     out=out)
     h = duration / steps
     if progress is False:
-        return _core.advect(x, field, t0, h, steps, method)
+        return _core.advect(x, field, t0, h, steps, method, out=out)
     # one call: the core reports every 1/100 of the steps (same bits as without)
     with Progress(progress, steps, "advect", "step") as bar:
         return _core.advect(x, field, t0, h, steps, method,
-                            lambda done, total: bar.update(done), max(1, steps // 100))
+                            lambda done, total: bar.update(done), max(1, steps // 100),
+                            out=out)
 
 
 def default_steps(field: Field, duration: float, x: np.ndarray, t0: float,

@@ -23,6 +23,7 @@ def frames_sampled(
     turns: float,
     points_arg: str = "points",
     progress: Callable[[int, int], object] | None = None,
+    out: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def frames_analytic(
     points: npt.NDArray[np.float64],
@@ -116,6 +117,9 @@ def sweep_mesh(
     join: str = "round",
     progress: Callable[[int, int], object] | None = None,
     turns: float = 0.0,
+    out_vertices: npt.NDArray[np.floating] | None = None,
+    out_normals: npt.NDArray[np.floating] | None = None,
+    out_uv: npt.NDArray[np.floating] | None = None,
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],
@@ -369,6 +373,7 @@ def advect(
     method: str,
     progress: Callable[[int, int], object] | None = None,
     every: int = 0,
+    out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def advect_runs(
     points: npt.NDArray[np.float64],
@@ -377,6 +382,7 @@ def advect_runs(
     method: str,
     progress: Callable[[int, int], object] | None = None,
     every: int = 0,
+    out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def deform_mesh(
     vertices: npt.NDArray[np.float64],

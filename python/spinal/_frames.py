@@ -19,9 +19,11 @@ from ._validate import (
     as_float_array,
     as_int,
     as_offsets,
+    as_out,
     as_points,
     as_real,
     as_turns,
+    fill_out,
     is_curve_list,
 )
 from .curves import Curve
@@ -118,7 +120,7 @@ def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"
 
 
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-             lengths, offsets, points_arg="points", report=None):
+             lengths, offsets, points_arg="points", report=None, out=None):
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
@@ -150,10 +152,12 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     # tangents (the core's `tangent_chords` flag)
     chords_from_tangents = reflection == "tangents"
 
-    def run(pts, offs, tgs):
-        return _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE,
+    def run(p, offs, tgs):
+        # the rows as given are written straight into `out` (the rows kept after merging
+        # repeats are spread over it by the caller)
+        return _core.frames_sampled(p, tgs, offs, method, DEFAULT_TANGENT_RULE,
                                     chords_from_tangents, closed, iv, if_, ev, ef, turns,
-                                    points_arg, report)
+                                    points_arg, report, out if p is pts else None)
 
     if pts is None or chords_from_tangents:  # (the quadrature's grid is the rows as given)
         out, angles = run(pts, offs, tgs)
@@ -193,6 +197,7 @@ def frames(
     guide_sign: str = "follow",
     on_invalid: str = "raise",
     progress=False,
+    out=None,
 ) -> np.ndarray:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
@@ -378,11 +383,19 @@ def frames(
         that does not move, the previous frames come back up to the guide's smoothing bias
         (about ``φ″/guide_weight``, ``φ″`` the previous twist's second difference per
         sample). Default ``False``: the RMF turned by one angle.
+    out : ndarray (n, 3, 3) float64, optional
+        An array to write the frames into (and return), for callers that reuse one buffer
+        across animation frames: exactly the result's shape and dtype float64, C-contiguous
+        and writeable, sharing no memory with an input (else a ValueError naming ``out``).
+        The frames are those of the call without ``out``, bit for bit; the usual calls
+        (sampled curves without ``constraints``, ``guide``, ``previous``, repeated samples
+        or skipped curves) write them there directly, the others copy them in. If the call
+        raises (or is interrupted by Ctrl-C), the contents of ``out`` are unspecified.
 
     Returns
     -------
     ndarray (n, 3, 3) float64
-        One frame per input row.
+        One frame per input row (``out`` itself when given).
 
     Raises
     ------
@@ -414,6 +427,10 @@ def frames(
     """
     on_invalid = as_choice(on_invalid, "on_invalid", ("raise", "skip"))
     progress = checked(progress)
+    out = as_out(out, [("points", points), ("tangents", tangents), ("initial", initial),
+                       ("end", end), ("guide", guide), ("previous", previous),
+                       ("constraints", constraints), ("u", u), ("lengths", lengths),
+                       ("offsets", offsets)])
     if on_invalid == "skip" and not isinstance(points, Curve):
         cut = _merge.invalid_curves(points, lengths, offsets, as_bool(closed, "closed"))
         if cut is not None:
@@ -422,10 +439,10 @@ def frames(
                                 "would move); leave the invalid curves out first")
             pts, offs, keep, kept, bad, nan, few = cut
             _skipped_warning(nan, few, closed, "their frames are NaN")
-            out = np.full((len(pts), 3, 3), np.nan)
+            res = np.full((len(pts), 3, 3), np.nan)
             if kept[-1]:
                 n, c = len(pts), len(offs) - 1
-                out[keep] = frames(
+                res[keep] = frames(
                     pts[keep], _cut_rows(tangents, keep, n), method=method,
                     initial=_cut_curves(initial, bad, c), closed=closed,
                     end=_cut_curves(end, bad, c), turns=turns, reflection=reflection,
@@ -433,7 +450,7 @@ def frames(
                     guide_weight=guide_weight, guide_tolerance=guide_tolerance,
                     previous=_cut_rows(previous, keep, n), previous_twist=previous_twist,
                     guide_sign=guide_sign, progress=progress)
-            return out
+            return fill_out(out, res)
     previous_twist = as_bool(previous_twist, "previous_twist")
     guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
     if previous_twist and previous is None:
@@ -441,16 +458,16 @@ def frames(
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
     if (constraints is not None or guide is not None or previous is not None
             or twist_rule != "arc_length" or isinstance(turns, (list, tuple, np.ndarray))):
-        out = _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
+        res = _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
                        lengths, offsets, constraints, twist_rule, guide, guide_weight,
                        guide_tolerance, previous, previous_twist, guide_sign)
-        with Progress(progress, len(out), "frames", "row") as bar:
-            bar.update(len(out))
-        return out
+        with Progress(progress, len(res), "frames", "row") as bar:
+            bar.update(len(res))
+        return fill_out(out, res)
     with Reported(progress, "frames", "row") as report:
-        out, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection,
-                             u, lengths, offsets, report=report.callback)
-    return out
+        res, _, _ = _compute(points, tangents, method, initial, closed, end, turns, reflection,
+                             u, lengths, offsets, report=report.callback, out=out)
+    return fill_out(out, res)
 
 
 def closing_angle(

@@ -19,10 +19,12 @@ from ._validate import (
     as_float_array,
     as_frames,
     as_int,
+    as_out,
     as_per_row,
     as_points,
     as_real,
     as_turns,
+    fill_out,
 )
 
 __all__ = ["sweep", "tube"]
@@ -99,6 +101,7 @@ def sweep(
     join: str = "round",
     progress=False,
     turns: float = 0,
+    out=None,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -242,6 +245,17 @@ def sweep(
         called as ``progress(rows_done, rows)`` from the calling thread, about every 20 ms
         while the count moves and once at the end. The work only counts (the same mesh, bit
         for bit, at the same speed).
+    out : Mesh, optional
+        A mesh of an earlier sweep (or tube) of the same sizes whose ``vertices``, and
+        ``normals`` and ``uv`` when the call makes them, are refilled in place by the core,
+        for callers that reuse the buffers across animation frames (a renderer's vertex
+        buffers). Each must have exactly the shape and dtype of the new result, be
+        C-contiguous and writeable and share no memory with an input, else a ValueError
+        naming it (``out.vertices`` …). Returns a new :class:`Mesh` whose ``vertices``,
+        ``normals`` and ``uv`` are those arrays; its ``faces`` (which depend only on the
+        sizes) and other attributes are new. The values are those of the call without
+        ``out``, bit for bit. If the call raises (or is interrupted by Ctrl-C), the
+        contents of the arrays of ``out`` are unspecified.
 
     Consecutive samples closer than ``2⁻⁴⁰ ≈ 9.1e-13`` times their curve's size (its
     bounding box's largest side) are one point: they are merged into the first of them,
@@ -287,7 +301,30 @@ def sweep(
     return _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
                        miter_limit, split_seams, strict, lengths, offsets, "scale",
                        tangents, tangent_rule, dtype, normals, uv, point_data, on_short,
-                       on_invalid, join, progress, turns)
+                       on_invalid, join, progress, turns, out)
+
+
+def _out_buffers(out, normals: bool, uv: bool, inputs) -> tuple:
+    """The arrays of the Mesh ``out`` the sweep refills: ``(vertices, normals, uv)``, None
+    for those the call does not make; the core checks their shapes, dtype, order and
+    writeability (errors name ``out.vertices`` …)."""
+    if out is None:
+        return None, None, None
+    if not isinstance(out, Mesh):
+        raise TypeError(f"out: expected a spinal.Mesh (of an earlier sweep or tube of the same "
+                        f"sizes), got {type(out).__name__}")
+    arrays = [("vertices", out.vertices, True), ("normals", out.normals, normals),
+              ("uv", out.uv, uv)]
+    found = []
+    for name, a, wanted in arrays:
+        if not wanted:
+            found.append(None)
+            continue
+        if a is None:
+            raise ValueError(f"out.{name}: None, but the call makes {name} (pass a Mesh made "
+                             f"with {name}=True, or {name}=False)")
+        found.append(as_out(a, inputs, f"out.{name}"))
+    return tuple(found)
 
 
 def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
@@ -316,7 +353,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 miter_limit, split_seams, strict, lengths, offsets, scale_arg,
                 tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
                 normals=True, uv=True, point_data=None, on_short="raise",
-                on_invalid="raise", join="round", progress=False, turns=0) -> Mesh:
+                on_invalid="raise", join="round", progress=False, turns=0, out=None) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     progress = checked(progress)
@@ -335,6 +372,10 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     join = as_choice(join, "join", ("round", "bevel", "miter"))
     miter_limit = as_real(miter_limit, "miter_limit")  # the core checks the range
     turns = as_turns(turns, "turns")  # the core checks where it applies and the profile
+    buffers = _out_buffers(out, want_normals, want_uv, [
+        ("points", points), ("profile", profile), ("frames", frames), (scale_arg, scale),
+        ("twist", twist), ("tangents", tangents), ("lengths", lengths),
+        ("offsets", offsets)])
     if frames is not None and turns == int(turns) and turns != 0:
         raise TypeError("turns: with frames= only a half number is used (it says the frames "
                         "close up to a half turn); the given frames carry their whole turns")
@@ -391,9 +432,16 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         curve_ids = curve_ids[~short]
         offs = np.concatenate([[0], np.cumsum(counts[~short])]).astype(np.int64)
         merge = None if merge is None else _merge.plan(pts, offs, closed)
+    if buffers[0] is not None and merge is None:
+        # the buffers are checked against the mesh of the rows kept: merge repeats first
+        p = _merge.plan(pts, offs, closed)
+        if p.merged and (p.status == _merge.VALID).all():
+            merge = p
     if offs.size == 1:  # every curve left out
         mesh = Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), np.zeros((0, 3)),
                     np.zeros((0, 2)), skipped_curves=skipped)
+        if out is not None:
+            mesh.vertices = fill_out(buffers[0], mesh.vertices, "out.vertices")
         mesh.point_data = {k: a[:0] for k, (a, _) in pdata.items()}
         mesh._n_rows, mesh._n_curves = n, curves
         return mesh
@@ -408,7 +456,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
                 profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
                 single, single, want_normals, want_uv, tg, join, report.callback,
-                float(turns),
+                float(turns), *buffers,
             )
 
     def merged(p):
@@ -689,6 +737,7 @@ def tube(
     join: str = "round",
     progress=False,
     turns: float = 0,
+    out=None,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r
@@ -699,7 +748,7 @@ def tube(
     (one per curve); the normals are tilted by the radius slope. ``sides``: 3 to 2**20.
     Other arguments (bundles as lists of curves, ``tangents``, ``tangent_rule``,
     ``dtype=numpy.float32``, ``normals``, ``uv``, ``point_data``, ``on_short``, ``on_invalid``,
-    ``join``, ``progress``, ``turns``) as in :func:`sweep`. The polygon of an even number of
+    ``join``, ``progress``, ``turns``, ``out``) as in :func:`sweep`. The polygon of an even number of
     sides maps onto itself under a half turn (vertex ``j`` to ``j + sides/2``), so a closed
     tube takes half-integer ``turns`` (an odd number of sides raises ValueError naming
     ``turns``).
@@ -718,4 +767,4 @@ def tube(
     return _sweep_mesh(points, profile, frames, radius, None, closed, caps, True, miter_limit,
                        split_seams, strict, lengths, offsets, "radius", tangents, tangent_rule,
                        dtype, normals, uv, point_data, on_short, on_invalid, join, progress,
-                       turns)
+                       turns, out=out)

@@ -287,3 +287,43 @@ def as_choice(x: Any, name: str, choices: tuple[str, ...]) -> str:
     if x not in choices:
         raise ValueError(f"{name}: unknown value {x!r}; expected one of {choices}")
     return x
+
+
+def as_out(out, inputs=(), name: str = "out"):
+    """A caller's output buffer ``out`` (or None), refused when it is not a NumPy array
+    (TypeError) or shares memory with one of ``inputs`` (``(argument name, value)`` pairs;
+    values that are not arrays, or lists of arrays, are passed over): a ValueError naming
+    ``name`` and the argument. Its shape, dtype, order and writeability are checked where
+    the result's shape is known (:func:`fill_out`, or the core)."""
+    if out is None:
+        return None
+    if not isinstance(out, np.ndarray):
+        raise TypeError(f"{name}: expected a NumPy array, got {type(out).__name__}")
+    for arg, value in inputs:
+        values = value if isinstance(value, (list, tuple)) else [value]
+        for v in values:
+            if isinstance(v, np.ndarray) and np.may_share_memory(out, v):
+                raise ValueError(f"{name}: shares memory with {arg} (an output must not "
+                                 f"overlap an input)")
+    return out
+
+
+def fill_out(out, result: np.ndarray, name: str = "out") -> np.ndarray:
+    """``result`` written into the caller's ``out`` (as the core checks it: exactly
+    ``result``'s shape and dtype, C-contiguous, writeable; else a ValueError naming
+    ``name``), which is returned; ``result`` itself when ``out`` is None."""
+    if out is None or out is result:
+        return result
+    want = f"{name}: expected a C-contiguous writeable {result.dtype} array of shape"
+    if out.dtype != result.dtype:
+        raise ValueError(f"{want} {result.shape}, got a {out.dtype} array of shape "
+                         f"{out.shape}")
+    if out.shape != result.shape:
+        raise ValueError(f"{want} {result.shape}, got shape {out.shape}")
+    if not out.flags.c_contiguous:
+        raise ValueError(f"{name}: must be C-contiguous (np.ascontiguousarray makes a copy "
+                         f"that is)")
+    if not out.flags.writeable:
+        raise ValueError(f"{name}: must be writeable")
+    out[...] = result
+    return out

@@ -42,6 +42,7 @@ pub mod torsion;
 pub mod transport;
 pub mod validate;
 
+mod carry;
 mod check;
 mod dispatch;
 mod request;

@@ -7,11 +7,12 @@
 //! transported from a provisional start vector; because each `Q` is a rotation taking `t_a`
 //! to `t_b`, the true vector at the end of a chunk is the provisional one turned about `t_b`
 //! by the angle that separates the true and provisional start vectors. The chunks go out in
-//! order to one worker per thread; a worker that has written chunk `c` takes the true end of
-//! chunk `c − 1` (its owner started earlier, so it is ready or nearly so), finds its chunk's
-//! angle and, without an end condition, turns the rows it has just written while they are
-//! still in the cache. With an end condition the rows are turned once, by the chunk angle
-//! plus the twist, in a parallel pass after the last chunk.
+//! order to one worker per thread; the angles are carried from chunk to chunk by whichever
+//! worker delivers the chunk the carry needs next ([`super::carry`]), so that no worker waits
+//! for another. Without an end condition a chunk's rows are turned as soon as its angle is
+//! known, by its own worker while they are still in the cache when it can. With an end
+//! condition the rows are turned once, by the chunk angle plus the twist, in a parallel pass
+//! after the last chunk.
 //!
 //! **Twist** (Wang et al. §6.3, Zheng §7.3). Among all frames `g = cos α r + sin α (t × r)`
 //! that meet a condition at the far end, `∫(κ² + α′²) ds` is least for `α` linear in arc
@@ -20,8 +21,6 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Mutex, OnceLock, PoisonError};
 
 use super::geometry::{any_perpendicular, rotate_about, signed_angle};
 
@@ -65,6 +64,16 @@ pub fn write_frame(buf: &mut [f64], r: DVec3, t: DVec3) {
     buf[8] = t.z;
 }
 
+/// Turn the rows of written frames about their `t` columns by `angle` (nothing for 0).
+pub(super) fn turn_rows(buf: &mut [f64], angle: f64) {
+    if angle != 0.0 {
+        let (sin, cos) = angle.sin_cos();
+        for f in buf.chunks_exact_mut(9) {
+            turn_frame(f, cos, sin);
+        }
+    }
+}
+
 /// Turn the `(r, s)` columns of a written frame about its `t` column.
 #[inline(always)]
 fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
@@ -91,37 +100,6 @@ pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
 /// What the transport of a chunk reports: the start vector it used (the true one for chunk
 /// 0, a provisional one otherwise), its last vector, and the chunk's arc length.
 pub type ChunkEnds = (DVec3, DVec3, f64);
-
-/// A chunk once its predecessors are known: its [`ChunkEnds`] and the angle that turns its
-/// provisional vectors into the true ones; `None` when a check failed in it or before it.
-type Resolved = Option<(ChunkEnds, f64)>;
-
-/// Publishes a chunk's state when dropped, so that a chunk that ends early (a failed check,
-/// or a panic) never leaves the chunk after it waiting.
-struct Publish<'a>(&'a OnceLock<Resolved>, Resolved);
-
-impl Drop for Publish<'_> {
-    fn drop(&mut self) {
-        let _ = self.0.set(self.1);
-    }
-}
-
-/// The state of a chunk that has been handed out (its worker is running): spin a little,
-/// then give the processor away.
-fn wait(cell: &OnceLock<Resolved>) -> Resolved {
-    let mut spins = 0u32;
-    loop {
-        if let Some(v) = cell.get() {
-            return *v;
-        }
-        if spins < 1 << 12 {
-            spins += 1;
-            std::hint::spin_loop();
-        } else {
-            std::thread::yield_now();
-        }
-    }
-}
 
 /// The curve data the scan needs besides the transport of a chunk itself.
 pub struct Scan<B, T, L> {
@@ -159,17 +137,17 @@ where
     /// tangent, of its own choice), writes its rows into `buf` (empty for the extra frame of
     /// a closed curve) and reports its [`ChunkEnds`].
     ///
-    /// Chunks are handed out in order to one worker per thread. When chunk `c` is written,
-    /// its worker waits for chunk `c − 1` to be resolved (its owner is running and a step
-    /// ahead, so the wait is short) and takes the angle that turns the provisional start
-    /// into the true one. Without an end condition it turns the rows at once, while they are
-    /// still in the cache; with one (an `end` or a closed curve) all rows are turned once,
-    /// by the chunk angle plus the twist, in a parallel pass after the last chunk. The frames
-    /// do not depend on the timing: chunk `c > 0` always starts from its provisional vector.
+    /// Chunks are handed out in order to one worker per thread, and the angle that turns a
+    /// chunk's provisional start into the true one is carried in chunk order by whichever
+    /// worker is free ([`super::carry`]): no worker waits for a chunk in another's hands.
+    /// Without an end condition each chunk's rows are turned as soon as its angle is known;
+    /// with one (an `end` or a closed curve) all rows are turned once, by the chunk angle plus
+    /// the twist, in a parallel pass after the last chunk. The frames do not depend on the
+    /// timing: chunk `c > 0` always starts from its provisional vector.
     ///
-    /// `work`, `boundary_step` and `tangent` must not use rayon themselves: a worker waiting
-    /// for the chunk before could then run a sibling worker on its own stack, which would
-    /// wait for it in turn.
+    /// `work`, `boundary_step` and `tangent` must not use rayon themselves: a worker that
+    /// has nothing left to take sleeps until the carry passes the running chunks, and must
+    /// not hold a task they need.
     pub fn scan<W>(&self, work: W, out: &mut [f64]) -> Option<f64>
     where
         W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
@@ -196,71 +174,24 @@ where
         // without an end condition the chunk angle is the whole correction: turn at once
         let turn_now = matches!(self.twist, Twist::None);
 
-        // one slot and one result per chunk (chunks ≤ rows), within
-        // `super::WORKING_BYTES_PER_ROW` (checked free by the binding's `ensure_memory` probe)
-        let mut slots: Vec<Mutex<&mut [f64]>> = out[..9 * write_rows]
-            .chunks_mut(9 * cs)
-            .map(Mutex::new)
-            .collect();
-        // a closed curve's extended frame may form a last chunk with no row to write
-        while slots.len() < chunks {
-            slots.push(Mutex::new(&mut []));
-        }
-        let done: Vec<OnceLock<Resolved>> = (0..chunks).map(|_| OnceLock::new()).collect();
-        let next = AtomicUsize::new(0);
-        let failed = AtomicBool::new(false);
-
-        let resolve = |c: usize, buf: &mut [f64]| -> Resolved {
-            let p = work(c, (c == 0).then_some(self.r0), buf)?;
-            if c == 0 {
-                return Some((p, 0.0));
-            }
-            let (prev, prev_angle) = wait(&done[c - 1])?;
+        // one slice of rows per chunk (chunks ≤ rows); a closed curve's extended frame may
+        // form a last chunk with no row to write
+        let mut bufs: Vec<&mut [f64]> = out[..9 * write_rows].chunks_mut(9 * cs).collect();
+        bufs.resize_with(chunks, Default::default);
+        let angle = |c: usize, prev: ChunkEnds, prev_angle: f64, p: ChunkEnds| {
             let a = c * cs;
             let last = rotate_about(prev.1, tt(a - 1), prev_angle);
             let true_start = (self.boundary_step)(a - 1, last);
-            let angle = signed_angle(p.0, true_start, tt(a));
-            if turn_now && angle != 0.0 {
-                let (sin, cos) = angle.sin_cos();
-                for f in buf.chunks_exact_mut(9) {
-                    turn_frame(f, cos, sin);
-                }
-            }
-            Some((p, angle))
+            signed_angle(p.0, true_start, tt(a))
         };
-        let worker = || {
-            loop {
-                let c = next.fetch_add(1, Ordering::Relaxed);
-                if c >= chunks {
-                    return;
-                }
-                let mut publish = Publish(&done[c], None);
-                if failed.load(Ordering::Relaxed) {
-                    continue;
-                }
-                let mut slot = slots[c].lock().unwrap_or_else(PoisonError::into_inner);
-                publish.1 = resolve(c, &mut slot);
-                if publish.1.is_none() {
-                    failed.store(true, Ordering::Relaxed);
-                }
-            }
-        };
-        let threads = rayon::current_num_threads().min(chunks);
-        if threads > 1 {
-            rayon::scope(|s| {
-                for _ in 1..threads {
-                    s.spawn(|_| worker());
-                }
-                worker();
-            });
-        } else {
-            worker();
-        }
-        drop(slots);
-        let resolved: Vec<(ChunkEnds, f64)> = done
-            .into_iter()
-            .map(|cell| cell.into_inner().flatten())
-            .collect::<Option<_>>()?;
+        // one result per chunk, within `super::WORKING_BYTES_PER_ROW` (checked free by the
+        // binding's `ensure_memory` probe)
+        let resolved = super::carry::run(
+            bufs,
+            |c, buf| work(c, (c == 0).then_some(self.r0), buf),
+            angle,
+            turn_now,
+        )?;
 
         let (last, last_angle) = resolved[chunks - 1];
         let end_r = rotate_about(last.1, tt(ext - 1), last_angle);

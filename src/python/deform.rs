@@ -6,17 +6,19 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use super::convert::{
-    Stop, Ticker, detach_stoppable, empty, slice_mut, triangles, value_error, vec3_array, vec3s,
+    Stop, Ticker, detach_stoppable, slice_mut, triangles, value_error, vec3_array, vec3s,
 };
 use super::fields::PyField;
+use super::out::{output, writing};
 use crate::alloc;
 use crate::deform::{self, advect::Method, refine};
 
-/// Advect points: `steps` steps of size `h` from `t0`; a new array. Ctrl-C stops it between
+/// Advect points: `steps` steps of size `h` from `t0`, into a new array (or `out`: see
+/// [`advect_runs`]). Ctrl-C stops it between
 /// blocks of steps (`KeyboardInterrupt`); `progress(done, steps)` is called at every multiple
 /// of `every` steps and at the end.
 #[pyfunction]
-#[pyo3(signature = (points, field, t0, h, steps, method, progress=None, every=0))]
+#[pyo3(signature = (points, field, t0, h, steps, method, progress=None, every=0, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn advect<'py>(
     py: Python<'py>,
@@ -28,21 +30,24 @@ pub fn advect<'py>(
     method: Method,
     progress: Option<Py<PyAny>>,
     every: usize,
+    out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let run = deform::advect::Run {
         t0,
         h,
         count: steps,
     };
-    advect_runs_impl(py, points, &field, &[run], method, progress, every)
+    advect_runs_impl(py, points, &field, &[run], method, progress, every, out)
 }
 
 /// Advect points through runs of equal steps one after the other, `runs` a list of
 /// `(t0, h, steps)` (the sub-intervals between a field's breakpoints), in one call: the
 /// points are put in their spatial order once. The bits are those of [`advect`] called for
-/// each run in turn. `progress(done, total)` counts the steps of all the runs.
+/// each run in turn. `progress(done, total)` counts the steps of all the runs. `out`: the
+/// `(n, 3)` float64 array to write the positions into (else a new one).
 #[pyfunction]
-#[pyo3(signature = (points, field, runs, method, progress=None, every=0))]
+#[pyo3(signature = (points, field, runs, method, progress=None, every=0, out=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn advect_runs<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -51,6 +56,7 @@ pub fn advect_runs<'py>(
     method: Method,
     progress: Option<Py<PyAny>>,
     every: usize,
+    out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let total = runs
         .iter()
@@ -66,10 +72,12 @@ pub fn advect_runs<'py>(
         .into_iter()
         .map(|(t0, h, count)| deform::advect::Run { t0, h, count })
         .collect();
-    advect_runs_impl(py, points, &field, &runs, method, progress, every)
+    advect_runs_impl(py, points, &field, &runs, method, progress, every, out)
 }
 
-/// The work of [`advect`] and [`advect_runs`].
+/// The work of [`advect`] and [`advect_runs`]; `out`: the `(n, 3)` float64 array to write
+/// the positions into (else a new one).
+#[allow(clippy::too_many_arguments)]
 fn advect_runs_impl<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -78,16 +86,17 @@ fn advect_runs_impl<'py>(
     method: Method,
     progress: Option<Py<PyAny>>,
     every: usize,
+    out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let field = &field.field;
     deform::advect::check_method(field, method)?;
     let x = vec3s("vertices", &points)?;
     deform::finite_rows("vertices", x)?;
-    let out = empty::<f64, numpy::Ix2>(py, "advect", &[x.len(), 3])?;
+    let out = output::<f64, numpy::Ix2>(py, "advect", &[x.len(), 3], out, "out")?;
     let stop = Stop::default();
     let mut ticker = Ticker::every(progress, every, &stop);
     {
-        let mut w = out.readwrite();
+        let mut w = writing(&out, "out")?;
         let o: &mut [DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut w)?);
         o.copy_from_slice(x);
         detach_stoppable(py, &stop, || {

@@ -11,6 +11,7 @@ use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, offsets_of,
     orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
+use super::out::{output, writing};
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
 /// Bytes a row checked free before a frames call: the output (72) and the working vectors
@@ -21,11 +22,12 @@ pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<
 
 /// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
 /// the points name `points_arg` (the argument the caller's user passed them as);
-/// `progress(done, rows)` is called from the waiting thread as curves are done.
+/// `progress(done, rows)` is called from the waiting thread as curves are done. `out`: the
+/// `(rows, 3, 3)` float64 array to write the frames into (else a new one).
 #[pyfunction]
 #[pyo3(signature = (points, tangents, offsets, method, tangent_rule, tangent_chords, closed,
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
-                    points_arg="points", progress=None))]
+                    points_arg="points", progress=None, out=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_sampled<'py>(
     py: Python<'py>,
@@ -43,6 +45,7 @@ pub fn frames_sampled<'py>(
     turns: f64,
     points_arg: &str,
     progress: Option<Py<PyAny>>,
+    out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<FramesAndAngles<'py>> {
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
@@ -67,9 +70,9 @@ pub fn frames_sampled<'py>(
     };
     // the output and the working vectors of the frames
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
-    let out = empty::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3])?;
+    let out = output::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3], out, "out")?;
     let angles = {
-        let mut rw = out.readwrite();
+        let mut rw = writing(&out, "out")?;
         let buf = slice_mut(&mut rw)?;
         let stop = Stop::default();
         let report = Report::new(progress, rows);

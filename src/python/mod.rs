@@ -11,6 +11,7 @@ mod fields;
 mod flesh;
 mod frames;
 mod mesh;
+mod out;
 mod ph;
 mod quaternion;
 mod sweep;

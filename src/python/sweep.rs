@@ -9,6 +9,7 @@ use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, frames_of, offsets_of,
     renamed, slice_mut, slice_of, vec2s, vec3s,
 };
+use super::out::{output, writing};
 use crate::sweep::{self, FrameSource, Options, Prepared, Spine};
 
 type MeshArrays<'py> = (
@@ -35,12 +36,14 @@ type MeshArrays<'py> = (
 /// scale at every sample). `progress(done, rows)` is called from the waiting thread as the
 /// spines are swept (rows of the spines done) and once at the end. `turns`: extra turns of
 /// a closed spine's computed frames; a half number joins the seam with a half turn (with
-/// given frames: they close that way; see `sweep::seam`).
+/// given frames: they close that way; see `sweep::seam`). `out_vertices`, `out_normals`,
+/// `out_uv`: arrays of exactly the shapes and dtype of the results to write them into
+/// (else new ones; named `out.vertices` … in errors).
 #[pyfunction]
 #[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
                     miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
                     normals=true, uv=true, tangents=None, join="round", progress=None,
-                    turns=0.0))]
+                    turns=0.0, out_vertices=None, out_normals=None, out_uv=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
@@ -64,6 +67,9 @@ pub fn sweep_mesh<'py>(
     join: &str,
     progress: Option<Py<PyAny>>,
     turns: f64,
+    out_vertices: Option<Bound<'py, PyAny>>,
+    out_normals: Option<Bound<'py, PyAny>>,
+    out_uv: Option<Bound<'py, PyAny>>,
 ) -> PyResult<MeshArrays<'py>> {
     let join = match join {
         "round" => sweep::Join::Round,
@@ -130,6 +136,7 @@ pub fn sweep_mesh<'py>(
         uv,
         scale_arg,
         report: Report::new(progress, offsets.last().copied().unwrap_or(0)),
+        out: [out_vertices, out_normals, out_uv],
     };
     match (single, index32) {
         (false, false) => job.run::<f64, i64>(py),
@@ -140,36 +147,51 @@ pub fn sweep_mesh<'py>(
 }
 
 /// A checked sweep, to be written into arrays of a chosen precision.
-struct Job<'a> {
+struct Job<'a, 'py> {
     prep: &'a Prepared<'a>,
     normals: bool,
     uv: bool,
     scale_arg: &'a str,
     /// The spine rows swept, reported to the caller's `progress(done, total)`.
     report: Option<Report>,
+    /// The caller's arrays for the vertices, normals and uv, where given.
+    out: [Option<Bound<'py, PyAny>>; 3],
 }
 
-impl Job<'_> {
-    fn run<'py, R, I>(&self, py: Python<'py>) -> PyResult<MeshArrays<'py>>
+impl<'py> Job<'_, 'py> {
+    fn run<R, I>(&self, py: Python<'py>) -> PyResult<MeshArrays<'py>>
     where
         R: sweep::Real + numpy::Element + bytemuck::Pod,
         I: sweep::Index + numpy::Element + bytemuck::Pod,
     {
         let (nv, nf) = (self.prep.layout.vertices, self.prep.layout.faces);
-        let v = empty::<R, numpy::Ix2>(py, "sweep", &[nv, 3])?;
+        let [ov, on, ou] = self.out.clone();
+        let v = output::<R, numpy::Ix2>(py, "sweep", &[nv, 3], ov, "out.vertices")?;
         let f = empty::<I, numpy::Ix2>(py, "sweep", &[nf, 3])?;
         let n = match self.normals {
-            true => Some(empty::<R, numpy::Ix2>(py, "sweep", &[nv, 3])?),
+            true => Some(output::<R, numpy::Ix2>(
+                py,
+                "sweep",
+                &[nv, 3],
+                on,
+                "out.normals",
+            )?),
             false => None,
         };
         let uv = match self.uv {
-            true => Some(empty::<R, numpy::Ix2>(py, "sweep", &[nv, 2])?),
+            true => Some(output::<R, numpy::Ix2>(
+                py,
+                "sweep",
+                &[nv, 2],
+                ou,
+                "out.uv",
+            )?),
             false => None,
         };
         let folds = {
-            let (mut wv, mut wf) = (v.readwrite(), f.readwrite());
-            let mut wn = n.as_ref().map(|a| a.readwrite());
-            let mut wu = uv.as_ref().map(|a| a.readwrite());
+            let (mut wv, mut wf) = (writing(&v, "out.vertices")?, f.readwrite());
+            let mut wn = n.as_ref().map(|a| writing(a, "out.normals")).transpose()?;
+            let mut wu = uv.as_ref().map(|a| writing(a, "out.uv")).transpose()?;
             let out = sweep::MeshMut::<R, I> {
                 vertices: bytemuck::cast_slice_mut(slice_mut(&mut wv)?),
                 faces: bytemuck::cast_slice_mut(slice_mut(&mut wf)?),
