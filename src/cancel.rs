@@ -257,6 +257,8 @@ mod tests {
                 weight: 1.0,
                 tolerance: 1e-3,
                 axis: false,
+                previous: &[],
+                previous_weight: 1.0,
             }),
             previous: None,
         };

@@ -77,8 +77,8 @@ def test_bad_previous_twist_is_named():
         spinal.frames(P, previous_twist=True)
     with pytest.raises(TypeError, match="^previous_twist:"):
         spinal.frames(P, previous=F, previous_twist="yes")
-    with pytest.raises(ValueError, match="^previous: with guide= the guide fixes"):
-        spinal.frames(P, previous=F, previous_twist=True, guide=[0, 0, 1])
+    with pytest.raises(ValueError, match="^previous_weight: must be a positive"):
+        spinal.frames(P, previous=F, guide=[0, 0, 1], previous_weight=-1.0)
     with pytest.raises(ValueError, match="^previous: cannot be combined with initial"):
         spinal.frames(P, previous=F, previous_twist=True, initial=[1, 0, 0])
     with pytest.raises(ValueError, match=r"^previous: expected shape \(50, 3, 3\)"):

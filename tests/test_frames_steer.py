@@ -496,12 +496,14 @@ def test_frames_in_time_turn_each_sample_no_more_than_its_tangent_by_default():
     two = np.concatenate([P, P[:, ::-1] + 50], axis=1)
     B = spinal.frames_in_time(two, lengths=[120, 120])
     np.testing.assert_allclose(B[:, :120], F, atol=1e-12)
-    # a guide per step: every step follows its own guide
+    # a guide per step: the first step follows its guide, the others their guide and the
+    # step before (by default with the guide's weight)
     up = np.broadcast_to([0.0, 0, 1], P.shape)
     Fg = spinal.frames_in_time(P, guide=up, guide_weight=10.0)
-    for k in (0, 7):
-        np.testing.assert_array_equal(Fg[k], spinal.frames(P[k], guide=[0, 0, 1],
-                                                           guide_weight=10.0))
+    np.testing.assert_array_equal(Fg[0], spinal.frames(P[0], guide=[0, 0, 1],
+                                                       guide_weight=10.0))
+    np.testing.assert_array_equal(Fg[7], spinal.frames(P[7], guide=[0, 0, 1], guide_weight=10.0,
+                                                       previous=Fg[6], previous_weight=10.0))
 
 
 def test_frames_in_time_of_the_adk_trajectory_do_not_flicker():
@@ -521,7 +523,7 @@ def test_axis_guides_take_their_signs_from_the_previous_frames():
     """guide= with previous=: each axis row (guide_sign='free') takes the sign that agrees with
     the previous frames, so a β-strand whose raw carbonyl guides come with the opposite signs
     at the next time step keeps its frames (alone, the first row's sign would turn them all
-    by 180°); frames_in_time does the same step by step; a direction guide refuses previous."""
+    by 180°); frames_in_time does the same step by step."""
     n, steps = 30, 12
     rng = np.random.default_rng(4)
 
@@ -548,8 +550,128 @@ def test_axis_guides_take_their_signs_from_the_previous_frames():
     gs = np.stack([carbonyls() * (-1) ** k for k in range(steps)])
     F = spinal.frames_in_time(pts, guide=gs, guide_sign="free")
     assert max(turn(F[k], F[k + 1]) for k in range(steps - 1)) < 15
-    with pytest.raises(ValueError, match="previous: with guide= the guide fixes"):
-        spinal.frames(strand(1), guide=flipped, previous=f0)
+
+
+def _guide_and_previous_case():
+    """A helix, a guide "up", and previous frames that follow another guide."""
+    t = np.linspace(0, 4 * np.pi, 120)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    prev = spinal.frames(h, guide=[1.0, 0, 0.3], guide_weight=5.0)
+    return h, np.array([0.0, 0, 1]), prev
+
+
+def test_a_direction_guide_and_previous_tend_to_either_alone():
+    """guide= with previous= (guide_sign="follow"): two soft targets of one twist solve. As
+    previous_weight → 0 the frames tend to the guide's alone, as guide_weight → 0 to those
+    of previous_twist=True alone, both linearly in the vanishing weight (the solution of
+    the quadratic is smooth in its weights)."""
+    h, up, prev = _guide_and_previous_case()
+    guide_only = spinal.frames(h, guide=up)
+    previous_only = spinal.frames(h, previous=prev, previous_twist=True, previous_weight=2.0)
+    assert np.abs(guide_only - previous_only).max() > 0.5
+    gaps = []
+    for w in (1e-3, 1e-6, 1e-9):
+        a = spinal.frames(h, guide=up, previous=prev, previous_weight=w)
+        b = spinal.frames(h, guide=up, guide_weight=w, previous=prev, previous_weight=2.0)
+        gaps.append((np.abs(a - guide_only).max(), np.abs(b - previous_only).max()))
+    gaps = np.array(gaps)
+    assert (gaps[-1] < 1e-8).all(), gaps
+    # linear: a thousandth of the weight, a thousandth of the gap
+    np.testing.assert_allclose(gaps[1:] / gaps[:-1], 1e-3, rtol=0.01)
+    # previous_twist changes nothing once a guide is given
+    np.testing.assert_array_equal(
+        spinal.frames(h, guide=up, previous=prev, previous_twist=True),
+        spinal.frames(h, guide=up, previous=prev))
+
+
+def test_equal_guide_and_previous_targets_add_their_weights():
+    """A guide equal to the previous frames' r columns: the target is the same, its weight
+    the sum, so the frames are the guide's alone (or previous_twist's alone) with the
+    weights added."""
+    h, _, prev = _guide_and_previous_case()
+    both = spinal.frames(h, guide=prev[:, :, 0], guide_weight=0.7, previous=prev,
+                         previous_weight=1.8)
+    np.testing.assert_allclose(both, spinal.frames(h, guide=prev[:, :, 0], guide_weight=2.5),
+                               atol=1e-12)
+    np.testing.assert_allclose(both, spinal.frames(h, previous=prev, previous_twist=True,
+                                                   previous_weight=2.5), atol=1e-12)
+
+
+def test_guide_and_previous_on_a_line_meet_at_the_weighted_mean_angle():
+    """On a straight line (unevenly sampled) the RMF does not turn; a constant guide at the
+    angle a from it and previous frames turned by b are met by the constant twist that
+    minimises W_g (α − a)² + W_p (α − b)², the weighted mean (W_g a + W_p b)/(W_g + W_p)
+    (the twist-rate term vanishes on a constant)."""
+    x = np.c_[np.cumsum(np.r_[0, 0.5 + np.random.default_rng(2).random(39)]), np.zeros((40, 2))]
+    rmf = spinal.frames(x)
+    r0, s0 = rmf[0, :, 0], rmf[0, :, 1]
+    a, b, wg, wp = 0.3, 2.0, 1.0, 3.0
+    prev = rmf.copy()
+    prev[:, :, 0] = np.cos(b) * r0 + np.sin(b) * s0
+    prev[:, :, 1] = np.cos(b) * s0 - np.sin(b) * r0
+    got = spinal.frames(x, guide=np.cos(a) * r0 + np.sin(a) * s0, guide_weight=wg,
+                        previous=prev, previous_weight=wp)
+    m = (wg * a + wp * b) / (wg + wp)
+    np.testing.assert_allclose(got[:, :, 0], np.tile(np.cos(m) * r0 + np.sin(m) * s0, (40, 1)),
+                               atol=1e-12)
+
+
+def test_guide_and_previous_minimise_the_combined_quadratic():
+    """The twist of guide= with previous= on a helix is the minimiser of
+    Σ (h̄/h_i)(α_{i+1} − α_i)² + Σ (μ_i/h̄)[W_g sin²∠(g, t_i)(α_i − φ_i)²
+    + W_p sin²∠(p_i, t_i)(α_i − ψ_i)²], solved here densely (numpy) from the RMF's angles
+    to the guide (φ) and to the previous r columns (ψ)."""
+    h, up, prev = _guide_and_previous_case()
+    wg, wp = 0.4, 2.5
+    got = spinal.frames(h, guide=up, guide_weight=wg, previous=prev, previous_weight=wp)
+    rmf = spinal.frames(h)
+    r, s, t = rmf[:, :, 0], rmf[:, :, 1], rmf[:, :, 2]
+
+    def angle_and_weight(g):
+        p = g - np.einsum("ij,ij->i", g, t)[:, None] * t
+        return (np.unwrap(np.arctan2((p * s).sum(1), (p * r).sum(1))),
+                1 - np.einsum("ij,ij->i", g, t) ** 2 / np.einsum("ij,ij->i", g, g))
+
+    phi, sg = angle_and_weight(np.tile(up, (len(h), 1)))
+    psi, sp = angle_and_weight(prev[:, :, 0])
+    psi += 2 * np.pi * np.round((phi[0] - psi[0]) / (2 * np.pi))
+    seg = np.linalg.norm(np.diff(h, axis=0), axis=1)
+    mean = seg.mean()
+    mu = 0.5 * (np.r_[0, seg] + np.r_[seg, 0])
+    n = len(h)
+    A = np.zeros((n, n))
+    for i, e in enumerate(mean / seg):
+        A[i, i] += e
+        A[i + 1, i + 1] += e
+        A[i, i + 1] -= e
+        A[i + 1, i] -= e
+    cg, cp = wg * sg * mu / mean, wp * sp * mu / mean
+    alpha = np.linalg.solve(A + np.diag(cg + cp), cg * phi + cp * psi)
+    turn = np.unwrap(np.arctan2((got[:, :, 0] * s).sum(1), (got[:, :, 0] * r).sum(1)))
+    turn += 2 * np.pi * np.round((alpha[0] - turn[0]) / (2 * np.pi))
+    np.testing.assert_allclose(turn, alpha, atol=1e-10)
+    assert np.ptp(alpha) > 1.0  # a twist that varies along the helix
+
+
+def test_frames_in_time_with_a_direction_guide_keep_to_the_step_before():
+    """frames_in_time(guide=) with the default guide_sign: from the second step on each step
+    follows its guide and the step before, so a guide that jitters in time moves the frames
+    less from step to step than following it alone."""
+    t = np.linspace(0, 4 * np.pi, 80)
+    h = np.c_[np.cos(t), np.sin(t), 0.2 * t]
+    steps = 10
+    rng = np.random.default_rng(5)
+    P = np.stack([h] * steps)
+    g = np.array([0.0, 0, 1]) + rng.normal(0, 0.4, (steps, 80, 3))
+    F = spinal.frames_in_time(P, guide=g)
+    alone = np.stack([spinal.frames(h, guide=g[k]) for k in range(steps)])
+
+    def step_turn(F):
+        return max(np.abs(F[k + 1] - F[k]).max() for k in range(steps - 1))
+
+    assert step_turn(F) < 0.6 * step_turn(alone), (step_turn(F), step_turn(alone))
+    np.testing.assert_array_equal(F[0], alone[0])
+    np.testing.assert_array_equal(F[3], spinal.frames(h, guide=g[3], previous=F[2]))
 
 
 def test_guide_is_a_direction_whatever_its_length():

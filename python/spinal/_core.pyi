@@ -79,6 +79,8 @@ def frames_steered(
     guide_tolerance: float,
     guide_axis: bool,
     previous: npt.NDArray[np.float64] | None,
+    guide_previous: npt.NDArray[np.float64] | None = None,
+    previous_weight: float = 1.0,
     points_arg: str = "points",
     d3: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...

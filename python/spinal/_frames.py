@@ -194,6 +194,7 @@ def frames(
     guide_tolerance: float = 1e-3,
     previous=None,
     previous_twist: bool = False,
+    previous_weight: float | None = None,
     guide_sign: str = "follow",
     on_invalid: str = "raise",
     progress=False,
@@ -355,7 +356,9 @@ def frames(
         With ``previous`` too, each row's sign is the one that agrees with the previous
         frames' ``r`` column (``g·r_prev ≥ 0``): the frames continue those of the previous
         time step rather than the first row's sign (a β-strand of an MD trajectory does not
-        flip between steps).
+        flip between steps); the signed guide is then followed alone. With ``"follow"``
+        and ``previous``, the guide and the previous frames are two targets of one solve
+        (see ``previous``).
     on_invalid : {"raise", "skip"}
         What to do with curves (of a bundle, or the one curve) that hold a NaN or an
         infinity or have fewer than 2 (closed: 3) distinct points: refuse them (ValueError
@@ -373,16 +376,30 @@ def frames(
         The frames of the same curve at the previous time step (same sample count): the
         result is the RMF (with any ``closed`` twist) turned by the one angle that brings it
         closest to ``previous`` (see :func:`frames_in_time`), so frames of a moving curve do
-        not flicker. Not with ``initial``, ``end``, ``constraints`` or ``guide``, which fix
-        the start themselves.
+        not flicker. Not with ``initial``, ``end`` or ``constraints``, which fix the start
+        themselves. With a ``guide`` (``guide_sign="follow"``) the guide and the previous
+        ``r`` columns ``p_i`` are two soft targets of one twist solve: ``α`` minimises
+        ``Σ (h̄/h_i)(α_{i+1} − α_i)² + Σ (μ_i/h̄)[guide_weight · w_i (α_i − φ_i)²
+        + previous_weight · v_i (α_i − ψ_i)²]``, ``ψ_i`` the angle of ``p_i``'s projection
+        from the RMF and ``v_i = sin²∠(p_i, t_i)`` (both angles unwrapped along the samples,
+        ``ψ`` by whole turns to within π of ``φ`` at the first sample with both). Each row's
+        two terms are one term at the weighted mean angle ``(c_g φ_i + c_p ψ_i)/(c_g + c_p)``
+        with the summed weight; so a guide that agrees with the previous frames acts with
+        ``guide_weight + previous_weight``, and as either weight goes to 0 the frames tend
+        (linearly in it) to those of the other target alone. ``previous_twist`` does not
+        change this.
     previous_twist : bool
         With ``previous``: follow its twist profile too, not only its start: the frames are
         those of ``guide=previous[:, :, 0]`` (the previous ``r`` columns, projected on the new
-        normal planes and smoothed by ``guide_weight`` as for ``guide``; ``guide_tolerance``
-        applies), so a twist the previous frames carried along the curve is kept. On a curve
+        normal planes and smoothed by ``previous_weight`` as ``guide`` by ``guide_weight``;
+        ``guide_tolerance`` applies), so a twist the previous frames carried along the curve is kept. On a curve
         that does not move, the previous frames come back up to the guide's smoothing bias
         (about ``φ″/guide_weight``, ``φ″`` the previous twist's second difference per
         sample). Default ``False``: the RMF turned by one angle.
+    previous_weight : float, optional
+        The weight of the previous frames' ``r`` against the twist rate, per sample (> 0),
+        with ``previous_twist`` or with a ``guide`` (see ``previous``). Default: the value of
+        ``guide_weight``.
     out : ndarray (n, 3, 3) float64, optional
         An array to write the frames into (and return), for callers that reuse one buffer
         across animation frames: exactly the result's shape and dtype float64, C-contiguous
@@ -449,10 +466,11 @@ def frames(
                     offsets=kept, twist_rule=twist_rule, guide=_cut_rows(guide, keep, n),
                     guide_weight=guide_weight, guide_tolerance=guide_tolerance,
                     previous=_cut_rows(previous, keep, n), previous_twist=previous_twist,
-                    guide_sign=guide_sign, progress=progress)
+                    previous_weight=previous_weight, guide_sign=guide_sign, progress=progress)
             return fill_out(out, res)
     previous_twist = as_bool(previous_twist, "previous_twist")
     guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
+    previous_weight = _previous_weight(previous_weight, guide_weight)
     if previous_twist and previous is None:
         raise TypeError("previous_twist: needs previous (the frames whose twist to follow)")
     guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
@@ -460,7 +478,7 @@ def frames(
             or twist_rule != "arc_length" or isinstance(turns, (list, tuple, np.ndarray))):
         res = _steered(points, tangents, method, initial, closed, end, turns, reflection, u,
                        lengths, offsets, constraints, twist_rule, guide, guide_weight,
-                       guide_tolerance, previous, previous_twist, guide_sign)
+                       guide_tolerance, previous, previous_twist, guide_sign, previous_weight)
         with Progress(progress, len(res), "frames", "row") as bar:
             bar.update(len(res))
         return fill_out(out, res)
@@ -608,22 +626,23 @@ def estimate_tangents(
 
 def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
              offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous,
-             previous_twist=False, guide_sign="follow"):
+             previous_twist=False, guide_sign="follow", previous_weight=None):
     """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
     ``guide``, ``previous`` or per-interval ``turns``)."""
     method = as_choice(method, "method", METHODS)
+    previous_weight = guide_weight if previous_weight is None else previous_weight
+    with_guide = guide is not None and previous is not None
+    free = as_choice(guide_sign, "guide_sign", ("follow", "free")) == "free"
     # an axis guide with the previous step's frames: previous picks each row's sign
-    signed_by_previous = guide is not None and previous is not None
-    if signed_by_previous and as_choice(guide_sign, "guide_sign", ("follow", "free")) != "free":
-        raise ValueError("previous: with guide= the guide fixes the frames that previous would "
-                         "choose; pass guide_sign='free' to let previous pick the sign of each "
-                         "guide row (an axis), so that the frames continue the previous ones")
-    if previous_twist:
+    signed_by_previous = with_guide and free
+    # a direction guide with the previous step's frames: two targets of one twist solve
+    targets = with_guide and not free
+    if previous_twist or targets:
         if method == "frenet":
             raise ValueError("previous: is not used by method='frenet': the Frenet frame is "
                              "fixed by the curve")
         for other, val in (("constraints", constraints),
-                           ("guide", None if signed_by_previous else guide),
+                           ("guide", None if with_guide else guide),
                            ("initial", initial), ("end", end)):
             if val is not None:
                 raise ValueError(f"previous: cannot be combined with {other} (they fix the "
@@ -655,12 +674,16 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         # the core names the rule that the lengths/offsets break
         _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE, False, closed, None,
                              None, None, None, 0)
+    before = None
     if signed_by_previous:
         guide, previous, guide_sign = _signed_by(guide, previous, rows), None, "follow"
+    elif targets:
+        before, previous = _previous_twist_guide(previous, rows), None
     elif previous_twist:
         guide, previous = _previous_twist_guide(previous, rows), None
+        guide_weight = previous_weight
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
-                     previous, offs, bundle, rows, guide_sign)
+                     previous, offs, bundle, rows, guide_sign, before, previous_weight)
 
     def run(pts, tgs, offs, steer):
         return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
@@ -685,11 +708,14 @@ def _steered_merged(run, p, pts, tgs, offs, steer, rows):
     """The steered frames on the rows that ``p`` keeps (a per-row guide and previous cut
     alike, constraint rows moved to the sample they merge into), spread back over the rows
     as given."""
-    steer = list(steer)  # turns, 5 constraint arrays, rule, guide, weight, tolerance, axis, prev
+    # turns, 5 constraint arrays, rule, guide, weight, tolerance, axis, prev, the previous
+    # frames' r as a second target of the guide, its weight
+    steer = list(steer)
     cut = (lambda a: None if a is None else np.ascontiguousarray(a[p.keep]))
     if steer[7] is not None and len(steer[7]) == rows:
         steer[7] = cut(steer[7])
     steer[11] = cut(steer[11])
+    steer[12] = cut(steer[12])
     cc, cr = steer[1], steer[2]
     if cr.size:
         kept = p.rows[offs[cc] + cr] - p.offsets[cc]
@@ -718,6 +744,17 @@ def _guide_options(guide_weight, guide_tolerance):
         raise ValueError(f"guide_tolerance: must be an angle in [0, π/2) radians, got "
                          f"{guide_tolerance}")
     return guide_weight, guide_tolerance
+
+
+def _previous_weight(previous_weight, guide_weight: float) -> float:
+    """``previous_weight`` as a float (checked as ``guide_weight``); None: ``guide_weight``."""
+    if previous_weight is None:
+        return guide_weight
+    previous_weight = as_real(previous_weight, "previous_weight")
+    if not 0.0 < previous_weight < np.inf:
+        raise ValueError(f"previous_weight: must be a positive finite number, got "
+                         f"{previous_weight}")
+    return previous_weight
 
 
 def _signed_by(guide, previous, rows: int) -> np.ndarray:
@@ -781,7 +818,7 @@ def frames_in_time(
     reflection: str = "chord",
     previous=None,
     previous_twist: bool = True,
-    previous_weight: float = 1000.0,
+    previous_weight: float | None = None,
     guide=None,
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
@@ -817,10 +854,14 @@ def frames_in_time(
       Equivalent to calling :func:`frames` with ``previous=`` step by step.
     * ``guide`` given: every step follows its guide (``(3,)``, ``(n, 3)`` for all steps or
       ``(T, n, 3)`` one per step; ``guide_weight``, ``guide_tolerance``, ``guide_sign`` as in
-      :func:`frames`), which carries the coherence in time; ``previous_twist`` does not
-      apply then. With ``guide_sign="free"`` (axes, such as raw carbonyl bonds) each step's
-      rows take the sign that agrees with the step before (``frames(guide=, previous=)``),
-      so the frames do not flip between steps.
+      :func:`frames`) and, from the second step on (or from the first with ``previous``),
+      the frames of the step before: they are :func:`frames` with ``guide=`` and
+      ``previous=`` the step before, the guide and the previous ``r`` columns two targets of
+      one twist solve weighted by ``guide_weight`` and ``previous_weight`` (by default the
+      same weight, so a guide that jitters in time moves the frames about half as much);
+      ``previous_twist`` does not apply then. With ``guide_sign="free"`` (axes, such as raw
+      carbonyl bonds) each step's rows take the sign that agrees with the step before and
+      the signed guide is followed alone, so the frames do not flip between steps.
 
     Parameters
     ----------
@@ -836,8 +877,9 @@ def frames_in_time(
         Frames of the step before the first one (to continue a sequence).
     previous_twist : bool
         Follow the previous step sample by sample (default) or by one turn per step.
-    previous_weight : float
+    previous_weight : float, optional
         The weight of the previous step's ``r`` against the twist rate, per sample (> 0).
+        Default: 1000 with ``previous_twist`` and no guide, ``guide_weight`` with a guide.
     guide, guide_weight, guide_tolerance, guide_sign
         A guide followed at every step (see above and :func:`frames`).
     progress : bool or callable
@@ -895,10 +937,9 @@ def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns
     """:func:`frames_in_time` step by step through :func:`frames` (``previous_twist``, a
     guide, or a bundle), with a ``progress`` report after every step."""
     p, tg, steps, n = _time_steps(points_t, tangents_t)
-    previous_weight = as_real(previous_weight, "previous_weight")
-    if not 0.0 < previous_weight < np.inf:
-        raise ValueError(f"previous_weight: must be a positive finite number, got "
-                         f"{previous_weight}")
+    # by default the previous step weighs 1000 alone, as much as the guide with a guide
+    previous_weight = _previous_weight(previous_weight,
+                                       1000.0 if guide is None else guide_weight)
     g = None
     if guide is not None:
         g = as_float_array(guide, "guide")
@@ -929,13 +970,13 @@ def _frames_step(k, p, tg, g, out, previous, guide_sign, initial, guide_weight,
     before = out[k - 1] if k else previous
     try:
         if g is not None:
-            # axes: each row's sign continues the step before (from the second step on)
+            # the guide and the step before (from the second step on): axes take their signs
+            # from it, directions are followed together with it
             gk = g[k] if g.ndim == 3 else g
-            by = before if guide_sign == "free" else None
-            out[k] = frames(pts, tgk, initial=None if by is not None else initial,
+            out[k] = frames(pts, tgk, initial=None if before is not None else initial,
                             guide=gk, guide_weight=guide_weight,
                             guide_tolerance=guide_tolerance, guide_sign=guide_sign,
-                            previous=by, **common)
+                            previous=before, previous_weight=previous_weight, **common)
         elif before is None:
             out[k] = frames(pts, tgk, initial=initial, **common)
         else:

@@ -153,12 +153,16 @@ def previous_frames(previous: Any, rows: int, what: str = "the frames of the sam
 
 
 def steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance, previous,
-             offs: np.ndarray, bundle: bool, rows: int, guide_sign: str = "follow"):
+             offs: np.ndarray, bundle: bool, rows: int, guide_sign: str = "follow",
+             guide_previous=None, previous_weight: float = 1.0):
     """The steering arguments of :func:`spinal.frames` as the core takes them: the turns,
     the five constraint arrays, the rule, the guide, its weight, tolerance and whether its
-    rows are axes (``guide_sign="free"``), previous."""
+    rows are axes (``guide_sign="free"``), previous, the previous frames' ``r`` columns as a
+    second target of the guide (``(rows, 3)`` or None) and their weight."""
     twist_rule = as_choice(twist_rule, "twist_rule", TWIST_RULES)
     axis = as_choice(guide_sign, "guide_sign", ("follow", "free")) == "free"
+    before = None if guide_previous is None else np.ascontiguousarray(guide_previous)
     return (_turns(turns), *_constraints(constraints, offs, bundle), twist_rule,
             guide_rows(guide, rows), as_real(guide_weight, "guide_weight"),
-            as_real(guide_tolerance, "guide_tolerance"), axis, previous_frames(previous, rows))
+            as_real(guide_tolerance, "guide_tolerance"), axis, previous_frames(previous, rows),
+            before, as_real(previous_weight, "previous_weight"))

@@ -32,6 +32,16 @@
 //! follows the sign that continues it, as molecular cartoon renderers flip alternate
 //! peptide planes. The first usable row keeps its sign; a closed curve still closes (the
 //! seam stays modulo 2π: axes that come back reversed after a round spread the half turn).
+//!
+//! The frames of the previous time step may be a second target (`previous`, their `r`
+//! columns `p_i` at the angles `ψ_i` from the RMF, weight `W_p`, `v_i = sin²∠(p_i, t_i)`):
+//!
+//! `E(α) = Σ_i (h̄ / h_i)(α_{i+1} − α_i)² + Σ_i (μ_i / h̄)[W w_i (α_i − φ_i)² + W_p v_i (α_i − ψ_i)²]`
+//!
+//! `ψ` is unwrapped along the samples like `φ`, then shifted by whole turns to within π of
+//! `φ` at the first sample with both. A row's two terms are one, `c (α_i − ᾱ_i)²` plus a
+//! constant, with `c = W w_i + W_p v_i` and `ᾱ_i = (W w_i φ_i + W_p v_i ψ_i) / c`, so the
+//! system is the one above with these weights and angles.
 
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -52,6 +62,11 @@ pub struct Guide<'a> {
     /// Each vector is an axis (`±g` alike): the guide angles are unwrapped modulo π, so the
     /// frame follows whichever sign continues it.
     pub axis: bool,
+    /// A second target: the `r` columns of the frames of the previous time step, one per
+    /// distinct sample (empty: none), followed as directions.
+    pub previous: &'a [DVec3],
+    /// `W_p`: the weight of the previous frames' error against the twist rate (per sample).
+    pub previous_weight: f64,
 }
 
 /// `a` modulo π, in `(−π/2, π/2]`: the turn to the nearer of `±g`.
@@ -78,6 +93,22 @@ pub fn check(g: &Guide) -> Result<()> {
     if let Some(i) = g.vectors.iter().position(|v| !v.is_finite()) {
         return Err(InputError::new(
             "guide",
+            format!("contains a non-finite value at row {i}"),
+        ));
+    }
+    let weighed = g.previous_weight.is_finite() && g.previous_weight > 0.0;
+    if !g.previous.is_empty() && !weighed {
+        return Err(InputError::new(
+            "previous_weight",
+            format!(
+                "must be a positive finite number, got {}",
+                g.previous_weight
+            ),
+        ));
+    }
+    if let Some(i) = g.previous.iter().position(|v| !v.is_finite()) {
+        return Err(InputError::new(
+            "previous",
             format!("contains a non-finite value at row {i}"),
         ));
     }
@@ -133,6 +164,49 @@ fn cyclic(lo: &[f64], d: &[f64], up: &[f64], b: &[f64]) -> Vec<f64> {
     x.iter().zip(&z).map(|(x, z)| x - f * z).collect()
 }
 
+/// Unwrap the angles along the samples (NaN: none), each within π (`axis`: π/2) of the one
+/// before; the first row with an angle and the last angle.
+fn unwrap(value: &mut [f64], axis: bool) -> Option<(usize, f64)> {
+    let mut prev: Option<f64> = None;
+    let mut first: Option<usize> = None;
+    for (i, v) in value.iter_mut().enumerate() {
+        if v.is_nan() {
+            continue;
+        }
+        if let Some(p) = prev {
+            *v = p + if axis {
+                wrap_half(*v - p)
+            } else {
+                wrap(*v - p)
+            };
+        }
+        prev = Some(*v);
+        first.get_or_insert(i);
+    }
+    first.zip(prev)
+}
+
+/// Shift the unwrapped angles `a` by whole turns so that, at the first row where `b` has an
+/// angle too (else at `a`'s first row against `b`'s first angle), `a` is within π of `b`.
+fn align(a: &mut [f64], b: &[f64]) {
+    let both = (0..a.len()).find(|&i| !a[i].is_nan() && !b[i].is_nan());
+    let pair = match both {
+        Some(i) => Some((a[i], b[i])),
+        None => a
+            .iter()
+            .find(|v| !v.is_nan())
+            .zip(b.iter().find(|v| !v.is_nan()))
+            .map(|(&x, &y)| (x, y)),
+    };
+    if let Some((x, y)) = pair {
+        let shift = (y - wrap(y - x)) - x;
+        let turns = (shift / TAU).round() * TAU;
+        for v in a.iter_mut() {
+            *v += turns;
+        }
+    }
+}
+
 /// The twist `α_i` of every distinct sample (see the module text). `r`, `t`: the RMF's
 /// reference vectors and unit tangents; `seg`: segment lengths; `closing`: the RMF's closing
 /// angle (closed curves); `pins`: fixed orientations (sorted distinct rows, unit vectors
@@ -164,39 +238,60 @@ pub fn twist(
         value[k] = signed_angle(r[k], v, t[k]);
         pinned[k] = true;
     }
+    let usable = |v: DVec3, i: usize| -> Option<(f64, f64)> {
+        let len = v.length();
+        let p = v - v.dot(t[i]) * t[i];
+        let s = p.length() / len;
+        (len > 0.0 && s > min_sin && s > 1e-12).then(|| (signed_angle(r[i], p, t[i]), s * s))
+    };
     for i in 0..n {
         if pinned[i] {
             continue;
         }
-        let gi = g(i);
-        let len = gi.length();
-        let p = gi - gi.dot(t[i]) * t[i];
-        let s = p.length() / len;
-        if len > 0.0 && s > min_sin && s > 1e-12 {
-            value[i] = signed_angle(r[i], p, t[i]);
-            weight[i] = s * s;
+        if let Some((v, w)) = usable(g(i), i) {
+            value[i] = v;
+            weight[i] = w;
         }
     }
     if cancel() {
         return Ok(Vec::new());
     }
     // unwrap along the samples
-    let mut prev: Option<f64> = None;
-    let mut first: Option<usize> = None;
-    for (i, v) in value.iter_mut().enumerate() {
-        if v.is_nan() {
-            continue;
+    let mut ends = unwrap(&mut value, guide.axis);
+    // the weight of the guide term in the rows below (1 where the previous frames are
+    // merged in, their weights then folded into `weight`)
+    let mut scale = guide.weight;
+    if !guide.previous.is_empty() {
+        let mut before = vec![f64::NAN; n];
+        let mut wp = vec![0.0; n];
+        for i in 0..n {
+            if !pinned[i] {
+                if let Some((v, w)) = usable(guide.previous[i], i) {
+                    before[i] = v;
+                    wp[i] = w;
+                }
+            }
         }
-        if let Some(p) = prev {
-            *v = p + if guide.axis {
-                wrap_half(*v - p)
+        if unwrap(&mut before, false).is_some() {
+            align(&mut before, &value);
+        }
+        for i in 0..n {
+            let (cg, cp) = (guide.weight * weight[i], guide.previous_weight * wp[i]);
+            if pinned[i] || cp == 0.0 {
+                weight[i] = cg;
+            } else if cg == 0.0 {
+                (value[i], weight[i]) = (before[i], cp);
             } else {
-                wrap(*v - p)
-            };
+                (value[i], weight[i]) = ((cg * value[i] + cp * before[i]) / (cg + cp), cg + cp);
+            }
         }
-        prev = Some(*v);
-        first.get_or_insert(i);
+        scale = 1.0;
+        let first = value.iter().position(|v| !v.is_nan());
+        let last = value.iter().rposition(|v| !v.is_nan());
+        ends = first.zip(last).map(|(f, l)| (f, value[l]));
     }
+    let first = ends.map(|e| e.0);
+    let prev = ends.map(|e| e.1);
     let Some(first) = first else {
         // no usable guide and no pin: the RMF (a closed curve with its closing twist)
         let mut alpha = vec![0.0; n];
@@ -255,7 +350,7 @@ pub fn twist(
             } else {
                 0.0
             } + if i < m { seg[i] } else { 0.0 });
-        let c = guide.weight * weight[i] * mu / mean;
+        let c = scale * weight[i] * mu / mean;
         d[i] += c;
         if c > 0.0 {
             b[i] += c * value[i];

@@ -145,6 +145,16 @@ pub fn compute_steered_cancellable(
                 ),
             ));
         }
+        if !g.previous.is_empty() && g.previous.len() != rows {
+            return Err(InputError::new(
+                "previous",
+                format!(
+                    "expected shape ({rows}, 3, 3) (the frames of the same curve at the \
+                     previous time step), got {} rows",
+                    g.previous.len()
+                ),
+            ));
+        }
     }
     let t: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 2)).collect();
     let r: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 0)).collect();

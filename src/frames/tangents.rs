@@ -544,14 +544,15 @@ pub fn guard_chords(c_in: DVec3, c_out: DVec3, u: DVec3) -> DVec3 {
         c_out.length_squared(),
         c_in.dot(c_out),
     );
-    // a turn under 30° and within 60° of both chords, without a square root
-    if turn >= 0.0
-        && turn * turn >= CORNER_COS2 * (qi * qo)
-        && a >= 0.0
-        && b >= 0.0
-        && a * a >= m2 * qi
-        && b * b >= m2 * qo
-    {
+    // a turn under 30° and within 60° of both chords, without a square root; all six
+    // comparisons made, without a branch between them (a smooth curve passes them all)
+    let pass = (turn >= 0.0)
+        & (turn * turn >= CORNER_COS2 * (qi * qo))
+        & (a >= 0.0)
+        & (b >= 0.0)
+        & (a * a >= m2 * qi)
+        & (b * b >= m2 * qo);
+    if pass {
         return u;
     }
     towards_bisector(c_in, c_out, u)

@@ -216,7 +216,7 @@ pub fn estimate_tangents<'py>(
                     initial_vectors, initial_frames, end_vectors, end_frames, turns,
                     con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
                     guide, guide_weight, guide_tolerance, guide_axis, previous,
-                    points_arg="points", d3=None))]
+                    guide_previous=None, previous_weight=1.0, points_arg="points", d3=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn frames_steered<'py>(
     py: Python<'py>,
@@ -246,6 +246,8 @@ pub fn frames_steered<'py>(
     guide_tolerance: f64,
     guide_axis: bool,
     previous: Option<PyReadonlyArray3<'py, f64>>,
+    guide_previous: Option<PyReadonlyArray2<'py, f64>>,
+    previous_weight: f64,
     points_arg: &str,
     d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
@@ -298,6 +300,12 @@ pub fn frames_steered<'py>(
         .map(|p| super::convert::frames_of("previous", p))
         .transpose()?;
     steer::check_lengths(rows, guide_rows.map(<[_]>::len), prev.map(<[_]>::len))?;
+    // the previous frames' `r` columns, a second target of the guide's twist solve
+    let before = guide_previous
+        .as_ref()
+        .map(|g| vec3s("previous", g))
+        .transpose()?;
+    steer::check_lengths(rows, None, before.map(<[_]>::len))?;
     let steering: Vec<Steering> = (0..curves.max(1))
         .map(|c| {
             let (a, b) = (offsets[c.min(curves)], offsets[(c + 1).min(curves)]);
@@ -310,6 +318,8 @@ pub fn frames_steered<'py>(
                     weight: guide_weight,
                     tolerance: guide_tolerance,
                     axis: guide_axis,
+                    previous: before.map_or(&[][..], |p| &p[a..b]),
+                    previous_weight,
                 }),
                 previous: prev.map(|p| &p[a..b]),
             }

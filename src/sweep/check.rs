@@ -4,7 +4,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::join;
+use super::join::Corner;
 use super::layout::{Plan, Size};
 use super::{Options, Profile, Spine, columns};
 use crate::cancel::Cancel;
@@ -14,12 +14,14 @@ use crate::frames::validate;
 /// Check one spine and plan its part of the mesh; polls `cancel` between its passes and
 /// before every block of rows within them, and returns `None` once it says stop (see
 /// [`crate::cancel`]). `given`: the frames came with the input and are checked too (frames
-/// computed here are rotations along the spine by construction).
+/// computed here are rotations along the spine by construction). `found`: the spine's size
+/// and corners as its layout found them ([`Size::with_corners`]), or `None` to find them.
 pub(super) fn check_spine(
     s: &Spine,
     opts: &Options,
     p: &Profile,
     given: bool,
+    found: Option<(Size, Vec<Corner>)>,
     cancel: Cancel<'_>,
 ) -> Result<Option<Plan>> {
     let n = s.points.len();
@@ -45,7 +47,7 @@ pub(super) fn check_spine(
     if cancel() {
         return Ok(None);
     }
-    let size = Size::of(s, opts, p);
+    let (size, corners) = found.unwrap_or_else(|| Size::with_corners(s, opts, p));
     let rings = size.rings;
     let min = if opts.closed { 3 } else { 2 };
     if rings < min {
@@ -141,17 +143,6 @@ pub(super) fn check_spine(
     for a in arc.iter_mut() {
         acc += *a;
         *a = acc;
-    }
-    let mut corners = Vec::new();
-    if size.extra > 0 || opts.join == super::Join::Miter {
-        let scale = if s.scale.len() == 1 {
-            s.scale
-        } else {
-            &s.scale[..rings]
-        };
-        join::corners(&s.points[..rings], scale, opts.closed, p, opts, |c| {
-            corners.push(c)
-        });
     }
     Ok(Some(Plan { size, arc, corners }))
 }

@@ -41,37 +41,13 @@
 //! join those of the surface of revolution; on the rings next to a corner those of the
 //! ring's own plane (their three-point derivative would reach across the corner).
 
-use glam::{DVec2, DVec3};
-use std::collections::{BTreeMap, BTreeSet};
-use std::hash::{BuildHasherDefault, Hasher};
-
-/// A hash of small integer keys (vertex and ring indices): one multiply (Fibonacci
-/// hashing), for the maps of one spine's joins.
-#[derive(Default)]
-struct IndexHasher(u64);
-
-impl Hasher for IndexHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        }
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.0 = (i as u64 ^ self.0).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
-}
-
-type HashMap<K, V> = std::collections::HashMap<K, V, BuildHasherDefault<IndexHasher>>;
-
 use super::faces::FacePattern;
 use super::kernel::Cols;
 use super::rings::{Geo, Rings};
 use super::scale::{Index, Real, put3, unscaled};
 use super::{MeshMut, Options, Profile};
 use crate::math::rotation::{minimal_rotation_matrix, rodrigues};
+use glam::{DVec2, DVec3};
 
 /// How the outer side of a corner is built (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -206,19 +182,6 @@ pub fn corners(
         };
         f(Corner { k, extra });
     }
-}
-
-/// Rings stored for the joins of a spine besides its own (see [`corners`]).
-pub(super) fn extra_rings(
-    x: &[DVec3],
-    scale: &[DVec2],
-    closed: bool,
-    p: &Profile,
-    opts: &Options,
-) -> usize {
-    let mut extra = 0;
-    corners(x, scale, closed, p, opts, |c| extra += c.extra);
-    extra
 }
 
 /// The turn of a corner: unit chords in and out, the unit axis `b` and the angle `φ`.
@@ -375,28 +338,42 @@ pub(super) fn write_joins<R: Real, I: Index>(
     let split = closed && stored > nr;
     let per_seg = pattern.per_segment();
     let mut bad = None;
-    // per ring (slot): the crease vertex (local) each column is welded to, or NONE
-    let mut weld: HashMap<usize, Vec<usize>> = HashMap::default();
-    // per ring written here: its vertices' positions (swept coordinates)
-    let mut pos: HashMap<usize, Vec<DVec3>> = HashMap::default();
-    // the tangents of the rings written here, as the end and as the start of a segment
-    let mut tangents: HashMap<usize, (DVec3, DVec3)> = HashMap::default();
-    // side segments whose faces the welds change → the ring their faces end on
-    let mut touched: BTreeMap<usize, usize> = BTreeMap::new();
+    // flat stores, indexed by ring (slot: the spine's rings, then the joins' rings) or by a
+    // row that a slot points to (NONE: none), so that no ring has an allocation of its own
+    let slots = stored + plan.extra;
+    // per ring: the row of `welds` holding the crease vertex (local) each column is welded
+    // to, or NONE
+    let (mut weld_of, mut welds) = (vec![NONE; slots], Vec::<usize>::new());
+    // per ring written here: the row of `pos` (its vertices' positions, swept coordinates)
+    // and of `tangents` (its tangents as the end and as the start of a segment)
+    let mut row_of = vec![NONE; slots];
+    let (mut pos, mut tangents) = (Vec::<DVec3>::new(), Vec::<(DVec3, DVec3)>::new());
+    // side segments whose faces the welds change → the ring their faces end on (NONE: not
+    // changed)
+    let mut touched = vec![NONE; stored];
     // join segments: (first face, from ring, to ring, corner sample)
     let mut bands: Vec<(usize, usize, usize, usize)> = Vec::new();
-    let is_corner: BTreeSet<usize> = corners.iter().map(|c| c.k).collect();
+    let mut is_corner = vec![false; nr];
+    for c in corners {
+        is_corner[c.k] = true;
+    }
     let mut claimed = is_corner.clone();
     let dist = |a: usize, b: usize| match b > a {
         true => arc[b] - arc[a],
         false => arc[nr] - arc[a] + arc[b],
     };
     let end_slot = |s: usize| if s + 1 == stored { 0 } else { s + 1 };
+    // a segment's faces are changed (ending on the ring they end on unless already moved)
+    let touch = |touched: &mut [usize], s: usize| {
+        if touched[s] == NONE {
+            touched[s] = end_slot(s);
+        }
+    };
     // the rings next to a round or bevelled corner, square to their own run (a tangent
     // estimate reaching across the corner would tilt them): tangent to the circle through
     // the ring's sample and its neighbours on that side, or along the chord where the run
     // ends there (a mitre keeps the frames' rings, whose bisector planes it joins)
-    let mut turned: HashMap<usize, Geo> = HashMap::default();
+    let (mut turned_of, mut turned) = (vec![NONE; nr], Vec::<Geo>::new());
     for c in corners.iter().filter(|c| c.extra > 0) {
         for ahead in [false, true] {
             let r = if ahead {
@@ -404,7 +381,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
             } else {
                 rings.before(c.k)
             };
-            if is_corner.contains(&r) || turned.contains_key(&r) {
+            if is_corner[r] || turned_of[r] != NONE {
                 continue;
             }
             let x = rings.x;
@@ -416,7 +393,8 @@ pub(super) fn write_joins<R: Real, I: Index>(
             };
             let Some(t) = t else { continue };
             let g = rings.geo_turned(r, t);
-            turned.insert(r, g);
+            turned_of[r] = turned.len();
+            turned.push(g);
             let slots = match r == 0 && split {
                 true => vec![0, nr],
                 false => vec![r],
@@ -432,17 +410,19 @@ pub(super) fn write_joins<R: Real, I: Index>(
                 }
             }
             if closed || r > 0 {
-                let s = rings.before(r);
-                touched.entry(s).or_insert(end_slot(s));
+                touch(&mut touched, rings.before(r));
             }
             if closed || r + 1 < nr {
-                touched.entry(r).or_insert(end_slot(r));
+                touch(&mut touched, r);
             }
         }
     }
     let geo_at = |slot: usize| {
         let k = if slot >= nr { slot - nr } else { slot };
-        turned.get(&k).copied().unwrap_or_else(|| rings.geo(k))
+        match turned_of.get(k) {
+            Some(&i) if i != NONE => turned[i],
+            _ => rings.geo(k),
+        }
     };
     let (turns, axes) = corner_axes(rings, corners);
     // per column of the corner at hand: inner?, the outgoing ring B's vertex and normal,
@@ -503,7 +483,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
         }
         // the sample's own ring: B (its inner side on the crease), or the mitre
         let kb = k * cols;
-        let mut at_k = Vec::with_capacity(cols);
+        let rk = tangents.len();
         for j in 0..cols {
             let v = match c.extra == 0 || inner[j] {
                 true => crease[j],
@@ -512,13 +492,14 @@ pub(super) fn write_joins<R: Real, I: Index>(
             if !put(&mut out, kb + j, v, unscale) && bad.is_none() {
                 bad = Some(kb + j);
             }
-            at_k.push(v.0);
+            pos.push(v.0);
         }
         let into = match closed && k == 0 {
             true => nr - 1,
             false => k - 1,
         };
-        tangents.insert(k, (if c.extra == 0 { din } else { dout }, dout));
+        row_of[k] = rk;
+        tangents.push((if c.extra == 0 { din } else { dout }, dout));
         if k == 0 && split {
             // the seam's copy of the ring, which the segment into the corner ends on
             for j in 0..cols {
@@ -531,13 +512,12 @@ pub(super) fn write_joins<R: Real, I: Index>(
                     bad = Some(nr * cols + j);
                 }
             }
-            pos.insert(nr, at_k.clone());
-            tangents.insert(nr, (if c.extra == 0 { din } else { dout }, dout));
+            // (the same positions and tangents as the ring's)
+            row_of[nr] = rk;
         }
-        pos.insert(k, at_k);
         // (a segment's end ring already moved to a corner's A stays moved)
-        touched.entry(k).or_insert(end_slot(k));
-        touched.entry(into).or_insert(end_slot(into));
+        touch(&mut touched, k);
+        touch(&mut touched, into);
         // the rings turning from A towards B, after the spine's rings
         let first = next_ring;
         let u = match k == 0 && split {
@@ -547,12 +527,13 @@ pub(super) fn write_joins<R: Real, I: Index>(
         for e in 0..c.extra {
             let (slot, ang) = (first + e, phi * e as f64 / c.extra as f64 - phi);
             let t = rodrigues(dout, axis, ang);
-            let (mut to_crease, mut at_e) = (vec![NONE; cols], Vec::with_capacity(cols));
+            let wr = welds.len();
+            welds.resize(wr + cols, NONE);
             for j in 0..cols {
                 let li = slot * cols + j;
                 let v = match inner[j] {
                     true => {
-                        to_crease[j] = kb + j;
+                        welds[wr + j] = kb + j;
                         crease[j]
                     }
                     false => {
@@ -564,14 +545,14 @@ pub(super) fn write_joins<R: Real, I: Index>(
                 if !put(&mut out, li, v, unscale) && bad.is_none() {
                     bad = Some(li);
                 }
-                at_e.push(v.0);
+                pos.push(v.0);
                 if let Some(uv) = out.uv.as_deref_mut() {
                     uv[li] = [unscaled(u, unscale), R::of(column.v[j])];
                 }
             }
-            weld.insert(slot, to_crease);
-            pos.insert(slot, at_e);
-            tangents.insert(slot, (t, t));
+            weld_of[slot] = wr / cols;
+            row_of[slot] = tangents.len();
+            tangents.push((t, t));
             let to = if e + 1 < c.extra { slot + 1 } else { k };
             let faces = &mut out.faces[jf..jf + per_seg];
             pattern.write(faces, e % 2 == 1, vbase + slot * cols, vbase + to * cols, 0);
@@ -590,7 +571,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
                     }
                 }
             }
-            touched.insert(into, first);
+            touched[into] = first;
         }
         // the neighbours' vertices past the bisector plane: welded to the crease, the rings
         // walked away from the corner while some column is welded (a column only where the
@@ -609,7 +590,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
                     true => nx + 1 == nr,
                     false => nx == 0,
                 };
-                if nx == k || claimed.contains(&nx) || (end && !closed) || (split && nx == 0) {
+                if nx == k || claimed[nx] || (end && !closed) || (split && nx == 0) {
                     break;
                 }
                 let g = geo_at(nx);
@@ -620,7 +601,11 @@ pub(super) fn write_joins<R: Real, I: Index>(
                     let past = (x - cx).dot(m);
                     if (ahead && past < 0.0) || (!ahead && past > 0.0) {
                         now[j] = true;
-                        weld.entry(nx).or_insert_with(|| vec![NONE; cols])[j] = kb + j;
+                        if weld_of[nx] == NONE {
+                            weld_of[nx] = welds.len() / cols;
+                            welds.resize(welds.len() + cols, NONE);
+                        }
+                        welds[weld_of[nx] * cols + j] = kb + j;
                         if !put(&mut out, nx * cols + j, crease[j], unscale) && bad.is_none() {
                             bad = Some(nx * cols + j);
                         }
@@ -629,10 +614,9 @@ pub(super) fn write_joins<R: Real, I: Index>(
                 if !now.iter().any(|&w| w) {
                     break;
                 }
-                claimed.insert(nx);
-                let before = rings.before(nx);
-                touched.entry(nx).or_insert(end_slot(nx));
-                touched.entry(before).or_insert(end_slot(before));
+                claimed[nx] = true;
+                touch(&mut touched, nx);
+                touch(&mut touched, rings.before(nx));
                 std::mem::swap(&mut cur, &mut now);
                 i = nx;
             }
@@ -640,22 +624,31 @@ pub(super) fn write_joins<R: Real, I: Index>(
     }
     // the vertex (local) that the faces use for vertex `l`, column `j` of a ring whose
     // welds are `w` (its crease vertex where it is welded)
-    let welded = |l: usize, j: usize, w: Option<&Vec<usize>>| match w.map(|w| w[j]) {
+    let welded = |l: usize, j: usize, w: Option<&[usize]>| match w.map(|w| w[j]) {
         Some(c) if c != NONE => c,
         _ => l,
     };
+    // a ring's welds, and its positions where it was written here
+    let weld = |s: usize| match weld_of[s] {
+        NONE => None,
+        r => Some(&welds[r * cols..(r + 1) * cols]),
+    };
+    let written = |s: usize| match row_of[s] {
+        NONE => None,
+        r => Some(&pos[r * cols..(r + 1) * cols]),
+    };
     // the welds on the faces they touch (each segment's faces use two rings), and the faces
     // they flatten
-    let ranges = touched
-        .iter()
-        .map(|(&s, &e)| (s * per_seg..(s + 1) * per_seg, s, e))
+    let changed = || (0..stored).filter(|&s| touched[s] != NONE);
+    let ranges = changed()
+        .map(|s| (s * per_seg..(s + 1) * per_seg, s, touched[s]))
         .chain(bands.iter().map(|&(f, a, b, _)| (f..f + per_seg, a, b)));
     let mut dropped = Vec::new();
     for (si, (r, a, b)) in ranges.enumerate() {
         if si % 4096 == 0 && cancel() {
             return (side_and_caps, bad);
         }
-        let (wa, wb) = (weld.get(&a), weld.get(&b));
+        let (wa, wb) = (weld(a), weld(b));
         let (la, lb) = (vbase + a * cols, vbase + b * cols);
         for fi in r {
             let f = &mut out.faces[fi];
@@ -680,38 +673,39 @@ pub(super) fn write_joins<R: Real, I: Index>(
     }
     // fold-over on the segments the joins changed, on the vertices as written
     let row = |s: usize| rings.rowbase + s;
-    folds.retain(|&r| !touched.contains_key(&(r - rings.rowbase)));
+    folds.retain(|&r| touched[r - rings.rowbase] == NONE);
     // a vertex of ring `slot` as the faces use it (its weld) and its position (`w`, `p`,
     // `g`: the ring's welds, written positions or plain geometry)
-    let at =
-        |slot: usize, j: usize, w: Option<&Vec<usize>>, p: Option<&Vec<DVec3>>, g: &Option<Geo>| {
-            let l = slot * cols + j;
-            let t = welded(l, j, w);
-            let x = match (t == l, p) {
-                (true, Some(p)) => p[j],
-                (false, _) => pos[&(t / cols)][t % cols],
-                (true, None) => {
-                    let g = g.unwrap_or_else(|| geo_at(slot));
-                    (g.b.0 + column.px[j] * g.ma) + column.py[j] * g.mb
-                }
-            };
-            (t, x)
+    let at = |slot: usize, j: usize, w: Option<&[usize]>, p: Option<&[DVec3]>, g: &Option<Geo>| {
+        let l = slot * cols + j;
+        let t = welded(l, j, w);
+        let x = match (t == l, p) {
+            (true, Some(p)) => p[j],
+            (false, _) => pos[row_of[t / cols] * cols + t % cols],
+            (true, None) => {
+                let g = g.unwrap_or_else(|| geo_at(slot));
+                (g.b.0 + column.px[j] * g.ma) + column.py[j] * g.mb
+            }
         };
-    let tangent = |slot: usize, start: bool| match tangents.get(&slot) {
-        Some(&(t_end, t_start)) => match start {
-            true => t_start,
-            false => t_end,
+        (t, x)
+    };
+    let tangent = |slot: usize, start: bool| match row_of[slot] {
+        NONE => geo_at(slot).t,
+        r => match start {
+            true => tangents[r].1,
+            false => tangents[r].0,
         },
-        None => geo_at(slot).t,
     };
     let folded = |a: usize, b: usize| {
-        let (ta, tb) = (tangent(a, true), tangent(b, false));
-        let plain = |slot: usize| match slot < stored && !tangents.contains_key(&slot) {
+        let plain = |slot: usize| match slot < stored && row_of[slot] == NONE {
             true => Some(geo_at(slot)),
             false => None,
         };
         let (ga, gb) = (plain(a), plain(b));
-        let (wa, wb, pa, pb) = (weld.get(&a), weld.get(&b), pos.get(&a), pos.get(&b));
+        // (a ring not written here has the tangent of its geometry)
+        let ta = ga.map_or_else(|| tangent(a, true), |g| g.t);
+        let tb = gb.map_or_else(|| tangent(b, false), |g| g.t);
+        let (wa, wb, pa, pb) = (weld(a), weld(b), written(a), written(b));
         (0..cols).any(|j| {
             let (ia, xa) = at(a, j, wa, pa, &ga);
             let (ib, xb) = at(b, j, wb, pb, &gb);
@@ -719,7 +713,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
             ia != ib && !(e.dot(ta) > 0.0 && e.dot(tb) > 0.0)
         })
     };
-    let segments = touched.iter().map(|(&s, &b)| (s, b, s));
+    let segments = changed().map(|s| (s, touched[s], s));
     let mut new_folds = Vec::new();
     for (i, (a, b, at)) in segments
         .chain(bands.iter().map(|&(_, a, b, k)| (a, b, k)))

@@ -30,8 +30,9 @@ pub(super) struct Size {
 
 impl Size {
     /// The size of the sweep of spine `x` (a spine too short to sweep gets a size, which its
-    /// check refuses).
-    pub(super) fn of(s: &Spine, opts: &Options, p: &Profile) -> Size {
+    /// check refuses) and the corners that get joins (those of a spine with join rings or
+    /// with mitred joins; none otherwise), found once for the layout and the sweep.
+    pub(super) fn with_corners(s: &Spine, opts: &Options, p: &Profile) -> (Size, Vec<Corner>) {
         let x = s.points;
         let n = x.len();
         let mut rings = n;
@@ -43,11 +44,17 @@ impl Size {
         } else {
             s.scale
         };
-        let extra = match scale.len() == 1 || scale.len() == rings {
-            true => join::extra_rings(&x[..rings], scale, opts.closed, p, opts),
-            false => 0, // refused by the checks
-        };
-        Size {
+        let mut corners = Vec::new();
+        if scale.len() == 1 || scale.len() == rings {
+            join::corners(&x[..rings], scale, opts.closed, p, opts, |c| {
+                corners.push(c)
+            });
+        } // (else refused by the checks)
+        let extra = corners.iter().map(|c| c.extra).sum();
+        if !(extra > 0 || opts.join == super::Join::Miter) {
+            corners = Vec::new();
+        }
+        let size = Size {
             extra,
             rings,
             segments: if opts.closed {
@@ -58,7 +65,8 @@ impl Size {
             caps: opts.caps && !opts.closed && p.closed,
             stored_rings: rings + usize::from(opts.closed && opts.split_seams),
             cols: p.len() + usize::from(p.closed && opts.split_seams),
-        }
+        };
+        (size, corners)
     }
     pub(super) fn vertices(&self) -> usize {
         (self.stored_rings + self.extra) * self.cols
@@ -92,6 +100,8 @@ impl std::ops::Deref for Plan {
 #[derive(Debug, Clone)]
 pub struct Layout {
     pub(super) sizes: Vec<Size>,
+    /// The corners of every spine that get joins (see [`Size::with_corners`]).
+    pub(super) corners: Vec<Vec<Corner>>,
     pub vertices: usize,
     pub faces: usize,
 }
@@ -174,21 +184,28 @@ pub fn layout_cancellable(
         ));
     }
     let mut sizes = crate::alloc::with_capacity("sweep layout", curves)?;
+    let mut corners = crate::alloc::with_capacity("sweep layout", curves)?;
     // blocks of curves in parallel (the joins' corners are found from the points)
-    let blocks: Vec<Option<Vec<Size>>> = (0..curves.div_ceil(BLOCK))
+    type Block = Vec<(Size, Vec<Corner>)>;
+    let blocks: Vec<Option<Block>> = (0..curves.div_ceil(BLOCK))
         .into_par_iter()
         .map(|b| match cancel() {
             true => None,
             false => Some(
                 (b * BLOCK..((b + 1) * BLOCK).min(curves))
-                    .map(|c| Size::of(&part(all, offsets, c), opts, profile))
+                    .map(|c| Size::with_corners(&part(all, offsets, c), opts, profile))
                     .collect(),
             ),
         })
         .collect();
     for b in blocks {
         match b {
-            Some(b) => sizes.extend(b),
+            Some(b) => {
+                for (s, c) in b {
+                    sizes.push(s);
+                    corners.push(c);
+                }
+            }
             None => return Ok(None),
         }
     }
@@ -196,5 +213,6 @@ pub fn layout_cancellable(
         vertices: sizes.iter().map(Size::vertices).sum(),
         faces: sizes.iter().map(|s| s.faces(profile)).sum(),
         sizes,
+        corners,
     }))
 }

@@ -398,7 +398,9 @@ impl Sweep<'_> {
                 false
             }
         };
-        let plan = match check_spine(&s, self.opts, self.sh.p, given, cancel) {
+        // the size and corners that the layout found (from the same rows)
+        let found = (self.layout.sizes[c], self.layout.corners[c].clone());
+        let plan = match check_spine(&s, self.opts, self.sh.p, given, Some(found), cancel) {
             Ok(Some(plan)) => plan,
             Ok(None) => return Outcome::Stopped,
             Err(e) => return Outcome::Checks(in_curve(e, self.offsets, c)),

@@ -172,6 +172,7 @@ fn faces_are_int32_below_two_to_the_31_vertices() {
     }
     let lay = |vertices| Layout {
         sizes: Vec::new(),
+        corners: Vec::new(),
         vertices,
         faces: 0,
     };
@@ -387,7 +388,7 @@ fn avx2_block_equals_baseline_block() {
     let p = Profile::new(&star(), true).expect("a star");
     let opts = options(false, true, true);
     let lay = layout(&spine, &[0, n], &p, &opts).expect("a sized sweep");
-    let plan = check_spine(&spine, &opts, &p, true, &cancel::never)
+    let plan = check_spine(&spine, &opts, &p, true, None, &cancel::never)
         .expect("a valid sweep")
         .expect("not stopped");
     let plan = &plan;
@@ -457,7 +458,7 @@ fn written(
     opts: &Options,
     tasks: (usize, usize),
 ) -> (Vec<u64>, Vec<i64>, Vec<usize>, Option<usize>) {
-    let plan = check_spine(spine, opts, p, true, &cancel::never)
+    let plan = check_spine(spine, opts, p, true, None, &cancel::never)
         .expect("a valid sweep")
         .expect("not stopped");
     let sh = Shared::new(
