@@ -9,8 +9,8 @@ use super::convert::{
     Stop, Ticker, detach_stoppable, empty, slice_mut, triangles, value_error, vec3_array, vec3s,
 };
 use super::fields::PyField;
-use crate::alloc;
 use crate::deform::{self, advect::Method, refine};
+use crate::run::alloc;
 
 /// Advect points: `steps` steps of size `h` from `t0`; a new array. Ctrl-C stops it between
 /// blocks of steps (`KeyboardInterrupt`); `progress(done, steps)` is called at every multiple
