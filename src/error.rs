@@ -1,5 +1,8 @@
 //! Errors for bad input. Every error names the argument it is about, so the binding layer
-//! can raise a Python `ValueError` whose message starts with that argument's name.
+//! can raise a Python `ValueError` whose message starts with that argument's name; two
+//! kinds are no fault of the input: a buffer that could not be allocated
+//! ([`ErrorKind::OutOfMemory`], raised as `MemoryError`) and a call stopped by its hook
+//! ([`ErrorKind::Stopped`], raised as `KeyboardInterrupt`).
 
 use std::fmt;
 
@@ -7,15 +10,16 @@ use std::fmt;
 #[derive(Debug, Clone, PartialEq)]
 pub struct InputError {
     /// Name of the argument as the user sees it (`"points"`, `"tangents"`, `"initial"`, …),
-    /// or of the call for [`ErrorKind::OutOfMemory`].
+    /// of the call for [`ErrorKind::OutOfMemory`], `"cancel"` for [`ErrorKind::Stopped`].
     pub arg: &'static str,
     /// What is wrong, in words, including the row index where one applies.
     pub msg: String,
-    /// Bad input, or input too large for the memory.
+    /// Bad input, input too large for the memory, or a call stopped by its hook.
     pub kind: ErrorKind,
 }
 
-/// The kind of an [`InputError`] (the binding raises `ValueError` or `MemoryError`).
+/// The kind of an [`InputError`] (the binding raises `ValueError`, `MemoryError` or
+/// `KeyboardInterrupt`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ErrorKind {
     /// A value, shape or combination of arguments that cannot be processed.
@@ -23,6 +27,9 @@ pub enum ErrorKind {
     Invalid,
     /// A buffer sized by the input could not be allocated.
     OutOfMemory,
+    /// The call's stop hook said stop ([`crate::run::cancel`]); the caller, which asked it
+    /// to stop, discards the error.
+    Stopped,
     /// Consecutive samples that coincide: invalid as given, which the Python layer answers
     /// by merging them (`frames::validate::distinct_rows`) where it can.
     Repeated,
@@ -53,6 +60,15 @@ impl InputError {
             arg: what,
             msg,
             kind: ErrorKind::OutOfMemory,
+        }
+    }
+
+    /// The error of a call stopped by its hook ([`crate::run::cancel`]).
+    pub fn stopped() -> Self {
+        InputError {
+            arg: "cancel",
+            msg: "stopped on request".to_string(),
+            kind: ErrorKind::Stopped,
         }
     }
 

@@ -8,7 +8,8 @@
 //!   (volume-preserving deformation by divergence-free fields, advection, the contact
 //!   stamper), [`flesh`] (spine-driven deformation with local volume preservation, on a
 //!   spine or a spine surface), [`math`] (the shared kernels: cubics, rotations, mesh
-//!   measures) and [`error`]. They work on `glam::DVec3` slices and
+//!   measures), [`run`] (the stop hook of long calls and fallible allocation) and
+//!   [`error`]. They work on `glam::DVec3` slices and
 //!   flat `f64` output buffers and return [`error::InputError`] for bad input, never
 //!   panicking on user data;
 //! * the binding folder `src/python/` (module `python`, compiled into the `spinal._core`
@@ -23,8 +24,6 @@
 // `!(a > b)` is used on purpose: it is also true when a value is NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod alloc;
-pub mod cancel;
 pub mod deform;
 pub mod error;
 pub mod flesh;
@@ -34,6 +33,7 @@ pub mod mesh;
 pub mod ph;
 mod python;
 pub mod quaternion;
+pub mod run;
 pub mod sweep;
 
 pub use error::InputError;

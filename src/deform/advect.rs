@@ -21,8 +21,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::Field;
-use crate::alloc;
-use crate::cancel::Cancel;
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Integrator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -602,7 +602,7 @@ fn advect_blocks(
 pub const BLOCK_SECONDS: f64 = 0.02;
 
 /// Evaluate the field at `points` into `out` (as many rows), polling `cancel` between
-/// blocks of points (`out` incomplete once it says stop; see [`crate::cancel`]).
+/// blocks of points (`out` incomplete once it says stop; see [`crate::run::cancel`]).
 pub fn eval_into(
     field: &Field,
     points: &[DVec3],
@@ -616,7 +616,7 @@ pub fn eval_into(
             "output buffer has the wrong size",
         ));
     }
-    crate::cancel::fill_in_blocks(out, CHUNK, cancel, |i| field.eval(points[i], t));
+    crate::run::cancel::fill_in_blocks(out, CHUNK, cancel, |i| field.eval(points[i], t));
     Ok(())
 }
 
@@ -625,6 +625,7 @@ mod tests {
     use super::super::{Swirl, SwirlKind, Translation};
     use super::*;
     use crate::math::rotation::rodrigues;
+    use crate::run::cancel;
 
     #[test]
     fn rk4_on_a_swirl_is_fourth_order() {
@@ -655,9 +656,12 @@ mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.1 * a)
             })
             .collect();
-        let strip = super::super::tube::strip_curve(&axis, 0.1, 1.0, Some(0.15), false).unwrap();
+        let strip =
+            super::super::tube::strip_curve(&axis, 0.1, 1.0, Some(0.15), false, &cancel::never)
+                .unwrap();
         // and so does a rod curl tool (its axis is a table of segments too)
-        let rod = super::super::rod::Rod::from_points(&axis, 0.1, Some(0.15), None).unwrap();
+        let rod = super::super::rod::Rod::from_points(&axis, 0.1, Some(0.15), None, &cancel::never)
+            .unwrap();
         let rod = super::super::curl::CurlTool::new(
             std::sync::Arc::new(rod),
             super::super::curl::Motion::Translate(DVec3::new(0.0, 0.0, -1.0)),

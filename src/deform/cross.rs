@@ -28,6 +28,7 @@
 //!
 //!   `v = s (R_t/ρ_ax) [ (1 − D) k + D′ (ρ_ax − R_t) e_θ × n ]`.
 
+use crate::run::cancel;
 use glam::DVec3;
 
 use super::shape::{Ball, Ring, Shape, ToolShape, blend, speed_factor, translate};
@@ -425,7 +426,8 @@ fn segment_shape(a: DVec3, b: DVec3, radius: f64, reach: f64) -> Option<ToolShap
             reach,
         })
     } else {
-        let rod = super::rod::Rod::from_points(&[a, b], radius, Some(reach), None).ok()?;
+        let rod = super::rod::Rod::from_points(&[a, b], radius, Some(reach), None, &cancel::never)
+            .ok()?;
         Shape::Rod(std::sync::Arc::new(rod))
     };
     Some(ToolShape { shape, power: None })

@@ -479,6 +479,7 @@ impl<D: Distance + Clone + Into<Shape>> Tool for CurlTool<D> {
 
 #[cfg(test)]
 mod tests {
+    use crate::run::cancel;
     use std::sync::Arc;
 
     use super::super::Field;
@@ -546,7 +547,7 @@ mod tests {
                 DVec3::new(a.sin(), 0.2 * (2.0 * a).sin(), a.cos())
             })
             .collect();
-        let rod = Arc::new(Rod::from_points(&axis, 0.15, Some(0.3), None).unwrap());
+        let rod = Arc::new(Rod::from_points(&axis, 0.15, Some(0.3), None, &cancel::never).unwrap());
         let om = DVec3::new(0.3, -1.0, 0.5);
         for (motion, p) in [
             (Motion::Translate(DVec3::new(0.2, 0.1, -1.0)), 2),

@@ -29,9 +29,9 @@
 use glam::DVec3;
 
 use super::shape::{speed_factor, translate};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// A tool given by a signed-distance grid (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -142,26 +142,11 @@ fn weights_avx2(
 }
 
 impl GridTool {
-    #[allow(clippy::too_many_arguments)]
+    /// The tool of the distance grid of `n` nodes per axis from `origin` at `spacing`, with
+    /// the coefficients `coef` and, in `tool`, its velocity, centre, reach and the `linear`
+    /// and `moving` flags; polls `cancel` between the planes of its passes over the cells
+    /// and fails with [`InputError::stopped`] once it says stop.
     pub fn new(
-        origin: DVec3,
-        spacing: f64,
-        n: [usize; 3],
-        coef: Vec<f64>,
-        velocity: DVec3,
-        center: DVec3,
-        reach: f64,
-        linear: bool,
-        moving: bool,
-    ) -> Result<GridTool> {
-        let t = (velocity, center, reach, linear, moving);
-        GridTool::new_cancellable(origin, spacing, n, coef, t, &cancel::never)
-    }
-
-    /// [`GridTool::new`] (its last five arguments in `tool`) that polls `cancel` between
-    /// the planes of its passes over the cells and fails with [`cancel::stopped`] once it
-    /// says stop.
-    pub fn new_cancellable(
         origin: DVec3,
         spacing: f64,
         n: [usize; 3],
@@ -172,7 +157,7 @@ impl GridTool {
         let (velocity, center, reach, linear, moving) = tool;
         let stop = || {
             if cancel() {
-                Err(cancel::stopped())
+                Err(InputError::stopped())
             } else {
                 Ok(())
             }
@@ -516,7 +501,7 @@ fn zip_rows(x: &mut [f64], y: &[f64], wide: bool, f: impl Fn(f64, f64) -> f64 + 
 /// derivative at the end nodes). The axes are filtered in turn, each line's operations in
 /// the order of the NumPy formulation (the same bits). At least 4 nodes per axis (errors name
 /// `grid`); polls `cancel` between lines and between the steps of long ones (`out`
-/// incomplete once it says stop; see [`crate::cancel`]).
+/// incomplete once it says stop; see [`crate::run::cancel`]).
 pub fn spline_coefficients(
     values: &[f64],
     n: [usize; 3],
@@ -663,7 +648,7 @@ pub const MIN_CELLS_PER_REACH: f64 = 4.0;
 /// validated: at least 4 nodes per axis, finite vectors, positive spacing and reach, at
 /// least [`MIN_CELLS_PER_REACH`] cells per reach, and a support that stays inside the grid
 /// ([`GridTool::new`]). The coefficients are copied (fallibly); `cancel` is polled in the
-/// checks and the passes over the cells ([`GridTool::new_cancellable`]).
+/// checks and the passes over the cells ([`GridTool::new`]).
 #[allow(clippy::too_many_arguments)]
 pub fn grid_tool(
     origin: DVec3,
@@ -699,8 +684,7 @@ pub fn grid_tool(
             ),
         ));
     }
-    if let Some(i) = crate::frames::validate::first_bad_cancellable(coef, |c| c.is_finite(), cancel)
-    {
+    if let Some(i) = crate::frames::validate::first_bad(coef, |c| c.is_finite(), cancel) {
         return Err(InputError::new(
             "grid",
             format!("spline coefficient {i} is not finite"),
@@ -708,7 +692,7 @@ pub fn grid_tool(
     }
     let coef = alloc::copied("grid", coef)?;
     let t = (velocity, center, reach, linear, moving);
-    let tool = GridTool::new_cancellable(origin, spacing, n, coef, t, cancel)?;
+    let tool = GridTool::new(origin, spacing, n, coef, t, cancel)?;
     super::bounded("velocity", tool)
 }
 
@@ -780,6 +764,7 @@ fn slope_bound(coef: &[f64], n: [usize; 3], spacing: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     /// Coefficients `c = |node − m|²`: the B-spline is `|X − m|² + 3·(1/3)` (its basis has
     /// variance 1/3 per axis), gradient `2(X − m)`.
@@ -797,8 +782,15 @@ mod tests {
             }
         }
         let o = DVec3::new(0.1, -0.2, 0.3);
-        let g = GridTool::new(o, 1.0, n, coef.clone(), DVec3::X, m, 2.0, false, false)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let g = GridTool::new(
+            o,
+            1.0,
+            n,
+            coef.clone(),
+            (DVec3::X, m, 2.0, false, false),
+            &cancel::never,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         for x in [DVec3::new(4.3, 5.1, 5.2), DVec3::new(5.0, 4.5, 6.0)] {
             let (d, n) = g.distance(x + o).unwrap();
             assert!((d - ((x - m).length_squared() + 1.0)).abs() < 1e-13, "{d}");
@@ -807,7 +799,17 @@ mod tests {
         assert!(g.distance(o + DVec3::new(9.5, 0.0, 0.0)).is_none());
         assert!(g.distance(o - DVec3::new(0.01, 0.0, 0.0)).is_none());
         // a support reaching the boundary is refused
-        assert!(GridTool::new(o, 1.0, n, coef, DVec3::X, m, 40.0, false, false).is_err());
+        assert!(
+            GridTool::new(
+                o,
+                1.0,
+                n,
+                coef,
+                (DVec3::X, m, 40.0, false, false),
+                &cancel::never
+            )
+            .is_err()
+        );
     }
 
     /// The AVX2 contraction gives the bits of the portable one (same operations per lane).
@@ -824,11 +826,8 @@ mod tests {
             0.1,
             n,
             coef,
-            DVec3::X,
-            DVec3::ZERO,
-            0.3,
-            false,
-            false,
+            (DVec3::X, DVec3::ZERO, 0.3, false, false),
+            &cancel::never,
         )
         .unwrap_or_else(|e| panic!("{e}"));
         let mut seen = 0;
@@ -864,6 +863,7 @@ mod tests {
 #[cfg(test)]
 mod timing {
     use super::*;
+    use crate::run::cancel;
 
     #[test]
     #[ignore]
@@ -883,11 +883,8 @@ mod timing {
             0.03,
             n,
             coef,
-            DVec3::X,
-            DVec3::ZERO,
-            0.3,
-            false,
-            false,
+            (DVec3::X, DVec3::ZERO, 0.3, false, false),
+            &cancel::never,
         )
         .unwrap_or_else(|e| panic!("{e}"));
         let pts: Vec<DVec3> = (0..1_000_000)

@@ -31,11 +31,11 @@ use glam::{DMat3, DQuat, DVec3};
 use super::curl::{Falloff, Pose, rotation_bound};
 use super::shape::{Distance, Shape, ToolShape};
 use super::{Tool, falloff};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{ROTATION_TOL, is_rotation, mat3_from_quat, quat_from_mat3};
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// Key orientations as the user gives them.
 #[derive(Debug, Clone)]
@@ -69,17 +69,10 @@ pub struct KeyPose {
 
 impl Keys {
     /// The keys, validated (errors name `times`, `positions`, `orientations`).
+    ///
+    /// Polls `cancel` between its passes over the keys and fails with [`InputError::stopped`] once
+    /// it says stop.
     pub fn new(
-        times: &[f64],
-        positions: &[DVec3],
-        orientations: Option<Orientations>,
-    ) -> Result<Keys> {
-        Keys::new_cancellable(times, positions, orientations, &cancel::never)
-    }
-
-    /// [`Keys::new`] that polls `cancel` between its passes over the keys and fails with
-    /// [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
         times: &[f64],
         positions: &[DVec3],
         orientations: Option<Orientations>,
@@ -87,7 +80,7 @@ impl Keys {
     ) -> Result<Keys> {
         let poll = || {
             if cancel() {
-                Err(cancel::stopped())
+                Err(InputError::stopped())
             } else {
                 Ok(())
             }
@@ -273,15 +266,9 @@ impl Keys {
         }
     }
 
-    /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`.
-    pub fn rates(&self) -> (f64, f64) {
-        self.rates_cancellable(&cancel::never)
-            .expect("never stopped")
-    }
-
-    /// [`Keys::rates`] that polls `cancel` every [`cancel::BLOCK`] intervals (`None` once it
-    /// says stop).
-    pub fn rates_cancellable(&self, cancel: Cancel<'_>) -> Option<(f64, f64)> {
+    /// The largest `|ċ|` (17 samples per interval, × 1.05) and `|ω|`, polling `cancel` every
+    /// [`cancel::BLOCK`] intervals (`None` once it says stop).
+    pub fn rates(&self, cancel: Cancel<'_>) -> Option<(f64, f64)> {
         let mut v: f64 = 0.0;
         for k in 0..self.times.len() - 1 {
             if k % cancel::BLOCK == 0 && cancel() {
@@ -319,20 +306,16 @@ pub struct Keyframed<D> {
 impl<D: Distance> Keyframed<D> {
     /// The tool, validated: a finite speed bound (errors name `times`); `center` is the point
     /// `C` of the shape taken to the key positions (default the shape's centre).
-    pub fn new(shape: D, keys: Keys, power: u8, center: Option<DVec3>) -> Result<Keyframed<D>> {
-        Keyframed::new_cancellable(shape, keys, power, center, &cancel::never)
-    }
-
-    /// [`Keyframed::new`] that polls `cancel` in the speed bound and fails with
-    /// [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
+    ///
+    /// Polls `cancel` in the speed bound and fails with [`InputError::stopped`] once it says stop.
+    pub fn new(
         shape: D,
         keys: Keys,
         power: u8,
         center: Option<DVec3>,
         cancel: Cancel<'_>,
     ) -> Result<Keyframed<D>> {
-        let (v, w) = keys.rates_cancellable(cancel).ok_or_else(cancel::stopped)?;
+        let (v, w) = keys.rates(cancel).ok_or_else(InputError::stopped)?;
         let offset = center.map_or(DVec3::ZERO, |c| c - shape.center());
         let tool = Keyframed {
             shape,
@@ -398,8 +381,9 @@ impl<D: Distance> Keyframed<D> {
 
     /// The curl bounds with `|Y| = |X − c|` at most the shape's extent plus `|C − C_shape|`.
     pub fn max_speed(&self) -> f64 {
-        let (v, w) = self.keys.rates();
-        self.speed_bound(v, w)
+        // never stopped (a stopped bound would be no bound)
+        let rates = self.keys.rates(&cancel::never);
+        rates.map_or(f64::INFINITY, |(v, w)| self.speed_bound(v, w))
     }
 
     /// The speed bound for the key rates `(|ċ|, |ω|)` ([`Keys::rates`]).
@@ -416,17 +400,9 @@ impl<D: Distance> Keyframed<D> {
 /// tool without one, not a curl field, defaults to 2; `center` the point `C` taken to the
 /// keys, default the shape's centre); any other field is carried rigidly about `center`
 /// (default the tool's natural centre; required for sums), and `power` is refused.
+///
+/// Polls `cancel` in the speed bound (see [`Keyframed::new`]).
 pub fn keyframed(
-    field: &super::Field,
-    keys: Keys,
-    power: Option<i64>,
-    center: Option<DVec3>,
-) -> Result<super::Field> {
-    keyframed_cancellable(field, keys, power, center, &cancel::never)
-}
-
-/// [`keyframed`] that polls `cancel` in the speed bound (see [`Keyframed::new_cancellable`]).
-pub fn keyframed_cancellable(
     field: &super::Field,
     keys: Keys,
     power: Option<i64>,
@@ -466,7 +442,7 @@ pub fn keyframed_cancellable(
                 ));
             }
         };
-        return Ok(super::Field::single(Carried::new_cancellable(
+        return Ok(super::Field::single(Carried::new(
             field.clone(),
             keys,
             c,
@@ -479,18 +455,10 @@ pub fn keyframed_cancellable(
         (None, None) => 2,
     };
     Ok(match shape.shape {
-        Shape::Ball(b) => {
-            super::Field::single(Keyframed::new_cancellable(b, keys, p, center, cancel)?)
-        }
-        Shape::Rod(r) => {
-            super::Field::single(Keyframed::new_cancellable(r, keys, p, center, cancel)?)
-        }
-        Shape::Grid(g) => {
-            super::Field::single(Keyframed::new_cancellable(g, keys, p, center, cancel)?)
-        }
-        Shape::Ring(r) => {
-            super::Field::single(Keyframed::new_cancellable(r, keys, p, center, cancel)?)
-        }
+        Shape::Ball(b) => super::Field::single(Keyframed::new(b, keys, p, center, cancel)?),
+        Shape::Rod(r) => super::Field::single(Keyframed::new(r, keys, p, center, cancel)?),
+        Shape::Grid(g) => super::Field::single(Keyframed::new(g, keys, p, center, cancel)?),
+        Shape::Ring(r) => super::Field::single(Keyframed::new(r, keys, p, center, cancel)?),
     })
 }
 
@@ -515,13 +483,9 @@ pub struct Carried {
 
 impl Carried {
     /// The carried field, validated: a finite speed bound (errors name `times`).
-    pub fn new(field: super::Field, keys: Keys, center: DVec3) -> Result<Carried> {
-        Carried::new_cancellable(field, keys, center, &cancel::never)
-    }
-
-    /// [`Carried::new`] that polls `cancel` in the speed bound and fails with
-    /// [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
+    ///
+    /// Polls `cancel` in the speed bound and fails with [`InputError::stopped`] once it says stop.
+    pub fn new(
         field: super::Field,
         keys: Keys,
         center: DVec3,
@@ -537,7 +501,7 @@ impl Carried {
         // the step rule's speed: the field's own plus the speed at which the pose moves its
         // pattern past the material, |ċ| + |ω| E with E the support's radius about C (|ċ|
         // alone where the support is unbounded)
-        let (v, w) = keys.rates_cancellable(cancel).ok_or_else(cancel::stopped)?;
+        let (v, w) = keys.rates(cancel).ok_or_else(InputError::stopped)?;
         let reach = field.support_radius(center);
         if let Some(e) = reach.filter(|e| v.is_finite() && w.is_finite() && !(w * e).is_finite()) {
             return Err(InputError::new(
@@ -723,7 +687,7 @@ mod tests {
         let u = DVec3::new(0.3, -0.2, 0.1);
         let times = [0.0, 0.5, 1.5, 2.0];
         let pos: Vec<DVec3> = times.iter().map(|t| DVec3::ONE + u * *t).collect();
-        let keys = Keys::new(&times, &pos, None).unwrap();
+        let keys = Keys::new(&times, &pos, None, &cancel::never).unwrap();
         for t in [0.1, 0.7, 1.9] {
             let p = keys.pose_in(t, t).unwrap();
             assert!((p.pose.c - (DVec3::ONE + u * t)).length() < 1e-15);
@@ -731,7 +695,9 @@ mod tests {
         }
         assert!(keys.pose_in(2.1, 2.1).is_none());
         assert_eq!(
-            Keys::new(&[0.0, 0.0], &pos[..2], None).unwrap_err().arg,
+            Keys::new(&[0.0, 0.0], &pos[..2], None, &cancel::never)
+                .unwrap_err()
+                .arg,
             "times"
         );
     }
@@ -748,7 +714,7 @@ mod tests {
                 DVec3::new(a.sin(), 0.15 * (2.0 * a).sin(), a.cos())
             })
             .collect();
-        let rod = Arc::new(Rod::from_points(&axis, 0.3, Some(0.3), None).unwrap());
+        let rod = Arc::new(Rod::from_points(&axis, 0.3, Some(0.3), None, &cancel::never).unwrap());
         let times: [f64; 4] = [0.0, 0.1, 0.2, 0.3];
         let pos: Vec<DVec3> = times
             .iter()
@@ -759,8 +725,8 @@ mod tests {
             .map(|t| DQuat::from_rotation_y(1.5 * t))
             .collect();
         for o in [None, Some(Orientations::Quaternions(turn))] {
-            let keys = Keys::new(&times, &pos, o).unwrap();
-            let tool = Keyframed::new(rod.clone(), keys, 2, None).unwrap();
+            let keys = Keys::new(&times, &pos, o, &cancel::never).unwrap();
+            let tool = Keyframed::new(rod.clone(), keys, 2, None, &cancel::never).unwrap();
             let (mut moved, mut skipped) = (0, 0);
             for b in 0..400 {
                 let q = b as f64 * 0.37;
@@ -800,6 +766,7 @@ mod tests {
             &times,
             &[DVec3::ZERO; 3],
             Some(Orientations::Quaternions(q)),
+            &cancel::never,
         )
         .unwrap();
         let p = keys.pose_in(1.3, 1.3).unwrap();

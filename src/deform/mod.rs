@@ -323,7 +323,7 @@ impl Field {
     /// fallibly (the out-of-memory error names `what`, the calling function).
     pub fn breakpoints(&self, what: &'static str) -> Result<Vec<f64>> {
         let n = self.tools.iter().map(|e| e.breakpoints().len()).sum();
-        let mut b = crate::alloc::with_capacity(what, n)?;
+        let mut b = crate::run::alloc::with_capacity(what, n)?;
         for e in &self.tools {
             b.extend_from_slice(e.breakpoints());
         }

@@ -35,11 +35,11 @@ use glam::{DMat3, DVec3};
 use super::cross::Sphere;
 use super::fields::{Rotation, Swirl, SwirlKind, Translation};
 use super::{Tool, falloff, finite, positive, reach_or};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::Hermite;
 use crate::math::rotation::{is_rotation, quat_from_mat3, rodrigues};
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// The name of the call in out-of-memory errors.
 const CALL: &str = "along_path";
@@ -105,19 +105,16 @@ impl PathTool {
     /// Build from samples (positions and orthonormal right-handed frames, strictly increasing
     /// arc length `s`, at least 2) and the parameters. The per-segment buffers are allocated
     /// fallibly (the out-of-memory error names `along_path`).
-    pub fn new(samples: Vec<Sample>, params: PathToolParams) -> Result<PathTool> {
-        PathTool::new_cancellable(samples, params, &cancel::never)
-    }
-
-    /// [`PathTool::new`] that polls `cancel` every [`cancel::BLOCK`] samples and fails with
-    /// [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
+    ///
+    /// Polls `cancel` every [`cancel::BLOCK`] samples and fails with [`InputError::stopped`] once
+    /// it says stop.
+    pub fn new(
         samples: Vec<Sample>,
         params: PathToolParams,
         cancel: Cancel<'_>,
     ) -> Result<PathTool> {
         let poll = |i: usize| match i % cancel::BLOCK == 0 && cancel() {
-            true => Err(cancel::stopped()),
+            true => Err(InputError::stopped()),
             false => Ok(()),
         };
         let duration = params.duration;
@@ -306,15 +303,9 @@ impl PathTool {
     }
 
     /// A bound of `|v|`: the parts' bounds at the largest tool speed and turning rate
-    /// (sampled at 17 points per segment, ×1.05).
-    pub fn max_speed(&self) -> f64 {
-        self.max_speed_cancellable(&cancel::never)
-            .expect("never stopped")
-    }
-
-    /// [`PathTool::max_speed`] that polls `cancel` every [`cancel::BLOCK`] segments (`None`
-    /// once it says stop).
-    pub fn max_speed_cancellable(&self, cancel: Cancel<'_>) -> Option<f64> {
+    /// (sampled at 17 points per segment, ×1.05), polling `cancel` every [`cancel::BLOCK`]
+    /// segments (`None` once it says stop).
+    pub fn max_speed(&self, cancel: Cancel<'_>) -> Option<f64> {
         let u = self.length() / self.params.duration;
         let mut vmax: f64 = 0.0;
         for (k, w) in self.samples.windows(2).enumerate() {
@@ -426,15 +417,12 @@ pub struct PathArgs<'a> {
 impl PathTool {
     /// The tool of `spinal.fields.along_path`, validated (errors name its arguments): at least
     /// 2 finite samples with no repeated consecutive point, one rotation per sample.
-    pub fn from_args(a: PathArgs<'_>) -> Result<PathTool> {
-        PathTool::from_args_cancellable(a, &cancel::never)
-    }
-
-    /// [`PathTool::from_args`] that polls `cancel` between and inside its passes over the
-    /// samples and fails with [`cancel::stopped`] once it says stop.
-    pub fn from_args_cancellable(a: PathArgs<'_>, cancel: Cancel<'_>) -> Result<PathTool> {
+    ///
+    /// Polls `cancel` between and inside its passes over the samples and fails with
+    /// [`InputError::stopped`] once it says stop.
+    pub fn from_args(a: PathArgs<'_>, cancel: Cancel<'_>) -> Result<PathTool> {
         let poll = |i: usize| match i % cancel::BLOCK == 0 && cancel() {
-            true => Err(cancel::stopped()),
+            true => Err(InputError::stopped()),
             false => Ok(()),
         };
         let x = a.points;
@@ -508,10 +496,8 @@ impl PathTool {
                 0.0
             },
         };
-        let tool = PathTool::new_cancellable(samples, params, cancel)?;
-        let speed = tool
-            .max_speed_cancellable(cancel)
-            .ok_or_else(cancel::stopped)?;
+        let tool = PathTool::new(samples, params, cancel)?;
+        let speed = tool.max_speed(cancel).ok_or_else(InputError::stopped)?;
         if !speed.is_finite() {
             return Err(InputError::new(
                 "duration",
@@ -528,7 +514,8 @@ impl Tool for PathTool {
         self.eval(x, t, tm)
     }
     fn max_speed(&self) -> f64 {
-        PathTool::max_speed(self)
+        // never stopped (a stopped bound would be no bound)
+        PathTool::max_speed(self, &cancel::never).unwrap_or(f64::INFINITY)
     }
     fn length_scale(&self) -> f64 {
         self.params.reach
@@ -600,7 +587,7 @@ mod tests {
             twist: 0.0,
             bend: 0.0,
         };
-        let tool = PathTool::new(samples.clone(), params).unwrap();
+        let tool = PathTool::new(samples.clone(), params, &cancel::never).unwrap();
         for (i, s) in samples.iter().enumerate() {
             let t = 0.5 + 2.0 * s.s / tool.length();
             let p = tool.pose(t).unwrap();

@@ -19,8 +19,8 @@ use glam::DVec3;
 
 use super::shape::Distance;
 use super::tube::{Axis, AxisSample};
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::run::cancel::Cancel;
 
 /// A rod about a spline axis (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -37,43 +37,27 @@ pub struct Rod {
 
 impl Rod {
     /// The rod of `spinal.fields.rod` about `points` ([`super::tube::axis_samples`]).
+    ///
+    /// Polls `cancel` in the axis set-up and checks (see [`Axis::new`]); fails with
+    /// [`InputError::stopped`] once it says stop.
     pub fn from_points(
-        points: &[DVec3],
-        radius: f64,
-        reach: Option<f64>,
-        center: Option<DVec3>,
-    ) -> Result<Rod> {
-        Rod::from_points_cancellable(points, radius, reach, center, &cancel::never)
-    }
-
-    /// [`Rod::from_points`] polling `cancel` in the axis set-up and checks (see
-    /// [`Axis::new_cancellable`]); fails with [`cancel::stopped`] once it says stop.
-    pub fn from_points_cancellable(
         points: &[DVec3],
         radius: f64,
         reach: Option<f64>,
         center: Option<DVec3>,
         cancel: Cancel<'_>,
     ) -> Result<Rod> {
-        let samples = super::tube::axis_samples_cancellable(points, cancel)?;
-        Rod::new_cancellable(samples, radius, reach, center, cancel)
+        let samples = super::tube::axis_samples(points, cancel)?;
+        Rod::new(samples, radius, reach, center, cancel)
     }
 
     /// The rod, validated: `radius` and `reach` (default `radius`) positive, finite `center`
     /// (default: the centroid of the sample polyline, segments weighted by their length), an
     /// axis whose foot points are unique within `radius + reach` ([`Axis::new`]; errors name
     /// `points`).
+    ///
+    /// Polls `cancel` in the axis checks ([`Axis::new`]).
     pub fn new(
-        samples: Vec<AxisSample>,
-        radius: f64,
-        reach: Option<f64>,
-        center: Option<DVec3>,
-    ) -> Result<Rod> {
-        Rod::new_cancellable(samples, radius, reach, center, &cancel::never)
-    }
-
-    /// [`Rod::new`] polling `cancel` in the axis checks ([`Axis::new_cancellable`]).
-    pub fn new_cancellable(
         samples: Vec<AxisSample>,
         radius: f64,
         reach: Option<f64>,
@@ -91,7 +75,7 @@ impl Rod {
                 format!("row {i} is not finite (NaN or inf)"),
             ));
         }
-        let axis = Axis::new_cancellable(samples, radius + reach, cancel)?;
+        let axis = Axis::new(samples, radius + reach, cancel)?;
         let center = center.map(|c| super::finite3("center", c)).transpose()?;
         Ok(Rod::with_axis(axis, radius, reach, center))
     }
@@ -164,6 +148,7 @@ impl Distance for Rod {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     #[test]
     fn a_straight_rod_is_a_capsule() {
@@ -175,7 +160,7 @@ mod tests {
             AxisSample { x: a, m: t, s: 0.0 },
             AxisSample { x: b, m: t, s },
         ];
-        let rod = Rod::new(samples, 0.2, Some(0.3), None).unwrap();
+        let rod = Rod::new(samples, 0.2, Some(0.3), None, &cancel::never).unwrap();
         assert!((rod.center - 0.5 * (a + b)).length() < 1e-15);
         for i in 0..300 {
             let q = i as f64 * 0.37;

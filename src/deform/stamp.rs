@@ -35,9 +35,9 @@ use glam::DVec3;
 use super::Field;
 use super::advect::{Method, integrate};
 use super::fields::Translation;
-use crate::alloc;
 use crate::error::{InputError, Result};
 use crate::math::mesh::signed_volume as volume;
+use crate::run::alloc;
 
 /// What one frame did.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -33,9 +33,9 @@ use glam::DVec3;
 
 use super::Field;
 use super::advect::{Run, advect_measuring};
-use crate::alloc;
-use crate::cancel::{Cancel, stopped};
-use crate::error::Result;
+use crate::error::{InputError, Result};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Largest accepted difference between the runs at `n` and `2n` steps, as a fraction of the
 /// field's length scale.
@@ -114,7 +114,7 @@ fn run(
         h: duration / steps as f64,
         count: steps,
     };
-    advect_measuring(field, points, r, cancel).ok_or_else(stopped)
+    advect_measuring(field, points, r, cancel).ok_or_else(InputError::stopped)
 }
 
 #[cfg(test)]
@@ -151,7 +151,7 @@ mod tests {
         // points near the axis, slower than the bound allows for
         let p = ball(500, 0.05);
         // long enough that the search ends before the bound
-        let n = measured_steps(&f, &p, 0.0, T, &crate::cancel::never).unwrap();
+        let n = measured_steps(&f, &p, 0.0, T, &crate::run::cancel::never).unwrap();
         assert!(n < f.default_steps(T).unwrap(), "{n}");
         // the error of the accepted run against a fine reference is within the tolerance
         let carried = |steps: usize| {
@@ -193,7 +193,7 @@ mod tests {
             Translation::new(DVec3::new(10.0, 0.0, 0.0), 0.5, DVec3::X, None, 2, false).unwrap();
         let f = Field::single(t);
         assert!(f.default_steps(3.0).unwrap() > 2 * FIRST);
-        let n = measured_steps(&f, &ball(200, 0.8), 0.0, 3.0, &crate::cancel::never).unwrap();
+        let n = measured_steps(&f, &ball(200, 0.8), 0.0, 3.0, &crate::run::cancel::never).unwrap();
         assert_eq!(n, 2 * FIRST);
     }
 
@@ -212,7 +212,7 @@ mod tests {
         )
         .unwrap();
         let f = Field::single(t);
-        let n = measured_steps(&f, &ball(50, 0.01), 0.0, 20.0, &crate::cancel::never).unwrap();
+        let n = measured_steps(&f, &ball(50, 0.01), 0.0, 20.0, &crate::run::cancel::never).unwrap();
         assert!(n as f64 >= 8.0 * 20.0 / 0.1, "{n}");
     }
 

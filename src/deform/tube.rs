@@ -46,10 +46,10 @@
 use glam::DVec3;
 
 use super::shape::{blend, translate};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// One axis sample: position, derivative `dγ/dS`, cumulative chord length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -181,18 +181,9 @@ pub struct StripAlong {
 impl StripAlong {
     /// The strip about the axis through `samples` (errors name `points` for the axis and
     /// `speed`).
+    ///
+    /// Polls `cancel` in the axis checks ([`Axis::new`]).
     pub fn new(
-        samples: Vec<AxisSample>,
-        speed: f64,
-        radius: f64,
-        reach: f64,
-        linear: bool,
-    ) -> Result<StripAlong> {
-        StripAlong::new_cancellable(samples, speed, radius, reach, linear, &cancel::never)
-    }
-
-    /// [`StripAlong::new`] polling `cancel` in the axis checks ([`Axis::new_cancellable`]).
-    pub fn new_cancellable(
         samples: Vec<AxisSample>,
         speed: f64,
         radius: f64,
@@ -207,7 +198,7 @@ impl StripAlong {
             ));
         }
         Ok(StripAlong {
-            axis: Axis::new_cancellable(samples, radius + reach, cancel)?,
+            axis: Axis::new(samples, radius + reach, cancel)?,
             speed,
             radius,
             reach,
@@ -221,17 +212,10 @@ impl Axis {
     /// samples, non-zero derivatives, increasing `S`, no cusp, curvature × (outer + segment
     /// arc) below 1 and no approach of distant parts closer than `2·outer` (errors name
     /// `points`).
-    pub fn new(samples: Vec<AxisSample>, outer: f64) -> Result<Axis> {
-        Axis::new_cancellable(samples, outer, &cancel::never)
-    }
-
-    /// [`Axis::new`] that polls `cancel` every [`cancel::BLOCK`] segments and in the
-    /// self-approach search, and fails with [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
-        samples: Vec<AxisSample>,
-        outer: f64,
-        cancel: Cancel<'_>,
-    ) -> Result<Axis> {
+    ///
+    /// Polls `cancel` every [`cancel::BLOCK`] segments and in the self-approach search, and fails
+    /// with [`InputError::stopped`] once it says stop.
+    pub fn new(samples: Vec<AxisSample>, outer: f64, cancel: Cancel<'_>) -> Result<Axis> {
         let bad = |m: String| InputError::new("points", m);
         let axis = bad;
         if samples.len() < 2 {
@@ -254,7 +238,7 @@ impl Axis {
         let mut worst: (usize, f64, f64) = (0, 0.0, 0.0);
         for (k, w) in samples.windows(2).enumerate() {
             if k % cancel::BLOCK == 0 && cancel() {
-                return Err(cancel::stopped());
+                return Err(InputError::stopped());
             }
             let ds = w[1].s - w[0].s;
             if !(ds > 0.0) {
@@ -335,7 +319,7 @@ impl Axis {
         param.push(last.s);
         let approach = self_approach(&dense, &param, outer, cancel);
         if cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         if let Some((i, j, d)) = approach {
             let seg = |i: usize| (i / PER).min(segs.len() - 1);
@@ -605,18 +589,9 @@ impl StripAlong {
 /// `dγ/dS` of the clamped C² spline, cumulative chord lengths), validated: `radius` and
 /// `reach` (default `radius`) positive, `speed` finite, then [`StripAlong::new`]'s checks and
 /// a finite speed bound.
+///
+/// Polls `cancel` in the axis checks (see [`Axis::new`]).
 pub fn strip_along(
-    samples: Vec<AxisSample>,
-    radius: f64,
-    speed: f64,
-    reach: Option<f64>,
-    linear: bool,
-) -> Result<StripAlong> {
-    strip_along_cancellable(samples, radius, speed, reach, linear, &cancel::never)
-}
-
-/// [`strip_along`] polling `cancel` in the axis checks (see [`Axis::new_cancellable`]).
-pub fn strip_along_cancellable(
     samples: Vec<AxisSample>,
     radius: f64,
     speed: f64,
@@ -629,7 +604,7 @@ pub fn strip_along_cancellable(
     let speed = super::finite("speed", speed)?;
     super::bounded(
         "speed",
-        StripAlong::new_cancellable(samples, speed, radius, reach, linear, cancel)?,
+        StripAlong::new(samples, speed, radius, reach, linear, cancel)?,
     )
 }
 
@@ -709,13 +684,10 @@ pub fn clamped_spline_slopes(x: &[DVec3], s: &[f64], m0: DVec3, m1: DVec3) -> Re
 /// consecutive point, parametrised by cumulative chord length `S`, with the derivatives of
 /// the clamped C² cubic spline through them ([`clamped_spline_slopes`]) whose end derivatives
 /// are the five-point unit tangents of `spinal.estimate_tangents` (errors name `points`).
-pub fn axis_samples(points: &[DVec3]) -> Result<Vec<AxisSample>> {
-    axis_samples_cancellable(points, &cancel::never)
-}
-
-/// [`axis_samples`] that polls `cancel` in its passes over the points and fails with
-/// [`cancel::stopped`] once it says stop.
-pub fn axis_samples_cancellable(points: &[DVec3], cancel: Cancel<'_>) -> Result<Vec<AxisSample>> {
+///
+/// Polls `cancel` in its passes over the points and fails with [`InputError::stopped`] once it says
+/// stop.
+pub fn axis_samples(points: &[DVec3], cancel: Cancel<'_>) -> Result<Vec<AxisSample>> {
     if points.len() < 2 {
         return Err(InputError::new(
             "points",
@@ -727,7 +699,7 @@ pub fn axis_samples_cancellable(points: &[DVec3], cancel: Cancel<'_>) -> Result<
     s.push(0.0);
     for (i, w) in points.windows(2).enumerate() {
         if i % cancel::BLOCK == 0 && cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         let chord = w[0].distance(w[1]);
         if !(chord > 0.0) {
@@ -738,14 +710,14 @@ pub fn axis_samples_cancellable(points: &[DVec3], cancel: Cancel<'_>) -> Result<
         }
         s.push(s[i] + chord);
     }
-    let tangents = crate::frames::tangents::estimate_rows_cancellable(
+    let tangents = crate::frames::tangents::estimate_rows(
         points,
         false,
         crate::frames::TangentRule::FivePointBounded,
         cancel,
     )?;
     if cancel() {
-        return Err(cancel::stopped());
+        return Err(InputError::stopped());
     }
     let m = clamped_spline_slopes(points, &s, tangents[0], tangents[points.len() - 1])?;
     alloc::collect(
@@ -760,19 +732,9 @@ pub fn axis_samples_cancellable(points: &[DVec3], cancel: Cancel<'_>) -> Result<
 
 /// The strip of `spinal.fields.strip_curve` about `points` ([`axis_samples`], then
 /// [`strip_along`]'s checks; errors name `points`, `radius`, `speed`, `reach`).
+///
+/// Polls `cancel` in the axis samples and checks (see [`Axis::new`]).
 pub fn strip_curve(
-    points: &[DVec3],
-    radius: f64,
-    speed: f64,
-    reach: Option<f64>,
-    linear: bool,
-) -> Result<StripAlong> {
-    strip_curve_cancellable(points, radius, speed, reach, linear, &cancel::never)
-}
-
-/// [`strip_curve`] polling `cancel` in the axis samples and checks (see
-/// [`Axis::new_cancellable`]).
-pub fn strip_curve_cancellable(
     points: &[DVec3],
     radius: f64,
     speed: f64,
@@ -780,8 +742,8 @@ pub fn strip_curve_cancellable(
     linear: bool,
     cancel: Cancel<'_>,
 ) -> Result<StripAlong> {
-    let samples = axis_samples_cancellable(points, cancel)?;
-    strip_along_cancellable(samples, radius, speed, reach, linear, cancel)
+    let samples = axis_samples(points, cancel)?;
+    strip_along(samples, radius, speed, reach, linear, cancel)
 }
 
 /// Points per segment at which the axis is checked.
@@ -938,7 +900,7 @@ mod tests {
 
     #[test]
     fn inside_the_tube_the_flow_is_the_axis_tangent() {
-        let s = StripAlong::new(arc(9, 1.0, 1.5), 2.0, 0.1, 0.1, false).unwrap();
+        let s = StripAlong::new(arc(9, 1.0, 1.5), 2.0, 0.1, 0.1, false, &cancel::never).unwrap();
         for th in [0.2f64, 0.7, 1.1] {
             let x = DVec3::new(1.05 * th.cos(), 1.05 * th.sin(), 0.03);
             let v = s.eval(x);
@@ -952,7 +914,8 @@ mod tests {
 
     #[test]
     fn sharp_bends_are_refused() {
-        let e = StripAlong::new(arc(9, 0.3, 1.5), 1.0, 0.2, 0.2, false).unwrap_err();
+        let e =
+            StripAlong::new(arc(9, 0.3, 1.5), 1.0, 0.2, 0.2, false, &cancel::never).unwrap_err();
         assert_eq!(e.arg, "points");
         assert!(
             e.msg.starts_with("the axis bends too sharply in segment "),
@@ -964,14 +927,15 @@ mod tests {
     #[test]
     fn an_axis_coming_back_near_itself_is_refused() {
         // 5.5 of 2π rad of a unit circle: the ends are 2 sin(0.39) = 0.76 apart
-        let e = StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.2, 0.2, false).unwrap_err();
+        let e =
+            StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.2, 0.2, false, &cancel::never).unwrap_err();
         assert_eq!(e.arg, "points");
         assert!(
             e.msg.starts_with("the axis comes within 0.7") && e.msg.contains("(segments 0 and"),
             "{e}"
         );
         // the same arc with a narrower tube is fine
-        assert!(StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.15, 0.15, false).is_ok());
+        assert!(StripAlong::new(arc(40, 1.0, 5.5), 1.0, 0.15, 0.15, false, &cancel::never).is_ok());
     }
 
     /// A brute-force check of [`self_approach`] on a hairpin and on random walks.
@@ -1056,29 +1020,35 @@ mod tests {
     #[test]
     fn strip_curve_names_its_arguments() {
         let x: Vec<DVec3> = arc(40, 1.0, 5.5).iter().map(|a| a.x).collect();
-        let e = strip_curve(&x, 0.2, 1.0, Some(0.2), false).unwrap_err();
+        let e = strip_curve(&x, 0.2, 1.0, Some(0.2), false, &cancel::never).unwrap_err();
         assert_eq!(e.arg, "points");
         assert!(e.msg.contains("comes within"), "{e}");
-        let ok = strip_curve(&x, 0.1, 1.0, Some(0.1), false).unwrap();
+        let ok = strip_curve(&x, 0.1, 1.0, Some(0.1), false, &cancel::never).unwrap();
         assert_eq!(ok.axis.samples.len(), 40);
         assert_eq!(
-            strip_curve(&x[..1], 0.1, 1.0, None, false).unwrap_err().arg,
+            strip_curve(&x[..1], 0.1, 1.0, None, false, &cancel::never)
+                .unwrap_err()
+                .arg,
             "points"
         );
         let mut rep = x.clone();
         rep[3] = rep[2];
         assert!(
-            strip_curve(&rep, 0.1, 1.0, None, false)
+            strip_curve(&rep, 0.1, 1.0, None, false, &cancel::never)
                 .unwrap_err()
                 .msg
                 .contains("coincide")
         );
         assert_eq!(
-            strip_curve(&x, -0.1, 1.0, None, false).unwrap_err().arg,
+            strip_curve(&x, -0.1, 1.0, None, false, &cancel::never)
+                .unwrap_err()
+                .arg,
             "radius"
         );
         assert_eq!(
-            strip_curve(&x, 0.1, f64::NAN, None, false).unwrap_err().arg,
+            strip_curve(&x, 0.1, f64::NAN, None, false, &cancel::never)
+                .unwrap_err()
+                .arg,
             "speed"
         );
     }
@@ -1087,7 +1057,7 @@ mod tests {
     /// `−|γ′|² + (X − γ)·γ″`, evaluated directly.
     #[test]
     fn the_foot_quintic_is_the_foot_equation() {
-        let axis = Axis::new(arc(9, 1.0, 1.5), 0.3).unwrap();
+        let axis = Axis::new(arc(9, 1.0, 1.5), 0.3, &cancel::never).unwrap();
         for (k, seg) in axis.segs.iter().enumerate() {
             for i in 0..20 {
                 let q = (i * 7 + k) as f64 * 0.31;
@@ -1111,7 +1081,7 @@ mod tests {
     /// (several blocks) against a dense polyline of it.
     #[test]
     fn a_box_the_axis_cannot_reach_has_no_foot_at_any_point() {
-        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3).unwrap();
+        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3, &cancel::never).unwrap();
         let (mut missed, mut reached) = (0, 0);
         for i in 0..3000 {
             let q = i as f64 * 0.173;
@@ -1144,7 +1114,7 @@ mod tests {
 
     #[test]
     fn block_boxes_keep_every_foot() {
-        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3).unwrap();
+        let axis = Axis::new(arc(60, 3.0, 4.0), 0.3, &cancel::never).unwrap();
         assert!(axis.blocks.len() >= 3);
         let dense: Vec<DVec3> = (0..59 * 400 + 1)
             .map(|i| {

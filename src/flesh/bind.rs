@@ -21,11 +21,11 @@ use rayon::prelude::*;
 
 use super::section::{MAX_LANES, edge_roots, edge_roots_lanes};
 use super::spine::SpineModel;
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::Result;
 use crate::math::bvh::Aabb;
 use crate::math::chain::ChainBoxes;
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Numbers stored per vertex besides the edge index.
 pub const COORDS: usize = 7;
@@ -327,16 +327,9 @@ fn between_planes(sp: &SpineModel, k: usize, p: DVec3) -> bool {
 }
 
 /// Register `vertices` on the rest spine.
-pub fn bind(rest: &SpineModel, vertices: &[DVec3]) -> Result<Binding> {
-    bind_cancellable(rest, vertices, &cancel::never)
-}
-
-/// [`bind`] that polls `cancel` before each vertex (see [`crate::cancel`]).
-pub fn bind_cancellable(
-    rest: &SpineModel,
-    vertices: &[DVec3],
-    cancel: Cancel<'_>,
-) -> Result<Binding> {
+///
+/// Polls `cancel` before each vertex (see [`crate::run::cancel`]).
+pub fn bind(rest: &SpineModel, vertices: &[DVec3], cancel: Cancel<'_>) -> Result<Binding> {
     super::check_vertices(vertices, rest.scale, "spine")?;
     let edges = Edges::new(rest)?;
     let nv = vertices.len();
@@ -472,6 +465,7 @@ fn bind_lanes<const L: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     /// A circle of `n` samples as a loop (first row repeated), with its RMF (`r` the
     /// binormal z all along, which closes).
@@ -538,8 +532,8 @@ mod tests {
             ..Default::default()
         };
         let mut frames = vec![0.0; 9 * pts.len()];
-        crate::frames::compute_into(&req, &mut frames).unwrap();
-        SpineModel::new("rest_spine", pts, &frames, false).unwrap()
+        crate::frames::compute_into(&req, &mut frames, &cancel::never).unwrap();
+        SpineModel::new("rest_spine", pts, &frames, false, &cancel::never).unwrap()
     }
 
     #[test]
@@ -555,7 +549,7 @@ mod tests {
             .collect();
         let sp = open_model(&pts);
         let (cpts, cframes) = circle(64);
-        let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true).unwrap();
+        let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true, &cancel::never).unwrap();
         // far from the origin with short edges: the round-off of positions of size 1e4
         // exceeds the edges' own scale, which the bounds must allow for
         let far: Vec<DVec3> = (0..n)
@@ -607,7 +601,7 @@ mod tests {
             // at a time), in input units
             let to_input = model.scale.inverse();
             let pts: Vec<DVec3> = run.iter().map(|r| to_input.of3(r.0)).collect();
-            let b = bind(model, &pts).unwrap();
+            let b = bind(model, &pts, &cancel::never).unwrap();
             for (i, (p, want)) in run.iter().enumerate() {
                 let got = (
                     b.edge[i] as usize,
@@ -645,7 +639,7 @@ mod tests {
                 verts.push(DVec3::new(x, 0.3 * ang.cos(), 0.3 * ang.sin()));
             }
         }
-        let b = bind(&sp, &verts).unwrap();
+        let b = bind(&sp, &verts, &cancel::never).unwrap();
         let mut ties = 0;
         for (i, &p) in verts.iter().enumerate() {
             let want = locate_by_scan(&sp, p);
@@ -668,7 +662,7 @@ mod tests {
     #[test]
     fn loops_bind_on_the_closing_edge_and_on_sample_planes() {
         let (pts, frames) = circle(12);
-        let sp = SpineModel::new("rest_spine", &pts, &frames, true).unwrap();
+        let sp = SpineModel::new("rest_spine", &pts, &frames, true, &cancel::never).unwrap();
         // the curvature at the seam is that of every other sample, from both sides
         let inner = sp.eval(6, 0.0).kappa.length();
         assert!((inner - 1.0).abs() < 0.04);
@@ -685,7 +679,7 @@ mod tests {
         for ang in [-0.2_f64, -0.01, 0.0, std::f64::consts::PI, 1.3] {
             for rad in [0.7, 1.25] {
                 let p = DVec3::new(rad * ang.cos(), rad * ang.sin(), 0.1);
-                let b = bind(&sp, &[p]).unwrap();
+                let b = bind(&sp, &[p], &cancel::never).unwrap();
                 let (k, a, tau) = (b.edge[0] as usize, b.coords[0], b.coords[1]);
                 assert_eq!(tau, 0.0);
                 let l = sp.eval(k, a);
@@ -700,10 +694,26 @@ mod tests {
             }
         }
         // an open spine's point past its end extends the end instead
-        let open = SpineModel::new("rest_spine", &pts[..7], &frames[..63], false).unwrap();
-        let b = bind(&open, &[DVec3::new(-1.0, -0.2, 0.0)]).unwrap();
+        let open = SpineModel::new(
+            "rest_spine",
+            &pts[..7],
+            &frames[..63],
+            false,
+            &cancel::never,
+        )
+        .unwrap();
+        let b = bind(&open, &[DVec3::new(-1.0, -0.2, 0.0)], &cancel::never).unwrap();
         assert!(b.coords[1] > 0.0);
         // a loop must repeat its first point
-        assert!(SpineModel::new("rest_spine", &pts[..12], &frames[..108], true).is_err());
+        assert!(
+            SpineModel::new(
+                "rest_spine",
+                &pts[..12],
+                &frames[..108],
+                true,
+                &cancel::never
+            )
+            .is_err()
+        );
     }
 }

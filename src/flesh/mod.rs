@@ -47,8 +47,8 @@ pub mod spine;
 pub mod surface;
 pub mod trisurf;
 
-pub use bind::{Binding, COORDS, bind, bind_cancellable};
-pub use pose::{deform, deform_cancellable};
+pub use bind::{Binding, COORDS, bind};
+pub use pose::deform;
 pub use solve::Solution;
 pub use spine::SpineModel;
 

@@ -17,27 +17,16 @@ use rayon::prelude::*;
 use super::bind::COORDS;
 use super::solve::{Solution, bend, unbend};
 use super::spine::SpineModel;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::scale;
+use crate::run::cancel::Cancel;
 
 /// Deform a registered shape. `twist` is empty or one angle (rad) per spine sample.
 /// Writes the vertices to `out` and the per-vertex flags (see [`super::solve`]) to `flags`.
-pub fn deform(
-    posed: &SpineModel,
-    edge: &[i64],
-    coords: &[f64],
-    sol: Solution,
-    twist: &[f64],
-    out: &mut [DVec3],
-    flags: &mut [u8],
-) -> Result<()> {
-    deform_cancellable(posed, edge, coords, sol, twist, out, flags, &cancel::never)
-}
-
-/// [`deform`] that polls `cancel` before each block of vertices (see [`crate::cancel`]).
+///
+/// Polls `cancel` before each block of vertices (see [`crate::run::cancel`]).
 #[allow(clippy::too_many_arguments)]
-pub fn deform_cancellable(
+pub fn deform(
     posed: &SpineModel,
     edge: &[i64],
     coords: &[f64],

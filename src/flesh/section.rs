@@ -178,6 +178,7 @@ pub fn edge_roots_lanes<const L: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     /// The roots one bracket at a time, with the threshold of `on_plane` computed in full
     /// (the reference of the tests below).
@@ -247,8 +248,8 @@ mod tests {
             ..Default::default()
         };
         let mut frames = vec![0.0; 9 * pts.len()];
-        crate::frames::compute_into(&req, &mut frames).unwrap();
-        SpineModel::new("rest_spine", pts, &frames, false).unwrap()
+        crate::frames::compute_into(&req, &mut frames, &cancel::never).unwrap();
+        SpineModel::new("rest_spine", pts, &frames, false, &cancel::never).unwrap()
     }
 
     #[test]

@@ -9,12 +9,12 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::{Hermite, Power};
 use crate::math::rotation::minimal_rotate;
 use crate::math::scale::{self, Pow2};
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// A sampled spine with its frames (`t` and `r` columns of `spinal.frames`).
 ///
@@ -66,6 +66,8 @@ fn curvatures(
             let k = (t[b] - t[a]) / len;
             Ok(k - t[j] * t[j].dot(k))
         }),
+        // the items poll on their own and fail when stopped
+        &cancel::never,
     )?;
     if closed && n >= 3 {
         // neighbours of the seam sample: n − 2 before it, 1 after it
@@ -98,18 +100,10 @@ impl SpineModel {
     /// `frames` is row-major `(n, 3, 3)` with columns `(r, s, t)` (the layout of the crate).
     /// `closed`: the spine is a loop given with its first sample (and frame) repeated at the
     /// end, so the closing edge is the last one.
+    ///
+    /// Polls `cancel` every [`cancel::BLOCK`] samples of its passes and fails with
+    /// [`InputError::stopped`] once it says stop.
     pub fn new(
-        arg: &'static str,
-        points: &[DVec3],
-        frames: &[f64],
-        closed: bool,
-    ) -> Result<SpineModel> {
-        SpineModel::new_cancellable(arg, points, frames, closed, &cancel::never)
-    }
-
-    /// [`SpineModel::new`] that polls `cancel` every [`cancel::BLOCK`] samples of its
-    /// passes and fails with [`cancel::stopped`] once it says stop.
-    pub fn new_cancellable(
         arg: &'static str,
         points: &[DVec3],
         frames: &[f64],
@@ -214,6 +208,7 @@ impl SpineModel {
                 cancel::poll(k, cancel)?;
                 Ok(minimal_rotate(t[k + 1], t[k], r[k + 1]))
             }),
+            &cancel::never,
         )?;
         Ok(SpineModel {
             scale: to_model,
@@ -342,7 +337,7 @@ fn check_walk(posed: &[DVec3], chords: &[f64]) -> crate::error::Result<()> {
 
 /// [`compass_walk`], with the polyline position `k + u` of every point (on edge `k` of
 /// `posed` at the fraction `u`; `u > 1` past the end, along the last edge). Polls `cancel`
-/// every [`cancel::BLOCK`] steps of the walk and fails with [`cancel::stopped`] once it
+/// every [`cancel::BLOCK`] steps of the walk and fails with [`InputError::stopped`] once it
 /// says stop.
 pub fn compass_walk_located(
     posed: &[DVec3],

@@ -27,11 +27,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::solve::CLAMPED_BEND;
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::cubic::basis;
 use crate::math::scale::{self, Pow2};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Flag: the vertex's foot is outside the surface (attached to the border, uncorrected).
 pub const OUTSIDE: u8 = 4;
@@ -409,12 +409,9 @@ fn try_cell(sf: &Surface, i: usize, j: usize, p: DVec3, best: &mut Option<Foot>)
 }
 
 /// Register `vertices` on the rest surface: `SURFACE_COORDS` numbers and the cell per vertex.
-pub fn bind_surface(rest: &Surface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec<f64>)> {
-    bind_surface_cancellable(rest, vertices, &cancel::never)
-}
-
-/// [`bind_surface`] that polls `cancel` before each vertex (see [`crate::cancel`]).
-pub fn bind_surface_cancellable(
+///
+/// Polls `cancel` before each vertex (see [`crate::run::cancel`]).
+pub fn bind_surface(
     rest: &Surface,
     vertices: &[DVec3],
     cancel: Cancel<'_>,
@@ -544,37 +541,16 @@ pub fn surface_offset(m: f64, g: f64, t: f64) -> (f64, bool) {
     (sign * h, true)
 }
 
-/// Deform registered vertices onto the posed surface (same grid shape); `rest_exp` is the
-/// exponent of the rest surface's [`Surface::scale`] (the units of `A0`, `B0`).
-pub fn deform_surface(
-    posed: &Surface,
-    rest_exp: i32,
-    cell: &[i64],
-    coords: &[f64],
-    corrected: bool,
-    out: &mut [DVec3],
-    flags: &mut [u8],
-) -> Result<()> {
-    deform_surface_cancellable(
-        posed,
-        rest_exp,
-        cell,
-        coords,
-        corrected,
-        out,
-        flags,
-        &cancel::never,
-    )
-}
-
-/// Vertices per block of a cancellable deformation ([`deform_surface_cancellable`]).
+/// Vertices per block of a cancellable deformation ([`deform_surface`]).
 const DEFORM_BLOCK: usize = 1 << 12;
 
-/// [`deform_surface`] that polls `cancel` before every block of [`DEFORM_BLOCK`] vertices
-/// and skips the remaining blocks once it says stop (`out` is then incomplete; see
-/// [`crate::cancel`]).
+/// Deform registered vertices onto the posed surface (same grid shape); `rest_exp` is the
+/// exponent of the rest surface's [`Surface::scale`] (the units of `A0`, `B0`).
+///
+/// Polls `cancel` before every block of [`DEFORM_BLOCK`] vertices and skips the remaining blocks
+/// once it says stop (`out` is then incomplete; see [`crate::run::cancel`]).
 #[allow(clippy::too_many_arguments)]
-pub fn deform_surface_cancellable(
+pub fn deform_surface(
     posed: &Surface,
     rest_exp: i32,
     cell: &[i64],

@@ -50,11 +50,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::surface::{SURFACE_COORDS, SurfLocal, Units, deform_vertex, newton_foot};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::bvh::{Aabb, Bvh};
 use crate::math::scale::{self, Pow2};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// A triangulated spine surface (model units, see [`super::surface::Surface::scale`]).
 #[derive(Clone, Debug)]
@@ -366,7 +366,7 @@ fn try_face(sf: &TriSurface, f: usize, p: DVec3, best: &mut Option<Foot>) {
 
 /// Register `vertices` on the rest triangle surface: the face and [`SURFACE_COORDS`] numbers
 /// per vertex (`[u, v, h0, A0, B0, C0, r1, r2, r3]`, as the grid model stores them).
-pub fn bind_trisurface_cancellable(
+pub fn bind_trisurface(
     rest: &TriSurface,
     vertices: &[DVec3],
     cancel: Cancel<'_>,
@@ -445,15 +445,10 @@ pub fn bind_trisurface_cancellable(
     Ok((face, coords))
 }
 
-/// [`bind_trisurface_cancellable`] without cancellation.
-pub fn bind_trisurface(rest: &TriSurface, vertices: &[DVec3]) -> Result<(Vec<i64>, Vec<f64>)> {
-    bind_trisurface_cancellable(rest, vertices, &cancel::never)
-}
-
 /// Deform vertices registered on a triangle surface onto the posed one (same faces);
 /// `rest_exp` is the exponent of the rest surface's scale.
 #[allow(clippy::too_many_arguments)]
-pub fn deform_trisurface_cancellable(
+pub fn deform_trisurface(
     posed: &TriSurface,
     rest_exp: i32,
     face: &[i64],
@@ -497,6 +492,7 @@ pub fn deform_trisurface_cancellable(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     /// A bent `n × n` grid triangulated, and a deterministic cloud of points about it.
     fn bent(n: usize) -> (Vec<DVec3>, Vec<i64>) {
@@ -562,7 +558,7 @@ mod tests {
         let (pts, f) = bent(12);
         let sf = TriSurface::new("rest_surface", &pts, &f).unwrap();
         let vs: Vec<DVec3> = cloud(300).into_iter().map(|p| p * 0.6).collect();
-        let (face, coords) = bind_trisurface(&sf, &vs).unwrap();
+        let (face, coords) = bind_trisurface(&sf, &vs, &cancel::never).unwrap();
         let mut inside = 0;
         for (k, p) in vs.iter().enumerate() {
             let c = &coords[SURFACE_COORDS * k..SURFACE_COORDS * (k + 1)];

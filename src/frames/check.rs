@@ -1,6 +1,7 @@
 //! The input checks of the driver: shapes, finite values, analytic samples, options that
 //! fit together, the distinct samples of a closed curve and the segments against the tangents.
 
+use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -89,7 +90,7 @@ fn check_torsion(req: &Request) -> Result<()> {
              object with u=...)",
         ));
     }
-    validate::finite("points", a.d3)?;
+    validate::finite("points", a.d3, &cancel::never)?;
     let diag = super::geometry::scale_and_diagonal(req.points.unwrap_or(&[])).1;
     let flat = |k: usize| {
         let (d1, d2) = (a.d1[k], a.d2[k]);
@@ -140,10 +141,10 @@ fn check_shapes(req: &Request, out: &[f64]) -> Result<usize> {
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }
     if let Some(p) = req.points {
-        validate::finite("points", p)?;
+        validate::finite("points", p, &cancel::never)?;
     }
     if let Some(t) = req.tangents {
-        validate::finite("tangents", t)?;
+        validate::finite("tangents", t, &cancel::never)?;
     }
     Ok(rows)
 }
@@ -158,8 +159,8 @@ fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
         ));
     }
     validate::finite_scalars("u", a.u)?;
-    validate::finite("points", a.d1)?;
-    validate::finite("points", a.d2)?;
+    validate::finite("points", a.d1, &cancel::never)?;
+    validate::finite("points", a.d2, &cancel::never)?;
     if let Some(i) = a.u.windows(2).position(|w| !(w[1] > w[0])) {
         return Err(InputError::new(
             "u",

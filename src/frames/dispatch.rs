@@ -1,6 +1,7 @@
 //! The driver: one curve ([`compute_into`], the fused fast path or the general stages), the
 //! plain RMF parts the steering modules build on, and a bundle of curves ([`compute_many`]).
 
+use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -8,7 +9,7 @@ use super::check::{check_input, check_segments, distinct_samples, rows_match};
 use super::double_reflection::DoubleReflection;
 use super::geometry::{self, any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
 use super::request::{Analytic, Method, Orientation, Request, STRAIGHT_TOL, pick, resolve};
-use super::transport::{Step, Twist, transport_into_cancellable};
+use super::transport::{Step, Twist, transport_into};
 use super::{frenet, fused, projection, rk4, rotation, tangents, torsion, validate};
 use crate::error::{InputError, Result};
 
@@ -102,12 +103,9 @@ pub(crate) fn bundle_slices<'o>(
 ///
 /// A curve whose size is far from 1 is first divided by a power of two (exact; see
 /// [`crate::math::scale`]), so the frames and the angle do not depend on its units.
-pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
-    compute_into_cancellable(req, out, &crate::cancel::never)
-}
-
-/// [`compute_into`] that polls `cancel` before every chunk of the fused scan and returns at
-/// once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
+///
+/// Polls `cancel` before every chunk of the fused scan and returns at once (with `out`
+/// incomplete) when it says stop (see [`crate::run::cancel`]).
 ///
 /// Memory: the per-row working vectors of this module (tangents, chords, segment lengths,
 /// normals, ω) take less than [`WORKING_BYTES_PER_ROW`], which the binding's
@@ -115,10 +113,10 @@ pub fn compute_into(req: &Request, out: &mut [f64]) -> Result<f64> {
 /// normalised copy of the input is allocated fallibly.
 ///
 /// [`WORKING_BYTES_PER_ROW`]: super::WORKING_BYTES_PER_ROW
-pub fn compute_into_cancellable(
+pub fn compute_into(
     req: &Request,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<f64> {
     super::check::turns(req)?;
     let owned = normalised(req)?;
@@ -132,7 +130,7 @@ pub fn compute_into_cancellable(
     match fused::try_open_points(req, out, cancel) {
         Some(angle) => Ok(angle),
         None if cancel() => Ok(0.0),
-        None => compute_general_cancellable(req, out, cancel),
+        None => compute_general(req, out, cancel),
     }
 }
 
@@ -185,17 +183,14 @@ impl Normalised {
 /// lengths, the unit tangents (`unit_tangents`), the segments against the tangents
 /// (`check_segments`); then the frames, Frenet (`frenet_frames`) or transported with the
 /// boundary condition (`transport_frames`).
-pub fn compute_general(req: &Request, out: &mut [f64]) -> Result<f64> {
-    compute_general_cancellable(req, out, &crate::cancel::never)
-}
-
-/// [`compute_general`] that polls `cancel` between its stages and inside the long ones (the
-/// tangent estimate, the search for a defined normal, the transport and the Frenet fill) and
-/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]).
-pub fn compute_general_cancellable(
+///
+/// Polls `cancel` between its stages and inside the long ones (the tangent estimate, the search for
+/// a defined normal, the transport and the Frenet fill) and returns at once (with `out` incomplete)
+/// when it says stop (see [`crate::run::cancel`]).
+pub fn compute_general(
     req: &Request,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<f64> {
     let rows = check_input(req, out)?;
     let n = distinct_samples(req, rows)?;
@@ -207,7 +202,7 @@ pub fn compute_general_cancellable(
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords_cancellable(x, closed, cancel)?
+        validate::chords(x, closed, cancel)?
     };
     if cancel() {
         return Ok(0.0);
@@ -252,7 +247,7 @@ fn unit_tangents(
     x: &[DVec3],
     chords: &[f64],
     n: usize,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
     let t: Vec<DVec3> = if let Some(a) = req.analytic {
         if let Some(j) = a.d1.par_iter().position_first(|d| !(d.length() > 0.0)) {
@@ -294,7 +289,7 @@ fn unit_tangents(
         })?;
         t
     } else {
-        tangents::estimate_cancellable(x, chords, req.closed, req.tangent_rule, cancel)?
+        tangents::estimate(x, chords, req.closed, req.tangent_rule, cancel)?
     };
     if req.tangent_chords && n < 4 {
         return Err(InputError::new(
@@ -351,7 +346,7 @@ fn frenet_frames(
     seg: &[f64],
     curvature: &Curvature,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<f64> {
     if req.initial.is_some() || req.end.is_some() || req.turns != 0.0 {
         return Err(InputError::new(
@@ -380,10 +375,10 @@ fn frenet_frames(
         return Ok(0.0);
     }
     if normals.iter().any(Option::is_some) {
-        frenet::frenet_into_cancellable(dr, &normals, seg, closed, out, cancel);
+        frenet::frenet_into(dr, &normals, seg, closed, out, cancel);
         return Ok(0.0);
     }
-    transport_into_cancellable(
+    transport_into(
         dr,
         t,
         seg,
@@ -401,7 +396,7 @@ fn transport_frames(
     ctx: &Ctx,
     dr: &DoubleReflection,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<f64> {
     let (req, t) = (ctx.req, ctx.t);
     match req.method {
@@ -464,7 +459,7 @@ impl Ctx<'_> {
         &self,
         step: &S,
         out: &mut [f64],
-        cancel: crate::cancel::Cancel<'_>,
+        cancel: crate::run::cancel::Cancel<'_>,
     ) -> Result<f64> {
         let (req, t, closed) = (self.req, self.t, self.closed);
         let n = t.len();
@@ -505,7 +500,7 @@ impl Ctx<'_> {
         } else {
             Twist::None
         };
-        Ok(transport_into_cancellable(
+        Ok(transport_into(
             step, t, self.seg, closed, r0, twist, out, cancel,
         ))
     }
@@ -528,14 +523,14 @@ pub(crate) struct RmfParts {
 pub(crate) fn rmf_parts(
     req: &Request,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<RmfParts> {
     let base = Request {
         end: None,
         turns: 0.0,
         ..*req
     };
-    let closing = compute_into_cancellable(&base, out, cancel)?;
+    let closing = compute_into(&base, out, cancel)?;
     if cancel() {
         // the caller polls `cancel` too and discards everything
         return Ok(RmfParts {
@@ -550,7 +545,7 @@ pub(crate) fn rmf_parts(
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords(x, req.closed)?
+        validate::chords(x, req.closed, &cancel::never)?
     };
     let seg = segment_lengths(req, x, n, chords);
     if req.closed && closing != 0.0 {
@@ -573,33 +568,16 @@ pub(crate) fn rmf_parts(
 /// Frames of many curves stored back to back (`offsets[c]..offsets[c+1]` are the rows of
 /// curve `c`), computed in parallel. `initial`/`end` hold 0, 1 or one entry per curve.
 /// Returns the raw end angle of every curve.
+///
+/// Polls `cancel` before each curve (see [`crate::run::cancel`]) and adds each curve's row count to
+/// `done` once its frames are written (a progress count).
 pub fn compute_many(
     template: &Request,
     offsets: &[usize],
     initial: &[Orientation],
     end: &[Orientation],
     out: &mut [f64],
-) -> Result<Vec<f64>> {
-    compute_many_cancellable(
-        template,
-        offsets,
-        initial,
-        end,
-        out,
-        &crate::cancel::never,
-        None,
-    )
-}
-
-/// [`compute_many`] that polls `cancel` before each curve (see [`crate::cancel`]) and adds
-/// each curve's row count to `done` once its frames are written (a progress count).
-pub fn compute_many_cancellable(
-    template: &Request,
-    offsets: &[usize],
-    initial: &[Orientation],
-    end: &[Orientation],
-    out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
     done: Option<&std::sync::atomic::AtomicUsize>,
 ) -> Result<Vec<f64>> {
     let curves = offsets.len().saturating_sub(1);
@@ -620,7 +598,7 @@ pub fn compute_many_cancellable(
                 end: pick(end, c),
                 ..*template
             };
-            let angle = compute_into_cancellable(&req, buf, cancel).map_err(|e| {
+            let angle = compute_into(&req, buf, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {

@@ -19,30 +19,20 @@ use super::double_reflection::DoubleReflection;
 use super::geometry::{rotate_about, signed_angle};
 use super::transport::{Step, write_frame};
 
+/// Rows between two polls of the cancel hook ([`frenet_into`]).
+const CANCEL_ROWS: usize = 1 << 16;
+
 /// Fill `out` (`rows` frames) from principal normals `normal[i]` (None where undefined).
+///
+/// Polls `cancel` between its passes and every [`CANCEL_ROWS`] rows of the transport across gaps,
+/// and returns at once (with `out` incomplete) when it says stop (see [`crate::run::cancel`]).
 pub fn frenet_into(
     dr: &DoubleReflection,
     normal: &[Option<DVec3>],
     seg: &[f64],
     closed: bool,
     out: &mut [f64],
-) {
-    frenet_into_cancellable(dr, normal, seg, closed, out, &crate::cancel::never);
-}
-
-/// Rows between two polls of the cancel hook ([`frenet_into_cancellable`]).
-const CANCEL_ROWS: usize = 1 << 16;
-
-/// [`frenet_into`] that polls `cancel` between its passes and every [`CANCEL_ROWS`] rows of
-/// the transport across gaps, and returns at once (with `out` incomplete) when it says stop
-/// (see [`crate::cancel`]).
-pub fn frenet_into_cancellable(
-    dr: &DoubleReflection,
-    normal: &[Option<DVec3>],
-    seg: &[f64],
-    closed: bool,
-    out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) {
     let t = dr.t;
     let n = t.len();

@@ -56,7 +56,7 @@ fn aligned_with(v: DVec3, vv: f64, ti: DVec3, tj: DVec3) -> bool {
 pub(super) fn try_open_points(
     req: &Request,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Option<f64> {
     let x = req.points?;
     let n = x.len();
@@ -184,7 +184,7 @@ pub(super) fn try_open_points(
         cs,
         ext: n,
     }
-    .scan_cancellable(work, out, cancel)
+    .scan(work, out, cancel)
 }
 
 /// A given tangent made unit, as `tangents::normalize_all` does; `None` where it cannot be.
@@ -668,12 +668,13 @@ fn transport_reflection(w: &mut Scratch, k0: usize, steps: usize, mut r: DVec3) 
 mod tests {
     use super::super::{Orientation, compute_general};
     use super::*;
+    use crate::run::cancel;
 
     fn both(req: &Request) -> (Vec<f64>, Vec<f64>, f64, f64) {
         let n = req.points.map_or(0, <[DVec3]>::len);
         let (mut a, mut b) = (vec![0.0; 9 * n], vec![0.0; 9 * n]);
-        let fa = try_open_points(req, &mut a, &crate::cancel::never).expect("fast path taken");
-        let fb = compute_general(req, &mut b).expect("valid input");
+        let fa = try_open_points(req, &mut a, &crate::run::cancel::never).expect("fast path taken");
+        let fb = compute_general(req, &mut b, &cancel::never).expect("valid input");
         (a, b, fa, fb)
     }
 
@@ -805,7 +806,7 @@ mod tests {
                 .build()
                 .unwrap();
             let mut out = vec![0.0; 9 * n];
-            let got = pool.install(|| try_open_points(req, &mut out, &crate::cancel::never));
+            let got = pool.install(|| try_open_points(req, &mut out, &crate::run::cancel::never));
             (got, out)
         };
         let (serial, one) = run(1, &req);
@@ -834,7 +835,7 @@ mod tests {
             };
             assert!(run(2, &bad).0.is_none(), "NaN at row {row}");
             let mut out = vec![0.0; 9 * n];
-            let err = super::super::compute_into(&bad, &mut out).unwrap_err();
+            let err = super::super::compute_into(&bad, &mut out, &cancel::never).unwrap_err();
             assert!(err.to_string().contains("points"), "{err}");
         }
     }
@@ -885,10 +886,13 @@ mod tests {
                         ..Default::default()
                     };
                     assert!(
-                        try_open_points(&req, &mut out, &crate::cancel::never).is_none(),
+                        try_open_points(&req, &mut out, &crate::run::cancel::never).is_none(),
                         "{bad} at {row}"
                     );
-                    assert!(compute_general(&req, &mut out).is_err(), "{bad} at {row}");
+                    assert!(
+                        compute_general(&req, &mut out, &cancel::never).is_err(),
+                        "{bad} at {row}"
+                    );
                 }
                 // a NaN point with good tangents: only the chords next to it see it
                 for row in [0, n / 2, n - 1] {
@@ -900,11 +904,11 @@ mod tests {
                         ..Default::default()
                     };
                     assert!(
-                        try_open_points(&req, &mut out, &crate::cancel::never).is_none(),
+                        try_open_points(&req, &mut out, &crate::run::cancel::never).is_none(),
                         "NaN point at {row}"
                     );
                     assert!(
-                        compute_general(&req, &mut out).is_err(),
+                        compute_general(&req, &mut out, &cancel::never).is_err(),
                         "NaN point at {row}"
                     );
                 }
@@ -964,7 +968,7 @@ mod tests {
                 .build()
                 .unwrap();
             let mut out = vec![0.0; 9 * n];
-            let angle = pool.install(|| super::super::compute_into(&req, &mut out));
+            let angle = pool.install(|| super::super::compute_into(&req, &mut out, &cancel::never));
             (angle.expect("valid closed curve"), out)
         };
         let (a1, f1) = run(1);
@@ -998,17 +1002,17 @@ mod tests {
                 ..Default::default()
             }
         }
-        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_some());
+        assert!(try_open_points(&req(&x), &mut out, &crate::run::cancel::never).is_some());
         x[1500] = x[1499]; // a repeated point
-        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_none());
+        assert!(try_open_points(&req(&x), &mut out, &crate::run::cancel::never).is_none());
         x[1500] = DVec3::new(f64::NAN, 0.0, 0.0);
-        assert!(try_open_points(&req(&x), &mut out, &crate::cancel::never).is_none());
+        assert!(try_open_points(&req(&x), &mut out, &crate::run::cancel::never).is_none());
         for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
             for row in [0, 1, 2, 1500, 2997, 2998, 2999] {
                 let mut y = curve(3000, 0);
                 y[row].y = bad;
                 assert!(
-                    try_open_points(&req(&y), &mut out, &crate::cancel::never).is_none(),
+                    try_open_points(&req(&y), &mut out, &crate::run::cancel::never).is_none(),
                     "{bad} at {row}"
                 );
             }
@@ -1022,13 +1026,13 @@ mod tests {
             initial: Some(Orientation::Vector(DVec3::ZERO)), // no normal-plane component
             ..Default::default()
         };
-        assert!(try_open_points(&bad, &mut out, &crate::cancel::never).is_none());
-        assert!(super::super::compute_into(&bad, &mut out).is_err());
+        assert!(try_open_points(&bad, &mut out, &crate::run::cancel::never).is_none());
+        assert!(super::super::compute_into(&bad, &mut out, &cancel::never).is_err());
         let closed = Request {
             points: Some(&x),
             closed: true,
             ..Default::default()
         };
-        assert!(try_open_points(&closed, &mut out, &crate::cancel::never).is_none());
+        assert!(try_open_points(&closed, &mut out, &crate::run::cancel::never).is_none());
     }
 }

@@ -211,7 +211,7 @@ fn align(a: &mut [f64], b: &[f64]) {
 /// reference vectors and unit tangents; `seg`: segment lengths; `closing`: the RMF's closing
 /// angle (closed curves); `pins`: fixed orientations (sorted distinct rows, unit vectors
 /// ⟂ their tangents); `turns`: extra turns across the seam of a closed curve. `cancel` is
-/// polled between the passes; a cancelled call returns no twist (see [`crate::cancel`]).
+/// polled between the passes; a cancelled call returns no twist (see [`crate::run::cancel`]).
 #[allow(clippy::too_many_arguments)]
 pub fn twist(
     r: &[DVec3],
@@ -222,7 +222,7 @@ pub fn twist(
     guide: &Guide,
     pins: &[(usize, DVec3)],
     turns: f64,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     check(guide)?;
     let n = t.len();

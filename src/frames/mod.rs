@@ -50,10 +50,7 @@ mod request;
 mod tests;
 
 pub(crate) use dispatch::{bundle_slices, rmf_parts};
-pub use dispatch::{
-    compute_general, compute_general_cancellable, compute_into, compute_into_cancellable,
-    compute_many, compute_many_cancellable,
-};
+pub use dispatch::{compute_general, compute_into, compute_many};
 pub(crate) use request::resolve;
 pub use request::{
     Analytic, FRAME_TANGENT_TOL, Method, Orientation, Request, STRAIGHT_TOL, WORKING_BYTES_PER_ROW,

@@ -66,18 +66,14 @@ fn col(f: &[f64], k: usize) -> DVec3 {
 }
 
 /// Frames of one curve, steered; `out` holds `9·rows` values.
-pub fn compute_steered(req: &Request, st: &Steering, out: &mut [f64]) -> Result<()> {
-    compute_steered_cancellable(req, st, out, &crate::cancel::never)
-}
-
-/// [`compute_steered`] that polls `cancel` inside the rotation-minimising frames and between
-/// the stages after them, and returns at once (with `out` incomplete) when it says stop (see
-/// [`crate::cancel`]).
-pub fn compute_steered_cancellable(
+///
+/// Polls `cancel` inside the rotation-minimising frames and between the stages after them, and
+/// returns at once (with `out` incomplete) when it says stop (see [`crate::run::cancel`]).
+pub fn compute_steered(
     req: &Request,
     st: &Steering,
     out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
     if req.method == Method::Frenet {
         let arg = if !st.constraints.is_empty() {
@@ -271,7 +267,7 @@ pub fn compute_steered_cancellable(
         if cancel() {
             return Ok(());
         }
-        time::align_cancellable(out, p, cancel)?;
+        time::align(out, p, cancel)?;
     }
     Ok(())
 }
@@ -279,6 +275,8 @@ pub fn compute_steered_cancellable(
 /// [`compute_steered`] over a bundle (`offsets` as in [`super::compute_many`]); `steer[c]`
 /// steers curve `c` (one entry: all curves), `initial`/`end` hold 0, 1 or one entry per
 /// curve.
+///
+/// Polls `cancel` before each curve and inside each (see [`compute_steered`]).
 pub fn compute_steered_many(
     template: &Request,
     offsets: &[usize],
@@ -286,28 +284,7 @@ pub fn compute_steered_many(
     end: &[Orientation],
     steer: &[Steering],
     out: &mut [f64],
-) -> Result<()> {
-    compute_steered_many_cancellable(
-        template,
-        offsets,
-        initial,
-        end,
-        steer,
-        out,
-        &crate::cancel::never,
-    )
-}
-
-/// [`compute_steered_many`] that polls `cancel` before each curve and inside each (see
-/// [`compute_steered_cancellable`]).
-pub fn compute_steered_many_cancellable(
-    template: &Request,
-    offsets: &[usize],
-    initial: &[Orientation],
-    end: &[Orientation],
-    steer: &[Steering],
-    out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
     let curves = offsets.len().saturating_sub(1);
     if steer.len() != 1 && steer.len() != curves {
@@ -330,7 +307,7 @@ pub fn compute_steered_many_cancellable(
                 ..*template
             };
             let st = steer[if steer.len() == 1 { 0 } else { c }];
-            compute_steered_cancellable(&req, &st, buf, cancel).map_err(|e| {
+            compute_steered(&req, &st, buf, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {

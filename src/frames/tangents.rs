@@ -52,11 +52,12 @@
 //!   the 4th order). Needs 4 tangents.
 
 use super::lanes::Arith;
+use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::alloc;
 use crate::error::{InputError, Result};
+use crate::run::alloc;
 
 /// How tangents are estimated from points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -285,6 +286,9 @@ fn cusp_error(i: usize) -> InputError {
     )
 }
 
+/// Rows per segment of a cancellable estimate ([`estimate`]).
+const CANCEL_SEGMENT: usize = 1 << 20;
+
 /// Unit tangents estimated from points (`closed`: the points form a loop, no repeated end).
 ///
 /// Errors if fewer than 2 points (3 for a loop) or if an estimate vanishes at an open end
@@ -292,26 +296,15 @@ fn cusp_error(i: usize) -> InputError {
 /// Points are assumed finite and free of repeated consecutive points (checked by the caller).
 ///
 /// `chords[i] = |x_{i+1} − x_i|` (mod n when closed), as returned by `validate::chords`.
+///
+/// Polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and returns the rows done so far
+/// once it says stop (see [`crate::run::cancel`]).
 pub fn estimate(
     x: &[DVec3],
     chords: &[f64],
     closed: bool,
     rule: TangentRule,
-) -> Result<Vec<DVec3>> {
-    estimate_cancellable(x, chords, closed, rule, &crate::cancel::never)
-}
-
-/// Rows per segment of a cancellable estimate ([`estimate_cancellable`]).
-const CANCEL_SEGMENT: usize = 1 << 20;
-
-/// [`estimate`] that polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and
-/// returns the rows done so far once it says stop (see [`crate::cancel`]).
-pub fn estimate_cancellable(
-    x: &[DVec3],
-    chords: &[f64],
-    closed: bool,
-    rule: TangentRule,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
     let n = x.len();
     let min = if closed { 3 } else { 2 };
@@ -681,19 +674,16 @@ fn raw_tangent(
 ///
 /// A curve whose size is far from 1 is divided by a power of two first (exact; see
 /// [`crate::math::scale`]): unit tangents do not depend on the units.
-pub fn estimate_rows(x: &[DVec3], closed: bool, rule: TangentRule) -> Result<Vec<DVec3>> {
-    estimate_rows_cancellable(x, closed, rule, &crate::cancel::never)
-}
-
-/// [`estimate_rows`] that polls `cancel` between its passes and for every row of the
-/// estimate (see [`crate::cancel`]); a cancelled call returns an incomplete result.
-pub fn estimate_rows_cancellable(
+///
+/// Polls `cancel` between its passes and for every row of the estimate (see
+/// [`crate::run::cancel`]); a cancelled call returns an incomplete result.
+pub fn estimate_rows(
     x: &[DVec3],
     closed: bool,
     rule: TangentRule,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
-    crate::frames::validate::finite("points", x)?;
+    crate::frames::validate::finite("points", x, &cancel::never)?;
     if cancel() {
         return Ok(Vec::new());
     }
@@ -709,11 +699,11 @@ pub fn estimate_rows_cancellable(
     if cancel() {
         return Ok(Vec::new());
     }
-    let chords = crate::frames::validate::chords_cancellable(&x[..n], closed, cancel)?;
+    let chords = crate::frames::validate::chords(&x[..n], closed, cancel)?;
     if cancel() {
         return Ok(Vec::new());
     }
-    let mut t = estimate_cancellable(&x[..n], &chords, closed, rule, cancel)?;
+    let mut t = estimate(&x[..n], &chords, closed, rule, cancel)?;
     if cancel() {
         return Ok(t);
     }
@@ -727,24 +717,16 @@ pub fn estimate_rows_cancellable(
 /// Unit tangents of many curves stored back to back (`offsets`: C + 1 start rows ending at
 /// `x.len()`), each as [`estimate_rows`] gives it, curves in parallel. Errors name the curve
 /// and its rows when there are several.
+///
+/// Polls `cancel` before every curve, inside each curve's estimate ([`estimate_rows`])
+/// and before every [`CANCEL_SEGMENT`] rows of the copy into the result; a cancelled call returns
+/// an incomplete result (see [`crate::run::cancel`]).
 pub fn estimate_many(
     x: &[DVec3],
     offsets: &[usize],
     closed: bool,
     rule: TangentRule,
-) -> Result<Vec<DVec3>> {
-    estimate_many_cancellable(x, offsets, closed, rule, &crate::cancel::never)
-}
-
-/// [`estimate_many`] that polls `cancel` before every curve, inside each curve's estimate
-/// ([`estimate_rows_cancellable`]) and before every [`CANCEL_SEGMENT`] rows of the copy into
-/// the result; a cancelled call returns an incomplete result (see [`crate::cancel`]).
-pub fn estimate_many_cancellable(
-    x: &[DVec3],
-    offsets: &[usize],
-    closed: bool,
-    rule: TangentRule,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
     crate::frames::validate::offsets(offsets, x.len())?;
     let curves = offsets.len() - 1;
@@ -755,7 +737,7 @@ pub fn estimate_many_cancellable(
                 return Ok(Vec::new());
             }
             let (a, b) = (offsets[c], offsets[c + 1]);
-            estimate_rows_cancellable(&x[a..b], closed, rule, cancel).map_err(|e| {
+            estimate_rows(&x[a..b], closed, rule, cancel).map_err(|e| {
                 if curves > 1 {
                     e.context(&format!("curve {c} (rows {a} to {})", b.max(1) - 1))
                 } else {
@@ -824,7 +806,7 @@ mod tests {
     use super::*;
 
     fn ch(x: &[DVec3]) -> Vec<f64> {
-        crate::frames::validate::chords(x, false).unwrap()
+        crate::frames::validate::chords(x, false, &cancel::never).unwrap()
     }
 
     fn helix(u: f64) -> DVec3 {
@@ -839,7 +821,7 @@ mod tests {
         let err = |n: usize| {
             let h = 3.0 / n as f64;
             let x: Vec<DVec3> = (0..=n).map(|i| helix(i as f64 * h)).collect();
-            let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+            let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
             (0..=n)
                 .map(|i| (t[i] - helix_t(i as f64 * h)).length())
                 .fold(0.0, f64::max)
@@ -859,7 +841,7 @@ mod tests {
             x.push(*x.last().unwrap() + h * d);
         }
         for rule in [TangentRule::FivePoint, TangentRule::FivePointBounded] {
-            let t = estimate_rows(&x, false, rule).unwrap();
+            let t = estimate_rows(&x, false, rule, &cancel::never).unwrap();
             for (i, ti) in t.iter().enumerate() {
                 assert!((*ti - d).length() < 1e-12, "{rule:?} {i}: {ti} {d}");
             }
@@ -872,7 +854,7 @@ mod tests {
             .iter()
             .map(|&u: &f64| DVec3::new((u / 2.0).cos(), (u / 2.0).sin(), 0.0) * 2.0)
             .collect();
-        let t = estimate_rows(&x, false, TangentRule::FivePoint).unwrap();
+        let t = estimate_rows(&x, false, TangentRule::FivePoint, &cancel::never).unwrap();
         let exact = DVec3::Y;
         let chord = (x[1] - x[0]).normalize();
         assert!(
@@ -890,7 +872,7 @@ mod tests {
             .iter()
             .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
             .collect();
-        let t = estimate(&x, &ch(&x), false, TangentRule::Circle).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::Circle, &cancel::never).unwrap();
         for (i, &u) in u.iter().enumerate() {
             let e = DVec3::new(-u.sin(), u.cos(), 0.0);
             assert!((t[i] - e).length() < 1e-14, "{i}");
@@ -901,7 +883,7 @@ mod tests {
             .iter()
             .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
             .collect();
-        let t = estimate(&x, &ch(&x), false, TangentRule::Circle).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::Circle, &cancel::never).unwrap();
         let b = ((x[1] - x[0]).normalize() + (x[2] - x[1]).normalize()).normalize();
         assert!(
             (t[1] - b).length() < 1e-15
@@ -917,7 +899,7 @@ mod tests {
             .iter()
             .map(|&v| DVec3::new(1.0, 2.0, 3.0) + v * d)
             .collect();
-        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
         for ti in &t {
             assert!((*ti - d).length() < 1e-9, "{ti}");
         }
@@ -928,8 +910,15 @@ mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
-        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointUniform).unwrap();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+        let b = estimate(
+            &x,
+            &ch(&x),
+            false,
+            TangentRule::FivePointUniform,
+            &cancel::never,
+        )
+        .unwrap();
         for i in 0..9 {
             assert!((a[i] - b[i]).length() < 1e-14);
         }
@@ -1055,8 +1044,15 @@ mod tests {
         .iter()
         .map(|&p| DVec3::from_array(p))
         .collect();
-        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
-        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+        let b = estimate(
+            &x,
+            &ch(&x),
+            false,
+            TangentRule::FivePointBounded,
+            &cancel::never,
+        )
+        .unwrap();
         let n = x.len();
         let mut acted = 0;
         for (i, c, p) in [
@@ -1079,22 +1075,49 @@ mod tests {
         }
         // fine samplings: the bound never acts
         let x: Vec<DVec3> = (0..=200).map(|i| helix(i as f64 * 0.015)).collect();
-        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
-        let b = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+        let b = estimate(
+            &x,
+            &ch(&x),
+            false,
+            TangentRule::FivePointBounded,
+            &cancel::never,
+        )
+        .unwrap();
         assert_eq!(a, b);
     }
 
     #[test]
     fn many_curves_name_the_curve() {
         let x: Vec<DVec3> = (0..9).map(|i| helix(i as f64 * 0.3)).collect();
-        let t = estimate_many(&x, &[0, 4, 9], false, TangentRule::FivePointBounded).unwrap();
+        let t = estimate_many(
+            &x,
+            &[0, 4, 9],
+            false,
+            TangentRule::FivePointBounded,
+            &cancel::never,
+        )
+        .unwrap();
         assert_eq!(
             &t[..4],
-            &estimate_rows(&x[..4], false, TangentRule::FivePointBounded).unwrap()[..]
+            &estimate_rows(
+                &x[..4],
+                false,
+                TangentRule::FivePointBounded,
+                &cancel::never
+            )
+            .unwrap()[..]
         );
         let mut y = x.clone();
         y[6] = y[5];
-        let e = estimate_many(&y, &[0, 4, 9], false, TangentRule::FivePointBounded).unwrap_err();
+        let e = estimate_many(
+            &y,
+            &[0, 4, 9],
+            false,
+            TangentRule::FivePointBounded,
+            &cancel::never,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("curve 1 (rows 4 to 8)"), "{e}");
     }
 
@@ -1177,7 +1200,8 @@ mod tests {
                         let d = DVec3::new(r() + r(), r() + r(), r() + r());
                         x.push(*x.last().unwrap() + d);
                     }
-                    let t = estimate(&x, &ch_closed(&x, closed), closed, rule).unwrap();
+                    let t =
+                        estimate(&x, &ch_closed(&x, closed), closed, rule, &cancel::never).unwrap();
                     let m = if closed { n } else { n - 1 };
                     // the unbounded rules leave their end tangents as the quartic gives them
                     let unbounded =
@@ -1202,14 +1226,21 @@ mod tests {
     }
 
     fn ch_closed(x: &[DVec3], closed: bool) -> Vec<f64> {
-        crate::frames::validate::chords(x, closed).unwrap()
+        crate::frames::validate::chords(x, closed, &cancel::never).unwrap()
     }
 
     #[test]
     fn exact_reversals_get_a_tangent_normal_to_the_chord() {
         // three points: the circle rule's estimate vanishes at the reversal
         let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO];
-        let t = estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap();
+        let t = estimate(
+            &x,
+            &ch(&x),
+            false,
+            TangentRule::FivePointBounded,
+            &cancel::never,
+        )
+        .unwrap();
         assert_eq!(t[1].dot(DVec3::X), 0.0);
         assert!((t[1].length() - 1.0).abs() < 1e-15);
         assert!(t[0].dot(DVec3::X) > 0.7 && t[2].dot(DVec3::X) < -0.7);
@@ -1224,7 +1255,14 @@ mod tests {
                 DVec3::new(-1.0, 0.5 + e, 0.0),
                 DVec3::new(-2.0, 1.0 + e, 0.0),
             ];
-            estimate(&x, &ch(&x), false, TangentRule::FivePointBounded).unwrap()[2]
+            estimate(
+                &x,
+                &ch(&x),
+                false,
+                TangentRule::FivePointBounded,
+                &cancel::never,
+            )
+            .unwrap()[2]
         };
         let (exact, near) = (y(0.0), y(1e-9));
         assert!(
@@ -1237,7 +1275,7 @@ mod tests {
         assert!(near.z == 0.0 && near.y > 0.0, "{near}");
         // two reversals in a row leave a segment with no forward tangent: refused
         let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO, DVec3::X];
-        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint).unwrap();
+        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
         let c = x[2] - x[1];
         assert!(c.dot(t[1] + t[2]) <= 1e-6);
     }
@@ -1286,12 +1324,12 @@ mod proptests {
             angle in -3.1..3.1f64, e in -900i32..900, rule in 0usize..4,
         ) {
             let rule = RULES[rule];
-            let t = estimate_rows(&x, false, rule).unwrap();
+            let t = estimate_rows(&x, false, rule, &cancel::never).unwrap();
             let q = DQuat::from_axis_angle(DVec3::new(axis.0, axis.1, axis.2).normalize(), angle);
             let s = crate::math::scale::ldexp(1.0, e);
             let shift = DVec3::new(3.0, -1.0, 2.0) * s;
             let y: Vec<DVec3> = x.iter().map(|&p| q * p * s + shift).collect();
-            let ty = estimate_rows(&y, false, rule).unwrap();
+            let ty = estimate_rows(&y, false, rule, &cancel::never).unwrap();
             for (a, b) in t.iter().zip(&ty) {
                 prop_assert!((a.length() - 1.0).abs() < 1e-13);
                 prop_assert!((q * *a - *b).length() < 1e-9, "{a} {b}");
@@ -1308,7 +1346,7 @@ mod proptests {
             let u = |i: usize| phase + std::f64::consts::TAU * i as f64 / n as f64;
             let x: Vec<DVec3> =
                 (0..n).map(|i| DVec3::new(u(i).cos(), u(i).sin(), 0.0) * r).collect();
-            let t = estimate_rows(&x, true, RULES[rule]).unwrap();
+            let t = estimate_rows(&x, true, RULES[rule], &cancel::never).unwrap();
             for (i, ti) in t.iter().enumerate() {
                 let want = DVec3::new(-u(i).sin(), u(i).cos(), 0.0);
                 prop_assert!((*ti - want).length() < 1e-12, "{i}: {ti} {want}");
@@ -1329,7 +1367,7 @@ mod proptests {
             for hi in &h {
                 x.push(*x.last().unwrap() + *hi * d);
             }
-            let t = estimate_rows(&x, false, RULES[rule]).unwrap();
+            let t = estimate_rows(&x, false, RULES[rule], &cancel::never).unwrap();
             for ti in &t {
                 prop_assert!((*ti - d).length() < 1e-12, "{ti} {d}");
             }

@@ -2,6 +2,7 @@
 //! boundary conditions, bundles and the input errors.
 
 use super::*;
+use crate::run::cancel;
 use std::f64::consts::{PI, TAU};
 
 use glam::{DMat3, DVec3};
@@ -24,7 +25,7 @@ fn wrap(a: f64) -> f64 {
 fn frames(req: &Request) -> Result<(Vec<f64>, f64)> {
     let rows = req.points.or(req.tangents).map_or(0, <[DVec3]>::len);
     let mut out = vec![0.0; 9 * rows];
-    let angle = compute_into(req, &mut out)?;
+    let angle = compute_into(req, &mut out, &cancel::never)?;
     Ok((out, angle))
 }
 
@@ -228,8 +229,9 @@ fn frames_are_rotations_with_t_the_unit_tangent() {
             })
             .expect("valid curve");
             assert_rotations(&out, 1e-12);
-            let est = tangents::estimate_rows(&x, closed, TangentRule::FivePointBounded)
-                .expect("regular curve");
+            let est =
+                tangents::estimate_rows(&x, closed, TangentRule::FivePointBounded, &cancel::never)
+                    .expect("regular curve");
             for (i, e) in est.iter().enumerate() {
                 assert!(
                     (col(&out, i, 2) - *e).length() < 1e-15,
@@ -397,8 +399,16 @@ fn compute_many_equals_each_curve_alone() {
                 ..Default::default()
             };
             let mut all = vec![0.0; 9 * x.len()];
-            let angles =
-                compute_many(&template, &offsets, &initial, &end, &mut all).expect("valid bundle");
+            let angles = compute_many(
+                &template,
+                &offsets,
+                &initial,
+                &end,
+                &mut all,
+                &cancel::never,
+                None,
+            )
+            .expect("valid bundle");
             for (c, w) in offsets.windows(2).enumerate() {
                 let one = Request {
                     points: Some(&x[w[0]..w[1]]),
@@ -424,7 +434,16 @@ fn compute_many_equals_each_curve_alone() {
             ..Default::default()
         };
         let mut all = vec![0.0; 9 * y.len()];
-        let err = compute_many(&template, &offsets, &[], &[], &mut all).unwrap_err();
+        let err = compute_many(
+            &template,
+            &offsets,
+            &[],
+            &[],
+            &mut all,
+            &cancel::never,
+            None,
+        )
+        .unwrap_err();
         assert_eq!(err.arg, "points");
         let rows = format!("curve 2 (rows {} to {})", offsets[2], offsets[3] - 1);
         assert!(err.msg.starts_with(&rows), "{err}");
@@ -707,7 +726,7 @@ fn errors_name_the_argument() {
     ];
     for (k, (arg, req, rows)) in cases.iter().enumerate() {
         let mut out = vec![0.0; 9 * rows];
-        match compute_into(req, &mut out) {
+        match compute_into(req, &mut out, &cancel::never) {
             Err(e) => assert_eq!(&e.arg, arg, "case {k}: {e}"),
             Ok(_) => panic!("case {k} ({arg}) was accepted"),
         }
@@ -724,7 +743,7 @@ fn errors_name_the_argument() {
             method,
             ..base
         };
-        compute_into(&req, &mut out).unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        compute_into(&req, &mut out, &cancel::never).unwrap_or_else(|e| panic!("{method:?}: {e}"));
         assert!(
             out.chunks_exact(9)
                 .all(|f| validate::is_rotation(f.try_into().unwrap()))
@@ -732,12 +751,48 @@ fn errors_name_the_argument() {
     }
     let mut out = vec![0.0; 9 * 30];
     let two = [Orientation::Vector(DVec3::Z); 2];
-    let err = compute_many(&base, &[0, 10, 20, 30], &two, &[], &mut out).unwrap_err();
+    let err = compute_many(
+        &base,
+        &[0, 10, 20, 30],
+        &two,
+        &[],
+        &mut out,
+        &cancel::never,
+        None,
+    )
+    .unwrap_err();
     assert_eq!(err.arg, "initial");
-    let err = compute_many(&base, &[0, 10, 20, 30], &[], &two, &mut out).unwrap_err();
+    let err = compute_many(
+        &base,
+        &[0, 10, 20, 30],
+        &[],
+        &two,
+        &mut out,
+        &cancel::never,
+        None,
+    )
+    .unwrap_err();
     assert_eq!(err.arg, "end");
-    let err = compute_many(&base, &[0, 20, 10, 30], &[], &[], &mut out).unwrap_err();
+    let err = compute_many(
+        &base,
+        &[0, 20, 10, 30],
+        &[],
+        &[],
+        &mut out,
+        &cancel::never,
+        None,
+    )
+    .unwrap_err();
     assert_eq!(err.arg, "lengths");
-    let err = compute_many(&base, &[0, 10, 29], &[], &[], &mut out).unwrap_err();
+    let err = compute_many(
+        &base,
+        &[0, 10, 29],
+        &[],
+        &[],
+        &mut out,
+        &cancel::never,
+        None,
+    )
+    .unwrap_err();
     assert_eq!(err.arg, "lengths");
 }

@@ -12,12 +12,13 @@
 //! `P_i`), in closed form and O(n). A sequence of curves `(T, n)` gets its RMFs in parallel
 //! over `T`; then, in order, each step is turned to its predecessor.
 
+use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Orientation, Request, compute_into_cancellable, validate};
-use crate::cancel::Cancel;
+use super::{Orientation, Request, compute_into, validate};
 use crate::error::{InputError, Result};
+use crate::run::cancel::Cancel;
 
 /// Column `k` of a row-major frame.
 fn col(f: &[f64], k: usize) -> DVec3 {
@@ -29,13 +30,10 @@ fn col(f: &[f64], k: usize) -> DVec3 {
 const BLOCK: usize = 1024;
 
 /// Turn every frame of `out` about its tangent by `c` (the columns `r, s`).
-pub fn turn_all(out: &mut [f64], c: f64) {
-    turn_all_cancellable(out, c, &crate::cancel::never);
-}
-
-/// [`turn_all`] that polls `cancel` before every block of rows and skips the remaining
-/// blocks once it says stop (see [`crate::cancel`]).
-pub fn turn_all_cancellable(out: &mut [f64], c: f64, cancel: Cancel<'_>) {
+///
+/// Polls `cancel` before every block of rows and skips the remaining blocks once it says stop (see
+/// [`crate::run::cancel`]).
+pub fn turn_all(out: &mut [f64], c: f64, cancel: Cancel<'_>) {
     let (sin, cos) = c.sin_cos();
     out.par_chunks_mut(9 * BLOCK).for_each(|b| {
         if cancel() {
@@ -53,13 +51,10 @@ pub fn turn_all_cancellable(out: &mut [f64], c: f64, cancel: Cancel<'_>) {
 
 /// The turn `c` that brings the frames `out` closest to `previous` (both row-major,
 /// `9·rows` values).
-pub fn best_turn(out: &[f64], previous: &[f64]) -> f64 {
-    best_turn_cancellable(out, previous, &crate::cancel::never)
-}
-
-/// [`best_turn`] that polls `cancel` before every block of rows (a cancelled call returns
-/// a meaningless turn, see [`crate::cancel`]).
-pub fn best_turn_cancellable(out: &[f64], previous: &[f64], cancel: Cancel<'_>) -> f64 {
+///
+/// Polls `cancel` before every block of rows (a cancelled call returns a meaningless turn, see
+/// [`crate::run::cancel`]).
+pub fn best_turn(out: &[f64], previous: &[f64], cancel: Cancel<'_>) -> f64 {
     let (y, x) = out
         .par_chunks(9 * BLOCK)
         .zip(previous.par_chunks(9 * BLOCK))
@@ -90,7 +85,7 @@ pub fn check_previous(previous: &[[f64; 9]], rows: usize) -> Result<()> {
             ),
         ));
     }
-    if let Some(i) = validate::first_bad(previous, validate::is_rotation) {
+    if let Some(i) = validate::first_bad(previous, validate::is_rotation, &cancel::never) {
         return Err(InputError::new(
             "previous",
             format!("row {i} is not a rotation matrix (columns r, s, t orthonormal, det +1)"),
@@ -100,52 +95,30 @@ pub fn check_previous(previous: &[[f64; 9]], rows: usize) -> Result<()> {
 }
 
 /// Turn the frames `out` (one curve) to be closest to `previous`.
-pub fn align(out: &mut [f64], previous: &[[f64; 9]]) -> Result<()> {
-    align_cancellable(out, previous, &crate::cancel::never)
-}
-
-/// [`align`] that polls `cancel` before every block of rows of its two passes (a cancelled
-/// call leaves `out` incomplete, see [`crate::cancel`]).
-pub fn align_cancellable(out: &mut [f64], previous: &[[f64; 9]], cancel: Cancel<'_>) -> Result<()> {
+///
+/// Polls `cancel` before every block of rows of its two passes (a cancelled call leaves `out`
+/// incomplete, see [`crate::run::cancel`]).
+pub fn align(out: &mut [f64], previous: &[[f64; 9]], cancel: Cancel<'_>) -> Result<()> {
     check_previous(previous, out.len() / 9)?;
     let prev: &[f64] = bytemuck::cast_slice(previous);
-    let c = best_turn_cancellable(out, prev, cancel);
+    let c = best_turn(out, prev, cancel);
     if cancel() {
         return Ok(());
     }
-    turn_all_cancellable(out, c, cancel);
+    turn_all(out, c, cancel);
     Ok(())
 }
 
 /// Frames of `steps` time steps of one curve of `rows` samples stored back to back in the
 /// request's arrays: the RMF of every step (in parallel), then each turned to be closest to
 /// the step before (step 0 to `previous` when given, else it starts from `initial`).
-pub fn frames_in_time(
-    template: &Request,
-    steps: usize,
-    rows: usize,
-    initial: Option<Orientation>,
-    previous: Option<&[[f64; 9]]>,
-    out: &mut [f64],
-) -> Result<()> {
-    frames_in_time_cancellable(
-        template,
-        steps,
-        rows,
-        initial,
-        previous,
-        out,
-        &crate::cancel::never,
-        None,
-    )
-}
-
-/// [`frames_in_time`] that polls `cancel` before every time step, inside each step's frames
-/// ([`super::compute_into_cancellable`]) and before every block of rows of the turns, and
-/// returns at once (with `out` incomplete) when it says stop (see [`crate::cancel`]); adds 1
-/// to `done` as each step's frames are computed (a progress count).
+///
+/// Polls `cancel` before every time step, inside each step's frames
+/// ([`super::compute_into`]) and before every block of rows of the turns, and returns
+/// at once (with `out` incomplete) when it says stop (see [`crate::run::cancel`]); adds 1 to `done`
+/// as each step's frames are computed (a progress count).
 #[allow(clippy::too_many_arguments)]
-pub fn frames_in_time_cancellable(
+pub fn frames_in_time(
     template: &Request,
     steps: usize,
     rows: usize,
@@ -197,7 +170,7 @@ pub fn frames_in_time_cancellable(
                 end: None,
                 ..*template
             };
-            let step = compute_into_cancellable(&req, buf, cancel)
+            let step = compute_into(&req, buf, cancel)
                 .map(|_| ())
                 .map_err(|e| e.context(&format!("time step {k}")));
             if let Some(d) = done {
@@ -210,16 +183,16 @@ pub fn frames_in_time_cancellable(
         return Ok(());
     }
     if let Some(p) = previous {
-        let c = best_turn_cancellable(&out[..9 * rows], bytemuck::cast_slice(p), cancel);
-        turn_all_cancellable(&mut out[..9 * rows], c, cancel);
+        let c = best_turn(&out[..9 * rows], bytemuck::cast_slice(p), cancel);
+        turn_all(&mut out[..9 * rows], c, cancel);
     }
     for k in 1..steps {
         if cancel() {
             return Ok(());
         }
         let (before, now) = out[9 * rows * (k - 1)..9 * rows * (k + 1)].split_at_mut(9 * rows);
-        let c = best_turn_cancellable(now, before, cancel);
-        turn_all_cancellable(now, c, cancel);
+        let c = best_turn(now, before, cancel);
+        turn_all(now, c, cancel);
     }
     Ok(())
 }

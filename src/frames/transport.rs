@@ -148,20 +148,14 @@ where
     /// `work`, `boundary_step` and `tangent` must not use rayon themselves: a worker that
     /// has nothing left to take sleeps until the carry passes the running chunks, and must
     /// not hold a task they need.
-    pub fn scan<W>(&self, work: W, out: &mut [f64]) -> Option<f64>
-    where
-        W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
-    {
-        self.scan_cancellable(work, out, &crate::cancel::never)
-    }
-
-    /// [`Scan::scan`] whose final turning pass polls `cancel` every [`CANCEL_ROWS`] rows
-    /// and stops once it says stop (`out` is then incomplete; `work` polls on its own).
-    pub fn scan_cancellable<W>(
+    ///
+    /// Its final turning pass polls `cancel` every [`CANCEL_ROWS`] rows and stops once it says
+    /// stop (`out` is then incomplete; `work` polls on its own).
+    pub fn scan<W>(
         &self,
         work: W,
         out: &mut [f64],
-        cancel: crate::cancel::Cancel<'_>,
+        cancel: crate::run::cancel::Cancel<'_>,
     ) -> Option<f64>
     where
         W: Fn(usize, Option<DVec3>, &mut [f64]) -> Option<ChunkEnds> + Sync,
@@ -251,6 +245,9 @@ where
     }
 }
 
+/// Rows of a chunk between two polls of the cancel hook ([`transport_into`]).
+const CANCEL_ROWS: usize = 1 << 16;
+
 /// Transport `r0` (unit, ⟂ `t[0]`) along the curve and write the frames.
 ///
 /// * `t`: unit tangents of the `n` distinct samples; `closed` adds the segment `n−1 → 0`.
@@ -260,6 +257,10 @@ where
 ///
 /// Returns the raw end angle `α` (closing angle, or angle to the end target), before adding
 /// `2π·turns`; 0 when there is no end condition.
+///
+/// Polls `cancel` every [`CANCEL_ROWS`] rows of every chunk and stops the scan once it says stop
+/// (`out` is then incomplete and the angle 0; see [`crate::run::cancel`]).
+#[allow(clippy::too_many_arguments)]
 pub fn transport_into<S: Step>(
     step: &S,
     t: &[DVec3],
@@ -268,33 +269,14 @@ pub fn transport_into<S: Step>(
     r0: DVec3,
     twist: Twist,
     out: &mut [f64],
-) -> f64 {
-    transport_into_cancellable(step, t, seg, closed, r0, twist, out, &crate::cancel::never)
-}
-
-/// Rows of a chunk between two polls of the cancel hook ([`transport_into_cancellable`]).
-const CANCEL_ROWS: usize = 1 << 16;
-
-/// [`transport_into`] that polls `cancel` every [`CANCEL_ROWS`] rows of every chunk and
-/// stops the scan once it says stop (`out` is then incomplete and the angle 0; see
-/// [`crate::cancel`]).
-#[allow(clippy::too_many_arguments)]
-pub fn transport_into_cancellable<S: Step>(
-    step: &S,
-    t: &[DVec3],
-    seg: &[f64],
-    closed: bool,
-    r0: DVec3,
-    twist: Twist,
-    out: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> f64 {
     let ext = if closed { t.len() } else { t.len() - 1 } + 1;
     let (_, cs) = plan(ext, step.is_rotation());
     transport_chunked(step, t, seg, closed, r0, twist, out, cs, cancel)
 }
 
-/// [`transport_into_cancellable`] with chunks of `cs` extended frames (the scan's result
+/// [`transport_into`] with chunks of `cs` extended frames (the scan's result
 /// does not depend on `cs` beyond rounding).
 #[allow(clippy::too_many_arguments)]
 fn transport_chunked<S: Step>(
@@ -306,7 +288,7 @@ fn transport_chunked<S: Step>(
     twist: Twist,
     out: &mut [f64],
     cs: usize,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> f64 {
     let n = t.len();
     let m = if closed { n } else { n - 1 }; // segments; extended frames 0..=m
@@ -343,7 +325,7 @@ fn transport_chunked<S: Step>(
         cs,
         ext,
     }
-    .scan_cancellable(work, out, cancel);
+    .scan(work, out, cancel);
     // `work` fails only when cancelled, and so does the scan
     debug_assert!(angle.is_some() || cancel());
     angle.unwrap_or(0.0)
@@ -354,6 +336,7 @@ mod tests {
     use super::super::double_reflection::DoubleReflection;
     use super::super::{Method, Orientation, Request, compute_general, compute_into};
     use super::*;
+    use crate::run::cancel;
     use std::f64::consts::TAU;
 
     fn pool(threads: usize) -> rayon::ThreadPool {
@@ -518,7 +501,7 @@ mod tests {
                                         twist,
                                         &mut out,
                                         cs,
-                                        &crate::cancel::never,
+                                        &crate::run::cancel::never,
                                     )
                                 });
                                 let what = format!(
@@ -574,7 +557,7 @@ mod tests {
                     (c != bad).then_some((s0, s0, 1.0))
                 };
                 let mut out = vec![0.0; 9 * n];
-                let got = pool(threads).install(|| scan.scan(work, &mut out));
+                let got = pool(threads).install(|| scan.scan(work, &mut out, &cancel::never));
                 assert!(got.is_none(), "chunk {bad} failed, {threads} threads");
             }
         }
@@ -623,7 +606,7 @@ mod tests {
                 let raw = pool(threads)
                     .install(|| {
                         assert!(plan(rows + 1, true).0 > 2, "cut on any thread count");
-                        compute_general(req, &mut out)
+                        compute_general(req, &mut out, &cancel::never)
                     })
                     .expect("valid input");
                 (out, raw)
@@ -643,7 +626,7 @@ mod tests {
             // compute_into (which may take the fused path) agrees
             let mut out = vec![0.0; 9 * rows];
             pool(2)
-                .install(|| compute_into(req, &mut out))
+                .install(|| compute_into(req, &mut out, &cancel::never))
                 .expect("valid input");
             assert!(worst(&out, &two) < 1e-12, "request {k}");
         }

@@ -15,12 +15,13 @@
 //!   that point backwards along a segment, and the unbounded end tangents of the `FivePoint`
 //!   and `FivePointUniform` rules, can fail it.
 
+use crate::run::cancel;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
-use crate::alloc;
 use crate::error::{ErrorKind, InputError, Result};
 use crate::math::rotation;
+use crate::run::alloc;
 
 /// Relative round-off tolerance for coinciding points.
 pub const COINCIDE_EPS: f64 = 8.0 * f64::EPSILON;
@@ -31,31 +32,24 @@ pub const MIN_ALIGNMENT: f64 = 1e-6;
 const CHECK_CHUNK: usize = 1 << 12;
 
 /// Index of the first element failing `ok`, scanning blocks in parallel.
-pub(crate) fn first_bad<T: Sync>(v: &[T], ok: impl Fn(&T) -> bool + Sync) -> Option<usize> {
-    first_bad_cancellable(v, ok, &crate::cancel::never)
-}
-
-/// [`first_bad`] that polls `cancel` before every block and finds nothing in the blocks
-/// after it says stop (see [`crate::cancel`]; the caller discards the result then).
-pub(crate) fn first_bad_cancellable<T: Sync>(
+///
+/// Polls `cancel` before every block and finds nothing in the blocks after it says stop (see
+/// [`crate::run::cancel`]; the caller discards the result then).
+pub(crate) fn first_bad<T: Sync>(
     v: &[T],
     ok: impl Fn(&T) -> bool + Sync,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Option<usize> {
-    crate::cancel::first_bad_index(v.len(), cancel, |i| ok(&v[i]))
+    crate::run::cancel::first_bad_index(v.len(), cancel, |i| ok(&v[i]))
 }
 
-pub fn finite(arg: &'static str, v: &[DVec3]) -> Result<()> {
-    finite_cancellable(arg, v, &crate::cancel::never)
-}
-
-/// [`finite`] that polls `cancel` before every block ([`first_bad_cancellable`]).
-pub fn finite_cancellable(
+/// Polls `cancel` before every block ([`first_bad`]).
+pub fn finite(
     arg: &'static str,
     v: &[DVec3],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
-    match first_bad_cancellable(v, |p| p.is_finite(), cancel) {
+    match first_bad(v, |p| p.is_finite(), cancel) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             arg,
@@ -65,7 +59,7 @@ pub fn finite_cancellable(
 }
 
 pub fn finite_scalars(arg: &'static str, v: &[f64]) -> Result<()> {
-    match first_bad(v, |p| p.is_finite()) {
+    match first_bad(v, |p| p.is_finite(), &cancel::never) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             arg,
@@ -105,23 +99,20 @@ pub fn repeated(a: DVec3, b: DVec3, floor: f64) -> bool {
     (b - a).abs().max_element() <= floor
 }
 
-/// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
-/// consecutive points ([`repeated`]).
-pub fn chords(x: &[DVec3], closed: bool) -> Result<Vec<f64>> {
-    chords_cancellable(x, closed, &crate::cancel::never)
-}
-
-/// Rows per segment of [`chords_cancellable`] between two polls of the cancel hook.
+/// Rows per segment of [`chords`] between two polls of the cancel hook.
 const CHORD_SEGMENT: usize = 1 << 20;
 
-/// [`chords`] that polls `cancel` before every segment of [`CHORD_SEGMENT`] chords and every
-/// block of the check for repeated points, and returns the chords done so far once it says
-/// stop (see [`crate::cancel`]). The chords are written in parallel into reserved room, so
-/// no thread zero-fills the whole buffer first.
-pub fn chords_cancellable(
+/// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
+/// consecutive points ([`repeated`]).
+///
+/// Polls `cancel` before every segment of [`CHORD_SEGMENT`] chords and every block of the check for
+/// repeated points, and returns the chords done so far once it says stop (see
+/// [`crate::run::cancel`]). The chords are written in parallel into reserved room, so no thread
+/// zero-fills the whole buffer first.
+pub fn chords(
     x: &[DVec3],
     closed: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     let n = x.len();
     let floor = repeat_floor(x);
@@ -149,7 +140,8 @@ pub fn chords_cancellable(
         );
     }
     // the first repeated point (a cancelled search finds none; the result is discarded)
-    let bad = crate::cancel::first_bad_index(m, cancel, |i| !repeated(x[i], x[next(i)], floor));
+    let bad =
+        crate::run::cancel::first_bad_index(m, cancel, |i| !repeated(x[i], x[next(i)], floor));
     match bad {
         None => Ok(seg),
         Some(i) => Err(InputError::new(
@@ -192,7 +184,7 @@ pub fn distinct_rows(
     x: &[DVec3],
     offsets: &[usize],
     closed: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<(Vec<usize>, Vec<CurveStatus>)> {
     self::offsets(offsets, x.len())?;
     let mut into = alloc::with_capacity("distinct_rows", x.len())?;
@@ -266,7 +258,7 @@ pub fn aligned(
         let d = v.dot(t[i] + t[j]);
         d > 0.0 && d * d > MIN_ALIGNMENT * MIN_ALIGNMENT * v.length_squared()
     };
-    let bad = crate::cancel::first_bad_index(m, &crate::cancel::never, ok);
+    let bad = crate::run::cancel::first_bad_index(m, &crate::run::cancel::never, ok);
     match bad {
         None => Ok(()),
         Some(i) => Err(InputError::new(
@@ -351,8 +343,8 @@ mod tests {
             p(0.0, f64::NAN),
             p(1.0, 1.0),
         ];
-        let (into, status) =
-            distinct_rows(&x, &[0, 7, 9, 11], false, &crate::cancel::never).expect("valid offsets");
+        let (into, status) = distinct_rows(&x, &[0, 7, 9, 11], false, &crate::run::cancel::never)
+            .expect("valid offsets");
         assert_eq!(into, [0, 0, 2, 2, 2, 5, 6, 7, 7, 9, 10]);
         assert_eq!(
             status,
@@ -364,8 +356,8 @@ mod tests {
         );
         // the kept rows pass the chord check the frames and sweeps make
         let kept: Vec<DVec3> = (0..7).filter(|&j| into[j] == j).map(|j| x[j]).collect();
-        assert!(chords(&kept, false).is_ok());
-        assert!(chords(&x[..7], false).unwrap_err().kind == ErrorKind::Repeated);
+        assert!(chords(&kept, false, &cancel::never).is_ok());
+        assert!(chords(&x[..7], false, &cancel::never).unwrap_err().kind == ErrorKind::Repeated);
         // closed: a last row that repeats the first joins it; a triangle with a repeat has
         // too few distinct points
         let tri = [
@@ -376,7 +368,7 @@ mod tests {
             p(e, 0.0),
         ];
         let (into, status) =
-            distinct_rows(&tri, &[0, 5], true, &crate::cancel::never).expect("valid offsets");
+            distinct_rows(&tri, &[0, 5], true, &crate::run::cancel::never).expect("valid offsets");
         assert_eq!(
             (into, status),
             (vec![0, 1, 1, 3, 0], vec![CurveStatus::Valid])
@@ -385,11 +377,11 @@ mod tests {
         let f = 0.8 * 2.0f64.powi(-40);
         let jit = [p(0.0, 0.0), p(1.0, 0.0), p(0.0, 1.0), p(f, 0.0), p(-f, 0.0)];
         let (into, _) =
-            distinct_rows(&jit, &[0, 5], true, &crate::cancel::never).expect("valid offsets");
+            distinct_rows(&jit, &[0, 5], true, &crate::run::cancel::never).expect("valid offsets");
         assert_eq!(into, [0, 1, 2, 0, 0]);
-        assert!(chords(&jit[..3], true).is_ok());
-        let (_, status) =
-            distinct_rows(&tri[..3], &[0, 3], true, &crate::cancel::never).expect("valid offsets");
+        assert!(chords(&jit[..3], true, &cancel::never).is_ok());
+        let (_, status) = distinct_rows(&tri[..3], &[0, 3], true, &crate::run::cancel::never)
+            .expect("valid offsets");
         assert_eq!(status, [CurveStatus::TooFew]);
     }
 

@@ -82,8 +82,8 @@ pub type EdgeList = (Vec<[usize; 2]>, Vec<[usize; 3]>);
 /// of every face slot (slot `k` of a face is its edge from corner `k` to corner `k + 1`).
 /// Buffers are allocated fallibly; the out-of-memory error names `what`.
 pub fn edges(what: &'static str, f: &[[usize; 3]]) -> crate::error::Result<EdgeList> {
-    let slots = crate::alloc::product(what, 3, f.len(), size_of::<([usize; 2], usize)>())?;
-    let mut keyed: Vec<([usize; 2], usize)> = crate::alloc::with_capacity(what, slots)?;
+    let slots = crate::run::alloc::product(what, 3, f.len(), size_of::<([usize; 2], usize)>())?;
+    let mut keyed: Vec<([usize; 2], usize)> = crate::run::alloc::with_capacity(what, slots)?;
     for (i, c) in f.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
@@ -92,10 +92,10 @@ pub fn edges(what: &'static str, f: &[[usize; 3]]) -> crate::error::Result<EdgeL
     }
     keyed.sort_unstable();
     let mut list: Vec<[usize; 2]> = Vec::new();
-    let mut slot = crate::alloc::filled(what, f.len(), [0usize; 3])?;
+    let mut slot = crate::run::alloc::filled(what, f.len(), [0usize; 3])?;
     for (e, s) in keyed {
         if list.last() != Some(&e) {
-            crate::alloc::push(what, &mut list, e)?;
+            crate::run::alloc::push(what, &mut list, e)?;
         }
         slot[s / 3][s % 3] = list.len() - 1;
     }
@@ -108,7 +108,7 @@ pub fn edge_counts(
     slot: &[[usize; 3]],
     n: usize,
 ) -> crate::error::Result<Vec<usize>> {
-    let mut count = crate::alloc::filled(what, n, 0usize)?;
+    let mut count = crate::run::alloc::filled(what, n, 0usize)?;
     for s in slot.iter().flatten() {
         count[*s] += 1;
     }

@@ -3,6 +3,7 @@
 //! ↔ matrix (Shepperd), the double-reflection step (Wang et al., ACM TOG 27(1), 2008, §4)
 //! and the scale invariance of whole frame computations.
 
+use crate::run::cancel;
 use glam::{DMat3, DQuat, DVec3};
 use proptest::prelude::*;
 
@@ -95,7 +96,7 @@ proptest! {
         let run = |pts: &[DVec3]| {
             let mut out = vec![0.0; 9 * pts.len()];
             let req = Request { points: Some(pts), ..Request::default() };
-            compute_into(&req, &mut out).map(|_| out)
+            compute_into(&req, &mut out, &cancel::never).map(|_| out)
         };
         let f = scale::ldexp(1.0, e);
         let xs: Vec<DVec3> = x.iter().map(|p| *p * f).collect();

@@ -17,8 +17,8 @@
 
 use glam::{DQuat, DVec3};
 
-use crate::alloc;
 use crate::error::Result;
+use crate::run::alloc;
 
 /// Scales within `[2^-SAFE_EXP, 2^SAFE_EXP]` need no normalisation: fifth powers of
 /// chords stay far inside the normal range (`2^±500`).

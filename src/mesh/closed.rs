@@ -13,9 +13,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::measure::{self, BLOCK, Index, Point, Scaled, corners, face_sum};
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh::scale_back;
+use crate::run::cancel::Cancel;
 
 /// The name of the call in out-of-memory errors.
 pub const CALL: &str = "closed tool";
@@ -23,14 +23,10 @@ pub const CALL: &str = "closed tool";
 /// The signed volume and the centroid of the solid bounded by a closed, consistently
 /// oriented, outward-wound triangle mesh (indices checked; errors name `mesh`): every edge in
 /// exactly two faces, each directed edge once, a positive volume.
-pub fn closed_volume_centroid<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<(f64, DVec3)> {
-    closed_volume_centroid_cancellable(v, f, &cancel::never)
-}
-
-/// [`closed_volume_centroid`] that polls `cancel` before every block of faces of each pass
-/// and returns at once (with a meaningless result) when it says stop (see
-/// [`crate::cancel`]).
-pub fn closed_volume_centroid_cancellable<P: Point, I: Index>(
+///
+/// Polls `cancel` before every block of faces of each pass and returns at once (with a meaningless
+/// result) when it says stop (see [`crate::run::cancel`]).
+pub fn closed_volume_centroid<P: Point, I: Index>(
     v: &[P],
     f: &[[I; 3]],
     cancel: Cancel<'_>,
@@ -40,11 +36,11 @@ pub fn closed_volume_centroid_cancellable<P: Point, I: Index>(
         return Err(InputError::new("mesh", "has no faces"));
     }
     let n = v.len();
-    measure::check_faces_cancellable(f, n, cancel).map_err(|e| InputError::new("mesh", e.msg))?;
+    measure::check_faces(f, n, cancel).map_err(|e| InputError::new("mesh", e.msg))?;
     if cancel() {
         return stopped;
     }
-    let st = measure::edges_cancellable(f, n, cancel)?;
+    let st = measure::edges(f, n, cancel)?;
     if cancel() {
         return stopped;
     }
@@ -110,7 +106,7 @@ fn first_bad_edge<I: Index>(
     n: usize,
     cancel: Cancel<'_>,
 ) -> Result<Option<InputError>> {
-    let total = crate::alloc::product(CALL, 3, f.len(), size_of::<u64>())?;
+    let total = crate::run::alloc::product(CALL, 3, f.len(), size_of::<u64>())?;
     let slots = |t: &[I; 3]| {
         let c = corners(t);
         [0, 1, 2].map(|k| {
@@ -119,7 +115,7 @@ fn first_bad_edge<I: Index>(
         })
     };
     // the end of every bucket, then (filled from the end) its start; `start[n]` = slots
-    let mut start = crate::alloc::filled(CALL, n + 1, 0usize)?;
+    let mut start = crate::run::alloc::filled(CALL, n + 1, 0usize)?;
     for block in f.chunks(BLOCK) {
         if cancel() {
             return Ok(None);
@@ -133,7 +129,7 @@ fn first_bad_edge<I: Index>(
         sum += *s;
         *s = sum;
     }
-    let mut keys = crate::alloc::filled(CALL, total, 0u64)?;
+    let mut keys = crate::run::alloc::filled(CALL, total, 0u64)?;
     for block in f.chunks(BLOCK) {
         if cancel() {
             return Ok(None);
@@ -196,30 +192,31 @@ fn first_bad_edge<I: Index>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::run::cancel;
 
     use crate::math::mesh::fixtures::cube_i64 as cube;
 
     #[test]
     fn closed_mesh_volume_centroid_and_refusals() {
         let (v, f) = cube();
-        let (vol, c) = closed_volume_centroid(&v, &f).unwrap();
+        let (vol, c) = closed_volume_centroid(&v, &f, &cancel::never).unwrap();
         assert!((vol - 1.0).abs() < 1e-15 && (c - DVec3::splat(0.5)).length() < 1e-15);
-        let e = closed_volume_centroid(&v, &f[1..]).unwrap_err();
+        let e = closed_volume_centroid(&v, &f[1..], &cancel::never).unwrap_err();
         assert!(e.msg.starts_with("not watertight"), "{e}");
         let flipped: Vec<[i64; 3]> = f.iter().map(|t| [t[0], t[2], t[1]]).collect();
-        let e = closed_volume_centroid(&v, &flipped).unwrap_err();
+        let e = closed_volume_centroid(&v, &flipped, &cancel::never).unwrap_err();
         assert!(e.msg.starts_with("encloses a non-positive volume"), "{e}");
         let mut mixed = f.clone();
         mixed[0] = [f[0][0], f[0][2], f[0][1]];
-        let e = closed_volume_centroid(&v, &mixed).unwrap_err();
+        let e = closed_volume_centroid(&v, &mixed, &cancel::never).unwrap_err();
         assert_eq!(
             (e.arg, e.msg.as_str()),
             ("mesh", "faces are not consistently oriented")
         );
-        let e = closed_volume_centroid(&v, &[[0, 1, 9]]).unwrap_err();
+        let e = closed_volume_centroid(&v, &[[0, 1, 9]], &cancel::never).unwrap_err();
         assert_eq!(e.arg, "mesh");
         assert!(e.msg.starts_with("face 0 refers to vertex 9"), "{e}");
-        assert!(closed_volume_centroid::<DVec3, i64>(&v, &[]).is_err());
+        assert!(closed_volume_centroid::<DVec3, i64>(&v, &[], &cancel::never).is_err());
     }
 
     #[test]
@@ -227,7 +224,7 @@ pub(crate) mod tests {
         let (v, f) = cube();
         // without the face (0, 2, 3), the face (0, 3, 1) comes first: its slot 0 → 1, the
         // diagonal (0, 3), lost its other face
-        let e = closed_volume_centroid(&v, &f[1..]).unwrap_err();
+        let e = closed_volume_centroid(&v, &f[1..], &cancel::never).unwrap_err();
         assert!(
             e.msg
                 .starts_with("not watertight: edge (0, 3) belongs to 1 faces"),
@@ -237,7 +234,7 @@ pub(crate) mod tests {
         // (0, 1) one of four slots, first met at the face (0, 1, 5)
         let mut d = f.clone();
         d.push([0, 0, 1]);
-        let e = closed_volume_centroid(&v, &d).unwrap_err();
+        let e = closed_volume_centroid(&v, &d, &cancel::never).unwrap_err();
         assert!(
             e.msg
                 .starts_with("not watertight: edge (0, 1) belongs to 4 faces"),
@@ -271,12 +268,12 @@ pub(crate) mod tests {
     #[test]
     fn torus_volume_and_centroid() {
         let (v, f) = torus(400, 100);
-        let (vol, c) = closed_volume_centroid(&v, &f).unwrap();
+        let (vol, c) = closed_volume_centroid(&v, &f, &cancel::never).unwrap();
         // Pappus: 2π R · π r², less the faceting
         let exact = std::f64::consts::TAU * std::f64::consts::PI * 0.09;
         assert!((vol / exact - 1.0).abs() < 2e-3, "{vol} {exact}");
         assert!(c.length() < 1e-12, "{c}");
-        let e = closed_volume_centroid(&v, &f[..f.len() - 1]).unwrap_err();
+        let e = closed_volume_centroid(&v, &f[..f.len() - 1], &cancel::never).unwrap_err();
         assert!(e.msg.starts_with("not watertight"), "{e}");
     }
 }

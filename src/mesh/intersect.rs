@@ -29,10 +29,10 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::measure::{Index, Point, corners};
-use crate::cancel::Cancel;
 use crate::error::{InputError, Result};
 use crate::math::bvh::{Aabb, Bvh};
 use crate::math::predicates::{orient, orient3d};
+use crate::run::cancel::Cancel;
 
 /// Faces per block of the candidate search (a Ctrl-C poll each).
 const BLOCK: usize = 1 << 12;
@@ -49,12 +49,12 @@ pub fn self_intersections<P: Point, I: Index>(
     limit: usize,
     cancel: Cancel<'_>,
 ) -> Result<Option<(Vec<[usize; 2]>, bool)>> {
-    super::measure::check_faces_cancellable(f, v.len(), cancel)?;
-    let tri: Vec<[usize; 3]> = crate::alloc::collect(CALL, f.iter().map(corners))?;
+    super::measure::check_faces(f, v.len(), cancel)?;
+    let tri: Vec<[usize; 3]> = crate::run::alloc::collect(CALL, f.iter().map(corners))?;
     let at = |i: usize| v[i].dvec3();
     let pts = |t: &[usize; 3]| [at(t[0]), at(t[1]), at(t[2])];
     let boxes: Vec<Aabb> =
-        crate::alloc::collect(CALL, tri.iter().map(|t| Aabb::of_points(&pts(t))))?;
+        crate::run::alloc::collect(CALL, tri.iter().map(|t| Aabb::of_points(&pts(t))))?;
     if cancel() {
         return Ok(None);
     }
@@ -273,8 +273,8 @@ fn segments_meet(p: DVec2, q: DVec2, r: DVec2, s: DVec2) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cancel;
     use crate::math::mesh::fixtures::{cube, octahedron};
+    use crate::run::cancel;
 
     fn pairs(v: &[DVec3], f: &[[usize; 3]]) -> Vec<[usize; 2]> {
         self_intersections(v, f, usize::MAX, &cancel::never)

@@ -26,9 +26,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh::{compensated_sum, pow2_scale, scale_back};
+use crate::run::cancel::Cancel;
 
 /// Faces per block of the compensated sums (fixed, so results do not depend on threads).
 pub(crate) const BLOCK: usize = 1 << 14;
@@ -92,30 +92,27 @@ pub(crate) fn corners<I: Index>(t: &[I; 3]) -> [usize; 3] {
     t.map(|i| i.get() as usize)
 }
 
-/// Refuse faces with an index outside `0..n` (the first such face; errors name `faces`).
-pub fn check_faces<I: Index>(f: &[[I; 3]], n: usize) -> Result<()> {
-    check_faces_cancellable(f, n, &cancel::never)
-}
-
 /// The first row of `values` (rows of `width` numbers, `f32` or `f64`) that holds a NaN or an
 /// infinity, blocks scanned in parallel; polls `cancel` before each block (a cancelled scan
-/// finds nothing in the blocks it skips, see [`crate::cancel`]).
+/// finds nothing in the blocks it skips, see [`crate::run::cancel`]).
 pub fn first_non_finite_row<T: Copy + Sync + Into<f64>>(
     values: &[T],
     width: usize,
     cancel: Cancel<'_>,
 ) -> Option<usize> {
     let rows = values.len() / width.max(1);
-    crate::cancel::first_bad_index(rows, cancel, |i| {
+    crate::run::cancel::first_bad_index(rows, cancel, |i| {
         values[i * width..(i + 1) * width]
             .iter()
             .all(|&v| v.into().is_finite())
     })
 }
 
-/// [`check_faces`] that polls `cancel` before every block of faces; a cancelled check passes
-/// the blocks it skips (the caller discards the result, see [`crate::cancel`]).
-pub fn check_faces_cancellable<I: Index>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<()> {
+/// Refuse faces with an index outside `0..n` (the first such face; errors name `faces`).
+///
+/// Polls `cancel` before every block of faces; a cancelled check passes the blocks it skips (the
+/// caller discards the result, see [`crate::run::cancel`]).
+pub fn check_faces<I: Index>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<()> {
     let bad = f
         .par_chunks(BLOCK)
         .position_first(|b| !cancel() && !b.iter().all(|t| valid(t, n)));
@@ -240,17 +237,10 @@ pub(crate) fn mean<P: Point>(v: &[P], s: f64, cancel: Cancel<'_>) -> DVec3 {
 
 /// Signed volume of the mesh `(v, f)` about its mean vertex (faces checked, errors name
 /// `faces`); positive for a closed mesh wound counter-clockwise seen from outside.
-pub fn volume<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    volume_cancellable(v, f, &cancel::never)
-}
-
-/// [`volume`] that polls `cancel` before every block of faces (a cancelled call returns a
-/// partial sum, see [`crate::cancel`]).
-pub fn volume_cancellable<P: Point, I: Index>(
-    v: &[P],
-    f: &[[I; 3]],
-    cancel: Cancel<'_>,
-) -> Result<f64> {
+///
+/// Polls `cancel` before every block of faces (a cancelled call returns a partial sum, see
+/// [`crate::run::cancel`]).
+pub fn volume<P: Point, I: Index>(v: &[P], f: &[[I; 3]], cancel: Cancel<'_>) -> Result<f64> {
     let sc = Scaled::of(v, true, cancel);
     let six = face_sum(
         f,
@@ -262,17 +252,10 @@ pub fn volume_cancellable<P: Point, I: Index>(
 }
 
 /// Total area of the triangles (faces checked, errors name `faces`).
-pub fn area<P: Point, I: Index>(v: &[P], f: &[[I; 3]]) -> Result<f64> {
-    area_cancellable(v, f, &cancel::never)
-}
-
-/// [`area`] that polls `cancel` before every block of faces (a cancelled call returns a
-/// partial sum, see [`crate::cancel`]).
-pub fn area_cancellable<P: Point, I: Index>(
-    v: &[P],
-    f: &[[I; 3]],
-    cancel: Cancel<'_>,
-) -> Result<f64> {
+///
+/// Polls `cancel` before every block of faces (a cancelled call returns a partial sum, see
+/// [`crate::run::cancel`]).
+pub fn area<P: Point, I: Index>(v: &[P], f: &[[I; 3]], cancel: Cancel<'_>) -> Result<f64> {
     let sc = Scaled::of(v, false, cancel);
     let twice = face_sum(
         f,
@@ -357,17 +340,10 @@ impl Key for u64 {
 }
 
 /// Edge statistics of the faces `f` over `n` vertices (faces checked, errors name `faces`).
-pub fn edges<I: Index>(f: &[[I; 3]], n: usize) -> Result<EdgeStats> {
-    edges_cancellable(f, n, &cancel::never)
-}
-
-/// [`edges`] that polls `cancel` before every chunk of faces and every part of the
-/// vertices (a cancelled call returns incomplete counts, see [`crate::cancel`]).
-pub fn edges_cancellable<I: Index>(
-    f: &[[I; 3]],
-    n: usize,
-    cancel: Cancel<'_>,
-) -> Result<EdgeStats> {
+///
+/// Polls `cancel` before every chunk of faces and every part of the vertices (a cancelled call
+/// returns incomplete counts, see [`crate::run::cancel`]).
+pub fn edges<I: Index>(f: &[[I; 3]], n: usize, cancel: Cancel<'_>) -> Result<EdgeStats> {
     if (2 * n as u64) < u32::MAX as u64 {
         edges_keyed::<I, u32>(f, n, cancel)
     } else {
@@ -709,6 +685,7 @@ fn sort_small<K: Key>(b: &mut [K]) {
 mod tests {
     use super::*;
     use crate::math::mesh::fixtures::octahedron;
+    use crate::run::cancel;
 
     fn oct() -> (Vec<[f64; 3]>, Vec<[i64; 3]>) {
         let (v, f) = octahedron();
@@ -721,13 +698,13 @@ mod tests {
     #[test]
     fn octahedron_measures() {
         let (v, f) = oct();
-        assert!((volume(&v, &f).unwrap() - 4.0 / 3.0).abs() < 1e-15);
+        assert!((volume(&v, &f, &cancel::never).unwrap() - 4.0 / 3.0).abs() < 1e-15);
         let a = 8.0 * 3f64.sqrt() / 2.0;
-        assert!((area(&v, &f).unwrap() - a).abs() < 1e-14);
+        assert!((area(&v, &f, &cancel::never).unwrap() - a).abs() < 1e-14);
         let v32: Vec<[f32; 3]> = v.iter().map(|p| p.map(|x| x as f32)).collect();
         let f32i: Vec<[i32; 3]> = f.iter().map(|t| t.map(|i| i as i32)).collect();
-        assert!((volume(&v32, &f32i).unwrap() - 4.0 / 3.0).abs() < 1e-6);
-        let e = edges(&f, 6).unwrap();
+        assert!((volume(&v32, &f32i, &cancel::never).unwrap() - 4.0 / 3.0).abs() < 1e-6);
+        let e = edges(&f, 6, &cancel::never).unwrap();
         assert_eq!(e.edges, 12);
         assert!(e.watertight());
     }
@@ -737,11 +714,17 @@ mod tests {
         // scaling by 2^k scales the area by 4^k and the volume by 8^k bit for bit while the
         // results are representable; beyond, `inf` or 0 but never NaN
         let (v, f) = oct();
-        let (a1, v1) = (area(&v, &f).unwrap(), volume(&v, &f).unwrap());
+        let (a1, v1) = (
+            area(&v, &f, &cancel::never).unwrap(),
+            volume(&v, &f, &cancel::never).unwrap(),
+        );
         for k in [-340i32, -300, -260, -150, -1, 0, 1, 100, 150, 250, 330] {
             let s = 2f64.powi(k);
             let w: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| x * s)).collect();
-            let (a, vol) = (area(&w, &f).unwrap(), volume(&w, &f).unwrap());
+            let (a, vol) = (
+                area(&w, &f, &cancel::never).unwrap(),
+                volume(&w, &f, &cancel::never).unwrap(),
+            );
             let want_a = a1 * s * s;
             let want_v = v1 * s * s * s;
             assert_eq!(
@@ -754,8 +737,8 @@ mod tests {
         // at 1e80 the plain sums overflowed to NaN; at 1e-80 they underflowed to 0
         for scale in [1e-120, 1e-80, 1e80, 1e102, 1e103] {
             let w: Vec<[f64; 3]> = v.iter().map(|p| p.map(|x| x * scale)).collect();
-            let a = area(&w, &f).unwrap();
-            let vol = volume(&w, &f).unwrap();
+            let a = area(&w, &f, &cancel::never).unwrap();
+            let vol = volume(&w, &f, &cancel::never).unwrap();
             assert!(
                 (a / (a1 * scale * scale) - 1.0).abs() < 1e-15 || a.is_infinite(),
                 "{a}"
@@ -769,28 +752,31 @@ mod tests {
     fn broken_meshes() {
         let (_, f) = oct();
         // a hole: three boundary edges
-        let e = edges(&f[1..], 6).unwrap();
+        let e = edges(&f[1..], 6, &cancel::never).unwrap();
         assert_eq!((e.boundary, e.closed()), (3, false));
         // a flipped face: its three edges are traversed twice the same way
         let mut g = f.clone();
         g[0] = [g[0][0], g[0][2], g[0][1]];
-        let e = edges(&g, 6).unwrap();
+        let e = edges(&g, 6, &cancel::never).unwrap();
         assert!(e.closed() && !e.winding_consistent() && e.inconsistent == 3);
         // a fin: a third face on an edge
         let mut g = f.clone();
         g.push([0, 2, 3]);
-        let e = edges(&g, 6).unwrap();
+        let e = edges(&g, 6, &cancel::never).unwrap();
         assert_eq!((e.non_manifold, e.boundary), (2, 1)); // 0-2 and 3-0 thrice, 2-3 once
         assert!(!e.watertight());
         // degenerate and out-of-range faces
-        let e = edges(&[[0i64, 0, 1]], 2).unwrap();
+        let e = edges(&[[0i64, 0, 1]], 2, &cancel::never).unwrap();
         assert_eq!((e.degenerate, e.edges, e.boundary), (1, 1, 0));
         assert!(e.winding_consistent() && !e.closed());
-        let err = edges(&[[0i64, 1, -1]], 3).unwrap_err();
+        let err = edges(&[[0i64, 1, -1]], 3, &cancel::never).unwrap_err();
         assert_eq!(err.arg, "faces");
         assert!(err.msg.contains("face 0 refers to vertex -1"), "{err}");
-        assert!(volume(&[[0.0; 3]; 3], &[[0i64, 1, 3]]).is_err());
-        assert_eq!(edges::<i64>(&[], 0).unwrap(), EdgeStats::default());
+        assert!(volume(&[[0.0; 3]; 3], &[[0i64, 1, 3]], &cancel::never).is_err());
+        assert_eq!(
+            edges::<i64>(&[], 0, &cancel::never).unwrap(),
+            EdgeStats::default()
+        );
     }
 
     /// The statistics by a map of the undirected edges (the definition, quadratic memory
@@ -842,25 +828,25 @@ mod tests {
         for (r, s) in [(3, 3), (50, 7), (700, 16), (1000, 40)] {
             let f = torus(r, s);
             let n = (r * s) as usize;
-            let e = edges(&f, n).unwrap();
+            let e = edges(&f, n, &cancel::never).unwrap();
             assert_eq!(e, brute(&f));
             assert!(e.watertight(), "{r} x {s}: {e:?}");
             assert_eq!(e.edges, 3 * n);
             let f32i: Vec<[i32; 3]> = f.iter().map(|t| t.map(|i| i as i32)).collect();
-            assert_eq!(edges(&f32i, n).unwrap(), e);
+            assert_eq!(edges(&f32i, n, &cancel::never).unwrap(), e);
             // one flipped face far into the mesh, one removed, one duplicated
             let mut g = f.clone();
             let k = g.len() * 2 / 3;
             g[k] = [g[k][1], g[k][0], g[k][2]];
-            let e = edges(&g, n).unwrap();
+            let e = edges(&g, n, &cancel::never).unwrap();
             assert_eq!((e.inconsistent, e.closed()), (3, true));
             assert_eq!(e, brute(&g));
             g.remove(k / 2);
             g.push(g[k / 3]);
-            assert_eq!(edges(&g, n).unwrap(), brute(&g));
+            assert_eq!(edges(&g, n, &cancel::never).unwrap(), brute(&g));
             // the vertices renumbered far apart: the slots are distributed by part first
             let far: Vec<[i64; 3]> = g.iter().map(|t| t.map(|i| (i * 7919) % n as i64)).collect();
-            assert_eq!(edges(&far, n).unwrap(), brute(&g));
+            assert_eq!(edges(&far, n, &cancel::never).unwrap(), brute(&g));
         }
         // random faces (with repeats, degenerate corners, unused vertices)
         let mut x = 0x9e3779b97f4a7c15u64;
@@ -872,12 +858,16 @@ mod tests {
         };
         for (n, faces) in [(4, 20), (30, 500), (5000, 30_000), (70_000, 60_000)] {
             let f: Vec<[i64; 3]> = (0..faces).map(|_| [next(n), next(n), next(n)]).collect();
-            assert_eq!(edges(&f, n as usize).unwrap(), brute(&f), "{n} vertices");
+            assert_eq!(
+                edges(&f, n as usize, &cancel::never).unwrap(),
+                brute(&f),
+                "{n} vertices"
+            );
         }
         // an index out of range in a late chunk is the one reported
         let mut f = torus(1000, 40);
         f[70_000][2] = 40_000;
-        let err = edges(&f, 40_000).unwrap_err();
+        let err = edges(&f, 40_000, &cancel::never).unwrap_err();
         assert!(
             err.msg.contains("face 70000 refers to vertex 40000"),
             "{err}"

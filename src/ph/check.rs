@@ -7,9 +7,9 @@
 use glam::DVec3;
 
 use super::{Cubic, Invariants};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Tolerance of the control-polygon PH test for spline input.
 pub const SPLINE_PH_TOL: f64 = 1e-7;
@@ -43,13 +43,10 @@ pub fn finite_rows<const N: usize>(arg: &'static str, rows: &[[f64; N]]) -> Resu
 }
 
 /// [`Cubic::is_ph`] per cubic, after checking the cubics (finite) and `tol` (≥ 0).
-pub fn is_ph_rows(cubics: &[Cubic], tol: f64) -> Result<Vec<bool>> {
-    is_ph_rows_cancellable(cubics, tol, &cancel::never)
-}
-
-/// [`is_ph_rows`] that polls `cancel` between blocks of cubics (an incomplete result once it
-/// says stop; see [`crate::cancel`]).
-pub fn is_ph_rows_cancellable(cubics: &[Cubic], tol: f64, cancel: Cancel<'_>) -> Result<Vec<bool>> {
+///
+/// Polls `cancel` between blocks of cubics (an incomplete result once it says stop; see
+/// [`crate::run::cancel`]).
+pub fn is_ph_rows(cubics: &[Cubic], tol: f64, cancel: Cancel<'_>) -> Result<Vec<bool>> {
     if !(tol >= 0.0) {
         return Err(InputError::new(
             "tol",
@@ -57,21 +54,18 @@ pub fn is_ph_rows_cancellable(cubics: &[Cubic], tol: f64, cancel: Cancel<'_>) ->
         ));
     }
     finite_cubics(cubics)?;
-    alloc::try_collect_cancellable("ph.is_ph", cubics.iter().map(|c| Ok(c.is_ph(tol))), cancel)
+    alloc::try_collect("ph.is_ph", cubics.iter().map(|c| Ok(c.is_ph(tol))), cancel)
 }
 
 /// [`Cubic::invariants`] per cubic; a control polygon with a zero-length leg (relative to
 /// the largest coordinate, 1e-14) or with undefined invariants (any but κ/τ non-finite: a
 /// straight or degenerate polygon) is an error naming the cubic.
-pub fn invariant_rows(cubics: &[Cubic]) -> Result<Vec<Invariants>> {
-    invariant_rows_cancellable(cubics, &cancel::never)
-}
-
-/// [`invariant_rows`] that polls `cancel` between blocks of cubics (an incomplete result
-/// once it says stop; see [`crate::cancel`]).
-pub fn invariant_rows_cancellable(cubics: &[Cubic], cancel: Cancel<'_>) -> Result<Vec<Invariants>> {
+///
+/// Polls `cancel` between blocks of cubics (an incomplete result once it says stop; see
+/// [`crate::run::cancel`]).
+pub fn invariant_rows(cubics: &[Cubic], cancel: Cancel<'_>) -> Result<Vec<Invariants>> {
     finite_cubics(cubics)?;
-    alloc::try_collect_cancellable(
+    alloc::try_collect(
         "ph.invariants",
         cubics.iter().enumerate().map(|(i, c)| {
             let scale =
@@ -207,6 +201,7 @@ fn argmax(x: &[f64]) -> Option<(usize, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     fn spline() -> Vec<Cubic> {
         let a = Cubic::from_quaternions([0.3, -1.2, 0.7, 0.4], [-0.5, 0.2, 1.1, -0.9], DVec3::ZERO);
@@ -222,8 +217,14 @@ mod tests {
         let e = finite_cubics(&c).unwrap_err();
         assert_eq!(e.arg, "control_points");
         assert_eq!(e.msg, "contains non-finite values (at index (1, 2, 1))");
-        assert_eq!(is_ph_rows(&c, 1e-9).unwrap_err().arg, "control_points");
-        assert_eq!(invariant_rows(&c).unwrap_err().arg, "control_points");
+        assert_eq!(
+            is_ph_rows(&c, 1e-9, &cancel::never).unwrap_err().arg,
+            "control_points"
+        );
+        assert_eq!(
+            invariant_rows(&c, &cancel::never).unwrap_err().arg,
+            "control_points"
+        );
         let e = finite_rows(
             "A0",
             &[[1.0, 2.0, 3.0, 4.0], [0.0, f64::INFINITY, 0.0, 0.0]],
@@ -235,9 +236,12 @@ mod tests {
     #[test]
     fn is_ph_tolerance_must_be_non_negative() {
         let c = spline();
-        assert_eq!(is_ph_rows(&c, 1e-9).unwrap(), vec![true, true]);
+        assert_eq!(
+            is_ph_rows(&c, 1e-9, &cancel::never).unwrap(),
+            vec![true, true]
+        );
         for tol in [-1.0, f64::NAN] {
-            let e = is_ph_rows(&c, tol).unwrap_err();
+            let e = is_ph_rows(&c, tol, &cancel::never).unwrap_err();
             assert_eq!(e.arg, "tol");
             assert!(e.msg.starts_with("must be non-negative"), "{e}");
         }
@@ -246,14 +250,14 @@ mod tests {
     #[test]
     fn invariants_of_degenerate_polygons_are_errors() {
         let c = spline();
-        assert_eq!(invariant_rows(&c).unwrap().len(), 2);
+        assert_eq!(invariant_rows(&c, &cancel::never).unwrap().len(), 2);
         let zero = Cubic::new([DVec3::ZERO, DVec3::ZERO, DVec3::X, DVec3::Y]);
-        let e = invariant_rows(&[c[0], zero]).unwrap_err();
+        let e = invariant_rows(&[c[0], zero], &cancel::never).unwrap_err();
         assert_eq!(e.arg, "control_points");
         assert!(e.msg.starts_with("cubic 1 has a zero-length leg"), "{e}");
         // a straight polygon that turns back: σ vanishes inside, κ_max = 0/0
         let back = Cubic::new([DVec3::ZERO, DVec3::X, DVec3::ZERO, DVec3::X]);
-        let e = invariant_rows(&[back]).unwrap_err();
+        let e = invariant_rows(&[back], &cancel::never).unwrap_err();
         assert_eq!(e.arg, "control_points");
         assert!(
             e.msg.starts_with("the invariants of cubic 0 are undefined"),

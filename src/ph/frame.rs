@@ -29,10 +29,10 @@
 use glam::{DMat3, DVec3};
 
 use super::{Cubic, Quat, bern2};
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::geometry::{any_perpendicular, rotate_about};
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Simpson subintervals of the objective `Î(λ)` (MJ (41)).
 pub const SIMPSON_N: usize = 20;
@@ -334,22 +334,19 @@ pub enum Start {
     Angle(f64),
 }
 
-/// Frame data of every segment of a G¹ PH spline.
-/// `omega_start` and `phi`, when given, must be finite.
-pub fn setup(cubics: &[Cubic], start: Start, phi: Option<f64>) -> Result<Vec<Segment>> {
-    setup_cancellable(cubics, start, phi, &cancel::never)
-}
-
-/// Segments between polls of the sequential pass of [`setup_cancellable`].
+/// Segments between polls of the sequential pass of [`setup`].
 const CHAIN_BLOCK: usize = 1 << 10;
 /// Segments per block of the parallel angle fits (each about 30 µs).
 const FIT_GRAIN: usize = 16;
 
-/// [`setup`] that polls `cancel` and fails with [`cancel::stopped`] once it says stop.
-/// The reference vector is carried from segment to segment in one sequential pass; the
-/// rational angle fits ([`fit_angle`], which depend only on their own segment) follow in
-/// parallel, so the result is that of fitting each segment in the pass.
-pub fn setup_cancellable(
+/// Frame data of every segment of a G¹ PH spline.
+/// `omega_start` and `phi`, when given, must be finite.
+///
+/// Polls `cancel` and fails with [`InputError::stopped`] once it says stop. The reference vector is
+/// carried from segment to segment in one sequential pass; the rational angle fits ([`fit_angle`],
+/// which depend only on their own segment) follow in parallel, so the result is that of fitting
+/// each segment in the pass.
+pub fn setup(
     cubics: &[Cubic],
     start: Start,
     phi: Option<f64>,
@@ -392,7 +389,7 @@ pub fn setup_cancellable(
     let mut out = alloc::with_capacity("PHSpline frames", cubics.len())?;
     for (i, c) in cubics.iter().enumerate() {
         if i % CHAIN_BLOCK == 0 && cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         let found =
             bent(c).and_then(|seg| Some((frenet_of(&seg, 0.0)?, frenet_of(&seg, 1.0)?, seg)));
@@ -435,8 +432,8 @@ pub fn setup_cancellable(
             fit_angle(seg, phi)
         }
     };
-    let Some(fits) = cancel::collect("PHSpline frames", out.len(), FIT_GRAIN, cancel, fit)? else {
-        return Err(cancel::stopped());
+    let Some(fits) = alloc::rows("PHSpline frames", out.len(), FIT_GRAIN, cancel, fit)? else {
+        return Err(InputError::stopped());
     };
     for (seg, fit) in out.iter_mut().zip(fits) {
         seg.fit = fit;
@@ -484,10 +481,17 @@ pub fn frame_at(c: &Cubic, seg: &Segment, v: f64, mode: Mode) -> (DMat3, f64) {
     }
 }
 
+/// Rows of a block of [`frames_at`] between polls.
+const CANCEL_ROWS: usize = 1 << 16;
+
 /// Frames (row-major, columns `r, s, t`, as NumPy sees an `(n, 3, 3)` array) and their
 /// angles from the principal normal at the global parameters `s` of a G¹ PH spline (see
 /// [`super::locate`]), in parallel: [`setup`] once, then [`frame_at`] per parameter.
 /// `frames` and `angles` hold one entry per parameter.
+///
+/// Polls `cancel` before every block of [`CANCEL_ROWS`] rows and skips the remaining blocks once it
+/// says stop (the outputs are then incomplete; see [`crate::run::cancel`]).
+#[allow(clippy::too_many_arguments)]
 pub fn frames_at(
     cubics: &[Cubic],
     s: &[f64],
@@ -496,40 +500,12 @@ pub fn frames_at(
     mode: Mode,
     frames: &mut [[f64; 9]],
     angles: &mut [f64],
-) -> Result<()> {
-    frames_at_cancellable(
-        cubics,
-        s,
-        start,
-        phi,
-        mode,
-        frames,
-        angles,
-        &crate::cancel::never,
-    )
-}
-
-/// Rows of a block of [`frames_at_cancellable`] between polls.
-const CANCEL_ROWS: usize = 1 << 16;
-
-/// [`frames_at`] that polls `cancel` before every block of [`CANCEL_ROWS`] rows and skips
-/// the remaining blocks once it says stop (the outputs are then incomplete; see
-/// [`crate::cancel`]).
-#[allow(clippy::too_many_arguments)]
-pub fn frames_at_cancellable(
-    cubics: &[Cubic],
-    s: &[f64],
-    start: Start,
-    phi: Option<f64>,
-    mode: Mode,
-    frames: &mut [[f64; 9]],
-    angles: &mut [f64],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
     use rayon::prelude::*;
     debug_assert!(frames.len() == s.len() && angles.len() == s.len());
-    super::check_params_cancellable(cubics.len(), s, cancel)?;
-    let segs = setup_cancellable(cubics, start, phi, cancel)?;
+    super::check_params(cubics.len(), s, cancel)?;
+    let segs = setup(cubics, start, phi, cancel)?;
     frames
         .par_chunks_mut(CANCEL_ROWS)
         .zip(angles.par_chunks_mut(CANCEL_ROWS))
@@ -555,6 +531,7 @@ pub fn frames_at_cancellable(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     fn r1() -> Cubic {
         Cubic::new([
@@ -590,11 +567,11 @@ mod tests {
         ];
         let s = [0.0, 0.3, 1.0, 1.7, 2.0];
         let start = Start::Angle(0.4);
-        let segs = setup(&c, start, None).unwrap();
+        let segs = setup(&c, start, None, &cancel::never).unwrap();
         for mode in [Mode::Frenet, Mode::Exact, Mode::Rational] {
             let mut f = vec![[0.0; 9]; s.len()];
             let mut a = vec![0.0; s.len()];
-            frames_at(&c, &s, start, None, mode, &mut f, &mut a).unwrap();
+            frames_at(&c, &s, start, None, mode, &mut f, &mut a, &cancel::never).unwrap();
             for (k, &x) in s.iter().enumerate() {
                 let (i, v) = crate::ph::locate(c.len(), x);
                 let (m, om) = frame_at(&c[i], &segs[i], v, mode);
@@ -603,19 +580,35 @@ mod tests {
             }
         }
         let mut f = vec![[0.0; 9]; 1];
-        let e = frames_at(&c, &[-0.5], start, None, Mode::Exact, &mut f, &mut [0.0]).unwrap_err();
+        let e = frames_at(
+            &c,
+            &[-0.5],
+            start,
+            None,
+            Mode::Exact,
+            &mut f,
+            &mut [0.0],
+            &cancel::never,
+        )
+        .unwrap_err();
         assert_eq!(e.arg, "s");
     }
 
     #[test]
     fn setup_needs_a_finite_start_angle_and_offset() {
         let c = [r1()];
-        let e = setup(&c, Start::Angle(f64::NAN), None).unwrap_err();
+        let e = setup(&c, Start::Angle(f64::NAN), None, &cancel::never).unwrap_err();
         assert_eq!(e.to_string(), "omega_start: must be finite");
-        let e = setup(&c, Start::Angle(0.0), Some(f64::INFINITY)).unwrap_err();
+        let e = setup(&c, Start::Angle(0.0), Some(f64::INFINITY), &cancel::never).unwrap_err();
         assert_eq!(e.to_string(), "phi: must be finite");
-        let e = setup(&c, Start::Vector(DVec3::new(f64::NAN, 0.0, 1.0)), None).unwrap_err();
+        let e = setup(
+            &c,
+            Start::Vector(DVec3::new(f64::NAN, 0.0, 1.0)),
+            None,
+            &cancel::never,
+        )
+        .unwrap_err();
         assert_eq!(e.arg, "initial");
-        assert!(setup(&c, Start::Angle(0.3), Some(0.1)).is_ok());
+        assert!(setup(&c, Start::Angle(0.3), Some(0.1), &cancel::never).is_ok());
     }
 }

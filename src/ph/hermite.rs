@@ -35,10 +35,10 @@
 use glam::DVec3;
 
 use super::Cubic;
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::geometry::any_perpendicular;
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// `|t₀ − t₁|` below which tangents count as parallel (angle < 1e-8 rad).
 pub const EPS_PARALLEL: f64 = 1e-8;
@@ -215,21 +215,11 @@ pub struct Rows {
 /// unit (they are normalised). Every row is checked (finite, non-zero tangents, `p₀ ≠ p₁`);
 /// with `all = false` the first row without a solution is an error, otherwise its reason
 /// is recorded in [`Rows::codes`]. With `batch` the messages name the row.
-pub fn hermite_rows(
-    p0: &[DVec3],
-    t0: &[DVec3],
-    p1: &[DVec3],
-    t1: &[DVec3],
-    all: bool,
-    batch: bool,
-) -> Result<Rows> {
-    hermite_rows_cancellable(p0, t0, p1, t1, all, batch, &cancel::never)
-}
-
-/// [`hermite_rows`] that polls `cancel` every [`cancel::BLOCK`] rows and fails with
-/// [`cancel::stopped`] once it says stop.
+///
+/// Polls `cancel` every [`cancel::BLOCK`] rows and fails with [`InputError::stopped`] once it says
+/// stop.
 #[allow(clippy::too_many_arguments)]
-pub fn hermite_rows_cancellable(
+pub fn hermite_rows(
     p0: &[DVec3],
     t0: &[DVec3],
     p1: &[DVec3],
@@ -257,7 +247,7 @@ pub fn hermite_rows_cancellable(
     };
     for i in 0..m {
         if i % cancel::BLOCK == 0 && cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         let at = |arg: &'static str, msg: &str| {
             let msg = if batch {
@@ -398,6 +388,7 @@ mod tests {
             &[3.0 * t1, DVec3::Y],
             true,
             true,
+            &cancel::never,
         )
         .unwrap();
         let want = hermite(p0, (2.0 * t0).normalize(), p1, (3.0 * t1).normalize());
@@ -419,6 +410,7 @@ mod tests {
             &[DVec3::Y],
             false,
             true,
+            &cancel::never,
         )
         .unwrap_err();
         assert_eq!(e.arg, "p0, t0, p1, t1");
@@ -430,10 +422,20 @@ mod tests {
             &[DVec3::Y],
             true,
             false,
+            &cancel::never,
         )
         .unwrap_err();
         assert_eq!((e.arg, e.msg.as_str()), ("t0", "zero tangent vector"));
-        let e = hermite_rows(&[DVec3::X], &[], &[DVec3::Y], &[DVec3::Y], true, false).unwrap_err();
+        let e = hermite_rows(
+            &[DVec3::X],
+            &[],
+            &[DVec3::Y],
+            &[DVec3::Y],
+            true,
+            false,
+            &cancel::never,
+        )
+        .unwrap_err();
         assert_eq!(
             e.to_string(),
             "p0, t0, p1, t1: must have the same number of rows"

@@ -25,9 +25,9 @@ pub mod hermite;
 
 use glam::DVec3;
 
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 use crate::math::cubic::Bezier;
 pub use crate::math::cubic::bern2;
@@ -385,18 +385,15 @@ pub fn locate(m: usize, s: f64) -> (usize, f64) {
 
 /// Check global parameters `s` of a spline of `m` segments: at least one segment, every
 /// value finite and within `[0, m]`.
-pub fn check_params(m: usize, s: &[f64]) -> Result<()> {
-    check_params_cancellable(m, s, &cancel::never)
-}
-
-/// [`check_params`] scanning `s` in parallel blocks that poll `cancel` (a stopped check
-/// passes; see [`crate::cancel`]).
-pub fn check_params_cancellable(m: usize, s: &[f64], cancel: Cancel<'_>) -> Result<()> {
+///
+/// Scans `s` in parallel blocks that poll `cancel` (a stopped check passes; see
+/// [`crate::run::cancel`]).
+pub fn check_params(m: usize, s: &[f64], cancel: Cancel<'_>) -> Result<()> {
     if m == 0 {
         return Err(InputError::new("control_points", "no segments"));
     }
     let inside = |x: &f64| x.is_finite() && *x >= 0.0 && *x <= m as f64;
-    if crate::frames::validate::first_bad_cancellable(s, inside, cancel).is_some() {
+    if crate::frames::validate::first_bad(s, inside, cancel).is_some() {
         return Err(InputError::new(
             "s",
             format!("values must be finite and within [0, {m}]"),
@@ -409,20 +406,20 @@ pub fn check_params_cancellable(m: usize, s: &[f64], cancel: Cancel<'_>) -> Resu
 /// of the spline `cubics` at the global parameters `s` (see [`locate`]), in parallel.
 pub fn eval_at(cubics: &[Cubic], s: &[f64], derivative: usize) -> Result<Vec<DVec3>> {
     let mut out = alloc::filled("PHSpline.evaluate", s.len(), DVec3::ZERO)?;
-    eval_into_cancellable(cubics, s, derivative, &mut out, &cancel::never)?;
+    eval_into(cubics, s, derivative, &mut out, &cancel::never)?;
     Ok(out)
 }
 
 /// [`eval_at`] into `out` (one row per parameter), polling `cancel` in the checks and
-/// between blocks of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
-pub fn eval_into_cancellable(
+/// between blocks of rows (`out` incomplete once it says stop; see [`crate::run::cancel`]).
+pub fn eval_into(
     cubics: &[Cubic],
     s: &[f64],
     derivative: usize,
     out: &mut [DVec3],
     cancel: Cancel<'_>,
 ) -> Result<()> {
-    check_params_cancellable(cubics.len(), s, cancel)?;
+    check_params(cubics.len(), s, cancel)?;
     check::finite_cubics(cubics)?;
     if derivative > 3 {
         return Err(InputError::new(
@@ -455,7 +452,7 @@ pub fn from_quaternion_rows(a0: &[Quat], a1: &[Quat], start: &[DVec3]) -> Result
 /// [`Cubic::from_quaternions`] row by row into `out` (one row `[b₀, b₁, b₂, b₃]` per pair of
 /// preimages): `a0`, `a1` scalar first, or `(x, y, z, w)` when not `scalar_first`; `start`
 /// holds one point for every row or one per row. Polls `cancel` in the checks and between
-/// blocks of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
+/// blocks of rows (`out` incomplete once it says stop; see [`crate::run::cancel`]).
 pub fn from_quaternion_rows_into(
     a0: &[Quat],
     a1: &[Quat],
@@ -475,11 +472,8 @@ pub fn from_quaternion_rows_into(
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }
     let finite = |arg: &'static str, rows: &[Quat]| {
-        let bad = crate::frames::validate::first_bad_cancellable(
-            rows,
-            |r| r.iter().all(|x| x.is_finite()),
-            cancel,
-        );
+        let bad =
+            crate::frames::validate::first_bad(rows, |r| r.iter().all(|x| x.is_finite()), cancel);
         bad.map_or(Ok(()), |i| {
             Err(InputError::new(
                 arg,
@@ -515,7 +509,7 @@ pub fn from_quaternion_rows_into(
         return Ok(());
     }
     let inside = |r: &[f64; 12]| r.iter().all(|x| x.is_finite());
-    match crate::frames::validate::first_bad_cancellable(out, inside, cancel) {
+    match crate::frames::validate::first_bad(out, inside, cancel) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
             "A0, A1",
@@ -530,20 +524,17 @@ pub fn from_quaternion_rows_into(
 /// [`Cubic::preimage`] of every cubic as a row `[A₀ (4), A₁ (4), residual]`; a cubic with a
 /// zero-length leg, or whose residual exceeds `tol` times the length of its control polygon
 /// (not PH), is an error naming it (`batch`: with its index).
-pub fn preimage_rows(cubics: &[Cubic], tol: f64, batch: bool) -> Result<Vec<[f64; 9]>> {
-    preimage_rows_cancellable(cubics, tol, batch, &crate::cancel::never)
-}
-
-/// [`preimage_rows`] that polls `cancel` between blocks of cubics (an incomplete result
-/// once it says stop; see [`crate::cancel`]).
-pub fn preimage_rows_cancellable(
+///
+/// Polls `cancel` between blocks of cubics (an incomplete result once it says stop; see
+/// [`crate::run::cancel`]).
+pub fn preimage_rows(
     cubics: &[Cubic],
     tol: f64,
     batch: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<[f64; 9]>> {
     check::finite_cubics(cubics)?;
-    alloc::try_collect_cancellable(
+    alloc::try_collect(
         "ph.preimage",
         cubics.iter().enumerate().map(|(i, c)| {
             let (q0, q1, res) = c.preimage().ok_or_else(|| {
@@ -638,7 +629,7 @@ mod tests {
     #[test]
     fn quaternion_rows_round_trip() {
         let c = two_segments();
-        let rows = preimage_rows(&c, 1e-9, true).unwrap();
+        let rows = preimage_rows(&c, 1e-9, true, &cancel::never).unwrap();
         let a0: Vec<Quat> = rows.iter().map(|r| [r[0], r[1], r[2], r[3]]).collect();
         let a1: Vec<Quat> = rows.iter().map(|r| [r[4], r[5], r[6], r[7]]).collect();
         assert!(rows.iter().all(|r| r[8] < 1e-12));
@@ -661,7 +652,7 @@ mod tests {
         let e = from_quaternion_rows(&a0, &a1, &[DVec3::ZERO; 3]).unwrap_err();
         assert_eq!(e.arg, "A0, A1, start");
         let flat = Cubic::new([DVec3::ZERO, DVec3::ZERO, DVec3::X, DVec3::Y]);
-        let e = preimage_rows(&[c[0], flat], 1e-9, true).unwrap_err();
+        let e = preimage_rows(&[c[0], flat], 1e-9, true, &cancel::never).unwrap_err();
         assert!(
             e.to_string().starts_with("control_points: cubic 1 has"),
             "{e}"
@@ -669,13 +660,13 @@ mod tests {
         // not PH: the residual names the cubic (batch) or not (one cubic)
         let mut bent = c[1];
         bent.b[1] += DVec3::new(0.0, 0.01, 0.0);
-        let e = preimage_rows(&[c[0], bent], 1e-9, true).unwrap_err();
+        let e = preimage_rows(&[c[0], bent], 1e-9, true, &cancel::never).unwrap_err();
         assert!(
             e.to_string()
                 .starts_with("control_points: cubic 1: not a PH cubic"),
             "{e}"
         );
-        let e = preimage_rows(&[bent], 1e-9, false).unwrap_err();
+        let e = preimage_rows(&[bent], 1e-9, false, &cancel::never).unwrap_err();
         assert!(
             e.to_string().starts_with("control_points: not a PH cubic"),
             "{e}"

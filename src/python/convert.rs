@@ -12,22 +12,26 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError};
 use std::time::Duration;
 
-use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::exceptions::{
+    PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyTypeError, PyValueError,
+};
 use pyo3::prelude::*;
 
 use super::threads;
-use crate::alloc;
 use crate::error::{ErrorKind, InputError};
 use crate::frames::{Method, Orientation, TangentRule};
+use crate::run::alloc;
 use crate::{deform, flesh, ph};
 
 /// `ValueError("arg: message")` (`MemoryError("call: out of memory …")` when a buffer sized
-/// by the input could not be allocated), so `?` works on core results.
+/// by the input could not be allocated, `KeyboardInterrupt` for a call stopped by its hook),
+/// so `?` works on core results.
 impl From<InputError> for PyErr {
     fn from(e: InputError) -> PyErr {
         match e.kind {
             ErrorKind::Invalid => PyValueError::new_err(e.to_string()),
             ErrorKind::OutOfMemory => PyMemoryError::new_err(e.to_string()),
+            ErrorKind::Stopped => PyKeyboardInterrupt::new_err(()),
             ErrorKind::Repeated => RepeatedPointsError::new_err(e.to_string()),
         }
     }
@@ -246,7 +250,7 @@ impl<'a> Ticker<'a> {
 /// The error as a `ValueError` naming `to` where the core named its argument `from` (a
 /// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
 pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {
-    if e.arg == from && e.kind != ErrorKind::OutOfMemory {
+    if e.arg == from && matches!(e.kind, ErrorKind::Invalid | ErrorKind::Repeated) {
         let msg = format!("{to}: {}", e.msg);
         match e.kind {
             ErrorKind::Repeated => RepeatedPointsError::new_err(msg),
@@ -366,7 +370,11 @@ pub fn orientations(
 
 /// PH cubics from control points `(m, 4, 3)`.
 pub fn cubics_of(call: &'static str, a: &PyReadonlyArray3<'_, f64>) -> PyResult<Vec<ph::Cubic>> {
-    Ok(cubics_from(call, cubic_points(a)?, &crate::cancel::never)?)
+    Ok(cubics_from(
+        call,
+        cubic_points(a)?,
+        &crate::run::cancel::never,
+    )?)
 }
 
 /// The control points of `(m, 4, 3)` cubics, four rows per cubic (see [`cubics_from`]).
@@ -381,17 +389,17 @@ pub fn cubic_points<'a>(a: &'a PyReadonlyArray3<'_, f64>) -> PyResult<&'a [DVec3
 }
 
 /// The cubics of [`cubic_points`] (allocated fallibly, naming `call`), polling `cancel` every
-/// [`crate::cancel::BLOCK`] cubics; needs no Python, so a heavy call makes them with the GIL
+/// [`crate::run::cancel::BLOCK`] cubics; needs no Python, so a heavy call makes them with the GIL
 /// released.
 pub fn cubics_from(
     call: &'static str,
     flat: &[DVec3],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> crate::error::Result<Vec<ph::Cubic>> {
     let mut out = alloc::with_capacity(call, flat.len() / 4)?;
-    for block in flat.chunks(4 * crate::cancel::BLOCK) {
+    for block in flat.chunks(4 * crate::run::cancel::BLOCK) {
         if cancel() {
-            return Err(crate::cancel::stopped());
+            return Err(crate::error::InputError::stopped());
         }
         out.extend(
             block

@@ -10,8 +10,8 @@ use super::convert::{
 };
 use super::fields::PyField;
 use super::out::{output, writing};
-use crate::alloc;
 use crate::deform::{self, advect::Method, refine};
+use crate::run::alloc;
 
 /// Advect points: `steps` steps of size `h` from `t0`, into a new array (or `out`: see
 /// [`advect_runs`]). Ctrl-C stops it between

@@ -12,11 +12,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
-use crate::alloc;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
     keyframe, path, rod, tube,
 };
+use crate::run::alloc;
 
 /// A divergence-free velocity field: a sum of tools built by the constructors of
 /// `spinal.fields` (see its module docstring for the maths).
@@ -471,7 +471,7 @@ pub fn field_strip_curve(
     let x = vec3s("points", &points)?;
     let stop = Stop::default();
     let tool = detach_stoppable(py, &stop, || {
-        tube::strip_curve_cancellable(x, radius, speed, reach, blend.0, &|| stop.requested())
+        tube::strip_curve(x, radius, speed, reach, blend.0, &|| stop.requested())
     })??;
     Ok(PyField::new(Field::single(tool), "strip_curve"))
 }
@@ -525,7 +525,7 @@ pub fn field_path(
     let x = vec3s("points", &points)?;
     let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
     // row-major (n, 3, 3) -> glam's column-major: transpose
-    let fr: Vec<DMat3> = crate::alloc::collect(
+    let fr: Vec<DMat3> = crate::run::alloc::collect(
         "along_path",
         rows.iter().map(|r| DMat3::from_cols_array(r).transpose()),
     )?;
@@ -554,7 +554,7 @@ pub fn field_path(
     );
     let stop = Stop::default();
     let p = detach_stoppable(py, &stop, || {
-        path::PathTool::from_args_cancellable(args, &|| stop.requested())
+        path::PathTool::from_args(args, &|| stop.requested())
     })??;
     Ok(PyField::new(Field::single(p), &name))
 }
@@ -690,7 +690,7 @@ pub fn field_rod(
     let stop = Stop::default();
     let rod = detach_stoppable(py, &stop, || {
         let c = center.map(DVec3::from);
-        rod::Rod::from_points_cancellable(x, radius, reach, c, &|| stop.requested())
+        rod::Rod::from_points(x, radius, reach, c, &|| stop.requested())
     })??;
     let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
     curl_field(rod, mo, falloff_power, moving, "rod")
@@ -733,8 +733,8 @@ pub fn field_keyframed(
     let stop = Stop::default();
     let f = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
-        let keys = keyframe::Keys::new_cancellable(t, x, orientations, &cancel)?;
-        keyframe::keyframed_cancellable(
+        let keys = keyframe::Keys::new(t, x, orientations, &cancel)?;
+        keyframe::keyframed(
             &tool.field,
             keys,
             falloff_power,

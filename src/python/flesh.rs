@@ -8,8 +8,8 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{Stop, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s};
-use crate::alloc;
 use crate::flesh::{self, Solution, surface, trisurf};
+use crate::run::alloc;
 
 type FleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>);
 type SurfaceFleshBinding<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>, i32);
@@ -40,8 +40,8 @@ pub fn flesh_bind<'py>(
     let stop = Stop::default();
     let b = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
-        let rest = flesh::SpineModel::new_cancellable("rest_spine", pts, fr, closed, &cancel)?;
-        flesh::bind_cancellable(&rest, v, &cancel)
+        let rest = flesh::SpineModel::new("rest_spine", pts, fr, closed, &cancel)?;
+        flesh::bind(&rest, v, &cancel)
     })??;
     let nv = b.edge.len();
     let coords = PyArray1::from_vec(py, b.coords).reshape([nv, flesh::COORDS])?;
@@ -87,9 +87,8 @@ pub fn flesh_deform<'py>(
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
             let cancel = || stop.requested();
-            let posed =
-                flesh::SpineModel::new_cancellable("posed_spine", pts, fr, closed, &cancel)?;
-            flesh::deform_cancellable(&posed, edge, coords, solution, tw, buf, &mut flags, &cancel)
+            let posed = flesh::SpineModel::new("posed_spine", pts, fr, closed, &cancel)?;
+            flesh::deform(&posed, edge, coords, solution, tw, buf, &mut flags, &cancel)
         })??;
     }
     Ok((out, PyArray1::from_vec(py, flags)))
@@ -142,7 +141,7 @@ pub fn flesh_surface_bind<'py>(
     let stop = Stop::default();
     let (cell, coords, exp) = detach_stoppable(py, &stop, || {
         let rest = surface::Surface::new("rest_surface", pts, nu, nv)?;
-        let (cell, coords) = surface::bind_surface_cancellable(&rest, v, &|| stop.requested())?;
+        let (cell, coords) = surface::bind_surface(&rest, v, &|| stop.requested())?;
         Ok::<_, crate::error::InputError>((cell, coords, rest.scale.exp()))
     })??;
     let n = cell.len();
@@ -196,7 +195,7 @@ pub fn flesh_surface_deform<'py>(
                 None => surface::Surface::new("posed_surface", pts, nu, nv)?,
             };
             let cancel = || stop.requested();
-            surface::deform_surface_cancellable(
+            surface::deform_surface(
                 &posed, rest_exp, cell, coords, corrected, buf, &mut flags, &cancel,
             )
         })??;
@@ -220,7 +219,7 @@ pub fn flesh_trisurface_bind<'py>(
     let stop = Stop::default();
     let (face, coords, exp) = detach_stoppable(py, &stop, || {
         let rest = trisurf::TriSurface::new("rest_surface", pts, fs)?;
-        let (face, coords) = trisurf::bind_trisurface_cancellable(&rest, v, &|| stop.requested())?;
+        let (face, coords) = trisurf::bind_trisurface(&rest, v, &|| stop.requested())?;
         Ok::<_, crate::error::InputError>((face, coords, rest.scale.exp()))
     })??;
     let n = face.len();
@@ -300,7 +299,7 @@ pub fn flesh_trisurface_deform<'py>(
                 }
                 None => trisurf::TriSurface::new("posed_surface", pts, fs)?,
             };
-            trisurf::deform_trisurface_cancellable(
+            trisurf::deform_trisurface(
                 &posed,
                 rest_exp,
                 face,

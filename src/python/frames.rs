@@ -79,9 +79,7 @@ pub fn frames_sampled<'py>(
         let done = Report::counter(&report);
         detach_reporting(py, &stop, report.as_ref(), || {
             let cancel = || stop.requested();
-            frames::compute_many_cancellable(
-                &template, &offsets, &initial, &end, buf, &cancel, done,
-            )
+            frames::compute_many(&template, &offsets, &initial, &end, buf, &cancel, done)
         })?
         .map_err(|e| renamed(e, "points", points_arg))?
     };
@@ -143,7 +141,7 @@ pub fn frames_analytic<'py>(
         let buf = slice_mut(&mut rw)?;
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            frames::compute_into_cancellable(&req, buf, &|| stop.requested())
+            frames::compute_into(&req, buf, &|| stop.requested())
         })??
     };
     Ok((out, angle))
@@ -191,7 +189,7 @@ pub fn estimate_tangents<'py>(
             let stop = Stop::default();
             detach_stoppable(py, &stop, || {
                 let cancel = || stop.requested();
-                frames::tangents::estimate_rows_cancellable(x, closed, rule, &cancel)
+                frames::tangents::estimate_rows(x, closed, rule, &cancel)
             })??
         }
         Some(o) => {
@@ -199,7 +197,7 @@ pub fn estimate_tangents<'py>(
             let stop = Stop::default();
             detach_stoppable(py, &stop, || {
                 let cancel = || stop.requested();
-                frames::tangents::estimate_many_cancellable(x, &offs, closed, rule, &cancel)
+                frames::tangents::estimate_many(x, &offs, closed, rule, &cancel)
             })??
         }
     };
@@ -361,13 +359,13 @@ pub fn frames_steered<'py>(
             let st = steering[0];
             let stop = Stop::default();
             detach_stoppable(py, &stop, || {
-                steer::compute_steered_cancellable(&req, &st, buf, &|| stop.requested())
+                steer::compute_steered(&req, &st, buf, &|| stop.requested())
             })??;
         } else {
             let stop = Stop::default();
             detach_stoppable(py, &stop, || {
                 let cancel = || stop.requested();
-                steer::compute_steered_many_cancellable(
+                steer::compute_steered_many(
                     &template, &offsets, &initial, &end, &steering, buf, &cancel,
                 )
             })?
@@ -437,7 +435,7 @@ pub fn frames_in_time<'py>(
         let report = Report::new(progress, steps);
         let done = Report::counter(&report);
         detach_reporting(py, &stop, report.as_ref(), || {
-            frames::time::frames_in_time_cancellable(
+            frames::time::frames_in_time(
                 &template,
                 steps,
                 rows,

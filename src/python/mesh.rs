@@ -19,7 +19,7 @@ pub fn mesh_volume(
     let f = triangles(&faces)?;
     let stop = Stop::default();
     Ok(detach_stoppable(py, &stop, || {
-        measure::volume_cancellable(v, f, &|| stop.requested())
+        measure::volume(v, f, &|| stop.requested())
     })??)
 }
 
@@ -42,7 +42,7 @@ pub fn mesh_closed_centroid(
     )?;
     let stop = Stop::default();
     let (vol, c) = detach_stoppable(py, &stop, || {
-        closed::closed_volume_centroid_cancellable(v, f, &|| stop.requested())
+        closed::closed_volume_centroid(v, f, &|| stop.requested())
     })??;
     Ok((vol, c.to_array()))
 }
@@ -141,9 +141,9 @@ pub fn mesh_measure(
     let cancel = || stop.requested();
     with_mesh!(&vs, &fs, |v, f| Ok(detach_stoppable(py, &stop, || {
         if area {
-            measure::area_cancellable(v, f, &cancel)
+            measure::area(v, f, &cancel)
         } else {
-            measure::volume_cancellable(v, f, &cancel)
+            measure::volume(v, f, &cancel)
         }
     })??))
 }
@@ -191,11 +191,11 @@ pub fn mesh_edges(
     let e = match faces {
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
-            detach_stoppable(py, &stop, || measure::edges_cancellable(f, n, &cancel))??
+            detach_stoppable(py, &stop, || measure::edges(f, n, &cancel))??
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
-            detach_stoppable(py, &stop, || measure::edges_cancellable(f, n, &cancel))??
+            detach_stoppable(py, &stop, || measure::edges(f, n, &cancel))??
         }
     };
     Ok((
@@ -244,13 +244,13 @@ pub fn mesh_check_faces(py: Python<'_>, faces: &Bound<'_, PyAny>, n: usize) -> P
         Faces::I64(a) => {
             let f = rows::<i64>("faces", &a)?;
             Ok(detach_stoppable(py, &stop, || {
-                measure::check_faces_cancellable(f, n, &cancel)
+                measure::check_faces(f, n, &cancel)
             })??)
         }
         Faces::I32(a) => {
             let f = rows::<i32>("faces", &a)?;
             Ok(detach_stoppable(py, &stop, || {
-                measure::check_faces_cancellable(f, n, &cancel)
+                measure::check_faces(f, n, &cancel)
             })??)
         }
     }

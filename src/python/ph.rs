@@ -12,8 +12,8 @@ use super::convert::{
     slice_of, vec3_of, vec3s,
 };
 use super::frames::FramesAndAngles;
-use crate::alloc;
 use crate::ph::{self, frame::Mode};
+use crate::run::alloc;
 
 type HermiteArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
@@ -39,7 +39,7 @@ pub fn ph_hermite<'py>(
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
-        ph::hermite::hermite_rows_cancellable(p0, t0, p1, t1, all, batch, &cancel)
+        ph::hermite::hermite_rows(p0, t0, p1, t1, all, batch, &cancel)
     })??;
     Ok((
         rows_of(py, rows.candidates, p0.len())?,
@@ -65,7 +65,7 @@ pub fn ph_eval<'py>(
         let o: &mut [glam::DVec3] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            ph::eval_into_cancellable(&cubics, s, derivative, o, &|| stop.requested())
+            ph::eval_into(&cubics, s, derivative, o, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -81,7 +81,7 @@ pub fn ph_invariants<'py>(
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
         let cubics = cubics_from("ph.invariants", points, &|| stop.requested())?;
-        ph::check::invariant_rows_cancellable(&cubics, &|| stop.requested())
+        ph::check::invariant_rows(&cubics, &|| stop.requested())
     })??;
     let out = alloc::flat("ph.invariants", rows.iter().map(|v| v.row()))?;
     let m = rows.len();
@@ -99,7 +99,7 @@ pub fn ph_is_ph<'py>(
     let stop = Stop::default();
     let out = detach_stoppable(py, &stop, || {
         let cubics = cubics_from("ph.is_ph", points, &|| stop.requested())?;
-        ph::check::is_ph_rows_cancellable(&cubics, tol, &|| stop.requested())
+        ph::check::is_ph_rows(&cubics, tol, &|| stop.requested())
     })??;
     Ok(PyArray1::from_vec(py, out))
 }
@@ -159,7 +159,7 @@ pub fn ph_preimage<'py>(
     let stop = Stop::default();
     let rows = detach_stoppable(py, &stop, || {
         let cubics = cubics_from("ph.preimage", points, &|| stop.requested())?;
-        let mut rows = ph::preimage_rows_cancellable(&cubics, tol, batch, &|| stop.requested())?;
+        let mut rows = ph::preimage_rows(&cubics, tol, batch, &|| stop.requested())?;
         if !scalar_first {
             rows.par_iter_mut().with_min_len(1 << 12).for_each(|r| {
                 r[0..4].rotate_left(1);
@@ -197,7 +197,7 @@ pub fn ph_frame_setup<'py>(
     let start = start_of(initial, omega_start)?;
     let stop = Stop::default();
     let segs = detach_stoppable(py, &stop, || {
-        ph::frame::setup_cancellable(&cubics, start, phi, &|| stop.requested())
+        ph::frame::setup(&cubics, start, phi, &|| stop.requested())
     })??;
     let out = alloc::flat("angle_fit", segs.iter().map(|s| s.to_row()))?;
     rows_of(py, out, segs.len())
@@ -229,7 +229,7 @@ pub fn ph_frames<'py>(
         let a = slice_mut(&mut ra)?;
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            ph::frame::frames_at_cancellable(&cubics, s, start, phi, mode, frames, a, &|| {
+            ph::frame::frames_at(&cubics, s, start, phi, mode, frames, a, &|| {
                 stop.requested()
             })
         })??;

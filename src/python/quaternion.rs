@@ -12,8 +12,8 @@ use super::convert::{
     Stop, detach_stoppable, empty, frames_of, quat_array, quats, slice_mut, slice_of, triangles,
     value_error, vec2s, vec3_of, vec3s,
 };
-use crate::alloc;
 use crate::quaternion::{self, camera, walk};
+use crate::run::alloc;
 
 /// Quaternions `(x, y, z, w)` of frames; see `spinal.quaternions.to_quaternions`.
 #[pyfunction]
@@ -25,7 +25,7 @@ pub fn quat_from_frames<'py>(
     let fr = frames_of("frames", &frames)?;
     let stop = Stop::default();
     let q = detach_stoppable(py, &stop, || {
-        quaternion::from_frames_cancellable(fr, continuous, &|| stop.requested())
+        quaternion::from_frames(fr, continuous, &|| stop.requested())
     })??;
     quat_array(py, q)
 }
@@ -47,7 +47,7 @@ pub fn quat_spin<'py>(
         let o = slice_mut(&mut rw)?;
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            quaternion::spin::spin_into_cancellable(fa, fb, o, &|| stop.requested())
+            quaternion::spin::spin_into(fa, fb, o, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -66,7 +66,7 @@ pub fn quat_to_frames<'py>(
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            quaternion::to_frames_cancellable(qs, buf, &|| stop.requested())
+            quaternion::to_frames(qs, buf, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -81,7 +81,7 @@ pub fn quat_continuous<'py>(
     let qs = quats("quaternions", &q)?;
     let stop = Stop::default();
     let v = detach_stoppable(py, &stop, || {
-        quaternion::continuous_cancellable(qs, &|| stop.requested())
+        quaternion::continuous(qs, &|| stop.requested())
     })??;
     quat_array(py, v)
 }
@@ -103,7 +103,7 @@ pub fn quat_slerp<'py>(
     let mut out = alloc::filled("slerp", a.len(), DQuat::IDENTITY)?;
     let stop = Stop::default();
     detach_stoppable(py, &stop, || {
-        quaternion::slerp_many_cancellable(a, b, us, &mut out, &|| stop.requested())
+        quaternion::slerp_many(a, b, us, &mut out, &|| stop.requested())
     })??;
     quat_array(py, out)
 }
@@ -124,7 +124,7 @@ pub fn quat_slerp_frames<'py>(
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            quaternion::slerp_frames_cancellable(fr, ku, nu, buf, &|| stop.requested())
+            quaternion::slerp_frames(fr, ku, nu, buf, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -140,7 +140,7 @@ pub fn quat_path_length(
     let qs = quats("quaternions", &q)?;
     let stop = Stop::default();
     Ok(detach_stoppable(py, &stop, || {
-        quaternion::path_length_cancellable(qs, closed, &|| stop.requested())
+        quaternion::path_length(qs, closed, &|| stop.requested())
     })??)
 }
 
@@ -168,7 +168,7 @@ pub fn quat_transport<'py>(
     let mut out = alloc::filled("quaternion_frames", rows, DQuat::IDENTITY)?;
     let stop = Stop::default();
     let angle = detach_stoppable(py, &stop, || {
-        quaternion::transport_cancellable(x, t, r, closed, turns, &mut out, &|| stop.requested())
+        quaternion::transport(x, t, r, closed, turns, &mut out, &|| stop.requested())
     })??;
     Ok((quat_array(py, out)?, angle))
 }
@@ -210,7 +210,7 @@ pub fn camera_inputs<'py>(
     };
     let stop = Stop::default();
     let c = detach_stoppable(py, &stop, || {
-        camera::inputs_cancellable(x, t, u, b, closed, mode, &|| stop.requested())
+        camera::inputs(x, t, u, b, closed, mode, &|| stop.requested())
     })??;
     let n = c.tangents.len();
     // the tangents' own buffer, reinterpreted (no copy)
@@ -241,7 +241,7 @@ pub fn camera_level<'py>(
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            camera::level_rows_cancellable(t, u, g, buf, &|| stop.requested())
+            camera::level_rows(t, u, g, buf, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -263,7 +263,7 @@ pub fn camera_orient<'py>(
         let buf: &mut [[f64; 9]] = bytemuck::cast_slice_mut(slice_mut(&mut rw)?);
         let stop = Stop::default();
         detach_stoppable(py, &stop, || {
-            camera::orient_cancellable(fr, b, buf, &|| stop.requested())
+            camera::orient(fr, b, buf, &|| stop.requested())
         })??;
     }
     Ok(out)
@@ -326,7 +326,7 @@ pub fn walk_mesh<'py>(
     let stop = Stop::default();
     let walk = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
-        walk::walk_path_cancellable(&w, face, p, d, mv, &|| stop.requested())
+        walk::walk_path(&w, face, p, d, mv, &|| stop.requested())
     })??;
     let (states, path) = (&walk.states, &walk.path);
     let k = states.len();
@@ -390,7 +390,7 @@ pub fn walk_mesh_many<'py>(
     let stop = Stop::default();
     let states = detach_stoppable(py, &stop, || {
         let w = walk::Walker::new(v, f)?;
-        walk::walk_many_cancellable(&w, &starts, mv, k, &|| stop.requested())
+        walk::walk_many(&w, &starts, mv, k, &|| stop.requested())
     })??;
     let nw = starts.len();
     let (pts, fcs, frs) = walker_states("walk_mesh_many", &states)?;

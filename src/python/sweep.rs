@@ -1,7 +1,7 @@
 //! Sweeps and tubes (`spinal.sweep`); the algorithm is in [`crate::sweep`].
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
-use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PySlice;
 
@@ -121,13 +121,10 @@ pub fn sweep_mesh<'py>(
     let stop = Stop::default();
     let prep = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
-        Prepared::new_cancellable(spine, &offsets, prof, profile_closed, opts, source, &cancel)
+        Prepared::new(spine, &offsets, prof, profile_closed, opts, source, &cancel)
     })?
-    .map_err(rename)?;
     // stopped only when a signal handler raised, whose error detach_stoppable returned
-    let Some(prep) = prep else {
-        return Err(PyKeyboardInterrupt::new_err(()));
-    };
+    .map_err(rename)?;
     // int32 faces only where every index fits
     let index32 = index32 && prep.layout.indices_fit_i32();
     let job = Job {

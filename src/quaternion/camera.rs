@@ -12,17 +12,17 @@
 //! * the bank (roll) angles, finite.
 //!
 //! The frames themselves are the rotation-minimising frames of `spinal.frames` or the level
-//! frames ([`level_rows_cancellable`] on the regular rows, carried by the rotation-minimising
-//! frame across the singular runs); [`orient_cancellable`] then rolls them by the bank and
+//! frames ([`level_rows`] on the regular rows, carried by the rotation-minimising
+//! frame across the singular runs); [`orient`] then rolls them by the bank and
 //! reorders them into camera columns.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::unit_tangents_cancellable;
-use crate::alloc;
+use super::unit_tangents;
 use crate::error::{InputError, Result};
 use crate::frames::validate;
+use crate::run::alloc;
 
 /// Largest `|t₀ × up|` at which a path counts as starting vertical.
 pub const VERTICAL_SIN: f64 = 1e-3;
@@ -52,6 +52,9 @@ pub enum Mode {
 /// Check and prepare the inputs of `camera_frames`: points `x` (`n ≥ 2`), optional tangents
 /// (`n` rows, finite and non-zero), optional world `up` (finite, non-zero; default `+z`),
 /// optional `bank` angles (finite), `closed`, and the mode.
+///
+/// Polls `cancel` inside the tangent estimate and between its passes, and returns at once (with
+/// incomplete inputs) when it says stop (see [`crate::run::cancel`]).
 pub fn inputs(
     x: &[DVec3],
     tangents: Option<&[DVec3]>,
@@ -59,22 +62,9 @@ pub fn inputs(
     bank: Option<&[f64]>,
     closed: bool,
     mode: Mode,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Inputs> {
-    inputs_cancellable(x, tangents, up, bank, closed, mode, &crate::cancel::never)
-}
-
-/// [`inputs`] that polls `cancel` inside the tangent estimate and between its passes, and
-/// returns at once (with incomplete inputs) when it says stop (see [`crate::cancel`]).
-pub fn inputs_cancellable(
-    x: &[DVec3],
-    tangents: Option<&[DVec3]>,
-    up: Option<DVec3>,
-    bank: Option<&[f64]>,
-    closed: bool,
-    mode: Mode,
-    cancel: crate::cancel::Cancel<'_>,
-) -> Result<Inputs> {
-    let t = unit_tangents_cancellable(x, tangents, closed, cancel)?;
+    let t = unit_tangents(x, tangents, closed, cancel)?;
     let stopped = |t: Vec<DVec3>| Inputs {
         tangents: t,
         up: DVec3::Z,
@@ -142,12 +132,12 @@ const GRAIN: usize = 1 << 12;
 /// plane of the unit tangent `t`; the other rows are zero (the caller carries the
 /// rotation-minimising frame across them). Stops between blocks once `cancel` says so (`out`
 /// is then incomplete).
-pub fn level_rows_cancellable(
+pub fn level_rows(
     tangents: &[DVec3],
     up: DVec3,
     regular: &[bool],
     out: &mut [[f64; 9]],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
     if regular.len() != tangents.len() || out.len() != tangents.len() {
         return Err(InputError::new(
@@ -179,11 +169,11 @@ pub fn level_rows_cancellable(
 /// rolled by `bank` about the gaze `t`: `up = cos b r + sin b s`, `right = cos b s − sin b r`,
 /// `back = −t` (a right-handed turn by `b` about the direction of travel). Stops between
 /// blocks once `cancel` says so (`out` is then incomplete).
-pub fn orient_cancellable(
+pub fn orient(
     frames: &[[f64; 9]],
     bank: Option<&[f64]>,
     out: &mut [[f64; 9]],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
     if out.len() != frames.len() || bank.is_some_and(|b| b.len() != frames.len()) {
         return Err(InputError::new(
@@ -215,6 +205,7 @@ pub fn orient_cancellable(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     fn line() -> Vec<DVec3> {
         (0..5).map(|i| DVec3::new(f64::from(i), 0.0, 0.0)).collect()
@@ -232,14 +223,23 @@ mod tests {
     fn points_and_tangents_are_checked() {
         let x = line();
         let tr = Mode::Transport;
-        assert_eq!(arg(inputs(&x[..1], None, None, None, false, tr)), "points");
+        assert_eq!(
+            arg(inputs(&x[..1], None, None, None, false, tr, &cancel::never)),
+            "points"
+        );
         let mut t = vec![DVec3::X; 5];
         t[2] = DVec3::ZERO;
-        assert_eq!(arg(inputs(&x, Some(&t), None, None, false, tr)), "tangents");
+        assert_eq!(
+            arg(inputs(&x, Some(&t), None, None, false, tr, &cancel::never)),
+            "tangents"
+        );
         t[2] = DVec3::NAN;
-        assert_eq!(arg(inputs(&x, Some(&t), None, None, false, tr)), "tangents");
+        assert_eq!(
+            arg(inputs(&x, Some(&t), None, None, false, tr, &cancel::never)),
+            "tangents"
+        );
         let t = vec![DVec3::new(3.0, 0.0, 0.0); 5];
-        let ok = inputs(&x, Some(&t), None, None, false, tr).expect("valid");
+        let ok = inputs(&x, Some(&t), None, None, false, tr, &cancel::never).expect("valid");
         assert_eq!(ok.tangents, vec![DVec3::X; 5]);
         assert_eq!((ok.up, ok.vertical, ok.regular), (DVec3::Z, false, None));
     }
@@ -249,17 +249,39 @@ mod tests {
         let x = line();
         let tr = Mode::Transport;
         for bad in [DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 1.0)] {
-            assert_eq!(arg(inputs(&x, None, Some(bad), None, false, tr)), "up");
+            assert_eq!(
+                arg(inputs(&x, None, Some(bad), None, false, tr, &cancel::never)),
+                "up"
+            );
         }
         // parallel to the first tangent: an error when given, the default only flags it
-        assert_eq!(arg(inputs(&x, None, Some(DVec3::X), None, false, tr)), "up");
+        assert_eq!(
+            arg(inputs(
+                &x,
+                None,
+                Some(DVec3::X),
+                None,
+                false,
+                tr,
+                &cancel::never
+            )),
+            "up"
+        );
         let z: Vec<DVec3> = x.iter().map(|p| DVec3::new(0.0, 0.0, p.x)).collect();
         assert!(
-            inputs(&z, None, None, None, false, tr)
+            inputs(&z, None, None, None, false, tr, &cancel::never)
                 .expect("default up")
                 .vertical
         );
-        let ok = inputs(&x, None, Some(DVec3::new(0.0, 2.0, 0.0)), None, false, tr);
+        let ok = inputs(
+            &x,
+            None,
+            Some(DVec3::new(0.0, 2.0, 0.0)),
+            None,
+            false,
+            tr,
+            &cancel::never,
+        );
         assert_eq!(ok.expect("valid").up, DVec3::Y);
     }
 
@@ -268,7 +290,15 @@ mod tests {
         let x = line();
         let bank = [0.0, 1.0, f64::INFINITY, 0.0, 0.0];
         assert_eq!(
-            arg(inputs(&x, None, None, Some(&bank), false, LEVEL)),
+            arg(inputs(
+                &x,
+                None,
+                None,
+                Some(&bank),
+                false,
+                LEVEL,
+                &cancel::never
+            )),
             "bank"
         );
     }
@@ -276,10 +306,11 @@ mod tests {
     #[test]
     fn a_level_horizon_needs_a_row_off_vertical() {
         let x = line();
-        let e = inputs(&x, None, Some(DVec3::X), None, false, LEVEL).expect_err("vertical");
+        let e = inputs(&x, None, Some(DVec3::X), None, false, LEVEL, &cancel::never)
+            .expect_err("vertical");
         assert_eq!(e.arg, "points");
         assert!(e.msg.starts_with("the path is parallel to up everywhere"));
-        let ok = inputs(&x, None, None, None, false, LEVEL).expect("horizontal");
+        let ok = inputs(&x, None, None, None, false, LEVEL, &cancel::never).expect("horizontal");
         assert_eq!(ok.regular, Some(vec![true; 5]));
     }
 
@@ -291,12 +322,12 @@ mod tests {
     fn level_rows_are_the_projected_up_and_zero_elsewhere() {
         let t = [DVec3::new(1.0, 0.0, 1.0).normalize(), DVec3::Z];
         let mut out = [[1.0; 9]; 2];
-        level_rows_cancellable(
+        level_rows(
             &t,
             DVec3::Z,
             &[true, false],
             &mut out,
-            &crate::cancel::never,
+            &crate::run::cancel::never,
         )
         .expect("valid");
         // up projected onto the plane normal to (1, 0, 1)/√2 is (−1, 0, 1)/√2
@@ -313,7 +344,7 @@ mod tests {
         let f = [[0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0]; 2];
         let b = [0.0, std::f64::consts::FRAC_PI_2];
         let mut out = [[0.0; 9]; 2];
-        orient_cancellable(&f, Some(&b), &mut out, &crate::cancel::never).expect("valid");
+        orient(&f, Some(&b), &mut out, &crate::run::cancel::never).expect("valid");
         // no roll: right = s, up = r, back = −t
         assert_eq!(col(&out[0], 0), -DVec3::Y);
         assert_eq!(col(&out[0], 1), DVec3::Z);
@@ -324,7 +355,7 @@ mod tests {
         assert!((col(&out[1], 0) + DVec3::Z).length() < 1e-15);
         let mut short = [[0.0; 9]; 1];
         assert_eq!(
-            orient_cancellable(&f, None, &mut short, &crate::cancel::never)
+            orient(&f, None, &mut short, &crate::run::cancel::never)
                 .expect_err("sizes")
                 .arg,
             "bank"

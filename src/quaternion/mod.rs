@@ -30,16 +30,16 @@ pub mod walk;
 use glam::{DMat3, DQuat, DVec3};
 use rayon::prelude::*;
 
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::tangents::{self as tangent_estimate, TangentRule};
 use crate::frames::{self, Method, Orientation, Request, validate};
 use crate::math::rotation;
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
-use crate::cancel::GRAIN;
+use crate::run::cancel::GRAIN;
 
-/// Rows per segment of a cancellable conversion ([`from_frames_cancellable`]).
+/// Rows per segment of a cancellable conversion ([`from_frames`]).
 const CANCEL_SEGMENT: usize = 1 << 20;
 
 /// The unit quaternion of a row-major rotation matrix (columns `r, s, t`), Shepperd's
@@ -68,13 +68,10 @@ pub fn canonical(q: DQuat) -> DQuat {
 
 /// Flip signs so that consecutive quaternions have a non-negative dot product, starting
 /// from the canonical sign of the first.
-pub fn make_continuous(q: &mut [DQuat]) {
-    make_continuous_cancellable(q, &cancel::never);
-}
-
-/// [`make_continuous`] that polls `cancel` every [`cancel::BLOCK`] rows and leaves the rest
-/// as they are once it says stop (see [`crate::cancel`]).
-pub fn make_continuous_cancellable(q: &mut [DQuat], cancel: Cancel<'_>) {
+///
+/// Polls `cancel` every [`cancel::BLOCK`] rows and leaves the rest as they are once it says stop
+/// (see [`crate::run::cancel`]).
+pub fn make_continuous(q: &mut [DQuat], cancel: Cancel<'_>) {
     if let Some(first) = q.first_mut() {
         *first = canonical(*first);
     }
@@ -89,14 +86,11 @@ pub fn make_continuous_cancellable(q: &mut [DQuat], cancel: Cancel<'_>) {
 }
 
 /// A sign-continuous copy of quaternions ([`make_continuous`]); non-finite rows are refused.
-pub fn continuous(q: &[DQuat]) -> Result<Vec<DQuat>> {
-    continuous_cancellable(q, &cancel::never)
-}
-
-/// [`continuous`] that polls `cancel` in its check and every [`cancel::BLOCK`] rows of the
-/// sign pass (an incomplete result once it says stop; see [`crate::cancel`]).
-pub fn continuous_cancellable(q: &[DQuat], cancel: Cancel<'_>) -> Result<Vec<DQuat>> {
-    if let Some(i) = validate::first_bad_cancellable(q, |v| v.is_finite(), cancel) {
+///
+/// Polls `cancel` in its check and every [`cancel::BLOCK`] rows of the sign pass (an incomplete
+/// result once it says stop; see [`crate::run::cancel`]).
+pub fn continuous(q: &[DQuat], cancel: Cancel<'_>) -> Result<Vec<DQuat>> {
+    if let Some(i) = validate::first_bad(q, |v| v.is_finite(), cancel) {
         return Err(InputError::new(
             "quaternions",
             format!("contains non-finite values (row {i})"),
@@ -110,24 +104,25 @@ pub fn continuous_cancellable(q: &[DQuat], cancel: Cancel<'_>) -> Result<Vec<DQu
         }
         v.extend_from_slice(block);
     }
-    make_continuous_cancellable(&mut v, cancel);
+    make_continuous(&mut v, cancel);
     Ok(v)
 }
 
 /// Quaternions of frames (row-major `(n, 3, 3)`), sign-continuous if asked.
-pub fn from_frames(frames: &[[f64; 9]], continuous: bool) -> Result<Vec<DQuat>> {
-    from_frames_cancellable(frames, continuous, &crate::cancel::never)
-}
-
-/// [`from_frames`] that polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and
-/// returns the rows done so far once it says stop (see [`crate::cancel`]).
-pub fn from_frames_cancellable(
+///
+/// Polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and returns the rows done so far
+/// once it says stop (see [`crate::run::cancel`]).
+pub fn from_frames(
     frames: &[[f64; 9]],
     continuous: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DQuat>> {
     // a cancelled check passes every row (the result is discarded)
-    if let Some(i) = validate::first_bad(frames, |f| cancel() || validate::is_rotation(f)) {
+    if let Some(i) = validate::first_bad(
+        frames,
+        |f| cancel() || validate::is_rotation(f),
+        &cancel::never,
+    ) {
         return Err(InputError::new(
             "frames",
             format!(
@@ -150,7 +145,7 @@ pub fn from_frames_cancellable(
         );
     }
     if continuous {
-        make_continuous_cancellable(&mut q, cancel);
+        make_continuous(&mut q, cancel);
     }
     Ok(q)
 }
@@ -175,20 +170,16 @@ fn unit_checked(q: DQuat) -> DQuat {
 }
 
 /// Frames of quaternions (normalised first; a zero or non-finite quaternion is refused).
-pub fn to_frames(q: &[DQuat], out: &mut [[f64; 9]]) -> Result<()> {
-    to_frames_cancellable(q, out, &crate::cancel::never)
-}
-
-/// [`to_frames`] that polls `cancel` before every block of rows and skips the remaining
-/// blocks once it returns `true` (`out` is then incomplete; see [`crate::cancel`]). Blocks,
-/// not rows: the first write to a fresh output page costs a page fault, so the loop
-/// also stops between the faults.
-pub fn to_frames_cancellable(
+///
+/// Polls `cancel` before every block of rows and skips the remaining blocks once it returns `true`
+/// (`out` is then incomplete; see [`crate::run::cancel`]). Blocks, not rows: the first write to a
+/// fresh output page costs a page fault, so the loop also stops between the faults.
+pub fn to_frames(
     q: &[DQuat],
     out: &mut [[f64; 9]],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<()> {
-    if let Some(i) = validate::first_bad(q, |v| cancel() || normalisable(v)) {
+    if let Some(i) = validate::first_bad(q, |v| cancel() || normalisable(v), &cancel::never) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite and cannot be normalised"),
@@ -216,13 +207,10 @@ pub fn slerp(a: DQuat, b: DQuat, u: f64) -> DQuat {
 }
 
 /// Slerp row by row (all three slices have the same length).
-pub fn slerp_many(a: &[DQuat], b: &[DQuat], u: &[f64], out: &mut [DQuat]) -> Result<()> {
-    slerp_many_cancellable(a, b, u, out, &cancel::never)
-}
-
-/// [`slerp_many`] that polls `cancel` in its checks and between blocks of rows (an
-/// incomplete result once it says stop; see [`crate::cancel`]).
-pub fn slerp_many_cancellable(
+///
+/// Polls `cancel` in its checks and between blocks of rows (an incomplete result once it says stop;
+/// see [`crate::run::cancel`]).
+pub fn slerp_many(
     a: &[DQuat],
     b: &[DQuat],
     u: &[f64],
@@ -230,7 +218,7 @@ pub fn slerp_many_cancellable(
     cancel: Cancel<'_>,
 ) -> Result<()> {
     for (arg, v) in [("q0", a), ("q1", b)] {
-        if let Some(i) = validate::first_bad_cancellable(v, normalisable, cancel) {
+        if let Some(i) = validate::first_bad(v, normalisable, cancel) {
             return Err(InputError::new(
                 arg,
                 format!("row {i} is zero or not finite"),
@@ -249,18 +237,10 @@ pub fn slerp_many_cancellable(
 /// key_u[n−1]]`. The quaternions of the keys are made sign-continuous, so each interval
 /// takes the short arc; `u` in `[key_u[i], key_u[i+1])` (the last interval closed) uses
 /// keys `i, i+1` with the weight `(u − key_u[i]) / (key_u[i+1] − key_u[i])`.
+///
+/// Polls `cancel` in its checks and between blocks of rows (an incomplete result once it says stop;
+/// see [`crate::run::cancel`]).
 pub fn slerp_frames(
-    frames: &[[f64; 9]],
-    key_u: &[f64],
-    new_u: &[f64],
-    out: &mut [[f64; 9]],
-) -> Result<()> {
-    slerp_frames_cancellable(frames, key_u, new_u, out, &cancel::never)
-}
-
-/// [`slerp_frames`] that polls `cancel` in its checks and between blocks of rows (an
-/// incomplete result once it says stop; see [`crate::cancel`]).
-pub fn slerp_frames_cancellable(
     frames: &[[f64; 9]],
     key_u: &[f64],
     new_u: &[f64],
@@ -287,14 +267,14 @@ pub fn slerp_frames_cancellable(
             format!("must be finite and strictly increasing (index {i})"),
         ));
     }
-    if let Some(i) = validate::first_bad_cancellable(new_u, |u| u.is_finite(), cancel) {
+    if let Some(i) = validate::first_bad(new_u, |u| u.is_finite(), cancel) {
         return Err(InputError::new(
             "new_u",
             format!("contains non-finite values (index {i})"),
         ));
     }
     let (lo, hi) = (key_u[0], key_u[n - 1]);
-    if let Some(i) = validate::first_bad_cancellable(new_u, |&u| (lo..=hi).contains(&u), cancel) {
+    if let Some(i) = validate::first_bad(new_u, |&u| (lo..=hi).contains(&u), cancel) {
         return Err(InputError::new(
             "new_u",
             format!(
@@ -306,7 +286,7 @@ pub fn slerp_frames_cancellable(
     if out.len() != new_u.len() {
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }
-    let q = from_frames_cancellable(frames, true, cancel)?;
+    let q = from_frames(frames, true, cancel)?;
     // a stopped conversion returns fewer rows
     if q.len() != n || cancel() {
         return Ok(());
@@ -334,16 +314,12 @@ fn arc(a: DQuat, b: DQuat) -> f64 {
 
 /// Length of the quaternion curve (unit quaternions, any signs), `closed` adding the arc
 /// from the last to the first.
-pub fn path_length(q: &[DQuat], closed: bool) -> Result<f64> {
-    path_length_cancellable(q, closed, &cancel::never)
-}
-
-/// [`path_length`] that polls `cancel` in its check and between blocks of arcs (a
-/// meaningless result once it says stop; see [`crate::cancel`]). The arcs are summed per
-/// block of [`GRAIN`] and the block sums in order, so the result does not depend on the
-/// number of threads.
-pub fn path_length_cancellable(q: &[DQuat], closed: bool, cancel: Cancel<'_>) -> Result<f64> {
-    if let Some(i) = validate::first_bad_cancellable(q, normalisable, cancel) {
+///
+/// Polls `cancel` in its check and between blocks of arcs (a meaningless result once it says stop;
+/// see [`crate::run::cancel`]). The arcs are summed per block of [`GRAIN`] and the block sums in
+/// order, so the result does not depend on the number of threads.
+pub fn path_length(q: &[DQuat], closed: bool, cancel: Cancel<'_>) -> Result<f64> {
+    if let Some(i) = validate::first_bad(q, normalisable, cancel) {
         return Err(InputError::new(
             "quaternions",
             format!("row {i} is zero or not finite"),
@@ -352,7 +328,7 @@ pub fn path_length_cancellable(q: &[DQuat], closed: bool, cancel: Cancel<'_>) ->
     let n = q.len();
     let m = if closed { n } else { n.saturating_sub(1) };
     let arc_at = |i: usize| arc(unit_checked(q[i]), unit_checked(q[(i + 1) % n]));
-    let sums = cancel::collect("quaternion_length", m.div_ceil(GRAIN), 1, cancel, |b| {
+    let sums = alloc::rows("quaternion_length", m.div_ceil(GRAIN), 1, cancel, |b| {
         (b * GRAIN..m.min((b + 1) * GRAIN)).map(arc_at).sum::<f64>()
     })?;
     Ok(sums.map_or(0.0, |s| s.iter().sum()))
@@ -362,12 +338,12 @@ pub fn path_length_cancellable(q: &[DQuat], closed: bool, cancel: Cancel<'_>) ->
 /// rows) normalised, or without them the estimate of `spinal.estimate_tangents`
 /// ([`tangent_estimate::estimate_rows`], five-point rule). Polls `cancel` inside the
 /// estimate and between the passes over given tangents; a cancelled call returns an
-/// incomplete result (see [`crate::cancel`]).
-pub(crate) fn unit_tangents_cancellable(
+/// incomplete result (see [`crate::run::cancel`]).
+pub(crate) fn unit_tangents(
     x: &[DVec3],
     t: Option<&[DVec3]>,
     closed: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
     if x.len() < 2 {
         return Err(InputError::new(
@@ -376,12 +352,7 @@ pub(crate) fn unit_tangents_cancellable(
         ));
     }
     let Some(t) = t else {
-        return tangent_estimate::estimate_rows_cancellable(
-            x,
-            closed,
-            TangentRule::FivePointBounded,
-            cancel,
-        );
+        return tangent_estimate::estimate_rows(x, closed, TangentRule::FivePointBounded, cancel);
     };
     if t.len() != x.len() {
         return Err(InputError::new(
@@ -390,15 +361,17 @@ pub(crate) fn unit_tangents_cancellable(
         ));
     }
     // a cancelled check passes every row (the result is discarded)
-    if let Some(i) = validate::first_bad(t, |v| cancel() || v.is_finite()) {
+    if let Some(i) = validate::first_bad(t, |v| cancel() || v.is_finite(), &cancel::never) {
         return Err(InputError::new(
             "tangents",
             format!("contains non-finite values (row {i})"),
         ));
     }
-    if let Some(i) = validate::first_bad(t, |v| {
-        cancel() || crate::math::scale::normalize(*v).is_some()
-    }) {
+    if let Some(i) = validate::first_bad(
+        t,
+        |v| cancel() || crate::math::scale::normalize(*v).is_some(),
+        &cancel::never,
+    ) {
         return Err(InputError::new(
             "tangents",
             format!("zero-length tangent at row {i}"),
@@ -418,7 +391,7 @@ fn default_reference(
     x: &[DVec3],
     t: &[DVec3],
     closed: bool,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<DVec3> {
     let req = Request {
         points: Some(x),
@@ -443,7 +416,7 @@ fn default_reference(
             1,
         )?,
     )?;
-    frames::compute_into_cancellable(&req, &mut buf, cancel)?;
+    frames::compute_into(&req, &mut buf, cancel)?;
     Ok(DVec3::new(buf[0], buf[3], buf[6]))
 }
 
@@ -462,6 +435,10 @@ fn default_reference(
 /// `out.len() == n + 1` also the frame carried once round the loop, corrected (`±q₀`: the
 /// sign tells whether the frames' circuit is an even or odd number of turns on S³). Returns
 /// the closing angle (0 for an open curve).
+///
+/// Polls `cancel` inside the tangent estimate and the default frames and before every segment of
+/// [`CANCEL_SEGMENT`] rows of the recurrence and the closing correction; once it says stop the rows
+/// not yet written are left as they are and `out` is incomplete (see [`crate::run::cancel`]).
 pub fn transport(
     x: &[DVec3],
     t: Option<&[DVec3]>,
@@ -469,22 +446,7 @@ pub fn transport(
     closed: bool,
     turns: f64,
     out: &mut [DQuat],
-) -> Result<f64> {
-    transport_cancellable(x, t, initial, closed, turns, out, &crate::cancel::never)
-}
-
-/// [`transport`] that polls `cancel` inside the tangent estimate and the default frames and
-/// before every segment of [`CANCEL_SEGMENT`] rows of the recurrence and the closing
-/// correction; once it says stop the rows not yet written are left as they are and `out`
-/// is incomplete (see [`crate::cancel`]).
-pub fn transport_cancellable(
-    x: &[DVec3],
-    t: Option<&[DVec3]>,
-    initial: Option<DVec3>,
-    closed: bool,
-    turns: f64,
-    out: &mut [DQuat],
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<f64> {
     if !turns.is_finite() || 2.0 * turns != (2.0 * turns).round() {
         return Err(InputError::new(
@@ -501,7 +463,7 @@ pub fn transport_cancellable(
             ),
         ));
     }
-    let t = &unit_tangents_cancellable(x, t, closed, cancel)?;
+    let t = &unit_tangents(x, t, closed, cancel)?;
     if cancel() {
         return Ok(0.0);
     }
@@ -575,7 +537,7 @@ pub fn transport_cancellable(
                     *q = (*q * DQuat::from_xyzw(0.0, 0.0, a.sin(), a.cos())).normalize();
                 });
         });
-    make_continuous_cancellable(out, cancel);
+    make_continuous(out, cancel);
     Ok(alpha)
 }
 
@@ -615,8 +577,8 @@ mod tests {
     #[test]
     fn continuous_refuses_non_finite_quaternions() {
         let q = [DQuat::IDENTITY, DQuat::from_xyzw(f64::NAN, 0.0, 0.0, 1.0)];
-        assert_eq!(arg_of(continuous(&q)), "quaternions");
-        let ok = continuous(&[-DQuat::IDENTITY, DQuat::IDENTITY]).expect("finite");
+        assert_eq!(arg_of(continuous(&q, &cancel::never)), "quaternions");
+        let ok = continuous(&[-DQuat::IDENTITY, DQuat::IDENTITY], &cancel::never).expect("finite");
         assert_eq!(ok, vec![DQuat::IDENTITY; 2]);
     }
 
@@ -625,7 +587,7 @@ mod tests {
         let keys = [rot(DVec3::Z, 0.0), rot(DVec3::Z, 1.0), rot(DVec3::X, 1.0)];
         let mut out = [[0.0; 9]; 1];
         let run = |f: &[[f64; 9]], ku: &[f64], nu: &[f64], out: &mut [[f64; 9]]| {
-            slerp_frames(f, ku, nu, out)
+            slerp_frames(f, ku, nu, out, &cancel::never)
         };
         assert_eq!(arg_of(run(&keys[..1], &[0.0], &[0.0], &mut out)), "frames");
         assert_eq!(
@@ -668,7 +630,7 @@ mod tests {
             .collect();
         let mut out = vec![DQuat::IDENTITY; x.len()];
         let mut run = |x: &[DVec3], t: Option<&[DVec3]>, r: Option<DVec3>| {
-            transport(x, t, r, false, 0.0, &mut out[..x.len()])
+            transport(x, t, r, false, 0.0, &mut out[..x.len()], &cancel::never)
         };
         assert_eq!(arg_of(run(&x[..1], None, None)), "points");
         assert_eq!(arg_of(run(&x[..1], Some(&x[..1]), None)), "points");

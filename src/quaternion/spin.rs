@@ -10,11 +10,11 @@
 
 use glam::DVec3;
 
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::FRAME_TANGENT_TOL;
 use crate::frames::validate;
+use crate::run::alloc;
+use crate::run::cancel::{self, Cancel};
 
 /// Column `k` (0: r, 1: s, 2: t) of a row-major frame.
 #[inline]
@@ -23,16 +23,16 @@ fn col(f: &[f64; 9], k: usize) -> DVec3 {
 }
 
 /// Finite rotation matrices, else an error naming `arg` and the row (a stopped check finds
-/// nothing; see [`crate::cancel`]).
+/// nothing; see [`crate::run::cancel`]).
 fn check_frames(arg: &'static str, f: &[[f64; 9]], cancel: Cancel<'_>) -> Result<()> {
     let finite = |m: &[f64; 9]| m.iter().all(|v| v.is_finite());
-    if let Some(i) = validate::first_bad_cancellable(f, finite, cancel) {
+    if let Some(i) = validate::first_bad(f, finite, cancel) {
         return Err(InputError::new(
             arg,
             format!("non-finite value in frame {i}"),
         ));
     }
-    if let Some(i) = validate::first_bad_cancellable(f, validate::is_rotation, cancel) {
+    if let Some(i) = validate::first_bad(f, validate::is_rotation, cancel) {
         return Err(InputError::new(
             arg,
             format!(
@@ -66,14 +66,14 @@ pub fn rows(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<usize> {
 /// `n` rows (one of `a`, `b` may hold a single frame, used for every row).
 pub fn spin(a: &[[f64; 9]], b: &[[f64; 9]]) -> Result<Vec<f64>> {
     let mut out = alloc::filled("spin", a.len().max(b.len()), 0.0)?;
-    spin_into_cancellable(a, b, &mut out, &cancel::never)?;
+    spin_into(a, b, &mut out, &cancel::never)?;
     Ok(out)
 }
 
 /// [`spin`] into `out` (of [`rows`] rows: `max(len a, len b)` when the lengths are valid),
 /// the frames checked before the lengths, polling `cancel` in the checks and between blocks
-/// of rows (`out` incomplete once it says stop; see [`crate::cancel`]).
-pub fn spin_into_cancellable(
+/// of rows (`out` incomplete once it says stop; see [`crate::run::cancel`]).
+pub fn spin_into(
     a: &[[f64; 9]],
     b: &[[f64; 9]],
     out: &mut [f64],

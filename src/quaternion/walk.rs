@@ -22,16 +22,16 @@
 
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
-use crate::alloc;
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::mesh;
+use crate::run::alloc;
+use crate::run::cancel::Cancel;
 
 /// Most edge crossings (estimated, see the module docs) of one move; a longer move is
 /// refused by name.
 const MAX_CROSSINGS: f64 = 1e8;
 
-/// Edge crossings between polls of a cancellable move ([`Walker::step_cancellable`]).
+/// Edge crossings between polls of a cancellable move ([`Walker::step`]).
 const CANCEL_CROSSINGS: usize = 1 << 14;
 
 /// A triangle mesh prepared for walking: faces and edge adjacency.
@@ -217,21 +217,18 @@ impl<'a> Walker<'a> {
         })
     }
 
-    /// One move of `(dx, dy)` in the walker's `(e₁, e₂)` axes. `path` receives every edge
-    /// crossing (point and the face entered).
-    pub fn step(&self, s: State, mv: DVec2, path: &mut Vec<(DVec3, usize)>) -> Result<State> {
-        self.step_cancellable(s, mv, path, &cancel::never)
-    }
-
     /// The edges a move of length `length` crosses, about (`length / median edge`).
     fn crossings_of(&self, length: f64) -> f64 {
         length / self.typical_edge
     }
 
-    /// [`Walker::step`] that polls `cancel` every [`CANCEL_CROSSINGS`] edge crossings; once
-    /// it says stop the move ends where it is (the result is then meaningless and the
-    /// caller discards it; see [`crate::cancel`]).
-    pub fn step_cancellable(
+    /// One move of `(dx, dy)` in the walker's `(e₁, e₂)` axes. `path` receives every edge
+    /// crossing (point and the face entered).
+    ///
+    /// Polls `cancel` every [`CANCEL_CROSSINGS`] edge crossings; once it says stop the move ends
+    /// where it is (the result is then meaningless and the caller discards it; see
+    /// [`crate::run::cancel`]).
+    pub fn step(
         &self,
         s: State,
         mv: DVec2,
@@ -360,18 +357,6 @@ pub struct Walk {
     pub path: Vec<PathPoint>,
 }
 
-/// One walker from `(face, point, direction)` (see [`Walker::start`]) making `moves` in turn
-/// (see [`Walker::step`]); records every state and the crossing path.
-pub fn walk_path(
-    w: &Walker,
-    face: i64,
-    point: DVec3,
-    direction: Option<DVec3>,
-    moves: &[DVec2],
-) -> Result<Walk> {
-    walk_path_cancellable(w, face, point, direction, moves, &cancel::never)
-}
-
 /// Bytes a crossing of the path takes: its [`PathPoint`] and the rows the binding makes of
 /// it (point, face, move).
 const PATH_BYTES: usize = size_of::<PathPoint>() + 5 * 8;
@@ -410,9 +395,12 @@ fn check_path_memory(w: &Walker, moves: &[DVec2]) -> Result<()> {
     Ok(())
 }
 
-/// [`walk_path`] that polls `cancel` before every move and inside long moves (see
-/// [`Walker::step_cancellable`]); a cancelled walk returns an incomplete result.
-pub fn walk_path_cancellable(
+/// One walker from `(face, point, direction)` (see [`Walker::start`]) making `moves` in turn
+/// (see [`Walker::step`]); records every state and the crossing path.
+///
+/// Polls `cancel` before every move and inside long moves (see [`Walker::step`]); a
+/// cancelled walk returns an incomplete result.
+pub fn walk_path(
     w: &Walker,
     face: i64,
     point: DVec3,
@@ -436,7 +424,7 @@ pub fn walk_path_cancellable(
             break;
         }
         crossings.clear();
-        s = w.step_cancellable(s, *m, &mut crossings, cancel)?;
+        s = w.step(s, *m, &mut crossings, cancel)?;
         alloc::reserve("walk_mesh", &mut path, crossings.len() + 1)?;
         path.extend(crossings.iter().map(|&(point, face)| PathPoint {
             point,
@@ -460,12 +448,9 @@ pub type Start = (i64, DVec3, Option<DVec3>);
 /// moves `moves[i·k .. (i+1)·k]`. Returns the `k + 1` states of every walker, walker by
 /// walker (the adjacency is built once, by the caller's [`Walker::new`]). The first error
 /// (in walker order) is reported with the walker's index.
-pub fn walk_many(w: &Walker, starts: &[Start], moves: &[DVec2], k: usize) -> Result<Vec<State>> {
-    walk_many_cancellable(w, starts, moves, k, &cancel::never)
-}
-
-/// [`walk_many`] that polls `cancel` before each move (see [`crate::cancel`]).
-pub fn walk_many_cancellable(
+///
+/// Polls `cancel` before each move (see [`crate::run::cancel`]).
+pub fn walk_many(
     w: &Walker,
     starts: &[Start],
     moves: &[DVec2],
@@ -508,9 +493,7 @@ pub fn walk_many_cancellable(
                         return Ok(());
                     }
                     crossings.clear();
-                    s = w
-                        .step_cancellable(s, *m, &mut crossings, cancel)
-                        .map_err(ctx)?;
+                    s = w.step(s, *m, &mut crossings, cancel).map_err(ctx)?;
                     out[j + 1] = s;
                 }
                 Ok(())
@@ -527,6 +510,7 @@ pub fn walk_many_cancellable(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
 
     use crate::math::mesh::fixtures::cube_i64 as cube;
 
@@ -541,14 +525,14 @@ mod tests {
             DVec2::new(0.0, 0.0),
             DVec2::new(-0.2, 2.5),
         ];
-        let walk = walk_path(&w, 2, p, None, &moves).unwrap();
+        let walk = walk_path(&w, 2, p, None, &moves, &cancel::never).unwrap();
         // by hand
         let mut s = w.start(2, p, None).unwrap();
         let mut states = vec![s];
         let mut path = vec![(s.point, s.face, 0)];
         for (k, m) in moves.iter().enumerate() {
             let mut crossings = Vec::new();
-            s = w.step(s, *m, &mut crossings).unwrap();
+            s = w.step(s, *m, &mut crossings, &cancel::never).unwrap();
             path.extend(crossings.iter().map(|&(q, g)| (q, g, k + 1)));
             path.push((s.point, s.face, k + 1));
             states.push(s);
@@ -569,7 +553,7 @@ mod tests {
         // the long moves cross edges of the cube
         assert!(walk.path.len() > moves.len() + 2);
         // a start off the face is an error of the start
-        let e = walk_path(&w, 2, DVec3::splat(5.0), None, &moves).unwrap_err();
+        let e = walk_path(&w, 2, DVec3::splat(5.0), None, &moves, &cancel::never).unwrap_err();
         assert_eq!(e.arg, "point");
     }
 
@@ -638,7 +622,9 @@ mod tests {
                     let s0 = w.start(face as i64, p, dir).expect("a point on the face");
                     assert_frame(&w, &s0);
                     let mut path = Vec::new();
-                    let s1 = w.step(s0, mv, &mut path).expect("a valid move");
+                    let s1 = w
+                        .step(s0, mv, &mut path, &cancel::never)
+                        .expect("a valid move");
                     assert!(!s1.stopped && path.len() >= 2, "{} crossings", path.len());
                     assert_frame(&w, &s1);
                     // every piece of the path lies in the face it crosses
@@ -657,7 +643,9 @@ mod tests {
                         "{length} vs {}",
                         mv.length()
                     );
-                    let back = w.step(s1, -mv, &mut Vec::new()).expect("a valid move");
+                    let back = w
+                        .step(s1, -mv, &mut Vec::new(), &cancel::never)
+                        .expect("a valid move");
                     assert_eq!(back.face, s0.face);
                     assert!((back.point - s0.point).length() < 1e-12);
                     assert!(
@@ -689,7 +677,7 @@ mod tests {
             (4.0, DVec3::new(0.5, 0.3, 0.0)),
         ] {
             let s = w
-                .step(s0, DVec2::new(length, 0.0), &mut Vec::new())
+                .step(s0, DVec2::new(length, 0.0), &mut Vec::new(), &cancel::never)
                 .expect("a move");
             assert!(
                 (s.point - want).length() < 1e-12,
@@ -698,7 +686,7 @@ mod tests {
             );
         }
         let s = w
-            .step(s0, DVec2::new(4.0, 0.0), &mut Vec::new())
+            .step(s0, DVec2::new(4.0, 0.0), &mut Vec::new(), &cancel::never)
             .expect("a move");
         assert!(
             (s.frame - s0.frame)
@@ -718,7 +706,7 @@ mod tests {
             .start(1, DVec3::new(0.5, 0.3, 0.0), Some(DVec3::X))
             .expect("on face 1");
         let s = w
-            .step(s0, DVec2::new(3.0, 0.0), &mut Vec::new())
+            .step(s0, DVec2::new(3.0, 0.0), &mut Vec::new(), &cancel::never)
             .expect("a move");
         assert!(s.stopped);
         assert!(
@@ -744,14 +732,14 @@ mod tests {
             let moves: Vec<DVec2> = (0..starts.len() * k)
                 .map(|j| DVec2::new(1.0 + 0.37 * j as f64, (0.9 * j as f64).sin()))
                 .collect();
-            let all = walk_many(&w, &starts, &moves, k).expect("valid walks");
+            let all = walk_many(&w, &starts, &moves, k, &cancel::never).expect("valid walks");
             assert_eq!(all.len(), starts.len() * (k + 1));
             for (i, &(face, point, dir)) in starts.iter().enumerate() {
                 let mut s = w.start(face, point, dir).expect("a start");
                 for j in 0..=k {
                     if j > 0 {
                         s = w
-                            .step(s, moves[i * k + j - 1], &mut Vec::new())
+                            .step(s, moves[i * k + j - 1], &mut Vec::new(), &cancel::never)
                             .expect("a move");
                     }
                     let got = all[i * (k + 1) + j];
@@ -763,11 +751,13 @@ mod tests {
             }
             let mut bad = moves.clone();
             bad[2 * k + 1].x = f64::NAN;
-            let err = walk_many(&w, &starts, &bad, k).unwrap_err();
+            let err = walk_many(&w, &starts, &bad, k, &cancel::never).unwrap_err();
             assert_eq!(err.arg, "moves");
             assert!(err.msg.starts_with("walker 2"), "{err}");
             assert_eq!(
-                walk_many(&w, &starts, &moves[1..], k).unwrap_err().arg,
+                walk_many(&w, &starts, &moves[1..], k, &cancel::never)
+                    .unwrap_err()
+                    .arg,
                 "moves"
             );
         }

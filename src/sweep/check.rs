@@ -7,13 +7,13 @@ use rayon::prelude::*;
 use super::join::Corner;
 use super::layout::{Plan, Size};
 use super::{Options, Profile, Spine, columns};
-use crate::cancel::Cancel;
 use crate::error::{InputError, Result};
 use crate::frames::validate;
+use crate::run::cancel::Cancel;
 
 /// Check one spine and plan its part of the mesh; polls `cancel` between its passes and
 /// before every block of rows within them, and returns `None` once it says stop (see
-/// [`crate::cancel`]). `given`: the frames came with the input and are checked too (frames
+/// [`crate::run::cancel`]). `given`: the frames came with the input and are checked too (frames
 /// computed here are rotations along the spine by construction). `found`: the spine's size
 /// and corners as its layout found them ([`Size::with_corners`]), or `None` to find them.
 pub(super) fn check_spine(
@@ -43,7 +43,7 @@ pub(super) fn check_spine(
             format!("has {} entries but points has {n} rows", s.twist.len()),
         ));
     }
-    validate::finite_cancellable("points", s.points, cancel)?;
+    validate::finite("points", s.points, cancel)?;
     if cancel() {
         return Ok(None);
     }
@@ -59,12 +59,12 @@ pub(super) fn check_spine(
             ),
         ));
     }
-    let chords = validate::chords_cancellable(&s.points[..rings], opts.closed, cancel)?;
+    let chords = validate::chords(&s.points[..rings], opts.closed, cancel)?;
     if cancel() {
         return Ok(None);
     }
     let bad_frame = match given {
-        true => validate::first_bad_cancellable(s.frames, validate::is_rotation, cancel),
+        true => validate::first_bad(s.frames, validate::is_rotation, cancel),
         false => None,
     };
     if let Some(i) = bad_frame {
@@ -116,7 +116,7 @@ pub(super) fn check_spine(
         return Ok(None);
     }
     let positive = |v: &DVec2| v.x > 0.0 && v.y > 0.0 && v.is_finite();
-    if let Some(i) = validate::first_bad_cancellable(s.scale, positive, cancel) {
+    if let Some(i) = validate::first_bad(s.scale, positive, cancel) {
         return Err(InputError::new(
             "scale",
             format!(
@@ -126,7 +126,7 @@ pub(super) fn check_spine(
             ),
         ));
     }
-    if let Some(i) = validate::first_bad_cancellable(s.twist, |v| v.is_finite(), cancel) {
+    if let Some(i) = validate::first_bad(s.twist, |v| v.is_finite(), cancel) {
         return Err(InputError::new(
             "twist",
             format!("non-finite value at row {i}"),

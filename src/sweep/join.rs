@@ -330,7 +330,7 @@ pub(super) fn write_joins<R: Real, I: Index>(
     vbase: usize,
     unscale: Option<i32>,
     folds: &mut Vec<usize>,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: crate::run::cancel::Cancel<'_>,
 ) -> (usize, Option<usize>) {
     let plan = rings.plan;
     let (cols, nr, stored) = (plan.cols, plan.rings, plan.stored_rings);

@@ -5,9 +5,9 @@ use rayon::prelude::*;
 
 use super::join::{self, Corner};
 use super::{Options, Profile, Spine};
-use crate::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 use crate::frames::validate;
+use crate::run::cancel::Cancel;
 
 /// The size of one spine's part of the mesh, from its rows alone (and, on a closed spine,
 /// whether its last point repeats the first); [`check_spine`] checks the spine.
@@ -156,20 +156,16 @@ pub(super) fn in_curve(e: InputError, offsets: &[usize], c: usize) -> InputError
 /// Size the mesh of a bundle of spines (`offsets[c]..offsets[c+1]` are the rows of spine `c`
 /// in the flat arrays): the sizes come from the row counts, and each spine is checked as it
 /// is swept.
-pub fn layout(all: &Spine, offsets: &[usize], profile: &Profile, opts: &Options) -> Result<Layout> {
-    let lay = layout_cancellable(all, offsets, profile, opts, &cancel::never)?;
-    Ok(lay.expect("a hook that never stops"))
-}
-
-/// [`layout`] that polls `cancel` before every block of curves, and returns `None` once it
-/// says stop (see [`crate::cancel`]).
-pub fn layout_cancellable(
+///
+/// Polls `cancel` before every block of curves and fails with [`InputError::stopped`] once
+/// it says stop (see [`crate::run::cancel`]).
+pub fn layout(
     all: &Spine,
     offsets: &[usize],
     profile: &Profile,
     opts: &Options,
     cancel: Cancel<'_>,
-) -> Result<Option<Layout>> {
+) -> Result<Layout> {
     const BLOCK: usize = 1 << 14;
     let curves = offsets.len().saturating_sub(1);
     let n = all.points.len();
@@ -183,8 +179,8 @@ pub fn layout_cancellable(
             ),
         ));
     }
-    let mut sizes = crate::alloc::with_capacity("sweep layout", curves)?;
-    let mut corners = crate::alloc::with_capacity("sweep layout", curves)?;
+    let mut sizes = crate::run::alloc::with_capacity("sweep layout", curves)?;
+    let mut corners = crate::run::alloc::with_capacity("sweep layout", curves)?;
     // blocks of curves in parallel (the joins' corners are found from the points)
     type Block = Vec<(Size, Vec<Corner>)>;
     let blocks: Vec<Option<Block>> = (0..curves.div_ceil(BLOCK))
@@ -206,13 +202,13 @@ pub fn layout_cancellable(
                     corners.push(c);
                 }
             }
-            None => return Ok(None),
+            None => return Err(InputError::stopped()),
         }
     }
-    Ok(Some(Layout {
+    Ok(Layout {
         vertices: sizes.iter().map(Size::vertices).sum(),
         faces: sizes.iter().map(|s| s.faces(profile)).sum(),
         sizes,
         corners,
-    }))
+    })
 }

@@ -78,7 +78,7 @@ mod tests;
 use glam::{DVec2, DVec3};
 
 pub use join::Join;
-pub use layout::{Layout, indices_fit_i32, layout, layout_cancellable};
+pub use layout::{Layout, indices_fit_i32, layout};
 pub use profile::Profile;
 pub use run::{FrameSource, Prepared, Written, sweep_into, sweep_many};
 pub use scale::{Index, Real};

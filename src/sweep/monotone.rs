@@ -20,9 +20,9 @@ use std::collections::BTreeMap;
 
 use glam::DVec2;
 
-use crate::cancel::{self, BLOCK, Cancel};
-use crate::error::Result;
+use crate::error::{InputError, Result};
 use crate::math::predicates::orient;
+use crate::run::cancel::{self, BLOCK, Cancel};
 
 /// Is `a` above `b` in the sweep order (higher, or as high and further left)?
 fn above(a: DVec2, b: DVec2) -> bool {
@@ -149,7 +149,7 @@ fn diagonals(q: &[DVec2], order: &[usize], cancel: Cancel<'_>) -> Result<Vec<[us
     let mut out = Vec::new();
     for (i, &v) in order.iter().enumerate() {
         if i % BLOCK == 0 && cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         // the edge that ends at v leaves the status; its helper, if a merge vertex, joins v
         let close = |status: &mut BTreeMap<Status, usize>, out: &mut Vec<[usize; 2]>| {
@@ -296,7 +296,7 @@ fn monotone_piece(
 /// `q` listed counter-clockwise: `m − 2` triangles on its own vertices, each of positive
 /// area, every edge of `q` in one triangle (in its direction) and every diagonal in two (in
 /// opposite directions). O(m log m). Polls `cancel` between its passes and every
-/// [`BLOCK`] vertices within them, and fails with [`cancel::stopped`] when it says stop.
+/// [`BLOCK`] vertices within them, and fails with [`InputError::stopped`] when it says stop.
 pub fn triangulate(q: &[DVec2], cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
     let m = q.len();
     let mut out = Vec::with_capacity(m.saturating_sub(2));
@@ -304,13 +304,13 @@ pub fn triangulate(q: &[DVec2], cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
         return Ok(out);
     }
     let stop = || match cancel() {
-        true => Err(cancel::stopped()),
+        true => Err(InputError::stopped()),
         false => Ok(()),
     };
     let mut order: Vec<usize> = (0..m).collect();
     // the vertices of a simple polygon are distinct
     if !cancel::sort_by(&mut order, |&a, &b| sweep_order(q[a], q[b]), cancel) {
-        return Err(cancel::stopped());
+        return Err(InputError::stopped());
     }
     let diag = diagonals(q, &order, cancel)?;
     drop(order);
@@ -468,7 +468,7 @@ mod tests {
         let mut tested = [0usize; 41];
         let mut straight = 0;
         let mut try_one = |p: &[DVec2], tested: &mut [usize; 41]| {
-            let Ok(prof) = Profile::new(p, true) else {
+            let Ok(prof) = Profile::new(p, true, &cancel::never) else {
                 return;
             };
             let q = &prof.points;
@@ -551,7 +551,7 @@ mod tests {
             if q.first() == q.last() {
                 q.pop();
             }
-            if let Ok(prof) = Profile::new(&q, true) {
+            if let Ok(prof) = Profile::new(&q, true, &cancel::never) {
                 check_polygon(&prof.points);
                 tested += 1;
             }
@@ -651,7 +651,7 @@ mod tests {
                 .map(|&v| DVec2::from_angle(0.3).rotate(v))
                 .collect();
             for p in [p, turned] {
-                let prof = Profile::new(&p, true).expect("a simple polygon");
+                let prof = Profile::new(&p, true, &cancel::never).expect("a simple polygon");
                 check_polygon(&prof.points);
             }
         }
@@ -691,7 +691,7 @@ mod tests {
                             .round()
                     })
                     .collect();
-                let prof = Profile::new(&q, true).expect("a simple polygon");
+                let prof = Profile::new(&q, true, &cancel::never).expect("a simple polygon");
                 check_polygon(&prof.points);
             }
         }

@@ -20,10 +20,10 @@
 
 use glam::DVec2;
 
-use crate::alloc;
-use crate::cancel::{self, BLOCK, Cancel};
 use crate::error::{InputError, Result};
 use crate::math::predicates::orient;
+use crate::run::alloc;
+use crate::run::cancel::{self, BLOCK, Cancel};
 
 /// A validated profile.
 #[derive(Debug, Clone)]
@@ -151,10 +151,10 @@ fn folds_back(a: DVec2, b: DVec2, c: DVec2) -> bool {
 /// the two edges it separated when it leaves. O(m log m), with exact predicates. Several
 /// edges ending at one point and edges folding back are found before the sweep, so that
 /// the ordered edges meet only where the sweep tests them. Polls `cancel` between its
-/// passes and every [`BLOCK`] events within them ([`cancel::stopped`] when it says stop).
+/// passes and every [`BLOCK`] events within them ([`InputError::stopped`] when it says stop).
 fn sweep_crossing(p: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Option<(usize, usize)>> {
     let stop = || match cancel() {
-        true => Err(cancel::stopped()),
+        true => Err(InputError::stopped()),
         false => Ok(()),
     };
     use std::collections::BTreeSet;
@@ -185,7 +185,7 @@ fn sweep_crossing(p: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Optio
         lex(x.0, y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2))
     };
     if !cancel::sort_by(&mut events, by, cancel) {
-        return Err(cancel::stopped());
+        return Err(InputError::stopped());
     }
     let adjacent = |a: usize, b: usize| {
         let (a, b) = (a.min(b), a.max(b));
@@ -266,23 +266,18 @@ fn probe(m: usize) -> Result<()> {
 impl Profile {
     /// Validate `points` (an `(m, 2)` polygon). A closed profile may repeat its first vertex
     /// at the end; it is dropped.
-    pub fn new(points: &[DVec2], closed: bool) -> Result<Profile> {
-        Profile::new_cancellable(points, closed, &cancel::never)
-    }
-
-    /// [`Profile::new`], polling `cancel` in the self-intersection test of a non-convex
-    /// profile (O(m log m)); fails with [`cancel::stopped`] when it says stop.
-    pub fn new_cancellable(points: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Profile> {
+    ///
+    /// Polls `cancel` in the self-intersection test of a non-convex profile (O(m log m)); fails
+    /// with [`InputError::stopped`] when it says stop.
+    pub fn new(points: &[DVec2], closed: bool, cancel: Cancel<'_>) -> Result<Profile> {
         const ARG: &str = "profile";
         // each pass over the vertices is followed by a poll, the slow ones (the convexity
         // test's arc tangents, the arc lengths) poll every [`BLOCK`] vertices as well
         let poll = || match cancel() {
-            true => Err(cancel::stopped()),
+            true => Err(InputError::stopped()),
             false => Ok(()),
         };
-        if let Some(j) =
-            crate::frames::validate::first_bad_cancellable(points, |p| p.is_finite(), cancel)
-        {
+        if let Some(j) = crate::frames::validate::first_bad(points, |p| p.is_finite(), cancel) {
             return Err(InputError::new(ARG, format!("non-finite value at row {j}")));
         }
         poll()?;
@@ -398,13 +393,10 @@ impl Profile {
 
     /// Triangles `[a, b, c]` covering the polygon, counter-clockwise in the profile plane
     /// (so their normal is `+t`, the direction of travel).
-    pub fn triangulate(&self) -> Result<Vec<[usize; 3]>> {
-        self.triangulate_cancellable(&cancel::never)
-    }
-
-    /// [`Profile::triangulate`], polling `cancel` in the triangulation of a non-convex
-    /// profile (O(m log m)); fails with [`cancel::stopped`] when it says stop.
-    pub fn triangulate_cancellable(&self, cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
+    ///
+    /// Polls `cancel` in the triangulation of a non-convex profile (O(m log m)); fails with
+    /// [`InputError::stopped`] when it says stop.
+    pub fn triangulate(&self, cancel: Cancel<'_>) -> Result<Vec<[usize; 3]>> {
         let m = self.points.len();
         // Counter-clockwise vertex order.
         let ccw: Vec<usize> = if self.area > 0.0 {
@@ -454,7 +446,7 @@ fn strictly_convex(p: &[DVec2], cancel: Cancel<'_>) -> Result<bool> {
     let (mut pos, mut neg, mut turning) = (false, false, 0.0);
     for j in 0..m {
         if j % BLOCK == 0 && cancel() {
-            return Err(cancel::stopped());
+            return Err(InputError::stopped());
         }
         let e1 = p[(j + 1) % m] - p[j];
         let e2 = p[(j + 2) % m] - p[(j + 1) % m];
@@ -637,7 +629,7 @@ mod tests {
             }
             assert!(cells.items.len() <= 9 * 10 * edges, "{}", cells.items.len());
         }
-        assert!(Profile::new(&p, false).is_ok());
+        assert!(Profile::new(&p, false, &cancel::never).is_ok());
     }
 
     #[test]
@@ -657,8 +649,8 @@ mod tests {
                 if rev {
                     p.reverse();
                 }
-                let prof = Profile::new(&p, true).unwrap();
-                let tris = prof.triangulate().unwrap();
+                let prof = Profile::new(&p, true, &cancel::never).unwrap();
+                let tris = prof.triangulate(&cancel::never).unwrap();
                 assert_eq!(tris.len(), p.len() - 2);
                 // every triangle counter-clockwise, total = |area|
                 for t in &tris {
@@ -688,9 +680,9 @@ mod tests {
                 if rev {
                     p.reverse();
                 }
-                let prof = Profile::new(&p, true).unwrap();
+                let prof = Profile::new(&p, true, &cancel::never).unwrap();
                 assert_eq!(prof.convex, convex);
-                let tris = prof.triangulate().unwrap();
+                let tris = prof.triangulate(&cancel::never).unwrap();
                 assert_eq!(tris.len(), p.len() - 2);
                 for t in &tris {
                     assert!(cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]) > 0.0);
@@ -704,7 +696,7 @@ mod tests {
             .map(|k| DVec2::from_angle(std::f64::consts::TAU * k as f64 / 1600.0))
             .collect();
         bad[800] = DVec2::new(1.5, 0.0);
-        assert!(Profile::new(&bad, true).is_err());
+        assert!(Profile::new(&bad, true, &cancel::never).is_err());
     }
 
     #[test]
@@ -713,13 +705,13 @@ mod tests {
             .iter()
             .map(|&(x, y)| DVec2::new(x, y))
             .collect();
-        assert!(Profile::new(&bowtie, true).is_err());
+        assert!(Profile::new(&bowtie, true, &cancel::never).is_err());
         let line: Vec<DVec2> = [(0., 0.), (1., 1.), (2., 2.)]
             .iter()
             .map(|&(x, y)| DVec2::new(x, y))
             .collect();
-        assert!(Profile::new(&line, true).is_err());
-        assert!(Profile::new(&line, false).is_ok());
+        assert!(Profile::new(&line, true, &cancel::never).is_err());
+        assert!(Profile::new(&line, false, &cancel::never).is_ok());
     }
 
     /// The definition: any two non-adjacent edges that meet, or adjacent ones that fold
@@ -892,8 +884,8 @@ mod tests {
                 if rev {
                     q.reverse();
                 }
-                let prof = Profile::new(&q, true).unwrap();
-                let tris = prof.triangulate().unwrap();
+                let prof = Profile::new(&q, true, &cancel::never).unwrap();
+                let tris = prof.triangulate(&cancel::never).unwrap();
                 assert_eq!(tris.len(), q.len() - 2);
                 use std::cmp::Ordering::Greater;
                 assert!(

@@ -11,7 +11,7 @@ use super::kernel::{Cols, Columns, RingScratch};
 use super::layout::Plan;
 use super::scale::{Index, Real, put3, unscaled};
 use super::{MeshMut, Profile, Spine, columns};
-use crate::cancel::Cancel;
+use crate::run::cancel::Cancel;
 
 /// The unit vector along a chord of the spine (zero for a zero chord), scaled by the largest
 /// component before squaring: any finite spine size.

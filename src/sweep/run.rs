@@ -11,13 +11,13 @@ use super::check::check_spine;
 use super::faces::FacePattern;
 use super::join::{Corner, write_joins};
 use super::kernel::{Columns, RingScratch};
-use super::layout::{Layout, Plan, in_curve, layout, layout_cancellable, part};
+use super::layout::{Layout, Plan, in_curve, layout, part};
 use super::rings::Rings;
 use super::scale::{Index, Real, Scaled, out_of_range, scaled_input};
 use super::{Mesh, MeshMut, Options, Profile, Spine};
-use crate::cancel::{self, Cancel};
-use crate::error::{InputError, Result};
+use crate::error::{ErrorKind, InputError, Result};
 use crate::frames::validate;
+use crate::run::cancel::{self, Cancel};
 
 /// Output bytes at most per block of rings of [`sweep_one`], or per piece of the columns of
 /// a ring larger than this (one poll of the cancel hook per block or piece). A cold output array is faulted in as it is written: on a loaded 2-core machine a
@@ -60,7 +60,7 @@ impl<'a> Shared<'a> {
             column: OnceLock::new(),
             pattern,
             tris: match caps {
-                true => p.triangulate_cancellable(cancel)?,
+                true => p.triangulate(cancel)?,
                 false => Vec::new(),
             },
             sign,
@@ -206,7 +206,7 @@ fn rmf_into(
         turns,
         ..crate::frames::Request::default()
     };
-    crate::frames::compute_into_cancellable(&req, buf[..n].as_flattened_mut(), cancel)?;
+    crate::frames::compute_into(&req, buf[..n].as_flattened_mut(), cancel)?;
     Ok(())
 }
 
@@ -276,7 +276,7 @@ impl Sweep<'_> {
         }
         // Split the buffers per spine.
         let sizes = &self.layout.sizes;
-        let mut jobs = crate::alloc::with_capacity("sweep", sizes.len())?;
+        let mut jobs = crate::run::alloc::with_capacity("sweep", sizes.len())?;
         let all_faces = out.faces;
         let (mut v, mut nr, mut u, mut f) = (out.vertices, out.normals, out.uv, &mut *all_faces);
         let mut vbase = 0;
@@ -524,34 +524,14 @@ pub struct Prepared<'a> {
 
 impl<'a> Prepared<'a> {
     /// Check a bundle of spines (`offsets` as in [`layout`]) with a profile polygon, and the
-    /// spines' `frames`.
-    pub fn new(
-        spine: Spine<'a>,
-        offsets: &'a [usize],
-        profile: &[DVec2],
-        profile_closed: bool,
-        opts: Options,
-    ) -> Result<Prepared<'a>> {
-        let prep = Prepared::new_cancellable(
-            spine,
-            offsets,
-            profile,
-            profile_closed,
-            opts,
-            FrameSource::Given,
-            &cancel::never,
-        )?;
-        Ok(prep.expect("a hook that never stops"))
-    }
-
-    /// [`Prepared::new`] with the frames from `frames`, polling `cancel` between its passes
-    /// and before every block of rows within them; returns `None` once it says stop (see
-    /// [`crate::cancel`]).
+    /// spines' frames from `frames`, polling `cancel` between its passes and before every
+    /// block of rows within them; fails with [`InputError::stopped`] once it says stop (see
+    /// [`crate::run::cancel`]).
     ///
     /// With computed frames ([`FrameSource::Rmf`]) a bad profile or option is reported only
     /// when every curve's frames can be computed, as when the frames were a call of their
     /// own before the sweep.
-    pub fn new_cancellable(
+    pub fn new(
         spine: Spine<'a>,
         offsets: &'a [usize],
         profile: &[DVec2],
@@ -559,10 +539,10 @@ impl<'a> Prepared<'a> {
         opts: Options,
         frames: FrameSource<'a>,
         cancel: Cancel<'_>,
-    ) -> Result<Option<Prepared<'a>>> {
+    ) -> Result<Prepared<'a>> {
         let scaled = scaled_input(spine.points, profile, spine.scale, cancel);
         if cancel() {
-            return Ok(None);
+            return Err(InputError::stopped());
         }
         let (points, prof, scale) = match &scaled {
             Some(s) => (&s.points[..], &s.profile[..], &s.scale[..]),
@@ -573,18 +553,18 @@ impl<'a> Prepared<'a> {
             scale,
             ..spine
         };
-        let set_up = Profile::new_cancellable(prof, profile_closed, cancel).and_then(|p| {
+        let set_up = Profile::new(prof, profile_closed, cancel).and_then(|p| {
             super::seam::shift(&p, opts.closed, opts.turns)?;
-            let lay = layout_cancellable(&view, offsets, &p, &opts, cancel)?;
-            Ok(lay.map(|l| (p, l)))
+            let lay = layout(&view, offsets, &p, &opts, cancel)?;
+            Ok((p, lay))
         });
         let (p, layout) = match (set_up, frames) {
-            (Ok(Some(pl)), _) => pl,
-            (Ok(None), _) => return Ok(None),
+            (Ok(pl), _) => pl,
+            (Err(e), _) if e.kind == ErrorKind::Stopped => return Err(e),
             // a stopped check of the profile is no error
             (Err(e), FrameSource::Given) => {
                 return match cancel() {
-                    true => Ok(None),
+                    true => Err(InputError::stopped()),
                     false => Err(e),
                 };
             }
@@ -595,12 +575,12 @@ impl<'a> Prepared<'a> {
                     return Err(fe);
                 }
                 return match cancel() {
-                    true => Ok(None),
+                    true => Err(InputError::stopped()),
                     false => Err(e),
                 };
             }
         };
-        Ok(Some(Prepared {
+        Ok(Prepared {
             spine,
             offsets,
             scaled,
@@ -608,7 +588,7 @@ impl<'a> Prepared<'a> {
             opts,
             frames,
             layout,
-        }))
+        })
     }
 
     /// The spine the sweep runs on (scaled or as given).
@@ -625,7 +605,7 @@ impl<'a> Prepared<'a> {
 
     /// Every spine swept into buffers of the sizes in `self.layout` (see
     /// [`sweep_into`]; with computed frames, each spine's frames first), polling `cancel`
-    /// before every spine and every block of rings within them (see [`crate::cancel`]),
+    /// before every spine and every block of rings within them (see [`crate::run::cancel`]),
     /// and adding each spine's row count to `done` once it is swept (a progress count).
     pub fn write_into<R: Real, I: Index>(
         &self,
@@ -657,7 +637,7 @@ pub fn sweep_many(
     profile: &Profile,
     opts: &Options,
 ) -> Result<Mesh> {
-    let lay = layout(all, offsets, profile, opts)?;
+    let lay = layout(all, offsets, profile, opts, &cancel::never)?;
     let mut mesh = Mesh {
         vertices: vec![DVec3::ZERO; lay.vertices],
         faces: vec![[0; 3]; lay.faces],

@@ -3,9 +3,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::cancel::Cancel;
 use crate::error::InputError;
 use crate::frames::validate;
+use crate::run::cancel::Cancel;
 
 /// Storage of the output coordinates: `f64`, or `f32` rounded from the `f64` results.
 pub trait Real: Copy + Send + Sync + 'static {
@@ -69,7 +69,7 @@ pub(super) fn scaled_input(
     cancel: Cancel<'_>,
 ) -> Option<Scaled> {
     use crate::math::scale as s;
-    let finite = validate::first_bad_cancellable(points, |p| p.is_finite(), cancel).is_none()
+    let finite = validate::first_bad(points, |p| p.is_finite(), cancel).is_none()
         && !cancel()
         && profile.iter().all(|p| p.is_finite())
         && scale

@@ -137,6 +137,7 @@ pub fn no_corners<C>(corners: &[C]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::cancel;
     use glam::DVec2;
 
     fn polygon(m: usize, a: f64, b: f64, off: f64) -> Profile {
@@ -146,7 +147,7 @@ mod tests {
                 DVec2::new(off + a * u.cos(), b * u.sin())
             })
             .collect();
-        Profile::new(&pts, true).expect("a simple polygon")
+        Profile::new(&pts, true, &cancel::never).expect("a simple polygon")
     }
 
     #[test]

@@ -7,7 +7,7 @@ use super::kernel::{Columns, RingScratch};
 use super::rings::{Block, Rings};
 use super::run::Shared;
 use super::*;
-use crate::cancel;
+use crate::run::cancel;
 use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 use std::sync::OnceLock;
@@ -149,7 +149,7 @@ fn assert_counts(x: &[DVec3], frames: &[[f64; 9]], p: &Profile, opts: &Options, 
         scale: &scale,
         twist: &[],
     };
-    let lay = layout(&spine, &[0, x.len()], p, opts).expect("a valid sweep");
+    let lay = layout(&spine, &[0, x.len()], p, opts, &cancel::never).expect("a valid sweep");
     let (v, f) = expected_counts(rings, p.len(), p.closed, opts);
     assert_eq!((lay.vertices, lay.faces), (v, f), "{opts:?}");
     let mesh = sweep(x, frames, &scale, p, opts);
@@ -193,7 +193,7 @@ fn capped_straight_tube_is_watertight_with_the_prism_volume() {
             if reverse {
                 pts.reverse();
             }
-            let p = Profile::new(&pts, true).expect("a simple polygon");
+            let p = Profile::new(&pts, true, &cancel::never).expect("a simple polygon");
             let opts = options(false, true, false);
             let mesh = sweep(&x, &frames, &vec![DVec2::ONE; 17], &p, &opts);
             assert_watertight(&mesh.faces);
@@ -251,7 +251,7 @@ fn closed_tube_is_watertight_with_the_mitred_volume() {
             if reverse {
                 pts.reverse();
             }
-            let p = Profile::new(&pts, true).expect("a simple polygon");
+            let p = Profile::new(&pts, true, &cancel::never).expect("a simple polygon");
             let opts = options(true, false, false);
             let mesh = sweep(&x, &frames, &vec![DVec2::splat(0.5); 24], &p, &opts);
             assert_watertight(&mesh.faces);
@@ -276,7 +276,7 @@ fn closed_tube_is_watertight_with_the_mitred_volume() {
 #[test]
 fn split_seams_stay_watertight_by_position() {
     let (x, frames) = circle(12, 2.0);
-    let p = Profile::new(&polygon(5), true).expect("a pentagon");
+    let p = Profile::new(&polygon(5), true, &cancel::never).expect("a pentagon");
     let scale = vec![DVec2::splat(0.4); 12];
     let mesh = sweep(&x, &frames, &scale, &p, &options(true, false, true));
     assert!(boundary_edges(&mesh.faces) > 0, "seams are open by index");
@@ -319,6 +319,7 @@ fn open_ribbon_has_its_rim_as_boundary() {
             DVec2::new(2.0, 0.0),
         ],
         false,
+        &cancel::never,
     )
     .expect("an open polyline");
     let (x, frames) = straight(9, 2.0);
@@ -345,8 +346,8 @@ fn open_ribbon_has_its_rim_as_boundary() {
 /// `layout` sizes every kind of sweep by the closed forms, and the mesh fills it.
 #[test]
 fn vertex_and_face_counts_equal_the_layout() {
-    let closed_p = Profile::new(&star(), true).expect("a star");
-    let open_p = Profile::new(&polygon(6)[..4], false).expect("an open polyline");
+    let closed_p = Profile::new(&star(), true, &cancel::never).expect("a star");
+    let open_p = Profile::new(&polygon(6)[..4], false, &cancel::never).expect("an open polyline");
     let (sx, sf) = straight(6, 1.0);
     let (cx, cf) = circle(8, 2.0);
     for p in [&closed_p, &open_p] {
@@ -385,9 +386,9 @@ fn avx2_block_equals_baseline_block() {
         scale: &scale,
         twist: &twist,
     };
-    let p = Profile::new(&star(), true).expect("a star");
+    let p = Profile::new(&star(), true, &cancel::never).expect("a star");
     let opts = options(false, true, true);
-    let lay = layout(&spine, &[0, n], &p, &opts).expect("a sized sweep");
+    let lay = layout(&spine, &[0, n], &p, &opts, &cancel::never).expect("a sized sweep");
     let plan = check_spine(&spine, &opts, &p, true, None, &cancel::never)
         .expect("a valid sweep")
         .expect("not stopped");
@@ -547,13 +548,17 @@ fn rings_in_pieces_equal_whole_rings() {
     let cases = [
         (
             helix,
-            Profile::new(&star(), true),
+            Profile::new(&star(), true, &cancel::never),
             options(false, false, true),
         ),
-        (helix, Profile::new(&cw, true), options(false, false, false)),
+        (
+            helix,
+            Profile::new(&cw, true, &cancel::never),
+            options(false, false, false),
+        ),
         (
             loop_,
-            Profile::new(&ribbon, false),
+            Profile::new(&ribbon, false, &cancel::never),
             options(true, false, true),
         ),
     ];
@@ -632,7 +637,7 @@ fn legs(deg: f64, n: usize) -> (Vec<DVec3>, Vec<[f64; 9]>) {
 /// profile's radius about the corner.
 #[test]
 fn corners_get_watertight_joins_and_smooth_spines_none() {
-    let p = Profile::new(&polygon(16), true).expect("a valid profile");
+    let p = Profile::new(&polygon(16), true, &cancel::never).expect("a valid profile");
     let r = DVec2::splat(0.05);
     for (deg, n) in [(90.0, 20), (150.0, 2), (170.0, 200)] {
         let (x, frames) = legs(deg, n);

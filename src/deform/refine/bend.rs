@@ -44,9 +44,9 @@ use glam::DVec3;
 
 use super::split::TORN;
 use super::{CALL, Gen, Refiner};
-use crate::alloc;
 use crate::deform::slip::Carry;
 use crate::error::Result;
+use crate::run::alloc;
 
 /// An edge is bent when `Φ` of its rest midpoint lies farther than this fraction of the edge
 /// from the chord midpoint: the flat face then misses the surface by about `BEND · ℓ`.

@@ -69,9 +69,9 @@
 use glam::DVec3;
 
 use super::{CALL, MAX_VALENCE, NONE, Refiner, Topology, min_angle};
-use crate::alloc;
 use crate::deform::slip::{self, Carry};
 use crate::error::Result;
+use crate::run::alloc;
 
 /// Faces of the strip with a smallest angle under this (1°, radians) are collapsed away.
 pub(super) const SLIVER: f64 = 1.0 * std::f64::consts::PI / 180.0;

@@ -4,9 +4,9 @@
 use glam::DVec3;
 
 use super::{CALL, MAX_VALENCE, NONE, Refiner, Topology, min_angle};
-use crate::alloc;
 use crate::deform::slip::Carry;
 use crate::error::Result;
+use crate::run::alloc;
 
 /// A flip changes the enclosed volume by the signed volume of the tetrahedron of its four
 /// vertices; it is allowed only below this fraction of `ℓ̄³` (see [`Refiner::flippable`]).

@@ -118,6 +118,7 @@
 //! `refine/flip.rs`, the collapses in `refine/collapse.rs`; this file holds the mesh, the
 //! refinement state and the integration loop ([`deform`]).
 
+use crate::run::cancel;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -126,8 +127,8 @@ use rayon::prelude::*;
 use super::Field;
 use super::advect::{Method, advect_steps};
 use super::slip::{self, Carry};
-use crate::alloc;
 use crate::error::{InputError, Result};
+use crate::run::alloc;
 
 mod bend;
 mod collapse;
@@ -466,12 +467,14 @@ pub fn deform(
     if check {
         // one linear pass over the faces before the first step (not polled: it takes about
         // what one step takes)
-        crate::mesh::closed::closed_volume_centroid(rest, faces).map_err(|mut e| {
-            if e.kind == crate::error::ErrorKind::Invalid {
-                e.msg.push_str("; pass check=False to deform it anyway");
-            }
-            e
-        })?;
+        crate::mesh::closed::closed_volume_centroid(rest, faces, &cancel::never).map_err(
+            |mut e| {
+                if e.kind == crate::error::ErrorKind::Invalid {
+                    e.msg.push_str("; pass check=False to deform it anyway");
+                }
+                e
+            },
+        )?;
     }
     let edges = topo.twin.iter().enumerate();
     let (sum, count) =

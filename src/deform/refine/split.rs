@@ -5,9 +5,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{CALL, Gen, NONE, Refiner, Topology, len2};
-use crate::alloc;
 use crate::deform::slip::{self, Carry};
 use crate::error::Result;
+use crate::run::alloc;
 
 /// A placement farther than this fraction of its edge from the chord midpoint marks the edge
 /// as torn by the flow (see the module docs).

@@ -2,9 +2,12 @@
 //! allocation aborts the process when the allocator refuses (under `ulimit -v`, a container
 //! limit, or a request larger than the address space); these helpers ask with
 //! `try_reserve_exact` and checked multiplication instead, and return
-//! [`InputError::out_of_memory`] naming the call, which the Python binding raises as
-//! `MemoryError`.
+//! [`InputError::out_of_memory`] (of kind [`ErrorKind::OutOfMemory`]) naming the call, which
+//! the Python binding raises as `MemoryError`.
+//!
+//! [`ErrorKind::OutOfMemory`]: crate::error::ErrorKind::OutOfMemory
 
+use super::cancel::{self, Cancel};
 use crate::error::{InputError, Result};
 
 /// An empty vector with room for exactly `n` elements.
@@ -37,28 +40,13 @@ pub fn collect<T>(what: &'static str, it: impl ExactSizeIterator<Item = T>) -> R
 }
 
 /// The `Ok` items of an iterator of known length, or its first error (or the out-of-memory
-/// error before any item is made).
+/// error before any item is made), polling `cancel` before every [`CANCEL_ITEMS`] items: once
+/// it says stop the items made so far are returned (an incomplete result the caller
+/// discards; see [`super::cancel`]).
 pub fn try_collect<T>(
     what: &'static str,
     it: impl ExactSizeIterator<Item = Result<T>>,
-) -> Result<Vec<T>> {
-    let mut v = with_capacity(what, it.len())?;
-    for x in it {
-        v.push(x?);
-    }
-    Ok(v)
-}
-
-/// Items between polls of [`try_collect_cancellable`].
-pub const CANCEL_ITEMS: usize = 1 << 14;
-
-/// [`try_collect`] that polls `cancel` before every [`CANCEL_ITEMS`] items and returns the
-/// items made so far once it says stop (an incomplete result the caller discards; see
-/// [`crate::cancel`]).
-pub fn try_collect_cancellable<T>(
-    what: &'static str,
-    it: impl ExactSizeIterator<Item = Result<T>>,
-    cancel: crate::cancel::Cancel<'_>,
+    cancel: Cancel<'_>,
 ) -> Result<Vec<T>> {
     let mut v = with_capacity(what, it.len())?;
     for (i, x) in it.enumerate() {
@@ -68,6 +56,22 @@ pub fn try_collect_cancellable<T>(
         v.push(x?);
     }
     Ok(v)
+}
+
+/// Items between polls of [`try_collect`].
+pub const CANCEL_ITEMS: usize = 1 << 14;
+
+/// The rows `row(0..n)` in a vector reserved fallibly (out of memory named by `what`) and
+/// written by [`cancel::fill_in_blocks`]; `Ok(None)` when `cancel` said stop.
+pub fn rows<T: Send + Default + Clone>(
+    what: &'static str,
+    n: usize,
+    grain: usize,
+    cancel: Cancel<'_>,
+    row: impl Fn(usize) -> T + Sync,
+) -> Result<Option<Vec<T>>> {
+    let mut out = filled(what, n, T::default())?;
+    Ok(cancel::fill_in_blocks(&mut out, grain, cancel, row).then_some(out))
 }
 
 /// The rows of an iterator of known length, concatenated.
@@ -148,16 +152,29 @@ mod tests {
         );
         assert!(flat("x", std::iter::repeat_n([0u64; 4], usize::MAX / 8)).is_err());
         let ok: [Result<u8>; 2] = [Ok(1), Ok(2)];
-        assert_eq!(try_collect("x", ok.into_iter()).unwrap(), vec![1, 2]);
+        let never = &cancel::never;
+        assert_eq!(try_collect("x", ok.into_iter(), never).unwrap(), vec![1, 2]);
         let bad = [Ok(1), Err(InputError::new("a", "b")), Ok(3)];
-        assert_eq!(try_collect("x", bad.into_iter()).unwrap_err().arg, "a");
+        assert_eq!(
+            try_collect("x", bad.into_iter(), never).unwrap_err().arg,
+            "a"
+        );
         let many = (0..3 * CANCEL_ITEMS).map(Ok);
-        let stop_now = try_collect_cancellable("x", many.clone(), &|| true).unwrap();
+        let stop_now = try_collect("x", many.clone(), &|| true).unwrap();
         assert!(stop_now.is_empty());
-        let all = try_collect_cancellable("x", many, &crate::cancel::never).unwrap();
+        let all = try_collect("x", many, never).unwrap();
         assert_eq!(all.len(), 3 * CANCEL_ITEMS);
         use rayon::prelude::*;
         let v = par_collect("x", (0..10_000u32).into_par_iter().map(|i| 2 * i)).unwrap();
         assert!(v.iter().enumerate().all(|(i, &x)| x == 2 * i as u32));
+        let n = 3 * cancel::GRAIN + 17;
+        let got = rows("x", n, 7, never, |i| i as u32).expect("room");
+        assert!(
+            got.expect("not stopped")
+                .iter()
+                .enumerate()
+                .all(|(i, &v)| v == i as u32)
+        );
+        assert_eq!(rows("x", n, 7, &|| true, |i| i as u32), Ok(None));
     }
 }
