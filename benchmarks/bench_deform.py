@@ -12,8 +12,8 @@ apart, the wall time (best of ``--repeat``), the time of each phase
 
 Cases: the drag (a curl translation tool of radius 0.9 centred on the unit sphere's surface,
 moved half a radius sideways: the tool's surface tears the mesh) on 2,562, 10,242 and 40,962
-vertices; the press of tests/test_deform.py (a 1.0-long stroke into 10,242 vertices); and
-the 40,962-vertex strokes of tests/test_deform.py, test_deform_tools.py and
+vertices; the press of tests/deform/test_deform.py (a 1.0-long stroke into 10,242 vertices); and
+the 40,962-vertex strokes of tests/deform/test_deform.py, test_deform_tools.py and
 test_deform_path.py (there run unrefined with ``spinal.advect``). Each case runs in a fresh
 process, so that its peak memory is its own. Targets for the drag: |volume change| ≤ 5e-4,
 output ≤ 10× input vertices, ≤ 10 s.
@@ -39,7 +39,7 @@ TARGET_VOLUME, TARGET_RATIO, TARGET_SECONDS = 5e-4, 10.0, 10.0
 
 
 def arc(n):
-    """The spatial arc over the unit sphere of tests/test_deform_path.py."""
+    """The spatial arc over the unit sphere of tests/deform/test_deform_path.py."""
     th = np.linspace(-0.5, 0.5, n)
     r = 1.32 - 0.12 * np.sin(np.pi * (th + 0.5))
     return np.c_[r * np.sin(th), 0.15 * np.sin(2 * th) * r, r * np.cos(th)]
@@ -51,17 +51,17 @@ def field(name):
 
     if name == "drag":
         return fields.translation(center=[0, 0, 0.9], radius=0.9, velocity=[0.5, 0, 0]), 1.0
-    if name == "press 1.0":  # tests/test_deform.py: PRESS, the long stroke
+    if name == "press 1.0":  # tests/deform/test_deform.py: PRESS, the long stroke
         return fields.translation([0, 0, 1.32], 0.3, [0, 0, -1]), 1.0
-    if name == "press 0.3":  # tests/test_deform.py: PRESS, 40k volume test
+    if name == "press 0.3":  # tests/deform/test_deform.py: PRESS, 40k volume test
         return fields.translation([0, 0, 1.32], 0.3, [0, 0, -1]), 0.3
-    if name == "sphere ∇p×∇q":  # tests/test_deform.py: PEER
+    if name == "sphere ∇p×∇q":  # tests/deform/test_deform.py: PEER
         return fields.sphere([0, 0, 0.9], 0.3, [1, 0, 0], reach=0.6, moving=False), 0.6
-    if name == "curved strip":  # tests/test_deform_tools.py
+    if name == "curved strip":  # tests/deform/test_deform_tools.py
         th = np.linspace(-0.6, 0.6, 13)
         axis = np.c_[np.sin(th), 0.15 * np.sin(2 * th), np.cos(th)]
         return fields.strip_curve(axis, 0.3, 1.0, reach=0.3), 0.2
-    if name == "path (rotate)":  # tests/test_deform_path.py
+    if name == "path (rotate)":  # tests/deform/test_deform_path.py
         return fields.along_path(arc(16), 0.3, 1.0, kind="rotate"), 1.0
     raise ValueError(f"unknown case {name!r}")
 
@@ -186,7 +186,7 @@ def main() -> int:
               f"{t['volume']:.3f} | {rss} | {verdict} |")
     print()
     print("volume change: relative, of the refined mesh (DeformReport.relative_change; its "
-          "volumes agree with trimesh and libigl to 1e-12 in tests/test_deform_refine.py); "
+          "volumes agree with trimesh and libigl to 1e-12 in tests/deform/test_deform_refine.py); "
           "unrefined: spinal.advect with the same steps. torn vertices: new vertices of edges "
           "torn by the tool's tangential slip, placed halfway along their path over the two "
           "sides and the tool's surface (DeformReport.torn_vertices). Peak RSS growth: VmHWM "

@@ -8,6 +8,16 @@ import textwrap
 import numpy as np
 import pytest
 
+# The tests live in one folder per concept (frames, sweep, deform, ...); a test module may
+# import the helpers of another concept's module by its name (`from test_deform import
+# volumes`), whichever folder pytest collects first.
+_HERE = os.path.dirname(os.path.abspath(__file__))
+for _name in sorted(os.listdir(_HERE)):
+    _dir = os.path.join(_HERE, _name)
+    usable = not _name.startswith(("_", ".")) and _name != "artifacts"
+    if usable and os.path.isdir(_dir) and _dir not in sys.path:
+        sys.path.insert(0, _dir)
+
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
 

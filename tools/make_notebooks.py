@@ -8,7 +8,7 @@ view and in the API reference). Run from the repository root:
 
 Execution uses nbclient (``pip install -e '.[test]'``) with pyvista off-screen. The stored
 outputs are tidied: no stderr streams (progress lines, warnings), no timing metadata, and
-pictures re-encoded as small palette PNGs. ``tests/test_notebooks.py`` checks that the
+pictures re-encoded as small palette PNGs. ``tests/api/test_notebooks.py`` checks that the
 committed notebooks' cells equal the ones written here and that they hold outputs; the test
 suite also executes them (nbmake). ``SPINAL_WRITE_IMAGES=1`` while executing them refreshes
 the README's pictures in docs/images/.

@@ -218,7 +218,7 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
     end planes the foot point is the end sample and ``v`` is :func:`sphere`'s field about it
     with velocity ``speed·T_end`` (continuous across the end planes). Exactly divergence-free:
     ``div(J(r) T) = J′ ∇r·T + J T′·∇s = 0`` (``∇r ⟂ T``, ``∇s ∥ T ⟂ T′``). Inside the tube
-    ``v = speed·T``; the flux through each cross-section is zero. ``tests/test_deform_tools.py``
+    ``v = speed·T``; the flux through each cross-section is zero. ``tests/deform/test_deform_tools.py``
     checks it against ``∇p × ∇q`` built from double-reflection frames by finite differences.
 
     Parameters
@@ -298,14 +298,14 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     skipped (the basis is a partition of unity, so ``d ≥ reach`` there).
 
     A sphere's sampled distance reproduces :func:`sphere` with a 3rd-order error in the grid
-    spacing (measured in ``tests/test_deform_tools.py``).
+    spacing (measured in ``tests/deform/test_deform_tools.py``).
 
     RK4 is only about 3rd order on this field: ``v`` uses ``∇d``, which is C¹ (the cubic
     B-spline's second derivatives jump across cell faces), so ``v``'s second derivatives jump
     there and each step across a face has an O(h³) local error; a path line crosses a fixed
     number of faces, so the global error falls about 8× per halving of the step where it
     crosses faces and 16× where it does not (measured for :func:`sdf_curl`: ratios 4.6–18,
-    mean order 3.3, ``tests/test_deform_curl.py``).
+    mean order 3.3, ``tests/deform/test_deform_curl.py``).
 
     Parameters
     ----------

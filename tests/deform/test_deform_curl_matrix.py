@@ -3,7 +3,7 @@ sdf_curl, mesh_curl and keyframed, each translating (``velocity=``; for keyframe
 with positions only) and turning (``angular_velocity=``, ``pivot=``; for keyframed: keys with
 orientations), each with a divergence test, an RK4 order test and the volume of a
 40,962-vertex icosphere split into integration and mesh error. The cells that
-tests/test_deform_curl.py already covers are not repeated here:
+tests/deform/test_deform_curl.py already covers are not repeated here:
 
 =============  ============================  ===============================  ==========
 tool, motion   divergence                    RK4 order                        40k volume

@@ -23,7 +23,7 @@ igl = pytest.importorskip("igl")
 pytest.importorskip("igl.predicates")
 
 _NAME = "rocker-arm.obj"
-_CANDIDATE = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes" / _NAME
+_CANDIDATE = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes" / _NAME
 PATH = _CANDIDATE if _CANDIDATE.exists() else None
 pytestmark = pytest.mark.skipif(PATH is None, reason=f"shared test mesh {_NAME} not available")
 

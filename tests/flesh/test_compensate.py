@@ -21,7 +21,7 @@ import spinal
 from spinal import _compensate
 
 TAU = 2 * np.pi
-MESHES = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "meshes"
+MESHES = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "meshes"
 
 
 # ---- meshes and references --------------------------------------------------------------------

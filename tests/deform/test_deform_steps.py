@@ -22,7 +22,7 @@ pytest.importorskip("igl")
 
 TOL = 1e-5  # the rule's tolerance, a fraction of the length scale
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+MESHES = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
 
 
 def hair_tool():

@@ -1,5 +1,6 @@
-"""Reproducers of the robustness review (sweeps and meshes, part b), one test per row of
-../shared/reviews/robustness-defects.md, each named after its row."""
+"""``Mesh`` checks its arrays: non-finite vertices, normals and uv, wrapped or out-of-range
+indices, float faces and planar vertices are refused by name (row ids of the robustness
+review in the docstrings)."""
 
 from __future__ import annotations
 
@@ -34,8 +35,8 @@ def test_mesh_refuses_non_finite_vertices_normals_and_uv():
     assert spinal.Mesh(wide[:, :3], F).volume == spinal.Mesh(V, F).volume
 
 
-def test_D10_mesh_validates_its_arrays():
-    """Mesh used to validate nothing: a negative index wrapped (volume from the wrong vertex),
+def test_mesh_refuses_wrapped_indices_float_faces_and_planar_vertices():
+    """D10: Mesh used to validate nothing: a negative index wrapped (volume from the wrong vertex),
     an out-of-range one raised IndexError from .volume, float faces were truncated and
     (V, 2) vertices gave an einsum error."""
     with pytest.raises(ValueError, match="faces: face 0 refers to vertex -1, but there are 3"):

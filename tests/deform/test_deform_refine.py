@@ -443,7 +443,7 @@ def test_the_drag_band_is_mostly_free_of_slivers():
     (without flips: 48.5% of 31,083 and 10,752), the volume change unchanged at −4.18e-5
     with 23,951 vertices (27,211). Most of the slivers left had all four vertices of a pair
     on one rest point's curve Ψ(p, ·), which no flip can mend; the collapses after the
-    integration take them to 1.3% and 907 (tests/test_deform_collapse.py)."""
+    integration take them to 1.3% and 907 (tests/deform/test_deform_collapse.py)."""
     s = trimesh.creation.icosphere(5)
     M, rep = spinal.deform(s, DRAG, 1.0)
     mesh = trimesh.Trimesh(M.vertices, M.faces, process=False)

@@ -434,7 +434,7 @@ def test_extrusion_twist_table():
             assert np.all(coarse / fine > 3.5), (sol, coarse, fine)
 
 
-_COW = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data",
+_COW = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data",
                     "meshes", "cow.obj")
 
 

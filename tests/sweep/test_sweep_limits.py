@@ -1,6 +1,7 @@
-"""Rows D11, D12 and D23 of the robustness review of the sweeps: frames of the reversed
-curve are refused by name (not an inside-out mesh), the cost is linear in the profile's
-vertices, and ``sides`` is bounded with a named error."""
+"""Limits of the sweeps: frames that run against the spine are refused by name (not an
+inside-out mesh) while frames of tight turns are swept, the cost is linear in the profile's
+vertices, and ``sides`` and the profile's size are bounded with named errors (row ids D11,
+D12, D23 of the robustness review in the docstrings)."""
 
 from __future__ import annotations
 
@@ -18,8 +19,8 @@ SQ = np.array([(0.1, 0.1), (-0.1, 0.1), (-0.1, -0.1), (0.1, -0.1)])
 TWO = np.array([[0, 0, 0], [1, 0, 0.0]])
 
 
-def test_D11_frames_against_the_spine_are_refused():
-    """Frames of the reversed helix, reversed back: every tangent points backwards."""
+def test_frames_against_the_spine_are_refused():
+    """D11: Frames of the reversed helix, reversed back: every tangent points backwards."""
     with pytest.raises(ValueError, match=r"frames: the tangent column t of row 0 "
                                          r"points against the spine"):
         spinal.sweep(H, SQ, frames=spinal.frames(H[::-1])[::-1])
@@ -64,8 +65,8 @@ def _chord_dots(points, frames, closed=False):
     return np.einsum("ij,ij->i", t, cin), np.einsum("ij,ij->i", t, cout)
 
 
-def test_D11_frames_of_tight_turns_are_accepted():
-    """Frames from spinal.frames on tight turns are swept: a coarse helix (6 samples a turn),
+def test_frames_of_tight_turns_are_accepted():
+    """D11: Frames from spinal.frames on tight turns are swept: a coarse helix (6 samples a turn),
     a hairpin of 2 samples round its bend, a closed loop, and a 150° corner between a long
     and a short chord, with a given tangent leaning onto the short chord so that it opposes
     the long one (one negative dot product: not a reversed frame)."""
@@ -113,8 +114,8 @@ def test_D11_frames_of_tight_turns_are_accepted():
 
 
 @pytest.mark.parametrize("caps", [False, True])
-def test_D12_cost_is_linear_in_the_profile(caps):
-    """64,000 sides on a 2-point spine took 30–48 s (an O(m²) simplicity test): now a
+def test_cost_is_linear_in_the_profile(caps):
+    """D12: 64,000 sides on a 2-point spine took 30–48 s (an O(m²) simplicity test): now a
     strictly convex profile is checked and fanned in O(m). Generous bounds for a loaded
     2-core machine; 4× the sides may cost at most ~12× (linear, with noise)."""
     t0 = time.perf_counter()
@@ -151,8 +152,8 @@ def _cpu_seconds(f, repeats=3):
     return best
 
 
-def test_D12_non_convex_profiles_of_many_vertices():
-    """A capped sweep of a non-convex profile is linear in its vertices: 8× the vertices of a
+def test_non_convex_profiles_of_many_vertices():
+    """D12: A capped sweep of a non-convex profile is linear in its vertices: 8× the vertices of a
     star cost at most 16× (an O(m²) check or ear clipping costs 64×, linear ~8×), and
     64,000 vertices (30–48 s when the profile check was O(m²)) take at most 2 s of CPU.
     The caps are right: the volume is the star's area times the spine's length."""
@@ -172,15 +173,15 @@ def test_D12_non_convex_profiles_of_many_vertices():
 
 
 @pytest.mark.parametrize("sides", [2**31, 2**62, 2**70])
-def test_D23_sides_has_an_upper_bound(sides):
-    """2**31 sides allocated 16 GiB; 2**62 and 2**70 gave numpy messages without the name."""
+def test_sides_has_an_upper_bound(sides):
+    """D23: 2**31 sides allocated 16 GiB; 2**62 and 2**70 gave numpy messages without the name."""
     with pytest.raises(ValueError, match=r"sides: at most 1,048,576 \(2\*\*20\) sides"):
         spinal.tube(TWO, 0.1, sides)
 
 
 @pytest.mark.parametrize("closed", [False, True])
-def test_D23_profile_vertices_have_an_upper_bound(closed):
-    """A profile of more than 2**24 vertices is refused by name (after a closed profile's
+def test_profile_vertices_have_an_upper_bound(closed):
+    """D23: A profile of more than 2**24 vertices is refused by name (after a closed profile's
     repeated first vertex is dropped: 2**24 + 2 rows then count 2**24 + 1)."""
     rows = 2**24 + 1 + int(closed)
     prof = np.zeros((rows, 2))

@@ -1,13 +1,13 @@
-"""Runtime rows of the robustness review (shared/reviews/robustness-defects.md): running out
-of memory raises ``MemoryError`` instead of aborting the interpreter (D16), Ctrl-C stops a
-long call promptly (D17), ``ph.fit`` bounds ``segments`` (D22).
+"""Running out of memory raises ``MemoryError`` instead of aborting the interpreter, Ctrl-C
+stops a long call promptly, and ``ph.fit`` bounds ``segments`` (each test's docstring names
+its row of the robustness review: D16, D17, D22).
 
-The memory tests run each reproducer in a child process whose address space is limited
+The memory tests run each case in a child process whose address space is limited
 (``RLIMIT_AS``) to what it already holds plus a small headroom, with inputs whose outputs
 or working buffers need several times that headroom: the child must catch ``MemoryError``
-and exit normally (before the fix several of them died of SIGABRT, 'memory allocation of N
-bytes failed'). The Ctrl-C tests send SIGINT from a timer thread inside the child and
-measure, in the child, the time from the signal to the ``KeyboardInterrupt``.
+and exit normally (without the checks several of them died of SIGABRT, 'memory allocation
+of N bytes failed'). The Ctrl-C tests send SIGINT from a timer thread inside the child and
+measure, in the child, the CPU time from the signal to the ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
@@ -191,7 +191,8 @@ D16_CASES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D16_CASES))
-def test_D16_out_of_memory_raises_memory_error(name):
+def test_out_of_memory_raises_memory_error(name):
+    """D16: Out of memory raises memory error."""
     setup, call, words = D16_CASES[name]
     r = run_limited(setup, call)
     assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
@@ -200,8 +201,8 @@ def test_D16_out_of_memory_raises_memory_error(name):
 
 
 @pytest.mark.slow
-def test_D16_memory_error_comes_from_the_core_not_an_abort():
-    """The review's reproducer: a 3e7-long move asks for a 2.4 GB crossing path; the walk
+def test_memory_error_comes_from_the_core_not_an_abort():
+    """D16: The review's reproducer: a 3e7-long move asks for a 2.4 GB crossing path; the walk
     grows its path fallibly and says which call ran out."""
     r = run_limited("b = trimesh.creation.box()\n",
                     "Q.walk_mesh(b.vertices, b.faces, 0, b.vertices[b.faces[0]].mean(0), "
@@ -210,12 +211,14 @@ def test_D16_memory_error_comes_from_the_core_not_an_abort():
 
 
 @pytest.mark.slow
-def test_D16_small_calls_unchanged_under_a_limit():
+def test_small_calls_unchanged_under_a_limit():
+    """D16: Small calls unchanged under a limit."""
     r = run_limited("", "print(spinal.estimate_tangents(H).shape); raise MemoryError('fine')")
     assert r.returncode == 0 and "(60, 3)" in r.stdout, (r.stdout, r.stderr)
 
 
-def test_D22_fit_segments_is_bounded():
+def test_fit_segments_is_bounded():
+    """D22: Fit segments is bounded."""
     with pytest.raises(ValueError, match=r"^segments: must be <= 100000"):
         ph.fit(spinal.curves.Helix(), segments=10**7)
     assert ph.fit(spinal.curves.Helix(), segments=4).segments == 4
@@ -368,7 +371,8 @@ D17_CASES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_CASES))
-def test_D17_ctrl_c_within_half_a_second(name):
+def test_ctrl_c_within_half_a_second(name):
+    """D17: Ctrl c within half a second."""
     setup, call = D17_CASES[name]
     assert late_after_sigint(setup, call) < 0.5
 
@@ -514,7 +518,8 @@ D17_ONCE_CASES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_ONCE_CASES))
-def test_D17_ctrl_c_within_half_a_second_inside_one_call(name):
+def test_ctrl_c_within_half_a_second_inside_one_call(name):
+    """D17: Ctrl c within half a second inside one call."""
     r = interrupt_once(*D17_ONCE_CASES[name])
     assert r.late < 0.5, r.report
     assert r.busy < 0.05, r.report  # no worker thread still running
@@ -576,7 +581,8 @@ D17_FRACTION_CASES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_FRACTION_CASES))
-def test_D17_ctrl_c_within_a_fraction_of_a_short_call(name):
+def test_ctrl_c_within_a_fraction_of_a_short_call(name):
+    """D17: Ctrl c within a fraction of a short call."""
     r = interrupt_once(*D17_FRACTION_CASES[name], after="full / 6", least=0.3)
     assert r.late < 0.2 * r.full, r.report
     assert r.busy < 0.05, r.report  # no worker thread still running
@@ -590,8 +596,8 @@ SDF_GRID = ("n = 300; x = np.linspace(-1, 1, n); X, Y, Z = np.meshgrid(x, x, x, 
 @pytest.mark.slow
 @pytest.mark.parametrize("tool", ["sdf_tool(D, [-1, -1, -1], 2 / (n - 1), [1, 0, 0]",
                                   "sdf_curl(D, [-1, -1, -1], 2 / (n - 1), velocity=[1, 0, 0]"])
-def test_D17_distance_grid_tools_stop_within_half_a_second(tool):
-    """A tool from the largest distance grid accepted (300³ nodes): the B-spline coefficients
+def test_distance_grid_tools_stop_within_half_a_second(tool):
+    """D17: A tool from the largest distance grid accepted (300³ nodes): the B-spline coefficients
     and the tool's cell minima are computed in Rust, polling Ctrl-C; what stays in NumPy
     (the default centre and reach) are single operations of well under half a second.
     Signalled halfway through."""
@@ -603,8 +609,8 @@ def test_D17_distance_grid_tools_stop_within_half_a_second(tool):
 
 
 @pytest.mark.slow
-def test_D17_cold_sweep_stops_promptly():
-    """The first sweep of a fresh process writes into output pages never touched before
+def test_cold_sweep_stops_promptly():
+    """D17: The first sweep of a fresh process writes into output pages never touched before
     (each write may fault one in); Ctrl-C in its writing phase (the set-up of these 2000
     curves takes about 0.2 s, the writing seconds) stops it within a quarter second,
     including the caps, which a stopped sweep no longer writes, and the curve ids of the
@@ -616,8 +622,8 @@ def test_D17_cold_sweep_stops_promptly():
                              after=0.5) < 0.25
 
 
-def test_D17_threads_setting_keeps_results():
-    """The calls stay bit-identical with the signal-watching pool (review: threads
+def test_threads_setting_keeps_results():
+    """D17: The calls stay bit-identical with the signal-watching pool (review: threads
     bit-identical)."""
     u = np.linspace(0, 4 * np.pi, 60)
     h = np.c_[np.cos(u), np.sin(u), 0.2 * u]
@@ -629,8 +635,8 @@ def test_D17_threads_setting_keeps_results():
 
 
 @pytest.mark.slow
-def test_D17_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
-    """A star profile of 2**22 vertices is not convex: the sweep first tests it for
+def test_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
+    """D17: A star profile of 2**22 vertices is not convex: the sweep first tests it for
     self-intersection (a sweep line over its 2**23 edge ends, about 4 s here) and then
     triangulates its caps (about 3 s), each in O(m log m) and each polling Ctrl-C every
     few thousand events; before, neither polled, and a stop waited for both."""
@@ -643,8 +649,8 @@ def test_D17_sweep_of_a_huge_non_convex_profile_stops_in_its_checks():
 
 
 @pytest.mark.slow
-def test_D17_sweep_of_a_huge_profile_stops_inside_a_ring():
-    """A profile of 2**23 vertices on a two-point spine: two rings of 96 MiB of float32
+def test_sweep_of_a_huge_profile_stops_inside_a_ring():
+    """D17: A profile of 2**23 vertices on a two-point spine: two rings of 96 MiB of float32
     vertices and 192 MiB of int32 faces. The writer polls Ctrl-C between pieces of at most
     1 MiB of a ring's columns, not only between rings, and builds the profile's columns per
     piece (0.8 GB peak); before, each ring was written whole after the columns and face

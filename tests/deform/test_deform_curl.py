@@ -5,7 +5,7 @@ Independent references: the curl of the potentials ``−(1/(2R^p)) φ(d)(Y × u)
 ``−(1/(3R^p)) φ(d) B`` taken by finite differences with the distance computed in NumPy/SciPy
 (the rod's axis by SciPy's clamped spline and a Newton foot point, the grid's by SciPy's
 natural splines), the sphere tools of spinal.fields (closed forms checked in
-tests/test_deform.py), SciPy's Hermite spline and rotations for the keyframed poses,
+tests/deform/test_deform.py), SciPy's Hermite spline and rotations for the keyframed poses,
 measured convergence orders, and mesh volumes from trimesh and libigl.
 """
 

@@ -14,7 +14,7 @@ import spinal
 
 pytestmark = pytest.mark.slow  # starts Dask workers
 
-ROOT = pathlib.Path(__file__).parents[1]
+ROOT = pathlib.Path(__file__).parents[2]
 
 
 def unaligned(a):

@@ -168,7 +168,7 @@ def test_self_intersections_are_libigls_pairs():
 def test_self_intersections_of_the_shared_meshes(name):
     """The shared meshes: the same pairs as libigl (81 on the cow, none on the others)."""
     trimesh = pytest.importorskip("trimesh")
-    path = pathlib.Path(__file__).resolve().parents[1].parent / "shared/data/meshes" / name
+    path = pathlib.Path(__file__).resolve().parents[2].parent / "shared/data/meshes" / name
     if not path.exists():
         pytest.skip(f"{path} is not available")
     t = trimesh.load(path, process=False, force="mesh")

@@ -333,7 +333,7 @@ def test_mesh_tools_are_divergence_free_and_move_with_the_tool():
 
 
 def test_volume_of_a_40k_icosphere_under_a_mesh_tool():
-    """von Funck's stroke of tests/test_deform.py with the sphere given as a 2,562-vertex
+    """von Funck's stroke of tests/deform/test_deform.py with the sphere given as a 2,562-vertex
     mesh (64-node grid): the same mesh floor, the integration error 3 orders below it."""
     import igl.predicates
 

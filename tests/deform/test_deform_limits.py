@@ -1,7 +1,8 @@
-"""The robustness review's reproducers for the deformation engine (rows D08, D13, D14, D15,
-D18, D24 of the review of main), each asserting the fixed behaviour. The deeper tests of
-each fix live beside the feature (test_fields_limits, test_strip_limits, test_deform_refine,
-test_stamp_limits)."""
+"""Limits of the deformation engine: speed bounds that overflow, strip curves of many
+samples, a large drag bounded and reported, ``refine`` below one, a tool that swallows the
+mesh, unbounded step counts (row ids of the robustness review in the docstrings). The deeper
+tests of each behaviour live beside the feature (test_fields_limits, test_strip_limits,
+test_deform_refine, test_stamp_limits)."""
 
 import time
 import warnings
@@ -54,15 +55,16 @@ _D08_CASES = {
 
 
 @pytest.mark.parametrize("case", sorted(_D08_CASES))
-def test_D08_an_overflowing_speed_bound_is_refused_not_stepped_four_times(case):
+def test_an_overflowing_speed_bound_is_refused_not_stepped_four_times(case):
     # was: max_speed inf, steps(1.0) == 4 (translation; strip_curve and strip(across) too)
+    """D08: An overflowing speed bound is refused not stepped four times."""
     arg, build = _D08_CASES[case]
     with pytest.raises(ValueError, match=f"^{arg}: .*(out of floating-point range|is inf)"):
         build()
 
 
-def test_D08_twist_bend_and_path_rates_stay_finite():
-    """The swirls' bound is ``|rate|·radius^k`` times a constant below 1: a finite rate
+def test_twist_bend_and_path_rates_stay_finite():
+    """D08: The swirls' bound is ``|rate|·radius^k`` times a constant below 1: a finite rate
     gives a finite bound (no overflow to refuse), and steps() refuses the step count it asks."""
     for f in (fl.twist([0, 0, 0], [0, 0, 1], _D08_BIG, .3), fl.bend([0, 0, 0], [0, 0, 1],
                                                                    _D08_BIG, .3),
@@ -72,8 +74,9 @@ def test_D08_twist_bend_and_path_rates_stay_finite():
             f.steps(1.0)
 
 
-def test_D13_strip_curve_builds_2000_samples_quickly():
+def test_strip_curve_builds_2000_samples_quickly():
     # was: about a minute (a per-row Python loop, O(n²)); now O(n) in Rust
+    """D13: Strip curve builds 2000 samples quickly."""
     n = 2000
     t = time.process_time()  # CPU time: a loaded machine does not stretch it
     f = fl.strip_curve(np.c_[np.linspace(0, 20, n), np.zeros(n), np.zeros(n)], .1, 1.0)
@@ -81,8 +84,9 @@ def test_D13_strip_curve_builds_2000_samples_quickly():
     assert np.isfinite(f.max_speed)
 
 
-def test_D14_a_large_drag_is_bounded_and_says_so():
+def test_a_large_drag_is_bounded_and_says_so():
     # was: 49,788 vertices added in 20 passes, no warning, nothing in the report
+    """D14: A large drag is bounded and says so."""
     sphere = trimesh.creation.icosphere(3)
     tool = fl.translation(center=[0, 0, .9], radius=.9, velocity=[.5, 0, 0])
     with warnings.catch_warnings(record=True) as caught:
@@ -102,21 +106,24 @@ def test_D14_a_large_drag_is_bounded_and_says_so():
     assert any(isinstance(w.message, spinal.RefinementWarning) for w in caught)
 
 
-def test_D15_refine_below_one_is_refused():
+def test_refine_below_one_is_refused():
     # was: refine=1e-300 doubled the mesh every pass
+    """D15: Refine below one is refused."""
     with pytest.raises(ValueError, match=r"^refine: must be at least 1 .* got 1e-300"):
         spinal.deform(trimesh.creation.icosphere(2), fl.translation([10, 0, 0], .3, [1, 0, 0]),
                       1.0, refine=1e-300, max_passes=8)
 
 
-def test_D18_a_tool_that_swallows_the_mesh_is_refused():
+def test_a_tool_that_swallows_the_mesh_is_refused():
     # was: every vertex snapped to the tool, volume x23.8, no warning
+    """D18: A tool that swallows the mesh is refused."""
     with pytest.raises(ValueError, match="^radius: the tool .* swallows the whole mesh"):
         spinal.stamp(trimesh.creation.icosphere(2), [0, 0, 1.32], [0, 0, 1.1], 10.0)
 
 
 @pytest.mark.parametrize("steps", [2**63, 2**40])
-def test_D24_unbounded_step_counts_are_refused(steps):
+def test_unbounded_step_counts_are_refused(steps):
     # was: 2**63 steps accepted (never returns)
+    """D24: Unbounded step counts are refused."""
     with pytest.raises(ValueError, match="^steps: "):
         spinal.advect(np.zeros((10, 3)), fl.translation([0, 0, 1.32], .3, [0, 0, -1]), .3, steps)

@@ -1,6 +1,7 @@
-"""The reproducers of the robustness review (numerics and arguments rows), each asserting the
-fixed behaviour: scale-invariant frames, quaternions of any size, named errors for every
-argument."""
+"""Results at any scale and arguments at their limits: frames of tiny and huge curves are
+those of the unit curve, quaternions of any size normalise, PH fits and fleshing stay
+finite or raise named errors, and every message names its argument (row ids of the
+robustness review in the docstrings)."""
 
 import warnings
 
@@ -22,7 +23,8 @@ _v = np.linspace(-1, 1, 41)
 POSED = np.c_[np.sin(_v), 1 - np.cos(_v), np.zeros(41)]
 
 
-def test_D01_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
+def test_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
+    """D01: Tiny curves with tangents give the frames of the unit curve."""
     t = spinal.estimate_tangents(H)
     for method in ("double_reflection", "frenet", "rotation", "projection"):
         f = spinal.frames(H * 1e-160, t, method=method)
@@ -34,7 +36,8 @@ def test_D01_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
         assert a == pytest.approx(spinal.closing_angle(K, tk), abs=1e-12)
 
 
-def test_D02_huge_and_tiny_curves_are_not_cusps():
+def test_huge_and_tiny_curves_are_not_cusps():
+    """D02: Huge and tiny curves are not cusps."""
     ref = spinal.frames(H)
     for s in (1e80, 1e-80, 1e-100, 1e150, 1e-150):
         np.testing.assert_allclose(spinal.frames(H * s), ref, atol=1e-12)
@@ -54,7 +57,8 @@ def test_D02_huge_and_tiny_curves_are_not_cusps():
         np.testing.assert_allclose(got, want, atol=1e-12)
 
 
-def test_D03_default_reference_vector_is_scale_invariant():
+def test_default_reference_vector_is_scale_invariant():
+    """D03: Default reference vector is scale invariant."""
     assert np.abs(spinal.frames(H * 1e70) - spinal.frames(H)).max() < 1e-12
     t = spinal.estimate_tangents(H)
     for s in (1e100, 1e-100):
@@ -65,7 +69,8 @@ def test_D03_default_reference_vector_is_scale_invariant():
     assert np.abs(spin).max() < 1e-4  # the rounding of x at 1e9, not a half turn
 
 
-def test_D04_from_quaternions_normalises_any_size():
+def test_from_quaternions_normalises_any_size():
+    """D04: From quaternions normalises any size."""
     q = np.array([0.1, 0.2, 0.3, 0.9])
     want = Q.from_quaternions(q)
     assert not np.allclose(want, np.eye(3))
@@ -76,7 +81,8 @@ def test_D04_from_quaternions_normalises_any_size():
         Q.from_quaternions([0.0, 0, 0, 0])
 
 
-def test_D05_quaternion_length_of_scaled_quaternions():
+def test_quaternion_length_of_scaled_quaternions():
+    """D05: Quaternion length of scaled quaternions."""
     q = np.array([[0.1, 0.2, 0.3, 0.9], [0, 0, 0, 1.0]])
     want = Q.quaternion_length(q)
     assert want == pytest.approx(0.394, abs=1e-3)
@@ -84,7 +90,8 @@ def test_D05_quaternion_length_of_scaled_quaternions():
         assert Q.quaternion_length(q * s) == pytest.approx(want, rel=1e-14)
 
 
-def test_D06_spin_checks_its_frames():
+def test_spin_checks_its_frames():
+    """D06: Spin checks its frames."""
     f = spinal.frames(H)
     with pytest.raises(ValueError, match="^a: non-finite value in frame 0"):
         Q.spin(np.full((3, 3), np.nan), np.eye(3))
@@ -100,7 +107,8 @@ def test_D06_spin_checks_its_frames():
     assert Q.spin(f, f).shape == (60,)
 
 
-def test_D07_ph_from_quaternions_overflow_is_a_named_error():
+def test_ph_from_quaternions_overflow_is_a_named_error():
+    """D07: Ph from quaternions overflow is a named error."""
     with pytest.raises(ValueError, match="out of the representable range"):
         ph.from_quaternions([0, 0, 0, 1e300], [0, 0, 1e300, 0])
     # large but representable: the same curve scaled by |A|²
@@ -111,7 +119,8 @@ def test_D07_ph_from_quaternions_overflow_is_a_named_error():
     np.testing.assert_allclose(big / 1e300, b, rtol=1e-12, atol=1e-300)
 
 
-def test_D09_huge_integers_name_the_argument():
+def test_huge_integers_name_the_argument():
+    """D09: Huge integers name the argument."""
     b = trimesh.creation.box()
     tool = fl.translation([0, 0, 1], 0.3, [1, 0, 0])
     calls = {
@@ -129,7 +138,8 @@ def test_D09_huge_integers_name_the_argument():
         spinal.stamp(trimesh.creation.icosphere(1), [0, 0, 1.32], [0, 0, 1.1], 0.3, frames=2**64)
 
 
-def test_D19_distinct_points_a_few_ulps_apart_far_from_the_origin():
+def test_distinct_points_a_few_ulps_apart_far_from_the_origin():
+    """D19: Distinct points a few ulps apart far from the origin."""
     f = spinal.frames(spinal.curves.Helix(), u=[1e15, 1e15 + 1, 1e15 + 2])
     assert f.shape == (3, 3, 3) and np.isfinite(f).all()
     x = np.c_[1e12 + np.arange(5) * 1e-3, np.zeros(5), np.zeros(5)]
@@ -144,7 +154,8 @@ def test_D19_distinct_points_a_few_ulps_apart_far_from_the_origin():
     assert np.array_equal(spinal.frames(y)[3], spinal.frames(y)[2])
 
 
-def test_D20_huge_finite_vectors_do_not_overflow():
+def test_huge_finite_vectors_do_not_overflow():
+    """D20: Huge finite vectors do not overflow."""
     ref = spinal.frames(H, initial=[1, 1, 0])
     np.testing.assert_allclose(spinal.frames(H, initial=[1e300, 1e300, 0]), ref, atol=1e-14)
     t = spinal.estimate_tangents(H)
@@ -162,7 +173,8 @@ def test_D20_huge_finite_vectors_do_not_overflow():
         spinal.tube(H, np.inf)
 
 
-def test_D21_loose_arguments_are_refused():
+def test_loose_arguments_are_refused():
+    """D21: Loose arguments are refused."""
     with pytest.raises(ValueError, match="^singular_angle: must be >= 0"):
         Q.camera_frames(H, mode="up", singular_angle=-1)
     with pytest.raises(ValueError, match="^singular_angle: must be finite"):
@@ -187,7 +199,8 @@ def test_D21_loose_arguments_are_refused():
     assert length == 0.0 and np.copysign(1.0, length) == 1.0
 
 
-def test_D25_messages_name_the_argument():
+def test_messages_name_the_argument():
+    """D25: Messages name the argument."""
     with pytest.raises(TypeError, match="^miter_limit: "):
         spinal.sweep(H, SQ, miter_limit=[4, 4])
     f = spinal.frames(H)

@@ -22,7 +22,7 @@ from spinal import fields
 igl = pytest.importorskip("igl")
 pytest.importorskip("igl.predicates")
 
-MESHES = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+MESHES = Path(__file__).resolve().parents[3] / "shared" / "data" / "meshes"
 
 
 def shared(*names):
@@ -142,7 +142,7 @@ def test_a_curl_twist_of_a_real_mesh_keeps_its_volume(name, unrefined):
     than their share of a 2e-3 volume budget meets 5e-4."""
     import sys
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
     import bench_deform_table
 
     m = trimesh.load(MESHES / name, force="mesh")
