@@ -24,7 +24,7 @@ POSED = np.c_[np.sin(_v), 1 - np.cos(_v), np.zeros(41)]
 
 
 def test_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
-    """D01: Tiny curves with tangents give the frames of the unit curve."""
+    """D01: a curve scaled down to 1e-300 with its tangents gets the unit curve's frames."""
     t = spinal.estimate_tangents(H)
     for method in ("double_reflection", "frenet", "rotation", "projection"):
         f = spinal.frames(H * 1e-160, t, method=method)
@@ -37,7 +37,7 @@ def test_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
 
 
 def test_huge_and_tiny_curves_are_not_cusps():
-    """D02: Huge and tiny curves are not cusps."""
+    """D02: very large and very small curves are not taken for cusps."""
     ref = spinal.frames(H)
     for s in (1e80, 1e-80, 1e-100, 1e150, 1e-150):
         np.testing.assert_allclose(spinal.frames(H * s), ref, atol=1e-12)
@@ -58,7 +58,7 @@ def test_huge_and_tiny_curves_are_not_cusps():
 
 
 def test_default_reference_vector_is_scale_invariant():
-    """D03: Default reference vector is scale invariant."""
+    """D03: the default reference vector does not depend on the curve's scale."""
     assert np.abs(spinal.frames(H * 1e70) - spinal.frames(H)).max() < 1e-12
     t = spinal.estimate_tangents(H)
     for s in (1e100, 1e-100):
@@ -70,7 +70,7 @@ def test_default_reference_vector_is_scale_invariant():
 
 
 def test_from_quaternions_normalises_any_size():
-    """D04: From quaternions normalises any size."""
+    """D04: frames from quaternions of any size are normalised."""
     q = np.array([0.1, 0.2, 0.3, 0.9])
     want = Q.from_quaternions(q)
     assert not np.allclose(want, np.eye(3))
@@ -82,7 +82,7 @@ def test_from_quaternions_normalises_any_size():
 
 
 def test_quaternion_length_of_scaled_quaternions():
-    """D05: Quaternion length of scaled quaternions."""
+    """D05: quaternion lengths of very large and very small quaternions."""
     q = np.array([[0.1, 0.2, 0.3, 0.9], [0, 0, 0, 1.0]])
     want = Q.quaternion_length(q)
     assert want == pytest.approx(0.394, abs=1e-3)
@@ -91,7 +91,7 @@ def test_quaternion_length_of_scaled_quaternions():
 
 
 def test_spin_checks_its_frames():
-    """D06: Spin checks its frames."""
+    """D06: spin checks the frames it is given."""
     f = spinal.frames(H)
     with pytest.raises(ValueError, match="^a: non-finite value in frame 0"):
         Q.spin(np.full((3, 3), np.nan), np.eye(3))
@@ -108,7 +108,7 @@ def test_spin_checks_its_frames():
 
 
 def test_ph_from_quaternions_overflow_is_a_named_error():
-    """D07: Ph from quaternions overflow is a named error."""
+    """D07: PH cubics from quaternions that overflow raise an error naming the argument."""
     with pytest.raises(ValueError, match="out of the representable range"):
         ph.from_quaternions([0, 0, 0, 1e300], [0, 0, 1e300, 0])
     # large but representable: the same curve scaled by |A|²
@@ -120,7 +120,7 @@ def test_ph_from_quaternions_overflow_is_a_named_error():
 
 
 def test_huge_integers_name_the_argument():
-    """D09: Huge integers name the argument."""
+    """D09: integers too large for the core raise an error naming the argument."""
     b = trimesh.creation.box()
     tool = fl.translation([0, 0, 1], 0.3, [1, 0, 0])
     calls = {
@@ -139,7 +139,7 @@ def test_huge_integers_name_the_argument():
 
 
 def test_distinct_points_a_few_ulps_apart_far_from_the_origin():
-    """D19: Distinct points a few ulps apart far from the origin."""
+    """D19: points a few ulps apart far from the origin stay distinct."""
     f = spinal.frames(spinal.curves.Helix(), u=[1e15, 1e15 + 1, 1e15 + 2])
     assert f.shape == (3, 3, 3) and np.isfinite(f).all()
     x = np.c_[1e12 + np.arange(5) * 1e-3, np.zeros(5), np.zeros(5)]
@@ -155,7 +155,7 @@ def test_distinct_points_a_few_ulps_apart_far_from_the_origin():
 
 
 def test_huge_finite_vectors_do_not_overflow():
-    """D20: Huge finite vectors do not overflow."""
+    """D20: very large finite vectors do not overflow."""
     ref = spinal.frames(H, initial=[1, 1, 0])
     np.testing.assert_allclose(spinal.frames(H, initial=[1e300, 1e300, 0]), ref, atol=1e-14)
     t = spinal.estimate_tangents(H)
@@ -174,7 +174,7 @@ def test_huge_finite_vectors_do_not_overflow():
 
 
 def test_loose_arguments_are_refused():
-    """D21: Loose arguments are refused."""
+    """D21: arguments of the wrong kind (bools for numbers, strings, ...) are refused."""
     with pytest.raises(ValueError, match="^singular_angle: must be >= 0"):
         Q.camera_frames(H, mode="up", singular_angle=-1)
     with pytest.raises(ValueError, match="^singular_angle: must be finite"):
@@ -200,7 +200,7 @@ def test_loose_arguments_are_refused():
 
 
 def test_messages_name_the_argument():
-    """D25: Messages name the argument."""
+    """D25: every error message names its argument."""
     with pytest.raises(TypeError, match="^miter_limit: "):
         spinal.sweep(H, SQ, miter_limit=[4, 4])
     f = spinal.frames(H)

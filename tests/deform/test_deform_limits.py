@@ -57,7 +57,7 @@ _D08_CASES = {
 @pytest.mark.parametrize("case", sorted(_D08_CASES))
 def test_an_overflowing_speed_bound_is_refused_not_stepped_four_times(case):
     # was: max_speed inf, steps(1.0) == 4 (translation; strip_curve and strip(across) too)
-    """D08: An overflowing speed bound is refused not stepped four times."""
+    """D08: a speed bound that overflows is refused instead of integrated in four steps."""
     arg, build = _D08_CASES[case]
     with pytest.raises(ValueError, match=f"^{arg}: .*(out of floating-point range|is inf)"):
         build()
@@ -86,7 +86,7 @@ def test_strip_curve_builds_2000_samples_quickly():
 
 def test_a_large_drag_is_bounded_and_says_so():
     # was: 49,788 vertices added in 20 passes, no warning, nothing in the report
-    """D14: A large drag is bounded and says so."""
+    """D14: a large drag stops at its vertex bound and says so."""
     sphere = trimesh.creation.icosphere(3)
     tool = fl.translation(center=[0, 0, .9], radius=.9, velocity=[.5, 0, 0])
     with warnings.catch_warnings(record=True) as caught:
@@ -108,7 +108,7 @@ def test_a_large_drag_is_bounded_and_says_so():
 
 def test_refine_below_one_is_refused():
     # was: refine=1e-300 doubled the mesh every pass
-    """D15: Refine below one is refused."""
+    """D15: refine below one is refused."""
     with pytest.raises(ValueError, match=r"^refine: must be at least 1 .* got 1e-300"):
         spinal.deform(trimesh.creation.icosphere(2), fl.translation([10, 0, 0], .3, [1, 0, 0]),
                       1.0, refine=1e-300, max_passes=8)
@@ -116,7 +116,7 @@ def test_refine_below_one_is_refused():
 
 def test_a_tool_that_swallows_the_mesh_is_refused():
     # was: every vertex snapped to the tool, volume x23.8, no warning
-    """D18: A tool that swallows the mesh is refused."""
+    """D18: a tool that swallows the whole mesh is refused."""
     with pytest.raises(ValueError, match="^radius: the tool .* swallows the whole mesh"):
         spinal.stamp(trimesh.creation.icosphere(2), [0, 0, 1.32], [0, 0, 1.1], 10.0)
 
@@ -124,6 +124,6 @@ def test_a_tool_that_swallows_the_mesh_is_refused():
 @pytest.mark.parametrize("steps", [2**63, 2**40])
 def test_unbounded_step_counts_are_refused(steps):
     # was: 2**63 steps accepted (never returns)
-    """D24: Unbounded step counts are refused."""
+    """D24: step counts beyond any bound are refused."""
     with pytest.raises(ValueError, match="^steps: "):
         spinal.advect(np.zeros((10, 3)), fl.translation([0, 0, 1.32], .3, [0, 0, -1]), .3, steps)

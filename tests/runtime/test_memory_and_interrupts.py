@@ -192,7 +192,7 @@ D16_CASES = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D16_CASES))
 def test_out_of_memory_raises_memory_error(name):
-    """D16: Out of memory raises memory error."""
+    """D16: running out of memory raises MemoryError in the child, which exits normally."""
     setup, call, words = D16_CASES[name]
     r = run_limited(setup, call)
     assert r.returncode == 0, (r.returncode, r.stdout, r.stderr[-3000:])
@@ -212,13 +212,13 @@ def test_memory_error_comes_from_the_core_not_an_abort():
 
 @pytest.mark.slow
 def test_small_calls_unchanged_under_a_limit():
-    """D16: Small calls unchanged under a limit."""
+    """D16: small calls run unchanged under the memory limit."""
     r = run_limited("", "print(spinal.estimate_tangents(H).shape); raise MemoryError('fine')")
     assert r.returncode == 0 and "(60, 3)" in r.stdout, (r.stdout, r.stderr)
 
 
 def test_fit_segments_is_bounded():
-    """D22: Fit segments is bounded."""
+    """D22: ph.fit bounds its segments."""
     with pytest.raises(ValueError, match=r"^segments: must be <= 100000"):
         ph.fit(spinal.curves.Helix(), segments=10**7)
     assert ph.fit(spinal.curves.Helix(), segments=4).segments == 4
@@ -237,6 +237,13 @@ D17_CASES = {
     "deform": (
         "s = trimesh.creation.icosphere(6); f = fl.translation([0, 0, 1.6], .5, [0, 0, -.5])\n",
         "spinal.deform(s, f, 1.0, 20000)"),
+    # 4,000 poses of a 201-sample spine, ~2 ms each: the stop comes between poses
+    "SpineBinding.animate": (
+        ("x = np.linspace(0, 4, 201); rest = np.c_[x, 0 * x, 0 * x]\n"
+         "V = np.random.default_rng(0).uniform([0, -.3, -.3], [4, .3, .3], (2_000, 3))\n"
+         "b = spinal.SpineBinding(V, rest); a = np.linspace(0, 1, 4000)[:, None]\n"
+         "P = np.stack([x + 0 * a, .05 * np.sin(3 * x * a), 0 * x + 0 * a], -1)\n"),
+        "b.animate(P)"),
     "frames_bundle": (
         ("s = np.linspace(0, 40, 5000); C = np.c_[np.cos(s), np.sin(s), .2 * s]\n"
          "X = np.concatenate([C + i for i in range(2000)])\n"),
@@ -372,7 +379,7 @@ D17_CASES = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_CASES))
 def test_ctrl_c_within_half_a_second(name):
-    """D17: Ctrl c within half a second."""
+    """D17: Ctrl-C stops each long call within half a second of CPU time after the signal."""
     setup, call = D17_CASES[name]
     assert late_after_sigint(setup, call) < 0.5
 
@@ -519,7 +526,7 @@ D17_ONCE_CASES = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_ONCE_CASES))
 def test_ctrl_c_within_half_a_second_inside_one_call(name):
-    """D17: Ctrl c within half a second inside one call."""
+    """D17: Ctrl-C stops each call within half a second even inside one long core call."""
     r = interrupt_once(*D17_ONCE_CASES[name])
     assert r.late < 0.5, r.report
     assert r.busy < 0.05, r.report  # no worker thread still running
@@ -582,7 +589,7 @@ D17_FRACTION_CASES = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(D17_FRACTION_CASES))
 def test_ctrl_c_within_a_fraction_of_a_short_call(name):
-    """D17: Ctrl c within a fraction of a short call."""
+    """D17: Ctrl-C stops a short call within a fraction of its duration."""
     r = interrupt_once(*D17_FRACTION_CASES[name], after="full / 6", least=0.3)
     assert r.late < 0.2 * r.full, r.report
     assert r.busy < 0.05, r.report  # no worker thread still running
