@@ -24,7 +24,7 @@ POSED = np.c_[np.sin(_v), 1 - np.cos(_v), np.zeros(41)]
 
 
 def test_tiny_curves_with_tangents_give_the_frames_of_the_unit_curve():
-    """D01: a curve scaled down to 1e-300 with its tangents gets the unit curve's frames."""
+    """D01: a curve scaled down to 1e-160 with its tangents gets the unit curve's frames."""
     t = spinal.estimate_tangents(H)
     for method in ("double_reflection", "frenet", "rotation", "projection"):
         f = spinal.frames(H * 1e-160, t, method=method)
@@ -174,7 +174,7 @@ def test_huge_finite_vectors_do_not_overflow():
 
 
 def test_loose_arguments_are_refused():
-    """D21: arguments of the wrong kind (bools for numbers, strings, ...) are refused."""
+    """D21: arguments out of range, non-finite or of the wrong type are refused by name."""
     with pytest.raises(ValueError, match="^singular_angle: must be >= 0"):
         Q.camera_frames(H, mode="up", singular_angle=-1)
     with pytest.raises(ValueError, match="^singular_angle: must be finite"):
