@@ -607,8 +607,10 @@ class SpineBinding:
             ``progress(done, T)``.
 
         Ctrl-C stops it between poses; each pose is computed in parallel over the vertices.
-        Clamped vertices (past the fold limit) are not reported per pose: ``self.clamped``
-        holds those of the last pose.
+        Vertices clamped in some pose (past the fold limit) are reported by one
+        :class:`spinal.FoldOverWarning` for the call, whose ``indices`` are every vertex
+        clamped in any pose (the message counts the poses and names the worst);
+        ``self.clamped`` holds those of the last pose.
         """
         solution = as_choice(solution, "solution", SOLUTIONS)
         blend = _blend(blend)

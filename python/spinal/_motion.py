@@ -20,8 +20,11 @@ parallel transport carried in time, as :func:`spinal.frames_in_time` does).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from ._mesh import FoldOverWarning
 from ._progress import Progress, checked
 from ._validate import as_finite
 
@@ -108,6 +111,7 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
             raise ValueError(f"slide: the slide of pose {bad[0]} is not finite ({sl[bad[0]]})")
     out = np.empty((steps, len(binding), binding._dim))
     prev = None
+    clamped: list[tuple[int, np.ndarray]] = []
     with Progress(progress, steps, "animate", "pose") as bar:
         for t in range(steps):
             try:
@@ -120,7 +124,24 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
             else:
                 fr = frames(posed, previous=prev, previous_twist=True,
                             guide_weight=previous_weight, closed=binding._closed)
-            out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5,
-                                          blend=blend)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5,
+                                              blend=blend)
+            for w in caught:
+                if issubclass(w.category, FoldOverWarning):
+                    clamped.append((t, w.message.indices))
+                else:
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
             bar.update(t + 1)
+    if clamped:
+        # one warning for the call, not one per pose
+        worst_t, worst = max(clamped, key=lambda c: (len(c[1]), -c[0]))
+        first_t, first = clamped[0]
+        every = np.unique(np.concatenate([c for _, c in clamped])).astype(np.int64)
+        warnings.warn(FoldOverWarning(
+            f"posed_spines_t: {every.size} vertices have no fold-free offset (bent past the "
+            f"existence limit) in {len(clamped)} of {steps} poses and were clamped, e.g. "
+            f"vertex {first[0]} in pose {first_t}; most in pose {worst_t} ({worst.size} "
+            f"vertices)", every), stacklevel=3)
     return out

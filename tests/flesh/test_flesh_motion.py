@@ -2,6 +2,8 @@
 ``SpineBinding.animate`` (Zhuo 2014 §5.2.2), against closed forms (translation along a line,
 rotation about an arc's centre) and the per-pose ``deform``."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -164,3 +166,32 @@ def test_slides_per_pose_must_be_finite_and_clamp_warnings_point_at_the_caller()
         with pytest.warns(spinal.FoldOverWarning) as rec:
             call()
         assert rec[0].filename == __file__
+
+
+def test_animate_warns_once_for_the_vertices_clamped_in_any_pose():
+    """A bar bent tighter pose after pose: the later poses clamp vertices past the fold limit.
+    One FoldOverWarning for the call (not one per pose) holds every vertex clamped in some
+    pose, the same as ``deform`` reports pose by pose."""
+    x = np.linspace(0, 4, 201)
+    rest = np.c_[x, 0 * x, 0 * x]
+    V = np.random.default_rng(0).uniform([0, -0.3, -0.3], [4, 0.3, 0.3], (5_000, 3))
+    b = spinal.SpineBinding(V, rest)
+    a = np.linspace(0, 1, 12)[:, None]
+    P = np.stack([x + 0 * a, 0.3 * np.sin(3 * x * a), 0 * x + 0 * a], -1)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        b.animate(P)
+    folds = [w for w in caught if issubclass(w.category, spinal.FoldOverWarning)]
+    assert len(folds) == 1
+    per_pose = []
+    for t in range(len(P)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            _, c = b.deform(P[t], return_clamped=True)
+        per_pose.append(c)
+    every = np.unique(np.concatenate(per_pose))
+    assert 0 < every.size < len(V)
+    np.testing.assert_array_equal(folds[0].message.indices, every)
+    hit = sum(c.size > 0 for c in per_pose)
+    assert f"in {hit} of {len(P)} poses" in str(folds[0].message)
+    assert folds[0].filename == __file__
