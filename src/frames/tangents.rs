@@ -52,6 +52,7 @@
 //!   the 4th order). Needs 4 tangents.
 
 use super::lanes::Arith;
+use super::tangent_lanes;
 use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -332,39 +333,54 @@ pub fn estimate(
             (start..(start + CANCEL_SEGMENT).min(n))
                 .into_par_iter()
                 .with_min_len(1 << 12)
-                .map(|i| {
-                    if five && chordal && !closed {
-                        let u = if rule == TangentRule::FivePointBounded {
-                            five_point_unit_open(x, i, |j| chords[j])
-                        } else {
-                            five_point_unit_unbounded(x, i, |j| chords[j])
-                        };
-                        return u.unwrap_or(DVec3::ZERO);
-                    }
-                    let v = raw_tangent(x, chords, i, closed, rule, five);
-                    let l = v.length();
-                    let u = v * (1.0 / l);
-                    let interior = closed || (i > 0 && i + 1 < n);
-                    if !(l > 0.0 && u.is_finite()) {
-                        // the neighbours cancel (a symmetric reversal): the chord guard's
-                        // bisector, at a sample with two chords
-                        if !(interior && v == DVec3::ZERO) {
-                            return DVec3::ZERO;
+                .map_init(
+                    || (usize::MAX, [DVec3::ZERO; 4]),
+                    |(at, group), i| {
+                        if five && chordal && !closed {
+                            let row = |i: usize| {
+                                if rule == TangentRule::FivePointBounded {
+                                    five_point_unit_open(x, i, |j| chords[j])
+                                } else {
+                                    five_point_unit_unbounded(x, i, |j| chords[j])
+                                }
+                                .unwrap_or(DVec3::ZERO)
+                            };
+                            // centred rows four at a time (the same bits), the rest one by one
+                            let Some(g) = tangent_lanes::group_of(i, n) else {
+                                return row(i);
+                            };
+                            if *at != g {
+                                *group = tangent_lanes::centred_group(x, chords, g)
+                                    .unwrap_or_else(|| std::array::from_fn(|k| row(g + k)));
+                                *at = g;
+                            }
+                            return group[i - g];
                         }
-                    }
-                    let u = match (l > 0.0, five && chordal) {
-                        (false, _) => DVec3::ZERO,
-                        (true, true) => guard_overshoot(x, i, closed, u),
-                        (true, false) => u,
-                    };
-                    if interior {
-                        let ii = i as isize;
-                        let (a, b) = (x[idx(ii - 1, n, closed)], x[idx(ii + 1, n, closed)]);
-                        guard_chords(x[i] - a, b - x[i], u)
-                    } else {
-                        u
-                    }
-                }),
+                        let v = raw_tangent(x, chords, i, closed, rule, five);
+                        let l = v.length();
+                        let u = v * (1.0 / l);
+                        let interior = closed || (i > 0 && i + 1 < n);
+                        if !(l > 0.0 && u.is_finite()) {
+                            // the neighbours cancel (a symmetric reversal): the chord guard's
+                            // bisector, at a sample with two chords
+                            if !(interior && v == DVec3::ZERO) {
+                                return DVec3::ZERO;
+                            }
+                        }
+                        let u = match (l > 0.0, five && chordal) {
+                            (false, _) => DVec3::ZERO,
+                            (true, true) => guard_overshoot(x, i, closed, u),
+                            (true, false) => u,
+                        };
+                        if interior {
+                            let ii = i as isize;
+                            let (a, b) = (x[idx(ii - 1, n, closed)], x[idx(ii + 1, n, closed)]);
+                            guard_chords(x[i] - a, b - x[i], u)
+                        } else {
+                            u
+                        }
+                    },
+                ),
         );
     }
     if !five && !closed && n >= 3 {
