@@ -84,3 +84,69 @@ pub fn group_of(i: usize, n: usize) -> Option<usize> {
     let g = i & !(L - 1);
     (g >= 2 && g + 6 <= n).then_some(g)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frames::tangents::five_point_unit_open;
+    use crate::run::cancel;
+
+    /// Every group's rows against the scalar function, bit for bit; returns (groups taken
+    /// four at a time, groups left to the scalar function).
+    fn compare(x: &[DVec3]) -> (usize, usize) {
+        let h = crate::frames::validate::chords(x, false, &cancel::never).unwrap();
+        let (mut fast, mut slow) = (0, 0);
+        for g in (0..x.len()).step_by(L) {
+            let Some(g) = group_of(g, x.len()) else {
+                continue;
+            };
+            match centred_group(x, &h, g) {
+                Some(t) => {
+                    fast += 1;
+                    for (k, tk) in t.iter().enumerate() {
+                        let s = five_point_unit_open(x, g + k, |j| h[j]).unwrap();
+                        assert_eq!(
+                            tk.to_array().map(f64::to_bits),
+                            s.to_array().map(f64::to_bits)
+                        );
+                    }
+                }
+                None => slow += 1,
+            }
+        }
+        (fast, slow)
+    }
+
+    #[test]
+    fn groups_are_the_scalar_tangents_bit_for_bit() {
+        // a smooth helix: every centred group four at a time
+        let x: Vec<DVec3> = (0..4003)
+            .map(|i| {
+                let u = i as f64 * 0.01;
+                DVec3::new(u.cos(), u.sin(), 0.05 * u)
+            })
+            .collect();
+        let (fast, slow) = compare(&x);
+        assert!(fast > 990 && slow == 0, "{fast} {slow}");
+        // a random walk (a linear congruential stream): most groups turn, some pass
+        let mut s = 12345u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        };
+        let mut x = vec![DVec3::ZERO];
+        for k in 1..20_000 {
+            // smooth stretches between rough ones
+            let d = if (k / 40) % 2 == 0 {
+                DVec3::new(1.0, 0.3 * (k as f64 * 0.05).sin(), 0.0)
+            } else {
+                DVec3::new(r(), r(), r())
+            };
+            x.push(*x.last().unwrap() + d);
+        }
+        let (fast, slow) = compare(&x);
+        assert!(fast > 100 && slow > 100, "{fast} {slow}");
+    }
+}
