@@ -30,7 +30,9 @@
 //!   either chord is turned towards the bisector until its margin against both chords is at
 //!   least half the bisector's. So no segment of a jagged polyline (a random walk, a coarse
 //!   streamline, a hairpin) runs against its tangents, and tubes keep their cross-section
-//!   through sharp corners. Smooth samplings never reach it.
+//!   through sharp corners. Smooth samplings never reach it. (The centred rows of the
+//!   chord-length rules on open curves run four at a time, [`super::tangent_lanes`]: the
+//!   same operations, the same bits.)
 //! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
 //!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
 //!   samples come from a uniform step of a smooth parameterisation):
