@@ -36,6 +36,7 @@ pub mod projection;
 pub mod rk4;
 pub mod rotation;
 pub mod steer;
+pub mod tangent_lanes;
 pub mod tangents;
 pub mod time;
 pub mod torsion;

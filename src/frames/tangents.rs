@@ -30,7 +30,9 @@
 //!   either chord is turned towards the bisector until its margin against both chords is at
 //!   least half the bisector's. So no segment of a jagged polyline (a random walk, a coarse
 //!   streamline, a hairpin) runs against its tangents, and tubes keep their cross-section
-//!   through sharp corners. Smooth samplings never reach it.
+//!   through sharp corners. Smooth samplings never reach it. (The centred rows of the
+//!   chord-length rules on open curves run four at a time, [`super::tangent_lanes`]: the
+//!   same operations, the same bits.)
 //! * Five-point uniform rule of Wang, Jüttler, Zheng & Liu (ACM TOG 2008, §6.1), with the
 //!   sample index as parameter (`12 x'(u_i) + O(h⁵)`, unit-tangent error O(h⁴) when the
 //!   samples come from a uniform step of a smooth parameterisation):
@@ -52,6 +54,7 @@
 //!   the 4th order). Needs 4 tangents.
 
 use super::lanes::Arith;
+use super::tangent_lanes;
 use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -332,39 +335,54 @@ pub fn estimate(
             (start..(start + CANCEL_SEGMENT).min(n))
                 .into_par_iter()
                 .with_min_len(1 << 12)
-                .map(|i| {
-                    if five && chordal && !closed {
-                        let u = if rule == TangentRule::FivePointBounded {
-                            five_point_unit_open(x, i, |j| chords[j])
-                        } else {
-                            five_point_unit_unbounded(x, i, |j| chords[j])
-                        };
-                        return u.unwrap_or(DVec3::ZERO);
-                    }
-                    let v = raw_tangent(x, chords, i, closed, rule, five);
-                    let l = v.length();
-                    let u = v * (1.0 / l);
-                    let interior = closed || (i > 0 && i + 1 < n);
-                    if !(l > 0.0 && u.is_finite()) {
-                        // the neighbours cancel (a symmetric reversal): the chord guard's
-                        // bisector, at a sample with two chords
-                        if !(interior && v == DVec3::ZERO) {
-                            return DVec3::ZERO;
+                .map_init(
+                    || (usize::MAX, [DVec3::ZERO; 4]),
+                    |(at, group), i| {
+                        if five && chordal && !closed {
+                            let row = |i: usize| {
+                                if rule == TangentRule::FivePointBounded {
+                                    five_point_unit_open(x, i, |j| chords[j])
+                                } else {
+                                    five_point_unit_unbounded(x, i, |j| chords[j])
+                                }
+                                .unwrap_or(DVec3::ZERO)
+                            };
+                            // centred rows four at a time (the same bits), the rest one by one
+                            let Some(g) = tangent_lanes::group_of(i, n) else {
+                                return row(i);
+                            };
+                            if *at != g {
+                                *group = tangent_lanes::centred_group(x, chords, g)
+                                    .unwrap_or_else(|| std::array::from_fn(|k| row(g + k)));
+                                *at = g;
+                            }
+                            return group[i - g];
                         }
-                    }
-                    let u = match (l > 0.0, five && chordal) {
-                        (false, _) => DVec3::ZERO,
-                        (true, true) => guard_overshoot(x, i, closed, u),
-                        (true, false) => u,
-                    };
-                    if interior {
-                        let ii = i as isize;
-                        let (a, b) = (x[idx(ii - 1, n, closed)], x[idx(ii + 1, n, closed)]);
-                        guard_chords(x[i] - a, b - x[i], u)
-                    } else {
-                        u
-                    }
-                }),
+                        let v = raw_tangent(x, chords, i, closed, rule, five);
+                        let l = v.length();
+                        let u = v * (1.0 / l);
+                        let interior = closed || (i > 0 && i + 1 < n);
+                        if !(l > 0.0 && u.is_finite()) {
+                            // the neighbours cancel (a symmetric reversal): the chord guard's
+                            // bisector, at a sample with two chords
+                            if !(interior && v == DVec3::ZERO) {
+                                return DVec3::ZERO;
+                            }
+                        }
+                        let u = match (l > 0.0, five && chordal) {
+                            (false, _) => DVec3::ZERO,
+                            (true, true) => guard_overshoot(x, i, closed, u),
+                            (true, false) => u,
+                        };
+                        if interior {
+                            let ii = i as isize;
+                            let (a, b) = (x[idx(ii - 1, n, closed)], x[idx(ii + 1, n, closed)]);
+                            guard_chords(x[i] - a, b - x[i], u)
+                        } else {
+                            u
+                        }
+                    },
+                ),
         );
     }
     if !five && !closed && n >= 3 {

@@ -123,25 +123,26 @@ pub fn chords(
         if cancel() {
             return Ok(seg);
         }
+        // the chords i → i + 1 of the segment, then the closing one (closed curves)
+        let stop = (start + CHORD_SEGMENT).min(m);
+        let inner = stop.min(n.saturating_sub(1));
         seg.par_extend(
-            (start..(start + CHORD_SEGMENT).min(m))
-                .into_par_iter()
+            x[start..inner + 1]
+                .par_windows(2)
                 .with_min_len(CHECK_CHUNK)
-                .map(|i| {
-                    let d = x[next(i)] - x[i];
-                    let l = d.length();
-                    if !(l > 1e-150 && l < 1e150) {
-                        // the square under- or overflowed: the length scaled first
-                        crate::math::scale::length(d)
-                    } else {
-                        l
-                    }
-                }),
+                .map(|w| chord_length(w[1] - w[0])),
         );
+        if stop > inner {
+            seg.push(chord_length(x[0] - x[n - 1]));
+        }
     }
-    // the first repeated point (a cancelled search finds none; the result is discarded)
-    let bad =
-        crate::run::cancel::first_bad_index(m, cancel, |i| !repeated(x[i], x[next(i)], floor));
+    // the first repeated point (a cancelled search finds none; the result is discarded); a
+    // chord longer than twice the floor repeats nothing (`|d|_∞ ≥ |d|/√3`), so the exact test
+    // runs only on the short ones
+    let short = 2.0 * floor;
+    let bad = crate::run::cancel::first_bad_index(m, cancel, |i| {
+        seg[i] > short || !repeated(x[i], x[next(i)], floor)
+    });
     match bad {
         None => Ok(seg),
         Some(i) => Err(InputError::new(
@@ -153,6 +154,17 @@ pub fn chords(
             ),
         )
         .with_kind(ErrorKind::Repeated)),
+    }
+}
+
+/// `|d|`, scaled first where its square under- or overflows.
+#[inline(always)]
+fn chord_length(d: DVec3) -> f64 {
+    let l = d.length();
+    if !(l > 1e-150 && l < 1e150) {
+        crate::math::scale::length(d)
+    } else {
+        l
     }
 }
 
