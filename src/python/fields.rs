@@ -11,6 +11,7 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
+use super::coerce;
 use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -74,13 +75,11 @@ impl PyField {
         points: &Bound<'py, PyAny>,
         t: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let validate = py.import("spinal._validate")?;
-        let arr = validate.getattr("as_points")?.call1((points, "points"))?;
-        let t: f64 = match t {
-            Some(t) => validate.getattr("as_real")?.call1((t, "t"))?.extract()?,
+        let arr = coerce::points(points, "points")?;
+        let t = match t {
+            Some(t) => coerce::real(t, "t")?,
             None => 0.0,
         };
-        let arr: PyReadonlyArray2<'py, f64> = arr.extract()?;
         let x = vec3s("points", &arr)?;
         deform::finite_rows("points", x)?;
         let t = deform::finite("t", t)?;

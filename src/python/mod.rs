@@ -5,6 +5,7 @@
 //! shapes) before calling in here, so these functions expect C-contiguous arrays of the
 //! right dtype. The core modules never name pyo3 (checked by a test below).
 
+mod coerce;
 mod convert;
 mod deform;
 mod fields;
