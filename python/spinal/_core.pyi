@@ -8,20 +8,17 @@ import numpy.typing as npt
 
 __version__: str
 
+# The options of a call, one dict built by the Python wrapper (keys as in src/python/*.rs).
+Options: TypeAlias = dict[str, object]
+# frames_*: method, tangent_rule, tangent_chords, closed, initial_vectors, initial_frames,
+# end_vectors, end_frames, turns, points_arg, and u, d1, d2, d3 for frames_steered
+FrameOptions: TypeAlias = Options
+
 def frames_sampled(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: float,
-    points_arg: str = "points",
+    options: FrameOptions,
     progress: Callable[[int, int], object] | None = None,
     out: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
@@ -30,13 +27,7 @@ def frames_analytic(
     u: npt.NDArray[np.float64],
     d1: npt.NDArray[np.float64],
     d2: npt.NDArray[np.float64],
-    method: str,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: float,
+    options: FrameOptions,
     d3: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 class RepeatedPointsError(ValueError): ...
@@ -56,45 +47,14 @@ def frames_steered(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
-    u: npt.NDArray[np.float64] | None,
-    d1: npt.NDArray[np.float64] | None,
-    d2: npt.NDArray[np.float64] | None,
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: npt.NDArray[np.float64],
-    con_curves: npt.NDArray[np.int64],
-    con_rows: npt.NDArray[np.int64],
-    con_vectors: npt.NDArray[np.float64],
-    con_frames: npt.NDArray[np.float64],
-    con_is_frame: npt.NDArray[np.bool_],
-    twist_rule: str,
-    guide: npt.NDArray[np.float64] | None,
-    guide_weight: float,
-    guide_tolerance: float,
-    guide_axis: bool,
-    previous: npt.NDArray[np.float64] | None,
-    guide_previous: npt.NDArray[np.float64] | None = None,
-    previous_weight: float = 1.0,
-    points_arg: str = "points",
-    d3: npt.NDArray[np.float64] | None = None,
+    options: FrameOptions,
+    steering: Options,
 ) -> npt.NDArray[np.float64]: ...
 def frames_in_time(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     steps: int,
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    turns: float,
+    options: FrameOptions,
     previous: npt.NDArray[np.float64] | None,
     progress: Callable[[int, int], object] | None = None,
 ) -> npt.NDArray[np.float64]: ...

@@ -12,6 +12,7 @@ mod fields;
 mod flesh;
 mod frames;
 mod mesh;
+mod options;
 mod out;
 mod ph;
 mod quaternion;
