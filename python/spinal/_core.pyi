@@ -335,23 +335,14 @@ def deform_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
     field: Field,
-    t0: float,
-    duration: float,
-    steps: int,
-    refine: float | None,
-    max_vertices: int,
-    max_passes: int,
-    progress: Callable[[int, int], object] | None,
-    check: bool = True,
+    options: Options,
+    progress: Callable[[int, int], object] | None = None,
 ) -> tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
-    tuple[
-        tuple[int, int, int, bool, float, float, int, int],
-        tuple[int, float, int, int, float, int, int],
-    ],
+    dict[str, int | float | bool],
 ]: ...
 def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...
 def mesh_measure(
