@@ -318,8 +318,6 @@ def advect(
     h: float,
     steps: int,
     method: str,
-    progress: Callable[[int, int], object] | None = None,
-    every: int = 0,
     out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def advect_runs(
@@ -421,12 +419,7 @@ def flesh_surface_deform(
 def stamp(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
-    start: tuple[float, float, float],
-    end: tuple[float, float, float],
-    radius: float,
-    reach: float,
-    frames: int,
-    iterations: int,
+    options: Options,
     progress: Callable[[int, int], object] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 

@@ -494,7 +494,9 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
         f"must be ≥ 0 and at most {MAX_ITERATIONS}, got {x}"))
     progress = checked(progress)
     with Progress(progress, frames, "stamp", "frame") as bar:
-        W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations,
+        options = {"start": tuple(a), "end": tuple(b), "radius": rho, "reach": reach,
+                   "frames": frames, "iterations": iterations}
+        W, rep = _core.stamp(V, F, options,
                              (lambda done, total: bar.update(done)) if bar else None)
     e, (rest, vol) = _volumes(F, V, W)
     change = vol / rest - 1 if rest != 0 else float("nan")

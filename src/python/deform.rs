@@ -16,12 +16,11 @@ use crate::deform::{self, advect::Method, refine};
 use crate::run::alloc;
 
 /// Advect points: `steps` steps of size `h` from `t0`, into a new array (or `out`: see
-/// [`advect_runs`]). Ctrl-C stops it between
-/// blocks of steps (`KeyboardInterrupt`); `progress(done, steps)` is called at every multiple
-/// of `every` steps and at the end.
+/// [`advect_runs`], which also reports progress: one run gives the same bits). Ctrl-C stops
+/// it between blocks of steps (`KeyboardInterrupt`).
 #[pyfunction]
-#[pyo3(signature = (points, field, t0, h, steps, method, progress=None, every=0, out=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, field, t0, h, steps, method, out=None))]
+#[allow(clippy::too_many_arguments)] // seven from Python, and the GIL token
 pub fn advect<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -30,8 +29,6 @@ pub fn advect<'py>(
     h: f64,
     steps: usize,
     method: Method,
-    progress: Option<Py<PyAny>>,
-    every: usize,
     out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let run = deform::advect::Run {
@@ -39,7 +36,7 @@ pub fn advect<'py>(
         h,
         count: steps,
     };
-    advect_runs_impl(py, points, &field, &[run], method, progress, every, out)
+    advect_runs_impl(py, points, &field, &[run], method, None, 0, out)
 }
 
 /// Advect points through runs of equal steps one after the other, `runs` a list of
@@ -202,23 +199,24 @@ pub fn deform_mesh<'py>(
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Contact stamper (see `deform::stamp`): a new vertex array and per-frame rows
-/// `(dent, time, residual, contact)`. Ctrl-C stops it between frames, after each of which
+/// `(dent, time, residual, contact)`. `options`: `start`, `end` (the stamp's path), `radius`,
+/// `reach`, `frames` and `iterations`. Ctrl-C stops it between frames, after each of which
 /// `progress(done, frames)` is called when given.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, start, end, radius, reach, frames, iterations, progress=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (vertices, faces, options, progress=None))]
 pub fn stamp<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, i64>,
-    start: [f64; 3],
-    end: [f64; 3],
-    radius: f64,
-    reach: f64,
-    frames: usize,
-    iterations: usize,
+    options: Options<'py>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<StampArrays<'py>> {
+    let start: [f64; 3] = options.get("start")?;
+    let end: [f64; 3] = options.get("end")?;
+    let radius: f64 = options.get("radius")?;
+    let reach: f64 = options.get("reach")?;
+    let frames: usize = options.get("frames")?;
+    let iterations: usize = options.get("iterations")?;
     let x = vec3s("vertices", &vertices)?;
     // negative indices become out of range, which the stamper reports
     let f: Vec<[usize; 3]> = alloc::collect(
