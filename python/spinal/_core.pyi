@@ -267,15 +267,7 @@ def field_grid_coefficients(values: npt.NDArray[np.float64]) -> npt.NDArray[np.f
 def field_path(
     points: npt.NDArray[np.float64],
     frames: npt.NDArray[np.float64],
-    radius: float,
-    duration: float,
-    kind: str,
-    tool: str,
-    rate: float,
-    t0: float,
-    reach: float | None,
-    falloff_power: int,
-    blend: str,
+    options: Options,
 ) -> Field: ...
 def field_zero() -> Field: ...
 def field_grid_curl(
@@ -293,14 +285,7 @@ def field_grid_curl(
 ) -> Field: ...
 def field_rod(
     points: npt.NDArray[np.float64],
-    radius: float,
-    center: _V3 | None,
-    reach: float | None,
-    velocity: _V3 | None,
-    angular_velocity: _V3 | None,
-    pivot: _V3 | None,
-    falloff_power: int,
-    moving: bool,
+    options: Options,
 ) -> Field: ...
 def field_keyframed(
     tool: Field,
