@@ -113,9 +113,9 @@ def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
         return _core.advect(x, field, t0, h, steps, method, out=out)
     # one call: the core reports every 1/100 of the steps (same bits as without)
     with Progress(progress, steps, "advect", "step") as bar:
-        return _core.advect(x, field, t0, h, steps, method,
-                            lambda done, total: bar.update(done), max(1, steps // 100),
-                            out=out)
+        return _core.advect_runs(x, field, [(t0, h, steps)], method,
+                                 lambda done, total: bar.update(done), max(1, steps // 100),
+                                 out=out)
 
 
 def default_steps(field: Field, duration: float, x: np.ndarray, t0: float,

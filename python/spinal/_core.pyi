@@ -8,20 +8,17 @@ import numpy.typing as npt
 
 __version__: str
 
+# The options of a call, one dict built by the Python wrapper (keys as in src/python/*.rs).
+Options: TypeAlias = dict[str, object]
+# frames_*: method, tangent_rule, tangent_chords, closed, initial_vectors, initial_frames,
+# end_vectors, end_frames, turns, points_arg, and u, d1, d2, d3 for frames_steered
+FrameOptions: TypeAlias = Options
+
 def frames_sampled(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: float,
-    points_arg: str = "points",
+    options: FrameOptions,
     progress: Callable[[int, int], object] | None = None,
     out: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
@@ -30,13 +27,7 @@ def frames_analytic(
     u: npt.NDArray[np.float64],
     d1: npt.NDArray[np.float64],
     d2: npt.NDArray[np.float64],
-    method: str,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: float,
+    options: FrameOptions,
     d3: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], float]: ...
 class RepeatedPointsError(ValueError): ...
@@ -56,45 +47,14 @@ def frames_steered(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
-    u: npt.NDArray[np.float64] | None,
-    d1: npt.NDArray[np.float64] | None,
-    d2: npt.NDArray[np.float64] | None,
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    end_vectors: npt.NDArray[np.float64] | None,
-    end_frames: npt.NDArray[np.float64] | None,
-    turns: npt.NDArray[np.float64],
-    con_curves: npt.NDArray[np.int64],
-    con_rows: npt.NDArray[np.int64],
-    con_vectors: npt.NDArray[np.float64],
-    con_frames: npt.NDArray[np.float64],
-    con_is_frame: npt.NDArray[np.bool_],
-    twist_rule: str,
-    guide: npt.NDArray[np.float64] | None,
-    guide_weight: float,
-    guide_tolerance: float,
-    guide_axis: bool,
-    previous: npt.NDArray[np.float64] | None,
-    guide_previous: npt.NDArray[np.float64] | None = None,
-    previous_weight: float = 1.0,
-    points_arg: str = "points",
-    d3: npt.NDArray[np.float64] | None = None,
+    options: FrameOptions,
+    steering: Options,
 ) -> npt.NDArray[np.float64]: ...
 def frames_in_time(
     points: npt.NDArray[np.float64] | None,
     tangents: npt.NDArray[np.float64] | None,
     steps: int,
-    method: str,
-    tangent_rule: str,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: npt.NDArray[np.float64] | None,
-    initial_frames: npt.NDArray[np.float64] | None,
-    turns: float,
+    options: FrameOptions,
     previous: npt.NDArray[np.float64] | None,
     progress: Callable[[int, int], object] | None = None,
 ) -> npt.NDArray[np.float64]: ...
@@ -105,23 +65,8 @@ def sweep_mesh(
     twist: npt.NDArray[np.float64] | None,
     offsets: npt.NDArray[np.int64],
     profile: npt.NDArray[np.float64],
-    profile_closed: bool,
-    closed: bool,
-    caps: bool,
-    miter_limit: float,
-    split_seams: bool,
-    scale_arg: str = "scale",
-    single: bool = False,
-    index32: bool = False,
-    normals: bool = True,
-    uv: bool = True,
-    tangents: npt.NDArray[np.float64] | None = None,
-    join: str = "round",
+    options: Options,
     progress: Callable[[int, int], object] | None = None,
-    turns: float = 0.0,
-    out_vertices: npt.NDArray[np.floating] | None = None,
-    out_normals: npt.NDArray[np.floating] | None = None,
-    out_uv: npt.NDArray[np.floating] | None = None,
 ) -> tuple[
     npt.NDArray[np.floating],
     npt.NDArray[np.signedinteger],
@@ -322,15 +267,7 @@ def field_grid_coefficients(values: npt.NDArray[np.float64]) -> npt.NDArray[np.f
 def field_path(
     points: npt.NDArray[np.float64],
     frames: npt.NDArray[np.float64],
-    radius: float,
-    duration: float,
-    kind: str,
-    tool: str,
-    rate: float,
-    t0: float,
-    reach: float | None,
-    falloff_power: int,
-    blend: str,
+    options: Options,
 ) -> Field: ...
 def field_zero() -> Field: ...
 def field_grid_curl(
@@ -348,14 +285,7 @@ def field_grid_curl(
 ) -> Field: ...
 def field_rod(
     points: npt.NDArray[np.float64],
-    radius: float,
-    center: _V3 | None,
-    reach: float | None,
-    velocity: _V3 | None,
-    angular_velocity: _V3 | None,
-    pivot: _V3 | None,
-    falloff_power: int,
-    moving: bool,
+    options: Options,
 ) -> Field: ...
 def field_keyframed(
     tool: Field,
@@ -373,8 +303,6 @@ def advect(
     h: float,
     steps: int,
     method: str,
-    progress: Callable[[int, int], object] | None = None,
-    every: int = 0,
     out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def advect_runs(
@@ -390,23 +318,14 @@ def deform_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
     field: Field,
-    t0: float,
-    duration: float,
-    steps: int,
-    refine: float | None,
-    max_vertices: int,
-    max_passes: int,
-    progress: Callable[[int, int], object] | None,
-    check: bool = True,
+    options: Options,
+    progress: Callable[[int, int], object] | None = None,
 ) -> tuple[
     npt.NDArray[np.float64],
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
-    tuple[
-        tuple[int, int, int, bool, float, float, int, int],
-        tuple[int, float, int, int, float, int, int],
-    ],
+    dict[str, int | float | bool],
 ]: ...
 def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...
 def mesh_measure(
@@ -485,12 +404,7 @@ def flesh_surface_deform(
 def stamp(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
-    start: tuple[float, float, float],
-    end: tuple[float, float, float],
-    radius: float,
-    reach: float,
-    frames: int,
-    iterations: int,
+    options: Options,
     progress: Callable[[int, int], object] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 

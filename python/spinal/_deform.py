@@ -339,13 +339,19 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
 
     try:
         W, Vr, Fr, counts, stats = _core.deform_mesh(
-            V, F, field, t0, duration, n, refine, max_vertices, max_passes,
-            None if progress is False else tick, bool(check))
+            V, F, field, {"t0": t0, "duration": duration, "steps": n, "refine": refine,
+                          "max_vertices": max_vertices, "max_passes": max_passes,
+                          "check": bool(check)},
+            None if progress is False else tick)
     finally:
         if bar:
             bar[0].close()
-    (passes, torn, over, bounded, t_int, t_ref, on_slip, chord), \
-        (flips, flip_volume, collapses, moves, collapse_volume, bent, bent_added) = stats
+    torn, over, bounded = stats["torn"], stats["over_threshold"], stats["bounded"]
+    on_slip, chord, bent = stats["slip_vertices"], stats["fallback"], stats["bent"]
+    flips, flip_volume = stats["flips"], stats["flip_volume"]
+    collapses, moves, collapse_volume = stats["collapses"], stats["moves"], stats["collapse_volume"]
+    passes, bent_added = stats["passes"], stats["bend_splits"]
+    t_int, t_ref = stats["time_integrate"], stats["time_refine"]
     clock = time.perf_counter()
     e, (rest, vol) = _volumes(Fr, Vr, W)
     change = vol / rest - 1 if rest != 0 else float("nan")
@@ -358,8 +364,9 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         # both runs with the mesh's own integrator (vertices at a tool's surface carried by
         # their side's velocity; spinal.advect's RK4 stages step across the surface there)
         def rerun(steps):
-            return _core.deform_mesh(Vr, Fr, field, t0, duration, steps, None, len(Vr), 0,
-                                     None, False)[0]
+            return _core.deform_mesh(Vr, Fr, field, {
+                "t0": t0, "duration": duration, "steps": steps, "refine": None,
+                "max_vertices": len(Vr), "max_passes": 0, "check": False})[0]
 
         W1 = W if torn == 0 else rerun(n)
         W2 = rerun(2 * n)
@@ -487,7 +494,9 @@ def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
         f"must be ≥ 0 and at most {MAX_ITERATIONS}, got {x}"))
     progress = checked(progress)
     with Progress(progress, frames, "stamp", "frame") as bar:
-        W, rep = _core.stamp(V, F, tuple(a), tuple(b), rho, reach, frames, iterations,
+        options = {"start": tuple(a), "end": tuple(b), "radius": rho, "reach": reach,
+                   "frames": frames, "iterations": iterations}
+        W, rep = _core.stamp(V, F, options,
                              (lambda done, total: bar.update(done)) if bar else None)
     e, (rest, vol) = _volumes(F, V, W)
     change = vol / rest - 1 if rest != 0 else float("nan")

@@ -512,10 +512,10 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
     f = _frames(x) if frames is None else as_float_array(frames, "frames")
     if f.shape != (len(x), 3, 3):
         raise ValueError(f"frames: expected shape {(len(x), 3, 3)}, got {f.shape}")
-    return _core.field_path(x, np.ascontiguousarray(f), as_real(radius, "radius"),
-                            as_real(duration, "duration"), kind, tool, as_finite(rate, "rate"),
-                            as_real(t0, "t0"), _opt(reach, "reach"), _power(falloff_power),
-                            blend)
+    return _core.field_path(x, np.ascontiguousarray(f), {
+        "radius": as_real(radius, "radius"), "duration": as_real(duration, "duration"),
+        "kind": kind, "tool": tool, "rate": as_finite(rate, "rate"), "t0": as_real(t0, "t0"),
+        "reach": _opt(reach, "reach"), "falloff_power": _power(falloff_power), "blend": blend})
 
 
 # ---- curl tools of any shape, keyframed tools ------------------------------------------------
@@ -598,9 +598,10 @@ def rod(points, radius, *, velocity=None, angular_velocity=None, pivot=None, cen
     ``center`` C defaults to the centroid of the sample polyline, ``reach`` to ``radius``."""
     u, w, p = _motion(velocity, angular_velocity, pivot)
     c = None if center is None else as_vector(center, "center")
-    return _core.field_rod(as_points(points, "points"), as_real(radius, "radius"), c,
-                           _opt(reach, "reach"), u, w, p, _power(falloff_power),
-                           as_bool(moving, "moving"))
+    return _core.field_rod(as_points(points, "points"), {
+        "radius": as_real(radius, "radius"), "center": c, "reach": _opt(reach, "reach"),
+        "velocity": u, "angular_velocity": w, "pivot": p, "falloff_power": _power(falloff_power),
+        "moving": as_bool(moving, "moving")})
 
 
 for _ctor in (sdf_curl, mesh_curl, rod):

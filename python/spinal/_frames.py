@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _core, _merge
 from ._progress import Progress, Reported, checked
-from ._steer import guide_rows, previous_frames, steering
+from ._steer import STEERING, guide_rows, previous_frames, steering
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -119,6 +119,15 @@ def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"
     return pts, tgs, offs, bundle
 
 
+def _shape(method: str, closed: bool, iv=None, if_=None, ev=None, ef=None, **more) -> dict:
+    """The options of the core's frames calls (``spinal._core.frames_*``): the method, the
+    default tangent rule, whether the curve is closed, the start and end orientations as
+    vectors and frames, and any call-specific ``more``."""
+    return {"method": method, "tangent_rule": DEFAULT_TANGENT_RULE, "closed": closed,
+            "initial_vectors": iv, "initial_frames": if_, "end_vectors": ev, "end_frames": ef,
+            **more}
+
+
 def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
              lengths, offsets, points_arg="points", report=None, out=None):
     method = as_choice(method, "method", METHODS)
@@ -136,8 +145,8 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
         iv, if_ = _orientation(initial, "initial", 1, False)
         ev, ef = _orientation(end, "end", 1, False)
         d3 = _third(points, uu, method)
-        out, angle = _core.frames_analytic(pts, uu, d1, d2, method, closed, iv, if_, ev, ef, turns,
-                                           d3)
+        out, angle = _core.frames_analytic(pts, uu, d1, d2, _shape(method, closed, iv, if_, ev, ef,
+                                                                   turns=turns), d3)
         if report is not None:
             report(len(out), len(out))
         return out, np.array([angle]), False
@@ -155,9 +164,9 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     def run(p, offs, tgs):
         # the rows as given are written straight into `out` (the rows kept after merging
         # repeats are spread over it by the caller)
-        return _core.frames_sampled(p, tgs, offs, method, DEFAULT_TANGENT_RULE,
-                                    chords_from_tangents, closed, iv, if_, ev, ef, turns,
-                                    points_arg, report, out if p is pts else None)
+        options = _shape(method, closed, iv, if_, ev, ef, tangent_chords=chords_from_tangents,
+                         turns=turns, points_arg=points_arg)
+        return _core.frames_sampled(p, tgs, offs, options, report, out if p is pts else None)
 
     if pts is None or chords_from_tangents:  # (the quadrature's grid is the rows as given)
         out, angles = run(pts, offs, tgs)
@@ -672,8 +681,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     ev, ef = _orientation(end, "end", curves, bundle)
     if bundle and (offs[0] != 0 or offs[-1] != rows or np.any(np.diff(offs) < 0)):
         # the core names the rule that the lengths/offsets break
-        _core.frames_sampled(pts, tgs, offs, method, DEFAULT_TANGENT_RULE, False, closed, None,
-                             None, None, None, 0)
+        _core.frames_sampled(pts, tgs, offs, _shape(method, closed, turns=0))
     before = None
     if signed_by_previous:
         guide, previous, guide_sign = _signed_by(guide, previous, rows), None, "follow"
@@ -686,9 +694,9 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
                      previous, offs, bundle, rows, guide_sign, before, previous_weight)
 
     def run(pts, tgs, offs, steer):
-        return _core.frames_steered(pts, tgs, offs, uu, d1, d2, method, DEFAULT_TANGENT_RULE,
-                                    reflection == "tangents", closed, iv, if_, ev, ef, *steer,
-                                    d3=d3)
+        options = _shape(method, closed, iv, if_, ev, ef, tangent_chords=reflection == "tangents",
+                         u=uu, d1=d1, d2=d2, d3=d3)
+        return _core.frames_steered(pts, tgs, offs, options, dict(zip(STEERING, steer)))
 
     if pts is None or uu is not None or reflection == "tangents":
         return run(pts, tgs, offs, steer)
@@ -917,9 +925,9 @@ def frames_in_time(
     flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
     try:
         with Reported(progress, "frames_in_time", "step") as report:
-            out = _core.frames_in_time(flat(p), flat(tg), steps, method, DEFAULT_TANGENT_RULE,
-                                       reflection == "tangents", closed, iv, if_, turns, prev,
-                                       report.callback)
+            options = _shape(method, closed, iv, if_, tangent_chords=reflection == "tangents",
+                             turns=turns)
+            out = _core.frames_in_time(flat(p), flat(tg), steps, options, prev, report.callback)
     except _core.RepeatedPointsError:
         if reflection == "tangents":
             raise

@@ -152,6 +152,12 @@ def previous_frames(previous: Any, rows: int, what: str = "the frames of the sam
     return np.ascontiguousarray(prev)
 
 
+#: The names of the values returned by :func:`steering` (the keys of the core's ``steering``).
+STEERING = ("turns", "con_curves", "con_rows", "con_vectors", "con_frames", "con_is_frame",
+            "twist_rule", "guide", "guide_weight", "guide_tolerance", "guide_axis", "previous",
+            "guide_previous", "previous_weight")
+
+
 def steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance, previous,
              offs: np.ndarray, bundle: bool, rows: int, guide_sign: str = "follow",
              guide_previous=None, previous_weight: float = 1.0):

@@ -452,12 +452,15 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     def core(pts, offs, fr, tg, sc, tw):
         fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
         with report:
-            return _core.sweep_mesh(
-                pts, fr, sc, tw, offs, np.ascontiguousarray(prof),
-                profile_closed, closed, caps, miter_limit, split_seams, scale_arg,
-                single, single, want_normals, want_uv, tg, join, report.callback,
-                float(turns), *buffers,
-            )
+            options = {
+                "profile_closed": profile_closed, "closed": closed, "caps": caps,
+                "miter_limit": miter_limit, "split_seams": split_seams, "scale_arg": scale_arg,
+                "single": single, "index32": single, "normals": want_normals, "uv": want_uv,
+                "tangents": tg, "join": join, "turns": float(turns),
+                **dict(zip(("out_vertices", "out_normals", "out_uv"), buffers)),
+            }
+            return _core.sweep_mesh(pts, fr, sc, tw, offs, np.ascontiguousarray(prof), options,
+                                    report.callback)
 
     def merged(p):
         # consecutive repeated samples: merged (a ring for the first row of each group)

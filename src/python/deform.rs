@@ -4,22 +4,23 @@
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use super::convert::{
     Stop, Ticker, detach_stoppable, slice_mut, triangles, value_error, vec3_array, vec3s,
 };
 use super::fields::PyField;
+use super::options::Options;
 use super::out::{output, writing};
 use crate::deform::{self, advect::Method, refine};
 use crate::run::alloc;
 
 /// Advect points: `steps` steps of size `h` from `t0`, into a new array (or `out`: see
-/// [`advect_runs`]). Ctrl-C stops it between
-/// blocks of steps (`KeyboardInterrupt`); `progress(done, steps)` is called at every multiple
-/// of `every` steps and at the end.
+/// [`advect_runs`], which also reports progress: one run gives the same bits). Ctrl-C stops
+/// it between blocks of steps (`KeyboardInterrupt`).
 #[pyfunction]
-#[pyo3(signature = (points, field, t0, h, steps, method, progress=None, every=0, out=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, field, t0, h, steps, method, out=None))]
+#[allow(clippy::too_many_arguments)] // seven from Python, and the GIL token
 pub fn advect<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -28,8 +29,6 @@ pub fn advect<'py>(
     h: f64,
     steps: usize,
     method: Method,
-    progress: Option<Py<PyAny>>,
-    every: usize,
     out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let run = deform::advect::Run {
@@ -37,7 +36,7 @@ pub fn advect<'py>(
         h,
         count: steps,
     };
-    advect_runs_impl(py, points, &field, &[run], method, progress, every, out)
+    advect_runs_impl(py, points, &field, &[run], method, None, 0, out)
 }
 
 /// Advect points through runs of equal steps one after the other, `runs` a list of
@@ -114,38 +113,37 @@ type DeformArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray1<i64>>,
-    (
-        (usize, usize, usize, bool, f64, f64, usize, usize),
-        (usize, f64, usize, usize, f64, usize, usize),
-    ),
+    Bound<'py, PyDict>,
 );
 
 /// Deform a closed mesh along a field, refining after every step (see `deform::refine`):
-/// `(vertices, rest_vertices, faces, vertices after each step, (passes, torn vertices, edges
-/// over the threshold, bounded, integration seconds, refinement seconds, vertices on a slip
-/// surface, vertices at a torn edge's chord midpoint), (flips, their volume change, collapses,
-/// moves, the volume change of the collapses and moves))`. `refine=None`
-/// only advects. With `check`, a mesh that is open, not edge-manifold, inconsistently wound
-/// or wound inwards is refused first (errors name `mesh`). Ctrl-C stops it between steps;
-/// `progress(done, total)` is called after every step when given.
+/// `(vertices, rest_vertices, faces, vertices after each step, statistics)`. The statistics
+/// are a dict: `passes`, `torn` (vertices), `over_threshold` (edges over the threshold),
+/// `bounded`, `time_integrate` and `time_refine` (seconds), `slip_vertices` (vertices on a
+/// slip surface), `fallback` (vertices at a torn edge's chord midpoint), `flips`,
+/// `flip_volume` (their volume change), `collapses`, `moves`, `collapse_volume` (the volume
+/// change of the collapses and moves), `bent` and `bend_splits`. `options`: `t0`,
+/// `duration`, `steps`, `refine` (`None` only advects), `max_vertices`, `max_passes` and
+/// `check` (default true). With `check`, a mesh that is open, not edge-manifold,
+/// inconsistently wound or wound inwards is refused first (errors name `mesh`). Ctrl-C stops
+/// it between steps; `progress(done, total)` is called after every step when given.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, field, t0, duration, steps, refine, max_vertices,
-                    max_passes, progress, check=true))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (vertices, faces, field, options, progress=None))]
 pub fn deform_mesh<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, i64>,
     field: PyRef<'py, PyField>,
-    t0: f64,
-    duration: f64,
-    steps: usize,
-    refine: Option<f64>,
-    max_vertices: usize,
-    max_passes: usize,
+    options: Options<'py>,
     progress: Option<Py<PyAny>>,
-    check: bool,
 ) -> PyResult<DeformArrays<'py>> {
+    let t0: f64 = options.get("t0")?;
+    let duration: f64 = options.get("duration")?;
+    let steps: usize = options.get("steps")?;
+    let refine: Option<f64> = options.opt("refine")?;
+    let max_vertices: usize = options.get("max_vertices")?;
+    let max_passes: usize = options.get("max_passes")?;
+    let check: bool = options.get_or("check", true)?;
     let field = &field.field;
     let x = vec3s("mesh", &vertices)?;
     // negative indices become out of range, which the core reports
@@ -173,55 +171,52 @@ pub fn deform_mesh<'py>(
     let faces = alloc::flat("deform", d.faces.iter().map(|f| f.map(|i| i as i64)))?;
     let nf = d.faces.len();
     let counts = alloc::collect("deform", d.step_vertices.iter().map(|&c| c as i64))?;
+    let stats = PyDict::new(py);
+    stats.set_item("passes", d.passes)?;
+    stats.set_item("torn", d.torn)?;
+    stats.set_item("over_threshold", d.over_threshold)?;
+    stats.set_item("bounded", d.bounded)?;
+    stats.set_item("time_integrate", d.time_integrate)?;
+    stats.set_item("time_refine", d.time_refine)?;
+    stats.set_item("slip_vertices", d.slip_vertices)?;
+    stats.set_item("fallback", d.fallback)?;
+    stats.set_item("flips", d.flips)?;
+    stats.set_item("flip_volume", d.flip_volume)?;
+    stats.set_item("collapses", d.collapses)?;
+    stats.set_item("moves", d.moves)?;
+    stats.set_item("collapse_volume", d.collapse_volume)?;
+    stats.set_item("bent", d.bent)?;
+    stats.set_item("bend_splits", d.bend_splits)?;
     Ok((
         vec3_array(py, d.vertices)?,
         vec3_array(py, d.rest)?,
         PyArray1::from_vec(py, faces).reshape([nf, 3])?,
         PyArray1::from_vec(py, counts),
-        (
-            (
-                d.passes,
-                d.torn,
-                d.over_threshold,
-                d.bounded,
-                d.time_integrate,
-                d.time_refine,
-                d.slip_vertices,
-                d.fallback,
-            ),
-            (
-                d.flips,
-                d.flip_volume,
-                d.collapses,
-                d.moves,
-                d.collapse_volume,
-                d.bent,
-                d.bend_splits,
-            ),
-        ),
+        stats,
     ))
 }
 
 type StampArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Contact stamper (see `deform::stamp`): a new vertex array and per-frame rows
-/// `(dent, time, residual, contact)`. Ctrl-C stops it between frames, after each of which
+/// `(dent, time, residual, contact)`. `options`: `start`, `end` (the stamp's path), `radius`,
+/// `reach`, `frames` and `iterations`. Ctrl-C stops it between frames, after each of which
 /// `progress(done, frames)` is called when given.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, start, end, radius, reach, frames, iterations, progress=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (vertices, faces, options, progress=None))]
 pub fn stamp<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, i64>,
-    start: [f64; 3],
-    end: [f64; 3],
-    radius: f64,
-    reach: f64,
-    frames: usize,
-    iterations: usize,
+    options: Options<'py>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<StampArrays<'py>> {
+    let start: [f64; 3] = options.get("start")?;
+    let end: [f64; 3] = options.get("end")?;
+    let radius: f64 = options.get("radius")?;
+    let reach: f64 = options.get("reach")?;
+    let frames: usize = options.get("frames")?;
+    let iterations: usize = options.get("iterations")?;
     let x = vec3s("vertices", &vertices)?;
     // negative indices become out of range, which the stamper reports
     let f: Vec<[usize; 3]> = alloc::collect(

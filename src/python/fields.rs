@@ -11,7 +11,9 @@ use numpy::{
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
+use super::coerce;
 use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
+use super::options::Options;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
     keyframe, path, rod, tube,
@@ -74,13 +76,11 @@ impl PyField {
         points: &Bound<'py, PyAny>,
         t: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let validate = py.import("spinal._validate")?;
-        let arr = validate.getattr("as_points")?.call1((points, "points"))?;
-        let t: f64 = match t {
-            Some(t) => validate.getattr("as_real")?.call1((t, "t"))?.extract()?,
+        let arr = coerce::points(points, "points")?;
+        let t = match t {
+            Some(t) => coerce::real(t, "t")?,
             None => 0.0,
         };
-        let arr: PyReadonlyArray2<'py, f64> = arr.extract()?;
         let x = vec3s("points", &arr)?;
         deform::finite_rows("points", x)?;
         let t = deform::finite("t", t)?;
@@ -506,22 +506,24 @@ pub fn field_grid(
 
 /// `spinal.fields.along_path`: spine samples `(n, 3)` and their frames `(n, 3, 3)` (columns
 /// `r, s, t`).
+/// `options`: `radius`, `duration`, `kind`, `tool`, `rate`, `t0`, `reach` (`None`: the
+/// radius), `falloff_power` and `blend`.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 pub fn field_path(
     py: Python<'_>,
     points: PyReadonlyArray2<'_, f64>,
     frames: PyReadonlyArray3<'_, f64>,
-    radius: f64,
-    duration: f64,
-    kind: path::PathKind,
-    tool: Carry,
-    rate: f64,
-    t0: f64,
-    reach: Option<f64>,
-    falloff_power: i64,
-    blend: Blend,
+    options: Options<'_>,
 ) -> PyResult<PyField> {
+    let radius: f64 = options.get("radius")?;
+    let duration: f64 = options.get("duration")?;
+    let kind: path::PathKind = options.get("kind")?;
+    let tool: Carry = options.get("tool")?;
+    let rate: f64 = options.get("rate")?;
+    let t0: f64 = options.get("t0")?;
+    let reach: Option<f64> = options.opt("reach")?;
+    let falloff_power: i64 = options.get("falloff_power")?;
+    let blend: Blend = options.get("blend")?;
     let x = vec3s("points", &points)?;
     let rows: &[[f64; 9]] = bytemuck::cast_slice(slice_of("frames", &frames)?);
     // row-major (n, 3, 3) -> glam's column-major: transpose
@@ -672,20 +674,22 @@ pub fn field_grid_curl(
 }
 
 /// `spinal.fields.rod`: a curl tool shaped as the tube about the axis through `points`.
+/// `options`: `radius`, `center`, `reach` (`None`: defaults), `velocity`, `angular_velocity`,
+/// `pivot` (the motion, each `None` when not given), `falloff_power` and `moving`.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 pub fn field_rod(
     py: Python<'_>,
     points: PyReadonlyArray2<'_, f64>,
-    radius: f64,
-    center: Option<[f64; 3]>,
-    reach: Option<f64>,
-    velocity: Option<[f64; 3]>,
-    angular_velocity: Option<[f64; 3]>,
-    pivot: Option<[f64; 3]>,
-    falloff_power: i64,
-    moving: bool,
+    options: Options<'_>,
 ) -> PyResult<PyField> {
+    let radius: f64 = options.get("radius")?;
+    let center: Option<[f64; 3]> = options.opt("center")?;
+    let reach: Option<f64> = options.opt("reach")?;
+    let velocity: Option<[f64; 3]> = options.opt("velocity")?;
+    let angular_velocity: Option<[f64; 3]> = options.opt("angular_velocity")?;
+    let pivot: Option<[f64; 3]> = options.opt("pivot")?;
+    let falloff_power: i64 = options.get("falloff_power")?;
+    let moving: bool = options.get("moving")?;
     let x = vec3s("points", &points)?;
     let stop = Stop::default();
     let rod = detach_stoppable(py, &stop, || {

@@ -11,6 +11,7 @@ use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, offsets_of,
     orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
+use super::options::Options;
 use super::out::{output, writing};
 use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
 
@@ -20,20 +21,11 @@ const PROBE_BYTES_PER_ROW: usize = 72 + frames::WORKING_BYTES_PER_ROW;
 
 pub type FramesAndAngles<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
-/// the points name `points_arg` (the argument the caller's user passed them as);
-/// `progress(done, rows)` is called from the waiting thread as curves are done. `out`: the
-/// `(rows, 3, 3)` float64 array to write the frames into (else a new one).
-#[pyfunction]
-#[pyo3(signature = (points, tangents, offsets, method, tangent_rule, tangent_chords, closed,
-                    initial_vectors, initial_frames, end_vectors, end_frames, turns,
-                    points_arg="points", progress=None, out=None))]
-#[allow(clippy::too_many_arguments)]
-pub fn frames_sampled<'py>(
-    py: Python<'py>,
-    points: Option<PyReadonlyArray2<'py, f64>>,
-    tangents: Option<PyReadonlyArray2<'py, f64>>,
-    offsets: PyReadonlyArray1<'py, i64>,
+/// The options shared by the frames calls, read from their `options` dict: `method`,
+/// `tangent_rule` (default five-point), `tangent_chords` (default false), `closed`, and the
+/// start and end orientations `initial_vectors`, `initial_frames`, `end_vectors`,
+/// `end_frames` (each absent or `None` when not given).
+struct Shape<'py> {
     method: Method,
     tangent_rule: TangentRule,
     tangent_chords: bool,
@@ -42,11 +34,50 @@ pub fn frames_sampled<'py>(
     initial_frames: Option<PyReadonlyArray3<'py, f64>>,
     end_vectors: Option<PyReadonlyArray2<'py, f64>>,
     end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: f64,
-    points_arg: &str,
+}
+
+impl<'py> Shape<'py> {
+    fn read(o: &Options<'py>) -> PyResult<Shape<'py>> {
+        Ok(Shape {
+            method: o.get("method")?,
+            tangent_rule: o.get_or("tangent_rule", Request::default().tangent_rule)?,
+            tangent_chords: o.get_or("tangent_chords", false)?,
+            closed: o.get("closed")?,
+            initial_vectors: o.opt("initial_vectors")?,
+            initial_frames: o.opt("initial_frames")?,
+            end_vectors: o.opt("end_vectors")?,
+            end_frames: o.opt("end_frames")?,
+        })
+    }
+}
+
+/// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
+/// the points name `points_arg` (the argument the caller's user passed them as);
+/// `progress(done, rows)` is called from the waiting thread as curves are done. `out`: the
+/// `(rows, 3, 3)` float64 array to write the frames into (else a new one).
+#[pyfunction]
+#[pyo3(signature = (points, tangents, offsets, options, progress=None, out=None))]
+pub fn frames_sampled<'py>(
+    py: Python<'py>,
+    points: Option<PyReadonlyArray2<'py, f64>>,
+    tangents: Option<PyReadonlyArray2<'py, f64>>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    options: Options<'py>,
     progress: Option<Py<PyAny>>,
     out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<FramesAndAngles<'py>> {
+    let Shape {
+        method,
+        tangent_rule,
+        tangent_chords,
+        closed,
+        initial_vectors,
+        initial_frames,
+        end_vectors,
+        end_frames,
+    } = Shape::read(&options)?;
+    let turns: f64 = options.get("turns")?;
+    let points_arg: String = options.get_or("points_arg", "points".to_string())?;
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
         .as_ref()
@@ -81,7 +112,7 @@ pub fn frames_sampled<'py>(
             let cancel = || stop.requested();
             frames::compute_many(&template, &offsets, &initial, &end, buf, &cancel, done)
         })?
-        .map_err(|e| renamed(e, "points", points_arg))?
+        .map_err(|e| renamed(e, "points", &points_arg))?
     };
     Ok((out, PyArray1::from_vec(py, angles)))
 }
@@ -90,24 +121,26 @@ pub fn frames_sampled<'py>(
 /// user passes the curve as `points` (with `u`); `d1`, `d2` (and `d3`, read by the torsion
 /// method only) come from its `d1`, `d2`, `d3`.
 #[pyfunction]
-#[pyo3(signature = (points, u, d1, d2, method, closed, initial_vectors, initial_frames,
-                    end_vectors, end_frames, turns, d3=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, u, d1, d2, options, d3=None))]
 pub fn frames_analytic<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
     u: PyReadonlyArray1<'py, f64>,
     d1: PyReadonlyArray2<'py, f64>,
     d2: PyReadonlyArray2<'py, f64>,
-    method: Method,
-    closed: bool,
-    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
-    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
-    end_vectors: Option<PyReadonlyArray2<'py, f64>>,
-    end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: f64,
+    options: Options<'py>,
     d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, f64)> {
+    let Shape {
+        method,
+        closed,
+        initial_vectors,
+        initial_frames,
+        end_vectors,
+        end_frames,
+        ..
+    } = Shape::read(&options)?;
+    let turns: f64 = options.get("turns")?;
     let pts = vec3s("points", &points)?;
     let us = slice_of("u", &u)?;
     let d1s = vec3s("points.d1", &d1)?;
@@ -210,49 +243,50 @@ pub fn estimate_tangents<'py>(
 /// the vector `con_vectors[k]` or, where `con_is_frame[k]`, the frame `con_frames[k]`. An
 /// analytic curve (one) passes `u`, `d1`, `d2` (and `d3`) as in [`frames_analytic`].
 #[pyfunction]
-#[pyo3(signature = (points, tangents, offsets, u, d1, d2, method, tangent_rule, tangent_chords, closed,
-                    initial_vectors, initial_frames, end_vectors, end_frames, turns,
-                    con_curves, con_rows, con_vectors, con_frames, con_is_frame, twist_rule,
-                    guide, guide_weight, guide_tolerance, guide_axis, previous,
-                    guide_previous=None, previous_weight=1.0, points_arg="points", d3=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, tangents, offsets, options, steering))]
 pub fn frames_steered<'py>(
     py: Python<'py>,
     points: Option<PyReadonlyArray2<'py, f64>>,
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     offsets: PyReadonlyArray1<'py, i64>,
-    u: Option<PyReadonlyArray1<'py, f64>>,
-    d1: Option<PyReadonlyArray2<'py, f64>>,
-    d2: Option<PyReadonlyArray2<'py, f64>>,
-    method: Method,
-    tangent_rule: TangentRule,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
-    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
-    end_vectors: Option<PyReadonlyArray2<'py, f64>>,
-    end_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: PyReadonlyArray1<'py, f64>,
-    con_curves: PyReadonlyArray1<'py, i64>,
-    con_rows: PyReadonlyArray1<'py, i64>,
-    con_vectors: PyReadonlyArray2<'py, f64>,
-    con_frames: PyReadonlyArray3<'py, f64>,
-    con_is_frame: PyReadonlyArray1<'py, bool>,
-    twist_rule: &str,
-    guide: Option<PyReadonlyArray2<'py, f64>>,
-    guide_weight: f64,
-    guide_tolerance: f64,
-    guide_axis: bool,
-    previous: Option<PyReadonlyArray3<'py, f64>>,
-    guide_previous: Option<PyReadonlyArray2<'py, f64>>,
-    previous_weight: f64,
-    points_arg: &str,
-    d3: Option<PyReadonlyArray2<'py, f64>>,
+    options: Options<'py>,
+    steering: Options<'py>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     use crate::frames::constraints::TwistRule;
     use crate::frames::guide::Guide;
     use crate::frames::steer::{self, Steering};
     use glam::DMat3;
+
+    let Shape {
+        method,
+        tangent_rule,
+        tangent_chords,
+        closed,
+        initial_vectors,
+        initial_frames,
+        end_vectors,
+        end_frames,
+    } = Shape::read(&options)?;
+    let u: Option<PyReadonlyArray1<'py, f64>> = options.opt("u")?;
+    let d1: Option<PyReadonlyArray2<'py, f64>> = options.opt("d1")?;
+    let d2: Option<PyReadonlyArray2<'py, f64>> = options.opt("d2")?;
+    let d3: Option<PyReadonlyArray2<'py, f64>> = options.opt("d3")?;
+    let points_arg: String = options.get_or("points_arg", "points".to_string())?;
+    let s = &steering;
+    let turns: PyReadonlyArray1<'py, f64> = s.get("turns")?;
+    let con_curves: PyReadonlyArray1<'py, i64> = s.get("con_curves")?;
+    let con_rows: PyReadonlyArray1<'py, i64> = s.get("con_rows")?;
+    let con_vectors: PyReadonlyArray2<'py, f64> = s.get("con_vectors")?;
+    let con_frames: PyReadonlyArray3<'py, f64> = s.get("con_frames")?;
+    let con_is_frame: PyReadonlyArray1<'py, bool> = s.get("con_is_frame")?;
+    let twist_rule: String = s.get("twist_rule")?;
+    let guide: Option<PyReadonlyArray2<'py, f64>> = s.opt("guide")?;
+    let guide_weight: f64 = s.get("guide_weight")?;
+    let guide_tolerance: f64 = s.get("guide_tolerance")?;
+    let guide_axis: bool = s.get("guide_axis")?;
+    let previous: Option<PyReadonlyArray3<'py, f64>> = s.opt("previous")?;
+    let guide_previous: Option<PyReadonlyArray2<'py, f64>> = s.opt("guide_previous")?;
+    let previous_weight: f64 = s.get_or("previous_weight", 1.0)?;
 
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
@@ -265,7 +299,7 @@ pub fn frames_steered<'py>(
     let initial = orientations("initial", initial_vectors, initial_frames)?;
     let end = orientations("end", end_vectors, end_frames)?;
     let turns = slice_of("turns", &turns)?;
-    let rule = match twist_rule {
+    let rule = match twist_rule.as_str() {
         "arc_length" => TwistRule::ArcLength,
         "min_angular_speed" => TwistRule::MinAngularSpeed,
         other => {
@@ -369,7 +403,7 @@ pub fn frames_steered<'py>(
                     &template, &offsets, &initial, &end, &steering, buf, &cancel,
                 )
             })?
-            .map_err(|e| renamed(e, "points", points_arg))?;
+            .map_err(|e| renamed(e, "points", &points_arg))?;
         }
     }
     Ok(out)
@@ -379,24 +413,26 @@ pub fn frames_steered<'py>(
 /// `(T·n, 3)`: each step's RMF, turned to be closest to the step before. `progress(done,
 /// steps)` is called from the waiting thread as the steps' frames are computed.
 #[pyfunction]
-#[pyo3(signature = (points, tangents, steps, method, tangent_rule, tangent_chords, closed,
-                    initial_vectors, initial_frames, turns, previous, progress=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, tangents, steps, options, previous, progress=None))]
 pub fn frames_in_time<'py>(
     py: Python<'py>,
     points: Option<PyReadonlyArray2<'py, f64>>,
     tangents: Option<PyReadonlyArray2<'py, f64>>,
     steps: usize,
-    method: Method,
-    tangent_rule: TangentRule,
-    tangent_chords: bool,
-    closed: bool,
-    initial_vectors: Option<PyReadonlyArray2<'py, f64>>,
-    initial_frames: Option<PyReadonlyArray3<'py, f64>>,
-    turns: f64,
+    options: Options<'py>,
     previous: Option<PyReadonlyArray3<'py, f64>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let Shape {
+        method,
+        tangent_rule,
+        tangent_chords,
+        closed,
+        initial_vectors,
+        initial_frames,
+        ..
+    } = Shape::read(&options)?;
+    let turns: f64 = options.get("turns")?;
     let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
     let tgs = tangents
         .as_ref()

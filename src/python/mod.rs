@@ -3,14 +3,18 @@
 //! pool of [`threads`] and maps [`InputError`](crate::InputError) to `ValueError`. It holds
 //! no algorithms; the Python package (`python/spinal`) normalises arguments (dtype, layout,
 //! shapes) before calling in here, so these functions expect C-contiguous arrays of the
-//! right dtype. The core modules never name pyo3 (checked by a test below).
+//! right dtype, and the options of a call as one dict ([`options`]). Nothing here imports
+//! the package's Python modules ([`coerce`] converts for `Field.__call__`). The core
+//! modules never name pyo3 (checked by a test below).
 
+mod coerce;
 mod convert;
 mod deform;
 mod fields;
 mod flesh;
 mod frames;
 mod mesh;
+mod options;
 mod out;
 mod ph;
 mod quaternion;

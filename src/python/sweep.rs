@@ -9,6 +9,7 @@ use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, frames_of, offsets_of,
     renamed, slice_mut, slice_of, vec2s, vec3s,
 };
+use super::options::Options as Request;
 use super::out::{output, writing};
 use crate::sweep::{self, FrameSource, Options, Prepared, Spine};
 
@@ -40,11 +41,8 @@ type MeshArrays<'py> = (
 /// `out_uv`: arrays of exactly the shapes and dtype of the results to write them into
 /// (else new ones; named `out.vertices` … in errors).
 #[pyfunction]
-#[pyo3(signature = (points, frames, scale, twist, offsets, profile, profile_closed, closed, caps,
-                    miter_limit, split_seams, scale_arg="scale", single=false, index32=false,
-                    normals=true, uv=true, tangents=None, join="round", progress=None,
-                    turns=0.0, out_vertices=None, out_normals=None, out_uv=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (points, frames, scale, twist, offsets, profile, options, progress=None))]
+#[allow(clippy::too_many_arguments)] // eight from Python, and the GIL token
 pub fn sweep_mesh<'py>(
     py: Python<'py>,
     points: PyReadonlyArray2<'py, f64>,
@@ -53,25 +51,27 @@ pub fn sweep_mesh<'py>(
     twist: Option<PyReadonlyArray1<'py, f64>>,
     offsets: PyReadonlyArray1<'py, i64>,
     profile: PyReadonlyArray2<'py, f64>,
-    profile_closed: bool,
-    closed: bool,
-    caps: bool,
-    miter_limit: f64,
-    split_seams: bool,
-    scale_arg: &str,
-    single: bool,
-    index32: bool,
-    normals: bool,
-    uv: bool,
-    tangents: Option<PyReadonlyArray2<'py, f64>>,
-    join: &str,
+    options: Request<'py>,
     progress: Option<Py<PyAny>>,
-    turns: f64,
-    out_vertices: Option<Bound<'py, PyAny>>,
-    out_normals: Option<Bound<'py, PyAny>>,
-    out_uv: Option<Bound<'py, PyAny>>,
 ) -> PyResult<MeshArrays<'py>> {
-    let join = match join {
+    let o = &options;
+    let profile_closed: bool = o.get("profile_closed")?;
+    let closed: bool = o.get("closed")?;
+    let caps: bool = o.get("caps")?;
+    let miter_limit: f64 = o.get("miter_limit")?;
+    let split_seams: bool = o.get("split_seams")?;
+    let scale_arg: String = o.get_or("scale_arg", "scale".to_string())?;
+    let single: bool = o.get_or("single", false)?;
+    let index32: bool = o.get_or("index32", false)?;
+    let normals: bool = o.get_or("normals", true)?;
+    let uv: bool = o.get_or("uv", true)?;
+    let tangents: Option<PyReadonlyArray2<'py, f64>> = o.opt("tangents")?;
+    let join: String = o.get_or("join", "round".to_string())?;
+    let turns: f64 = o.get_or("turns", 0.0)?;
+    let out_vertices: Option<Bound<'py, PyAny>> = o.opt("out_vertices")?;
+    let out_normals: Option<Bound<'py, PyAny>> = o.opt("out_normals")?;
+    let out_uv: Option<Bound<'py, PyAny>> = o.opt("out_uv")?;
+    let join = match join.as_str() {
         "round" => sweep::Join::Round,
         "bevel" => sweep::Join::Bevel,
         "miter" => sweep::Join::Miter,
@@ -117,7 +117,7 @@ pub fn sweep_mesh<'py>(
         join,
         turns,
     };
-    let rename = |e| renamed(e, "scale", scale_arg);
+    let rename = |e| renamed(e, "scale", &scale_arg);
     let stop = Stop::default();
     let prep = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
@@ -131,7 +131,7 @@ pub fn sweep_mesh<'py>(
         prep: &prep,
         normals,
         uv,
-        scale_arg,
+        scale_arg: &scale_arg,
         report: Report::new(progress, offsets.last().copied().unwrap_or(0)),
         out: [out_vertices, out_normals, out_uv],
     };

@@ -8,13 +8,13 @@ import spinal
 from spinal import _core
 
 PTS = np.ascontiguousarray(np.c_[np.arange(4.0), np.zeros(4), np.zeros(4)])
+ANALYTIC = {"method": "rotation", "closed": False, "turns": 0}
 
 
 def sampled(method="double_reflection", rule="five_point", offsets=(0, 4), end_frames=None):
-    return _core.frames_sampled(
-        PTS, None, np.array(offsets, dtype=np.int64), method, rule, False, False,
-        None, None, None, end_frames, 0,
-    )
+    options = {"method": method, "tangent_rule": rule, "closed": False,
+               "end_frames": end_frames, "turns": 0}
+    return _core.frames_sampled(PTS, None, np.array(offsets, dtype=np.int64), options)
 
 
 def test_option_strings_name_the_argument_and_list_the_choices():
@@ -47,11 +47,9 @@ def test_array_messages_name_the_argument():
         sampled(end_frames=frames)
     u = np.linspace(0.0, 1.0, 4)
     with pytest.raises(ValueError, match=r"^points\.d1: expected shape \(n, 3\)"):
-        _core.frames_analytic(PTS, u, np.zeros((7, 2)), np.zeros((7, 3)), "rotation", False,
-                              None, None, None, None, 0)
+        _core.frames_analytic(PTS, u, np.zeros((7, 2)), np.zeros((7, 3)), ANALYTIC)
     with pytest.raises(ValueError, match=r"^points\.d2: expected shape \(n, 3\)"):
-        _core.frames_analytic(PTS, u, np.zeros((7, 3)), np.zeros((7, 2)), "rotation", False,
-                              None, None, None, None, 0)
+        _core.frames_analytic(PTS, u, np.zeros((7, 3)), np.zeros((7, 2)), ANALYTIC)
 
 
 def test_ph_frame_setup_rows_are_34_wide():

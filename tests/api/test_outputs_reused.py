@@ -60,8 +60,9 @@ def test_frames_into_out_are_the_frames_without_it(case):
 def test_frames_core_writes_into_out_without_a_copy():
     x = curve(300)
     offs = np.array([0, len(x)], dtype=np.int64)
-    args = (x, None, offs, "double_reflection", "five_point_bounded", False, False, None, None,
-            None, None, 0.0)
+    options = {"method": "double_reflection", "tangent_rule": "five_point_bounded",
+               "closed": False, "turns": 0.0}
+    args = (x, None, offs, options)
     want, _ = _core.frames_sampled(*args)
     out = garbage(want.shape)
     got, _ = _core.frames_sampled(*args, out=out)

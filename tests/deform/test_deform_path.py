@@ -197,17 +197,17 @@ def test_core_path_constructor_names_the_argument():
     args = {"radius": 0.2, "duration": 1.0, "kind": "translate", "tool": "push", "rate": 0.0,
             "t0": 0.0, "reach": None, "falloff_power": 2, "blend": "c1"}
     with pytest.raises(ValueError, match="^points: need at least 2"):
-        spinal._core.field_path(pts[:1], frames[:1], *args.values())
+        spinal._core.field_path(pts[:1], frames[:1], args)
     rep = pts.copy()
     rep[2] = rep[1]
     with pytest.raises(ValueError, match="^points: consecutive samples 1 and 2 coincide"):
-        spinal._core.field_path(rep, frames, *args.values())
+        spinal._core.field_path(rep, frames, args)
     bad = frames.copy()
     bad[1] *= 2
     with pytest.raises(ValueError, match="^frames: frame 1 is not a rotation"):
-        spinal._core.field_path(pts, bad, *args.values())
+        spinal._core.field_path(pts, bad, args)
     with pytest.raises(ValueError, match="^duration"):
-        spinal._core.field_path(pts, frames, 0.2, -1.0, *list(args.values())[2:])
+        spinal._core.field_path(pts, frames, {**args, "duration": -1.0})
 
 
 # ---- contact stamper (Zheng's thesis §11.2.6) -----------------------------------------------
