@@ -131,28 +131,21 @@ impl Refiner<'_> {
         )?;
         let at = self.image(&mids, done);
         let mut bent = alloc::with_capacity(CALL, cand.len())?;
-        bent.extend(cand.iter().zip(&mids).zip(at).zip(keep).filter_map(
-            |(((&e, &m), p), keep)| {
-                let Gen::Material(m) = m else {
-                    return None;
-                };
-                if !keep {
-                    return None;
-                }
-                let (a, b) = self.topo.ends(e);
-                let l2 = w[a].distance_squared(w[b]);
-                // bent, but not torn away from the chord (a flow the steps do not resolve, whose
-                // split would fall back to the chord midpoint and resolve nothing)
-                let d = p - 0.5 * (w[a] + w[b]);
-                let d2 = d.length_squared();
-                let bent = d2 > BEND * BEND * l2
-                    || (matches!(self.carry[a], Carry::Free)
-                        && matches!(self.carry[b], Carry::Free)
-                        && self.share_of(w, e, d) > self.share);
-                (bent && (d2 <= TORN * TORN * l2 || (d2.is_finite() && self.smooth(a, b, m))))
-                    .then_some(e)
-            },
-        ));
+        bent.extend(cand.iter().zip(at).zip(keep).filter_map(|((&e, p), keep)| {
+            if !keep {
+                return None;
+            }
+            let (a, b) = self.topo.ends(e);
+            // both ends carried by the field (the midpoint then too: `keep`)
+            let free = matches!(self.carry[a], Carry::Free) && matches!(self.carry[b], Carry::Free);
+            let l2 = w[a].distance_squared(w[b]);
+            // bent, but not torn away from the chord (a flow the steps do not resolve, whose
+            // split would fall back to the chord midpoint and resolve nothing)
+            let d = p - 0.5 * (w[a] + w[b]);
+            let d2 = d.length_squared();
+            let bent = d2 > BEND * BEND * l2 || (free && self.share_of(w, e, d) > self.share);
+            (bent && (d2 <= TORN * TORN * l2 || (d2.is_finite() && free))).then_some(e)
+        }));
         Ok(bent)
     }
 
