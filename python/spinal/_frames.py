@@ -539,13 +539,15 @@ def estimate_tangents(
 
     * ``"five_point_bounded"`` (default): ``"five_point"`` below, with each open end tangent
       bounded by the turn of the last two chords: with ``ĉ`` the end chord and ``φ`` its
-      angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than
-      ``min(φ, 45°)`` from ``ĉ`` is turned towards ``ĉ`` onto the cone
-      ``∠(t, ĉ) = min(φ, 45°)`` (in the plane of ``ĉ`` and ``t``). On smooth samplings the
-      exact end tangent leans ``κh/2 + O(h²)`` from the end chord, inside the cone, so the
-      estimate stays O(h⁴) there; on coarse samplings (e.g. 20-point streamlines) the
-      one-sided quartic extrapolates the last bends and can lean far past the end chord
-      (chisel-shaped tube ends), which the bound removes. Where the end chords turn by more
+      angle to the neighbouring chord (``φ ≈ κh``), an end tangent leaning more than ``α``
+      from ``ĉ`` is turned towards ``ĉ`` onto the cone ``∠(t, ĉ) = α`` (in the plane of
+      ``ĉ`` and ``t``), where ``α = φ/2`` on coarse samplings (``φ ≥ 20°``), ``α = φ`` on
+      fine ones (``φ ≤ 10°``), a smoothstep between, and never more than 45°. On smooth
+      samplings the exact end tangent leans ``κh/2 + O(h²)`` from the end chord (half the
+      turn only to first order), inside the whole-turn cone, so the estimate stays O(h⁴)
+      there; on coarse samplings (e.g. 20-point streamlines) the one-sided quartic
+      extrapolates the last bends and can lean far past the end chord (chisel-shaped tube
+      ends), which the half-turn bound removes. Where the end chords turn by more
       than 30° (an end corner), the result is then blended towards ``ĉ`` with the corner
       weight of the chord guard below: from 60° on the end tangent is the end chord, and a
       tube's end is cut square to it. The circle rule's end tangent (3 or 4 points) is

@@ -180,7 +180,8 @@ def sweep(
         How the tangents are estimated when neither ``frames`` nor ``tangents`` is given:
         a ``method`` of :func:`spinal.estimate_tangents` — ``"five_point_bounded"`` (default:
         the 4th-order five-point chord-length rule whose end tangents lean from the end chord
-        by at most the turn of the last two chords and at most 45°, so coarse spines get no
+        by at most half the turn of the last two chords (the whole turn where it is under
+        10°, which keeps the 4th order) and at most 45°, so coarse spines get no
         chisel-shaped ends), ``"five_point"`` (ends unbounded), ``"five_point_uniform"`` or ``"circle"``.
     dtype : "float64" or "float32" (or numpy.float64, numpy.float32)
         Precision of ``vertices``, ``normals`` and ``uv``. With ``float32`` everything is

@@ -15,15 +15,20 @@
 //!   overshooting at a kink next to very uneven chords), the circle estimate is used
 //!   instead.
 //! * Bounded ends (the default rule, `FivePointBounded`): the five-point chord-length rule
-//!   with each open end tangent kept inside the cone about the end chord `ĉ` whose
-//!   half-angle is the turn `φ` between the end chord and its neighbour (the discrete
-//!   curvature at the end, `φ ≈ κh`), and never wider than 45°; a tangent leaning further is
-//!   turned towards `ĉ` onto the cone, in the plane of `ĉ` and the tangent. On a smooth curve the exact end tangent
-//!   leans `κh/2 + O(h²)` from the end chord, half the cone, so fine samplings keep the 4th
-//!   order untouched; on coarse samplings (20-point streamlines) the one-sided quartic
-//!   extrapolates the last bends and overshoots, which made chisel-shaped tube ends. (The
-//!   cone is ours: Wang et al. §6.1 give only the one-sided stencils; the circle rule of
-//!   Zheng §7.1 at an end leans exactly by the circle's half-turn, inside the same cone.)
+//!   with each open end tangent kept inside a cone about the end chord `ĉ`, set by the turn
+//!   `φ` between the end chord and its neighbour (the discrete curvature at the end,
+//!   `φ ≈ κh`): half the turn, `φ/2`, on coarse samplings (`φ ≥ 20°`), the whole turn on
+//!   fine ones (`φ ≤ 10°`), a smoothstep between, and never wider than 45°; a tangent
+//!   leaning further is turned towards `ĉ` onto the cone, in the plane of `ĉ` and the
+//!   tangent. On a smooth curve the exact end tangent leans `κh/2 + O(h²)` from the end
+//!   chord: half the turn only to first order (the `O(h²)` term has either sign, and uneven
+//!   end chords move it towards the longer one), so a half-turn cone would clip fine
+//!   samplings at `O(h²)`; the whole-turn cone below 10° keeps them at 4th order. On coarse
+//!   samplings (20-point streamlines) the one-sided quartic extrapolates the last bends and
+//!   overshoots, which made chisel-shaped tube ends; there the end leans at most half the
+//!   turn, as the circle through the last three points does on equal chords. (The cone is
+//!   ours: Wang et al. §6.1 give only the one-sided stencils; the circle rule of Zheng §7.1
+//!   at an end leans exactly by the circle's half-turn.)
 //! * Chord guard (every rule, at every sample with two chords; [`guard_chords`]): where the
 //!   chords turn by more than 30° the estimate is blended towards their bisector, the tangent
 //!   of a corner (fully from 60° on), and an estimate that points more than about 60° from
@@ -69,7 +74,9 @@ pub enum TangentRule {
     /// at least 5 points, else the circle rule (3–4 points) or the chord (2 points).
     FivePoint,
     /// [`TangentRule::FivePoint`] with bounded open ends (the default): an end tangent leans
-    /// from the end chord by at most the turn between the last two chords, and at most 45°.
+    /// from the end chord by at most half the turn `φ` between the last two chords where
+    /// `φ ≥ 20°`, by at most `φ` where `φ ≤ 10°` (fine samplings keep their 4th order), and
+    /// never more than 45° ([`bound_end`]).
     FivePointBounded,
     /// The uniform five-point stencils of the TOG paper (index as parameter).
     FivePointUniform,
@@ -422,14 +429,20 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
 /// Cosine of the widest end cone of [`bound_end`], 45°.
 pub const END_CONE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
+/// Cosines of the end turns `φ` between which [`bound_end`]'s cone narrows from the whole
+/// turn (fine samplings, up to 10°) to half the turn (coarse ones, from 20° on).
+pub const END_HALF_COS: [f64; 2] = [0.984_807_753_012_208, 0.939_692_620_785_908_4];
+
 /// The end tangent `u` at the open end `i` (0 or n − 1, `n ≥ 3`), turned towards the end
-/// chord `ĉ` onto the cone of half-angle `min(φ, 45°)` about it, `φ = ∠(ĉ, p̂)` (`p̂` the
-/// neighbouring chord), where it leans further; unchanged inside the cone. The 45° cap
-/// keeps the end faces of coarse tubes within 45° of their end chord however sharply the
-/// last chords turn (a smooth curve's end leans `κh/2`, far inside it). Where the end chords
-/// turn by more than 30° (a corner of the polyline, as [`guard_chords`] has it) the result
-/// is then blended towards `ĉ` with the same smoothstep weight, `ĉ` itself from 60° on: the
-/// end of a coarse polyline is cut square to its last chord.
+/// chord `ĉ` onto the cone about it where it leans further; unchanged inside the cone. With
+/// `φ = ∠(ĉ, p̂)` the turn of the end chords (`p̂` the neighbouring chord), the cone's
+/// half-angle is `φ` up to `φ = 10°`, `φ/2` from 20° on, `φ·(1 − w/2)` between (`w` the
+/// smoothstep from 10° to 20°), and at most 45°. A smooth curve's end leans `κh/2 + O(h²)`,
+/// inside the whole-turn cone of fine samplings; coarse samplings end within half their
+/// last turn, so the end faces of their tubes stay close to square to the end chord. Where
+/// the end chords turn by more than 30° (a corner of the polyline, as [`guard_chords`] has
+/// it) the result is then blended towards `ĉ` with the same smoothstep weight, `ĉ` itself
+/// from 60° on: the end of a coarse polyline is cut square to its last chord.
 #[inline]
 pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
     let n = x.len();
@@ -441,22 +454,18 @@ pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
     let (Some(c), Some(p)) = (c.try_normalize(), p.try_normalize()) else {
         return u;
     };
-    // the cone's half-angle: the turn φ of the end chords, at most 45°
     let d = c.dot(p);
-    let (cos_phi, sin_phi) = match d {
-        d if d >= END_CONE_COS => (d, c.cross(p).length()),
-        _ => (END_CONE_COS, END_CONE_COS),
-    };
-    let u = if u.dot(c) >= cos_phi {
+    let (cos_a, sin_a) = end_cone(d, c.cross(p).length());
+    let u = if u.dot(c) >= cos_a {
         u
     } else {
         // the direction of the lean in the normal plane of ĉ; for a tangent along −ĉ, the
         // turn of the chords continued (away from p̂), or any normal on a straight end
         let side = (u - u.dot(c) * c)
             .try_normalize()
-            .or_else(|| (c * cos_phi - p).try_normalize())
+            .or_else(|| (c * d - p).try_normalize())
             .unwrap_or_else(|| super::geometry::any_perpendicular(c));
-        (cos_phi * c + sin_phi * side).normalize_or(c)
+        (cos_a * c + sin_a * side).normalize_or(c)
     };
     // a corner next to the end (a turn over 30°): towards the end chord, as the chord guard
     // turns interior tangents towards the bisector, fully from 60° on
@@ -466,6 +475,25 @@ pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
         ((1.0 - w) * u + w * c).normalize_or(c)
     } else {
         u
+    }
+}
+
+/// Cosine and sine of [`bound_end`]'s cone half-angle for end chords turning by `φ`, given
+/// as `cos φ` and `sin φ`: `φ` itself (the same values, bit for bit) up to 10°, `φ/2` from
+/// 20° on with a smoothstep between, at most 45°.
+#[inline]
+fn end_cone(cos_phi: f64, sin_phi: f64) -> (f64, f64) {
+    if cos_phi >= END_HALF_COS[0] {
+        return (cos_phi, sin_phi);
+    }
+    let phi = sin_phi.atan2(cos_phi);
+    let (lo, hi) = (END_HALF_COS[0].acos(), END_HALF_COS[1].acos());
+    let s = ((phi - lo) / (hi - lo)).clamp(0.0, 1.0);
+    let half = phi * (1.0 - 0.5 * s * s * (3.0 - 2.0 * s));
+    if half >= std::f64::consts::FRAC_PI_4 {
+        (END_CONE_COS, END_CONE_COS)
+    } else {
+        (half.cos(), half.sin())
     }
 }
 
@@ -1072,18 +1100,31 @@ mod tests {
         )
         .unwrap();
         let n = x.len();
+        // the cone's half-angle: the whole turn up to 10°, half of it from 20° on
+        let cone = |turn: f64| {
+            let (lo, hi) = (10f64.to_radians(), 20f64.to_radians());
+            let s = ((turn - lo) / (hi - lo)).clamp(0.0, 1.0);
+            (turn * (1.0 - 0.5 * s * s * (3.0 - 2.0 * s))).min(std::f64::consts::FRAC_PI_4)
+        };
         let mut acted = 0;
         for (i, c, p) in [
             (0, x[1] - x[0], x[2] - x[1]),
             (n - 1, x[n - 1] - x[n - 2], x[n - 2] - x[n - 3]),
         ] {
             let (c, p) = (c.normalize(), p.normalize());
-            let turn = c.angle_between(p);
+            let phi = c.angle_between(p);
+            let turn = cone(phi);
             assert!(b[i].angle_between(c) <= turn + 1e-12, "{i}");
             if a[i].angle_between(c) > turn {
                 acted += 1;
-                // on the cone, leaning to the same side as the unbounded tangent
-                assert!((b[i].angle_between(c) - turn).abs() < 1e-12);
+                // on the cone (closer to ĉ next to a corner of over 30°), leaning to the
+                // same side as the unbounded tangent
+                let lean = b[i].angle_between(c);
+                if phi < 30f64.to_radians() {
+                    assert!((lean - turn).abs() < 1e-12);
+                } else {
+                    assert!(lean < turn);
+                }
                 assert!(c.cross(a[i]).normalize().dot(c.cross(b[i]).normalize()) > 1.0 - 1e-12);
             }
         }

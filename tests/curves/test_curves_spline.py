@@ -461,13 +461,14 @@ def test_spline_pickles_and_shows_its_kind():
 
 
 def test_a_million_evaluations_take_well_under_a_second():
+    """CPU time, not wall time: a loaded machine stretches the wall clock, not the work."""
     s = Spline(random_points(200, 20), "natural_cubic")
     u = np.random.default_rng(21).uniform(*s.domain, 1_000_000)
     best = np.inf
     for _ in range(3):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         x = s.point(u)
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, time.process_time() - t0)
     assert x.shape == (1_000_000, 3)
     assert best < 0.5, best
 

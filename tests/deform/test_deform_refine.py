@@ -78,11 +78,11 @@ def test_d14_drag_of_a_small_sphere_is_bounded_and_fast():
     hundred vertices added in a few ms, and every edge across the tool's slip resolved."""
     s = trimesh.creation.icosphere(3)
     V, F = icosphere(3)
-    clock = time.perf_counter()
+    clock = time.process_time()  # CPU time: a loaded machine stretches only the wall clock
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         M, rep = spinal.deform(s, DRAG, 1.0, max_passes=20)
-    elapsed = time.perf_counter() - clock
+    elapsed = time.process_time() - clock
     assert elapsed < 5, elapsed
     assert rep.max_vertices == 8 * len(V)
     assert len(M.vertices) <= 4 * len(V)  # far from the bound: nothing grows without limit

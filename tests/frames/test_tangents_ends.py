@@ -1,6 +1,7 @@
 """The default tangent rule's end tangents: 4th order on fine samplings, and never leaning
-from the end chord by more than the turn of the last two chords (nor more than 45°) on coarse
-ones; tangents of bundles (lengths=/offsets=)."""
+from the end chord by more than half the turn of the last two chords (from a turn of 20° on;
+the whole turn up to 10°) nor more than 45° on coarse ones; tangents of bundles
+(lengths=/offsets=)."""
 
 import numpy as np
 import pytest
@@ -24,6 +25,14 @@ def _end_lean_and_turn(pts, t):
     lean = np.r_[_angle(t[:, 0], c0), _angle(t[:, -1], d0)]
     turn = np.r_[_angle(c0, c1), _angle(d0, d1)]
     return lean, turn
+
+
+def _cone(turn):
+    """The end cone's half-angle for end chords turning by ``turn``: the whole turn up to 10°,
+    half of it from 20° on (a smoothstep between), at most 45°."""
+    lo, hi = np.radians(10), np.radians(20)
+    s = np.clip((turn - lo) / (hi - lo), 0, 1)
+    return np.minimum(turn * (1 - 0.5 * s * s * (3 - 2 * s)), np.pi / 4)
 
 
 def _helix(u):
@@ -74,14 +83,16 @@ def _coarse_curves(count, n, seed):
     return np.array(out)
 
 
-def test_end_tangents_within_the_turn_of_the_last_two_chords_and_45_degrees():
+def test_end_tangents_within_half_the_turn_of_the_last_two_chords_and_45_degrees():
     pts = _coarse_curves(3000, 20, 1)
     flat = pts.reshape(-1, 3)
     lengths = [20] * len(pts)
     t = spinal.estimate_tangents(flat, lengths=lengths).reshape(pts.shape)
     lean, turn = _end_lean_and_turn(pts, t)
-    cone = np.minimum(turn, np.pi / 4)
+    cone = _cone(turn)
     assert np.all(lean <= cone + 1e-12), np.max(lean - cone)
+    coarse = turn >= np.radians(20)
+    assert coarse.sum() > 1000 and np.all(lean[coarse] <= turn[coarse] / 2 + 1e-12)
     # the unbounded one-sided quartic overshoots on many of these ends
     t4 = spinal.estimate_tangents(flat, lengths=lengths, method="five_point").reshape(pts.shape)
     lean4, _ = _end_lean_and_turn(pts, t4)
@@ -116,7 +127,26 @@ def test_end_tangents_of_the_fornix_streamlines():
     pts = np.array(streamline.set_number_of_points(list(lines), 20), dtype=np.float64)
     t = spinal.estimate_tangents(pts.reshape(-1, 3), lengths=[20] * len(pts)).reshape(pts.shape)
     lean, turn = _end_lean_and_turn(pts, t)
-    assert np.all(lean <= np.minimum(turn, np.pi / 4) + 1e-12)
+    assert np.all(lean <= _cone(turn) + 1e-12)
+
+
+def test_ends_of_drifting_random_walks_lean_at_most_half_their_last_turn():
+    """Coarse random walks with drift (12 points): the one-sided quartic leans ends up to 144°
+    from their end chord; the default keeps every end within half the turn of its last two
+    chords where that turn is 20° or more, and within 45°."""
+    rng = np.random.default_rng(7)
+    pts = np.array([np.cumsum(rng.normal(size=(12, 3)) + [1.5, 0, 0], 0) for _ in range(200)])
+    flat, lengths = pts.reshape(-1, 3), [12] * len(pts)
+    t = spinal.estimate_tangents(flat, lengths=lengths).reshape(pts.shape)
+    lean, turn = _end_lean_and_turn(pts, t)
+    t4 = spinal.estimate_tangents(flat, lengths=lengths, method="five_point").reshape(pts.shape)
+    lean4, _ = _end_lean_and_turn(pts, t4)
+    assert np.sum(lean4 > np.pi / 4) > 20  # the unbounded rule leans far
+    assert np.all(lean <= np.pi / 4 + 1e-12)
+    coarse = turn >= np.radians(20)
+    assert coarse.sum() > 200
+    assert np.all(lean[coarse] <= turn[coarse] / 2 + 1e-12), np.max(lean[coarse] - turn[coarse] / 2)
+    assert np.all(lean <= turn + 1e-12)
 
 
 def test_circle_rule_and_short_curves_keep_the_bound():
