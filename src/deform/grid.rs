@@ -28,7 +28,7 @@
 
 use glam::DVec3;
 
-use super::shape::{speed_factor, translate};
+use super::shape::{Distance, speed_factor, translate};
 use crate::error::{InputError, Result};
 use crate::run::alloc;
 use crate::run::cancel::Cancel;
@@ -759,6 +759,28 @@ fn slope_bound(coef: &[f64], n: [usize; 3], spacing: f64) -> f64 {
         }
     }
     DVec3::from(m).length() / spacing
+}
+
+impl Distance for GridTool {
+    #[inline(always)]
+    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
+        GridTool::distance(self, x)
+    }
+    fn reach(&self) -> f64 {
+        self.reach
+    }
+    fn center(&self) -> DVec3 {
+        self.center
+    }
+    fn extent(&self) -> f64 {
+        self.support_extent()
+    }
+    fn gradient_bound(&self) -> f64 {
+        self.slope_bound()
+    }
+    fn wants_locality(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -5,8 +5,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::grid::GridTool;
-use super::rod::Rod;
+pub use super::{Shape, ToolShape};
 
 /// The signed distance of a tool's shape (negative inside), in the shape's own frame.
 pub trait Distance: Send + Sync + std::fmt::Debug {
@@ -146,81 +145,6 @@ impl Distance for Ring {
     fn extent(&self) -> f64 {
         self.major + self.minor + self.reach
     }
-}
-
-impl Distance for GridTool {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        GridTool::distance(self, x)
-    }
-    fn reach(&self) -> f64 {
-        self.reach
-    }
-    fn center(&self) -> DVec3 {
-        self.center
-    }
-    fn extent(&self) -> f64 {
-        self.support_extent()
-    }
-    fn gradient_bound(&self) -> f64 {
-        self.slope_bound()
-    }
-    fn wants_locality(&self) -> bool {
-        true
-    }
-}
-
-/// A tool's shape, for tools that can be posed by keys ([`super::keyframe`]).
-#[derive(Debug, Clone)]
-pub enum Shape {
-    Ball(Ball),
-    Rod(Arc<Rod>),
-    Grid(Arc<GridTool>),
-    Ring(Ring),
-}
-
-impl Shape {
-    /// The shape's centre `C`.
-    pub fn center(&self) -> DVec3 {
-        match self {
-            Shape::Ball(b) => b.center(),
-            Shape::Rod(r) => r.center(),
-            Shape::Grid(g) => Distance::center(&**g),
-            Shape::Ring(r) => r.center(),
-        }
-    }
-}
-
-impl From<Ring> for Shape {
-    fn from(r: Ring) -> Shape {
-        Shape::Ring(r)
-    }
-}
-
-impl From<Ball> for Shape {
-    fn from(b: Ball) -> Shape {
-        Shape::Ball(b)
-    }
-}
-
-impl From<Arc<Rod>> for Shape {
-    fn from(r: Arc<Rod>) -> Shape {
-        Shape::Rod(r)
-    }
-}
-
-impl From<Arc<GridTool>> for Shape {
-    fn from(g: Arc<GridTool>) -> Shape {
-        Shape::Grid(g)
-    }
-}
-
-/// The shape of a built tool and its falloff power (`None` for tools that are not curl
-/// fields: the keyframed tool then needs one).
-#[derive(Debug, Clone)]
-pub struct ToolShape {
-    pub shape: Shape,
-    pub power: Option<u8>,
 }
 
 /// `(D, D′)` of the region function at signed distance `d`, reach `rf`.

@@ -31,11 +31,11 @@
 //!
 //! Fold-over (§4.3): the normal bend clamps at the focal point `1/(wκ1)` as in
 //! [`super::solve`], the binormal factors are capped below at
-//! [`super::solve::BINORMAL_MIN_FACTOR`] unless they cancel (`w = 1`).
+//! [`super::BINORMAL_MIN_FACTOR`] unless they cancel (`w = 1`).
 
 use glam::DVec2;
 
-use super::solve::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
+use super::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
 use crate::error::{InputError, Result};
 
 /// The blend weight `w` checked: finite and in `[0, 1]` (errors name `blend`).

@@ -52,6 +52,16 @@ pub use pose::deform;
 pub use solve::Solution;
 pub use spine::SpineModel;
 
+/// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
+/// no policy past the limit).
+pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
+/// Curvatures below this (1/length units) are treated as straight: the step is the identity.
+pub const TINY_CURVATURE: f64 = 1e-300;
+
+/// Flag bits reported per vertex.
+pub const CLAMPED_BEND: u8 = 1;
+pub const CLAMPED_UNBEND: u8 = 2;
+
 /// Refuse vertices that are not finite, or that leave the range of `f64` once brought to the
 /// units of a rest model (`to_model`) far smaller than 1; errors name `vertices` and say
 /// which model (`"spine"` or `"surface"`).

@@ -31,6 +31,8 @@
 
 use glam::DVec2;
 
+pub use super::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
+
 /// Which offset correction to apply.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solution {
@@ -67,16 +69,6 @@ impl Solution {
         }
     }
 }
-
-/// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
-/// no policy past the limit).
-pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
-/// Curvatures below this (1/length units) are treated as straight: the step is the identity.
-pub const TINY_CURVATURE: f64 = 1e-300;
-
-/// Flag bits reported per vertex.
-pub const CLAMPED_BEND: u8 = 1;
-pub const CLAMPED_UNBEND: u8 = 2;
 
 #[inline(always)]
 fn unit_normal(k: DVec2, fallback: DVec2) -> (DVec2, f64) {

@@ -23,9 +23,8 @@ use super::double_reflection::dr_step;
 use super::geometry::{any_perpendicular, bounds, rotate_about, signed_angle};
 use super::lanes::{Arith, F4, L, V4};
 use super::rotation::rotation_step;
-use super::tangents::{
-    CHORD_MARGIN, CORNER_COS2, OVERSHOOT_COS, centred_weights, circle_normal, five_point_unit_open,
-};
+use super::tangent_lanes::{CHORD_MARGIN, CORNER_COS2, OVERSHOOT_COS, centred_weights};
+use super::tangents::{circle_normal, five_point_unit_open};
 use super::transport::{ChunkEnds, Scan, Twist, plan, write_frame};
 use super::validate::{MIN_ALIGNMENT, REPEAT_REL, repeated};
 use super::{Method, Request, STRAIGHT_TOL, TangentRule, resolve};

@@ -4,7 +4,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::join::Corner;
+use super::corners::Corner;
 use super::layout::{Plan, Size};
 use super::{Options, Profile, Spine, columns};
 use crate::error::{InputError, Result};
