@@ -35,36 +35,10 @@
 
 use glam::{DMat3, DVec3};
 
+use super::shape::{falloff_ratio, outside_shell};
 use super::{Tool, bounded, falloff as falloff_power, finite, finite3, positive, reach_or, unit};
 use crate::error::Result;
 use crate::math::rotation::rodrigues;
-
-/// `((R − |d|)/R)^(p−1)` and `e = R − |d|` for `|d| < R`, `None` outside the support. The
-/// factor `e^{p−1}/R^p` of the curl fields is the first value over `R`: written with the
-/// ratio `e/R ∈ (0, 1]`, it neither overflows nor underflows at any scale of the tool.
-#[inline(always)]
-fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
-    let e = reach - d.abs();
-    if !(e > 0.0) {
-        return None;
-    }
-    let q = e / reach;
-    let qp = match p {
-        2 => q,
-        3 => q * q,
-        _ => q * q * q,
-    };
-    Some((qp, e))
-}
-
-/// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
-/// points far from the tool cost a few multiplications).
-#[inline(always)]
-fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
-    let outer = rho + reach;
-    let inner = rho - reach;
-    !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
-}
 
 /// Sphere tool translating with velocity `u` (curl field, eq. 12.1–12.2 corrected).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,7 +89,7 @@ impl Translation {
         }
         let r = r2.sqrt();
         let d = r - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((ep, e)) = falloff_ratio(d, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let u = self.velocity;
@@ -142,7 +116,7 @@ impl Translation {
         let y = x - c;
         let r = y.length();
         let d = r - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((ep, e)) = falloff_ratio(d, self.reach, self.power) else {
             return glam::DMat3::ZERO;
         };
         let k = -0.5 / self.reach; // with ep = (e/R)^{p−1}: −1/(2R^p) · R^{p−1}
@@ -268,7 +242,7 @@ impl Rotation {
         }
         let rc = rc2.sqrt();
         let d = rc - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((ep, e)) = falloff_ratio(d, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let y = x - self.pivot;

@@ -18,7 +18,7 @@
 use glam::DVec3;
 
 use super::axis::{Axis, AxisSample};
-use super::shape::Distance;
+use super::shape::{Distance, radial};
 use crate::error::{InputError, Result};
 use crate::run::cancel::Cancel;
 
@@ -120,9 +120,7 @@ impl Distance for Rod {
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let c = self.closest(x)?;
         let y = x - c;
-        let r = y.length();
-        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
-        Some((r - self.radius, g))
+        Some(radial(y, y.length(), self.radius))
     }
     fn reach(&self) -> f64 {
         self.reach

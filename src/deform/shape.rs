@@ -84,13 +84,10 @@ impl Distance for Ball {
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let y = x - self.center;
         let r2 = y.length_squared();
-        let (outer, inner) = (self.radius + self.reach, self.radius - self.reach);
-        if !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner) {
+        if outside_shell(r2, self.radius, self.reach) {
             return None;
         }
-        let r = r2.sqrt();
-        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
-        Some((r - self.radius, g))
+        Some(radial(y, r2.sqrt(), self.radius))
     }
     fn reach(&self) -> f64 {
         self.reach
@@ -188,4 +185,40 @@ pub(crate) fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64
         m = m.max(g * g + g * db * l(d));
     }
     m
+}
+
+/// `((R − |d|)/R)^(p−1)` and `e = R − |d|` for `|d| < R`, `None` outside the support. The
+/// factor `e^{p−1}/R^p` of the curl fields ([`super::fields`], [`super::curl::Falloff`]) is the first value over `R`: written with the
+/// ratio `e/R ∈ (0, 1]`, it neither overflows nor underflows at any scale of the tool.
+#[inline(always)]
+pub(crate) fn falloff_ratio(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
+    let e = reach - d.abs();
+    if !(e > 0.0) {
+        return None;
+    }
+    let q = e / reach;
+    let qp = match p {
+        2 => q,
+        3 => q * q,
+        _ => q * q * q,
+    };
+    Some((qp, e))
+}
+
+/// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
+/// points far from the tool cost a few multiplications).
+#[inline(always)]
+pub(crate) fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
+    let outer = rho + reach;
+    let inner = rho - reach;
+    !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
+}
+
+/// The signed distance `r − ρ` from a sphere (or a tube about an axis) of radius `ρ` of a
+/// point at `y` from its centre (its nearest axis point), `r = |y|`, and its gradient
+/// `y/r` (zero at the centre).
+#[inline(always)]
+pub(crate) fn radial(y: DVec3, r: f64, rho: f64) -> (f64, DVec3) {
+    let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
+    (r - rho, g)
 }

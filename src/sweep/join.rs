@@ -192,6 +192,8 @@ fn put<R: Real>(
 /// faces left out are those the welds flatten, the kept ones moved to the front) and the
 /// first vertex (local) out of the output type's range. Polls `cancel` between blocks of
 /// corners; a stopped call leaves its part of the output incomplete.
+// Kept whole: the corners, their welds and the rewrite of the faces they touch share a dozen
+// flat stores (`weld_of`, `row_of`, `touched`, `bands`, …) and the closures over them.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_joins<R: Real, I: Index>(
     rings: &Rings,

@@ -1,4 +1,5 @@
-//! Unit tests of the tangent rules: exactness on lines, circles and cubics, the guards at\ncorners and ends, and the lanes' bits.
+//! Unit tests of the tangent rules: their orders, exactness on lines and circles, the
+//! Lagrange weights against Fornberg's, the bounded ends and the chord guard.
 
 use super::*;
 
