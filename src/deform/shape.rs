@@ -222,3 +222,10 @@ pub(crate) fn radial(y: DVec3, r: f64, rho: f64) -> (f64, DVec3) {
     let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
     (r - rho, g)
 }
+
+/// A point `c` of a tool carried with its velocity `u` at time `t` (`c + u t`) when the tool
+/// moves, else `c`.
+#[inline(always)]
+pub(crate) fn moved(c: DVec3, u: DVec3, moving: bool, t: f64) -> DVec3 {
+    if moving { c + u * t } else { c }
+}

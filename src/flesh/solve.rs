@@ -31,6 +31,7 @@
 
 use glam::DVec2;
 
+use super::bent_normal;
 pub use super::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
 
 /// Which offset correction to apply.
@@ -135,13 +136,7 @@ pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVe
             let (n, kk) = unit_normal(k1, DVec2::X);
             let x = d.dot(n);
             let xt = x / lam;
-            let disc = 1.0 - 2.0 * kk * xt;
-            let x1 = if disc < 0.0 {
-                *flags |= CLAMPED_BEND;
-                1.0 / kk
-            } else {
-                2.0 * xt / (1.0 + disc.sqrt())
-            };
+            let x1 = bent_normal(kk, xt, flags);
             d + (x1 - x) * n
         }
         Solution::Binormal => {

@@ -231,12 +231,13 @@ pub(super) fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use glam::DVec3;
     use std::sync::atomic::{AtomicBool, Ordering};
 
-    fn pool(threads: usize) -> rayon::ThreadPool {
+    /// A rayon pool of `threads` workers.
+    pub(in crate::frames) fn pool(threads: usize) -> rayon::ThreadPool {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()

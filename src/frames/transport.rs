@@ -311,18 +311,12 @@ fn transport_chunked<S: Step>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::carry::tests::pool;
     use super::super::double_reflection::DoubleReflection;
     use super::super::{Method, Orientation, Request, compute_general, compute_into};
     use super::*;
     use crate::run::cancel;
     use std::f64::consts::TAU;
-
-    fn pool(threads: usize) -> rayon::ThreadPool {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool")
-    }
 
     /// The same values, bit for bit.
     fn same_bits(a: &[f64], b: &[f64]) -> bool {
