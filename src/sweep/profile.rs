@@ -598,6 +598,33 @@ pub(crate) mod fixtures {
             .map(|&a| (0.05 + rng.unit()) * DVec2::from_angle(a))
             .collect()
     }
+
+    /// A star of `m` spikes: vertices at equal angles, alternately at radius 1 and `inner`.
+    pub fn spiked_star(m: usize, inner: f64) -> Vec<DVec2> {
+        (0..m)
+            .map(|k| {
+                let r = if k % 2 == 0 { 1.0 } else { inner };
+                r * DVec2::from_angle(std::f64::consts::TAU * k as f64 / m as f64)
+            })
+            .collect()
+    }
+
+    /// A comb of `k` teeth of height 1 on a bar of height 0.1 along `[0, 1]`.
+    pub fn comb(k: usize) -> Vec<DVec2> {
+        let mut p = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 0.1),
+        ];
+        for i in (0..k).rev() {
+            let x = i as f64 / k as f64;
+            let w = 0.5 / k as f64;
+            p.extend(
+                [(x + w, 0.1), (x + w, 1.1), (x, 1.1), (x, 0.1)].map(|(x, y)| DVec2::new(x, y)),
+            );
+        }
+        p
+    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Unit tests of the profile: its checks, exact orientation, the crossing sweep and the
 //! triangulation of convex and non-convex profiles.
 
-use super::fixtures::{Rng, star_shaped};
+use super::fixtures::{Rng, comb, spiked_star, star_shaped};
 use super::*;
 use crate::math::predicates::{accurate_area2, accurate_cover2};
 
@@ -253,30 +253,7 @@ fn sweep_finds_crossings_like_testing_all_pairs() {
 /// neighbour is found.
 #[test]
 fn packed_spikes_are_checked_in_m_log_m() {
-    let star = |m: usize| -> Vec<DVec2> {
-        (0..m)
-            .map(|k| {
-                let r = if k % 2 == 0 { 1.0 } else { 0.2 };
-                r * DVec2::from_angle(std::f64::consts::TAU * k as f64 / m as f64)
-            })
-            .collect()
-    };
-    let comb = |k: usize| -> Vec<DVec2> {
-        let mut p = vec![
-            DVec2::new(0.0, 0.0),
-            DVec2::new(1.0, 0.0),
-            DVec2::new(1.0, 0.1),
-        ];
-        for i in (0..k).rev() {
-            let x = i as f64 / k as f64;
-            let w = 0.5 / k as f64;
-            p.extend(
-                [(x + w, 0.1), (x + w, 1.1), (x, 1.1), (x, 0.1)].map(|(x, y)| DVec2::new(x, y)),
-            );
-        }
-        p
-    };
-    for mut p in [star(100_000), comb(25_000)] {
+    for mut p in [spiked_star(100_000, 0.2), comb(25_000)] {
         assert_eq!(sweep_crossing(&p, true, &cancel::never).unwrap(), None);
         for rev in [false, true] {
             let mut q = p.clone();
