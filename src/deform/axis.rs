@@ -1,10 +1,10 @@
-//! The axis curve of a strip or a rod along a curve, and its nearest points.
+//! The axis curve of a strip along a curve ([`super::tube`]) or of a rod ([`super::rod`]),
+//! and its nearest points (foot points).
 //!
 //! **Axis.** The C¹ piecewise cubic Hermite curve through the samples `x_k` with derivatives
 //! `m_k = dγ/dS` at the cumulative chord lengths `S_k` (`spinal.fields.strip_curve` uses the
-//! clamped C² cubic spline's derivatives, [`clamped_spline_slopes`] in `super::tube::strip_curve`, so
-//! `γ` is C²). Segment `k`, `λ ∈ [0, 1]`:
-//! `γ(λ) = a + bλ + cλ² + dλ³` with `a = x_k`, `b = m_k ΔS_k`,
+//! clamped C² cubic spline's derivatives, [`clamped_spline_slopes`], so `γ` is C²). Segment
+//! `k`, `λ ∈ [0, 1]`: `γ(λ) = a + bλ + cλ² + dλ³` with `a = x_k`, `b = m_k ΔS_k`,
 //! `c = 3(x_{k+1} − x_k) − (2m_k + m_{k+1}) ΔS_k`, `d = 2(x_k − x_{k+1}) + (m_k + m_{k+1}) ΔS_k`.
 //!
 //! **Where it is valid.** The foot point must be unique within `r < ρ + R_f`: curvature times

@@ -10,6 +10,10 @@
 //! `dX/dt = v(X, t)` by [`advect`] (RK4, explicit Euler for comparison, a volume-exact
 //! splitting), path lines in parallel; [`refine`] carries a closed mesh and refines it while it
 //! integrates; [`stamp`] is the contact stamper.
+//!
+//! The tools share their vocabulary from [`shape`] (signed distances, the region function);
+//! the shape a tool reports for keyframing is a [`Shape`] of this module, and the axis curve
+//! of the strip along a curve and of the rod is [`axis`].
 
 pub mod advect;
 pub mod axis;

@@ -2,7 +2,7 @@
 //! process-wide setting (a thread count, or the default) and one rayon pool per size, built
 //! the first time that size is used and kept. The default is `RAYON_NUM_THREADS` when it
 //! holds a positive integer (rayon's own convention), else the number of logical CPUs.
-//! `detach_in_pool` (in `super::convert`) runs every heavy call inside the pool of the current
+//! [`super::convert::detach_in_pool`] runs every heavy call inside the pool of the current
 //! setting, so a process pool of Dask or joblib workers can give each worker one thread.
 
 use std::collections::HashMap;

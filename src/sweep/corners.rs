@@ -6,8 +6,9 @@
 //! profile), or by 15° or more where its plain mitred ring would need more than
 //! `miter_limit` or cross the ring of a neighbouring sample. For ring planes through `x_a`,
 //! `x_b` with unit normals `n_a`, `n_b` (the chords' bisectors), the line where they meet lies
-//! `|(x_b − x_a)·n_a| / |n_a × n_b|` from `x_b` within its plane,, and the ring
-//! reaches `ρ_b min(1 / cos(φ_b/2), miter_limit)` there.
+//! `|(x_b − x_a)·n_a| / |n_a × n_b|` from `x_b` within its plane, and the ring reaches
+//! `ρ_b min(1 / cos(φ_b/2), miter_limit)` there (`ρ_b`: the largest distance of a profile
+//! vertex from the spine, scaled).
 
 use super::{Options, Profile};
 use glam::{DVec2, DVec3};
