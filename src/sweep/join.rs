@@ -25,7 +25,7 @@
 //!
 //! A sample gets a join where its chords turn by 15° or more and its plain mitred ring
 //! would either need more than `miter_limit` or cross the ring of a neighbouring sample
-//! (their planes meet within the profile's reach, see [`super::corners`]), and where it is a
+//! (their planes meet within the profile's reach, see [`corners`]), and where it is a
 //! corner of the polyline whatever the profile: a turn of 60° or more, or of 28° or more
 //! between samples that turn by a quarter of it at most. Everywhere else, and so on every
 //! smooth, well-sampled spine, the rings are those of the plain sweep, bit for bit.
