@@ -31,7 +31,7 @@
 use crate::run::cancel;
 use glam::DVec3;
 
-use super::shape::{Ball, Ring, Shape, ToolShape, blend, speed_factor, translate};
+use super::shape::{Ball, Ring, Shape, ToolShape, blend, moved, speed_factor, translate};
 use super::{Field, Tool, bounded, finite, finite3, positive, reach_or, unit};
 use crate::error::{InputError, Result};
 
@@ -72,11 +72,7 @@ impl Sphere {
 
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
-        let c = if self.moving {
-            self.center + self.velocity * t
-        } else {
-            self.center
-        };
+        let c = moved(self.center, self.velocity, self.moving, t);
         let y = x - c;
         let r2 = y.length_squared();
         let outer = self.radius + self.reach;
@@ -164,11 +160,7 @@ impl Capsule {
 
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
-        let a = if self.moving {
-            self.a + self.velocity * t
-        } else {
-            self.a
-        };
+        let a = moved(self.a, self.velocity, self.moving, t);
         let (p, _) = closest(x, a, self.ab, self.inv_len2);
         let w = x - p;
         let r = w.length();

@@ -32,8 +32,8 @@
 
 use glam::{DMat3, DVec3};
 
-use super::shape::ToolShape;
 pub use super::shape::{Distance, Shape};
+use super::shape::{ToolShape, falloff_ratio};
 use super::{Tool, bounded, falloff as falloff_power, finite3};
 use crate::error::{InputError, Result};
 
@@ -49,18 +49,9 @@ pub struct Falloff {
 impl Falloff {
     #[inline(always)]
     pub fn at(d: f64, reach: f64, p: u8) -> Option<Falloff> {
-        let e = reach - d.abs();
-        if !(e > 0.0) {
-            return None;
-        }
         // k = (e/R)^{p−1}/R: the ratio e/R ∈ (0, 1] keeps R^p from overflowing (or
         // underflowing) at any scale of the tool
-        let q = e / reach;
-        let qp = match p {
-            2 => q,
-            3 => q * q,
-            _ => q * q * q,
-        };
+        let (qp, e) = falloff_ratio(d, reach, p)?;
         let pf = p as f64;
         Some(Falloff {
             k: qp / reach,

@@ -35,35 +35,24 @@
 
 use glam::{DMat3, DVec3};
 
+use super::shape::{falloff_ratio, moved, outside_shell};
 use super::{Tool, bounded, falloff as falloff_power, finite, finite3, positive, reach_or, unit};
 use crate::error::Result;
 use crate::math::rotation::rodrigues;
 
-/// `((R − |d|)/R)^(p−1)` and `e = R − |d|` for `|d| < R`, `None` outside the support. The
-/// factor `e^{p−1}/R^p` of the curl fields is the first value over `R`: written with the
-/// ratio `e/R ∈ (0, 1]`, it neither overflows nor underflows at any scale of the tool.
+/// The falloff of a ball of radius `ρ` at `Y` from its centre: `(|Y|, d, ((R − |d|)/R)^(p−1),
+/// e)` with `d = |Y| − ρ`, `e = R − |d|`; `None` outside the support `|d| < R` (the shell is
+/// tested first, without a square root).
 #[inline(always)]
-fn falloff(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
-    let e = reach - d.abs();
-    if !(e > 0.0) {
+fn ball_falloff(y: DVec3, rho: f64, reach: f64, p: u8) -> Option<(f64, f64, f64, f64)> {
+    let r2 = y.length_squared();
+    if outside_shell(r2, rho, reach) {
         return None;
     }
-    let q = e / reach;
-    let qp = match p {
-        2 => q,
-        3 => q * q,
-        _ => q * q * q,
-    };
-    Some((qp, e))
-}
-
-/// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
-/// points far from the tool cost a few multiplications).
-#[inline(always)]
-fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
-    let outer = rho + reach;
-    let inner = rho - reach;
-    !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
+    let r = r2.sqrt();
+    let d = r - rho;
+    let (ep, e) = falloff_ratio(d, reach, p)?;
+    Some((r, d, ep, e))
 }
 
 /// Sphere tool translating with velocity `u` (curl field, eq. 12.1–12.2 corrected).
@@ -103,19 +92,9 @@ impl Translation {
 
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
-        let c = if self.moving {
-            self.center + self.velocity * t
-        } else {
-            self.center
-        };
+        let c = moved(self.center, self.velocity, self.moving, t);
         let y = x - c;
-        let r2 = y.length_squared();
-        if outside_shell(r2, self.radius, self.reach) {
-            return DVec3::ZERO;
-        }
-        let r = r2.sqrt();
-        let d = r - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((r, d, ep, e)) = ball_falloff(y, self.radius, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let u = self.velocity;
@@ -134,15 +113,11 @@ impl Translation {
     /// `∂A/∂x_j = −(1/(2R^p)) [φ′ n_j (Y × u) + φ e_j × u]`, `φ′ = −p sgn(d) e^{p−1}`.
     #[inline]
     pub fn potential_jacobian(&self, x: DVec3, t: f64) -> glam::DMat3 {
-        let c = if self.moving {
-            self.center + self.velocity * t
-        } else {
-            self.center
-        };
+        let c = moved(self.center, self.velocity, self.moving, t);
         let y = x - c;
         let r = y.length();
         let d = r - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((ep, e)) = falloff_ratio(d, self.reach, self.power) else {
             return glam::DMat3::ZERO;
         };
         let k = -0.5 / self.reach; // with ep = (e/R)^{p−1}: −1/(2R^p) · R^{p−1}
@@ -198,11 +173,7 @@ impl Tool for Translation {
         }
     }
     fn slip_surface(&self, x: DVec3, t: f64) -> Option<(f64, DVec3)> {
-        let c = if self.moving {
-            self.center + self.velocity * t
-        } else {
-            self.center
-        };
+        let c = moved(self.center, self.velocity, self.moving, t);
         let y = x - c;
         let r = y.length();
         (r > 0.0).then(|| (r - self.radius, y / r))
@@ -262,13 +233,7 @@ impl Rotation {
     #[inline]
     pub fn eval(&self, x: DVec3, t: f64) -> DVec3 {
         let yc = x - self.center_at(t);
-        let rc2 = yc.length_squared();
-        if outside_shell(rc2, self.radius, self.reach) {
-            return DVec3::ZERO;
-        }
-        let rc = rc2.sqrt();
-        let d = rc - self.radius;
-        let Some((ep, e)) = falloff(d, self.reach, self.power) else {
+        let Some((rc, d, ep, e)) = ball_falloff(yc, self.radius, self.reach, self.power) else {
             return DVec3::ZERO;
         };
         let y = x - self.pivot;

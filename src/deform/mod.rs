@@ -10,8 +10,13 @@
 //! `dX/dt = v(X, t)` by [`advect`] (RK4, explicit Euler for comparison, a volume-exact
 //! splitting), path lines in parallel; [`refine`] carries a closed mesh and refines it while it
 //! integrates; [`stamp`] is the contact stamper.
+//!
+//! The tools share their vocabulary from [`shape`] (signed distances, the region function);
+//! the shape a tool reports for keyframing is a [`Shape`] of this module, and the axis curve
+//! of the strip along a curve and of the rod is [`axis`].
 
 pub mod advect;
+pub mod axis;
 pub mod cross;
 pub mod curl;
 pub mod fields;
@@ -34,6 +39,62 @@ use glam::{DMat3, DVec3};
 use crate::error::{InputError, Result};
 pub use cross::{Capsule, Sphere, StripAcross, Torus};
 pub use fields::{Rotation, Swirl, SwirlKind, Translation};
+use grid::GridTool;
+use rod::Rod;
+use shape::{Ball, Distance, Ring};
+
+/// A tool's shape, for tools that can be posed by keys ([`keyframe`]).
+#[derive(Debug, Clone)]
+pub enum Shape {
+    Ball(Ball),
+    Rod(Arc<Rod>),
+    Grid(Arc<GridTool>),
+    Ring(Ring),
+}
+
+impl Shape {
+    /// The shape's centre `C`.
+    pub fn center(&self) -> DVec3 {
+        match self {
+            Shape::Ball(b) => b.center(),
+            Shape::Rod(r) => r.center(),
+            Shape::Grid(g) => Distance::center(&**g),
+            Shape::Ring(r) => r.center(),
+        }
+    }
+}
+
+impl From<Ring> for Shape {
+    fn from(r: Ring) -> Shape {
+        Shape::Ring(r)
+    }
+}
+
+impl From<Ball> for Shape {
+    fn from(b: Ball) -> Shape {
+        Shape::Ball(b)
+    }
+}
+
+impl From<Arc<Rod>> for Shape {
+    fn from(r: Arc<Rod>) -> Shape {
+        Shape::Rod(r)
+    }
+}
+
+impl From<Arc<GridTool>> for Shape {
+    fn from(g: Arc<GridTool>) -> Shape {
+        Shape::Grid(g)
+    }
+}
+
+/// The shape of a built tool and its falloff power (`None` for tools that are not curl
+/// fields: the keyframed tool then needs one).
+#[derive(Debug, Clone)]
+pub struct ToolShape {
+    pub shape: Shape,
+    pub power: Option<u8>,
+}
 
 /// A divergence-free velocity field of one tool.
 ///
@@ -96,7 +157,7 @@ pub trait Tool: Send + Sync + std::fmt::Debug {
 
     /// The tool's shape (its signed distance, centre and reach) for tools that a
     /// [`keyframe::Keyframed`] tool can pose; `None` for the others.
-    fn shape(&self) -> Option<shape::ToolShape> {
+    fn shape(&self) -> Option<ToolShape> {
         None
     }
 

@@ -3,7 +3,7 @@
 //!
 //! **Axis.** As for the curved strip of [`super::tube`]: the C¹ piecewise cubic Hermite curve
 //! `γ` through the samples `x_k` with derivatives `m_k = dγ/dS` at the cumulative chord
-//! lengths `S_k` ([`super::tube::axis_samples`]: the clamped C² cubic spline's derivatives, so `γ` is
+//! lengths `S_k` ([`super::axis::axis_samples`]: the clamped C² cubic spline's derivatives, so `γ` is
 //! C²; two samples give a straight segment, a capsule).
 //!
 //! **Distance.** `d(X) = |X − γ(s*)| − ρ` with `s*` the foot point, `(X − γ(s*))·γ′(s*) = 0`,
@@ -17,8 +17,8 @@
 
 use glam::DVec3;
 
-use super::shape::Distance;
-use super::tube::{Axis, AxisSample};
+use super::axis::{Axis, AxisSample};
+use super::shape::{Distance, radial};
 use crate::error::{InputError, Result};
 use crate::run::cancel::Cancel;
 
@@ -36,7 +36,7 @@ pub struct Rod {
 }
 
 impl Rod {
-    /// The rod of `spinal.fields.rod` about `points` ([`super::tube::axis_samples`]).
+    /// The rod of `spinal.fields.rod` about `points` ([`super::axis::axis_samples`]).
     ///
     /// Polls `cancel` in the axis set-up and checks (see [`Axis::new`]); fails with
     /// [`InputError::stopped`] once it says stop.
@@ -47,7 +47,7 @@ impl Rod {
         center: Option<DVec3>,
         cancel: Cancel<'_>,
     ) -> Result<Rod> {
-        let samples = super::tube::axis_samples(points, cancel)?;
+        let samples = super::axis::axis_samples(points, cancel)?;
         Rod::new(samples, radius, reach, center, cancel)
     }
 
@@ -120,9 +120,7 @@ impl Distance for Rod {
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let c = self.closest(x)?;
         let y = x - c;
-        let r = y.length();
-        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
-        Some((r - self.radius, g))
+        Some(radial(y, y.length(), self.radius))
     }
     fn reach(&self) -> f64 {
         self.reach

@@ -5,8 +5,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::grid::GridTool;
-use super::rod::Rod;
+pub use super::{Shape, ToolShape};
 
 /// The signed distance of a tool's shape (negative inside), in the shape's own frame.
 pub trait Distance: Send + Sync + std::fmt::Debug {
@@ -85,13 +84,10 @@ impl Distance for Ball {
     fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let y = x - self.center;
         let r2 = y.length_squared();
-        let (outer, inner) = (self.radius + self.reach, self.radius - self.reach);
-        if !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner) {
+        if outside_shell(r2, self.radius, self.reach) {
             return None;
         }
-        let r = r2.sqrt();
-        let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
-        Some((r - self.radius, g))
+        Some(radial(y, r2.sqrt(), self.radius))
     }
     fn reach(&self) -> f64 {
         self.reach
@@ -148,81 +144,6 @@ impl Distance for Ring {
     }
 }
 
-impl Distance for GridTool {
-    #[inline(always)]
-    fn distance(&self, x: DVec3) -> Option<(f64, DVec3)> {
-        GridTool::distance(self, x)
-    }
-    fn reach(&self) -> f64 {
-        self.reach
-    }
-    fn center(&self) -> DVec3 {
-        self.center
-    }
-    fn extent(&self) -> f64 {
-        self.support_extent()
-    }
-    fn gradient_bound(&self) -> f64 {
-        self.slope_bound()
-    }
-    fn wants_locality(&self) -> bool {
-        true
-    }
-}
-
-/// A tool's shape, for tools that can be posed by keys ([`super::keyframe`]).
-#[derive(Debug, Clone)]
-pub enum Shape {
-    Ball(Ball),
-    Rod(Arc<Rod>),
-    Grid(Arc<GridTool>),
-    Ring(Ring),
-}
-
-impl Shape {
-    /// The shape's centre `C`.
-    pub fn center(&self) -> DVec3 {
-        match self {
-            Shape::Ball(b) => b.center(),
-            Shape::Rod(r) => r.center(),
-            Shape::Grid(g) => Distance::center(&**g),
-            Shape::Ring(r) => r.center(),
-        }
-    }
-}
-
-impl From<Ring> for Shape {
-    fn from(r: Ring) -> Shape {
-        Shape::Ring(r)
-    }
-}
-
-impl From<Ball> for Shape {
-    fn from(b: Ball) -> Shape {
-        Shape::Ball(b)
-    }
-}
-
-impl From<Arc<Rod>> for Shape {
-    fn from(r: Arc<Rod>) -> Shape {
-        Shape::Rod(r)
-    }
-}
-
-impl From<Arc<GridTool>> for Shape {
-    fn from(g: Arc<GridTool>) -> Shape {
-        Shape::Grid(g)
-    }
-}
-
-/// The shape of a built tool and its falloff power (`None` for tools that are not curl
-/// fields: the keyframed tool then needs one).
-#[derive(Debug, Clone)]
-pub struct ToolShape {
-    pub shape: Shape,
-    pub power: Option<u8>,
-}
-
 /// `(D, D′)` of the region function at signed distance `d`, reach `rf`.
 #[inline(always)]
 pub(crate) fn blend(d: f64, rf: f64, linear: bool) -> (f64, f64) {
@@ -264,4 +185,47 @@ pub(crate) fn speed_factor(rf: f64, linear: bool, l: impl Fn(f64) -> f64) -> f64
         m = m.max(g * g + g * db * l(d));
     }
     m
+}
+
+/// `((R − |d|)/R)^(p−1)` and `e = R − |d|` for `|d| < R`, `None` outside the support. The
+/// factor `e^{p−1}/R^p` of the curl fields ([`super::fields`], [`super::curl::Falloff`]) is the first value over `R`: written with the
+/// ratio `e/R ∈ (0, 1]`, it neither overflows nor underflows at any scale of the tool.
+#[inline(always)]
+pub(crate) fn falloff_ratio(d: f64, reach: f64, p: u8) -> Option<(f64, f64)> {
+    let e = reach - d.abs();
+    if !(e > 0.0) {
+        return None;
+    }
+    let q = e / reach;
+    let qp = match p {
+        2 => q,
+        3 => q * q,
+        _ => q * q * q,
+    };
+    Some((qp, e))
+}
+
+/// `|Y|² = r2` lies outside the shell `ρ − R < |Y| < ρ + R` (a test without a square root, so
+/// points far from the tool cost a few multiplications).
+#[inline(always)]
+pub(crate) fn outside_shell(r2: f64, rho: f64, reach: f64) -> bool {
+    let outer = rho + reach;
+    let inner = rho - reach;
+    !(r2 < outer * outer) || (inner > 0.0 && r2 <= inner * inner)
+}
+
+/// The signed distance `r − ρ` from a sphere (or a tube about an axis) of radius `ρ` of a
+/// point at `y` from its centre (its nearest axis point), `r = |y|`, and its gradient
+/// `y/r` (zero at the centre).
+#[inline(always)]
+pub(crate) fn radial(y: DVec3, r: f64, rho: f64) -> (f64, DVec3) {
+    let g = if r > 0.0 { y * (1.0 / r) } else { DVec3::ZERO };
+    (r - rho, g)
+}
+
+/// A point `c` of a tool carried with its velocity `u` at time `t` (`c + u t`) when the tool
+/// moves, else `c`.
+#[inline(always)]
+pub(crate) fn moved(c: DVec3, u: DVec3, moving: bool, t: f64) -> DVec3 {
+    if moving { c + u * t } else { c }
 }

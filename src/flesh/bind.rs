@@ -464,6 +464,7 @@ fn bind_lanes<const L: usize>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::section::tests::model;
     use super::*;
     use crate::run::cancel;
 
@@ -525,17 +526,6 @@ mod tests {
         (best.1, best.2, best.3)
     }
 
-    /// The model of an open spine through `pts` with its default frames.
-    fn open_model(pts: &[DVec3]) -> SpineModel {
-        let req = crate::frames::Request {
-            points: Some(pts),
-            ..Default::default()
-        };
-        let mut frames = vec![0.0; 9 * pts.len()];
-        crate::frames::compute_into(&req, &mut frames, &cancel::never).unwrap();
-        SpineModel::new("rest_spine", pts, &frames, false, &cancel::never).unwrap()
-    }
-
     #[test]
     fn the_hierarchy_finds_the_sections_of_the_scan_bit_for_bit() {
         // a wavy open spine and a closed circle; points near and far, on sample planes and
@@ -547,7 +537,7 @@ mod tests {
                 DVec3::new(u, (2.0 * u).sin() * 0.5, (0.7 * u).cos() * 0.3)
             })
             .collect();
-        let sp = open_model(&pts);
+        let sp = model(&pts);
         let (cpts, cframes) = circle(64);
         let loop_sp = SpineModel::new("rest_spine", &cpts, &cframes, true, &cancel::never).unwrap();
         // far from the origin with short edges: the round-off of positions of size 1e4
@@ -561,7 +551,7 @@ mod tests {
                 )
             })
             .collect();
-        let far_sp = open_model(&far);
+        let far_sp = model(&far);
         for (model, count) in [(&sp, 4000), (&loop_sp, 2000), (&far_sp, 4000)] {
             let edges = Edges::new(model).unwrap();
             let mut run = Vec::new();
@@ -626,7 +616,7 @@ mod tests {
         let pts: Vec<DVec3> = (0..n)
             .map(|i| DVec3::new(i as f64 * 0.16, 0.0, 0.0))
             .collect();
-        let sp = open_model(&pts);
+        let sp = model(&pts);
         let mut verts = Vec::new();
         for ring in 0..300 {
             let x = if ring % 5 == 0 {

@@ -31,11 +31,11 @@
 //!
 //! Fold-over (§4.3): the normal bend clamps at the focal point `1/(wκ1)` as in
 //! [`super::solve`], the binormal factors are capped below at
-//! [`super::solve::BINORMAL_MIN_FACTOR`] unless they cancel (`w = 1`).
+//! [`super::BINORMAL_MIN_FACTOR`] unless they cancel (`w = 1`).
 
 use glam::DVec2;
 
-use super::solve::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
+use super::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE, bent_normal};
 use crate::error::{InputError, Result};
 
 /// The blend weight `w` checked: finite and in `[0, 1]` (errors name `blend`).
@@ -119,13 +119,7 @@ pub fn bend_blend(w: f64, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVec
     };
     let wk = w * kk;
     let xt = x / lam_n;
-    let disc = 1.0 - 2.0 * wk * xt;
-    let xa = if disc < 0.0 {
-        *flags |= CLAMPED_BEND;
-        1.0 / wk
-    } else {
-        2.0 * xt / (1.0 + disc.sqrt())
-    };
+    let xa = bent_normal(wk, xt, flags);
     let y1 = binormal_pair(y / lam_b, 1.0 - wk * xa, 1.0 - kk * xa, CLAMPED_BEND, flags);
     xa * n + y1 * b
 }

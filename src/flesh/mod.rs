@@ -52,6 +52,31 @@ pub use pose::deform;
 pub use solve::Solution;
 pub use spine::SpineModel;
 
+/// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
+/// no policy past the limit).
+pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
+/// Curvatures below this (1/length units) are treated as straight: the step is the identity.
+pub const TINY_CURVATURE: f64 = 1e-300;
+
+/// Flag bits reported per vertex.
+pub const CLAMPED_BEND: u8 = 1;
+pub const CLAMPED_UNBEND: u8 = 2;
+
+/// The normal offset after a bend by the curvature `κ` (Eq. 15 in its stable form,
+/// `x1 = 2x_t/(1 + √(1 − 2κ x_t))`, of the stretched offset `x_t`), clamped at the focal
+/// point `1/κ` with [`CLAMPED_BEND`] set in `flags` where no fold-free root exists. Shared by
+/// the normal solution ([`solve`]) and the blend's normal stage ([`blend`]).
+#[inline(always)]
+fn bent_normal(kk: f64, xt: f64, flags: &mut u8) -> f64 {
+    let disc = 1.0 - 2.0 * kk * xt;
+    if disc < 0.0 {
+        *flags |= CLAMPED_BEND;
+        1.0 / kk
+    } else {
+        2.0 * xt / (1.0 + disc.sqrt())
+    }
+}
+
 /// Refuse vertices that are not finite, or that leave the range of `f64` once brought to the
 /// units of a rest model (`to_model`) far smaller than 1; errors name `vertices` and say
 /// which model (`"spine"` or `"surface"`).

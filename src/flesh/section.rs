@@ -176,7 +176,7 @@ pub fn edge_roots_lanes<const L: usize>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::run::cancel;
 
@@ -242,7 +242,7 @@ mod tests {
     }
 
     /// An open spine through `pts` with its default frames.
-    fn model(pts: &[DVec3]) -> SpineModel {
+    pub(in crate::flesh) fn model(pts: &[DVec3]) -> SpineModel {
         let req = crate::frames::Request {
             points: Some(pts),
             ..Default::default()

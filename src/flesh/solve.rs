@@ -31,6 +31,9 @@
 
 use glam::DVec2;
 
+use super::bent_normal;
+pub use super::{BINORMAL_MIN_FACTOR, CLAMPED_BEND, CLAMPED_UNBEND, TINY_CURVATURE};
+
 /// Which offset correction to apply.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Solution {
@@ -67,16 +70,6 @@ impl Solution {
         }
     }
 }
-
-/// Below this `1 − κ1 x'` the binormal solution is clamped (a choice of ours: the thesis gives
-/// no policy past the limit).
-pub const BINORMAL_MIN_FACTOR: f64 = 1e-3;
-/// Curvatures below this (1/length units) are treated as straight: the step is the identity.
-pub const TINY_CURVATURE: f64 = 1e-300;
-
-/// Flag bits reported per vertex.
-pub const CLAMPED_BEND: u8 = 1;
-pub const CLAMPED_UNBEND: u8 = 2;
 
 #[inline(always)]
 fn unit_normal(k: DVec2, fallback: DVec2) -> (DVec2, f64) {
@@ -143,13 +136,7 @@ pub fn bend(sol: Solution, d: DVec2, k1: DVec2, lam: f64, flags: &mut u8) -> DVe
             let (n, kk) = unit_normal(k1, DVec2::X);
             let x = d.dot(n);
             let xt = x / lam;
-            let disc = 1.0 - 2.0 * kk * xt;
-            let x1 = if disc < 0.0 {
-                *flags |= CLAMPED_BEND;
-                1.0 / kk
-            } else {
-                2.0 * xt / (1.0 + disc.sqrt())
-            };
+            let x1 = bent_normal(kk, xt, flags);
             d + (x1 - x) * n
         }
         Solution::Binormal => {

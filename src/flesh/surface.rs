@@ -560,10 +560,7 @@ pub fn deform_surface(
     flags: &mut [u8],
     cancel: Cancel<'_>,
 ) -> Result<()> {
-    let nv = cell.len();
-    if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
-        return Err(InputError::new("coords", "inconsistent array sizes"));
-    }
+    check_sizes(cell.len(), coords, out, flags)?;
     let cells = (posed.nu - 1) * posed.nv;
     if let Some(i) = cell
         .iter()
@@ -574,11 +571,57 @@ pub fn deform_surface(
             format!("vertex {i} is bound to a cell the posed grid does not have"),
         ));
     }
-    let q = posed.scale.exp();
-    let units = Units::new(posed.scale, rest_exp)?;
+    let foot = |c: i64, x: &[f64]| {
+        let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
+        posed.eval(i, j, x[0], x[1])
+    };
+    let vertices = Bound {
+        at: cell,
+        coords,
+        corrected,
+    };
+    deform_bound(posed.scale, rest_exp, vertices, out, flags, cancel, foot)
+}
+
+/// `coords` (SURFACE_COORDS per vertex), `out` and `flags` sized for `nv` vertices.
+pub(super) fn check_sizes(nv: usize, coords: &[f64], out: &[DVec3], flags: &[u8]) -> Result<()> {
+    if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
+        return Err(InputError::new("coords", "inconsistent array sizes"));
+    }
+    Ok(())
+}
+
+/// Vertices registered on a surface: the cell or face `at` of each, its coordinates
+/// (SURFACE_COORDS per vertex), and whether the offsets are corrected.
+pub(super) struct Bound<'a> {
+    pub(super) at: &'a [i64],
+    pub(super) coords: &'a [f64],
+    pub(super) corrected: bool,
+}
+
+/// Every vertex onto the posed surface of scale `scale` (blocks of [`DEFORM_BLOCK`] in
+/// parallel, polling `cancel` before each): [`deform_vertex`] at `foot(at, x)`, the posed
+/// surface's local frame at the foot of a vertex bound to cell or face `at` with coordinates
+/// `x`; then [`in_range`]. Shared by [`deform_surface`] and
+/// [`super::trisurf::deform_trisurface`], which check the cells or faces first.
+pub(super) fn deform_bound(
+    scale: Pow2,
+    rest_exp: i32,
+    vertices: Bound<'_>,
+    out: &mut [DVec3],
+    flags: &mut [u8],
+    cancel: Cancel<'_>,
+    foot: impl Fn(i64, &[f64]) -> SurfLocal + Sync,
+) -> Result<()> {
+    let Bound {
+        at,
+        coords,
+        corrected,
+    } = vertices;
+    let units = Units::new(scale, rest_exp)?;
     out.par_chunks_mut(DEFORM_BLOCK)
         .zip(flags.par_chunks_mut(DEFORM_BLOCK))
-        .zip(cell.par_chunks(DEFORM_BLOCK))
+        .zip(at.par_chunks(DEFORM_BLOCK))
         .zip(coords.par_chunks(SURFACE_COORDS * DEFORM_BLOCK))
         .for_each(|(((o, f), c), x)| {
             if cancel() {
@@ -586,11 +629,10 @@ pub fn deform_surface(
             }
             let rows = o.iter_mut().zip(f.iter_mut()).zip(c);
             for (((o, f), &c), x) in rows.zip(x.chunks_exact(SURFACE_COORDS)) {
-                let (i, j) = (c as usize / posed.nv, c as usize % posed.nv);
-                deform_vertex(posed.eval(i, j, x[0], x[1]), corrected, &units, o, f, x);
+                deform_vertex(foot(c, x), corrected, &units, o, f, x);
             }
         });
-    in_range(out, q, rest_exp, cancel)
+    in_range(out, scale.exp(), rest_exp, cancel)
 }
 
 /// `Ok` unless a posed position `out` left the finite numbers: a binding (size exponent

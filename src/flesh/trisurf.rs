@@ -49,7 +49,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::surface::{SURFACE_COORDS, SurfLocal, Units, deform_vertex, newton_foot};
+use super::surface::{Bound, SURFACE_COORDS, SurfLocal, check_sizes, deform_bound, newton_foot};
 use crate::error::{InputError, Result};
 use crate::math::bvh::{Aabb, Bvh};
 use crate::math::scale::{self, Pow2};
@@ -458,10 +458,7 @@ pub fn deform_trisurface(
     flags: &mut [u8],
     cancel: Cancel<'_>,
 ) -> Result<()> {
-    let nv = face.len();
-    if coords.len() != SURFACE_COORDS * nv || out.len() != nv || flags.len() != nv {
-        return Err(InputError::new("coords", "inconsistent array sizes"));
-    }
+    check_sizes(face.len(), coords, out, flags)?;
     let nf = posed.faces.len();
     if let Some(i) = face.iter().position(|&f| f < 0 || f as usize >= nf) {
         return Err(InputError::new(
@@ -469,24 +466,13 @@ pub fn deform_trisurface(
             format!("vertex {i} is bound to a face the posed surface does not have"),
         ));
     }
-    let units = Units::new(posed.scale, rest_exp)?;
-    const BLOCK: usize = 1 << 12;
-    out.par_chunks_mut(BLOCK)
-        .zip(flags.par_chunks_mut(BLOCK))
-        .zip(face.par_chunks(BLOCK))
-        .zip(coords.par_chunks(SURFACE_COORDS * BLOCK))
-        .for_each(|(((o, fl), fc), x)| {
-            if cancel() {
-                return;
-            }
-            let rows = o.iter_mut().zip(fl.iter_mut()).zip(fc);
-            for (((o, fl), &f), x) in rows.zip(x.chunks_exact(SURFACE_COORDS)) {
-                let l = posed.eval(f as usize, x[0], x[1]);
-                deform_vertex(l, corrected, &units, o, fl, x);
-            }
-        });
-    let q = posed.scale.exp();
-    super::surface::in_range(out, q, rest_exp, cancel)
+    let foot = |f: i64, x: &[f64]| posed.eval(f as usize, x[0], x[1]);
+    let vertices = Bound {
+        at: face,
+        coords,
+        corrected,
+    };
+    deform_bound(posed.scale, rest_exp, vertices, out, flags, cancel, foot)
 }
 
 #[cfg(test)]

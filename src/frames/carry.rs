@@ -19,7 +19,7 @@
 
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
-use super::transport::{ChunkEnds, turn_rows};
+use glam::DVec3;
 
 /// The shared state of the chunks, behind one lock (taken a few times per chunk).
 struct State<'a> {
@@ -206,13 +206,38 @@ where
         .collect()
 }
 
+/// What the transport of a chunk reports: the start vector it used (the true one for chunk
+/// 0, a provisional one otherwise), its last vector, and the chunk's arc length.
+pub type ChunkEnds = (DVec3, DVec3, f64);
+
+/// Turn the rows of written frames about their `t` columns by `angle` (nothing for 0).
+fn turn_rows(buf: &mut [f64], angle: f64) {
+    if angle != 0.0 {
+        let (sin, cos) = angle.sin_cos();
+        for f in buf.chunks_exact_mut(9) {
+            turn_frame(f, cos, sin);
+        }
+    }
+}
+
+/// Turn the `(r, s)` columns of a written frame about its `t` column.
+#[inline(always)]
+pub(super) fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
+    for row in 0..3 {
+        let (r, s) = (f[3 * row], f[3 * row + 1]);
+        f[3 * row] = cos * r + sin * s;
+        f[3 * row + 1] = cos * s - sin * r;
+    }
+}
+
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use glam::DVec3;
     use std::sync::atomic::{AtomicBool, Ordering};
 
-    fn pool(threads: usize) -> rayon::ThreadPool {
+    /// A rayon pool of `threads` workers.
+    pub(in crate::frames) fn pool(threads: usize) -> rayon::ThreadPool {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()

@@ -5,6 +5,7 @@ use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::carry::turn_frame;
 use super::check::{check_input, check_segments, distinct_samples, rows_match};
 use super::double_reflection::DoubleReflection;
 use super::geometry::{self, any_perpendicular, rotate_about, scale_and_diagonal, signed_angle};
@@ -554,11 +555,7 @@ pub(crate) fn rmf_parts(
         let mut arc = 0.0;
         for (i, f) in out.chunks_exact_mut(9).take(n).enumerate() {
             let (sin, cos) = (-closing * arc / length).sin_cos();
-            for row in 0..3 {
-                let (r, s) = (f[3 * row], f[3 * row + 1]);
-                f[3 * row] = cos * r + sin * s;
-                f[3 * row + 1] = cos * s - sin * r;
-            }
+            turn_frame(f, cos, sin);
             arc += seg[i];
         }
     }

@@ -212,6 +212,8 @@ fn align(a: &mut [f64], b: &[f64]) {
 /// angle (closed curves); `pins`: fixed orientations (sorted distinct rows, unit vectors
 /// ⟂ their tangents); `turns`: extra turns across the seam of a closed curve. `cancel` is
 /// polled between the passes; a cancelled call returns no twist (see [`crate::run::cancel`]).
+// Kept whole: one assembly of the cyclic tridiagonal system (guide terms, pins, the seam)
+// over shared working vectors, then its solve.
 #[allow(clippy::too_many_arguments)]
 pub fn twist(
     r: &[DVec3],

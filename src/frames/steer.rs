@@ -11,6 +11,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::carry::turn_frame;
 use super::constraints::{self, TwistRule};
 use super::guide::{self, Guide};
 use super::{Method, Orientation, Request, resolve, rmf_parts, time};
@@ -65,16 +66,10 @@ fn col(f: &[f64], k: usize) -> DVec3 {
     DVec3::new(f[k], f[3 + k], f[6 + k])
 }
 
-/// Frames of one curve, steered; `out` holds `9·rows` values.
-///
-/// Polls `cancel` inside the rotation-minimising frames and between the stages after them, and
-/// returns at once (with `out` incomplete) when it says stop (see [`crate::run::cancel`]).
-pub fn compute_steered(
-    req: &Request,
-    st: &Steering,
-    out: &mut [f64],
-    cancel: crate::run::cancel::Cancel<'_>,
-) -> Result<()> {
+/// The steering's own checks, before any work: what method='frenet' cannot use, what
+/// `previous` cannot be combined with, the guide, and the rows of `previous` and of the
+/// constraints against the curve's `rows`.
+fn check_steering(req: &Request, st: &Steering, rows: usize) -> Result<()> {
     if req.method == Method::Frenet {
         let arg = if !st.constraints.is_empty() {
             "constraints"
@@ -113,7 +108,6 @@ pub fn compute_steered(
     if let Some(g) = &st.guide {
         guide::check(g)?;
     }
-    let rows = out.len() / 9;
     if let Some(p) = st.previous {
         time::check_previous(p, rows)?;
     }
@@ -126,34 +120,15 @@ pub fn compute_steered(
             ));
         }
     }
-    let parts = rmf_parts(req, out, cancel)?;
-    if cancel() {
-        return Ok(());
-    }
-    let n = parts.n;
-    if let Some(g) = &st.guide {
-        if g.vectors.len() != 1 && g.vectors.len() != rows {
-            return Err(InputError::new(
-                "guide",
-                format!(
-                    "expected shape (3,) or ({rows}, 3) (one vector per sample), got ({}, 3)",
-                    g.vectors.len()
-                ),
-            ));
-        }
-        if !g.previous.is_empty() && g.previous.len() != rows {
-            return Err(InputError::new(
-                "previous",
-                format!(
-                    "expected shape ({rows}, 3, 3) (the frames of the same curve at the \
-                     previous time step), got {} rows",
-                    g.previous.len()
-                ),
-            ));
-        }
-    }
-    let t: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 2)).collect();
-    let r: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 0)).collect();
+    Ok(())
+}
+
+/// The fixed orientations of one curve's twist, sorted by row: the constraints, `initial`
+/// and `end` (each row given once), and row 0's own vector where `end` or a closed curve
+/// needs an anchor. `t`, `r`: the RMF's tangents and reference vectors, one per distinct
+/// sample.
+fn pins_of(req: &Request, st: &Steering, t: &[DVec3], r: &[DVec3]) -> Result<Vec<(usize, DVec3)>> {
+    let n = t.len();
     let mut pins: Vec<(usize, DVec3)> = Vec::new();
     for c in st.constraints {
         if c.row >= n {
@@ -196,6 +171,50 @@ pub fn compute_steered(
         pins.push((0, r[0]));
     }
     pins.sort_by_key(|p| p.0);
+    Ok(pins)
+}
+
+/// Frames of one curve, steered; `out` holds `9·rows` values.
+///
+/// Polls `cancel` inside the rotation-minimising frames and between the stages after them, and
+/// returns at once (with `out` incomplete) when it says stop (see [`crate::run::cancel`]).
+pub fn compute_steered(
+    req: &Request,
+    st: &Steering,
+    out: &mut [f64],
+    cancel: crate::run::cancel::Cancel<'_>,
+) -> Result<()> {
+    let rows = out.len() / 9;
+    check_steering(req, st, rows)?;
+    let parts = rmf_parts(req, out, cancel)?;
+    if cancel() {
+        return Ok(());
+    }
+    let n = parts.n;
+    if let Some(g) = &st.guide {
+        if g.vectors.len() != 1 && g.vectors.len() != rows {
+            return Err(InputError::new(
+                "guide",
+                format!(
+                    "expected shape (3,) or ({rows}, 3) (one vector per sample), got ({}, 3)",
+                    g.vectors.len()
+                ),
+            ));
+        }
+        if !g.previous.is_empty() && g.previous.len() != rows {
+            return Err(InputError::new(
+                "previous",
+                format!(
+                    "expected shape ({rows}, 3, 3) (the frames of the same curve at the \
+                     previous time step), got {} rows",
+                    g.previous.len()
+                ),
+            ));
+        }
+    }
+    let t: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 2)).collect();
+    let r: Vec<DVec3> = out.chunks_exact(9).take(n).map(|f| col(f, 0)).collect();
+    let pins = pins_of(req, st, &t, &r)?;
     if cancel() {
         return Ok(());
     }
@@ -252,11 +271,7 @@ pub fn compute_steered(
         .for_each(|(f, &a)| {
             if a != 0.0 {
                 let (sin, cos) = a.sin_cos();
-                for row in 0..3 {
-                    let (r, s) = (f[3 * row], f[3 * row + 1]);
-                    f[3 * row] = cos * r + sin * s;
-                    f[3 * row + 1] = cos * s - sin * r;
-                }
+                turn_frame(f, cos, sin);
             }
         });
     if rows > n {

@@ -17,7 +17,6 @@
 use glam::DVec3;
 
 use super::lanes::{Arith, F4, L, V4};
-use super::tangents::{CHORD_MARGIN, CORNER_COS2, OVERSHOOT_COS, centred_weights};
 
 /// The unit tangents of the rows `g … g + 3` (all four centred: `2 ≤ g`, `g + 6 ≤ n`) when
 /// each passes the scalar rule's tests, else `None` (the caller then asks the scalar
@@ -83,6 +82,41 @@ pub fn centred_group(x: &[DVec3], h: &[f64], g: usize) -> Option<[DVec3; L]> {
 pub fn group_of(i: usize, n: usize) -> Option<usize> {
     let g = i & !(L - 1);
     (g >= 2 && g + 6 <= n).then_some(g)
+}
+
+/// Smallest accepted margin of an estimated tangent against the chords at its sample,
+/// relative to the bisector's (see [`guard_chords`](super::tangents::guard_chords)).
+pub const CHORD_MARGIN: f64 = 0.5;
+
+/// `cos² 30° = 3/4`, for [`guard_chords`](super::tangents::guard_chords)' test without square roots.
+pub const CORNER_COS2: f64 = 0.75;
+
+/// Smallest accepted cosine between the five-point estimate and the circle (3-point)
+/// estimate; below it the quartic overshoots (a kink, or wildly uneven spacing) and the
+/// circle estimate is used.
+pub const OVERSHOOT_COS: f64 = 0.5;
+
+/// The weights of `centred_five_point` in [`super::tangents`] for `x₀, x₁, x₃, x₄` (relative to `x₂`); generic so
+/// that the fused path evaluates the same formula four samples at a time.
+#[inline(always)]
+pub(super) fn centred_weights<T: Arith>(h0: T, h1: T, h2: T, h3: T) -> [T; 4] {
+    // Positions relative to x₂, scaled by 1/(h₁ + h₂): the direction does not depend on the
+    // scale, and O(1) values keep the products below far from under/overflow.
+    let k = T::splat(1.0) / (h1 + h2);
+    let (t0, t1, t3, t4) = (-(h0 + h1) * k, -h1 * k, h2 * k, (h2 + h3) * k);
+    // Lagrange weights w_j = n_j / d_j; multiplying all by d₀d₁d₃d₄ (> 0 for
+    // t₀ < t₁ < 0 < t₃ < t₄) leaves the direction and needs no division.
+    let d0 = (t0 - t1) * t0 * (t0 - t3) * (t0 - t4);
+    let d1 = (t1 - t0) * t1 * (t1 - t3) * (t1 - t4);
+    let d3 = (t3 - t0) * (t3 - t1) * t3 * (t3 - t4);
+    let d4 = (t4 - t0) * (t4 - t1) * t4 * (t4 - t3);
+    let (d01, d34) = (d0 * d1, d3 * d4);
+    [
+        -(t1 * t3 * t4) * (d1 * d34),
+        -(t0 * t3 * t4) * (d0 * d34),
+        -(t0 * t1 * t4) * (d01 * d4),
+        -(t0 * t1 * t3) * (d01 * d3),
+    ]
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::carry::turn_frame;
 use super::{Orientation, Request, compute_into, validate};
 use crate::error::{InputError, Result};
 use crate::run::cancel::Cancel;
@@ -40,11 +41,7 @@ pub fn turn_all(out: &mut [f64], c: f64, cancel: Cancel<'_>) {
             return;
         }
         for f in b.chunks_exact_mut(9) {
-            for row in 0..3 {
-                let (r, s) = (f[3 * row], f[3 * row + 1]);
-                f[3 * row] = cos * r + sin * s;
-                f[3 * row + 1] = cos * s - sin * r;
-            }
+            turn_frame(f, cos, sin);
         }
     });
 }

@@ -19,6 +19,8 @@
 //! length: `α(s) = α_L s / L`. `α_L` is the signed angle from the transported reference
 //! vector at the end to the target (`r_0` itself for a closed curve), plus `2π·turns`.
 
+pub use super::carry::ChunkEnds;
+use super::carry::turn_frame;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -64,26 +66,6 @@ pub fn write_frame(buf: &mut [f64], r: DVec3, t: DVec3) {
     buf[8] = t.z;
 }
 
-/// Turn the rows of written frames about their `t` columns by `angle` (nothing for 0).
-pub(super) fn turn_rows(buf: &mut [f64], angle: f64) {
-    if angle != 0.0 {
-        let (sin, cos) = angle.sin_cos();
-        for f in buf.chunks_exact_mut(9) {
-            turn_frame(f, cos, sin);
-        }
-    }
-}
-
-/// Turn the `(r, s)` columns of a written frame about its `t` column.
-#[inline(always)]
-fn turn_frame(f: &mut [f64], cos: f64, sin: f64) {
-    for row in 0..3 {
-        let (r, s) = (f[3 * row], f[3 * row + 1]);
-        f[3 * row] = cos * r + sin * s;
-        f[3 * row + 1] = cos * s - sin * r;
-    }
-}
-
 /// How a curve of `ext` extended frames is cut into chunks for the parallel scan: `(chunks,
 /// chunk size)`. One chunk unless the step is a rotation and the curve is long. The cut does
 /// not depend on the number of threads (one thread scans the chunks in turn), so the frames
@@ -96,10 +78,6 @@ pub fn plan(ext: usize, is_rotation: bool) -> (usize, usize) {
     };
     (ext.div_ceil(cs), cs)
 }
-
-/// What the transport of a chunk reports: the start vector it used (the true one for chunk
-/// 0, a provisional one otherwise), its last vector, and the chunk's arc length.
-pub type ChunkEnds = (DVec3, DVec3, f64);
 
 /// The curve data the scan needs besides the transport of a chunk itself.
 pub struct Scan<B, T, L> {
@@ -333,18 +311,12 @@ fn transport_chunked<S: Step>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::carry::tests::pool;
     use super::super::double_reflection::DoubleReflection;
     use super::super::{Method, Orientation, Request, compute_general, compute_into};
     use super::*;
     use crate::run::cancel;
     use std::f64::consts::TAU;
-
-    fn pool(threads: usize) -> rayon::ThreadPool {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool")
-    }
 
     /// The same values, bit for bit.
     fn same_bits(a: &[f64], b: &[f64]) -> bool {

@@ -117,6 +117,12 @@ impl Report {
     }
 }
 
+/// The number of rayon workers seen from inside a heavy call (for the tests).
+#[pyfunction]
+pub fn pool_threads(py: Python<'_>) -> PyResult<usize> {
+    detach_in_pool(py, rayon::current_num_threads)
+}
+
 /// [`detach_stoppable`] that also calls `report`'s callback from the calling thread, at
 /// most every [`SIGNAL_INTERVAL`] while the count moves and once at the end with the final
 /// count (the work itself never calls into Python, so reports cost it one atomic add per

@@ -92,7 +92,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(threads::set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(threads::num_threads_setting, m)?)?;
     m.add_function(wrap_pyfunction!(threads::get_num_threads, m)?)?;
-    m.add_function(wrap_pyfunction!(threads::pool_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(convert::pool_threads, m)?)?;
     m.add_function(wrap_pyfunction!(frames::distinct_rows, m)?)?;
     m.add(
         "RepeatedPointsError",

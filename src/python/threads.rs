@@ -9,10 +9,8 @@ use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-
-use super::convert::{detach_in_pool, value_error};
 
 /// Largest thread count accepted (a typo such as `10**6` must not spawn a million threads).
 pub const MAX_THREADS: usize = 1024;
@@ -90,7 +88,7 @@ pub fn set_num_threads(n: Option<usize>) -> PyResult<()> {
             SETTING.store(n, Ordering::Relaxed);
         }
         Some(n) => {
-            return Err(value_error(format!(
+            return Err(PyValueError::new_err(format!(
                 "n: must be a positive int at most {MAX_THREADS}, got {n}"
             )));
         }
@@ -111,10 +109,4 @@ pub fn num_threads_setting() -> Option<usize> {
 #[pyfunction]
 pub fn get_num_threads() -> usize {
     current_threads()
-}
-
-/// The number of rayon workers seen from inside a heavy call (for the tests).
-#[pyfunction]
-pub fn pool_threads(py: Python<'_>) -> PyResult<usize> {
-    detach_in_pool(py, rayon::current_num_threads)
 }

@@ -4,7 +4,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::join::Corner;
+use super::corners::Corner;
 use super::layout::{Plan, Size};
 use super::{Options, Profile, Spine, columns};
 use crate::error::{InputError, Result};
@@ -16,6 +16,8 @@ use crate::run::cancel::Cancel;
 /// [`crate::run::cancel`]). `given`: the frames came with the input and are checked too (frames
 /// computed here are rotations along the spine by construction). `found`: the spine's size
 /// and corners as its layout found them ([`Size::with_corners`]), or `None` to find them.
+// Kept whole: the checks share the spine's chords buffer (reused for the arc lengths) and
+// poll between and within their passes in one sequence.
 pub(super) fn check_spine(
     s: &Spine,
     opts: &Options,

@@ -5,8 +5,24 @@ use glam::DVec3;
 use std::ops::Range;
 
 use super::Profile;
-use super::rings::Geo;
 use super::scale::{Real, unscaled};
+
+/// A ring's centre and the images of the profile's axes.
+pub(super) type Axes = (DVec3, DVec3, DVec3);
+
+/// One ring of the smooth swept surface.
+#[derive(Clone, Copy)]
+pub(super) struct Geo {
+    /// Spine sample.
+    pub(super) k: usize,
+    /// Centre and profile axes of the smooth surface.
+    pub(super) b: Axes,
+    /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
+    /// `x + a_j·ma + b_j·mb`.
+    pub(super) ma: DVec3,
+    pub(super) mb: DVec3,
+    pub(super) t: DVec3,
+}
 
 /// The stored columns of a profile (`cols`: one more than the profile for split seams),
 /// one array per quantity: the profile vertex `p`, the weights `w` of the ring's six cross

@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::join::{self, Corner};
+use super::corners::{self, Corner};
 use super::{Options, Profile, Spine};
 use crate::error::{InputError, Result};
 use crate::frames::validate;
@@ -46,7 +46,7 @@ impl Size {
         };
         let mut corners = Vec::new();
         if scale.len() == 1 || scale.len() == rings {
-            join::corners(&x[..rings], scale, opts.closed, p, opts, |c| {
+            corners::corners(&x[..rings], scale, opts.closed, p, opts, |c| {
                 corners.push(c)
             });
         } // (else refused by the checks)

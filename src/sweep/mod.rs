@@ -59,6 +59,7 @@
 
 mod caps;
 mod check;
+mod corners;
 mod faces;
 pub mod join;
 mod kernel;
@@ -77,7 +78,7 @@ mod tests;
 
 use glam::{DVec2, DVec3};
 
-pub use join::Join;
+pub use corners::Join;
 pub use layout::{Layout, indices_fit_i32, layout};
 pub use profile::Profile;
 pub use run::{FrameSource, Prepared, Written, sweep_into, sweep_many};

@@ -399,7 +399,7 @@ mod tests {
     use super::*;
     use crate::math::predicates::{accurate_area2, accurate_cover2};
     use crate::sweep::profile::Profile;
-    use crate::sweep::profile::fixtures::{Rng, star_shaped};
+    use crate::sweep::profile::fixtures::{Rng, comb, spiked_star as star, star_shaped};
     use std::collections::HashMap;
 
     /// Check that `tris` triangulates the counter-clockwise simple polygon `q`: `m − 2`
@@ -557,31 +557,6 @@ mod tests {
             }
         }
         assert!(tested > 1900, "{tested}");
-    }
-
-    fn star(m: usize, inner: f64) -> Vec<DVec2> {
-        (0..m)
-            .map(|k| {
-                let r = if k % 2 == 0 { 1.0 } else { inner };
-                r * DVec2::from_angle(std::f64::consts::TAU * k as f64 / m as f64)
-            })
-            .collect()
-    }
-
-    fn comb(k: usize) -> Vec<DVec2> {
-        let mut p = vec![
-            DVec2::new(0.0, 0.0),
-            DVec2::new(1.0, 0.0),
-            DVec2::new(1.0, 0.1),
-        ];
-        for i in (0..k).rev() {
-            let x = i as f64 / k as f64;
-            let w = 0.5 / k as f64;
-            p.extend(
-                [(x + w, 0.1), (x + w, 1.1), (x, 1.1), (x, 0.1)].map(|(x, y)| DVec2::new(x, y)),
-            );
-        }
-        p
     }
 
     /// A square spiral of `turns` turns and corridor width 1 (every vertex on a grid).

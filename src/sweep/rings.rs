@@ -7,7 +7,7 @@ use std::ops::Range;
 use std::sync::OnceLock;
 
 use super::faces::FacePattern;
-use super::kernel::{Cols, Columns, RingScratch};
+use super::kernel::{Axes, Cols, Columns, Geo, RingScratch};
 use super::layout::Plan;
 use super::scale::{Index, Real, put3, unscaled};
 use super::{MeshMut, Profile, Spine, columns};
@@ -83,23 +83,6 @@ fn spine_weights(arc: &[f64], i: usize, r_n: usize, closed: bool) -> ([usize; 3]
         let h2 = arc[i + 1] - arc[i];
         ([i - 1, i, i + 1], central_weights(h1, h2))
     }
-}
-
-/// A ring's centre and the images of the profile's axes.
-pub(super) type Axes = (DVec3, DVec3, DVec3);
-
-/// One ring of the smooth swept surface.
-#[derive(Clone, Copy)]
-pub(super) struct Geo {
-    /// Spine sample.
-    k: usize,
-    /// Centre and profile axes of the smooth surface.
-    pub(super) b: Axes,
-    /// The axes with the mitre stretch `M(a) = a + (f − 1)(a·k)k`: vertex `j` is
-    /// `x + a_j·ma + b_j·mb`.
-    pub(super) ma: DVec3,
-    pub(super) mb: DVec3,
-    pub(super) t: DVec3,
 }
 
 /// One block of rings' share of the outputs (`f`: the faces of its segments): whole rings,

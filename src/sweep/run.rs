@@ -8,8 +8,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::caps::write_caps;
 use super::check::check_spine;
+use super::corners::Corner;
 use super::faces::FacePattern;
-use super::join::{Corner, write_joins};
+use super::join::write_joins;
 use super::kernel::{Columns, RingScratch};
 use super::layout::{Layout, Plan, in_curve, layout, part};
 use super::rings::Rings;

@@ -1,11 +1,7 @@
 """Limits of the compiled fields and of advection: speed bounds that overflow, step counts
-that no call could finish, Ctrl-C during a long advection, and the package's import graph."""
+that no call could finish, and Ctrl-C during a long advection."""
 
 from __future__ import annotations
-
-import ast
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -54,34 +50,3 @@ def test_ctrl_c_stops_a_long_advection():
     setup = ("x = np.random.default_rng(0).normal(size=(200_000, 3))\n"
              "f = fl.translation([0, 0, 1.32], 0.3, [0, 0, -1])\n")
     assert late_after_sigint(setup, "spinal.advect(x, f, 0.3, 20_000)", after=1.0) < 0.5
-
-
-def test_the_package_imports_in_one_direction():
-    """No import cycle among spinal's modules (module-level and function-level imports)."""
-    pkg = Path(spinal.__file__).parent
-    graph = {}
-    for path in pkg.glob("*.py"):
-        mod = path.stem
-        deps = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom) and node.level == 1:
-                if node.module:
-                    deps.add(node.module.split(".")[0])
-                else:
-                    deps.update(a.name for a in node.names)
-        graph[mod] = {d for d in deps if (pkg / f"{d}.py").exists() and d != mod}
-    state = {}
-
-    def visit(m, stack):
-        state[m] = "open"
-        for d in graph.get(m, ()):
-            if state.get(d) == "open":
-                raise AssertionError("import cycle: " + " -> ".join(stack + [m, d]))
-            if d not in state:
-                visit(d, stack + [m])
-        state[m] = "done"
-
-    for m in graph:
-        if m not in state and m != "__init__":
-            visit(m, [])
-    assert os.path.basename(str(pkg)) == "spinal"

@@ -329,6 +329,8 @@ impl Refiner<'_> {
     /// the chords between the images of the path's points.
     /// Returns how many were split (all of `chosen` unless `chords` is false: see
     /// [`Refiner::split_terminals`]).
+    // Kept whole: the placement of every new point and the splits that use it share the
+    // images of the paths' junctions, computed once for all chosen edges.
     fn place_and_split(
         &mut self,
         w: &mut Vec<DVec3>,
