@@ -40,6 +40,7 @@ import numpy as np
 
 from . import _core
 from ._mesh import Mesh, mesh_arrays, signed_volume
+from ._types import AnyMesh
 from ._validate import as_positive
 
 __all__ = ["CompensationReport", "compensate_volume"]
@@ -323,7 +324,7 @@ def _scale_exponent(V: np.ndarray) -> int:
     return max(-1000, min(1000, e))
 
 
-def compensate_volume(mesh, target: float) -> tuple[Mesh, CompensationReport]:
+def compensate_volume(mesh: AnyMesh, target: float) -> tuple[Mesh, CompensationReport]:
     r"""Give a closed mesh the volume ``target`` by moving every vertex the same distance
     ``h`` along its unit normal (global volume compensation, Zhuo 2014 §2.2.2 and ch. IX).
 

@@ -4,6 +4,7 @@ re-exported there."""
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 
@@ -21,6 +22,7 @@ from ._spline import (
     periodic_bspline,
     row_norms,
 )
+from ._types import Array, Float64Array, Param
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -58,53 +60,53 @@ class Curve:
     def _eval(self, u: np.ndarray, k: int) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def point(self, u) -> np.ndarray:
+    def point(self, u: Param) -> Float64Array:
         """Points ``x(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 0)
 
-    def d1(self, u) -> np.ndarray:
+    def d1(self, u: Param) -> Float64Array:
         """First derivative ``x′(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 1)
 
-    def d2(self, u) -> np.ndarray:
+    def d2(self, u: Param) -> Float64Array:
         """Second derivative ``x″(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 2)
 
-    def d3(self, u) -> np.ndarray:
+    def d3(self, u: Param) -> Float64Array:
         """Third derivative ``x‴(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 3)
 
-    def parameters(self, n: int) -> np.ndarray:
+    def parameters(self, n: int) -> Float64Array:
         """``n`` uniformly spaced parameters over :attr:`domain` (both ends included)."""
         n = as_int(n, "n", 2, MAX_SAMPLES, out_of_bounds=lambda x: (
             f"a sample count must be at least 2 and at most {MAX_SAMPLES:,}, got {x}"))
         return np.linspace(self.domain[0], self.domain[1], n)
 
-    def sample(self, n: int) -> np.ndarray:
+    def sample(self, n: int) -> Float64Array:
         """``n`` points at uniformly spaced parameters over :attr:`domain`."""
         return self.point(self.parameters(n))
 
-    def tangent(self, u) -> np.ndarray:
+    def tangent(self, u: Param) -> Float64Array:
         """Unit tangents ``x′/|x′|``."""
         d = self.d1(u)
         return d / np.linalg.norm(d, axis=1, keepdims=True)
 
-    def curvature(self, u) -> np.ndarray:
+    def curvature(self, u: Param) -> Float64Array:
         """Curvature ``κ = |x′ × x″| / |x′|³`` (1/length)."""
         d1, d2 = self.d1(u), self.d2(u)
         return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
 
-    def torsion(self, u) -> np.ndarray:
+    def torsion(self, u: Param) -> Float64Array:
         """Torsion ``τ = det(x′, x″, x‴) / |x′ × x″|²`` (1/length; undefined where κ = 0)."""
         d1, d2, d3 = self.d1(u), self.d2(u), self.d3(u)
         c = np.cross(d1, d2)
         return np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
 
-    def speed(self, u) -> np.ndarray:
+    def speed(self, u: Param) -> Float64Array:
         """``|x′(u)|`` (length per unit parameter)."""
         return np.linalg.norm(self.d1(u), axis=1)
 
-    def frenet(self, u) -> np.ndarray:
+    def frenet(self, u: Param) -> Float64Array:
         """Exact Frenet frames ``(k, 3, 3)``, columns ``(N, B, T)`` (undefined where κ = 0)."""
         d1, d2 = self.d1(u), self.d2(u)
         t = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
@@ -124,7 +126,10 @@ class Helix(Curve):
     Arc length ``s = c u`` with ``c = √(a² + b²)``; ``κ = a/c²``, ``τ = b/c²``.
     """
 
-    def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0):
+    a: float
+    b: float
+
+    def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0) -> None:
         a = as_finite(a, "a")
         if not a > 0:
             raise ValueError(f"a: the helix radius must be positive and finite, got {a!r}")
@@ -143,7 +148,7 @@ class Helix(Curve):
             return np.stack([-a * c, -a * s, z], axis=1)
         return np.stack([a * s, -a * c, z], axis=1)
 
-    def rmf(self, u, angle: float = 0.0) -> np.ndarray:
+    def rmf(self, u: Param, angle: float = 0.0) -> Float64Array:
         """Exact rotation-minimising frames ``(k, 3, 3)`` (columns ``r, s, t``).
 
         ``r(u) = cos θ N + sin θ B`` with ``θ = angle − τ c (u − u_0)``: the Frenet frame
@@ -166,9 +171,14 @@ class TorusKnot(Curve):
     The defaults (p, q, R, r) = (2, 7, 0.6, 0.3) are the torus knot of Wang et al. (2008).
     """
 
+    p: int
+    q: int
+    R: float
+    r: float
+
     closed = True
 
-    def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3):
+    def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3) -> None:
         # positive integers: the curve closes after u = 2π only then
         p, q = (as_int(v, k, 1, _MAX_WINDINGS, out_of_bounds=lambda x: (
             f"the winding number must be a positive integer at most {_MAX_WINDINGS:,}, got {x}"))
@@ -206,9 +216,11 @@ class Viviani(Curve):
     is ``r = x/|x|`` (the sphere normal) up to a constant rotation about the tangent.
     """
 
+    a: float
+
     closed = True
 
-    def __init__(self, a: float = 1.0):
+    def __init__(self, a: float = 1.0) -> None:
         self.a = as_positive(a, "a")
         self.domain = (0.0, 4 * math.pi)
 
@@ -228,7 +240,11 @@ class Viviani(Curve):
 class Polynomial(Curve):
     """Polynomial curve ``x(u) = Σ_j c_j u^j`` with coefficient rows ``c_j`` (shape (d+1, 3))."""
 
-    def __init__(self, coefficients, domain: tuple[float, float] = (0.0, 1.0)):
+    coefficients: Float64Array
+
+    def __init__(
+        self, coefficients: Array, domain: tuple[float, float] = (0.0, 1.0)
+    ) -> None:
         c = as_float_array(coefficients, "coefficients")
         if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] < 2:
             raise ValueError(f"coefficients: expected shape (d+1, 3) with d >= 1, got {c.shape}")
@@ -253,7 +269,9 @@ class Polynomial(Curve):
 class Bezier(Polynomial):
     """Bézier curve on ``u ∈ [0, 1]`` with control points of shape ``(d+1, 3)``."""
 
-    def __init__(self, control_points):
+    control_points: Float64Array
+
+    def __init__(self, control_points: Array) -> None:
         p = as_float_array(control_points, "control_points")
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2:
             raise ValueError(f"control_points: expected shape (d+1, 3), d >= 1, got {p.shape}")
@@ -383,7 +401,17 @@ class Spline(Curve):
     (100, 3)
     """
 
-    def __init__(self, points, kind: str = "catmull_rom", closed: bool = False):
+    points: Float64Array
+    kind: Literal["catmull_rom", "natural_cubic", "bspline"]
+    closed: bool
+    knots: Float64Array
+
+    def __init__(
+        self,
+        points: Array,
+        kind: Literal["catmull_rom", "natural_cubic", "bspline"] = "catmull_rom",
+        closed: bool = False,
+    ) -> None:
         kind = as_choice(kind, "kind", _SPLINE_KINDS)
         closed = as_bool(closed, "closed")
         p = as_float_array(points, "points")
@@ -446,7 +474,7 @@ class Spline(Curve):
         """The arc length ``∫|x′| du`` over :attr:`domain` (closed: once round the loop)."""
         return float(self._arc_table()[3][-1])
 
-    def arc_length_parameters(self, n: int) -> np.ndarray:
+    def arc_length_parameters(self, n: int) -> Float64Array:
         """``n`` parameters ``u`` at equal arc-length steps, increasing.
 
         Open: both ends included, ``s(u_i) = i L/(n − 1)``. Closed: ``s(u_i) = i L/n``,
@@ -466,7 +494,7 @@ class Spline(Curve):
             u[-1] = self.domain[1]
         return np.clip(u, *self.domain)
 
-    def sample_arc_length(self, n: int) -> np.ndarray:
+    def sample_arc_length(self, n: int) -> Float64Array:
         """``n`` points equally spaced in arc length, ``(n, 3)``:
         ``point(arc_length_parameters(n))``. Open: both end points included. Closed: the
         first point is not repeated at the end, as ``spinal.frames``, ``spinal.tube`` and

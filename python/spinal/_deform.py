@@ -29,6 +29,7 @@ import time
 import warnings
 from dataclasses import dataclass
 from dataclasses import field as _dc_field
+from typing import Literal
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from ._advect import MAX_STEPS, default_steps
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import volumes_at_scale as _volumes
 from ._progress import Progress, checked
+from ._types import AnyMesh, Array, Float64Array, Int64Array, ProgressArg
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
 from .fields import Field
 
@@ -204,13 +206,13 @@ class DeformReport:
     passes: int
     integration_error: float | None = None  # relative, Richardson estimate (estimate=True)
     mesh_error: float | None = None  # relative_change − integration_error
-    rest_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
+    rest_vertices: Float64Array | None = _dc_field(default=None, repr=False, compare=False)
     converged: bool = True
     edges_over_threshold: int = 0
     max_vertices: int | None = None
     torn_vertices: int = 0
-    step_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
-    timings: dict | None = _dc_field(default=None, repr=False, compare=False)
+    step_vertices: Int64Array | None = _dc_field(default=None, repr=False, compare=False)
+    timings: dict[str, float] | None = _dc_field(default=None, repr=False, compare=False)
     slip_vertices: int = 0
     chord_vertices: int = 0
     flips: int = 0
@@ -240,9 +242,20 @@ class DeformReport:
         return s
 
 
-def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: int = 30,
-           t0=0.0, estimate: bool = False, progress=False,
-           max_vertices=None, check: bool = True) -> tuple[Mesh, DeformReport]:
+def deform(
+    mesh: AnyMesh,
+    field: Field,
+    duration: float,
+    steps: int | None = None,
+    *,
+    refine: float | None = 1.5,
+    max_passes: int = 30,
+    t0: float = 0.0,
+    estimate: bool = False,
+    progress: ProgressArg = False,
+    max_vertices: int | None = None,
+    check: bool | Literal["intersections"] = True,
+) -> tuple[Mesh, DeformReport]:
     """Deform a closed triangle mesh along a divergence-free field and report the volume.
 
     The vertices are advected with RK4 (the steps of :func:`spinal.advect`, default step
@@ -436,14 +449,23 @@ class StampReport:
     rest_volume: float
     volume: float
     relative_change: float
-    dent: np.ndarray
-    time: np.ndarray
-    residual: np.ndarray
-    contact: np.ndarray
+    dent: Float64Array
+    time: Float64Array
+    residual: Float64Array
+    contact: Int64Array
 
 
-def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
-          iterations: int = 2, progress=False) -> tuple[Mesh, StampReport]:
+def stamp(
+    mesh: AnyMesh,
+    start: Array,
+    end: Array,
+    radius: float,
+    *,
+    reach: float | None = None,
+    frames: int = 10,
+    iterations: int = 2,
+    progress: ProgressArg = False,
+) -> tuple[Mesh, StampReport]:
     """Press a sphere into a closed mesh in contact only (thesis §11.2.6, the "stamper"),
     giving the dented volume back as a protrusion around the contact.
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import functools
 import numbers
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import Literal
 
 import numpy as np
 
@@ -13,6 +14,7 @@ from . import _core
 from ._core import Field
 from ._mesh import mesh_arrays
 from ._progress import Progress, checked
+from ._types import Array, Blend, FalloffPower, Form
 from ._validate import (
     as_bool,
     as_finite,
@@ -55,8 +57,15 @@ def _power(x) -> int:
 
 
 @_recorded
-def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
-                moving: bool = True) -> Field:
+def translation(
+    center: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A spherical tool moving with constant ``velocity``, pushing the material around it.
 
     Curl field (thesis eq. 12.1–12.2, corrected sign and scale)::
@@ -83,8 +92,16 @@ def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
 
 
 @_recorded
-def rotation(center, radius, axis, angular_speed, *, pivot=None, reach=None,
-             falloff_power: int = 2) -> Field:
+def rotation(
+    center: Array,
+    radius: float,
+    axis: Array,
+    angular_speed: float,
+    *,
+    pivot: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+) -> Field:
     """A spherical tool turning at ``angular_speed`` (rad/time, right-handed) about ``axis``
     through ``pivot`` (default: its centre, a tool spinning in place).
 
@@ -110,7 +127,9 @@ def _swirl(center, axis, rate, radius, form, bend: bool) -> Field:
 
 
 @_recorded
-def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
+def twist(
+    center: Array, axis: Array, rate: float, radius: float, *, form: Form = "rate"
+) -> Field:
     """Twist about ``axis`` through ``center``: angle rate ``κ z`` (rad/time) at height
     ``z = a·(X − center)``, fading to 0 at distance ``radius`` from the centre.
 
@@ -123,7 +142,9 @@ def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
 
 
 @_recorded
-def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
+def bend(
+    center: Array, axis: Array, rate: float, radius: float, *, form: Form = "rate"
+) -> Field:
     """The thesis's "bend" (eq. 12.6, a differential swirl): angle rate ``β r²`` about
     ``axis`` through ``center``, ``r = |X − center|``, fading to 0 at ``radius``.
 
@@ -135,8 +156,15 @@ def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
 
 
 @_recorded
-def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
-           moving: bool = True) -> Field:
+def sphere(
+    center: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """von Funck's region translation around a sphere (``r_i = radius``,
     ``r_o = radius + reach``): ``v = ∇p × ∇q`` with ``p = (1 − D) N·Y``, ``q = (1 − D) B·Y``::
 
@@ -150,8 +178,16 @@ def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def capsule(start, end, radius, velocity, *, reach=None, blend: str = "c1",
-            moving: bool = True) -> Field:
+def capsule(
+    start: Array,
+    end: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """Region translation around a capsule (segment ``start``–``end``, ``radius``): the exact
     distance-field extension of :func:`sphere` to a free-form tool, ``Y = X − midpoint``,
     ``d`` the capsule's signed distance, ``n = ∇d``. Divergence-free for any C¹ distance.
@@ -162,8 +198,16 @@ def capsule(start, end, radius, velocity, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
-          blend: str = "c1") -> Field:
+def strip(
+    start: Array,
+    end: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    kind: Literal["along", "across"] = "along",
+    reach: float | None = None,
+    blend: Blend = "c1",
+) -> Field:
     """A straight strip (a capsule from ``start`` to ``end``) moving the material around it
     (thesis §11.2.2–11.2.3; type I moves the material along the strip, type II across it).
 
@@ -180,8 +224,17 @@ def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
 
 
 @_recorded
-def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
-          moving: bool = True) -> Field:
+def torus(
+    center: Array,
+    axis: Array,
+    major: float,
+    minor: float,
+    speed: float,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """A torus (major radius ``major``, tube radius ``minor``) moving along its ``axis`` with
     ``speed`` (thesis §11.2.4; the two half-torus fields summed in closed form)::
 
@@ -196,7 +249,14 @@ def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Field:
+def strip_curve(
+    points: Array,
+    radius: float,
+    speed: float,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+) -> Field:
     """A strip of type I along a curved axis (thesis §11.2.2, "sticking", type I): the material
     within ``radius`` of the axis flows along it at ``speed`` (length/time, from
     ``points[0]`` towards ``points[-1]``; negative: backwards), leaves at the head, comes back
@@ -280,8 +340,17 @@ def _grid_spline(values, origin, h, center, reach):
 
 
 @_recorded
-def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend: str = "c1",
-             moving: bool = True) -> Field:
+def sdf_tool(
+    grid: Array,
+    origin: Array,
+    spacing: float,
+    velocity: Array,
+    *,
+    center: Array | None = None,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """A free-form tool given by its signed distance sampled on a grid, translating with
     ``velocity``: Zheng's extended spherical field with the object's distance (thesis §11.2.1;
     the distance-field extension of :func:`sphere`)::
@@ -364,8 +433,17 @@ def _closed_mesh(mesh):
 
 
 @_recorded
-def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
-              blend: str = "c1", moving: bool = True, progress=False) -> Field:
+def mesh_tool(
+    mesh: object,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    resolution: int = 64,
+    center: Array | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
+) -> Field:
     """A free-form tool given as a closed triangle mesh, translating with ``velocity``: the
     field of :func:`sdf_tool` with the mesh's signed distance sampled on a grid.
 
@@ -460,9 +538,20 @@ def sum(fields: Iterable[Field]) -> Field:
 
 
 @_recorded
-def along_path(points, radius, duration, *, kind: str = "translate", tool: str = "push",
-               rate=0.0, frames=None, t0=0.0, reach=None, falloff_power: int = 2,
-               blend: str = "c1") -> Field:
+def along_path(
+    points: Array,
+    radius: float,
+    duration: float,
+    *,
+    kind: Literal["translate", "rotate", "twist", "bend"] = "translate",
+    tool: Literal["push", "carry"] = "push",
+    rate: float = 0.0,
+    frames: Array | None = None,
+    t0: float = 0.0,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    blend: Blend = "c1",
+) -> Field:
     """A spherical tool travelling along a spine from ``points[0]`` (at time ``t0``) to
     ``points[-1]`` (at ``t0 + duration``) at constant speed ``u = L/duration`` in chord
     length ``L``, deforming the material around it; at rest (zero field) outside that time.
@@ -550,8 +639,19 @@ _CURL_DOC = """
 
 
 @_recorded
-def sdf_curl(grid, origin, spacing, *, velocity=None, angular_velocity=None, pivot=None,
-             center=None, reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+def sdf_curl(
+    grid: Array,
+    origin: Array,
+    spacing: float,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    center: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A curl tool whose shape is a signed distance sampled on a grid (negative inside):
     ``d`` the C² tricubic B-spline interpolating the samples and ``g`` its exact gradient,
     as for :func:`sdf_tool` (whose arguments ``grid``, ``origin``, ``spacing``, ``center``
@@ -572,9 +672,19 @@ def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, piv
 
 
 @_recorded
-def mesh_curl(mesh, *, velocity=None, angular_velocity=None, pivot=None, reach=None,
-              resolution: int = 64, center=None, falloff_power: int = 2,
-              moving: bool = True, progress=False) -> Field:
+def mesh_curl(
+    mesh: object,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    reach: float | None = None,
+    resolution: int = 64,
+    center: Array | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
+) -> Field:
     """A curl tool whose shape is a closed triangle mesh: its signed distance sampled on the
     grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``,
     ``progress``; needs libigl), then :func:`sdf_curl`."""
@@ -584,8 +694,18 @@ def mesh_curl(mesh, *, velocity=None, angular_velocity=None, pivot=None, reach=N
 
 
 @_recorded
-def rod(points, radius, *, velocity=None, angular_velocity=None, pivot=None, center=None,
-        reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+def rod(
+    points: Array,
+    radius: float,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    center: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A curl tool whose shape is a rod: the tube of ``radius`` ρ about the axis through
     ``points`` (two points: a capsule).
 
@@ -610,8 +730,15 @@ del _ctor
 
 
 @_recorded
-def keyframed(tool, times, positions, orientations=None, *,
-              falloff_power: int | None = None, center=None) -> Field:
+def keyframed(
+    tool: Field,
+    times: Array,
+    positions: Array,
+    orientations: Array | None = None,
+    *,
+    falloff_power: FalloffPower | None = None,
+    center: Array | None = None,
+) -> Field:
     """``tool`` following keyframed rigid poses ``(t_k, c_k, Q_k)``: the pose ``(c(t), Q(t))``
     takes the tool's point ``C`` to ``c(t)`` and turns it by ``Q(t)`` about it (``c_k = C``,
     ``Q_k = I`` leave it in place). Every field can be keyframed, in one of two ways.

@@ -9,12 +9,14 @@ Tech 2014; Zhuo & Rossignac, CGF 32(2) 2013). See :class:`SpineBinding` and :fun
 from __future__ import annotations
 
 import warnings
+from typing import Literal, overload
 
 import numpy as np
 
 from . import _core, _motion
 from ._frames import _spine_frames
 from ._mesh import FoldOverWarning
+from ._types import Array, Float64Array, Int64Array, ProgressArg, SpineSolution
 from ._validate import as_bool, as_choice, as_float_array, as_real
 
 SOLUTIONS = ("radial", "normal", "binormal", "blend", "none")
@@ -307,7 +309,9 @@ class SpineBinding:
         Messages start with the argument's name: wrong shapes, NaN/inf, repeated spine points.
     """
 
-    def __init__(self, vertices, rest_spine, *, closed: bool = False):
+    clamped: Int64Array
+
+    def __init__(self, vertices: Array, rest_spine: Array, *, closed: bool = False) -> None:
         closed = as_bool(closed, "closed")
         rest, dim = _spine(rest_spine, "rest_spine", closed)
         v = _vertices(vertices, dim)
@@ -325,21 +329,21 @@ class SpineBinding:
         return len(self._edge)
 
     @property
-    def edge(self) -> np.ndarray:
+    def edge(self) -> Int64Array:
         """``(V,)`` int64: the rest spine edge ``k`` (between samples ``k`` and ``k + 1``) that
         holds each vertex's cross-section; ``0`` or ``n − 2`` for vertices past the ends. On a
         closed spine edge ``n − 1`` is the closing edge (from sample ``n − 1`` to sample 0)."""
         return self._edge.copy()
 
     @property
-    def rest_frames(self) -> np.ndarray:
+    def rest_frames(self) -> Float64Array:
         """``(n, 3, 3)`` float64: the rest spine's frames (columns ``r, s, t``) in which the
         offsets are stored. A rigid motion ``x ↦ Rx + c`` of the whole shape is the pose
         ``deform(rest_spine @ R.T + c, posed_frames=R @ rest_frames)``."""
         return self._frames.copy()
 
     @property
-    def param(self) -> np.ndarray:
+    def param(self) -> Float64Array:
         """``(V,)`` float64: the parameter ``a ∈ [0, 1]`` of the section on its edge
         (dimensionless; the section's spine point is the cubic Hermite ``C(a)`` between ``R_k``
         and ``R_{k+1}``, see the class notes). Vertices past
@@ -347,7 +351,7 @@ class SpineBinding:
         return self._coords[:, 0].copy()
 
     @property
-    def arc_length(self) -> np.ndarray:
+    def arc_length(self) -> Float64Array:
         """``(V,)`` float64: rest arc length ``S_k + a (S_{k+1} − S_k)`` of each vertex's
         section along the rest polyline (``S_k`` the cumulative chord lengths), in the units of
         the input; ``0`` or the total length past the ends."""
@@ -356,13 +360,13 @@ class SpineBinding:
         return s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
 
     @property
-    def offset(self) -> np.ndarray:
+    def offset(self) -> Float64Array:
         """``(V, 2)`` float64: each vertex's offset from the spine in its section, as
         coordinates along the ``r`` and ``s`` columns of the interpolated rest frame (units of
         the input; in the planar case ``s`` is out of the plane, so the second column is 0)."""
         return self._coords[:, 2:4].copy()
 
-    def posed_spine(self, posed_spine, *, stretchable: bool = False) -> np.ndarray:
+    def posed_spine(self, posed_spine: Array, *, stretchable: bool = False) -> Float64Array:
         """The posed spine as used by :meth:`deform`: ``(n, 3)`` (resampled when not
         stretchable)."""
         return self._posed(posed_spine, stretchable)[0]
@@ -395,20 +399,65 @@ class SpineBinding:
         pts, at = _resample(posed, np.diff(self._lengths))
         return pts, m, at
 
+    @overload
     def deform(
         self,
-        posed_spine,
+        posed_spine: Array,
         *,
-        solution: str = "radial",
-        blend=None,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
-        twist=None,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[True],
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> tuple[Float64Array, Int64Array]: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
         strict: bool = False,
         return_clamped: bool = False,
-        posed_frames=None,
-        posed_up=None,
-        slide=0.0,
-    ):
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]:
         r"""The shape posed on ``posed_spine`` with its volume preserved locally.
 
         Every vertex is rebuilt from the posed spine at its registered parameter by
@@ -575,9 +624,18 @@ class SpineBinding:
             out = np.ascontiguousarray(out[:, :2])
         return out, frames1
 
-    def animate(self, posed_spines_t, *, solution: str = "radial", blend=None,
-                stretchable: bool = False, twist=None, slide=0.0,
-                previous_weight: float = 1000.0, progress=False) -> np.ndarray:
+    def animate(
+        self,
+        posed_spines_t: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        slide: float | Array = 0.0,
+        previous_weight: float = 1000.0,
+        progress: ProgressArg = False,
+    ) -> Float64Array:
         r"""The shape posed on a sequence of posed spines, with frames that follow each
         other in time: ``(T, V, 3)`` (or ``(T, V, 2)`` in the plane).
 
@@ -663,21 +721,69 @@ def _report_clamped(flags: np.ndarray, strict: bool, level: int = 3) -> np.ndarr
     return clamped
 
 
+@overload
 def flesh(
-    vertices,
-    rest_spine,
-    posed_spine,
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
     *,
-    solution: str = "radial",
-    blend=None,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
-    twist=None,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array: ...
+@overload
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[True],
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> tuple[Float64Array, Int64Array]: ...
+@overload
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
     strict: bool = False,
     return_clamped: bool = False,
     closed: bool = False,
-    posed_frames=None,
-    posed_up=None,
-):
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]:
     r"""Bend a shape with its spine and keep its volume locally (Zhuo 2014): ``(V, 3)``.
 
     One-shot form of ``SpineBinding(vertices, rest_spine).deform(posed_spine, ...)``; see

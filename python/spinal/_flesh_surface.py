@@ -6,13 +6,18 @@ its volume locally when the surface moves (Zhuo 2014 Ch. VI). See :class:`Surfac
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING, Literal, overload
 
 import numpy as np
 
 from . import _core
 from ._flesh import _unit_sized
 from ._mesh import FoldOverWarning
+from ._types import Array, Float64Array, Int64Array, SurfaceSolution
 from ._validate import as_bool, as_choice, as_float_array
+
+if TYPE_CHECKING:
+    from ._mesh import Mesh
 
 
 def _grid(x, name: str) -> np.ndarray:
@@ -155,7 +160,11 @@ class SurfaceBinding:
         a grid as one array.
     """
 
-    def __init__(self, vertices, rest_surface):
+    clamped: Int64Array
+
+    def __init__(
+        self, vertices: Array, rest_surface: Array | Mesh | tuple[Array, Array]
+    ) -> None:
         v = as_float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
@@ -182,13 +191,13 @@ class SurfaceBinding:
         return len(self._cell)
 
     @property
-    def face(self) -> np.ndarray:
+    def face(self) -> Int64Array:
         """``(V,)`` int64: the face of each foot (triangulated surfaces only)."""
         self._only("face", triangles=True)
         return self._cell.copy()
 
     @property
-    def barycentric(self) -> np.ndarray:
+    def barycentric(self) -> Float64Array:
         """``(V, 3)`` barycentric coordinates of the feet on their faces (triangulated
         surfaces only)."""
         self._only("barycentric", triangles=True)
@@ -201,19 +210,19 @@ class SurfaceBinding:
             raise TypeError(f"{name}: only for {kind} rest_surface")
 
     @property
-    def uv(self) -> np.ndarray:
+    def uv(self) -> Float64Array:
         """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet (grids only)."""
         self._only("uv", triangles=False)
         i, j = np.divmod(self._cell, self._shape[1])
         return np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
 
     @property
-    def offset(self) -> np.ndarray:
+    def offset(self) -> Float64Array:
         """``(V,)`` signed offsets ``h`` along the rest normal."""
         return self._coords[:, 2].copy()
 
     @property
-    def rest_frames(self) -> np.ndarray:
+    def rest_frames(self) -> Float64Array:
         """``(nu, nv, 3, 3)`` frames of the rest surface at its samples, columns ``(e1, e2,
         N)``: ``e1`` the direction of ``S_u``, ``e2 = N × e1`` in the surface, ``N`` the
         normal (all by the central differences the binding uses). ``R @ rest_frames`` are
@@ -229,8 +238,49 @@ class SurfaceBinding:
         only the second kind of face uses."""
         return self._rest_frames.copy()
 
-    def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
-               return_clamped: bool = False, posed_frames=None, posed_up=None):
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[True],
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> tuple[Float64Array, Int64Array]: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]:
         """The shape on ``posed_surface`` (same grid shape; for a triangulated rest surface
         the posed vertex array ``(n, 3)``, or a mesh with the same faces): ``(V, 3)``.
 
@@ -317,9 +367,53 @@ class SurfaceBinding:
         return (out, clamped) if return_clamped else out
 
 
-def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "offset",
-                  strict: bool = False, return_clamped: bool = False, posed_frames=None,
-                  posed_up=None):
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array: ...
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[True],
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> tuple[Float64Array, Int64Array]: ...
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]:
     """Bend a shape with a spine surface and keep its volume locally (Zhuo 2014 Ch. VI).
 
     One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``

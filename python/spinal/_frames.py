@@ -3,13 +3,26 @@
 from __future__ import annotations
 
 import warnings
-from typing import Any
+from collections.abc import Sequence
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _merge
 from ._progress import Progress, Reported, checked
 from ._steer import STEERING, guide_rows, previous_frames, steering
+from ._types import (
+    Array,
+    Constraints,
+    CurveBundle,
+    Float64Array,
+    FrameMethod,
+    Ints,
+    ProgressArg,
+    Reflection,
+    TangentRule,
+)
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -184,31 +197,31 @@ def _spine_frames(points, name: str, initial=None, closed: bool = False) -> np.n
 
 
 def frames(
-    points,
-    tangents=None,
+    points: Array | Curve | CurveBundle | None,
+    tangents: Array | CurveBundle | None = None,
     *,
-    method: str = "double_reflection",
-    initial=None,
+    method: FrameMethod = "double_reflection",
+    initial: Array | None = None,
     closed: bool = False,
-    end=None,
+    end: Array | None = None,
     turns: float = 0,
-    reflection: str = "chord",
-    u=None,
-    lengths=None,
-    offsets=None,
-    constraints=None,
-    twist_rule: str = "arc_length",
-    guide=None,
+    reflection: Reflection = "chord",
+    u: int | Array | None = None,
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    constraints: Constraints | Sequence[Constraints | None] | None = None,
+    twist_rule: Literal["arc_length", "min_angular_speed"] = "arc_length",
+    guide: Array | None = None,
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
-    previous=None,
+    previous: Array | None = None,
     previous_twist: bool = False,
     previous_weight: float | None = None,
-    guide_sign: str = "follow",
-    on_invalid: str = "raise",
-    progress=False,
-    out=None,
-) -> np.ndarray:
+    guide_sign: Literal["follow", "free"] = "follow",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    progress: ProgressArg = False,
+    out: npt.NDArray[np.float64] | None = None,
+) -> Float64Array:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
     ``frames[i][:, 2] = t_i`` is the unit tangent, ``frames[i][:, 0] = r_i`` the reference
@@ -498,15 +511,15 @@ def frames(
 
 
 def closing_angle(
-    points,
-    tangents=None,
+    points: Array | Curve | CurveBundle | None,
+    tangents: Array | CurveBundle | None = None,
     *,
-    method: str = "double_reflection",
-    reflection: str = "chord",
-    u=None,
-    lengths=None,
-    offsets=None,
-):
+    method: FrameMethod = "double_reflection",
+    reflection: Reflection = "chord",
+    u: int | Array | None = None,
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+) -> float | Float64Array:
     r"""The closing (holonomy) angle of the rotation-minimising frame of a closed curve.
 
     Carry a reference vector ``r_0`` once round the loop with the RMF; the result ``r_n``
@@ -527,14 +540,14 @@ def closing_angle(
 
 
 def estimate_tangents(
-    points,
+    points: Array | CurveBundle,
     *,
     closed: bool = False,
-    method: str = DEFAULT_TANGENT_RULE,
-    lengths=None,
-    offsets=None,
-    on_invalid: str = "raise",
-) -> np.ndarray:
+    method: TangentRule = "five_point_bounded",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    on_invalid: Literal["raise", "skip"] = "raise",
+) -> Float64Array:
     r"""Unit tangents estimated from sampled points, ``(n, 3)``.
 
     * ``"five_point_bounded"`` (default): ``"five_point"`` below, with each open end tangent
@@ -816,25 +829,25 @@ def _previous_twist_guide(previous, rows: int) -> np.ndarray:
 
 
 def frames_in_time(
-    points_t,
-    tangents_t=None,
+    points_t: Array | None,
+    tangents_t: Array | None = None,
     *,
-    method: str = "double_reflection",
-    initial=None,
+    method: FrameMethod = "double_reflection",
+    initial: Array | None = None,
     closed: bool = False,
     turns: float = 0,
-    reflection: str = "chord",
-    previous=None,
+    reflection: Reflection = "chord",
+    previous: Array | None = None,
     previous_twist: bool = True,
     previous_weight: float | None = None,
-    guide=None,
+    guide: Array | None = None,
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
-    guide_sign: str = "follow",
-    lengths=None,
-    offsets=None,
-    progress=False,
-) -> np.ndarray:
+    guide_sign: Literal["follow", "free"] = "follow",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    progress: ProgressArg = False,
+) -> Float64Array:
     r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
 
     ``points_t`` holds ``T`` time steps of the same curve (or bundle, with ``lengths`` /

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 import pathlib
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _files
+from ._types import Array, Float64Array, Int64Array, PointData
 from ._validate import as_float_array
 
 __all__ = ["FoldOverWarning", "Mesh", "SkippedCurvesWarning", "mesh_arrays"]
@@ -20,7 +23,10 @@ class PrecisionWarning(UserWarning):
     profile's smallest edge as swept, so vertices merge or the cross-section is distorted.
     ``spacing`` and ``feature`` hold the two lengths."""
 
-    def __init__(self, message: str, spacing: float, feature: float):
+    spacing: float
+    feature: float
+
+    def __init__(self, message: str, spacing: float, feature: float) -> None:
         super().__init__(message)
         self.spacing = spacing
         self.feature = feature
@@ -36,8 +42,13 @@ class FoldOverWarning(UserWarning):
     of all curves back to back); for a bundle ``curves`` holds the curve of each and
     ``rows`` the row within that curve (None for a single spine)."""
 
-    def __init__(self, message: str, indices: np.ndarray, curves: np.ndarray | None = None,
-                 rows: np.ndarray | None = None):
+    indices: Int64Array
+    curves: Int64Array | None
+    rows: Int64Array | None
+
+    def __init__(
+        self, message: str, indices: Int64Array, curves: Int64Array | None = None, rows: Int64Array | None = None
+    ) -> None:
         super().__init__(message)
         self.indices = indices
         self.curves = curves
@@ -54,7 +65,9 @@ class SkippedCurvesWarning(UserWarning):
     """A sweep with ``on_short="skip"`` left out curves too short to sweep; ``curves`` holds
     their ids (also in ``Mesh.skipped_curves``)."""
 
-    def __init__(self, message: str, curves: np.ndarray):
+    curves: Int64Array
+
+    def __init__(self, message: str, curves: Int64Array) -> None:
         super().__init__(message)
         self.curves = curves
 
@@ -228,9 +241,28 @@ class Mesh:
         Curves of a bundle left out by ``on_short="skip"`` (empty when none).
     """
 
-    def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None, *,
-                 point_data=None, cell_data=None, sample_of=None, curve_of=None,
-                 skipped_curves=None):
+    vertices: npt.NDArray[np.float64] | npt.NDArray[np.float32]
+    faces: Int64Array | npt.NDArray[np.int32]
+    normals: Float64Array | None
+    uv: Float64Array | None
+    fold_over: Int64Array
+    point_data: dict[str, npt.NDArray[Any]]
+    skipped_curves: Int64Array
+
+    def __init__(
+        self,
+        vertices: Array,
+        faces: Array,
+        normals: Array | None = None,
+        uv: Array | None = None,
+        fold_over: Array | None = None,
+        *,
+        point_data: PointData | None = None,
+        cell_data: PointData | None = None,
+        sample_of: Array | None = None,
+        curve_of: Array | None = None,
+        skipped_curves: Array | None = None,
+    ) -> None:
         single = isinstance(vertices, np.ndarray) and vertices.dtype == np.float32
         V = vertices if single else as_float_array(vertices, "vertices")
         if V.ndim != 2 or V.shape[1] != 3:
@@ -266,7 +298,7 @@ class Mesh:
         return mesh
 
     @property
-    def cell_data(self) -> dict:
+    def cell_data(self) -> dict[str, npt.NDArray[Any]]:
         """Per-face attributes (see the class docstring)."""
         runs = self.__dict__.get("_curve_id_runs")
         if runs is not None:
@@ -275,7 +307,7 @@ class Mesh:
         return self._cell_data
 
     @cell_data.setter
-    def cell_data(self, value) -> None:
+    def cell_data(self, value: dict[str, npt.NDArray[Any]]) -> None:
         self._cell_data, self._curve_id_runs = value, None
 
     def _lazy_curve_id(self, curve_ids: np.ndarray, faces_per_curve: np.ndarray) -> None:
@@ -295,7 +327,7 @@ class Mesh:
         return self._rings
 
     @property
-    def sample_of(self) -> np.ndarray | None:
+    def sample_of(self) -> Int64Array | None:
         """The spine row of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._sample_of is None and self._rings is not None:
             rings = self._ring_arrays()
@@ -303,11 +335,11 @@ class Mesh:
         return self._sample_of
 
     @sample_of.setter
-    def sample_of(self, value) -> None:
+    def sample_of(self, value: Int64Array | None) -> None:
         self._sample_of = _index_array(value, "sample_of", len(self.vertices), none=True)
 
     @property
-    def curve_of(self) -> np.ndarray | None:
+    def curve_of(self) -> Int64Array | None:
         """The curve of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._curve_of is None and self._rings is not None:
             rings = self._ring_arrays()
@@ -315,7 +347,7 @@ class Mesh:
         return self._curve_of
 
     @curve_of.setter
-    def curve_of(self, value) -> None:
+    def curve_of(self, value: Int64Array | None) -> None:
         self._curve_of = _index_array(value, "curve_of", len(self.vertices), none=True)
 
     def __repr__(self) -> str:
@@ -344,7 +376,7 @@ class Mesh:
         keys = ("edges", "boundary", "non_manifold", "inconsistent", "degenerate")
         return dict(zip(keys, _core.mesh_edges(F, len(V))))
 
-    def self_intersections(self, limit: int = 10_000_000) -> np.ndarray:
+    def self_intersections(self, limit: int = 10_000_000) -> npt.NDArray[np.int64]:
         """The pairs of faces that intersect other than along the vertices and edges they
         share: ``(K, 2)`` int64 face indices ``i < j``, sorted (empty for an embedded mesh).
 
@@ -403,7 +435,7 @@ class Mesh:
         return np.ascontiguousarray(V), np.ascontiguousarray(F).reshape(-1, 3)
 
     @staticmethod
-    def concatenate(meshes) -> Mesh:
+    def concatenate(meshes: Sequence[Mesh]) -> Mesh:
         """One mesh of all ``meshes`` (a sequence of :class:`Mesh`), for chunked pipelines:
         vertices stacked, faces offset by the vertices before them. ``normals``/``uv`` are kept
         when every mesh has them; ``point_data``/``cell_data`` keys present in every mesh are
@@ -469,7 +501,7 @@ class Mesh:
             [m.skipped_curves + s for m, s in zip(meshes, curves)]).astype(np.int64)
         return mesh
 
-    def to_trimesh(self):
+    def to_trimesh(self) -> Any:
         """A ``trimesh.Trimesh`` with the same vertices, faces and normals (no merging or
         reordering; ``uv`` goes to a ``TextureVisuals`` when present, else a ``point_data``
         array ``"colors"`` (RGB(A), as in :meth:`save`) to the vertex colours; ``point_data``
@@ -492,7 +524,7 @@ class Mesh:
             face_attributes=dict(self.cell_data),
         )
 
-    def to_pyvista(self):
+    def to_pyvista(self) -> Any:
         """A ``pyvista.PolyData`` with point data ``Normals`` (active normals), the texture
         coordinates ``uv`` and every array of ``point_data``; cell data from ``cell_data``."""
         import pyvista as pv
@@ -511,7 +543,9 @@ class Mesh:
             poly.cell_data[k] = v
         return poly
 
-    def save(self, path: str | os.PathLike, *, colors=None) -> pathlib.Path:
+    def save(
+        self, path: str | os.PathLike[str], *, colors: str | Array | None = None
+    ) -> pathlib.Path:
         """Write the mesh to ``path``; no third-party package is needed. Returns the path.
 
         * ``.ply``: binary little-endian PLY: positions, normals ``nx ny nz`` and texture
@@ -546,7 +580,7 @@ class Mesh:
         return _files.write(self, path, colors)
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> Mesh:
+    def load(cls, path: str | os.PathLike[str]) -> Mesh:
         """Read a triangle mesh: ``.ply``, ``.obj``, ``.stl``, ``.glb``/``.gltf`` and
         ``.off`` through trimesh, ``.vtp``/``.vtk`` through pyvista (polygons are
         triangulated). Normals, texture coordinates, vertex colours (as ``point_data
@@ -556,8 +590,13 @@ class Mesh:
         """
         return cls(**_files.read(path))
 
-    def plot(self, screenshot: str | os.PathLike | None = None, *, window_size=(800, 600),
-             **kwargs: Any):
+    def plot(
+        self,
+        screenshot: str | os.PathLike[str] | None = None,
+        *,
+        window_size: tuple[int, int] = (800, 600),
+        **kwargs: Any,
+    ) -> npt.NDArray[np.uint8] | None:
         """Render with pyvista.
 
         Off-screen (when there is no display, or when ``screenshot`` is given) the image is

@@ -4,12 +4,18 @@ re-exported there."""
 from __future__ import annotations
 
 from math import comb
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core
+from ._types import Array, Float64Array
 from ._validate import MAX_SAMPLES, as_bool, as_finite, as_float_array, as_int, as_positive, as_real
+
+if TYPE_CHECKING:
+    from ._curves import Curve
+    from ._mesh import Mesh
 
 
 def _finite(a: np.ndarray, name: str) -> np.ndarray:
@@ -40,7 +46,21 @@ def _cubics(x: Any, name: str = "control_points") -> tuple[np.ndarray, bool]:
     raise ValueError(f"{name}: expected shape (4, 3) or (m, 4, 3), got {a.shape}")
 
 
-def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: Literal[False] = False
+) -> Float64Array: ...
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: Literal[True]
+) -> Float64Array | list[Float64Array]: ...
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: bool = False
+) -> Float64Array | list[Float64Array]: ...
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: bool = False
+) -> Float64Array | list[Float64Array]:
     """G¹ Hermite interpolation by a PH cubic (Mäurer & Jüttler §3.2, Table 1, signed).
 
     Finds the PH cubics from ``p0`` to ``p1`` whose end tangents point along ``t0`` and
@@ -104,7 +124,7 @@ def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
     return lists[0] if single else lists
 
 
-def is_ph(control_points, tol: float = 1e-9):
+def is_ph(control_points: Array, tol: float = 1e-9) -> bool | npt.NDArray[np.bool_]:
     """Control-polygon test for PH cubics (Maurer & Jüttler (17)).
 
     A cubic is PH iff the angles ``θ₁₂ = ∠(d₁, d₂)`` and ``θ₂₃ = ∠(d₂, d₃)`` agree and
@@ -120,7 +140,9 @@ def is_ph(control_points, tol: float = 1e-9):
     return bool(out[0]) if single else out
 
 
-def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = False) -> np.ndarray:
+def from_quaternions(
+    A0: Array, A1: Array, start: Array = (0.0, 0.0, 0.0), *, scalar_first: bool = False
+) -> Float64Array:
     """The PH cubic with the quaternion preimage ``A(v) = A0(1 − v) + A1 v``.
 
     Its hodograph is ``x′(v) = A(v) i A(v)*`` (vector part), so ``σ = |A|²``. Control points
@@ -142,7 +164,9 @@ def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = Fals
     return out[0] if single else out
 
 
-def preimage(control_points, *, scalar_first: bool = False, tol: float = 1e-9):
+def preimage(
+    control_points: Array, *, scalar_first: bool = False, tol: float = 1e-9
+) -> tuple[Float64Array, Float64Array]:
     """Quaternion preimage ``(A0, A1)`` of a PH cubic (inverse of :func:`from_quaternions`).
 
     ``A0`` is the root of ``A i A* = 3d₁`` that rotates ``x̂`` onto ``d₁`` along the shortest
@@ -164,7 +188,7 @@ _INV_KEYS = ("L1", "L2", "L3", "cos_theta", "sin_theta", "delta", "a", "b", "c",
              "kappa_over_tau", "sigma_min", "kappa_max")
 
 
-def invariants(control_points) -> dict:
+def invariants(control_points: Array) -> dict[str, Any]:
     """Scalar invariants of a PH cubic (Mäurer & Jüttler (18), (31); torsion signed by ``Δ``).
 
     Keys: ``L1, L2, L3`` (leg lengths), ``cos_theta, sin_theta`` (``θ = ∠(d₁, d₂)``),
@@ -181,7 +205,7 @@ def invariants(control_points) -> dict:
             for i, k in enumerate(_INV_KEYS)}
 
 
-def evaluate(control_points, v, derivative: int = 0) -> np.ndarray:
+def evaluate(control_points: Array, v: float | Array, derivative: int = 0) -> Float64Array:
     """Points (``derivative=0``) or derivatives ``dᵏx/dvᵏ`` (k ≤ 3) of one cubic at ``v``.
 
     ``control_points`` (4, 3); ``v`` a float or ``(n,)`` in [0, 1]. Returns ``(n, 3)``.
@@ -210,7 +234,9 @@ def _fit_dict(rows: np.ndarray, single: bool) -> dict:
     return d
 
 
-def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = None) -> dict:
+def angle_fit(
+    control_points: Array, *, omega_start: float = 0.0, phi: float | None = None
+) -> dict[str, Any]:
     """The rational approximation of the RMF angle on one PH cubic (MJ (34)–(41)).
 
     ``Ω(0) = omega_start`` (radians from ``n`` towards ``b``). With ``sg = sign k`` and the
@@ -397,7 +423,9 @@ class PHSpline:
     also sets :attr:`deviation` (per segment, the largest distance to the input).
     """
 
-    def __init__(self, control_points, knots=None):
+    deviation: Float64Array | None
+
+    def __init__(self, control_points: Array, knots: Array | None = None) -> None:
         cp, _ = _cubics(control_points)
         kn = _spline_knots(knots, cp.shape[0])
         # no cubics, non-finite values, knots not increasing, gaps, not PH, not G¹
@@ -421,12 +449,12 @@ class PHSpline:
 
     # -- geometry -----------------------------------------------------------------------
     @property
-    def control_points(self) -> np.ndarray:
+    def control_points(self) -> Float64Array:
         """``(m, 4, 3)`` control points (read-only)."""
         return self._cp
 
     @property
-    def knots(self) -> np.ndarray:
+    def knots(self) -> Float64Array:
         """``(m + 1,)`` joint parameters (read-only)."""
         return self._knots
 
@@ -447,7 +475,7 @@ class PHSpline:
             raise ValueError(f"s: expected a scalar or a 1-D array, got shape {a.shape}")
         return np.ascontiguousarray(np.atleast_1d(a))  # values: the core (finite, in [0, m])
 
-    def samples(self, n_per_segment: int = 16) -> np.ndarray:
+    def samples(self, n_per_segment: int = 16) -> Float64Array:
         """``m·n + 1`` uniformly spaced spline parameters ``s`` (the joints included)."""
         most = max(1, (MAX_SAMPLES - 1) // self.segments)
         n = as_int(n_per_segment, "n_per_segment", 1, most, out_of_bounds=lambda x: (
@@ -455,7 +483,7 @@ class PHSpline:
             f"{MAX_SAMPLES:,} samples), got {x}"))
         return np.linspace(0.0, self.segments, self.segments * n + 1)
 
-    def parameter(self, u) -> np.ndarray:
+    def parameter(self, u: float | Array) -> Float64Array:
         """Spline parameters ``s`` of curve parameters ``u`` (linear between the knots)."""
         a = np.atleast_1d(_finite(as_float_array(u, "u"), "u"))
         k = self._knots
@@ -463,12 +491,12 @@ class PHSpline:
             raise ValueError(f"u: values must lie within [{k[0]}, {k[-1]}]")
         return np.interp(a, k, np.arange(self.segments + 1, dtype=float))
 
-    def evaluate(self, s, derivative: int = 0) -> np.ndarray:
+    def evaluate(self, s: float | Array, derivative: int = 0) -> Float64Array:
         """Points (or derivatives with respect to the local ``v``) at ``s``, ``(n, 3)``."""
         d = as_int(derivative, "derivative", minimum=0)  # <= 3: the core
         return _core.ph_eval(self._cp, self._s(s), d)
 
-    def points(self, n_per_segment: int = 16) -> np.ndarray:
+    def points(self, n_per_segment: int = 16) -> Float64Array:
         """Points at :meth:`samples` ``(m·n + 1, 3)``."""
         return self.evaluate(self.samples(n_per_segment))
 
@@ -485,7 +513,7 @@ class PHSpline:
         om = as_finite(omega_start, "omega_start")
         return _core.ph_frames(self._cp, self._s(s), mode, self._initial(initial), om, None)
 
-    def frenet(self, s) -> np.ndarray:
+    def frenet(self, s: float | Array) -> Float64Array:
         """Rational Frenet frames ``(n, 3, 3)``, columns ``(n, b, t)``: ``t = x′/σ``,
         ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). Evaluated as the Euler–Rodrigues frame of the
         quaternion preimage (columns of the rotation ``A(v)/|A(v)|``), which on a PH cubic is
@@ -494,8 +522,15 @@ class PHSpline:
         used."""
         return self._frames(s, "frenet", None, 0.0)[0]
 
-    def rmf(self, s=None, *, initial=None, exact: bool = False, omega_start: float = 0.0,
-            n_per_segment: int = 16) -> np.ndarray:
+    def rmf(
+        self,
+        s: float | Array | None = None,
+        *,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+        n_per_segment: int = 16,
+    ) -> Float64Array:
         """Rotation-minimising frames ``(n, 3, 3)`` (columns ``r, s, t``) at ``s``.
 
         ``exact=True``: the RMF of the PH spline, ``r = sin Ω b + cos Ω n`` with the closed
@@ -513,22 +548,32 @@ class PHSpline:
         mode = "exact" if as_bool(exact, "exact") else "rational"
         return self._frames(s, mode, initial, omega_start)[0]
 
-    def angle(self, s, *, initial=None, exact: bool = False, omega_start: float = 0.0
-              ) -> np.ndarray:
+    def angle(
+        self,
+        s: float | Array,
+        *,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+    ) -> Float64Array:
         """The angle of :meth:`rmf`'s ``r`` at ``s``, radians from ``n`` towards ``b`` of
         the local cubic: ``Ω̃`` (rational, default) or ``Ω`` (``exact=True``). Per cubic, not
         unwrapped across joints; 0 on straight cubics."""
         mode = "exact" if as_bool(exact, "exact") else "rational"
         return self._frames(s, mode, initial, omega_start)[1]
 
-    def angle_fit(self, *, initial=None, omega_start: float = 0.0) -> dict:
+    def angle_fit(
+        self, *, initial: Array | None = None, omega_start: float = 0.0
+    ) -> dict[str, Any]:
         """Per-cubic data of the rational angle function (see :func:`angle_fit`; the start
         as in :meth:`rmf`). Values are ``(m,)`` arrays, ``beta``/``gamma`` ``(m, 3)``."""
         om = as_finite(omega_start, "omega_start")
         rows = _core.ph_frame_setup(self._cp, self._initial(initial), om, None)
         return _fit_dict(rows, False)
 
-    def rational_frames(self, *, initial=None, omega_start: float = 0.0) -> dict:
+    def rational_frames(
+        self, *, initial: Array | None = None, omega_start: float = 0.0
+    ) -> dict[str, Float64Array]:
         """Bernstein coefficients of the rational RMF, per cubic (MJ (29), rotated pair).
 
         MJ write the frame with the Frenet numerators ``n̂ = σx″ − σ′x′``, ``b̂ = x′ × x″``
@@ -555,8 +600,14 @@ class PHSpline:
             _straighten(rf, st, self._cp[st], r)
         return rf
 
-    def surface(self, section_ctrl, section_weights=None, *, initial=None,
-                omega_start: float = 0.0) -> np.ndarray:
+    def surface(
+        self,
+        section_ctrl: Array,
+        section_weights: Array | None = None,
+        *,
+        initial: Array | None = None,
+        omega_start: float = 0.0,
+    ) -> Float64Array:
         """Rational Bézier sweep surface, one homogeneous patch per cubic (MJ (42), corrected).
 
         ``s(u, v) = x(v) + c₂(u) f₂(v) + c₃(u) f₃(v)`` with the rational frame of
@@ -574,8 +625,16 @@ class PHSpline:
         rf = self.rational_frames(initial=initial, omega_start=omega_start)
         return _sweep_patches(self._cp, rf, c, wj)
 
-    def sweep(self, profile, *, n_per_segment: int = 16, initial=None, exact: bool = False,
-              omega_start: float = 0.0, **kwargs):
+    def sweep(
+        self,
+        profile: Array,
+        *,
+        n_per_segment: int = 16,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+        **kwargs: Any,
+    ) -> Mesh:
         """A triangle mesh of a profile swept along the spline: :func:`spinal.sweep` on the
         points :meth:`points` ``(n_per_segment)`` with the frames :meth:`rmf` (rational by
         default, the frame of :meth:`surface`). ``kwargs`` go to :func:`spinal.sweep`
@@ -769,8 +828,16 @@ def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
     return k, "knots"
 
 
-def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=None,
-        max_segments: int = 4096) -> PHSpline:
+def fit(
+    curve: Curve | Array,
+    *,
+    tol: float | None = None,
+    segments: int | None = None,
+    knots: Array | None = None,
+    tangents: Array | None = None,
+    domain: tuple[float, float] | None = None,
+    max_segments: int = 4096,
+) -> PHSpline:
     """Convert a curve into a G¹ spline of PH cubics (Mäurer & Jüttler §3.2, Theorem 10).
 
     Each interval ``[kᵢ, kᵢ₊₁]`` of the knots gets the PH cubic of :func:`hermite` through

@@ -45,11 +45,14 @@ everywhere (turned by π more: ``K < 0``); for ``δ ≥ π`` no turn avoids para
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from ._frames import estimate_tangents
 from ._frames import frames as _frames
+from ._types import Array, Float64Array
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -60,6 +63,10 @@ from ._validate import (
     as_points,
 )
 from .curves import Curve
+
+if TYPE_CHECKING:
+    from ._mesh import Mesh
+    from ._ph import PHSpline
 
 __all__ = ["ProfileSurface", "profile_surface"]
 
@@ -153,35 +160,35 @@ class ProfileSurface:
         join the profile's last sample to its first).
     """
 
-    u: np.ndarray
-    v: np.ndarray
-    points: np.ndarray
-    normals: np.ndarray
-    frames: np.ndarray
-    spine_curvature: np.ndarray
-    profile_tangents: np.ndarray
-    profile_curvature: np.ndarray
-    mu: np.ndarray
-    curvature_u: np.ndarray
-    curvature_v: np.ndarray
-    k1: np.ndarray
-    k2: np.ndarray
-    d1: np.ndarray
-    d2: np.ndarray
-    gaussian: np.ndarray
-    mean: np.ndarray
-    parabolic_sign: np.ndarray
-    singular_points: np.ndarray
+    u: Float64Array
+    v: Float64Array
+    points: Float64Array
+    normals: Float64Array
+    frames: Float64Array
+    spine_curvature: Float64Array
+    profile_tangents: Float64Array
+    profile_curvature: Float64Array
+    mu: Float64Array
+    curvature_u: Float64Array
+    curvature_v: Float64Array
+    k1: Float64Array
+    k2: Float64Array
+    d1: Float64Array
+    d2: Float64Array
+    gaussian: Float64Array
+    mean: Float64Array
+    parabolic_sign: npt.NDArray[np.int8]
+    singular_points: Float64Array
     singularity_free: bool
     convex: bool
     profile_turning: float
     frame_turning: float
     convexity_criterion: bool
-    convex_turns: np.ndarray | None
+    convex_turns: Float64Array | None
     closed: bool
     profile_closed: bool
 
-    def parabolic_lines(self, space: str = "parameters") -> list[np.ndarray]:
+    def parabolic_lines(self, space: Literal["parameters", "points"] = "parameters") -> list[Float64Array]:
         """The parabolic lines (``K = 0``, MJ (14) and §2.3) as polylines.
 
         Marching squares on the sample grid of ``K μ = −κ_c κ cos ϑ`` (the zeros of ``K``
@@ -224,7 +231,7 @@ class ProfileSurface:
                 out.append(_bilinear(self.points, fi, fj, self.profile_closed))
         return out
 
-    def mesh(self):
+    def mesh(self) -> Mesh:
         """The sample grid as a :class:`spinal.Mesh` with the surface's normals.
 
         Vertex ``i·nv + j`` is ``points[i, j]`` (so ``field.ravel()`` of any ``(nu, nv)``
@@ -255,8 +262,17 @@ class ProfileSurface:
 # the function
 
 
-def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None,
-                    closed: bool = False, profile_closed: bool = False) -> ProfileSurface:
+def profile_surface(
+    spine: Array | Curve | PHSpline,
+    profile: Array | Curve,
+    u: int | Array | None = None,
+    v: int | Array | None = None,
+    *,
+    frames: Array | None = None,
+    initial: Array | None = None,
+    closed: bool = False,
+    profile_closed: bool = False,
+) -> ProfileSurface:
     r"""Normals, principal curvatures, parabolic lines, singular points and convexity of the
     profile (moulding) surface ``X(u, v) = x(u) + a(v) r(u) + b(v) s(u)`` swept with the
     rotation-minimising frame (RMF) ``(r, s, t)`` (Mäurer & Jüttler 1999, "MJ", §2.2–2.3).

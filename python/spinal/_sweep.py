@@ -5,13 +5,16 @@ from __future__ import annotations
 import functools
 import re
 import warnings
+from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _merge
 from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._progress import Reported, checked
+from ._types import Array, CurveBundle, Ints, PointData, ProgressArg, TangentRule
 from ._validate import (
     as_bool,
     as_choice,
@@ -76,32 +79,32 @@ def _ranges(rows: np.ndarray, most: int = 20) -> str:
 
 
 def sweep(
-    points,
-    profile,
+    points: Array | CurveBundle,
+    profile: Array,
     *,
-    frames=None,
-    scale=None,
-    twist=None,
+    frames: Array | None = None,
+    scale: float | Array | None = None,
+    twist: float | Array | None = None,
     closed: bool = False,
     caps: bool = True,
     profile_closed: bool = True,
     miter_limit: float = 4.0,
     split_seams: bool = False,
     strict: bool = False,
-    lengths=None,
-    offsets=None,
-    tangents=None,
-    tangent_rule: str = DEFAULT_TANGENT_RULE,
-    dtype="float64",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    tangents: Array | None = None,
+    tangent_rule: TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
-    point_data=None,
-    on_short: str = "raise",
-    on_invalid: str = "raise",
-    join: str = "round",
-    progress=False,
+    point_data: PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
+    progress: ProgressArg = False,
     turns: float = 0,
-    out=None,
+    out: Mesh | None = None,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -717,30 +720,30 @@ def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols, extra=None,
 
 
 def tube(
-    points,
-    radius=1.0,
+    points: Array | CurveBundle,
+    radius: float | Array = 1.0,
     sides: int = 16,
     *,
-    frames=None,
+    frames: Array | None = None,
     closed: bool = False,
     caps: bool = True,
     miter_limit: float = 4.0,
     split_seams: bool = False,
     strict: bool = False,
-    lengths=None,
-    offsets=None,
-    tangents=None,
-    tangent_rule: str = DEFAULT_TANGENT_RULE,
-    dtype="float64",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    tangents: Array | None = None,
+    tangent_rule: TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
-    point_data=None,
-    on_short: str = "raise",
-    on_invalid: str = "raise",
-    join: str = "round",
-    progress=False,
+    point_data: PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
+    progress: ProgressArg = False,
     turns: float = 0,
-    out=None,
+    out: Mesh | None = None,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r

@@ -26,9 +26,13 @@ Meshes are read by :meth:`spinal.Mesh.load` and written by :meth:`spinal.Mesh.sa
 import os as _os
 import pathlib as _pathlib
 import warnings as _warnings
+from collections.abc import Callable as _Callable
+from collections.abc import Iterable as _Iterable
+from typing import Literal as _Literal
 from typing import NamedTuple as _NamedTuple
 
 import numpy as _np
+import numpy.typing as _npt
 
 __all__ = ["STREAMLINE_SUFFIXES", "Streamlines", "read_streamlines", "tube_file"]
 
@@ -265,9 +269,18 @@ def _summarise(folds: list, skipped: list, other: dict) -> None:
         _warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
-def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
-              chunk_points: int = 1 << 20, dtype="float32", colors=None, join: str = "round",
-              progress=False) -> _pathlib.Path:
+def tube_file(
+    src: str | _os.PathLike[str] | _Iterable[object],
+    dst: str | _os.PathLike[str],
+    radius: float | str = 0.25,
+    sides: int = 8,
+    *,
+    chunk_points: int = 1 << 20,
+    dtype: _npt.DTypeLike = "float32",
+    colors: str | None = None,
+    join: _Literal["round", "bevel", "miter"] = "round",
+    progress: bool | _Callable[[int], object] = False,
+) -> _pathlib.Path:
     """Sweep a tube around every streamline of ``src`` into the mesh file ``dst``, a chunk
     of streamlines at a time.
 
