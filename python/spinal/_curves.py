@@ -9,6 +9,7 @@ from typing import Literal
 import numpy as np
 
 from ._spline import (
+    ArcTable,
     arc_length_table,
     bspline_pieces,
     catmull_rom_slopes,
@@ -22,7 +23,7 @@ from ._spline import (
     periodic_bspline,
     row_norms,
 )
-from ._types import Array, Float64Array, Param
+from ._types import Array, Float64Array, Param, SplineKind
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -37,10 +38,10 @@ from ._validate import (
 _MAX_WINDINGS = 1_000_000
 
 #: The kinds of :class:`Spline`.
-_SPLINE_KINDS = ("catmull_rom", "natural_cubic", "bspline")
+_SPLINE_KINDS: tuple[SplineKind, ...] = ("catmull_rom", "natural_cubic", "bspline")
 
 
-def _u(u) -> np.ndarray:
+def _u(u: Param) -> np.ndarray:
     arr = as_float_array(u, "u")
     if arr.ndim > 1:
         raise ValueError(f"u: expected a scalar or a 1-D array, got shape {arr.shape}")
@@ -89,22 +90,26 @@ class Curve:
     def tangent(self, u: Param) -> Float64Array:
         """Unit tangents ``x′/|x′|``."""
         d = self.d1(u)
-        return d / np.linalg.norm(d, axis=1, keepdims=True)
+        out: Float64Array = d / np.linalg.norm(d, axis=1, keepdims=True)
+        return out
 
     def curvature(self, u: Param) -> Float64Array:
         """Curvature ``κ = |x′ × x″| / |x′|³`` (1/length)."""
         d1, d2 = self.d1(u), self.d2(u)
-        return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+        out: Float64Array = np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+        return out
 
     def torsion(self, u: Param) -> Float64Array:
         """Torsion ``τ = det(x′, x″, x‴) / |x′ × x″|²`` (1/length; undefined where κ = 0)."""
         d1, d2, d3 = self.d1(u), self.d2(u), self.d3(u)
         c = np.cross(d1, d2)
-        return np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
+        out: Float64Array = np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
+        return out
 
     def speed(self, u: Param) -> Float64Array:
         """``|x′(u)|`` (length per unit parameter)."""
-        return np.linalg.norm(self.d1(u), axis=1)
+        out: Float64Array = np.linalg.norm(self.d1(u), axis=1)
+        return out
 
     def frenet(self, u: Param) -> Float64Array:
         """Exact Frenet frames ``(k, 3, 3)``, columns ``(N, B, T)`` (undefined where κ = 0)."""
@@ -136,7 +141,7 @@ class Helix(Curve):
         self.a, self.b = a, as_finite(b, "b")
         self.domain = (0.0, 2 * math.pi * as_positive(turns, "turns"))
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         a, b = self.a, self.b
         c, s = np.cos(u), np.sin(u)
         z = np.zeros_like(u)
@@ -189,7 +194,7 @@ class TorusKnot(Curve):
         self.p, self.q, self.R, self.r = p, q, R, r
         self.domain = (0.0, 2 * math.pi)
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         p, q, R, r = self.p, self.q, self.R, self.r
         cq, sq = np.cos(q * u), np.sin(q * u)
         cp, sp = np.cos(p * u), np.sin(p * u)
@@ -224,7 +229,7 @@ class Viviani(Curve):
         self.a = as_positive(a, "a")
         self.domain = (0.0, 4 * math.pi)
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         a = self.a
         c, s = np.cos(u), np.sin(u)
         c2, s2 = np.cos(u / 2), np.sin(u / 2)
@@ -256,7 +261,7 @@ class Polynomial(Curve):
             raise ValueError(f"domain: expected two finite values lo < hi, got {domain!r}")
         self.domain = (float(d[0]), float(d[1]))
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         c = self.coefficients
         d = c.shape[0] - 1
         out = np.zeros((u.shape[0], 3))
@@ -441,9 +446,9 @@ class Spline(Curve):
         self.points, self.kind, self.closed, self.knots = p, kind, closed, knots
         self.domain = (float(knots[0]), float(knots[-1]))
         self._coef = derivative_coefficients(c)
-        self._table = None  # the arc-length table, built when first needed
+        self._table: ArcTable | None = None  # the arc-length table, built when first needed
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         lo, hi = self.domain
         if self.closed:
             u = lo + np.mod(u - lo, hi - lo)
@@ -460,11 +465,11 @@ class Spline(Curve):
                         len(self.knots) - 2)
         return horner(self._coef[k], piece, u - self.knots[piece])
 
-    def _speed(self, piece, s):
+    def _speed(self, piece: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``|x′|`` on ``piece`` at the local parameter ``s``."""
         return row_norms(horner(self._coef[1], piece, s))
 
-    def _arc_table(self):
+    def _arc_table(self) -> ArcTable:
         if self._table is None:
             self._table = arc_length_table(self._speed, np.diff(self.knots))
         return self._table
@@ -492,7 +497,8 @@ class Spline(Curve):
         u[0] = self.domain[0]
         if not self.closed:
             u[-1] = self.domain[1]
-        return np.clip(u, *self.domain)
+        out: Float64Array = np.clip(u, *self.domain)
+        return out
 
     def sample_arc_length(self, n: int) -> Float64Array:
         """``n`` points equally spaced in arc length, ``(n, 3)``:

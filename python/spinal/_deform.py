@@ -343,9 +343,9 @@ def deform(
             raise ValueError(f"check: expected True, False or 'intersections', got {check!r}")
         check = as_bool(check, "check")
     progress = checked(progress)
-    bar = []  # the progress report, made when the core reports the step count
+    bar: list[Progress] = []  # the progress report, made when the core reports the step count
 
-    def tick(done, total):
+    def tick(done: int, total: int) -> None:
         if not bar:
             bar.append(Progress(progress, total, "deform", "step"))
         bar[0].update(done)
@@ -376,7 +376,7 @@ def deform(
         clock = time.perf_counter()
         # both runs with the mesh's own integrator (vertices at a tool's surface carried by
         # their side's velocity; spinal.advect's RK4 stages step across the surface there)
-        def rerun(steps):
+        def rerun(steps: int) -> np.ndarray:
             return _core.deform_mesh(Vr, Fr, field, {
                 "t0": t0, "duration": duration, "steps": steps, "refine": None,
                 "max_vertices": len(Vr), "max_passes": 0, "check": False})[0]
@@ -417,11 +417,12 @@ def deform(
     return out, report
 
 
-def _positive(x, name: str) -> float:
+def _positive(x: object, name: str) -> float:
     x = as_finite(x, name)
     if not x > 0:
         raise ValueError(f"{name}: must be positive, got {x}")
-    return x
+    out: float = x
+    return out
 
 
 @dataclass(frozen=True)

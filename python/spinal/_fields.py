@@ -6,9 +6,11 @@ from __future__ import annotations
 import functools
 import numbers
 from collections.abc import Callable, Iterable
-from typing import Literal
+from typing import Any, Literal, ParamSpec
 
 import numpy as np
+
+_P = ParamSpec("_P")
 
 from . import _core
 from ._core import Field
@@ -27,12 +29,12 @@ from ._validate import (
 )
 
 
-def _recorded(ctor):
+def _recorded(ctor: Callable[_P, Field]) -> Callable[_P, Field]:
     """The constructor, with the call remembered by the field it returns: a field pickles as
     the calls that built it (``Field.__reduce__`` → :func:`_rebuild`)."""
 
     @functools.wraps(ctor)
-    def build(*args, **kwargs):
+    def build(*args: _P.args, **kwargs: _P.kwargs) -> Field:
         # a progress report does not change the field: not part of its recipe
         kept = {k: v for k, v in kwargs.items() if k != "progress"}
         return ctor(*args, **kwargs)._with_recipe(ctor.__name__, args, kept)
@@ -40,7 +42,7 @@ def _recorded(ctor):
     return build
 
 
-def _rebuild(recipe) -> Field:
+def _rebuild(recipe: Iterable[tuple[str, tuple[Any, ...], dict[str, Any]]]) -> Field:
     """The field of a pickled recipe: the sum of ``name(*args, **kwargs)`` over its calls."""
     out = _core.field_zero()
     for name, args, kwargs in recipe:
@@ -48,11 +50,11 @@ def _rebuild(recipe) -> Field:
     return out
 
 
-def _opt(x, name: str) -> float | None:
+def _opt(x: object, name: str) -> float | None:
     return None if x is None else as_real(x, name)
 
 
-def _power(x) -> int:
+def _power(x: object) -> int:
     return as_int(x, "falloff_power")
 
 
@@ -121,7 +123,8 @@ def rotation(
         _power(falloff_power))
 
 
-def _swirl(center, axis, rate, radius, form, bend: bool) -> Field:
+def _swirl(center: Array, axis: Array, rate: float, radius: float, form: str, bend: bool
+           ) -> Field:
     return _core.field_swirl(as_vector(center, "center"), as_vector(axis, "axis"),
                              as_real(rate, "rate"), as_real(radius, "radius"), form, bend)
 
@@ -308,16 +311,19 @@ def _spline_prefilter(values: np.ndarray) -> np.ndarray:
     return _core.field_grid_coefficients(np.ascontiguousarray(values, dtype=np.float64))
 
 
-def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name):
+def _grid_field(values: np.ndarray, origin: np.ndarray, h: float, velocity: Array,
+                center: Array | None, reach: float | None, blend: str, moving: bool,
+                name: str) -> Field:
     """The tool of a sampled distance: the default centre and reach from the samples, the
     B-spline coefficients, then the core (which checks the spacing against the reach and that
     the support stays inside the grid)."""
     u = as_vector(velocity, "velocity")
-    coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
+    coef, c, r = _grid_spline(values, origin, h, center, reach)
+    return _core.field_grid(coef, origin, h, u, c, r, blend, as_bool(moving, "moving"), name)
 
 
-def _grid_spline(values, origin, h, center, reach):
+def _grid_spline(values: np.ndarray, origin: np.ndarray, h: float, center: Array | None,
+                 reach: float | None) -> tuple[np.ndarray, np.ndarray, float]:
     """The B-spline coefficients of sampled distances with the tool's centre (default: the
     volume-fraction centroid of the inside) and reach (default: its bounding radius)."""
     if not (values <= 0).any():
@@ -333,10 +339,10 @@ def _grid_spline(values, origin, h, center, reach):
     if reach is None:
         idx = np.argwhere(values <= 0)
         nodes = origin + idx * h
-        reach = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
+        r = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
     else:
-        reach = as_real(reach, "reach")
-    return _spline_prefilter(values), c, reach
+        r = as_real(reach, "reach")
+    return _spline_prefilter(values), c, r
 
 
 @_recorded
@@ -394,10 +400,12 @@ def sdf_tool(
     reach the grid's edge): ``ValueError`` naming ``grid`` otherwise.
     """
     a, o, h = _sdf_samples(grid, origin, spacing)
-    return _grid_field(a, o, h, velocity, center, reach, blend, moving, "sdf_tool")
+    out: Field = _grid_field(a, o, h, velocity, center, reach, blend, moving, "sdf_tool")
+    return out
 
 
-def _sdf_samples(grid, origin, spacing):
+def _sdf_samples(grid: Array, origin: Array, spacing: float
+                 ) -> tuple[np.ndarray, np.ndarray, float]:
     """The samples of ``sdf_tool``/``sdf_curl`` as a float64 array, checked, with the origin
     and spacing."""
     a = as_float_array(grid, "grid")
@@ -424,7 +432,7 @@ SLAB_PER_FACE = 32
 MIN_CELLS_PER_REACH = 4
 
 
-def _closed_mesh(mesh):
+def _closed_mesh(mesh: object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Vertices, faces and the enclosed volume's centroid of a closed, outward-wound mesh
     (the core checks it, naming ``mesh``)."""
     V, F = mesh_arrays(mesh)
@@ -473,10 +481,12 @@ def mesh_tool(
         stop.
     """
     values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
-    return _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
+    out: Field = _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
+    return out
 
 
-def _mesh_samples(mesh, reach, resolution, center, progress):
+def _mesh_samples(mesh: object, reach: float | None, resolution: int, center: Array | None,
+                  progress: object) -> tuple[np.ndarray, np.ndarray, float, np.ndarray, float]:
     """The signed distance of a closed mesh sampled on the grid of :func:`mesh_tool`:
     samples, origin, spacing, centre and reach."""
     progress = checked(progress)
@@ -485,9 +495,9 @@ def _mesh_samples(mesh, reach, resolution, center, progress):
     rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else as_real(reach, "reach")
     if not rf > 0:
         raise ValueError(f"reach: must be positive, got {rf}")
-    res = resolution
-    if isinstance(res, bool) or not isinstance(res, numbers.Integral):
-        raise TypeError(f"resolution: expected an integer, got {type(res).__name__}")
+    if isinstance(resolution, bool) or not isinstance(resolution, numbers.Integral):
+        raise TypeError(f"resolution: expected an integer, got {type(resolution).__name__}")
+    res = int(resolution)
     if not 16 <= res <= 256:
         raise ValueError(f"resolution: must be in 16 … 256, got {res}")
     pad = 4
@@ -609,7 +619,8 @@ def along_path(
 
 # ---- curl tools of any shape, keyframed tools ------------------------------------------------
 
-def _motion(velocity, angular_velocity, pivot):
+def _motion(velocity: Array | None, angular_velocity: Array | None, pivot: Array | None
+            ) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None]:
     return (None if velocity is None else as_vector(velocity, "velocity"),
             None if angular_velocity is None else as_vector(angular_velocity, "angular_velocity"),
             None if pivot is None else as_vector(pivot, "pivot"))
@@ -659,15 +670,17 @@ def sdf_curl(
     inside the grid). RK4 is about 3rd order on it where path lines cross cell faces (see
     :func:`sdf_tool`)."""
     a, o, h = _sdf_samples(grid, origin, spacing)
-    return _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
+    out: Field = _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
                       moving, "sdf_curl")
+    return out
 
 
-def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, pivot,
-               falloff_power, moving, name):
+def _grid_curl(values: np.ndarray, origin: np.ndarray, h: float, center: Array | None,
+               reach: float | None, velocity: Array | None, angular_velocity: Array | None,
+               pivot: Array | None, falloff_power: int, moving: bool, name: str) -> Field:
     u, w, p = _motion(velocity, angular_velocity, pivot)
-    coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid_curl(coef, origin, h, c, reach, u, w, p, _power(falloff_power),
+    coef, c, r = _grid_spline(values, origin, h, center, reach)
+    return _core.field_grid_curl(coef, origin, h, c, r, u, w, p, _power(falloff_power),
                                  as_bool(moving, "moving"), name)
 
 
@@ -689,8 +702,9 @@ def mesh_curl(
     grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``,
     ``progress``; needs libigl), then :func:`sdf_curl`."""
     values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
-    return _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
+    out: Field = _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
                       falloff_power, moving, "mesh_curl")
+    return out
 
 
 @_recorded
@@ -725,7 +739,7 @@ def rod(
 
 
 for _ctor in (sdf_curl, mesh_curl, rod):
-    _ctor.__doc__ += _CURL_DOC
+    _ctor.__doc__ = (_ctor.__doc__ or "") + _CURL_DOC
 del _ctor
 
 

@@ -19,10 +19,10 @@ from ._mesh import FoldOverWarning
 from ._types import Array, Float64Array, Int64Array, ProgressArg, SpineSolution
 from ._validate import as_bool, as_choice, as_float_array, as_real
 
-SOLUTIONS = ("radial", "normal", "binormal", "blend", "none")
+SOLUTIONS: tuple[SpineSolution, ...] = ("radial", "normal", "binormal", "blend", "none")
 
 
-def _spine(x, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
+def _spine(x: Array, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
     """A spine as ``(n, 3)`` rows and its width (2 or 3); a loop (``closed``) loses a repeated
     first point at its end."""
     arr = as_float_array(x, name)
@@ -54,7 +54,7 @@ def _loop(a: np.ndarray, closed: bool) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([a, a[:1]])) if closed else a
 
 
-def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray):
+def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A closed posed spine resampled at the rest samples' fractions of the loop's length
     (chord-length parameter): ``(n, 3)`` points and their positions ``k + u`` on the posed
     loop's edges (edge ``k`` from row ``k`` to row ``k + 1 mod m``). A loop cannot keep every
@@ -81,11 +81,13 @@ def _scale(a: np.ndarray) -> float:
 
 def _norms(d: np.ndarray) -> np.ndarray:
     """Row lengths without overflow or underflow in the squares (hypot)."""
-    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    out: np.ndarray = np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    return out
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
-    return np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
+    out: np.ndarray = np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
+    return out
 
 
 def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -97,7 +99,8 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.nda
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
-def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
+def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray
+                   ) -> np.ndarray:
     """Reference vector of the posed spine's first frame (a choice of ours: Zhuo 2014 does not
     say how the posed spine's initial normal is chosen; any choice keeps the volume; this one is
     rigid-motion equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal
@@ -127,10 +130,11 @@ def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.n
         psi = 2 * np.arctan2(v @ t0, w)
     c, s = np.cos(psi), np.sin(psi)
     rolled = c * r0 + s * np.cross(t0, r0) + (1 - c) * (t0 @ r0) * t0
-    return q @ rolled
+    out: np.ndarray = q @ rolled
+    return out
 
 
-def _vertices(vertices, dim: int) -> np.ndarray:
+def _vertices(vertices: Array, dim: int) -> np.ndarray:
     """``(V, dim)`` vertices as ``(V, 3)`` (the planar case gets z = 0)."""
     v = as_float_array(vertices, "vertices")
     if v.ndim != 2 or v.shape[1] != dim:
@@ -179,7 +183,8 @@ def _roll_to(frames1: np.ndarray, r0: np.ndarray, name: str) -> np.ndarray:
     return out
 
 
-def _given_roll(frames1, posed_frames, posed_up, at, m: int, closed: bool):
+def _given_roll(frames1: np.ndarray, posed_frames: Array | None, posed_up: Array | None,
+                at: np.ndarray, m: int, closed: bool) -> np.ndarray:
     """The posed frames with the roll the caller gives: ``frames1`` (the posed spine's frames,
     whose tangents are kept) with ``r`` the given reference vectors — the ``r`` columns of
     ``posed_frames`` or the ``posed_up`` vectors at the caller's ``m`` posed rows — blended
@@ -357,7 +362,8 @@ class SpineBinding:
         the input; ``0`` or the total length past the ends."""
         k = self._edge
         s = self._lengths
-        return s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
+        out: Float64Array = s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
+        return out
 
     @property
     def offset(self) -> Float64Array:
@@ -369,9 +375,11 @@ class SpineBinding:
     def posed_spine(self, posed_spine: Array, *, stretchable: bool = False) -> Float64Array:
         """The posed spine as used by :meth:`deform`: ``(n, 3)`` (resampled when not
         stretchable)."""
-        return self._posed(posed_spine, stretchable)[0]
+        out: Float64Array = self._posed(posed_spine, stretchable)[0]
+        return out
 
-    def _posed(self, posed_spine, stretchable, slide=0.0):
+    def _posed(self, posed_spine: Array, stretchable: bool, slide: float = 0.0
+               ) -> tuple[np.ndarray, int, np.ndarray]:
         """The posed spine as used, the caller's row count ``m`` and the positions ``k + u``
         of the used samples on the caller's polyline (edge ``k``, fraction ``u``)."""
         posed, dim = _spine(posed_spine, "posed_spine", self._closed)
@@ -580,11 +588,14 @@ class SpineBinding:
         They are also stored in ``self.clamped`` and reported by a
         :class:`spinal.FoldOverWarning` (``indices`` attribute).
         """
-        return self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+        out: Float64Array | tuple[Float64Array, Int64Array] = self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
                             posed_frames, posed_up, slide, blend)
+        return out
 
-    def _deform(self, posed_spine, solution, stretchable, twist, strict, return_clamped,
-                posed_frames, posed_up, slide, blend=None):
+    def _deform(self, posed_spine: Array, solution: SpineSolution, stretchable: bool,
+                twist: float | Array | None, strict: bool, return_clamped: bool,
+                posed_frames: Array | None, posed_up: Array | None, slide: float,
+                blend: float | None = None) -> Float64Array | tuple[Float64Array, Int64Array]:
         """:meth:`deform` (also of :func:`flesh`: either is two frames above this one, so
         a clamp warning points at the caller's line)."""
         solution = as_choice(solution, "solution", SOLUTIONS)
@@ -605,7 +616,9 @@ class SpineBinding:
         out, _ = self._apply(posed, frames1, solution, twist, strict, level=5, blend=blend)
         return (out, self.clamped) if return_clamped else out
 
-    def _apply(self, posed, frames1, solution, twist, strict, level, blend=None):
+    def _apply(self, posed: np.ndarray, frames1: np.ndarray | None, solution: str,
+               twist: float | Array | None, strict: bool, level: int,
+               blend: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The shape on the used posed spine ``posed`` with the frames ``frames1`` (None: the
         default posed frames): the deformed vertices and the frames used. A clamp warning
         points ``level`` frames up from the warning."""
@@ -689,13 +702,13 @@ class SpineBinding:
         return _roll_to(frames1, init, "posed_spine")
 
 
-def _blend(blend) -> float | None:
+def _blend(blend: object) -> float | None:
     """``blend`` as a Python float (or ``None``); the core checks its value and that it
     comes with ``solution="blend"``."""
     return None if blend is None else as_real(blend, "blend")
 
 
-def _twist(twist, n: int) -> np.ndarray:
+def _twist(twist: float | Array, n: int) -> np.ndarray:
     """``twist`` as ``(n,)`` angles (a number is used for every sample); the core checks
     the values."""
     tw = as_float_array(twist, "twist")
@@ -806,5 +819,6 @@ def flesh(
         binding = SpineBinding(vertices, rest_spine, closed=closed)
     except MemoryError as e:
         raise MemoryError(f"flesh: {e}") from None
-    return binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+    out: Float64Array | tuple[Float64Array, Int64Array] = binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
                            posed_frames, posed_up, 0.0, blend)
+    return out

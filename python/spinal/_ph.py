@@ -3,6 +3,7 @@ re-exported there."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from math import comb
 from typing import TYPE_CHECKING, Any, Literal, overload
 
@@ -10,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._types import Array, Float64Array
+from ._types import Array, Float64Array, Param
 from ._validate import MAX_SAMPLES, as_bool, as_finite, as_float_array, as_int, as_positive, as_real
 
 if TYPE_CHECKING:
@@ -220,7 +221,7 @@ _FIT_KEYS = ("straight", "omega0", "omega1", "k", "a", "b", "c", "phi", "sg", "l
              "lambda_star", "I_min")
 
 
-def _fit_dict(rows: np.ndarray, single: bool) -> dict:
+def _fit_dict(rows: np.ndarray, single: bool) -> dict[str, Any]:
     d = {key: rows[:, i].copy() for i, key in enumerate(_FIT_KEYS)}
     d["straight"] = d["straight"].astype(bool)
     d["beta"] = rows[:, 12:15].copy()
@@ -326,7 +327,7 @@ def _erf_col(k: int, p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.stack(c, axis=1)
 
 
-def _spline_knots(knots, m: int) -> np.ndarray:
+def _spline_knots(knots: Array | None, m: int) -> np.ndarray:
     """The ``(m + 1,)`` joint parameters of a spline of ``m`` cubics (default ``0 … m``);
     their values are checked by the core (``ph_check_spline``)."""
     if knots is None:
@@ -337,7 +338,7 @@ def _spline_knots(knots, m: int) -> np.ndarray:
     return np.ascontiguousarray(kn)
 
 
-def _rational_numerators(fit: dict) -> dict:
+def _rational_numerators(fit: dict[str, Any]) -> dict[str, np.ndarray]:
     """Bernstein numerators of the rational RMF of bent cubics from :func:`angle_fit` data
     (see :meth:`PHSpline.rational_frames`): ``f2, f3`` (m, 7, 3), ``weight`` (m, 7),
     ``tangent`` (m, 3, 3) and ``speed`` (m, 3)."""
@@ -358,7 +359,7 @@ def _rational_numerators(fit: dict) -> dict:
             "speed": speed}
 
 
-def _straighten(rf: dict, st: np.ndarray, cp: np.ndarray, r: np.ndarray) -> None:
+def _straighten(rf: dict[str, np.ndarray], st: np.ndarray, cp: np.ndarray, r: np.ndarray) -> None:
     """Overwrite the rows ``st`` (a boolean mask) of ``rf`` — the straight cubics ``cp``
     (k, 4, 3) — with constant numerators: ``r`` (k, 3) the reference vectors, weight 1, and
     the polynomial tangent ``3d`` with its speed."""
@@ -373,7 +374,7 @@ def _straighten(rf: dict, st: np.ndarray, cp: np.ndarray, r: np.ndarray) -> None
                                     L[:, 2]], axis=1)
 
 
-def _section(section_ctrl, section_weights) -> tuple[np.ndarray, np.ndarray]:
+def _section(section_ctrl: Array, section_weights: Array | None) -> tuple[np.ndarray, np.ndarray]:
     """Cross-section control points ``(m + 1, 2)`` and their positive weights."""
     c = _finite(as_float_array(section_ctrl, "section_ctrl"), "section_ctrl")
     if c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1:
@@ -389,7 +390,7 @@ def _section(section_ctrl, section_weights) -> tuple[np.ndarray, np.ndarray]:
     return c, wj
 
 
-def _sweep_patches(cp: np.ndarray, rf: dict, c: np.ndarray, wj: np.ndarray) -> np.ndarray:
+def _sweep_patches(cp: np.ndarray, rf: dict[str, np.ndarray], c: np.ndarray, wj: np.ndarray) -> np.ndarray:
     """Homogeneous control points ``(segments, 10, m + 1, 4)`` of the rational sweep of the
     section ``(c, wj)`` along cubics ``cp`` with the rational frame ``rf``."""
     om = _elevate(rf["weight"], 9)                    # (m, 10)
@@ -461,7 +462,8 @@ class PHSpline:
     @property
     def segments(self) -> int:
         """The number ``m`` of PH cubics; the spline parameter ``s`` runs over ``[0, m]``."""
-        return self._cp.shape[0]
+        out: int = self._cp.shape[0]
+        return out
 
     def __len__(self) -> int:
         return self.segments
@@ -469,7 +471,7 @@ class PHSpline:
     def __repr__(self) -> str:
         return f"PHSpline(segments={self.segments})"
 
-    def _s(self, s) -> np.ndarray:
+    def _s(self, s: Param) -> np.ndarray:
         a = as_float_array(s, "s")
         if a.ndim > 1:
             raise ValueError(f"s: expected a scalar or a 1-D array, got shape {a.shape}")
@@ -489,7 +491,8 @@ class PHSpline:
         k = self._knots
         if np.any((a < k[0]) | (a > k[-1])):
             raise ValueError(f"u: values must lie within [{k[0]}, {k[-1]}]")
-        return np.interp(a, k, np.arange(self.segments + 1, dtype=float))
+        out: Float64Array = np.interp(a, k, np.arange(self.segments + 1, dtype=float))
+        return out
 
     def evaluate(self, s: float | Array, derivative: int = 0) -> Float64Array:
         """Points (or derivatives with respect to the local ``v``) at ``s``, ``(n, 3)``."""
@@ -501,7 +504,7 @@ class PHSpline:
         return self.evaluate(self.samples(n_per_segment))
 
     # -- frames -------------------------------------------------------------------------
-    def _initial(self, initial):
+    def _initial(self, initial: Array | None) -> np.ndarray | None:
         if initial is None:
             return None
         r = as_float_array(initial, "initial")
@@ -509,7 +512,8 @@ class PHSpline:
             raise ValueError(f"initial: expected shape (3,), got {r.shape}")
         return np.ascontiguousarray(r)
 
-    def _frames(self, s, mode, initial, omega_start):
+    def _frames(self, s: Param, mode: str, initial: Array | None, omega_start: float
+                ) -> tuple[Float64Array, Float64Array]:
         om = as_finite(omega_start, "omega_start")
         return _core.ph_frames(self._cp, self._s(s), mode, self._initial(initial), om, None)
 
@@ -520,7 +524,8 @@ class PHSpline:
         the Frenet frame turned by a constant angle — well conditioned where ``x′ × x″`` is
         tiny. On straight cubics (no Frenet frame) the reference vector of :meth:`rmf` is
         used."""
-        return self._frames(s, "frenet", None, 0.0)[0]
+        out: Float64Array = self._frames(s, "frenet", None, 0.0)[0]
+        return out
 
     def rmf(
         self,
@@ -546,7 +551,8 @@ class PHSpline:
         if s is None:
             s = self.samples(n_per_segment)
         mode = "exact" if as_bool(exact, "exact") else "rational"
-        return self._frames(s, mode, initial, omega_start)[0]
+        out: Float64Array = self._frames(s, mode, initial, omega_start)[0]
+        return out
 
     def angle(
         self,
@@ -560,7 +566,8 @@ class PHSpline:
         the local cubic: ``Ω̃`` (rational, default) or ``Ω`` (``exact=True``). Per cubic, not
         unwrapped across joints; 0 on straight cubics."""
         mode = "exact" if as_bool(exact, "exact") else "rational"
-        return self._frames(s, mode, initial, omega_start)[1]
+        out: Float64Array = self._frames(s, mode, initial, omega_start)[1]
+        return out
 
     def angle_fit(
         self, *, initial: Array | None = None, omega_start: float = 0.0
@@ -664,13 +671,17 @@ def _bez(cp: np.ndarray, v: np.ndarray, k: int = 0) -> np.ndarray:
     u = 1 - v
     b0, b1, b2, b3 = (cp[:, None, i] for i in range(4))
     if k == 0:
-        return u**3 * b0 + 3 * u**2 * v * b1 + 3 * u * v**2 * b2 + v**3 * b3
+        out: np.ndarray = u**3 * b0 + 3 * u**2 * v * b1 + 3 * u * v**2 * b2 + v**3 * b3
+        return out
     if k == 1:
-        return 3 * (u**2 * (b1 - b0) + 2 * u * v * (b2 - b1) + v**2 * (b3 - b2))
-    return 6 * (u * (b2 - 2 * b1 + b0) + v * (b3 - 2 * b2 + b1))
+        out = 3 * (u**2 * (b1 - b0) + 2 * u * v * (b2 - b1) + v**2 * (b3 - b2))
+        return out
+    out = 6 * (u * (b2 - 2 * b1 + b0) + v * (b3 - 2 * b2 + b1))
+    return out
 
 
-def _hermite_batch(p0, t0, p1, t1):
+def _hermite_batch(p0: np.ndarray, t0: np.ndarray, p1: np.ndarray, t1: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Best candidate per row (q, 4, 3) and reason codes (0 = solved)."""
     try:
         cand, counts, codes = _core.ph_hermite(
@@ -682,7 +693,8 @@ def _hermite_batch(p0, t0, p1, t1):
     return cand.reshape(-1, 2, 4, 3)[:, 0], counts, codes
 
 
-def _dev_curve(curve, cp, ta, tb, lo, hi) -> np.ndarray:
+def _dev_curve(curve: Curve, cp: np.ndarray, ta: np.ndarray, tb: np.ndarray, lo: float,
+               hi: float) -> np.ndarray:
     """Max distance from 41 points of each cubic to the curve arc over [ta, tb] (per row),
     in blocks of 1024 rows (the scan needs 64 kB per row)."""
     if cp.shape[0] > 1024:
@@ -709,7 +721,8 @@ def _dev_curve(curve, cp, ta, tb, lo, hi) -> np.ndarray:
         step = np.where(gp > 0, g / np.where(gp > 0, gp, 1.0), 0.0)
         u = np.clip(u - step, a[:, None], b[:, None])
     dist = np.linalg.norm(curve.point(u.ravel()).reshape(q, 41, 3) - X, axis=-1)
-    return dist.max(axis=1)
+    out: np.ndarray = dist.max(axis=1)
+    return out
 
 
 def _dev_rows(cp: np.ndarray, pts: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
@@ -734,11 +747,11 @@ def _dev_rows(cp: np.ndarray, pts: np.ndarray, ia: np.ndarray, ib: np.ndarray) -
     return out
 
 
-def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float]:
+def _inflections(curve: Curve, lo: float, hi: float, n: int, diag: float) -> list[float]:
     """Parameters where κ has a local minimum with κ·diag < 1e-6 (golden-section refined)."""
     u = np.linspace(lo, hi, n)
     k = curve.curvature(u)
-    out = []
+    out: list[float] = []
     g = (np.sqrt(5) - 1) / 2
     for i in np.flatnonzero((k[1:-1] <= k[:-2]) & (k[1:-1] <= k[2:])) + 1:
         a, b = u[i - 1], u[i + 1]
@@ -758,23 +771,26 @@ def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float
     return out
 
 
-def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
-                   diag: float) -> np.ndarray:
+def _initial_knots(shape: Curve | None, pts: np.ndarray | None,
+                   data: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]], lo: float,
+                   hi: float, diag: float) -> np.ndarray:
     """Starting knots of the adaptive fit: uniform (4 intervals of a curve, every ⌈n/8⌉-th
     row of samples), the inflections (κ minima with κ·diag < 1e-6, or rows where the
     discrete binormal flips), then intervals halved until the tangent turns by less than
     π/2 on each (8-point scan)."""
-    if analytic:
+    analytic = shape is not None
+    if shape is not None:
         h_min = 1e-6 * (hi - lo)
-        infl = [x for x in _inflections(curve, lo, hi, 256, diag)
+        infl = [x for x in _inflections(shape, lo, hi, 256, diag)
                 if lo + h_min < x < hi - h_min]
         # uniform knots give way to nearby inflections (no sliver intervals)
-        k = {x for x in np.linspace(lo, hi, 5).tolist()
-             if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
-        k.update(infl)
+        start = {x for x in np.linspace(lo, hi, 5).tolist()
+                 if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
+        start.update(infl)
     else:
+        assert pts is not None  # samples when not analytic
         n = pts.shape[0]
-        k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
+        start = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
         d = np.diff(pts, axis=0)
         bn = np.cross(d[:-1], d[1:])
         bl = np.linalg.norm(bn, axis=1)
@@ -782,9 +798,9 @@ def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
         bn = bn / np.where(ok, bl, 1.0)[:, None]
         for j in range(len(bn) - 1):
             if ok[j] and ok[j + 1] and bn[j] @ bn[j + 1] < 0:  # rows j+1 and j+2
-                k.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
+                start.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
         h_min = 1.0
-    k = np.array(sorted(k))
+    k = np.array(sorted(start))
     for _ in range(64):
         sub = k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.linspace(0, 1, 9)
         if not analytic:
@@ -805,7 +821,8 @@ def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
 _MAX_FIT_SEGMENTS = 100_000
 
 
-def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
+def _fixed_knots(segments: int | None, knots: Array | None, analytic: bool, lo: float,
+                 hi: float) -> tuple[np.ndarray, str]:
     """The knots of a fit with ``segments`` uniform intervals or explicit ``knots``, and the
     name of the argument that set them."""
     if segments is not None:
@@ -894,18 +911,19 @@ def fit(
         raise TypeError("tol, segments, knots: pass at most one of them")
     max_segments = as_int(max_segments, "max_segments", 1, _MAX_FIT_SEGMENTS)
     analytic = isinstance(curve, Curve)
-    if analytic:
+    shape = curve if isinstance(curve, Curve) else None  # the analytic curve
+    pts: np.ndarray | None = None  # the samples
+    if isinstance(curve, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (exact tangents)")
         lo, hi = curve.domain if domain is None else domain
         lo, hi = float(lo), float(hi)
         if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
             raise ValueError(f"domain: expected a finite interval (lo, hi), got {domain!r}")
-        pts = None
         probe = curve.point(np.linspace(lo, hi, 257))
         diag = float(np.linalg.norm(probe.max(0) - probe.min(0)))
 
-        def data(k):
+        def data(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             return curve.point(k), curve.tangent(k)
     else:
         if domain is not None:
@@ -932,11 +950,11 @@ def fit(
         lo, hi = 0.0, float(n - 1)
         diag = float(np.linalg.norm(pts.max(0) - pts.min(0)))
 
-        def data(k):
+        def data(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             i = k.astype(np.intp)
             return pts[i], T[i]
 
-    def solve(k, what):
+    def solve(k: np.ndarray, what: str) -> np.ndarray:
         p, t = data(k)
         cp, counts, codes = _hermite_batch(p[:-1], t[:-1], p[1:], t[1:])
         bad = np.flatnonzero(counts == 0)
@@ -946,10 +964,17 @@ def fit(
                              f"{_REASONS[int(codes[i])]}; split it or move the knots")
         return cp
 
-    def deviation(cp, k):
-        if analytic:
-            return _dev_curve(curve, cp, k[:-1], k[1:], lo, hi)
+    def deviation(cp: np.ndarray, k: np.ndarray) -> np.ndarray:
+        if shape is not None:
+            return _dev_curve(shape, cp, k[:-1], k[1:], lo, hi)
+        assert pts is not None  # samples when not analytic
         return _dev_rows(cp, pts, k[:-1].astype(np.intp), k[1:].astype(np.intp))
+
+    def deviation_between(cp: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if shape is not None:
+            return _dev_curve(shape, cp, a, b, lo, hi)
+        assert pts is not None  # samples when not analytic
+        return _dev_rows(cp, pts, a.astype(np.intp), b.astype(np.intp))
 
     if segments is not None or knots is not None:
         k, what = _fixed_knots(segments, knots, analytic, lo, hi)
@@ -959,7 +984,7 @@ def fit(
         return sp
 
     tol = 1e-5 * diag if tol is None else as_positive(tol, "tol")
-    k = _initial_knots(curve, pts, data, analytic, lo, hi, diag)
+    k = _initial_knots(shape, pts, data, lo, hi, diag)
     h_min = 1e-6 * (hi - lo) if analytic else 1.0
     # work queue, processed in batches
     pending = [(k[i], k[i + 1]) for i in range(len(k) - 1)]
@@ -973,8 +998,7 @@ def fit(
         dev = np.full(a.size, np.inf)
         okr = counts > 0
         if okr.any():
-            dev_ok = (_dev_curve(curve, cp[okr], a[okr], b[okr], lo, hi) if analytic else
-                      _dev_rows(cp[okr], pts, a[okr].astype(np.intp), b[okr].astype(np.intp)))
+            dev_ok = deviation_between(cp[okr], a[okr], b[okr])
             dev[okr] = dev_ok
         pending = []
         for j in range(a.size):

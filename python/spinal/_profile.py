@@ -45,7 +45,7 @@ everywhere (turned by π more: ``K < 0``); for ``δ ≥ π`` no turn avoids para
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -224,7 +224,8 @@ class ProfileSurface:
         for fi, fj in lines:
             if space == "parameters":
                 pu = np.interp(fi, np.arange(nu), self.u)
-                vx = np.r_[self.v, self._v_end] if self.profile_closed else self.v
+                v_end: float | None = getattr(self, "_v_end")  # noqa: B009 (set by profile_surface)
+                vx = np.r_[self.v, v_end] if self.profile_closed else self.v
                 pv = np.interp(fj, np.arange(len(vx)), vx)
                 out.append(np.stack([pu, pv], axis=1))
             else:
@@ -252,7 +253,7 @@ class ProfileSurface:
         faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
                                 np.stack([b, d, c], -1).reshape(-1, 3)])
         uv = np.stack(np.meshgrid(self.u, self.v, indexing="ij"), -1).reshape(-1, 2)
-        data = {k: np.array(getattr(self, k)).reshape(-1)
+        data: dict[str, Array] = {k: np.array(getattr(self, k)).reshape(-1)
                 for k in ("gaussian", "mean", "k1", "k2", "mu", "parabolic_sign")}
         return Mesh(self.points.reshape(-1, 3), faces, self.normals.reshape(-1, 3), uv,
                     point_data=data)
@@ -470,7 +471,7 @@ def profile_surface(
     sing = _singular_points(mu, uu, vv, v_end)
     conv = _convexity(T, kc, k, prof_size, spine_size, profile_closed)
 
-    def ro(arr):
+    def ro(arr: np.ndarray) -> np.ndarray:
         arr = np.ascontiguousarray(arr)
         arr.setflags(write=False)
         return arr
@@ -505,7 +506,7 @@ def _repeat_floor(p: np.ndarray) -> float:
     return float(np.max(p.max(axis=0) - p.min(axis=0))) * 2.0**-40
 
 
-def _count_or_values(x, name: str, domain: tuple[float, float], default: int) -> np.ndarray:
+def _count_or_values(x: object, name: str, domain: tuple[float, float], default: int) -> np.ndarray:
     if x is None:
         x = default
     if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
@@ -523,21 +524,23 @@ def _count_or_values(x, name: str, domain: tuple[float, float], default: int) ->
     return np.array(arr, dtype=float)
 
 
-def _curve_params(curve: Curve, x, name: str) -> np.ndarray:
+def _curve_params(curve: Curve, x: object, name: str) -> np.ndarray:
     return _count_or_values(x, name, curve.domain, _DEFAULT_COUNT)
 
 
-def _spline_params(spline, x) -> np.ndarray:
+def _spline_params(spline: PHSpline, x: object) -> np.ndarray:
     m = spline.segments
     if x is None:
-        return spline.samples(16)
+        out: np.ndarray = spline.samples(16)
+        return out
     uu = _count_or_values(x, "u", (0.0, float(m)), _DEFAULT_COUNT)
     if uu[0] < 0 or uu[-1] > m:
         raise ValueError(f"u: spline parameters must lie within [0, {m}]")
     return uu
 
 
-def _profile(profile, v, profile_closed: bool):
+def _profile(profile: Array | Curve, v: object, profile_closed: bool
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float | None]:
     """``(c (nv, 2), T (nv, 2), κ_c (nv,), v (nv,), size, v_end)``; ``v_end`` is the
     parameter at which a closed profile returns to its first sample (None when open)."""
     if isinstance(profile, Curve):
@@ -585,7 +588,7 @@ def _profile(profile, v, profile_closed: bool):
     return c, T, kc, vv, _size(c), (float(vv[-1] + h[-1]) if profile_closed else None)
 
 
-def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray):
+def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangents and signed curvatures of a 2-D polyline from the circle through each
     sample and its neighbours: ``T ∝ α/|α|² + β/|β|²`` (α, β the chords in and out),
     ``κ = 2 (α × β)/(|α||β||α + β|)``."""
@@ -622,7 +625,8 @@ def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray):
 def _reflect(t: np.ndarray, chord: np.ndarray) -> np.ndarray:
     """The tangent at the far end of a circular arc: ``t`` reflected in the chord."""
     e = chord / np.hypot(*chord)
-    return 2 * np.dot(t / np.hypot(*t), e) * e - t / np.hypot(*t)
+    out: np.ndarray = 2 * np.dot(t / np.hypot(*t), e) * e - t / np.hypot(*t)
+    return out
 
 
 def _curvature_vector(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
@@ -630,7 +634,8 @@ def _curvature_vector(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
     sp2 = np.einsum("ij,ij->i", d1, d1)
     if np.any(sp2 == 0):
         raise ValueError("spine: the curve is not regular (zero derivative) at a sample")
-    return np.cross(np.cross(d1, d2), d1) / sp2[:, None] ** 2
+    out: np.ndarray = np.cross(np.cross(d1, d2), d1) / sp2[:, None] ** 2
+    return out
 
 
 def _circle_curvature(x: np.ndarray, closed: bool) -> np.ndarray:
@@ -648,7 +653,8 @@ def _circle_curvature(x: np.ndarray, closed: bool) -> np.ndarray:
     kn[~(pp > 0)] = 0.0
     if not closed:
         kn[0], kn[-1] = kn[1], kn[-2]
-    return kn
+    out: np.ndarray = kn
+    return out
 
 
 def _extrapolate_ends(k: np.ndarray, uu: np.ndarray) -> np.ndarray:
@@ -661,7 +667,8 @@ def _extrapolate_ends(k: np.ndarray, uu: np.ndarray) -> np.ndarray:
     return k
 
 
-def _checked_frames(frames, x, uu, kn, size, tangents) -> np.ndarray:
+def _checked_frames(frames: Array, x: np.ndarray, uu: np.ndarray, kn: np.ndarray, size: float,
+                    tangents: np.ndarray | None) -> np.ndarray:
     """User frames: rotation matrices, one per sample, without a turn about the tangent
     beyond :data:`_TWIST_TOL`."""
     F, _ = as_frames(frames, "frames", len(x))
@@ -706,7 +713,8 @@ def _checked_frames(frames, x, uu, kn, size, tangents) -> np.ndarray:
 # singular points, convexity
 
 
-def _singular_points(mu, uu, vv, v_end) -> np.ndarray:
+def _singular_points(mu: np.ndarray, uu: np.ndarray, vv: np.ndarray, v_end: float | None
+                     ) -> np.ndarray:
     profile_closed = v_end is not None
     vx = np.r_[vv, v_end] if profile_closed else vv
     out = []
@@ -722,7 +730,9 @@ def _singular_points(mu, uu, vv, v_end) -> np.ndarray:
     return arr
 
 
-def _convexity(T, kc, k, prof_size, spine_size, profile_closed):
+def _convexity(T: np.ndarray, kc: np.ndarray, k: np.ndarray, prof_size: float,
+               spine_size: float, profile_closed: bool
+               ) -> tuple[float, float, bool, np.ndarray | None]:
     """``(δ, ΔΩ, Cor. 9 criterion, interval of turns or None)``."""
     gamma = np.unwrap(np.arctan2(T[:, 1], T[:, 0]))
     delta = float(gamma.max() - gamma.min())
@@ -755,6 +765,10 @@ def _convexity(T, kc, k, prof_size, spine_size, profile_closed):
 # marching squares
 
 
+#: An edge of the sample grid: ``("u", i, j)`` from (i, j) to (i+1, j), ``("v", i, j)`` to (i, j+1).
+_Edge: TypeAlias = tuple[str, int, int]
+
+
 def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]]:
     """Zero lines of ``f`` on its grid as ``(i, j)`` fractional index polylines: crossings
     on edges between ``f > 0`` and ``f ≤ 0`` samples, chained through shared edges."""
@@ -763,13 +777,13 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
     cols = nv if wrap_v else nv - 1
 
     # crossing points, keyed by edge: "u" edges (i, j)-(i+1, j), "v" edges (i, j)-(i, j+1)
-    def u_edge(i, j):
+    def u_edge(i: int, j: int) -> _Edge:
         return ("u", i, j % nv)
 
-    def v_edge(i, j):
+    def v_edge(i: int, j: int) -> _Edge:
         return ("v", i, j % nv)
 
-    def point(key):
+    def point(key: _Edge) -> tuple[float, float]:
         kind, i, j = key
         if kind == "u":
             a, b = f[i, j], f[i + 1, j]
@@ -778,9 +792,9 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
         a, b = f[i, j], f[i, jn]
         return float(i), j + a / (a - b)
 
-    graph: dict = {}
+    graph: dict[_Edge, list[_Edge]] = {}
 
-    def link(p, q):
+    def link(p: _Edge, q: _Edge) -> None:
         graph.setdefault(p, []).append(q)
         graph.setdefault(q, []).append(p)
 
@@ -812,7 +826,7 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
                 link(bottom, left)
                 link(right, top)
     lines = []
-    seen: set = set()
+    seen: set[_Edge] = set()
     starts = [n for n, nb in graph.items() if len(nb) == 1] + list(graph)
     for start in starts:
         if start in seen:
@@ -843,5 +857,6 @@ def _bilinear(P: np.ndarray, fi: np.ndarray, fj: np.ndarray, wrap: bool) -> np.n
     a = (fi - i0)[:, None]
     b = (fj - np.floor(fj))[:, None] if wrap else (fj - j0)[:, None]
     j1 = (j0 + 1) % nv
-    return ((1 - a) * (1 - b) * P[i0, j0] + a * (1 - b) * P[i0 + 1, j0]
+    out: np.ndarray = ((1 - a) * (1 - b) * P[i0, j0] + a * (1 - b) * P[i0 + 1, j0]
             + (1 - a) * b * P[i0, j1] + a * b * P[i0 + 1, j1])
+    return out

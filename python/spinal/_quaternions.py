@@ -32,7 +32,7 @@ def _from_xyzw(q: np.ndarray, scalar_first: bool) -> np.ndarray:
     return np.ascontiguousarray(q[..., [3, 0, 1, 2]]) if scalar_first else q
 
 
-def _quats(x, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
+def _quats(x: Array, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
     """(n, 4) xyzw array and whether the input was a single quaternion."""
     q = as_float_array(x, name)
     single = q.ndim == 1
@@ -123,7 +123,7 @@ def slerp_frames(frames: Array, new_u: Array, key_u: Array | None = None) -> Flo
     return _core.quat_slerp_frames(f, np.ascontiguousarray(ku), np.ascontiguousarray(nu))
 
 
-def _initial_r(initial):
+def _initial_r(initial: Array | None) -> np.ndarray | None:
     """The reference vector at row 0 as given: a (3,) vector or a frame's first column."""
     if initial is None:
         return None
@@ -186,7 +186,7 @@ def quaternion_frames(
             raise ValueError(f"tangents: expected shape {pts.shape} to match points, got {t.shape}")
     r0 = _initial_r(initial)
 
-    def transport(pts, offs, t):
+    def transport(pts: np.ndarray, offs: np.ndarray, t: np.ndarray) -> np.ndarray:
         n = len(pts)
         repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
         core_pts = pts[:-1] if repeat else pts
@@ -285,13 +285,14 @@ def camera_frames(
     singular = as_finite(singular_angle, "singular_angle", 0.0, np.pi / 2)
     turns = as_int(turns, "turns")
 
-    def camera(pts, offs, t, b):
+    def camera(pts: np.ndarray, offs: np.ndarray, t: np.ndarray, b: np.ndarray) -> np.ndarray:
         t, uu, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
                                                        singular)
         if mode == "transport":
             init = None if vertical else uu
             f = frames(pts, t, initial=init, closed=closed, turns=turns)
         else:
+            assert regular is not None  # (given in the "up" mode)
             f = _level_frames(pts, t, uu, regular, closed)
         # spinal frame (r, s, t) = (up, right, gaze), rolled by the bank about the gaze
         # (up' = cos b up + sin b (t × up)), then reordered to camera (right, up, −gaze)
@@ -299,7 +300,8 @@ def camera_frames(
 
     # consecutive repeated samples (a pause in a GPS track) merged: their rows get the
     # camera of the row they repeat
-    return _merge.on_rows(camera, pts, np.array([0, n], dtype=np.int64), closed, False, (t, b))
+    out: Float64Array = _merge.on_rows(camera, pts, np.array([0, n], dtype=np.int64), closed, False, (t, b))
+    return out
 
 
 def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
@@ -310,11 +312,12 @@ def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
     return g
 
 
-def _angle_about(a, b, t) -> float:
+def _angle_about(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> float:
     return float(np.arctan2(np.cross(a, b) @ t, a @ b))
 
 
-def _level_frames(pts, t, u, regular, closed):
+def _level_frames(pts: np.ndarray, t: np.ndarray, u: np.ndarray, regular: np.ndarray,
+                  closed: bool) -> np.ndarray:
     """Level-horizon frames; ``regular``: the rows where ``u`` projects onto the normal plane
     (checked by the core: at least one)."""
     n = len(pts)
@@ -375,7 +378,7 @@ class WalkResult(NamedTuple):
     path_moves: Int64Array
 
 
-def _faces(faces) -> np.ndarray:
+def _faces(faces: Array) -> np.ndarray:
     fa = np.asarray(faces)
     if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
         raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "

@@ -32,3 +32,4 @@ Param: TypeAlias = float | Array
 FalloffPower: TypeAlias = Literal[2, 3, 4]
 Blend: TypeAlias = Literal["c1", "linear"]
 Form: TypeAlias = Literal["rate", "curl"]
+SplineKind: TypeAlias = Literal["catmull_rom", "natural_cubic", "bspline"]
