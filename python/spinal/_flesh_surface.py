@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Literal, overload
 import numpy as np
 
 from . import _core
-from ._flesh import _unit_sized
+from ._flesh_roll import _unit_sized
 from ._mesh import FoldOverWarning
 from ._types import Array, Float64Array, Int64Array, SurfaceSolution
 from ._validate import as_bool, as_choice, as_float_array
