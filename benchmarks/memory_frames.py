@@ -48,8 +48,9 @@ class Measured(types.ModuleType):
             return r
         return call
 
-import spinal._frames, spinal.quaternions
-spinal._frames._core = spinal.quaternions._core = Measured('measured')
+import spinal._frames, spinal._frames_time, spinal.quaternions
+spinal._frames._core = spinal._frames_time._core = Measured('measured')
+spinal.quaternions._core = spinal._frames._core
 n = {n}
 # the inputs written in place (no temporaries of their size)
 s = np.linspace(0, 1000 * np.pi, n, endpoint=False)

@@ -38,7 +38,8 @@ from ._core import __version__
 from ._deform import DeformReport, RefinementWarning, StampReport, deform, stamp
 from ._flesh import SpineBinding, flesh
 from ._flesh_surface import SurfaceBinding, flesh_surface
-from ._frames import closing_angle, estimate_tangents, frames, frames_in_time
+from ._frames import closing_angle, estimate_tangents, frames
+from ._frames_time import frames_in_time
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._profile import ProfileSurface, profile_surface
 from ._sweep import sweep, tube

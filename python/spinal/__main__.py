@@ -19,6 +19,8 @@ from __future__ import annotations
 import argparse
 import pathlib
 import sys
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -51,8 +53,9 @@ def ribbon(x: np.ndarray, F: np.ndarray, width: float) -> spinal.Mesh:
 def square_profile(y0: float, y1: float, z0: float, z1: float, k: int) -> np.ndarray:
     """The rectangle [y0, y1] × [z0, z1] as a polygon with k vertices per side."""
     e = np.linspace(0, 1, k, endpoint=False)
-    return np.r_[np.c_[y0 + (y1 - y0) * e, z0 + 0 * e], np.c_[y1 + 0 * e, z0 + (z1 - z0) * e],
+    out: np.ndarray = np.r_[np.c_[y0 + (y1 - y0) * e, z0 + 0 * e], np.c_[y1 + 0 * e, z0 + (z1 - z0) * e],
                  np.c_[y1 - (y1 - y0) * e, z1 + 0 * e], np.c_[y0 + 0 * e, z1 - (z1 - z0) * e]]
+    return out
 
 
 def demo(out: pathlib.Path) -> int:
@@ -144,9 +147,9 @@ def demo(out: pathlib.Path) -> int:
     print("  helix (a=1, b=0.5, length 20) vs closed-form RMF, max angle error (rad):")
     print("      n  double_reflection   rotation   projection")
     for n in (64, 128, 256, 512, 1024):
-        e = {m: err for (k, m, err) in rows if k == n}
-        print(f"  {n:5d}  {e['double_reflection']:17.3e}  {e['rotation']:9.3e}  "
-              f"{e['projection']:11.3e}")
+        errs = {m: err for (k, m, err) in rows if k == n}
+        print(f"  {n:5d}  {errs['double_reflection']:17.3e}  {errs['rotation']:9.3e}  "
+              f"{errs['projection']:11.3e}")
     print(f"  closed knot tube: {len(tube.vertices)} vertices, watertight {tube.is_watertight}, "
           f"volume {tube.volume:.6f}")
     print(f"  tube (ρ = {r}, {sides} sides) round a circle (R = {R}) vs Pappus 2πR·A = "
@@ -172,7 +175,7 @@ def demo(out: pathlib.Path) -> int:
     return 0
 
 
-def _pyvista():
+def _pyvista() -> Any:
     """pyvista set up to render off-screen without a window and without warnings: on a Linux
     machine with no display VTK renders through EGL instead of trying X first."""
     import os
@@ -187,15 +190,18 @@ def _pyvista():
     return pv
 
 
-def render_pictures(out, x, F, alpha, tube, ring, dented, report, tool_end, bar, bent_bars,
-                    bar_change, posed_spine) -> list[pathlib.Path]:
+def render_pictures(out: pathlib.Path, x: np.ndarray, F: np.ndarray, alpha: float | np.ndarray,
+                    tube: spinal.Mesh, ring: spinal.Mesh, dented: spinal.Mesh,
+                    report: spinal.DeformReport, tool_end: np.ndarray, bar: spinal.Mesh,
+                    bent_bars: dict[str, spinal.Mesh], bar_change: dict[str, float],
+                    posed_spine: np.ndarray) -> list[pathlib.Path]:
     """One labelled PNG per part of the demo (needs pyvista): the frames as a ribbon, the
     closed knot tube, the dent with its volume report and the bar bent without and with the
     volume correction, side by side."""
     pv = _pyvista()
-    written = []
+    written: list[pathlib.Path] = []
 
-    def finish(pl, name):
+    def finish(pl: Any, name: str) -> None:
         path = out / name
         pl.screenshot(str(path))
         pl.close()
@@ -260,7 +266,7 @@ def render_pictures(out, x, F, alpha, tube, ring, dented, report, tool_end, bar,
     return written
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(
         prog="python -m spinal",
         description="spinal: moving frames, sweeps and volume-preserving deformations along "

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import itertools
+from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core
 from ._progress import Progress, checked
+from ._types import Array, Float64Array, ProgressArg
 from ._validate import as_choice, as_finite, as_int, as_out, as_points
 from .fields import Field
 
@@ -17,8 +20,17 @@ __all__ = ["advect"]
 MAX_STEPS = 100_000_000
 
 
-def advect(vertices, field: Field, duration, steps=None, *, method: str = "rk4",
-           t0=0.0, progress=False, out=None) -> np.ndarray:
+def advect(
+    vertices: Array,
+    field: Field,
+    duration: float,
+    steps: int | None = None,
+    *,
+    method: Literal["rk4", "euler", "split"] = "rk4",
+    t0: float = 0.0,
+    progress: ProgressArg = False,
+    out: npt.NDArray[np.float64] | None = None,
+) -> Float64Array:
     """Move points along a velocity field for ``duration``: integrate ``dX/dt = v(X, t)``
     from ``t0`` to ``t0 + duration`` for every point, independently and in parallel.
 

@@ -12,8 +12,16 @@ import argparse
 import pathlib
 import sys
 import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, TextIO
 
 import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:  # Python 3.11+ at run time
+    from typing import Self
+
+    from .io import Streamlines
 
 #: Spine rows per chunk of a bundle streamed to a file (a progress step; Ctrl-C stops
 #: between chunks).
@@ -50,10 +58,10 @@ class _Progress:
         if self.bar is not None:
             self.bar.update(done - self.bar.n)
 
-    def __enter__(self):
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         if self.bar is not None:
             self.bar.close()
 
@@ -63,7 +71,7 @@ def _say(quiet: bool, text: str) -> None:
         print(text, file=sys.stderr)
 
 
-def read_curves(path: pathlib.Path):
+def read_curves(path: pathlib.Path) -> Streamlines:
     """``Streamlines`` of a streamline file, or of one curve given as an array file."""
     from . import io
 
@@ -83,7 +91,7 @@ def read_curves(path: pathlib.Path):
     return io.Streamlines([np.asarray(x, dtype=np.float64)], {}, {})
 
 
-def _per_point(s, name: str, what: str) -> list:
+def _per_point(s: Streamlines, name: str, what: str) -> list[np.ndarray]:
     """The per-point arrays of ``name`` (per-streamline values repeated along each)."""
     if name in s.point_data:
         return [np.asarray(a) for a in s.point_data[name]]
@@ -101,12 +109,14 @@ def _colormap(t: np.ndarray) -> np.ndarray:
     try:
         from matplotlib import colormaps
 
-        return colormaps["viridis"](t)[:, :3]
+        out: np.ndarray = colormaps["viridis"](t)[:, :3]
+        return out
     except ImportError:
-        return np.c_[t, t, 1 - t]
+        out = np.c_[t, t, 1 - t]
+        return out
 
 
-def _colors(s, spec: str) -> list:
+def _colors(s: Streamlines, spec: str) -> list[np.ndarray]:
     """One ``(n_i, 3)`` array of colours in [0, 1] per streamline."""
     import spinal
 
@@ -119,7 +129,7 @@ def _colors(s, spec: str) -> list:
             out.append(np.abs(t))
         return out
     values = _per_point(s, spec, "--color")
-    v = np.concatenate(values) if values else np.zeros(0)
+    v: np.ndarray = np.concatenate(values) if values else np.zeros(0)
     if v.ndim == 2 and v.shape[1] in (3, 4):
         rgb = v[:, :3].astype(np.float64)
         if v.dtype == np.uint8 or rgb.max(initial=0) > 1:
@@ -133,7 +143,7 @@ def _colors(s, spec: str) -> list:
     return np.split(np.clip(rgb, 0, 1), ends)
 
 
-def _check_paths(a, output_suffixes=None) -> None:
+def _check_paths(a: argparse.Namespace, output_suffixes: Sequence[str] | None = None) -> None:
     """Refuse a missing input and an unknown output format before any work."""
     src = pathlib.Path(getattr(a, "input", None) or a.file)
     if not src.exists():
@@ -145,7 +155,7 @@ def _check_paths(a, output_suffixes=None) -> None:
                              f"{', '.join(output_suffixes)}")
 
 
-def tube(a) -> int:
+def tube(a: argparse.Namespace) -> int:
     import spinal
 
     from . import io
@@ -161,9 +171,10 @@ def tube(a) -> int:
                                                                                 "orientation"):
         # nothing needs the whole bundle: read and tubed a block at a time, written as
         # it goes (memory of one block)
-        src = pathlib.Path(a.input)
-        if src.suffix.lower() not in io.STREAMLINE_SUFFIXES:
-            src = read_curves(src).points
+        path = pathlib.Path(a.input)
+        src: pathlib.Path | list[np.ndarray] = path
+        if path.suffix.lower() not in io.STREAMLINE_SUFFIXES:
+            src = read_curves(path).points
         with _Progress(None, "tube", a.quiet) as bar:
             io.tube_file(src, out, a.radius, a.sides, chunk_points=BLOCK_ROWS, dtype=dtype,
                          colors=a.color, join=a.join,
@@ -180,12 +191,12 @@ def tube(a) -> int:
     t1 = time.perf_counter()
     if out.suffix.lower() in STREAMED:
         # per-point radius and colours computed over the whole bundle, then streamed out
-        data = [{} for _ in s.points]
+        per_curve: list[dict[str, np.ndarray]] = [{} for _ in s.points]
         for name, values in (("radius", radius), ("colors", colors)):
-            for d, v in zip(data, values or ()):
+            for d, v in zip(per_curve, values or ()):
                 d[name] = v
         with _Progress(None, "tube", a.quiet) as bar:
-            io.tube_file(zip(s.points, data), out, "radius" if radius else a.radius,
+            io.tube_file(zip(s.points, per_curve), out, "radius" if radius else a.radius,
                          a.sides, chunk_points=BLOCK_ROWS, dtype=dtype,
                          colors="colors" if colors else None, join=a.join,
                          progress=(lambda done: bar.step(done)) if bar.bar else False)
@@ -193,7 +204,8 @@ def tube(a) -> int:
                       f"{time.perf_counter() - t1:.2f} s)")
         return 0
     r = a.radius if radius is None else np.concatenate(radius).astype(float)
-    data = None if colors is None else {"colors": np.concatenate(colors)}
+    data: dict[str, npt.ArrayLike] | None = (
+        None if colors is None else {"colors": np.concatenate(colors)})
     with _Progress(rows, "tube", a.quiet) as bar:
         mesh = spinal.tube(s.points, r, a.sides, dtype=dtype, join=a.join, point_data=data,
                            on_short="skip", on_invalid="skip",
@@ -205,7 +217,7 @@ def tube(a) -> int:
     return 0
 
 
-def frames(a) -> int:
+def frames(a: argparse.Namespace) -> int:
     import spinal
 
     _check_paths(a, (".npz",))
@@ -223,7 +235,7 @@ def frames(a) -> int:
     return 0
 
 
-def info(a) -> int:
+def info(a: argparse.Namespace) -> int:
     import spinal
 
     _check_paths(a)
@@ -280,7 +292,7 @@ def _box(x: np.ndarray) -> str:
     return " × ".join(f"[{a:.4g}, {b:.4g}]" for a, b in zip(lo, hi, strict=True))
 
 
-def add_commands(sub) -> None:
+def add_commands(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """The ``tube``, ``frames`` and ``info`` sub-commands on an argparse sub-parser set."""
     t = sub.add_parser(
         "tube", help="tube every streamline of a file and write the mesh",
@@ -330,18 +342,20 @@ def add_commands(sub) -> None:
     i.set_defaults(run=info)
 
 
-def run(a) -> int:
+def run(a: argparse.Namespace) -> int:
     """Run the sub-command of the parsed arguments ``a``: its status, 1 after an error of
     the input (one line on stderr), 130 after Ctrl-C."""
     import warnings
 
-    def one_line(message, category, filename, lineno, file=None, line=None):
+    def one_line(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                 file: TextIO | None = None, line: str | None = None) -> None:
         print(f"spinal {a.command}: warning: {message}", file=sys.stderr)
 
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
-            return a.run(a)
+            out: int = a.run(a)
+            return out
     except KeyboardInterrupt:
         print("spinal: interrupted", file=sys.stderr)
         return 130

@@ -34,12 +34,15 @@ The maths, in the mesh's length unit L (volumes in L³, areas in L²):
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
 from . import _core
 from ._mesh import Mesh, mesh_arrays, signed_volume
+from ._types import AnyMesh
 from ._validate import as_positive
 
 __all__ = ["CompensationReport", "compensate_volume"]
@@ -155,7 +158,11 @@ def steiner_coefficients(X: np.ndarray, F: np.ndarray) -> tuple[float, float, fl
 # ---- Steiner's offset ----------------------------------------------------------------------
 
 
-def _unscaled(x, e: int):
+@overload
+def _unscaled(x: float, e: int) -> float: ...
+@overload
+def _unscaled(x: np.ndarray, e: int) -> np.ndarray: ...
+def _unscaled(x: float | np.ndarray, e: int) -> float | np.ndarray:
     """``x · 2**e`` (a length with ``e``, a volume with ``3e``), ``±inf`` past float64."""
     with np.errstate(over="ignore", under="ignore"):
         y = np.ldexp(x, e)
@@ -194,10 +201,10 @@ def steiner_offset(coefficients: tuple[float, float, float, float], target: floa
     the mesh scaled by ``2**e``)."""
     V, A, M, C = coefficients
 
-    def p(h):  # V(h) − target, Horner
+    def p(h: float) -> float:  # V(h) − target, Horner
         return (V - target) + h * (A + h * (M + h * C))
 
-    def dp(h):
+    def dp(h: float) -> float:
         return A + h * (2 * M + 3 * h * C)
 
     lo, hi = _increasing_branch(A, M, C)
@@ -220,7 +227,8 @@ def steiner_offset(coefficients: tuple[float, float, float, float], target: floa
     return _newton_on_bracket(p, dp, lo, hi, _start(coefficients, target, lo, hi))
 
 
-def _start(coefficients, target: float, lo: float, hi: float) -> float:
+def _start(coefficients: tuple[float, float, float, float], target: float, lo: float,
+           hi: float) -> float:
     """A real root of the cubic in ``[lo, hi]`` from ``numpy.roots`` (eigenvalues of the
     companion matrix), else ``(target − V)/A``."""
     V, A, M, C = coefficients
@@ -230,7 +238,7 @@ def _start(coefficients, target: float, lo: float, hi: float) -> float:
     return float(real[np.argmin(np.abs(real))]) if len(real) else (target - V) / A
 
 
-def _bracket(p, step: float) -> float:
+def _bracket(p: Callable[[float], float], step: float) -> float:
     """An end ``h`` (same sign as ``step``) with ``p(h)`` of the other sign than ``p(0)``, by
     doubling ``step`` (``p`` monotone and unbounded that way)."""
     h = step
@@ -241,7 +249,8 @@ def _bracket(p, step: float) -> float:
     return h  # pragma: no cover - p is unbounded on that side
 
 
-def _newton_on_bracket(p, dp, lo: float, hi: float, h: float) -> float:
+def _newton_on_bracket(p: Callable[[float], float], dp: Callable[[float], float], lo: float,
+                       hi: float, h: float) -> float:
     """The root of the increasing ``p`` in ``[lo, hi]`` (``p(lo) ≤ 0 ≤ p(hi)``) from ``h``:
     Newton steps, a bisection whenever a step would leave the bracket or does not halve the
     step before it (Press et al., *Numerical Recipes*, §9.4 ``rtsafe``)."""
@@ -323,7 +332,7 @@ def _scale_exponent(V: np.ndarray) -> int:
     return max(-1000, min(1000, e))
 
 
-def compensate_volume(mesh, target: float) -> tuple[Mesh, CompensationReport]:
+def compensate_volume(mesh: AnyMesh, target: float) -> tuple[Mesh, CompensationReport]:
     r"""Give a closed mesh the volume ``target`` by moving every vertex the same distance
     ``h`` along its unit normal (global volume compensation, Zhuo 2014 §2.2.2 and ch. IX).
 

@@ -1,7 +1,7 @@
 """Type stubs for the compiled core (``spinal._core``). Use the wrappers in ``spinal``."""
 
 from collections.abc import Callable, Sequence
-from typing import TypeAlias
+from typing import TypeAlias, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -203,7 +203,7 @@ class Field:
     def max_speed(self) -> float: ...
     @property
     def length_scale(self) -> float: ...
-    def steps(self, duration: float, points: npt.NDArray[np.float64] | None = None, t0: float | None = None) -> int: ...
+    def steps(self, duration: float, points: npt.ArrayLike | None = None, t0: float | None = None) -> int: ...
     def __reduce__(self) -> tuple[object, tuple[list[object]]]: ...
     def _with_recipe(self, name: str, args: tuple[object, ...], kwargs: dict[str, object]) -> Field: ...
 
@@ -314,6 +314,25 @@ def advect_runs(
     every: int = 0,
     out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
+class DeformStats(TypedDict):
+    """The counts and timings of :func:`deform_mesh` (a dict at run time)."""
+
+    passes: int
+    torn: int
+    over_threshold: int
+    bounded: bool
+    time_integrate: float
+    time_refine: float
+    slip_vertices: int
+    fallback: int
+    flips: int
+    flip_volume: float
+    collapses: int
+    moves: int
+    collapse_volume: float
+    bent: int
+    bend_splits: int
+
 def deform_mesh(
     vertices: npt.NDArray[np.float64],
     faces: npt.NDArray[np.int64],
@@ -325,7 +344,7 @@ def deform_mesh(
     npt.NDArray[np.float64],
     npt.NDArray[np.int64],
     npt.NDArray[np.int64],
-    dict[str, int | float | bool],
+    DeformStats,
 ]: ...
 def mesh_volume(vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]) -> float: ...
 def mesh_measure(

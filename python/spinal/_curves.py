@@ -4,10 +4,12 @@ re-exported there."""
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 
 from ._spline import (
+    ArcTable,
     arc_length_table,
     bspline_pieces,
     catmull_rom_slopes,
@@ -21,6 +23,7 @@ from ._spline import (
     periodic_bspline,
     row_norms,
 )
+from ._types import Array, Float64Array, Param, SplineKind
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -35,10 +38,10 @@ from ._validate import (
 _MAX_WINDINGS = 1_000_000
 
 #: The kinds of :class:`Spline`.
-_SPLINE_KINDS = ("catmull_rom", "natural_cubic", "bspline")
+_SPLINE_KINDS: tuple[SplineKind, ...] = ("catmull_rom", "natural_cubic", "bspline")
 
 
-def _u(u) -> np.ndarray:
+def _u(u: Param) -> np.ndarray:
     arr = as_float_array(u, "u")
     if arr.ndim > 1:
         raise ValueError(f"u: expected a scalar or a 1-D array, got shape {arr.shape}")
@@ -58,53 +61,57 @@ class Curve:
     def _eval(self, u: np.ndarray, k: int) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def point(self, u) -> np.ndarray:
+    def point(self, u: Param) -> Float64Array:
         """Points ``x(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 0)
 
-    def d1(self, u) -> np.ndarray:
+    def d1(self, u: Param) -> Float64Array:
         """First derivative ``x′(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 1)
 
-    def d2(self, u) -> np.ndarray:
+    def d2(self, u: Param) -> Float64Array:
         """Second derivative ``x″(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 2)
 
-    def d3(self, u) -> np.ndarray:
+    def d3(self, u: Param) -> Float64Array:
         """Third derivative ``x‴(u)``, shape ``(k, 3)``."""
         return self._eval(_u(u), 3)
 
-    def parameters(self, n: int) -> np.ndarray:
+    def parameters(self, n: int) -> Float64Array:
         """``n`` uniformly spaced parameters over :attr:`domain` (both ends included)."""
         n = as_int(n, "n", 2, MAX_SAMPLES, out_of_bounds=lambda x: (
             f"a sample count must be at least 2 and at most {MAX_SAMPLES:,}, got {x}"))
         return np.linspace(self.domain[0], self.domain[1], n)
 
-    def sample(self, n: int) -> np.ndarray:
+    def sample(self, n: int) -> Float64Array:
         """``n`` points at uniformly spaced parameters over :attr:`domain`."""
         return self.point(self.parameters(n))
 
-    def tangent(self, u) -> np.ndarray:
+    def tangent(self, u: Param) -> Float64Array:
         """Unit tangents ``x′/|x′|``."""
         d = self.d1(u)
-        return d / np.linalg.norm(d, axis=1, keepdims=True)
+        out: Float64Array = d / np.linalg.norm(d, axis=1, keepdims=True)
+        return out
 
-    def curvature(self, u) -> np.ndarray:
+    def curvature(self, u: Param) -> Float64Array:
         """Curvature ``κ = |x′ × x″| / |x′|³`` (1/length)."""
         d1, d2 = self.d1(u), self.d2(u)
-        return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+        out: Float64Array = np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+        return out
 
-    def torsion(self, u) -> np.ndarray:
+    def torsion(self, u: Param) -> Float64Array:
         """Torsion ``τ = det(x′, x″, x‴) / |x′ × x″|²`` (1/length; undefined where κ = 0)."""
         d1, d2, d3 = self.d1(u), self.d2(u), self.d3(u)
         c = np.cross(d1, d2)
-        return np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
+        out: Float64Array = np.einsum("ij,ij->i", c, d3) / np.einsum("ij,ij->i", c, c)
+        return out
 
-    def speed(self, u) -> np.ndarray:
+    def speed(self, u: Param) -> Float64Array:
         """``|x′(u)|`` (length per unit parameter)."""
-        return np.linalg.norm(self.d1(u), axis=1)
+        out: Float64Array = np.linalg.norm(self.d1(u), axis=1)
+        return out
 
-    def frenet(self, u) -> np.ndarray:
+    def frenet(self, u: Param) -> Float64Array:
         """Exact Frenet frames ``(k, 3, 3)``, columns ``(N, B, T)`` (undefined where κ = 0)."""
         d1, d2 = self.d1(u), self.d2(u)
         t = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
@@ -124,14 +131,17 @@ class Helix(Curve):
     Arc length ``s = c u`` with ``c = √(a² + b²)``; ``κ = a/c²``, ``τ = b/c²``.
     """
 
-    def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0):
+    a: float
+    b: float
+
+    def __init__(self, a: float = 1.0, b: float = 0.5, turns: float = 1.0) -> None:
         a = as_finite(a, "a")
         if not a > 0:
             raise ValueError(f"a: the helix radius must be positive and finite, got {a!r}")
         self.a, self.b = a, as_finite(b, "b")
         self.domain = (0.0, 2 * math.pi * as_positive(turns, "turns"))
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         a, b = self.a, self.b
         c, s = np.cos(u), np.sin(u)
         z = np.zeros_like(u)
@@ -143,7 +153,7 @@ class Helix(Curve):
             return np.stack([-a * c, -a * s, z], axis=1)
         return np.stack([a * s, -a * c, z], axis=1)
 
-    def rmf(self, u, angle: float = 0.0) -> np.ndarray:
+    def rmf(self, u: Param, angle: float = 0.0) -> Float64Array:
         """Exact rotation-minimising frames ``(k, 3, 3)`` (columns ``r, s, t``).
 
         ``r(u) = cos θ N + sin θ B`` with ``θ = angle − τ c (u − u_0)``: the Frenet frame
@@ -166,9 +176,14 @@ class TorusKnot(Curve):
     The defaults (p, q, R, r) = (2, 7, 0.6, 0.3) are the torus knot of Wang et al. (2008).
     """
 
+    p: int
+    q: int
+    R: float
+    r: float
+
     closed = True
 
-    def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3):
+    def __init__(self, p: int = 2, q: int = 7, R: float = 0.6, r: float = 0.3) -> None:
         # positive integers: the curve closes after u = 2π only then
         p, q = (as_int(v, k, 1, _MAX_WINDINGS, out_of_bounds=lambda x: (
             f"the winding number must be a positive integer at most {_MAX_WINDINGS:,}, got {x}"))
@@ -179,7 +194,7 @@ class TorusKnot(Curve):
         self.p, self.q, self.R, self.r = p, q, R, r
         self.domain = (0.0, 2 * math.pi)
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         p, q, R, r = self.p, self.q, self.R, self.r
         cq, sq = np.cos(q * u), np.sin(q * u)
         cp, sp = np.cos(p * u), np.sin(p * u)
@@ -206,13 +221,15 @@ class Viviani(Curve):
     is ``r = x/|x|`` (the sphere normal) up to a constant rotation about the tangent.
     """
 
+    a: float
+
     closed = True
 
-    def __init__(self, a: float = 1.0):
+    def __init__(self, a: float = 1.0) -> None:
         self.a = as_positive(a, "a")
         self.domain = (0.0, 4 * math.pi)
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         a = self.a
         c, s = np.cos(u), np.sin(u)
         c2, s2 = np.cos(u / 2), np.sin(u / 2)
@@ -228,7 +245,11 @@ class Viviani(Curve):
 class Polynomial(Curve):
     """Polynomial curve ``x(u) = Σ_j c_j u^j`` with coefficient rows ``c_j`` (shape (d+1, 3))."""
 
-    def __init__(self, coefficients, domain: tuple[float, float] = (0.0, 1.0)):
+    coefficients: Float64Array
+
+    def __init__(
+        self, coefficients: Array, domain: tuple[float, float] = (0.0, 1.0)
+    ) -> None:
         c = as_float_array(coefficients, "coefficients")
         if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] < 2:
             raise ValueError(f"coefficients: expected shape (d+1, 3) with d >= 1, got {c.shape}")
@@ -240,7 +261,7 @@ class Polynomial(Curve):
             raise ValueError(f"domain: expected two finite values lo < hi, got {domain!r}")
         self.domain = (float(d[0]), float(d[1]))
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         c = self.coefficients
         d = c.shape[0] - 1
         out = np.zeros((u.shape[0], 3))
@@ -253,7 +274,9 @@ class Polynomial(Curve):
 class Bezier(Polynomial):
     """Bézier curve on ``u ∈ [0, 1]`` with control points of shape ``(d+1, 3)``."""
 
-    def __init__(self, control_points):
+    control_points: Float64Array
+
+    def __init__(self, control_points: Array) -> None:
         p = as_float_array(control_points, "control_points")
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2:
             raise ValueError(f"control_points: expected shape (d+1, 3), d >= 1, got {p.shape}")
@@ -383,7 +406,17 @@ class Spline(Curve):
     (100, 3)
     """
 
-    def __init__(self, points, kind: str = "catmull_rom", closed: bool = False):
+    points: Float64Array
+    kind: Literal["catmull_rom", "natural_cubic", "bspline"]
+    closed: bool
+    knots: Float64Array
+
+    def __init__(
+        self,
+        points: Array,
+        kind: Literal["catmull_rom", "natural_cubic", "bspline"] = "catmull_rom",
+        closed: bool = False,
+    ) -> None:
         kind = as_choice(kind, "kind", _SPLINE_KINDS)
         closed = as_bool(closed, "closed")
         p = as_float_array(points, "points")
@@ -413,9 +446,9 @@ class Spline(Curve):
         self.points, self.kind, self.closed, self.knots = p, kind, closed, knots
         self.domain = (float(knots[0]), float(knots[-1]))
         self._coef = derivative_coefficients(c)
-        self._table = None  # the arc-length table, built when first needed
+        self._table: ArcTable | None = None  # the arc-length table, built when first needed
 
-    def _eval(self, u, k):
+    def _eval(self, u: np.ndarray, k: int) -> np.ndarray:
         lo, hi = self.domain
         if self.closed:
             u = lo + np.mod(u - lo, hi - lo)
@@ -432,11 +465,11 @@ class Spline(Curve):
                         len(self.knots) - 2)
         return horner(self._coef[k], piece, u - self.knots[piece])
 
-    def _speed(self, piece, s):
+    def _speed(self, piece: np.ndarray, s: np.ndarray) -> np.ndarray:
         """``|x′|`` on ``piece`` at the local parameter ``s``."""
         return row_norms(horner(self._coef[1], piece, s))
 
-    def _arc_table(self):
+    def _arc_table(self) -> ArcTable:
         if self._table is None:
             self._table = arc_length_table(self._speed, np.diff(self.knots))
         return self._table
@@ -446,7 +479,7 @@ class Spline(Curve):
         """The arc length ``∫|x′| du`` over :attr:`domain` (closed: once round the loop)."""
         return float(self._arc_table()[3][-1])
 
-    def arc_length_parameters(self, n: int) -> np.ndarray:
+    def arc_length_parameters(self, n: int) -> Float64Array:
         """``n`` parameters ``u`` at equal arc-length steps, increasing.
 
         Open: both ends included, ``s(u_i) = i L/(n − 1)``. Closed: ``s(u_i) = i L/n``,
@@ -464,9 +497,10 @@ class Spline(Curve):
         u[0] = self.domain[0]
         if not self.closed:
             u[-1] = self.domain[1]
-        return np.clip(u, *self.domain)
+        out: Float64Array = np.clip(u, *self.domain)
+        return out
 
-    def sample_arc_length(self, n: int) -> np.ndarray:
+    def sample_arc_length(self, n: int) -> Float64Array:
         """``n`` points equally spaced in arc length, ``(n, 3)``:
         ``point(arc_length_parameters(n))``. Open: both end points included. Closed: the
         first point is not repeated at the end, as ``spinal.frames``, ``spinal.tube`` and

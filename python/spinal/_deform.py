@@ -29,6 +29,7 @@ import time
 import warnings
 from dataclasses import dataclass
 from dataclasses import field as _dc_field
+from typing import Literal
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from ._advect import MAX_STEPS, default_steps
 from ._mesh import Mesh, mesh_arrays
 from ._mesh import volumes_at_scale as _volumes
 from ._progress import Progress, checked
+from ._types import AnyMesh, Array, Float64Array, Int64Array, ProgressArg
 from ._validate import as_bool, as_finite, as_int, as_real, as_vector
 from .fields import Field
 
@@ -204,13 +206,13 @@ class DeformReport:
     passes: int
     integration_error: float | None = None  # relative, Richardson estimate (estimate=True)
     mesh_error: float | None = None  # relative_change − integration_error
-    rest_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
+    rest_vertices: Float64Array | None = _dc_field(default=None, repr=False, compare=False)
     converged: bool = True
     edges_over_threshold: int = 0
     max_vertices: int | None = None
     torn_vertices: int = 0
-    step_vertices: np.ndarray | None = _dc_field(default=None, repr=False, compare=False)
-    timings: dict | None = _dc_field(default=None, repr=False, compare=False)
+    step_vertices: Int64Array | None = _dc_field(default=None, repr=False, compare=False)
+    timings: dict[str, float] | None = _dc_field(default=None, repr=False, compare=False)
     slip_vertices: int = 0
     chord_vertices: int = 0
     flips: int = 0
@@ -240,9 +242,20 @@ class DeformReport:
         return s
 
 
-def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: int = 30,
-           t0=0.0, estimate: bool = False, progress=False,
-           max_vertices=None, check: bool = True) -> tuple[Mesh, DeformReport]:
+def deform(
+    mesh: AnyMesh,
+    field: Field,
+    duration: float,
+    steps: int | None = None,
+    *,
+    refine: float | None = 1.5,
+    max_passes: int = 30,
+    t0: float = 0.0,
+    estimate: bool = False,
+    progress: ProgressArg = False,
+    max_vertices: int | None = None,
+    check: bool | Literal["intersections"] = True,
+) -> tuple[Mesh, DeformReport]:
     """Deform a closed triangle mesh along a divergence-free field and report the volume.
 
     The vertices are advected with RK4 (the steps of :func:`spinal.advect`, default step
@@ -330,9 +343,9 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
             raise ValueError(f"check: expected True, False or 'intersections', got {check!r}")
         check = as_bool(check, "check")
     progress = checked(progress)
-    bar = []  # the progress report, made when the core reports the step count
+    bar: list[Progress] = []  # the progress report, made when the core reports the step count
 
-    def tick(done, total):
+    def tick(done: int, total: int) -> None:
         if not bar:
             bar.append(Progress(progress, total, "deform", "step"))
         bar[0].update(done)
@@ -363,7 +376,7 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
         clock = time.perf_counter()
         # both runs with the mesh's own integrator (vertices at a tool's surface carried by
         # their side's velocity; spinal.advect's RK4 stages step across the surface there)
-        def rerun(steps):
+        def rerun(steps: int) -> np.ndarray:
             return _core.deform_mesh(Vr, Fr, field, {
                 "t0": t0, "duration": duration, "steps": steps, "refine": None,
                 "max_vertices": len(Vr), "max_passes": 0, "check": False})[0]
@@ -404,11 +417,12 @@ def deform(mesh, field: Field, duration, steps=None, *, refine=1.5, max_passes: 
     return out, report
 
 
-def _positive(x, name: str) -> float:
+def _positive(x: object, name: str) -> float:
     x = as_finite(x, name)
     if not x > 0:
         raise ValueError(f"{name}: must be positive, got {x}")
-    return x
+    out: float = x
+    return out
 
 
 @dataclass(frozen=True)
@@ -436,14 +450,23 @@ class StampReport:
     rest_volume: float
     volume: float
     relative_change: float
-    dent: np.ndarray
-    time: np.ndarray
-    residual: np.ndarray
-    contact: np.ndarray
+    dent: Float64Array
+    time: Float64Array
+    residual: Float64Array
+    contact: Int64Array
 
 
-def stamp(mesh, start, end, radius, *, reach=None, frames: int = 10,
-          iterations: int = 2, progress=False) -> tuple[Mesh, StampReport]:
+def stamp(
+    mesh: AnyMesh,
+    start: Array,
+    end: Array,
+    radius: float,
+    *,
+    reach: float | None = None,
+    frames: int = 10,
+    iterations: int = 2,
+    progress: ProgressArg = False,
+) -> tuple[Mesh, StampReport]:
     """Press a sphere into a closed mesh in contact only (thesis §11.2.6, the "stamper"),
     giving the dented volume back as a protrusion around the contact.
 

@@ -4,33 +4,42 @@ re-exported there."""
 from __future__ import annotations
 
 import functools
-import numbers
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from typing import Any, Literal, ParamSpec
 
 import numpy as np
 
 from . import _core
 from ._core import Field
-from ._mesh import mesh_arrays
-from ._progress import Progress, checked
+from ._fields_grid import (
+    _grid_curl,
+    _grid_field,
+    _mesh_samples,
+    _motion,
+    _opt,
+    _power,
+    _sdf_samples,
+)
+from ._types import Array, Blend, FalloffPower, Form
 from ._validate import (
     as_bool,
     as_finite,
     as_float_array,
-    as_int,
     as_points,
-    as_positive,
     as_real,
     as_vector,
 )
 
+_P = ParamSpec("_P")
 
-def _recorded(ctor):
+
+
+def _recorded(ctor: Callable[_P, Field]) -> Callable[_P, Field]:
     """The constructor, with the call remembered by the field it returns: a field pickles as
     the calls that built it (``Field.__reduce__`` → :func:`_rebuild`)."""
 
     @functools.wraps(ctor)
-    def build(*args, **kwargs):
+    def build(*args: _P.args, **kwargs: _P.kwargs) -> Field:
         # a progress report does not change the field: not part of its recipe
         kept = {k: v for k, v in kwargs.items() if k != "progress"}
         return ctor(*args, **kwargs)._with_recipe(ctor.__name__, args, kept)
@@ -38,7 +47,7 @@ def _recorded(ctor):
     return build
 
 
-def _rebuild(recipe) -> Field:
+def _rebuild(recipe: Iterable[tuple[str, tuple[Any, ...], dict[str, Any]]]) -> Field:
     """The field of a pickled recipe: the sum of ``name(*args, **kwargs)`` over its calls."""
     out = _core.field_zero()
     for name, args, kwargs in recipe:
@@ -46,17 +55,16 @@ def _rebuild(recipe) -> Field:
     return out
 
 
-def _opt(x, name: str) -> float | None:
-    return None if x is None else as_real(x, name)
-
-
-def _power(x) -> int:
-    return as_int(x, "falloff_power")
-
-
 @_recorded
-def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
-                moving: bool = True) -> Field:
+def translation(
+    center: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A spherical tool moving with constant ``velocity``, pushing the material around it.
 
     Curl field (thesis eq. 12.1–12.2, corrected sign and scale)::
@@ -83,8 +91,16 @@ def translation(center, radius, velocity, *, reach=None, falloff_power: int = 2,
 
 
 @_recorded
-def rotation(center, radius, axis, angular_speed, *, pivot=None, reach=None,
-             falloff_power: int = 2) -> Field:
+def rotation(
+    center: Array,
+    radius: float,
+    axis: Array,
+    angular_speed: float,
+    *,
+    pivot: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+) -> Field:
     """A spherical tool turning at ``angular_speed`` (rad/time, right-handed) about ``axis``
     through ``pivot`` (default: its centre, a tool spinning in place).
 
@@ -104,13 +120,16 @@ def rotation(center, radius, axis, angular_speed, *, pivot=None, reach=None,
         _power(falloff_power))
 
 
-def _swirl(center, axis, rate, radius, form, bend: bool) -> Field:
+def _swirl(center: Array, axis: Array, rate: float, radius: float, form: str, bend: bool
+           ) -> Field:
     return _core.field_swirl(as_vector(center, "center"), as_vector(axis, "axis"),
                              as_real(rate, "rate"), as_real(radius, "radius"), form, bend)
 
 
 @_recorded
-def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
+def twist(
+    center: Array, axis: Array, rate: float, radius: float, *, form: Form = "rate"
+) -> Field:
     """Twist about ``axis`` through ``center``: angle rate ``κ z`` (rad/time) at height
     ``z = a·(X − center)``, fading to 0 at distance ``radius`` from the centre.
 
@@ -123,7 +142,9 @@ def twist(center, axis, rate, radius, *, form: str = "rate") -> Field:
 
 
 @_recorded
-def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
+def bend(
+    center: Array, axis: Array, rate: float, radius: float, *, form: Form = "rate"
+) -> Field:
     """The thesis's "bend" (eq. 12.6, a differential swirl): angle rate ``β r²`` about
     ``axis`` through ``center``, ``r = |X − center|``, fading to 0 at ``radius``.
 
@@ -135,8 +156,15 @@ def bend(center, axis, rate, radius, *, form: str = "rate") -> Field:
 
 
 @_recorded
-def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
-           moving: bool = True) -> Field:
+def sphere(
+    center: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """von Funck's region translation around a sphere (``r_i = radius``,
     ``r_o = radius + reach``): ``v = ∇p × ∇q`` with ``p = (1 − D) N·Y``, ``q = (1 − D) B·Y``::
 
@@ -150,8 +178,16 @@ def sphere(center, radius, velocity, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def capsule(start, end, radius, velocity, *, reach=None, blend: str = "c1",
-            moving: bool = True) -> Field:
+def capsule(
+    start: Array,
+    end: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """Region translation around a capsule (segment ``start``–``end``, ``radius``): the exact
     distance-field extension of :func:`sphere` to a free-form tool, ``Y = X − midpoint``,
     ``d`` the capsule's signed distance, ``n = ∇d``. Divergence-free for any C¹ distance.
@@ -162,8 +198,16 @@ def capsule(start, end, radius, velocity, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
-          blend: str = "c1") -> Field:
+def strip(
+    start: Array,
+    end: Array,
+    radius: float,
+    velocity: Array,
+    *,
+    kind: Literal["along", "across"] = "along",
+    reach: float | None = None,
+    blend: Blend = "c1",
+) -> Field:
     """A straight strip (a capsule from ``start`` to ``end``) moving the material around it
     (thesis §11.2.2–11.2.3; type I moves the material along the strip, type II across it).
 
@@ -180,8 +224,17 @@ def strip(start, end, radius, velocity, *, kind: str = "along", reach=None,
 
 
 @_recorded
-def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
-          moving: bool = True) -> Field:
+def torus(
+    center: Array,
+    axis: Array,
+    major: float,
+    minor: float,
+    speed: float,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """A torus (major radius ``major``, tube radius ``minor``) moving along its ``axis`` with
     ``speed`` (thesis §11.2.4; the two half-torus fields summed in closed form)::
 
@@ -196,7 +249,14 @@ def torus(center, axis, major, minor, speed, *, reach=None, blend: str = "c1",
 
 
 @_recorded
-def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Field:
+def strip_curve(
+    points: Array,
+    radius: float,
+    speed: float,
+    *,
+    reach: float | None = None,
+    blend: Blend = "c1",
+) -> Field:
     """A strip of type I along a curved axis (thesis §11.2.2, "sticking", type I): the material
     within ``radius`` of the axis flows along it at ``speed`` (length/time, from
     ``points[0]`` towards ``points[-1]``; negative: backwards), leaves at the head, comes back
@@ -240,48 +300,18 @@ def strip_curve(points, radius, speed, *, reach=None, blend: str = "c1") -> Fiel
                                    as_real(speed, "speed"), _opt(reach, "reach"), blend)
 
 
-def _spline_prefilter(values: np.ndarray) -> np.ndarray:
-    """Coefficients (n + 2 per axis, one ghost layer each side) of the natural cubic B-spline
-    interpolating ``values`` on a unit grid: per axis ``c_0 = d_0``, ``c_{n−1} = d_{n−1}``,
-    ``c_{i−1} + 4c_i + c_{i+1} = 6d_i`` inside, ghosts ``c_{−1} = 2c_0 − c_1`` (zero second
-    derivative at the end nodes). Solved in the core, line by line in parallel."""
-    return _core.field_grid_coefficients(np.ascontiguousarray(values, dtype=np.float64))
-
-
-def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name):
-    """The tool of a sampled distance: the default centre and reach from the samples, the
-    B-spline coefficients, then the core (which checks the spacing against the reach and that
-    the support stays inside the grid)."""
-    u = as_vector(velocity, "velocity")
-    coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
-
-
-def _grid_spline(values, origin, h, center, reach):
-    """The B-spline coefficients of sampled distances with the tool's centre (default: the
-    volume-fraction centroid of the inside) and reach (default: its bounding radius)."""
-    if not (values <= 0).any():
-        raise ValueError("grid: no node is inside the tool (all distances are positive)")
-    if center is None:
-        # volume-fraction weights of the nodes' cells, clamp(1/2 − d/h, 0, 1)
-        w = np.clip(0.5 - values / h, 0.0, 1.0)
-        idx = np.argwhere(w > 0)
-        ww = w[w > 0]
-        c = origin + (idx * ww[:, None]).sum(axis=0) / ww.sum() * h
-    else:
-        c = as_vector(center, "center")
-    if reach is None:
-        idx = np.argwhere(values <= 0)
-        nodes = origin + idx * h
-        reach = float((np.linalg.norm(nodes - c, axis=1) - values[values <= 0]).max())
-    else:
-        reach = as_real(reach, "reach")
-    return _spline_prefilter(values), c, reach
-
-
 @_recorded
-def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend: str = "c1",
-             moving: bool = True) -> Field:
+def sdf_tool(
+    grid: Array,
+    origin: Array,
+    spacing: float,
+    velocity: Array,
+    *,
+    center: Array | None = None,
+    reach: float | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+) -> Field:
     """A free-form tool given by its signed distance sampled on a grid, translating with
     ``velocity``: Zheng's extended spherical field with the object's distance (thesis §11.2.1;
     the distance-field extension of :func:`sphere`)::
@@ -325,47 +355,22 @@ def sdf_tool(grid, origin, spacing, velocity, *, center=None, reach=None, blend:
     reach the grid's edge): ``ValueError`` naming ``grid`` otherwise.
     """
     a, o, h = _sdf_samples(grid, origin, spacing)
-    return _grid_field(a, o, h, velocity, center, reach, blend, moving, "sdf_tool")
-
-
-def _sdf_samples(grid, origin, spacing):
-    """The samples of ``sdf_tool``/``sdf_curl`` as a float64 array, checked, with the origin
-    and spacing."""
-    a = as_float_array(grid, "grid")
-    if a.ndim != 3 or min(a.shape) < 8:
-        raise ValueError(f"grid: expected a 3-D array with at least 8 nodes per axis, got "
-                         f"shape {a.shape}")
-    if not np.isfinite(a).all():
-        i = tuple(int(v) for v in np.argwhere(~np.isfinite(a))[0])
-        raise ValueError(f"grid: value at node {i} is not finite")
-    if a.size > 300**3:
-        raise ValueError(f"grid: {a.size} nodes is too many (at most 300³)")
-    o = as_vector(origin, "origin")
-    h = as_positive(spacing, "spacing")
-    return np.array(a, dtype=np.float64), o, h
-
-
-#: Grid nodes per slab of a mesh's sampled distance with progress reports (whole planes;
-#: at least one plane), and at least this many per face of the mesh.
-SLAB_NODES = 1 << 16
-SLAB_PER_FACE = 32
-
-# cells per reach that the blend region needs (the core refuses coarser grids, naming
-# `spacing`; `mesh_tool` chooses its spacing and names `resolution`)
-MIN_CELLS_PER_REACH = 4
-
-
-def _closed_mesh(mesh):
-    """Vertices, faces and the enclosed volume's centroid of a closed, outward-wound mesh
-    (the core checks it, naming ``mesh``)."""
-    V, F = mesh_arrays(mesh)
-    _, centroid = _core.mesh_closed_centroid(V, F)
-    return V, F, np.asarray(centroid)
+    out: Field = _grid_field(a, o, h, velocity, center, reach, blend, moving, "sdf_tool")
+    return out
 
 
 @_recorded
-def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
-              blend: str = "c1", moving: bool = True, progress=False) -> Field:
+def mesh_tool(
+    mesh: object,
+    velocity: Array,
+    *,
+    reach: float | None = None,
+    resolution: int = 64,
+    center: Array | None = None,
+    blend: Blend = "c1",
+    moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
+) -> Field:
     """A free-form tool given as a closed triangle mesh, translating with ``velocity``: the
     field of :func:`sdf_tool` with the mesh's signed distance sampled on a grid.
 
@@ -395,58 +400,8 @@ def mesh_tool(mesh, velocity, *, reach=None, resolution: int = 64, center=None,
         stop.
     """
     values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
-    return _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
-
-
-def _mesh_samples(mesh, reach, resolution, center, progress):
-    """The signed distance of a closed mesh sampled on the grid of :func:`mesh_tool`:
-    samples, origin, spacing, centre and reach."""
-    progress = checked(progress)
-    V, F, centroid = _closed_mesh(mesh)
-    c = centroid if center is None else as_vector(center, "center")
-    rf = float(np.linalg.norm(V - c, axis=1).max()) if reach is None else as_real(reach, "reach")
-    if not rf > 0:
-        raise ValueError(f"reach: must be positive, got {rf}")
-    res = resolution
-    if isinstance(res, bool) or not isinstance(res, numbers.Integral):
-        raise TypeError(f"resolution: expected an integer, got {type(res).__name__}")
-    if not 16 <= res <= 256:
-        raise ValueError(f"resolution: must be in 16 … 256, got {res}")
-    pad = 4
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    h = float((hi - lo).max() + 2 * rf) / (res - 1 - 2 * pad)
-    if not rf >= MIN_CELLS_PER_REACH * h:
-        need = int(np.ceil(((hi - lo).max() + 2 * rf) / (rf / MIN_CELLS_PER_REACH))) + 2 * pad + 1
-        raise ValueError(
-            f"resolution: grid too coarse: spacing {h:.4g} must be at most reach/"
-            f"{MIN_CELLS_PER_REACH} = {rf / MIN_CELLS_PER_REACH:.4g}; use resolution ≥ {need}")
-    try:
-        import igl
-    except ImportError as e:  # pragma: no cover - libigl is a test dependency
-        raise ImportError("mesh_tool: building the distance grid needs libigl (pip install "
-                          "libigl); or sample the distance yourself and use "
-                          "fields.sdf_tool") from e
-    origin = lo - rf - pad * h
-    shape = np.ceil((hi - lo + 2 * (rf + pad * h)) / h).astype(int) + 1
-    axes = [origin[i] + h * np.arange(shape[i]) for i in range(3)]
-    # with progress: slabs of whole x planes of at least SLAB_NODES nodes, and of at least
-    # SLAB_PER_FACE nodes per face (libigl builds its tree of the faces again for every
-    # call; this keeps that under a few per cent); each point's distance is its own, so the
-    # slabs give the one call's values. Reports (and Ctrl-C) come between them.
-    d = np.empty(tuple(shape))
-    plane = int(shape[1] * shape[2])
-    per = int(shape[0]) if progress is False else max(
-        1, max(SLAB_NODES, SLAB_PER_FACE * len(F)) // plane)
-    yz = np.stack(np.meshgrid(axes[1], axes[2], indexing="ij"), axis=-1).reshape(-1, 2)
-    with Progress(progress, d.size, "distance grid", "node") as bar:
-        for i0 in range(0, int(shape[0]), per):
-            xs = axes[0][i0:i0 + per]
-            P = np.column_stack([np.repeat(xs, plane), np.tile(yz, (len(xs), 1))])
-            d[i0:i0 + len(xs)] = igl.signed_distance(
-                P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0].reshape(
-                    len(xs), shape[1], shape[2])
-            bar.update((i0 + len(xs)) * plane)
-    return d, origin, h, c, rf
+    out: Field = _grid_field(values, origin, h, velocity, c, rf, blend, moving, "mesh_tool")
+    return out
 
 
 def sum(fields: Iterable[Field]) -> Field:
@@ -460,9 +415,20 @@ def sum(fields: Iterable[Field]) -> Field:
 
 
 @_recorded
-def along_path(points, radius, duration, *, kind: str = "translate", tool: str = "push",
-               rate=0.0, frames=None, t0=0.0, reach=None, falloff_power: int = 2,
-               blend: str = "c1") -> Field:
+def along_path(
+    points: Array,
+    radius: float,
+    duration: float,
+    *,
+    kind: Literal["translate", "rotate", "twist", "bend"] = "translate",
+    tool: Literal["push", "carry"] = "push",
+    rate: float = 0.0,
+    frames: Array | None = None,
+    t0: float = 0.0,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    blend: Blend = "c1",
+) -> Field:
     """A spherical tool travelling along a spine from ``points[0]`` (at time ``t0``) to
     ``points[-1]`` (at ``t0 + duration``) at constant speed ``u = L/duration`` in chord
     length ``L``, deforming the material around it; at rest (zero field) outside that time.
@@ -520,11 +486,6 @@ def along_path(points, radius, duration, *, kind: str = "translate", tool: str =
 
 # ---- curl tools of any shape, keyframed tools ------------------------------------------------
 
-def _motion(velocity, angular_velocity, pivot):
-    return (None if velocity is None else as_vector(velocity, "velocity"),
-            None if angular_velocity is None else as_vector(angular_velocity, "angular_velocity"),
-            None if pivot is None else as_vector(pivot, "pivot"))
-
 
 _CURL_DOC = """
 
@@ -550,8 +511,19 @@ _CURL_DOC = """
 
 
 @_recorded
-def sdf_curl(grid, origin, spacing, *, velocity=None, angular_velocity=None, pivot=None,
-             center=None, reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+def sdf_curl(
+    grid: Array,
+    origin: Array,
+    spacing: float,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    center: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A curl tool whose shape is a signed distance sampled on a grid (negative inside):
     ``d`` the C² tricubic B-spline interpolating the samples and ``g`` its exact gradient,
     as for :func:`sdf_tool` (whose arguments ``grid``, ``origin``, ``spacing``, ``center``
@@ -559,33 +531,47 @@ def sdf_curl(grid, origin, spacing, *, velocity=None, angular_velocity=None, piv
     inside the grid). RK4 is about 3rd order on it where path lines cross cell faces (see
     :func:`sdf_tool`)."""
     a, o, h = _sdf_samples(grid, origin, spacing)
-    return _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
+    out: Field = _grid_curl(a, o, h, center, reach, velocity, angular_velocity, pivot, falloff_power,
                       moving, "sdf_curl")
-
-
-def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, pivot,
-               falloff_power, moving, name):
-    u, w, p = _motion(velocity, angular_velocity, pivot)
-    coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid_curl(coef, origin, h, c, reach, u, w, p, _power(falloff_power),
-                                 as_bool(moving, "moving"), name)
+    return out
 
 
 @_recorded
-def mesh_curl(mesh, *, velocity=None, angular_velocity=None, pivot=None, reach=None,
-              resolution: int = 64, center=None, falloff_power: int = 2,
-              moving: bool = True, progress=False) -> Field:
+def mesh_curl(
+    mesh: object,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    reach: float | None = None,
+    resolution: int = 64,
+    center: Array | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+    progress: bool | Callable[[int, int], object] = False,
+) -> Field:
     """A curl tool whose shape is a closed triangle mesh: its signed distance sampled on the
     grid of :func:`mesh_tool` (same ``mesh``, ``reach``, ``resolution``, ``center``,
     ``progress``; needs libigl), then :func:`sdf_curl`."""
     values, origin, h, c, rf = _mesh_samples(mesh, reach, resolution, center, progress)
-    return _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
+    out: Field = _grid_curl(values, origin, h, c, rf, velocity, angular_velocity, pivot,
                       falloff_power, moving, "mesh_curl")
+    return out
 
 
 @_recorded
-def rod(points, radius, *, velocity=None, angular_velocity=None, pivot=None, center=None,
-        reach=None, falloff_power: int = 2, moving: bool = True) -> Field:
+def rod(
+    points: Array,
+    radius: float,
+    *,
+    velocity: Array | None = None,
+    angular_velocity: Array | None = None,
+    pivot: Array | None = None,
+    center: Array | None = None,
+    reach: float | None = None,
+    falloff_power: FalloffPower = 2,
+    moving: bool = True,
+) -> Field:
     """A curl tool whose shape is a rod: the tube of ``radius`` ρ about the axis through
     ``points`` (two points: a capsule).
 
@@ -605,13 +591,22 @@ def rod(points, radius, *, velocity=None, angular_velocity=None, pivot=None, cen
 
 
 for _ctor in (sdf_curl, mesh_curl, rod):
-    _ctor.__doc__ += _CURL_DOC
+    _ctor.__doc__ = (_ctor.__doc__ or "") + _CURL_DOC
+
+
 del _ctor
 
 
 @_recorded
-def keyframed(tool, times, positions, orientations=None, *,
-              falloff_power: int | None = None, center=None) -> Field:
+def keyframed(
+    tool: Field,
+    times: Array,
+    positions: Array,
+    orientations: Array | None = None,
+    *,
+    falloff_power: FalloffPower | None = None,
+    center: Array | None = None,
+) -> Field:
     """``tool`` following keyframed rigid poses ``(t_k, c_k, Q_k)``: the pose ``(c(t), Q(t))``
     takes the tool's point ``C`` to ``c(t)`` and turns it by ``Q(t)`` about it (``c_k = C``,
     ``Q_k = I`` leave it in place). Every field can be keyframed, in one of two ways.

@@ -16,8 +16,12 @@ import json
 import os
 import pathlib
 import struct
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ._mesh import Mesh
 
 #: The suffixes :func:`write` writes.
 WRITES = (".ply", ".vtp", ".obj", ".stl", ".glb")
@@ -25,7 +29,7 @@ WRITES = (".ply", ".vtp", ".obj", ".stl", ".glb")
 READS = (".ply", ".obj", ".stl", ".glb", ".gltf", ".off", ".vtp", ".vtk")
 
 
-def _path(path, formats: tuple, kind: str) -> tuple[pathlib.Path, str]:
+def _path(path: str | os.PathLike[str], formats: tuple[str, ...], kind: str) -> tuple[pathlib.Path, str]:
     """``path`` as a Path and its lower-case suffix, one of ``formats`` (errors name
     ``path``)."""
     if not isinstance(path, (str, os.PathLike)):
@@ -38,16 +42,18 @@ def _path(path, formats: tuple, kind: str) -> tuple[pathlib.Path, str]:
     return path, suffix
 
 
-def write(mesh, path, colors=None) -> pathlib.Path:
+def write(mesh: Mesh, path: str | os.PathLike[str], colors: object = None) -> pathlib.Path:
     """Write ``mesh`` (a :class:`spinal.Mesh`) to ``path`` in the format of its suffix."""
     path, suffix = _path(path, WRITES, "")
     rgb, rest = vertex_colors(mesh, colors)
     if suffix == ".vtp":
         _write_vtp(mesh, path, rgb, rest)
-        return path
+        out: pathlib.Path = path
+        return out
     if suffix == ".stl":
         _write_stl(mesh, path)
-        return path
+        out = path
+        return out
     if len(mesh.vertices) >= 2**31:
         raise ValueError(f"path: {suffix[1:].upper()} indices here are 32-bit; the mesh is too "
                          f"large (save as .vtp)")
@@ -57,10 +63,11 @@ def write(mesh, path, colors=None) -> pathlib.Path:
         _write_glb(mesh, path, rgb)
     else:
         _write_obj(mesh, path, rgb)
-    return path
+    out = path
+    return out
 
 
-def _write_obj(mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
+def _write_obj(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
     with open(path, "w") as f:
         f.write("# spinal mesh\n")
         if rgb is None:
@@ -84,7 +91,7 @@ def _write_obj(mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
         np.savetxt(f, data, fmt=fmt)
 
 
-def _write_stl(mesh, path: pathlib.Path) -> None:
+def _write_stl(mesh: Mesh, path: pathlib.Path) -> None:
     """Binary STL: an 80-byte header, the triangle count, then per triangle its unit
     normal (from the corners' cross product; zero for a degenerate triangle), its three
     corners (float32) and a zero attribute word. STL holds positions only."""
@@ -103,14 +110,14 @@ def _write_stl(mesh, path: pathlib.Path) -> None:
         f.write(rec.tobytes())
 
 
-def _write_glb(mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
+def _write_glb(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
     """Binary glTF 2.0: a JSON chunk describing one mesh primitive (triangles) whose
     attributes live in one binary buffer, each view aligned to 4 bytes."""
     V = np.ascontiguousarray(mesh.vertices, dtype="<f4")
     parts, views, accessors, attributes = [], [], [], {}
     offset = 0
 
-    def add(a: np.ndarray, component: int, kind: str, target: int, **extra) -> int:
+    def add(a: np.ndarray, component: int, kind: str, target: int, **extra: Any) -> int:
         nonlocal offset
         raw = np.ascontiguousarray(a).tobytes()
         views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(raw),
@@ -152,7 +159,7 @@ def _write_glb(mesh, path: pathlib.Path, rgb: np.ndarray | None) -> None:
         f.write(struct.pack("<I4s", len(binary), b"BIN\0") + binary)
 
 
-def read(path) -> dict:
+def read(path: str | os.PathLike[str]) -> dict[str, Any]:
     """The arrays of the mesh file ``path``: ``vertices``, ``faces`` and, where the file has
     them, ``normals``, ``uv``, ``point_data`` (vertex colours as ``"colors"``) and
     ``cell_data``; the keyword arguments of :class:`spinal.Mesh`."""
@@ -164,7 +171,7 @@ def read(path) -> dict:
     return _read_trimesh(path)
 
 
-def _need(module: str):
+def _need(module: str) -> Any:
     import importlib
 
     try:
@@ -175,14 +182,14 @@ def _need(module: str):
             f"index once published; from a clone: pip install -e '.[io]')") from None
 
 
-def _read_trimesh(path: pathlib.Path) -> dict:
+def _read_trimesh(path: pathlib.Path) -> dict[str, Any]:
     trimesh = _need("trimesh")
     m = trimesh.load(os.fspath(path), process=False, force="mesh")
     if path.suffix.lower() == ".stl":
         # STL repeats every corner: shared corners become shared vertices, as a closed
         # mesh needs
         m.merge_vertices(merge_tex=True, merge_norm=True)
-    out = {"vertices": np.asarray(m.vertices, dtype=np.float64),
+    out: dict[str, Any] = {"vertices": np.asarray(m.vertices, dtype=np.float64),
            "faces": np.asarray(m.faces, dtype=np.int64), "point_data": {}}
     raw = m.metadata.get("_ply_raw")
     if raw is not None and "vertex" in raw:
@@ -206,7 +213,7 @@ def _read_trimesh(path: pathlib.Path) -> dict:
     return out
 
 
-def _grouped(data: np.ndarray, names: list) -> dict:
+def _grouped(data: np.ndarray, names: list[Any]) -> dict[str, Any]:
     """PLY properties ``name`` or ``name_0 … name_{k-1}`` as arrays ``(n,)`` or ``(n, k)``
     (the inverse of :func:`_columns`)."""
     out, seen = {}, set()
@@ -215,7 +222,7 @@ def _grouped(data: np.ndarray, names: list) -> dict:
         if base and j.isdigit():
             if base in seen:
                 continue
-            cols = []
+            cols: list[Any] = []
             while f"{base}_{len(cols)}" in names:
                 cols.append(data[f"{base}_{len(cols)}"])
             if cols:
@@ -226,7 +233,7 @@ def _grouped(data: np.ndarray, names: list) -> dict:
     return out
 
 
-def _from_ply(raw: dict, out: dict) -> dict:
+def _from_ply(raw: dict[str, Any], out: dict[str, Any]) -> dict[str, Any]:
     """The arrays of a PLY file from trimesh's raw elements: every vertex property (the
     positions read by trimesh are kept), normals ``nx ny nz``, texture coordinates ``s t``
     (or ``u v``, ``texture_u texture_v``), colours ``red green blue (alpha)`` and the other
@@ -246,7 +253,7 @@ def _from_ply(raw: dict, out: dict) -> dict:
         out["vertices"] = np.stack([np.asarray(data[c], dtype=np.float64) for c in "xyz"], 1)
         out["faces"] = tri
 
-    def columns(*cols):
+    def columns(*cols: str) -> np.ndarray | None:
         if all(c in names for c in cols):
             taken.update(cols)
             return np.stack([np.asarray(data[c]) for c in cols], axis=1)
@@ -276,13 +283,13 @@ def _from_ply(raw: dict, out: dict) -> dict:
     return out
 
 
-def _read_vtk(path: pathlib.Path) -> dict:
+def _read_vtk(path: pathlib.Path) -> dict[str, Any]:
     pv = _need("pyvista")
     data = pv.read(os.fspath(path))
     poly = data if isinstance(data, pv.PolyData) else data.extract_surface()
     tri = poly.triangulate() if not poly.is_all_triangles else poly
     faces = np.asarray(tri.faces, dtype=np.int64).reshape(-1, 4)[:, 1:]
-    out = {"vertices": np.asarray(tri.points, dtype=np.float64), "faces": faces,
+    out: dict[str, Any] = {"vertices": np.asarray(tri.points, dtype=np.float64), "faces": faces,
            "point_data": {}, "cell_data": {}}
     for k in tri.point_data:
         a = np.asarray(tri.point_data[k])
@@ -309,7 +316,7 @@ _VTK_TYPES = {"f8": "Float64", "f4": "Float32", "i1": "Int8", "u1": "UInt8", "i2
               "u2": "UInt16", "i4": "Int32", "u4": "UInt32", "i8": "Int64", "u8": "UInt64"}
 
 
-def _plain(a: np.ndarray, kinds: dict) -> np.ndarray:
+def _plain(a: np.ndarray, kinds: dict[str, Any]) -> np.ndarray:
     """``a`` in a little-endian dtype of ``kinds`` (bools as uint8; int64 as int32 where the
     format has no 64-bit integers and the values fit, else float64)."""
     a = np.asarray(a)
@@ -324,7 +331,7 @@ def _plain(a: np.ndarray, kinds: dict) -> np.ndarray:
     return a.astype(a.dtype.newbyteorder("<"), copy=False)
 
 
-def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
+def _columns(data: dict[str, Any], kinds: dict[str, Any], taken: set[str], what: str) -> list[Any]:
     """``(property name, 1-D little-endian array)`` of every column of the attribute
     arrays (``name`` or ``name_0 … name_{k-1}``)."""
     cols = []
@@ -343,7 +350,7 @@ def _columns(data: dict, kinds: dict, taken: set, what: str) -> list:
     return cols
 
 
-def vertex_colors(mesh, colors) -> tuple[np.ndarray | None, dict]:
+def vertex_colors(mesh: Mesh, colors: object) -> tuple[np.ndarray | None, dict[str, Any]]:
     """The vertex colours to write, ``(V, 3|4)`` uint8 or None, and the ``point_data``
     arrays written besides them (all but the one the colours came from)."""
     rest = dict(mesh.point_data)
@@ -376,7 +383,8 @@ def vertex_colors(mesh, colors) -> tuple[np.ndarray | None, dict]:
                      f"{c.dtype}")
 
 
-def _ply_chunk(mesh, rgb: np.ndarray | None, point_data: dict, base: int = 0):
+def _ply_chunk(mesh: Mesh, rgb: np.ndarray | None, point_data: dict[str, Any], base: int = 0
+               ) -> tuple[np.ndarray, np.ndarray]:
     """The vertex and face records of ``mesh`` as PLY stores them (structured arrays, the
     property declarations in their dtypes' order); face indices shifted by ``base``."""
     V, F = mesh.vertices, mesh.faces
@@ -403,21 +411,21 @@ def _ply_chunk(mesh, rgb: np.ndarray | None, point_data: dict, base: int = 0):
     return vert, face
 
 
-def _ply_header(vert_dtype: np.dtype, face_dtype: np.dtype, nv: int, nf: int) -> bytes:
-    def decl(dt):
+def _ply_header(vert_dtype: np.dtype[Any], face_dtype: np.dtype[Any], nv: int, nf: int) -> bytes:
+    def decl(dt: np.dtype[Any]) -> str:
         return _PLY_TYPES[f"{dt.kind}{dt.itemsize}"]
 
     header = ["ply", "format binary_little_endian 1.0", "comment written by spinal",
               f"element vertex {nv}"]
-    header += [f"property {decl(vert_dtype[n])} {n}" for n in vert_dtype.names]
+    header += [f"property {decl(vert_dtype[n])} {n}" for n in vert_dtype.names or ()]
     header += [f"element face {nf}", "property list uchar int vertex_indices"]
-    header += [f"property {decl(face_dtype[n])} {n}" for n in face_dtype.names[2:]]
+    header += [f"property {decl(face_dtype[n])} {n}" for n in (face_dtype.names or ())[2:]]
     header += ["end_header"]
     return ("\n".join(header) + "\n").encode("ascii")
 
 
-def _write_ply(mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
+def _write_ply(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict[str, Any]) -> None:
     vert, face = _ply_chunk(mesh, rgb, point_data)
     with open(path, "wb") as f:
         f.write(_ply_header(vert.dtype, face.dtype, len(vert), len(face)))
@@ -425,8 +433,8 @@ def _write_ply(mesh, path: pathlib.Path, rgb: np.ndarray | None,
         f.write(face.tobytes())
 
 
-def _vtp_chunk(mesh, rgb: np.ndarray | None, point_data: dict, vbase: int = 0,
-               fbase: int = 0) -> list:
+def _vtp_chunk(mesh: Mesh, rgb: np.ndarray | None, point_data: dict[str, Any], vbase: int = 0,
+               fbase: int = 0) -> list[Any]:
     """``(section, name, array)`` of every array of ``mesh`` in the order of the appended
     blocks; connectivity shifted by ``vbase`` vertices, offsets by ``fbase`` faces."""
     nf = len(mesh.faces)
@@ -446,13 +454,13 @@ def _vtp_chunk(mesh, rgb: np.ndarray | None, point_data: dict, vbase: int = 0,
     return [(sec, name, np.ascontiguousarray(_plain(a, _VTK_TYPES))) for sec, name, a in out]
 
 
-def _vtp_header(arrays: list, sizes: list, nv: int, nf: int) -> bytes:
+def _vtp_header(arrays: list[Any], sizes: list[Any], nv: int, nf: int) -> bytes:
     """The XML of a VTK PolyData file whose appended blocks hold ``arrays`` (as
     :func:`_vtp_chunk` gives them; only names, dtypes and shapes are read) of ``sizes``
     bytes each."""
     from xml.sax.saxutils import quoteattr
 
-    tags = {"Points": [], "Polys": [], "PointData": [], "CellData": []}
+    tags: dict[str, list[str]] = {"Points": [], "Polys": [], "PointData": [], "CellData": []}
     offset = 0
     for (sec, name, a), size in zip(arrays, sizes, strict=True):
         comps = 1 if a.ndim == 1 else a.shape[1]
@@ -484,8 +492,8 @@ def _vtp_header(arrays: list, sizes: list, nv: int, nf: int) -> bytes:
 _VTP_END = b"\n</AppendedData>\n</VTKFile>\n"
 
 
-def _write_vtp(mesh, path: pathlib.Path, rgb: np.ndarray | None,
-               point_data: dict) -> None:
+def _write_vtp(mesh: Mesh, path: pathlib.Path, rgb: np.ndarray | None,
+               point_data: dict[str, Any]) -> None:
     """VTK XML PolyData, format 'appended' raw: every array is a UInt64 byte count followed
     by its bytes after the ``_`` of ``<AppendedData>`` (VTK file formats, "XML File
     Formats", Kitware)."""
@@ -512,11 +520,11 @@ class Spool:
             raise ValueError(f"dst: streamed meshes are written as .ply or .vtp, got "
                              f"{suffix!r}")
         self.path, self.kind = path, suffix
-        self.parts: list = []  # temporary files, one per block of the file
-        self.layout = None  # the dtypes (and names) of the first chunk, kept by the others
+        self.parts: list[Any] = []  # temporary files, one per block of the file
+        self.layout: Any = None  # the dtypes (and names) of the first chunk, kept by the others
         self.nv = self.nf = 0
 
-    def _files(self, n: int) -> list:
+    def _files(self, n: int) -> list[Any]:
         import tempfile
 
         while len(self.parts) < n:
@@ -524,7 +532,7 @@ class Spool:
             self.parts.append(tempfile.TemporaryFile(dir=self.path.parent))  # noqa: SIM115
         return self.parts
 
-    def add(self, mesh, rgb: np.ndarray | None, point_data: dict) -> None:
+    def add(self, mesh: Mesh, rgb: np.ndarray | None, point_data: dict[str, Any]) -> None:
         """Append ``mesh`` (its faces shifted past the vertices so far)."""
         if self.kind == ".ply":
             vert, face = _ply_chunk(mesh, rgb, point_data, self.nv)
@@ -563,7 +571,8 @@ class Spool:
                     sizes.append(t.tell())
                     t.seek(0)
                 if self.kind == ".ply":
-                    out.write(_ply_header(*self.layout, self.nv, self.nf))
+                    vert_dtype, face_dtype = self.layout
+                    out.write(_ply_header(vert_dtype, face_dtype, self.nv, self.nf))
                     for t in self.parts:
                         shutil.copyfileobj(t, out, 1 << 22)
                 else:

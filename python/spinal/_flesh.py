@@ -9,18 +9,21 @@ Tech 2014; Zhuo & Rossignac, CGF 32(2) 2013). See :class:`SpineBinding` and :fun
 from __future__ import annotations
 
 import warnings
+from typing import Literal, overload
 
 import numpy as np
 
 from . import _core, _motion
+from ._flesh_roll import _given_roll, _posed_initial, _roll_to
 from ._frames import _spine_frames
 from ._mesh import FoldOverWarning
+from ._types import Array, Float64Array, Int64Array, ProgressArg, SpineSolution
 from ._validate import as_bool, as_choice, as_float_array, as_real
 
-SOLUTIONS = ("radial", "normal", "binormal", "blend", "none")
+SOLUTIONS: tuple[SpineSolution, ...] = ("radial", "normal", "binormal", "blend", "none")
 
 
-def _spine(x, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
+def _spine(x: Array, name: str, closed: bool = False) -> tuple[np.ndarray, int]:
     """A spine as ``(n, 3)`` rows and its width (2 or 3); a loop (``closed``) loses a repeated
     first point at its end."""
     arr = as_float_array(x, name)
@@ -52,7 +55,7 @@ def _loop(a: np.ndarray, closed: bool) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([a, a[:1]])) if closed else a
 
 
-def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray):
+def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A closed posed spine resampled at the rest samples' fractions of the loop's length
     (chord-length parameter): ``(n, 3)`` points and their positions ``k + u`` on the posed
     loop's edges (edge ``k`` from row ``k`` to row ``k + 1 mod m``). A loop cannot keep every
@@ -66,24 +69,19 @@ def _resample_loop(posed: np.ndarray, rest_arc: np.ndarray):
     return np.ascontiguousarray(pts), k + u
 
 
-def _unit_sized(a: np.ndarray) -> np.ndarray:
-    """``a`` times the power of two that brings its largest absolute entry into [0.5, 1)
-    (exact; ``a`` itself when it is zero)."""
-    m = float(np.abs(a).max(initial=0.0))
-    return np.ldexp(a, -np.frexp(m)[1]) if m > 0 and np.isfinite(m) else a
-
-
 def _scale(a: np.ndarray) -> float:
     return max(float(np.abs(a).max(initial=0.0)), 1e-300)
 
 
 def _norms(d: np.ndarray) -> np.ndarray:
     """Row lengths without overflow or underflow in the squares (hypot)."""
-    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    out: np.ndarray = np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    return out
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
-    return np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
+    out: np.ndarray = np.r_[0.0, np.cumsum(_norms(np.diff(points, axis=0)))]
+    return out
 
 
 def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,40 +93,7 @@ def _resample(posed: np.ndarray, chords: np.ndarray) -> tuple[np.ndarray, np.nda
     return _core.flesh_resample(posed, np.ascontiguousarray(chords, dtype=np.float64))
 
 
-def _posed_initial(rest: np.ndarray, f0: np.ndarray, posed: np.ndarray, t1: np.ndarray):
-    """Reference vector of the posed spine's first frame (a choice of ours: Zhuo 2014 does not
-    say how the posed spine's initial normal is chosen; any choice keeps the volume; this one is
-    rigid-motion equivariant and symmetric): ``r1 = Q R_t0(ψ) r0`` with ``Q`` the minimal
-    rotation taking the rest start tangent ``t0`` to the posed one ``t1`` and ``ψ`` the twist
-    about ``t0`` (swing–twist split) of ``Qᵀ K``, ``K`` the best-fit (Kabsch) rotation of the
-    rest onto the posed samples; ``ψ = 0`` when either spine is straight (the roll about it is
-    then free). A rigid motion ``K`` gives ``r1 = K r0``; swapping the spines gives the
-    inverse roll."""
-    r0, t0 = f0[:, 0], f0[:, 2]
-    q = _core.minimal_rotation(t0, t1)
-    # each spine divided by a power of two near its size first (exact; the rotation does not
-    # depend on it): the products of coordinates below leave float64's range beyond 1e±150
-    a = _unit_sized(rest - rest.mean(0))
-    b = _unit_sized(posed - posed.mean(0))
-    u, sv, vt = np.linalg.svd(a.T @ b)
-    sa = np.linalg.svd(a, compute_uv=False)
-    sb = np.linalg.svd(b, compute_uv=False)
-    psi = 0.0
-    if sv[1] > 1e-9 * sv[0] and sa[1] > 1e-9 * sa[0] and sb[1] > 1e-9 * sb[0]:
-        d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-        k = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-        m = q.T @ k
-        # quaternion (v, w) of m, up to a common factor; its twist about t0 has angle
-        # 2 atan2(v·t0, w)
-        w = 1.0 + np.trace(m)
-        v = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
-        psi = 2 * np.arctan2(v @ t0, w)
-    c, s = np.cos(psi), np.sin(psi)
-    rolled = c * r0 + s * np.cross(t0, r0) + (1 - c) * (t0 @ r0) * t0
-    return q @ rolled
-
-
-def _vertices(vertices, dim: int) -> np.ndarray:
+def _vertices(vertices: Array, dim: int) -> np.ndarray:
     """``(V, dim)`` vertices as ``(V, 3)`` (the planar case gets z = 0)."""
     v = as_float_array(vertices, "vertices")
     if v.ndim != 2 or v.shape[1] != dim:
@@ -148,115 +113,6 @@ def _rest_frames(rest: np.ndarray, dim: int, closed: bool = False) -> np.ndarray
         return _spine_frames(rest, "rest_spine", initial=np.array([-t0[1], t0[0], 0.0]),
                              closed=closed)
     return _spine_frames(rest, "rest_spine", closed=closed)
-
-
-def _rotations(f: np.ndarray, name: str) -> None:
-    """Refuse frames that are not proper rotations (columns orthonormal, det +1)."""
-    err = np.abs(np.swapaxes(f, -1, -2) @ f - np.eye(3)).max(axis=(-2, -1))
-    bad = np.flatnonzero(~(err < 1e-6) | ~(np.linalg.det(f) > 0))
-    if bad.size:
-        raise ValueError(f"{name}: row {bad[0]} is not a rotation (expected orthonormal "
-                         f"columns r, s, t with det +1, like spinal.frames)")
-
-
-def _roll_to(frames1: np.ndarray, r0: np.ndarray, name: str) -> np.ndarray:
-    """``frames1`` rolled about their tangents by the constant angle that turns the first
-    reference vector onto ``r0`` projected on the first normal plane (the RMF is linear in
-    its initial vector, so this is the RMF started from ``r0``)."""
-    r, s_, t0 = frames1[0][:, 0], frames1[0][:, 1], frames1[0][:, 2]
-    p = r0 - (r0 @ t0) * t0
-    if not np.linalg.norm(p) > 1e-3 * np.linalg.norm(r0):
-        raise ValueError(f"{name}: its reference vector is parallel to the posed spine's "
-                         f"first tangent")
-    g = np.arctan2(p @ s_, p @ r)
-    c, sn = np.cos(g), np.sin(g)
-    out = frames1.copy()
-    rr, ss = frames1[:, :, 0], frames1[:, :, 1]
-    out[:, :, 0] = c * rr + sn * ss
-    out[:, :, 1] = c * ss - sn * rr
-    return out
-
-
-def _given_roll(frames1, posed_frames, posed_up, at, m: int, closed: bool):
-    """The posed frames with the roll the caller gives: ``frames1`` (the posed spine's frames,
-    whose tangents are kept) with ``r`` the given reference vectors — the ``r`` columns of
-    ``posed_frames`` or the ``posed_up`` vectors at the caller's ``m`` posed rows — blended
-    linearly to the positions ``at`` (``k + u`` on the caller's polyline) of the samples and
-    projected onto their normal planes. One ``(3, 3)`` frame instead sets the first frame:
-    the RMF started from it."""
-    name = "posed_frames" if posed_frames is not None else "posed_up"
-    t = frames1[:, :, 2]
-    if posed_frames is not None:
-        f = as_float_array(posed_frames, name)
-        if f.shape == (3, 3):
-            _rotations(f[None], name)
-            return _roll_to(frames1, f[:, 0], name)
-        if closed and f.shape == (m + 1, 3, 3):  # the caller repeated the first row
-            f = f[:m]
-        if f.shape != (m, 3, 3):
-            raise ValueError(f"{name}: expected shape (3, 3) or ({m}, 3, 3) like posed_spine's "
-                             f"rows, got {f.shape}")
-        _rotations(f, name)
-        vecs, tg = f[:, :, 0], f[:, :, 2]
-    else:
-        u = as_float_array(posed_up, name)
-        if closed and u.shape == (m + 1, 3):
-            u = u[:m]
-        if u.shape == (3,):
-            u = np.broadcast_to(u, (m, 3))
-        if u.shape != (m, 3):
-            raise ValueError(f"{name}: expected shape (3,) or ({m}, 3) like posed_spine's rows, "
-                             f"got {u.shape}")
-        # directions: each row divided by its largest component first, so that lengths of
-        # 1e300 or 1e-300 neither overflow nor vanish in the norm
-        big = np.abs(u).max(axis=1, keepdims=True)
-        bad = np.flatnonzero(~np.isfinite(u).all(axis=1) | ~(big[:, 0] > 0))
-        if bad.size:
-            raise ValueError(f"{name}: row {bad[0]} is not a finite non-zero vector")
-        u = u / big
-        vecs, tg = u / np.linalg.norm(u, axis=1, keepdims=True), None
-    # the caller's rows around every sample
-    k = np.floor(at).astype(np.int64)
-    if closed:
-        k %= m
-        nxt = (k + 1) % m
-        w = np.clip(at - np.floor(at), 0.0, 1.0)
-    else:
-        k = np.clip(k, 0, m - 2)
-        nxt = k + 1
-        w = np.clip(at - k, 0.0, 1.0)
-    row = np.where(w < 0.5, k, nxt)
-    if tg is not None:
-        tb = (1 - w)[:, None] * tg[k] + w[:, None] * tg[nxt]
-        cos = np.einsum("ij,ij->i", tb, t) / np.linalg.norm(tb, axis=1)
-        bad = np.flatnonzero(~(cos > 0.5))
-        if bad.size:
-            j = bad[0]
-            raise ValueError(
-                f"{name}: row {row[j]}: its t column is "
-                f"{np.degrees(np.arccos(np.clip(cos[j], -1, 1))):.0f}° from the posed spine's "
-                f"tangent (expected the posed spine's frames, columns r, s, t like spinal.frames)")
-    v = (1 - w)[:, None] * vecs[k] + w[:, None] * vecs[nxt]
-    r = v - np.einsum("ij,ij->i", v, t)[:, None] * t
-    nr = np.linalg.norm(r, axis=1)
-    bad = np.flatnonzero(~(nr > 1e-3))
-    if bad.size:
-        j = bad[0]
-        raise ValueError(f"{name}: row {row[j]}: the reference vector is parallel to the posed "
-                         f"spine's tangent (or turns by a half turn between rows)")
-    r = r / nr[:, None]
-    dots = np.einsum("ij,ij->i", r[:-1], r[1:])
-    if closed:
-        dots = np.r_[dots, r[-1] @ r[0]]
-    bad = np.flatnonzero(~(dots > -0.5))
-    if bad.size:
-        raise ValueError(f"{name}: the roll turns by 120° or more between posed samples "
-                         f"{bad[0]} and {(bad[0] + 1) % len(r)}; give a roll that turns less "
-                         f"between samples")
-    out = frames1.copy()
-    out[:, :, 0] = r
-    out[:, :, 1] = np.cross(t, r)
-    return out
 
 
 class SpineBinding:
@@ -307,7 +163,9 @@ class SpineBinding:
         Messages start with the argument's name: wrong shapes, NaN/inf, repeated spine points.
     """
 
-    def __init__(self, vertices, rest_spine, *, closed: bool = False):
+    clamped: Int64Array
+
+    def __init__(self, vertices: Array, rest_spine: Array, *, closed: bool = False) -> None:
         closed = as_bool(closed, "closed")
         rest, dim = _spine(rest_spine, "rest_spine", closed)
         v = _vertices(vertices, dim)
@@ -325,21 +183,21 @@ class SpineBinding:
         return len(self._edge)
 
     @property
-    def edge(self) -> np.ndarray:
+    def edge(self) -> Int64Array:
         """``(V,)`` int64: the rest spine edge ``k`` (between samples ``k`` and ``k + 1``) that
         holds each vertex's cross-section; ``0`` or ``n − 2`` for vertices past the ends. On a
         closed spine edge ``n − 1`` is the closing edge (from sample ``n − 1`` to sample 0)."""
         return self._edge.copy()
 
     @property
-    def rest_frames(self) -> np.ndarray:
+    def rest_frames(self) -> Float64Array:
         """``(n, 3, 3)`` float64: the rest spine's frames (columns ``r, s, t``) in which the
         offsets are stored. A rigid motion ``x ↦ Rx + c`` of the whole shape is the pose
         ``deform(rest_spine @ R.T + c, posed_frames=R @ rest_frames)``."""
         return self._frames.copy()
 
     @property
-    def param(self) -> np.ndarray:
+    def param(self) -> Float64Array:
         """``(V,)`` float64: the parameter ``a ∈ [0, 1]`` of the section on its edge
         (dimensionless; the section's spine point is the cubic Hermite ``C(a)`` between ``R_k``
         and ``R_{k+1}``, see the class notes). Vertices past
@@ -347,27 +205,30 @@ class SpineBinding:
         return self._coords[:, 0].copy()
 
     @property
-    def arc_length(self) -> np.ndarray:
+    def arc_length(self) -> Float64Array:
         """``(V,)`` float64: rest arc length ``S_k + a (S_{k+1} − S_k)`` of each vertex's
         section along the rest polyline (``S_k`` the cumulative chord lengths), in the units of
         the input; ``0`` or the total length past the ends."""
         k = self._edge
         s = self._lengths
-        return s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
+        out: Float64Array = s[k] + self._coords[:, 0] * (s[k + 1] - s[k])
+        return out
 
     @property
-    def offset(self) -> np.ndarray:
+    def offset(self) -> Float64Array:
         """``(V, 2)`` float64: each vertex's offset from the spine in its section, as
         coordinates along the ``r`` and ``s`` columns of the interpolated rest frame (units of
         the input; in the planar case ``s`` is out of the plane, so the second column is 0)."""
         return self._coords[:, 2:4].copy()
 
-    def posed_spine(self, posed_spine, *, stretchable: bool = False) -> np.ndarray:
+    def posed_spine(self, posed_spine: Array, *, stretchable: bool = False) -> Float64Array:
         """The posed spine as used by :meth:`deform`: ``(n, 3)`` (resampled when not
         stretchable)."""
-        return self._posed(posed_spine, stretchable)[0]
+        out: Float64Array = self._posed(posed_spine, stretchable)[0]
+        return out
 
-    def _posed(self, posed_spine, stretchable, slide=0.0):
+    def _posed(self, posed_spine: Array, stretchable: bool, slide: float = 0.0
+               ) -> tuple[np.ndarray, int, np.ndarray]:
         """The posed spine as used, the caller's row count ``m`` and the positions ``k + u``
         of the used samples on the caller's polyline (edge ``k``, fraction ``u``)."""
         posed, dim = _spine(posed_spine, "posed_spine", self._closed)
@@ -395,20 +256,65 @@ class SpineBinding:
         pts, at = _resample(posed, np.diff(self._lengths))
         return pts, m, at
 
+    @overload
     def deform(
         self,
-        posed_spine,
+        posed_spine: Array,
         *,
-        solution: str = "radial",
-        blend=None,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
         stretchable: bool = False,
-        twist=None,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: Literal[True],
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> tuple[Float64Array, Int64Array]: ...
+    @overload
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
         strict: bool = False,
         return_clamped: bool = False,
-        posed_frames=None,
-        posed_up=None,
-        slide=0.0,
-    ):
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+    def deform(
+        self,
+        posed_spine: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+        slide: float = 0.0,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]:
         r"""The shape posed on ``posed_spine`` with its volume preserved locally.
 
         Every vertex is rebuilt from the posed spine at its registered parameter by
@@ -531,11 +437,14 @@ class SpineBinding:
         They are also stored in ``self.clamped`` and reported by a
         :class:`spinal.FoldOverWarning` (``indices`` attribute).
         """
-        return self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+        out: Float64Array | tuple[Float64Array, Int64Array] = self._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
                             posed_frames, posed_up, slide, blend)
+        return out
 
-    def _deform(self, posed_spine, solution, stretchable, twist, strict, return_clamped,
-                posed_frames, posed_up, slide, blend=None):
+    def _deform(self, posed_spine: Array, solution: SpineSolution, stretchable: bool,
+                twist: float | Array | None, strict: bool, return_clamped: bool,
+                posed_frames: Array | None, posed_up: Array | None, slide: float,
+                blend: float | None = None) -> Float64Array | tuple[Float64Array, Int64Array]:
         """:meth:`deform` (also of :func:`flesh`: either is two frames above this one, so
         a clamp warning points at the caller's line)."""
         solution = as_choice(solution, "solution", SOLUTIONS)
@@ -556,7 +465,9 @@ class SpineBinding:
         out, _ = self._apply(posed, frames1, solution, twist, strict, level=5, blend=blend)
         return (out, self.clamped) if return_clamped else out
 
-    def _apply(self, posed, frames1, solution, twist, strict, level, blend=None):
+    def _apply(self, posed: np.ndarray, frames1: np.ndarray | None, solution: str,
+               twist: float | Array | None, strict: bool, level: int,
+               blend: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The shape on the used posed spine ``posed`` with the frames ``frames1`` (None: the
         default posed frames): the deformed vertices and the frames used. A clamp warning
         points ``level`` frames up from the warning."""
@@ -575,9 +486,18 @@ class SpineBinding:
             out = np.ascontiguousarray(out[:, :2])
         return out, frames1
 
-    def animate(self, posed_spines_t, *, solution: str = "radial", blend=None,
-                stretchable: bool = False, twist=None, slide=0.0,
-                previous_weight: float = 1000.0, progress=False) -> np.ndarray:
+    def animate(
+        self,
+        posed_spines_t: Array,
+        *,
+        solution: SpineSolution = "radial",
+        blend: float | None = None,
+        stretchable: bool = False,
+        twist: float | Array | None = None,
+        slide: float | Array = 0.0,
+        previous_weight: float = 1000.0,
+        progress: ProgressArg = False,
+    ) -> Float64Array:
         r"""The shape posed on a sequence of posed spines, with frames that follow each
         other in time: ``(T, V, 3)`` (or ``(T, V, 2)`` in the plane).
 
@@ -631,13 +551,13 @@ class SpineBinding:
         return _roll_to(frames1, init, "posed_spine")
 
 
-def _blend(blend) -> float | None:
+def _blend(blend: object) -> float | None:
     """``blend`` as a Python float (or ``None``); the core checks its value and that it
     comes with ``solution="blend"``."""
     return None if blend is None else as_real(blend, "blend")
 
 
-def _twist(twist, n: int) -> np.ndarray:
+def _twist(twist: float | Array, n: int) -> np.ndarray:
     """``twist`` as ``(n,)`` angles (a number is used for every sample); the core checks
     the values."""
     tw = as_float_array(twist, "twist")
@@ -663,21 +583,75 @@ def _report_clamped(flags: np.ndarray, strict: bool, level: int = 3) -> np.ndarr
     return clamped
 
 
+@overload
 def flesh(
-    vertices,
-    rest_spine,
-    posed_spine,
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
     *,
-    solution: str = "radial",
-    blend=None,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
     stretchable: bool = False,
-    twist=None,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array: ...
+
+
+@overload
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: Literal[True],
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> tuple[Float64Array, Int64Array]: ...
+
+
+@overload
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
     strict: bool = False,
     return_clamped: bool = False,
     closed: bool = False,
-    posed_frames=None,
-    posed_up=None,
-):
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+
+
+def flesh(
+    vertices: Array,
+    rest_spine: Array,
+    posed_spine: Array,
+    *,
+    solution: SpineSolution = "radial",
+    blend: float | None = None,
+    stretchable: bool = False,
+    twist: float | Array | None = None,
+    strict: bool = False,
+    return_clamped: bool = False,
+    closed: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]:
     r"""Bend a shape with its spine and keep its volume locally (Zhuo 2014): ``(V, 3)``.
 
     One-shot form of ``SpineBinding(vertices, rest_spine).deform(posed_spine, ...)``; see
@@ -700,5 +674,6 @@ def flesh(
         binding = SpineBinding(vertices, rest_spine, closed=closed)
     except MemoryError as e:
         raise MemoryError(f"flesh: {e}") from None
-    return binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
+    out: Float64Array | tuple[Float64Array, Int64Array] = binding._deform(posed_spine, solution, stretchable, twist, strict, return_clamped,
                            posed_frames, posed_up, 0.0, blend)
+    return out

@@ -6,16 +6,21 @@ its volume locally when the surface moves (Zhuo 2014 Ch. VI). See :class:`Surfac
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
 
 from . import _core
-from ._flesh import _unit_sized
+from ._flesh_roll import _unit_sized
 from ._mesh import FoldOverWarning
+from ._types import Array, Float64Array, Int64Array, SurfaceSolution
 from ._validate import as_bool, as_choice, as_float_array
 
+if TYPE_CHECKING:
+    from ._mesh import Mesh
 
-def _grid(x, name: str) -> np.ndarray:
+
+def _grid(x: object, name: str) -> np.ndarray:
     arr = as_float_array(x, name)
     if arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 2 or arr.shape[1] < 2:
         raise ValueError(f"{name}: expected a grid of shape (nu, nv, 3), nu, nv ≥ 2, got "
@@ -23,7 +28,7 @@ def _grid(x, name: str) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
-def _is_mesh(x) -> bool:
+def _is_mesh(x: object) -> bool:
     """A triangulated surface: ``(vertices, faces)`` with integer faces, or an object with
     ``vertices`` and ``faces`` (spinal.Mesh, trimesh.Trimesh)."""
     if isinstance(x, tuple) and len(x) == 2:
@@ -31,14 +36,15 @@ def _is_mesh(x) -> bool:
     return hasattr(x, "vertices") and hasattr(x, "faces")
 
 
-def _mesh(x, name: str) -> tuple[np.ndarray, np.ndarray]:
+def _mesh(x: object, name: str) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices (n, 3) float64, faces (F, 3) int64)`` of a triangulated surface; the core
     checks the values (finite, indices in range, no degenerate faces)."""
-    V, F = x if isinstance(x, tuple) else (x.vertices, x.faces)
-    V = as_float_array(V, name)
+    given: Any = x
+    vertices, faces = given if isinstance(given, tuple) else (given.vertices, given.faces)
+    V = as_float_array(vertices, name)
     if V.ndim != 2 or V.shape[1] != 3:
         raise ValueError(f"{name}: expected vertices of shape (n, 3), got {V.shape}")
-    F = np.asarray(F)
+    F = np.asarray(faces)
     if F.dtype.kind not in "iu":
         raise TypeError(f"{name}: expected integer faces, got dtype {F.dtype}")
     if F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
@@ -68,7 +74,8 @@ def _surface_frames(g: np.ndarray) -> np.ndarray:
     return np.stack([e1, np.cross(n, e1), n], axis=-1)
 
 
-def _surface_directions(posed_frames, posed_up, shape):
+def _surface_directions(posed_frames: Array | None, posed_up: Array | None,
+                        shape: tuple[int, ...]) -> tuple[str, np.ndarray] | None:
     """The ``(name, (rows, 3) directions)`` the core lays the offsets along, or ``None``;
     ``shape`` is the grid's ``(nu, nv)`` or the triangulated surface's ``(n,)``."""
     if posed_frames is None and posed_up is None:
@@ -155,7 +162,13 @@ class SurfaceBinding:
         a grid as one array.
     """
 
-    def __init__(self, vertices, rest_surface):
+    clamped: Int64Array
+    _faces: np.ndarray | None  # the rest faces of a triangulated surface (None: a grid)
+    _shape: tuple[int, ...] | None  # the grid's (nu, nv) (None: triangles)
+
+    def __init__(
+        self, vertices: Array, rest_surface: Array | Mesh | tuple[Array, Array]
+    ) -> None:
         v = as_float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected shape (V, 3), got {v.shape}")
@@ -182,18 +195,19 @@ class SurfaceBinding:
         return len(self._cell)
 
     @property
-    def face(self) -> np.ndarray:
+    def face(self) -> Int64Array:
         """``(V,)`` int64: the face of each foot (triangulated surfaces only)."""
         self._only("face", triangles=True)
         return self._cell.copy()
 
     @property
-    def barycentric(self) -> np.ndarray:
+    def barycentric(self) -> Float64Array:
         """``(V, 3)`` barycentric coordinates of the feet on their faces (triangulated
         surfaces only)."""
         self._only("barycentric", triangles=True)
         u, v = self._coords[:, 0], self._coords[:, 1]
-        return np.c_[1 - u - v, u, v]
+        out: Float64Array = np.c_[1 - u - v, u, v]
+        return out
 
     def _only(self, name: str, triangles: bool) -> None:
         if (self._faces is not None) != triangles:
@@ -201,19 +215,21 @@ class SurfaceBinding:
             raise TypeError(f"{name}: only for {kind} rest_surface")
 
     @property
-    def uv(self) -> np.ndarray:
+    def uv(self) -> Float64Array:
         """``(V, 2)`` grid coordinates ``(i + u, j + v)`` of the feet (grids only)."""
         self._only("uv", triangles=False)
+        assert self._shape is not None  # (a grid)
         i, j = np.divmod(self._cell, self._shape[1])
-        return np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
+        out: Float64Array = np.c_[i + self._coords[:, 0], j + self._coords[:, 1]]
+        return out
 
     @property
-    def offset(self) -> np.ndarray:
+    def offset(self) -> Float64Array:
         """``(V,)`` signed offsets ``h`` along the rest normal."""
         return self._coords[:, 2].copy()
 
     @property
-    def rest_frames(self) -> np.ndarray:
+    def rest_frames(self) -> Float64Array:
         """``(nu, nv, 3, 3)`` frames of the rest surface at its samples, columns ``(e1, e2,
         N)``: ``e1`` the direction of ``S_u``, ``e2 = N × e1`` in the surface, ``N`` the
         normal (all by the central differences the binding uses). ``R @ rest_frames`` are
@@ -229,8 +245,49 @@ class SurfaceBinding:
         only the second kind of face uses."""
         return self._rest_frames.copy()
 
-    def deform(self, posed_surface, *, solution: str = "offset", strict: bool = False,
-               return_clamped: bool = False, posed_frames=None, posed_up=None):
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[False] = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: Literal[True],
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> tuple[Float64Array, Int64Array]: ...
+    @overload
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+    def deform(
+        self,
+        posed_surface: Array,
+        *,
+        solution: SurfaceSolution = "offset",
+        strict: bool = False,
+        return_clamped: bool = False,
+        posed_frames: Array | None = None,
+        posed_up: Array | None = None,
+    ) -> Float64Array | tuple[Float64Array, Int64Array]:
         """The shape on ``posed_surface`` (same grid shape; for a triangulated rest surface
         the posed vertex array ``(n, 3)``, or a mesh with the same faces): ``(V, 3)``.
 
@@ -280,7 +337,8 @@ class SurfaceBinding:
             out, flags = _core.flesh_trisurface_deform(
                 pv, self._faces, self._cell, self._coords, self._exp, solution == "offset",
                 dirs)
-            return self._report(out, flags, strict, return_clamped)
+            res: Float64Array | tuple[Float64Array, Int64Array] = self._report(out, flags, strict, return_clamped)
+            return res
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:
             raise ValueError(f"posed_surface: expected the rest grid's shape "
@@ -291,12 +349,12 @@ class SurfaceBinding:
                                                 solution == "offset", dirs)
         return self._report(out, flags, strict, return_clamped)
 
-    def _posed_vertices(self, posed_surface) -> np.ndarray:
+    def _posed_vertices(self, posed_surface: object) -> np.ndarray:
         """The posed vertices of a triangulated binding (an array, or a mesh whose faces
         are the rest faces)."""
         if _is_mesh(posed_surface):
             pv, faces = _mesh(posed_surface, "posed_surface")
-            if not np.array_equal(faces, self._faces):
+            if self._faces is None or not np.array_equal(faces, self._faces):
                 raise ValueError("posed_surface: its faces differ from rest_surface's")
         else:
             pv = as_float_array(posed_surface, "posed_surface")
@@ -305,7 +363,8 @@ class SurfaceBinding:
                              f"vertices, shape ({self._nverts}, 3), got {pv.shape}")
         return np.ascontiguousarray(pv, dtype=np.float64)
 
-    def _report(self, out, flags, strict, return_clamped):
+    def _report(self, out: Float64Array, flags: np.ndarray, strict: bool, return_clamped: bool
+                ) -> Float64Array | tuple[Float64Array, Int64Array]:
         clamped = np.flatnonzero(flags).astype(np.int64)
         self.clamped = clamped
         if clamped.size:
@@ -317,9 +376,53 @@ class SurfaceBinding:
         return (out, clamped) if return_clamped else out
 
 
-def flesh_surface(vertices, rest_surface, posed_surface, *, solution: str = "offset",
-                  strict: bool = False, return_clamped: bool = False, posed_frames=None,
-                  posed_up=None):
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[False] = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array: ...
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: Literal[True],
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> tuple[Float64Array, Int64Array]: ...
+@overload
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]: ...
+def flesh_surface(
+    vertices: Array,
+    rest_surface: Array | Mesh | tuple[Array, Array],
+    posed_surface: Array,
+    *,
+    solution: SurfaceSolution = "offset",
+    strict: bool = False,
+    return_clamped: bool = False,
+    posed_frames: Array | None = None,
+    posed_up: Array | None = None,
+) -> Float64Array | tuple[Float64Array, Int64Array]:
     """Bend a shape with a spine surface and keep its volume locally (Zhuo 2014 Ch. VI).
 
     One-shot form of ``SurfaceBinding(vertices, rest_surface).deform(posed_surface, ...)``

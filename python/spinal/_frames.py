@@ -1,139 +1,71 @@
-"""Moving frames along curves: the Python face of ``spinal._core``."""
+"""Moving frames along curves: the Python face of ``spinal._core`` (:func:`frames`,
+:func:`closing_angle`, :func:`estimate_tangents`; :func:`frames_in_time` is in
+``_frames_time``, the reading of the arguments in ``_frames_args``)."""
+
 
 from __future__ import annotations
 
-import warnings
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _merge
+from ._frames_args import (
+    METHODS,
+    REFLECTIONS,
+    TANGENT_RULES,
+    _analytic,
+    _cut_curves,
+    _cut_rows,
+    _guide_options,
+    _orientation,
+    _previous_twist_guide,
+    _previous_weight,
+    _sampled,
+    _shape,
+    _signed_by,
+    _skipped_warning,
+    _third,
+)
 from ._progress import Progress, Reported, checked
-from ._steer import STEERING, guide_rows, previous_frames, steering
+from ._steer import STEERING, steering
+from ._types import (
+    Array,
+    Constraints,
+    CurveBundle,
+    Float64Array,
+    FrameMethod,
+    Ints,
+    ProgressArg,
+    Reflection,
+    TangentRule,
+)
 from ._validate import (
-    MAX_SAMPLES,
     as_bool,
     as_choice,
     as_curves,
-    as_finite,
-    as_float_array,
-    as_int,
-    as_offsets,
     as_out,
     as_points,
-    as_real,
     as_turns,
     fill_out,
     is_curve_list,
 )
 from .curves import Curve
 
-__all__ = ["closing_angle", "estimate_tangents", "frames", "frames_in_time"]
-
-METHODS = ("double_reflection", "projection", "rotation", "frenet", "rk4", "rk4_phi", "torsion",
-           "bisector")
-REFLECTIONS = ("chord", "tangents")
-TANGENT_RULES = ("five_point_bounded", "five_point", "five_point_uniform", "circle")
-DEFAULT_TANGENT_RULE = "five_point_bounded"
+__all__ = ["closing_angle", "estimate_tangents", "frames"]
 
 
-
-def _orientation(x: Any, name: str, curves: int, bundle: bool):
-    """Split an initial/end argument into (vectors (k,3), frames (k,3,3)) for the core."""
-    if x is None:
-        return None, None
-    a = as_float_array(x, name)
-    if a.shape == (3,):
-        return np.ascontiguousarray(a[None, :]), None
-    if bundle and a.shape == (curves, 3):
-        return np.ascontiguousarray(a), None
-    if a.shape == (3, 3):
-        return None, np.ascontiguousarray(a[None])
-    if bundle and a.shape == (curves, 3, 3):
-        return None, np.ascontiguousarray(a)
-    expect = "(3,) or (3, 3)" + (f", ({curves}, 3) or ({curves}, 3, 3)" if bundle else "")
-    raise ValueError(f"{name}: expected shape {expect}, got {a.shape}")
-
-
-def _analytic(curve: Curve, u: Any):
-    """Points, parameters and exact derivatives at the samples and midpoints."""
-    if u is None:
-        raise TypeError("u: required with an analytic curve (parameter values or a sample count)")
-    if isinstance(u, (int, np.integer)) and not isinstance(u, bool):
-        count = as_int(u, "u", 2, MAX_SAMPLES, out_of_bounds=lambda x: (
-            f"a sample count must be at least 2 and at most {MAX_SAMPLES:,}, got {x}"))
-        try:
-            uu = curve.parameters(count)
-        except MemoryError:
-            raise MemoryError(f"u: {count} samples do not fit in memory") from None
-    else:
-        uu = as_float_array(u, "u")
-        if uu.ndim != 1 or uu.size < 2:  # the midpoints below need two values
-            raise ValueError(f"u: expected a 1-D array of at least 2 values, got shape {uu.shape}")
-    uu = np.ascontiguousarray(uu)
-    full = np.empty(2 * uu.size - 1)
-    full[0::2] = uu
-    full[1::2] = 0.5 * (uu[:-1] + uu[1:])
-    return (
-        np.ascontiguousarray(curve.point(uu)),
-        uu,
-        np.ascontiguousarray(curve.d1(full)),
-        np.ascontiguousarray(curve.d2(full)),
-    )
-
-
-def _third(curve: Curve, uu: np.ndarray, method: str):
-    """``x‴`` at the samples and midpoints for the torsion method (None for the others)."""
-    if method != "torsion":
-        return None
-    full = np.empty(2 * uu.size - 1)
-    full[0::2], full[1::2] = uu, 0.5 * (uu[:-1] + uu[1:])
-    return np.ascontiguousarray(curve.d3(full))
-
-
-def _sampled(points, tangents, reflection, lengths, offsets, points_arg="points"):
-    """Sampled points and tangents as the core takes them: ``(pts, tgs, offs, bundle)``, rows
-    ``(N, 3)`` float64 (either may be ``None``), CSR offsets ``(C + 1,)`` and whether the
-    call is a bundle; a sequence of ``(n_i, 3)`` curves (any real dtype, nibabel's
-    ``ArraySequence``) is one bundle, as one array with ``lengths``/``offsets``."""
-    if is_curve_list(points) or (points is None and is_curve_list(tangents)):
-        # a sequence of curves: the rows back to back, the lengths from the sequence
-        pts, offs, bundle = (None, None, True) if points is None else as_curves(
-            points, lengths, offsets, points_arg)
-        tgs = None
-        if tangents is not None:
-            tgs, toffs, _ = as_curves(tangents, None, None, "tangents")
-            if offs is not None and not np.array_equal(toffs, offs):
-                raise ValueError("tangents: the curves must have the lengths of points'")
-            offs = toffs if offs is None else offs
-    else:
-        pts = None if points is None else as_points(points, points_arg)
-        tgs = None if tangents is None else as_points(tangents, "tangents")
-        offs = None
-    if pts is None and (tgs is None or reflection != "tangents"):
-        raise TypeError("points: required (only reflection='tangents' works from tangents alone)")
-    rows = (pts if pts is not None else tgs).shape[0]
-    bundle = offs is not None
-    if offs is None:
-        offs, bundle = as_offsets(rows, lengths, offsets)
-    return pts, tgs, offs, bundle
-
-
-def _shape(method: str, closed: bool, iv=None, if_=None, ev=None, ef=None, **more) -> dict:
-    """The options of the core's frames calls (``spinal._core.frames_*``): the method, the
-    default tangent rule, whether the curve is closed, the start and end orientations as
-    vectors and frames, and any call-specific ``more``."""
-    return {"method": method, "tangent_rule": DEFAULT_TANGENT_RULE, "closed": closed,
-            "initial_vectors": iv, "initial_frames": if_, "end_vectors": ev, "end_frames": ef,
-            **more}
-
-
-def _compute(points, tangents, method, initial, closed, end, turns, reflection, u,
-             lengths, offsets, points_arg="points", report=None, out=None):
+def _compute(points: object, tangents: object, method: object, initial: object, closed: object,
+             end: object, turns: object, reflection: object, u: object, lengths: object,
+             offsets: object, points_arg: str = "points", report: Reported | None = None,
+             out: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
     method = as_choice(method, "method", METHODS)
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
     turns = as_turns(turns, "turns")
+    pts: np.ndarray | None
     if isinstance(points, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (its exact tangents are used)")
@@ -161,7 +93,8 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     # tangents (the core's `tangent_chords` flag)
     chords_from_tangents = reflection == "tangents"
 
-    def run(p, offs, tgs):
+    def run(p: np.ndarray | None, offs: np.ndarray, tgs: np.ndarray | None
+            ) -> tuple[np.ndarray, np.ndarray]:
         # the rows as given are written straight into `out` (the rows kept after merging
         # repeats are spread over it by the caller)
         options = _shape(method, closed, iv, if_, ev, ef, tangent_chords=chords_from_tangents,
@@ -175,40 +108,42 @@ def _compute(points, tangents, method, initial, closed, end, turns, reflection, 
     return out, angles, bundle
 
 
-def _spine_frames(points, name: str, initial=None, closed: bool = False) -> np.ndarray:
+def _spine_frames(points: object, name: str, initial: object = None, closed: bool = False
+                  ) -> np.ndarray:
     """The default frames of one curve passed to a spinal function as ``name`` (errors about
     the points name it)."""
     out, _, _ = _compute(points, None, "double_reflection", initial, closed, None, 0, "chord",
                          None, None, None, points_arg=name)
-    return out
+    res: np.ndarray = out
+    return res
 
 
 def frames(
-    points,
-    tangents=None,
+    points: Array | Curve | CurveBundle | None,
+    tangents: Array | CurveBundle | None = None,
     *,
-    method: str = "double_reflection",
-    initial=None,
+    method: FrameMethod = "double_reflection",
+    initial: Array | None = None,
     closed: bool = False,
-    end=None,
+    end: Array | None = None,
     turns: float = 0,
-    reflection: str = "chord",
-    u=None,
-    lengths=None,
-    offsets=None,
-    constraints=None,
-    twist_rule: str = "arc_length",
-    guide=None,
+    reflection: Reflection = "chord",
+    u: int | Array | None = None,
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    constraints: Constraints | Sequence[Constraints | None] | None = None,
+    twist_rule: Literal["arc_length", "min_angular_speed"] = "arc_length",
+    guide: Array | None = None,
     guide_weight: float = 1.0,
     guide_tolerance: float = 1e-3,
-    previous=None,
+    previous: Array | None = None,
     previous_twist: bool = False,
     previous_weight: float | None = None,
-    guide_sign: str = "follow",
-    on_invalid: str = "raise",
-    progress=False,
-    out=None,
-) -> np.ndarray:
+    guide_sign: Literal["follow", "free"] = "follow",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    progress: ProgressArg = False,
+    out: npt.NDArray[np.float64] | None = None,
+) -> Float64Array:
     r"""Moving frames along a curve: ``(n, 3, 3)`` rotation matrices, columns ``(r, s, t)``.
 
     ``frames[i][:, 2] = t_i`` is the unit tangent, ``frames[i][:, 0] = r_i`` the reference
@@ -498,15 +433,15 @@ def frames(
 
 
 def closing_angle(
-    points,
-    tangents=None,
+    points: Array | Curve | CurveBundle | None,
+    tangents: Array | CurveBundle | None = None,
     *,
-    method: str = "double_reflection",
-    reflection: str = "chord",
-    u=None,
-    lengths=None,
-    offsets=None,
-):
+    method: FrameMethod = "double_reflection",
+    reflection: Reflection = "chord",
+    u: int | Array | None = None,
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+) -> float | Float64Array:
     r"""The closing (holonomy) angle of the rotation-minimising frame of a closed curve.
 
     Carry a reference vector ``r_0`` once round the loop with the RMF; the result ``r_n``
@@ -527,14 +462,14 @@ def closing_angle(
 
 
 def estimate_tangents(
-    points,
+    points: Array | CurveBundle,
     *,
     closed: bool = False,
-    method: str = DEFAULT_TANGENT_RULE,
-    lengths=None,
-    offsets=None,
-    on_invalid: str = "raise",
-) -> np.ndarray:
+    method: TangentRule = "five_point_bounded",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    on_invalid: Literal["raise", "skip"] = "raise",
+) -> Float64Array:
     r"""Unit tangents estimated from sampled points, ``(n, 3)``.
 
     * ``"five_point_bounded"`` (default): ``"five_point"`` below, with each open end tangent
@@ -624,20 +559,24 @@ def estimate_tangents(
         pts = as_points(points, "points")
         offs, bundle = np.array([0, len(pts)], dtype=np.int64), False
 
-        def run(pts, offs):
+        def run(pts: np.ndarray, offs: np.ndarray) -> np.ndarray:
             return _core.estimate_tangents(pts, closed, method)
     else:
         pts, offs, bundle = as_curves(points, lengths, offsets)
 
-        def run(pts, offs):
+        def run(pts: np.ndarray, offs: np.ndarray) -> np.ndarray:
             return _core.estimate_tangents(pts, closed, method, offs)
     # consecutive repeated samples merged (they get the tangent of the row they join)
-    return _merge.on_rows(run, pts, offs, closed, bundle)
+    res: Float64Array = _merge.on_rows(run, pts, offs, closed, bundle)
+    return res
 
 
-def _steered(points, tangents, method, initial, closed, end, turns, reflection, u, lengths,
-             offsets, constraints, twist_rule, guide, guide_weight, guide_tolerance, previous,
-             previous_twist=False, guide_sign="follow", previous_weight=None):
+def _steered(points: object, tangents: object, method: object, initial: object, closed: object,
+             end: object, turns: object, reflection: object, u: object, lengths: object,
+             offsets: object, constraints: object, twist_rule: object, guide: object,
+             guide_weight: float, guide_tolerance: float, previous: object,
+             previous_twist: bool = False, guide_sign: str = "follow",
+             previous_weight: float | None = None) -> np.ndarray:
     """:func:`frames` with its steering arguments (``constraints``, ``twist_rule``,
     ``guide``, ``previous`` or per-interval ``turns``)."""
     method = as_choice(method, "method", METHODS)
@@ -661,6 +600,7 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     reflection = as_choice(reflection, "reflection", REFLECTIONS)
     closed = as_bool(closed, "closed")
     d1 = d2 = d3 = uu = tgs = None
+    pts: np.ndarray | None
     if isinstance(points, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (its exact tangents "
@@ -675,7 +615,9 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
         if u is not None:
             raise TypeError("u: only used with an analytic curve from spinal.curves")
         pts, tgs, offs, bundle = _sampled(points, tangents, reflection, lengths, offsets)
-    rows = (pts if pts is not None else tgs).shape[0]
+    ref = pts if pts is not None else tgs
+    assert ref is not None  # (_sampled refuses neither)
+    rows = ref.shape[0]
     if uu is not None:
         offs, bundle = np.array([0, rows], dtype=np.int64), False
     curves = offs.size - 1
@@ -695,7 +637,8 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     steer = steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance,
                      previous, offs, bundle, rows, guide_sign, before, previous_weight)
 
-    def run(pts, tgs, offs, steer):
+    def run(pts: np.ndarray | None, tgs: np.ndarray | None, offs: np.ndarray,
+            steer: Sequence[object]) -> np.ndarray:
         options = _shape(method, closed, iv, if_, ev, ef, tangent_chords=reflection == "tangents",
                          u=uu, d1=d1, d2=d2, d3=d3)
         return _core.frames_steered(pts, tgs, offs, options, dict(zip(STEERING, steer)))
@@ -714,14 +657,19 @@ def _steered(points, tangents, method, initial, closed, end, turns, reflection, 
     return _steered_merged(run, p, pts, tgs, offs, steer, rows)
 
 
-def _steered_merged(run, p, pts, tgs, offs, steer, rows):
+def _steered_merged(run: Callable[..., np.ndarray], p: _merge.Plan, pts: np.ndarray,
+                    tgs: np.ndarray | None, offs: np.ndarray, steer: Sequence[Any],
+                    rows: int) -> np.ndarray:
     """The steered frames on the rows that ``p`` keeps (a per-row guide and previous cut
     alike, constraint rows moved to the sample they merge into), spread back over the rows
     as given."""
     # turns, 5 constraint arrays, rule, guide, weight, tolerance, axis, prev, the previous
     # frames' r as a second target of the guide, its weight
     steer = list(steer)
-    cut = (lambda a: None if a is None else np.ascontiguousarray(a[p.keep]))
+
+    def cut(a: np.ndarray | None) -> np.ndarray | None:
+        return None if a is None else np.ascontiguousarray(a[p.keep])
+
     if steer[7] is not None and len(steer[7]) == rows:
         steer[7] = cut(steer[7])
     steer[11] = cut(steer[11])
@@ -740,277 +688,5 @@ def _steered_merged(run, p, pts, tgs, offs, steer, rows):
         out = run(cut(pts), cut(tgs), p.offsets, steer)
     except ValueError as exc:
         raise ValueError(_merge.as_given(str(exc), p, offs)) from None
-    return out[p.rows]
-
-
-def _guide_options(guide_weight, guide_tolerance):
-    """``guide_weight`` and ``guide_tolerance`` as floats, checked even when no guide or
-    previous uses them (the same bounds as the core's)."""
-    guide_weight = as_real(guide_weight, "guide_weight")
-    if not 0.0 < guide_weight < np.inf:
-        raise ValueError(f"guide_weight: must be a positive finite number, got {guide_weight}")
-    guide_tolerance = as_finite(guide_tolerance, "guide_tolerance", 0.0)
-    if not guide_tolerance < np.pi / 2:
-        raise ValueError(f"guide_tolerance: must be an angle in [0, π/2) radians, got "
-                         f"{guide_tolerance}")
-    return guide_weight, guide_tolerance
-
-
-def _previous_weight(previous_weight, guide_weight: float) -> float:
-    """``previous_weight`` as a float (checked as ``guide_weight``); None: ``guide_weight``."""
-    if previous_weight is None:
-        return guide_weight
-    previous_weight = as_real(previous_weight, "previous_weight")
-    if not 0.0 < previous_weight < np.inf:
-        raise ValueError(f"previous_weight: must be a positive finite number, got "
-                         f"{previous_weight}")
-    return previous_weight
-
-
-def _signed_by(guide, previous, rows: int) -> np.ndarray:
-    """The axis guide ``guide`` with every row's sign agreeing with the ``r`` column of
-    ``previous`` (checked as :func:`frames` checks it): ``(rows, 3)``."""
-    g = guide_rows(guide, rows)
-    prev = _previous_twist_guide(previous, rows)
-    g = np.broadcast_to(g, (rows, 3))
-    flip = np.einsum("ij,ij->i", g, prev) < 0
-    return np.where(flip[:, None], -g, g)
-
-
-def _skipped_warning(nan, few, closed, what: str) -> None:
-    from ._mesh import SkippedCurvesWarning
-
-    msg = _merge.skipped_message("points", nan, few, bool(closed), what)
-    warnings.warn(SkippedCurvesWarning(msg, np.union1d(nan, few)), stacklevel=3)
-
-
-def _cut_rows(a, keep: np.ndarray, n: int):
-    """A per-row argument (``n`` rows, or a list of one array per curve) on the rows kept;
-    anything else (one vector for all rows, None) as given."""
-    if a is None:
-        return None
-    if not isinstance(a, np.ndarray) and is_curve_list(a):
-        a = np.concatenate([np.asarray(x, dtype=float) for x in a])
-    arr = np.asarray(a, dtype=float)
-    return arr[keep] if arr.ndim >= 2 and arr.shape[0] == n else a
-
-
-def _cut_curves(a, bad: np.ndarray, curves: int):
-    """A per-curve ``initial``/``end`` (``(C, 3)`` or ``(C, 3, 3)``) on the curves kept;
-    one for all curves as given."""
-    if a is None:
-        return None
-    arr = np.asarray(a, dtype=float)
-    per_curve = arr.ndim == 3 or (arr.ndim == 2 and arr.shape != (3, 3))
-    return np.delete(arr, bad, axis=0) if per_curve and arr.shape[0] == curves else a
-
-
-def _previous_twist_guide(previous, rows: int) -> np.ndarray:
-    """The ``r`` columns of ``previous`` (checked: one rotation per row) as a guide."""
-    prev = previous_frames(previous, rows)
-    m = prev
-    err = np.abs(np.swapaxes(m, -1, -2) @ m - np.eye(3)).max(axis=(-2, -1))
-    bad = np.flatnonzero(~(err < 1e-6) | ~(np.linalg.det(m) > 0))
-    if bad.size:
-        raise ValueError(f"previous: row {bad[0]} is not a rotation matrix (columns r, s, t "
-                         f"orthonormal, det +1)")
-    return np.ascontiguousarray(prev[:, :, 0])
-
-
-def frames_in_time(
-    points_t,
-    tangents_t=None,
-    *,
-    method: str = "double_reflection",
-    initial=None,
-    closed: bool = False,
-    turns: float = 0,
-    reflection: str = "chord",
-    previous=None,
-    previous_twist: bool = True,
-    previous_weight: float | None = None,
-    guide=None,
-    guide_weight: float = 1.0,
-    guide_tolerance: float = 1e-3,
-    guide_sign: str = "follow",
-    lengths=None,
-    offsets=None,
-    progress=False,
-) -> np.ndarray:
-    r"""Frames of a curve moving in time that do not flicker: ``(T, n, 3, 3)``.
-
-    ``points_t`` holds ``T`` time steps of the same curve (or bundle, with ``lengths`` /
-    ``offsets``), ``(T, n, 3)`` (same sample count at every step). The first step gets its
-    rotation-minimising frame (from ``initial``, or turned closest to ``previous``); then:
-
-    * ``previous_twist=True`` (default): every step follows the frames of the step before
-      sample by sample: they are :func:`frames` with ``previous=`` the step before and
-      ``previous_twist=True``, i.e. the guide ``previous[:, :, 0]`` (the previous ``r``
-      columns projected on the new normal planes) with the weight ``previous_weight``, so
-      each sample's frame turns between steps by about as much as its tangent does, however
-      the curve's own twist changes (an MD trajectory of a protein backbone, a swimming
-      tail). With the default weight 1000 the frame of a sample is the one closest to its
-      previous frame up to a smoothing bias of about ``φ″/1000`` (see ``guide_weight`` of
-      :func:`frames`). The steps are computed in order.
-    * ``previous_twist=False``: every step gets its rotation-minimising frame (computed in
-      parallel over ``T``), turned about the tangents by the one angle ``c`` that brings it
-      closest to the frames of the step before: ``c`` minimises ``Σ_i ‖R_t(c) U_i − P_i‖²``
-      (Frobenius; every sample counts the same), in closed form
-      ``c = atan2(Σ s·P_r − r·P_s, Σ r·P_r + s·P_s)``. All RMFs of a curve differ only by such
-      a constant turn (Zheng 2008, Cor. 4.1.3), so the frames stay rotation minimising along
-      the curve and change in time only as much as the RMF does (Ma 1996, §3.5.3, aligns the
-      frames of similar curves by one rotation); where the curve's total torsion changes
-      between steps, frames far from the middle turn by that much more than their tangents.
-      Equivalent to calling :func:`frames` with ``previous=`` step by step.
-    * ``guide`` given: every step follows its guide (``(3,)``, ``(n, 3)`` for all steps or
-      ``(T, n, 3)`` one per step; ``guide_weight``, ``guide_tolerance``, ``guide_sign`` as in
-      :func:`frames`) and, from the second step on (or from the first with ``previous``),
-      the frames of the step before: they are :func:`frames` with ``guide=`` and
-      ``previous=`` the step before, the guide and the previous ``r`` columns two targets of
-      one twist solve weighted by ``guide_weight`` and ``previous_weight`` (by default the
-      same weight, so a guide that jitters in time moves the frames about half as much);
-      ``previous_twist`` does not apply then. With ``guide_sign="free"`` (axes, such as raw
-      carbonyl bonds) each step's rows take the sign that agrees with the step before and
-      the signed guide is followed alone, so the frames do not flip between steps.
-
-    Parameters
-    ----------
-    points_t : array_like (T, n, 3)
-        The curve (bundle) at ``T`` time steps.
-    tangents_t : array_like (T, n, 3), optional
-        Tangents at every step (else estimated as in :func:`frames`).
-    method, closed, turns, reflection, lengths, offsets
-        As in :func:`frames` (a closed curve keeps its closing twist at every step).
-    initial : array_like (3,) or (3, 3), optional
-        The start of the first step (as in :func:`frames`); not with ``previous``.
-    previous : array_like (n, 3, 3), optional
-        Frames of the step before the first one (to continue a sequence).
-    previous_twist : bool
-        Follow the previous step sample by sample (default) or by one turn per step.
-    previous_weight : float, optional
-        The weight of the previous step's ``r`` against the twist rate, per sample (> 0).
-        Default: 1000 with ``previous_twist`` and no guide, ``guide_weight`` with a guide.
-    guide, guide_weight, guide_tolerance, guide_sign
-        A guide followed at every step (see above and :func:`frames`).
-    progress : bool or callable
-        Report the time steps done: ``True`` shows a bar (tqdm when installed, in a
-        terminal or a notebook) or a line on stderr at every tenth; a callable is called as
-        ``progress(steps_done, T)``. The same frames, bit for bit.
-
-    Returns
-    -------
-    ndarray (T, n, 3, 3) float64
-
-    Raises
-    ------
-    ValueError
-        As :func:`frames` (the message names the time step), a ``previous`` of another shape
-        than ``(n, 3, 3)`` or not made of rotations, a ``guide`` of another shape.
-    """
-    previous_twist = as_bool(previous_twist, "previous_twist")
-    guide_weight, guide_tolerance = _guide_options(guide_weight, guide_tolerance)
-    guide_sign = as_choice(guide_sign, "guide_sign", ("follow", "free"))
-    progress = checked(progress)
-    chained = previous_twist or guide is not None or lengths is not None or offsets is not None
-    if chained:
-        return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
-                                       reflection, previous, previous_twist, previous_weight,
-                                       guide, guide_weight, guide_tolerance, guide_sign,
-                                       lengths, offsets, progress)
-    method = as_choice(method, "method", METHODS)
-    reflection = as_choice(reflection, "reflection", REFLECTIONS)
-    closed = as_bool(closed, "closed")
-    turns = as_turns(turns, "turns")
-    p, tg, steps, n = _time_steps(points_t, tangents_t)
-    iv, if_ = _orientation(initial, "initial", 1, False)
-    prev = previous_frames(previous, n, "the frames of the step before")
-    flat = (lambda a: None if a is None else np.ascontiguousarray(a.reshape(-1, 3)))
-    try:
-        with Reported(progress, "frames_in_time", "step") as report:
-            options = _shape(method, closed, iv, if_, tangent_chords=reflection == "tangents",
-                             turns=turns)
-            out = _core.frames_in_time(flat(p), flat(tg), steps, options, prev, report.callback)
-    except _core.RepeatedPointsError:
-        if reflection == "tangents":
-            raise
-        # repeated samples: step by step through frames(previous=), which merges them
-        return _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns,
-                                       reflection, previous, False, 1.0, None, 1.0, 1e-3,
-                                       "follow", None, None, progress)
-    return out.reshape(steps, n, 3, 3)
-
-
-def _frames_in_time_chained(points_t, tangents_t, method, initial, closed, turns, reflection,
-                            previous, previous_twist, previous_weight, guide, guide_weight,
-                            guide_tolerance, guide_sign, lengths, offsets,
-                            progress=False) -> np.ndarray:
-    """:func:`frames_in_time` step by step through :func:`frames` (``previous_twist``, a
-    guide, or a bundle), with a ``progress`` report after every step."""
-    p, tg, steps, n = _time_steps(points_t, tangents_t)
-    # by default the previous step weighs 1000 alone, as much as the guide with a guide
-    previous_weight = _previous_weight(previous_weight,
-                                       1000.0 if guide is None else guide_weight)
-    g = None
-    if guide is not None:
-        g = as_float_array(guide, "guide")
-        if g.shape not in ((3,), (n, 3), (steps, n, 3)):
-            raise ValueError(f"guide: expected shape (3,), ({n}, 3) or ({steps}, {n}, 3), "
-                             f"got {g.shape}")
-    if previous is not None:
-        previous = previous_frames(previous, n, "the frames of the step before")
-        if initial is not None:
-            raise ValueError("previous: cannot be combined with initial (the previous frames "
-                             "fix the start)")
-    out = np.empty((steps, n, 3, 3))
-    common = {"method": method, "closed": closed, "turns": turns, "reflection": reflection,
-              "lengths": lengths, "offsets": offsets}
-    with Progress(progress, steps, "frames_in_time", "step") as bar:
-        for k in range(steps):
-            _frames_step(k, p, tg, g, out, previous, guide_sign, initial, guide_weight,
-                         guide_tolerance, previous_twist, previous_weight, common)
-            bar.update(k + 1)
-    return out
-
-
-def _frames_step(k, p, tg, g, out, previous, guide_sign, initial, guide_weight,
-                 guide_tolerance, previous_twist, previous_weight, common) -> None:
-    """Step ``k`` of :func:`_frames_in_time_chained` into ``out[k]``."""
-    pts = p[k] if p is not None else None
-    tgk = tg[k] if tg is not None else None
-    before = out[k - 1] if k else previous
-    try:
-        if g is not None:
-            # the guide and the step before (from the second step on): axes take their signs
-            # from it, directions are followed together with it
-            gk = g[k] if g.ndim == 3 else g
-            out[k] = frames(pts, tgk, initial=None if before is not None else initial,
-                            guide=gk, guide_weight=guide_weight,
-                            guide_tolerance=guide_tolerance, guide_sign=guide_sign,
-                            previous=before, previous_weight=previous_weight, **common)
-        elif before is None:
-            out[k] = frames(pts, tgk, initial=initial, **common)
-        else:
-            out[k] = frames(pts, tgk, previous=before, previous_twist=previous_twist,
-                            guide_weight=previous_weight, **common)
-    except ValueError as exc:
-        msg = str(exc)
-        for arg, name in (("points: ", "points_t"), ("tangents: ", "tangents_t")):
-            if msg.startswith(arg):
-                raise ValueError(f"{name}: time step {k}: {msg[len(arg):]}") from None
-        raise
-
-
-def _time_steps(points_t, tangents_t):
-    """``points_t``, ``tangents_t`` as float arrays ``(T, n, 3)`` (either may be None, not
-    both), and ``T``, ``n``."""
-    p = None if points_t is None else as_float_array(points_t, "points_t")
-    tg = None if tangents_t is None else as_float_array(tangents_t, "tangents_t")
-    ref = p if p is not None else tg
-    if ref is None:
-        raise TypeError("points_t: required")
-    for a, name in ((p, "points_t"), (tg, "tangents_t")):
-        if a is not None and (a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1):
-            raise ValueError(f"{name}: expected shape (T, n, 3), got {a.shape}")
-    if p is not None and tg is not None and p.shape != tg.shape:
-        raise ValueError(f"tangents_t: shape {tg.shape} does not match points_t {p.shape}")
-    return p, tg, ref.shape[0], ref.shape[1]
+    res: np.ndarray = out[p.rows]
+    return res

@@ -10,7 +10,9 @@ again on the rows kept, so clean input pays nothing for this.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -37,7 +39,8 @@ class Plan:
     @property
     def rows(self) -> np.ndarray:
         """For every given row, its row among the kept rows (the kept row it merged into)."""
-        return (np.cumsum(self.keep) - 1)[self.into]
+        rows: np.ndarray = (np.cumsum(self.keep) - 1)[self.into]
+        return rows
 
     @property
     def merged(self) -> bool:
@@ -87,7 +90,7 @@ def as_given(msg: str, p: Plan, offs: np.ndarray) -> str:
         j = int(p.offsets[c]) + int(k)
         return str(int(row_of[j] - offs[c])) if 0 <= j < len(row_of) else k
 
-    def rows(mm: re.Match) -> str:
+    def rows(mm: re.Match[str]) -> str:
         out = mm.group(1) + local(mm.group(2))
         if mm.group(3) and mm.group(4):
             out += mm.group(3) + local(mm.group(4))
@@ -98,8 +101,8 @@ def as_given(msg: str, p: Plan, offs: np.ndarray) -> str:
     return head + _ROWS.sub(rows, tail)
 
 
-def on_rows(call, pts: np.ndarray, offs: np.ndarray, closed: bool, bundle: bool,
-            per_row=(), arg: str = "points"):
+def on_rows(call: Callable[..., Any], pts: np.ndarray, offs: np.ndarray, closed: bool,
+            bundle: bool, per_row: Sequence[np.ndarray | None] = (), arg: str = "points") -> Any:
     """``call(pts, offs, *per_row)``, or, where the core finds repeated samples, the same
     call on the rows kept (``per_row``: other ``(n, …)`` arrays, cut alike, None passed
     through) with its first result spread back over the rows as given: ``(out, rest…)``.
@@ -121,7 +124,8 @@ def on_rows(call, pts: np.ndarray, offs: np.ndarray, closed: bool, bundle: bool,
     return (out, *rest) if isinstance(res, tuple) else out
 
 
-def invalid_curves(points, lengths, offsets, closed: bool):
+def invalid_curves(points: object, lengths: object, offsets: object, closed: bool
+                   ) -> tuple[np.ndarray, ...] | None:
     """The curves of ``points`` (one curve, or a bundle as :func:`spinal.frames` takes it)
     that hold a NaN or an infinity or have too few distinct samples (2; 3 closed), for
     ``on_invalid="skip"``: ``None`` when there are none, else ``(pts, offs, keep_rows,

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 import pathlib
-from typing import Any
+from collections.abc import Sequence
+from typing import Any, Literal, overload
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _files
+from ._types import Array, Float64Array, Int64Array, PointData
 from ._validate import as_float_array
 
 __all__ = ["FoldOverWarning", "Mesh", "SkippedCurvesWarning", "mesh_arrays"]
@@ -20,12 +23,15 @@ class PrecisionWarning(UserWarning):
     profile's smallest edge as swept, so vertices merge or the cross-section is distorted.
     ``spacing`` and ``feature`` hold the two lengths."""
 
-    def __init__(self, message: str, spacing: float, feature: float):
+    spacing: float
+    feature: float
+
+    def __init__(self, message: str, spacing: float, feature: float) -> None:
         super().__init__(message)
         self.spacing = spacing
         self.feature = feature
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         message = self.args[0] if self.args else ""
         return type(self), (message, self.spacing, self.feature), self.__dict__
 
@@ -36,14 +42,19 @@ class FoldOverWarning(UserWarning):
     of all curves back to back); for a bundle ``curves`` holds the curve of each and
     ``rows`` the row within that curve (None for a single spine)."""
 
-    def __init__(self, message: str, indices: np.ndarray, curves: np.ndarray | None = None,
-                 rows: np.ndarray | None = None):
+    indices: Int64Array
+    curves: Int64Array | None
+    rows: Int64Array | None
+
+    def __init__(
+        self, message: str, indices: Int64Array, curves: Int64Array | None = None, rows: Int64Array | None = None
+    ) -> None:
         super().__init__(message)
         self.indices = indices
         self.curves = curves
         self.rows = rows
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         # the default (cls, args, state) would call cls(message) without indices; pickling
         # matters for process pools, which send exceptions (and recorded warnings) back
         message = self.args[0] if self.args else ""
@@ -54,11 +65,13 @@ class SkippedCurvesWarning(UserWarning):
     """A sweep with ``on_short="skip"`` left out curves too short to sweep; ``curves`` holds
     their ids (also in ``Mesh.skipped_curves``)."""
 
-    def __init__(self, message: str, curves: np.ndarray):
+    curves: Int64Array
+
+    def __init__(self, message: str, curves: Int64Array) -> None:
         super().__init__(message)
         self.curves = curves
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         message = self.args[0] if self.args else ""
         return type(self), (message, self.curves), self.__dict__
 
@@ -86,17 +99,18 @@ def volumes_at_scale(F: np.ndarray, reference: np.ndarray, *others: np.ndarray
                for V in (reference, *others)]
 
 
-def mesh_arrays(mesh):
+def mesh_arrays(mesh: object) -> tuple[Float64Array, Int64Array]:
     """``(vertices (V, 3) float64, faces (F, 3) int64)`` of a spinal.Mesh, a trimesh.Trimesh or a
     ``(vertices, faces)`` pair, named ``mesh`` in errors."""
-    if isinstance(mesh, tuple) and len(mesh) == 2:
-        V, F = mesh
-    elif hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
-        V, F = mesh.vertices, mesh.faces
+    given: Any = mesh
+    if isinstance(given, tuple) and len(given) == 2:
+        vertices, faces = given
+    elif hasattr(given, "vertices") and hasattr(given, "faces"):
+        vertices, faces = given.vertices, given.faces
     else:
         raise TypeError("mesh: expected a spinal.Mesh, a trimesh.Trimesh or (vertices, faces)")
-    V = np.ascontiguousarray(as_float_array(V, "mesh"), dtype=np.float64)
-    F = np.asarray(F)
+    V = np.ascontiguousarray(as_float_array(vertices, "mesh"), dtype=np.float64)
+    F = np.asarray(faces)
     if V.ndim != 2 or V.shape[1] != 3:
         raise ValueError(f"mesh: vertices must have shape (n, 3), got {V.shape}")
     if not np.isfinite(V).all():
@@ -111,7 +125,7 @@ def mesh_arrays(mesh):
     return V, F
 
 
-def _as_faces(faces, n: int) -> np.ndarray:
+def _as_faces(faces: Array, n: int) -> np.ndarray:
     """``faces`` as an ``(F, 3)`` int64 (or int32) array with every index in ``0..n``."""
     if isinstance(faces, (str, bytes)):
         raise TypeError(f"faces: expected an (F, 3) array of integers, got {type(faces).__name__}")
@@ -134,11 +148,11 @@ def _as_faces(faces, n: int) -> np.ndarray:
     return F
 
 
-def _rows_or_none(x, name: str, n: int, width: int):
+def _rows_or_none(x: Array | None, name: str, n: int, width: int) -> np.ndarray | None:
     if x is None:
         return None
-    single = isinstance(x, np.ndarray) and x.dtype == np.float32
-    a = x if single else as_float_array(x, name)
+    a = (x if isinstance(x, np.ndarray) and x.dtype == np.float32
+         else as_float_array(x, name))
     if a.shape != (n, width):
         raise ValueError(f"{name}: expected shape ({n}, {width}) (one row per vertex), got "
                          f"{a.shape}")
@@ -146,7 +160,14 @@ def _rows_or_none(x, name: str, n: int, width: int):
     return a
 
 
-def _index_array(x, name: str, n: int | None = None, none: bool = False):
+@overload
+def _index_array(x: Array | None, name: str, n: int | None = None,
+                 none: Literal[False] = False) -> Int64Array: ...
+@overload
+def _index_array(x: Array | None, name: str, n: int | None, none: Literal[True]
+                 ) -> Int64Array | None: ...
+def _index_array(x: Array | None, name: str, n: int | None = None, none: bool = False
+                 ) -> Int64Array | None:
     if x is None:
         return None if none else np.zeros(0, dtype=np.int64)
     a = np.asarray(x)
@@ -159,7 +180,7 @@ def _index_array(x, name: str, n: int | None = None, none: bool = False):
     return a.astype(np.int64, copy=False)
 
 
-def _attributes(data, name: str, n: int) -> dict:
+def _attributes(data: object, name: str, n: int) -> dict[str, np.ndarray]:
     """A dict of ``(n,)`` / ``(n, k)`` numeric arrays (``name`` in errors)."""
     if data is None:
         return {}
@@ -181,7 +202,8 @@ def _rows_of(m: Mesh) -> int:
     """Spine rows a mesh stands for (for offsetting ``sample_of`` when joining)."""
     n = getattr(m, "_n_rows", None)
     if n is not None:
-        return n
+        out: int = n
+        return out
     s = m.sample_of
     return int(s.max()) + 1 if s is not None and len(s) else 0
 
@@ -189,7 +211,8 @@ def _rows_of(m: Mesh) -> int:
 def _curves_of(m: Mesh) -> int:
     n = getattr(m, "_n_curves", None)
     if n is not None:
-        return n
+        out: int = n
+        return out
     c = m.curve_of
     return int(c.max()) + 1 if c is not None and len(c) else 0
 
@@ -228,11 +251,38 @@ class Mesh:
         Curves of a bundle left out by ``on_short="skip"`` (empty when none).
     """
 
-    def __init__(self, vertices, faces, normals=None, uv=None, fold_over=None, *,
-                 point_data=None, cell_data=None, sample_of=None, curve_of=None,
-                 skipped_curves=None):
-        single = isinstance(vertices, np.ndarray) and vertices.dtype == np.float32
-        V = vertices if single else as_float_array(vertices, "vertices")
+    vertices: npt.NDArray[np.float64] | npt.NDArray[np.float32]
+    faces: Int64Array | npt.NDArray[np.int32]
+    normals: Float64Array | None
+    uv: Float64Array | None
+    fold_over: Int64Array
+    point_data: dict[str, npt.NDArray[Any]]
+    skipped_curves: Int64Array
+    # the lazily built layouts of a sweep's mesh
+    _cell_data: dict[str, npt.NDArray[Any]]
+    _curve_id_runs: tuple[np.ndarray, np.ndarray] | None
+    _sample_of: Int64Array | None
+    _curve_of: Int64Array | None
+    _rings: Any  # (ring_sample, ring_curve, cols), a function returning it, or None
+    _n_rows: int | None
+    _n_curves: int | None
+
+    def __init__(
+        self,
+        vertices: Array,
+        faces: Array,
+        normals: Array | None = None,
+        uv: Array | None = None,
+        fold_over: Array | None = None,
+        *,
+        point_data: PointData | None = None,
+        cell_data: PointData | None = None,
+        sample_of: Array | None = None,
+        curve_of: Array | None = None,
+        skipped_curves: Array | None = None,
+    ) -> None:
+        V = (vertices if isinstance(vertices, np.ndarray) and vertices.dtype == np.float32
+             else as_float_array(vertices, "vertices"))
         if V.ndim != 2 or V.shape[1] != 3:
             raise ValueError(f"vertices: expected an array of shape (V, 3), got shape {V.shape}")
         _core.mesh_check_finite(np.ascontiguousarray(V), "vertices")
@@ -250,7 +300,9 @@ class Mesh:
         self.skipped_curves = _index_array(skipped_curves, "skipped_curves")
 
     @classmethod
-    def _of_sweep(cls, vertices, faces, normals, uv, fold_over, rings, rows, curves) -> Mesh:
+    def _of_sweep(cls, vertices: np.ndarray, faces: np.ndarray, normals: np.ndarray | None,
+                  uv: np.ndarray | None, fold_over: Array, rings: Any, rows: int,
+                  curves: int) -> Mesh:
         """A sweep's mesh without the checks (the core built it); ``rings`` is the compact
         vertex layout ``(ring_sample (R,), ring_curve (R,), cols)``: stored ring ``r`` holds
         vertices ``r*cols .. (r+1)*cols`` of spine row ``ring_sample[r]``, curve
@@ -266,7 +318,7 @@ class Mesh:
         return mesh
 
     @property
-    def cell_data(self) -> dict:
+    def cell_data(self) -> dict[str, npt.NDArray[Any]]:
         """Per-face attributes (see the class docstring)."""
         runs = self.__dict__.get("_curve_id_runs")
         if runs is not None:
@@ -275,7 +327,7 @@ class Mesh:
         return self._cell_data
 
     @cell_data.setter
-    def cell_data(self, value) -> None:
+    def cell_data(self, value: dict[str, npt.NDArray[Any]]) -> None:
         self._cell_data, self._curve_id_runs = value, None
 
     def _lazy_curve_id(self, curve_ids: np.ndarray, faces_per_curve: np.ndarray) -> None:
@@ -283,39 +335,42 @@ class Mesh:
         faces, built when ``cell_data`` is first read."""
         self._curve_id_runs = (curve_ids, faces_per_curve)
 
-    def __setstate__(self, state) -> None:
+    def __setstate__(self, state: dict[str, Any]) -> None:
         if "cell_data" in state:  # pickled before cell_data was built on first read
             state["_cell_data"] = state.pop("cell_data")
         self.__dict__.update(state)
 
-    def _ring_arrays(self):
+    def _ring_arrays(self) -> tuple[np.ndarray, np.ndarray, int]:
         """The sweep's ring layout ``(ring_sample, ring_curve, cols)``, built on first use."""
         if callable(self._rings):
             self._rings = self._rings()
-        return self._rings
+        rings: tuple[np.ndarray, np.ndarray, int] = self._rings
+        return rings
 
     @property
-    def sample_of(self) -> np.ndarray | None:
+    def sample_of(self) -> Int64Array | None:
         """The spine row of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._sample_of is None and self._rings is not None:
             rings = self._ring_arrays()
             self._sample_of = np.repeat(rings[0], rings[2])
-        return self._sample_of
+        out: Int64Array | None = self._sample_of
+        return out
 
     @sample_of.setter
-    def sample_of(self, value) -> None:
+    def sample_of(self, value: Int64Array | None) -> None:
         self._sample_of = _index_array(value, "sample_of", len(self.vertices), none=True)
 
     @property
-    def curve_of(self) -> np.ndarray | None:
+    def curve_of(self) -> Int64Array | None:
         """The curve of every vertex, ``(V,)`` int64 (None when not from a sweep)."""
         if self._curve_of is None and self._rings is not None:
             rings = self._ring_arrays()
             self._curve_of = np.repeat(rings[1], rings[2])
-        return self._curve_of
+        out: Int64Array | None = self._curve_of
+        return out
 
     @curve_of.setter
-    def curve_of(self, value) -> None:
+    def curve_of(self, value: Int64Array | None) -> None:
         self._curve_of = _index_array(value, "curve_of", len(self.vertices), none=True)
 
     def __repr__(self) -> str:
@@ -344,7 +399,7 @@ class Mesh:
         keys = ("edges", "boundary", "non_manifold", "inconsistent", "degenerate")
         return dict(zip(keys, _core.mesh_edges(F, len(V))))
 
-    def self_intersections(self, limit: int = 10_000_000) -> np.ndarray:
+    def self_intersections(self, limit: int = 10_000_000) -> npt.NDArray[np.int64]:
         """The pairs of faces that intersect other than along the vertices and edges they
         share: ``(K, 2)`` int64 face indices ``i < j``, sorted (empty for an embedded mesh).
 
@@ -403,7 +458,7 @@ class Mesh:
         return np.ascontiguousarray(V), np.ascontiguousarray(F).reshape(-1, 3)
 
     @staticmethod
-    def concatenate(meshes) -> Mesh:
+    def concatenate(meshes: Sequence[Mesh]) -> Mesh:
         """One mesh of all ``meshes`` (a sequence of :class:`Mesh`), for chunked pipelines:
         vertices stacked, faces offset by the vertices before them. ``normals``/``uv`` are kept
         when every mesh has them; ``point_data``/``cell_data`` keys present in every mesh are
@@ -424,27 +479,27 @@ class Mesh:
         V = np.concatenate([m.vertices for m in meshes])
         nv = np.cumsum([0] + [len(m.vertices) for m in meshes])
         big = nv[-1] > np.iinfo(np.int32).max
-        ftype = np.int64 if big or any(m.faces.dtype == np.int64 for m in meshes) else np.int32
+        ftype: type[np.signedinteger[Any]] = np.int64 if big or any(m.faces.dtype == np.int64 for m in meshes) else np.int32
         F = np.concatenate([m.faces.astype(ftype, copy=False) + ftype(o)
                             for m, o in zip(meshes, nv[:-1])])
 
-        def joined(attr):
+        def joined(attr: str) -> np.ndarray | None:
             parts = [getattr(m, attr) for m in meshes]
             return None if any(p is None for p in parts) else np.concatenate(parts)
 
         rows = np.cumsum([0] + [_rows_of(m) for m in meshes])
         curves = np.cumsum([0] + [_curves_of(m) for m in meshes])
 
-        def shifted(attr, shift):
+        def shifted(attr: str, shift: np.ndarray) -> np.ndarray | None:
             parts = [getattr(m, attr) for m in meshes]
             if any(p is None for p in parts):
                 return None
             return np.concatenate([p + s for p, s in zip(parts, shift)])
 
-        def common(attr, shift_curve):
+        def common(attr: str, shift_curve: bool) -> dict[str, np.ndarray]:
             keys = [k for k in getattr(meshes[0], attr)
                     if all(k in getattr(m, attr) for m in meshes)]
-            out = {}
+            out: dict[str, np.ndarray] = {}
             for k in keys:
                 parts = [getattr(m, attr)[k] for m in meshes]
                 if shift_curve and k == "curve_id":
@@ -469,14 +524,14 @@ class Mesh:
             [m.skipped_curves + s for m, s in zip(meshes, curves)]).astype(np.int64)
         return mesh
 
-    def to_trimesh(self):
+    def to_trimesh(self) -> Any:
         """A ``trimesh.Trimesh`` with the same vertices, faces and normals (no merging or
         reordering; ``uv`` goes to a ``TextureVisuals`` when present, else a ``point_data``
         array ``"colors"`` (RGB(A), as in :meth:`save`) to the vertex colours; ``point_data``
         and ``cell_data`` to ``vertex_attributes`` and ``face_attributes``)."""
         import trimesh
 
-        visual = None
+        visual: Any = None
         if self.uv is not None:
             visual = trimesh.visual.TextureVisuals(uv=self.uv)
         elif "colors" in self.point_data:
@@ -492,7 +547,7 @@ class Mesh:
             face_attributes=dict(self.cell_data),
         )
 
-    def to_pyvista(self):
+    def to_pyvista(self) -> Any:
         """A ``pyvista.PolyData`` with point data ``Normals`` (active normals), the texture
         coordinates ``uv`` and every array of ``point_data``; cell data from ``cell_data``."""
         import pyvista as pv
@@ -511,7 +566,9 @@ class Mesh:
             poly.cell_data[k] = v
         return poly
 
-    def save(self, path: str | os.PathLike, *, colors=None) -> pathlib.Path:
+    def save(
+        self, path: str | os.PathLike[str], *, colors: str | Array | None = None
+    ) -> pathlib.Path:
         """Write the mesh to ``path``; no third-party package is needed. Returns the path.
 
         * ``.ply``: binary little-endian PLY: positions, normals ``nx ny nz`` and texture
@@ -546,7 +603,7 @@ class Mesh:
         return _files.write(self, path, colors)
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> Mesh:
+    def load(cls, path: str | os.PathLike[str]) -> Mesh:
         """Read a triangle mesh: ``.ply``, ``.obj``, ``.stl``, ``.glb``/``.gltf`` and
         ``.off`` through trimesh, ``.vtp``/``.vtk`` through pyvista (polygons are
         triangulated). Normals, texture coordinates, vertex colours (as ``point_data
@@ -556,8 +613,13 @@ class Mesh:
         """
         return cls(**_files.read(path))
 
-    def plot(self, screenshot: str | os.PathLike | None = None, *, window_size=(800, 600),
-             **kwargs: Any):
+    def plot(
+        self,
+        screenshot: str | os.PathLike[str] | None = None,
+        *,
+        window_size: tuple[int, int] = (800, 600),
+        **kwargs: Any,
+    ) -> npt.NDArray[np.uint8] | None:
         """Render with pyvista.
 
         Off-screen (when there is no display, or when ``screenshot`` is given) the image is
@@ -580,7 +642,8 @@ class Mesh:
             img = pl.screenshot(None if screenshot is None else os.fspath(screenshot),
                                 return_img=True)
             pl.close()
-            return img
+            shot: npt.NDArray[np.uint8] = img
+            return shot
         pl.show()
         return None
 

@@ -21,12 +21,18 @@ parallel transport carried in time, as :func:`spinal.frames_in_time` does).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._mesh import FoldOverWarning
 from ._progress import Progress, checked
 from ._validate import as_finite
+
+if TYPE_CHECKING:
+    from ._flesh import SpineBinding
 
 
 def _arc(points: np.ndarray) -> np.ndarray:
@@ -38,10 +44,12 @@ def _point_at(points: np.ndarray, s: np.ndarray, arc: np.ndarray) -> np.ndarray:
     """Points at arc lengths ``s`` along the open polyline (its end edges extended)."""
     k = np.clip(np.searchsorted(arc, s, side="right") - 1, 0, len(points) - 2)
     u = (s - arc[k]) / (arc[k + 1] - arc[k])
-    return points[k] + u[:, None] * (points[k + 1] - points[k])
+    out: np.ndarray = points[k] + u[:, None] * (points[k + 1] - points[k])
+    return out
 
 
-def slid(posed: np.ndarray, ds: float, closed: bool):
+def slid(posed: np.ndarray, ds: float, closed: bool
+         ) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
     """The polyline whose compass walk is that of ``posed`` slid by ``ds``: it starts at the
     point at arc length ``ds`` (rows after it follow; a loop wraps round), and a map of
     positions on it (arc lengths) back to arc lengths on ``posed``."""
@@ -63,12 +71,13 @@ def slid(posed: np.ndarray, ds: float, closed: bool):
     return np.concatenate([x, keep]), (lambda s: s + ds)
 
 
-def as_slide(slide) -> float:
+def as_slide(slide: object) -> float:
     """``slide`` as a finite float (``ValueError``/``TypeError`` naming it)."""
     return as_finite(slide, "slide")
 
 
-def positions(at_q: np.ndarray, q: np.ndarray, back, posed: np.ndarray, closed: bool):
+def positions(at_q: np.ndarray, q: np.ndarray, back: Callable[[np.ndarray], np.ndarray],
+              posed: np.ndarray, closed: bool) -> np.ndarray:
     """Positions ``k + u`` on the slid polyline ``q`` as positions on ``posed`` (clamped to
     its rows, for blending the caller's per-row frames)."""
     ring_q = np.concatenate([q, q[:1]]) if closed else q
@@ -80,20 +89,21 @@ def positions(at_q: np.ndarray, q: np.ndarray, back, posed: np.ndarray, closed: 
     arc = _arc(ring)
     s = np.clip(s, 0.0, arc[-1])
     j = np.clip(np.searchsorted(arc, s, side="right") - 1, 0, len(ring) - 2)
-    return j + (s - arc[j]) / (arc[j + 1] - arc[j])
+    out: np.ndarray = j + (s - arc[j]) / (arc[j + 1] - arc[j])
+    return out
 
 
-def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previous_weight,
-            progress, blend=None) -> np.ndarray:
+def animate(binding: SpineBinding, posed_spines_t: ArrayLike, solution: str,
+            stretchable: bool, twist: float | ArrayLike | None, slide: ArrayLike, previous_weight: object,
+            progress: object, blend: float | None = None) -> np.ndarray:
     """:meth:`spinal.SpineBinding.animate` (see there)."""
     from ._frames import frames
     from ._validate import as_float_array, as_real
 
-    progress = checked(progress)
-    previous_weight = as_real(previous_weight, "previous_weight")
-    if not 0.0 < previous_weight < np.inf:
-        raise ValueError(f"previous_weight: must be a positive finite number, got "
-                         f"{previous_weight}")
+    report = checked(progress)
+    weight = as_real(previous_weight, "previous_weight")
+    if not 0.0 < weight < np.inf:
+        raise ValueError(f"previous_weight: must be a positive finite number, got {weight}")
     P = as_float_array(posed_spines_t, "posed_spines_t")
     if P.ndim != 3 or P.shape[0] < 1:
         raise ValueError(f"posed_spines_t: expected shape (T, m, {binding._dim}) — one posed "
@@ -112,7 +122,7 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
     out = np.empty((steps, len(binding), binding._dim))
     prev = None
     clamped: list[tuple[int, np.ndarray]] = []
-    with Progress(progress, steps, "animate", "pose") as bar:
+    with Progress(report, steps, "animate", "pose") as bar:
         for t in range(steps):
             try:
                 posed, _, _ = binding._posed(P[t], stretchable, float(sl[t]))
@@ -123,13 +133,13 @@ def animate(binding, posed_spines_t, solution, stretchable, twist, slide, previo
                 fr = None
             else:
                 fr = frames(posed, previous=prev, previous_twist=True,
-                            guide_weight=previous_weight, closed=binding._closed)
+                            guide_weight=weight, closed=binding._closed)
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 out[t], prev = binding._apply(posed, fr, solution, twist, False, level=5,
                                               blend=blend)
             for w in caught:
-                if issubclass(w.category, FoldOverWarning):
+                if isinstance(w.message, FoldOverWarning):
                     clamped.append((t, w.message.indices))
                 else:
                     warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

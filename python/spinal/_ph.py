@@ -3,21 +3,34 @@ re-exported there."""
 
 from __future__ import annotations
 
-from math import comb
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core
+from ._ph_bezier import (
+    _finite,
+    _rational_numerators,
+    _section,
+    _straighten,
+    _sweep_patches,
+)
+from ._ph_fit import (
+    _MAX_FIT_SEGMENTS,
+    _REASONS,
+    _dev_curve,
+    _dev_rows,
+    _fixed_knots,
+    _hermite_batch,
+    _initial_knots,
+)
+from ._types import Array, Float64Array, Param
 from ._validate import MAX_SAMPLES, as_bool, as_finite, as_float_array, as_int, as_positive, as_real
 
-
-def _finite(a: np.ndarray, name: str) -> np.ndarray:
-    """Finite values, for the inputs of Python-side computations (the core checks its own)."""
-    if not np.all(np.isfinite(a)):
-        bad = np.argwhere(~np.isfinite(a))[0]
-        raise ValueError(f"{name}: contains non-finite values (at index {tuple(bad.tolist())})")
-    return a
+if TYPE_CHECKING:
+    from ._curves import Curve
+    from ._mesh import Mesh
 
 
 def _vectors(x: Any, name: str, width: int = 3) -> tuple[np.ndarray, bool]:
@@ -40,7 +53,27 @@ def _cubics(x: Any, name: str = "control_points") -> tuple[np.ndarray, bool]:
     raise ValueError(f"{name}: expected shape (4, 3) or (m, 4, 3), got {a.shape}")
 
 
-def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: Literal[False] = False
+) -> Float64Array: ...
+
+
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: Literal[True]
+) -> Float64Array | list[Float64Array]: ...
+
+
+@overload
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: bool = False
+) -> Float64Array | list[Float64Array]: ...
+
+
+def hermite(
+    p0: Array, t0: Array, p1: Array, t1: Array, *, all: bool = False
+) -> Float64Array | list[Float64Array]:
     """G¹ Hermite interpolation by a PH cubic (Mäurer & Jüttler §3.2, Table 1, signed).
 
     Finds the PH cubics from ``p0`` to ``p1`` whose end tangents point along ``t0`` and
@@ -104,7 +137,7 @@ def hermite(p0, t0, p1, t1, *, all: bool = False) -> np.ndarray:
     return lists[0] if single else lists
 
 
-def is_ph(control_points, tol: float = 1e-9):
+def is_ph(control_points: Array, tol: float = 1e-9) -> bool | npt.NDArray[np.bool_]:
     """Control-polygon test for PH cubics (Maurer & Jüttler (17)).
 
     A cubic is PH iff the angles ``θ₁₂ = ∠(d₁, d₂)`` and ``θ₂₃ = ∠(d₂, d₃)`` agree and
@@ -120,7 +153,9 @@ def is_ph(control_points, tol: float = 1e-9):
     return bool(out[0]) if single else out
 
 
-def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = False) -> np.ndarray:
+def from_quaternions(
+    A0: Array, A1: Array, start: Array = (0.0, 0.0, 0.0), *, scalar_first: bool = False
+) -> Float64Array:
     """The PH cubic with the quaternion preimage ``A(v) = A0(1 − v) + A1 v``.
 
     Its hodograph is ``x′(v) = A(v) i A(v)*`` (vector part), so ``σ = |A|²``. Control points
@@ -142,7 +177,9 @@ def from_quaternions(A0, A1, start=(0.0, 0.0, 0.0), *, scalar_first: bool = Fals
     return out[0] if single else out
 
 
-def preimage(control_points, *, scalar_first: bool = False, tol: float = 1e-9):
+def preimage(
+    control_points: Array, *, scalar_first: bool = False, tol: float = 1e-9
+) -> tuple[Float64Array, Float64Array]:
     """Quaternion preimage ``(A0, A1)`` of a PH cubic (inverse of :func:`from_quaternions`).
 
     ``A0`` is the root of ``A i A* = 3d₁`` that rotates ``x̂`` onto ``d₁`` along the shortest
@@ -164,7 +201,7 @@ _INV_KEYS = ("L1", "L2", "L3", "cos_theta", "sin_theta", "delta", "a", "b", "c",
              "kappa_over_tau", "sigma_min", "kappa_max")
 
 
-def invariants(control_points) -> dict:
+def invariants(control_points: Array) -> dict[str, Any]:
     """Scalar invariants of a PH cubic (Mäurer & Jüttler (18), (31); torsion signed by ``Δ``).
 
     Keys: ``L1, L2, L3`` (leg lengths), ``cos_theta, sin_theta`` (``θ = ∠(d₁, d₂)``),
@@ -181,7 +218,7 @@ def invariants(control_points) -> dict:
             for i, k in enumerate(_INV_KEYS)}
 
 
-def evaluate(control_points, v, derivative: int = 0) -> np.ndarray:
+def evaluate(control_points: Array, v: float | Array, derivative: int = 0) -> Float64Array:
     """Points (``derivative=0``) or derivatives ``dᵏx/dvᵏ`` (k ≤ 3) of one cubic at ``v``.
 
     ``control_points`` (4, 3); ``v`` a float or ``(n,)`` in [0, 1]. Returns ``(n, 3)``.
@@ -196,7 +233,7 @@ _FIT_KEYS = ("straight", "omega0", "omega1", "k", "a", "b", "c", "phi", "sg", "l
              "lambda_star", "I_min")
 
 
-def _fit_dict(rows: np.ndarray, single: bool) -> dict:
+def _fit_dict(rows: np.ndarray, single: bool) -> dict[str, Any]:
     d = {key: rows[:, i].copy() for i, key in enumerate(_FIT_KEYS)}
     d["straight"] = d["straight"].astype(bool)
     d["beta"] = rows[:, 12:15].copy()
@@ -210,7 +247,9 @@ def _fit_dict(rows: np.ndarray, single: bool) -> dict:
     return d
 
 
-def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = None) -> dict:
+def angle_fit(
+    control_points: Array, *, omega_start: float = 0.0, phi: float | None = None
+) -> dict[str, Any]:
     """The rational approximation of the RMF angle on one PH cubic (MJ (34)–(41)).
 
     ``Ω(0) = omega_start`` (radians from ``n`` towards ``b``). With ``sg = sign k`` and the
@@ -246,61 +285,7 @@ def angle_fit(control_points, *, omega_start: float = 0.0, phi: float | None = N
 # Bernstein helpers (vectorised over segments: coefficient axis 1)
 
 
-def _bmul(f: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """Product of Bernstein polynomials ``(m, p+1, ...)`` and ``(m, q+1, ...)``."""
-    p, q = f.shape[1] - 1, g.shape[1] - 1
-    while f.ndim < g.ndim:
-        f = f[..., None]
-    while g.ndim < f.ndim:
-        g = g[..., None]
-    shape = np.broadcast_shapes(f[:, :1].shape, g[:, :1].shape)
-    out = np.zeros((shape[0], p + q + 1) + shape[2:])
-    for i in range(p + 1):
-        for j in range(q + 1):
-            out[:, i + j] += comb(p, i) * comb(q, j) / comb(p + q, i + j) * f[:, i] * g[:, j]
-    return out
-
-
-def _elevate(f: np.ndarray, to: int) -> np.ndarray:
-    """Degree elevation along axis 1 up to degree ``to``."""
-    while f.shape[1] - 1 < to:
-        m = f.shape[1]  # new degree
-        g = np.zeros((f.shape[0], m + 1) + f.shape[2:])
-        for i in range(m + 1):
-            a = i / m
-            if i > 0:
-                g[:, i] += a * f[:, i - 1]
-            if i < m:
-                g[:, i] += (1 - a) * f[:, i]
-        f = g
-    return f
-
-
-def _beval(f: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Evaluate Bernstein coefficients ``(p+1, ...)`` at ``v`` (n,) -> ``(n, ...)``."""
-    p = f.shape[0] - 1
-    B = np.stack([comb(p, i) * v**i * (1 - v) ** (p - i) for i in range(p + 1)], axis=1)
-    return np.tensordot(B, f, axes=(1, 0))
-
-
-def _erf_col(k: int, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Symmetric bilinear form of column ``k`` of ``R(A)|A|²`` (scalar-first ``(m, 4)``):
-    ``col(A, A)`` is ``A i A*``, ``A j A*``, ``A k A*`` for k = 0, 1, 2."""
-    w1, x1, y1, z1 = p.T
-    w2, x2, y2, z2 = q.T
-    if k == 0:
-        c = (w1 * w2 + x1 * x2 - y1 * y2 - z1 * z2, x1 * y2 + y1 * x2 + w1 * z2 + z1 * w2,
-             x1 * z2 + z1 * x2 - w1 * y2 - y1 * w2)
-    elif k == 1:
-        c = (x1 * y2 + y1 * x2 - w1 * z2 - z1 * w2, w1 * w2 - x1 * x2 + y1 * y2 - z1 * z2,
-             y1 * z2 + z1 * y2 + w1 * x2 + x1 * w2)
-    else:
-        c = (x1 * z2 + z1 * x2 + w1 * y2 + y1 * w2, y1 * z2 + z1 * y2 - w1 * x2 - x1 * w2,
-             w1 * w2 - x1 * x2 - y1 * y2 + z1 * z2)
-    return np.stack(c, axis=1)
-
-
-def _spline_knots(knots, m: int) -> np.ndarray:
+def _spline_knots(knots: Array | None, m: int) -> np.ndarray:
     """The ``(m + 1,)`` joint parameters of a spline of ``m`` cubics (default ``0 … m``);
     their values are checked by the core (``ph_check_spline``)."""
     if knots is None:
@@ -309,73 +294,6 @@ def _spline_knots(knots, m: int) -> np.ndarray:
     if kn.shape != (m + 1,):
         raise ValueError(f"knots: expected shape ({m + 1},), got {kn.shape}")
     return np.ascontiguousarray(kn)
-
-
-def _rational_numerators(fit: dict) -> dict:
-    """Bernstein numerators of the rational RMF of bent cubics from :func:`angle_fit` data
-    (see :meth:`PHSpline.rational_frames`): ``f2, f3`` (m, 7, 3), ``weight`` (m, 7),
-    ``tangent`` (m, 3, 3) and ``speed`` (m, 3)."""
-    A0, A1 = fit["preimage"][:, 0], fit["preimage"][:, 1]
-    cols = [np.stack([_erf_col(k, A0, A0), _erf_col(k, A0, A1), _erf_col(k, A1, A1)], 1)
-            for k in range(3)]                      # each (m, 3 coefficients, 3)
-    speed = np.stack([(A0 * A0).sum(1), (A0 * A1).sum(1), (A1 * A1).sum(1)], axis=1)
-    psi = fit["erf_angle"] + fit["phi"]
-    cp_, sp_ = np.cos(psi)[:, None, None], np.sin(psi)[:, None, None]
-    e2 = cp_ * cols[1] + sp_ * cols[2]
-    e3 = cp_ * cols[2] - sp_ * cols[1]
-    G = fit["sg"][:, None] * fit["gamma"]
-    B = fit["beta"]
-    GB2 = 2 * _bmul(G, B)
-    BG = _bmul(B, B) - _bmul(G, G)
-    return {"f2": _bmul(GB2, e3) + _bmul(BG, e2), "f3": _bmul(BG, e3) - _bmul(GB2, e2),
-            "weight": _bmul(speed, _bmul(B, B) + _bmul(G, G)), "tangent": cols[0],
-            "speed": speed}
-
-
-def _straighten(rf: dict, st: np.ndarray, cp: np.ndarray, r: np.ndarray) -> None:
-    """Overwrite the rows ``st`` (a boolean mask) of ``rf`` — the straight cubics ``cp``
-    (k, 4, 3) — with constant numerators: ``r`` (k, 3) the reference vectors, weight 1, and
-    the polynomial tangent ``3d`` with its speed."""
-    d = np.diff(cp, axis=1)
-    t = d[:, 0] / np.linalg.norm(d[:, 0], axis=1)[:, None]
-    rf["f2"][st] = r[:, None, :]
-    rf["f3"][st] = np.cross(t, r)[:, None, :]
-    rf["weight"][st] = 1.0
-    L = np.linalg.norm(d, axis=2)
-    rf["tangent"][st] = 3 * d
-    rf["speed"][st] = 3 * np.stack([L[:, 0], np.einsum("ij,ij->i", d[:, 0], d[:, 1]) / L[:, 0],
-                                    L[:, 2]], axis=1)
-
-
-def _section(section_ctrl, section_weights) -> tuple[np.ndarray, np.ndarray]:
-    """Cross-section control points ``(m + 1, 2)`` and their positive weights."""
-    c = _finite(as_float_array(section_ctrl, "section_ctrl"), "section_ctrl")
-    if c.ndim != 2 or c.shape[1] != 2 or c.shape[0] < 1:
-        raise ValueError(f"section_ctrl: expected shape (m + 1, 2), got {c.shape}")
-    if section_weights is None:
-        return c, np.ones(c.shape[0])
-    wj = _finite(as_float_array(section_weights, "section_weights"), "section_weights")
-    if wj.shape != (c.shape[0],):
-        raise ValueError(f"section_weights: expected shape ({c.shape[0]},), got "
-                         f"{wj.shape}")
-    if not np.all(wj > 0):
-        raise ValueError("section_weights: must be positive")
-    return c, wj
-
-
-def _sweep_patches(cp: np.ndarray, rf: dict, c: np.ndarray, wj: np.ndarray) -> np.ndarray:
-    """Homogeneous control points ``(segments, 10, m + 1, 4)`` of the rational sweep of the
-    section ``(c, wj)`` along cubics ``cp`` with the rational frame ``rf``."""
-    om = _elevate(rf["weight"], 9)                    # (m, 10)
-    xom = _bmul(cp, rf["weight"])                     # (m, 10, 3)
-    F2 = _elevate(rf["f2"], 9)
-    F3 = _elevate(rf["f3"], 9)
-    C0, C2, C3 = wj, wj * c[:, 0], wj * c[:, 1]
-    num = (xom[:, :, None, :] * C0[None, None, :, None]
-           + F2[:, :, None, :] * C2[None, None, :, None]
-           + F3[:, :, None, :] * C3[None, None, :, None])
-    wt = om[:, :, None] * C0[None, None, :]
-    return np.concatenate([num, wt[..., None]], axis=3)
 
 
 class PHSpline:
@@ -397,7 +315,9 @@ class PHSpline:
     also sets :attr:`deviation` (per segment, the largest distance to the input).
     """
 
-    def __init__(self, control_points, knots=None):
+    deviation: Float64Array | None
+
+    def __init__(self, control_points: Array, knots: Array | None = None) -> None:
         cp, _ = _cubics(control_points)
         kn = _spline_knots(knots, cp.shape[0])
         # no cubics, non-finite values, knots not increasing, gaps, not PH, not G¹
@@ -421,19 +341,20 @@ class PHSpline:
 
     # -- geometry -----------------------------------------------------------------------
     @property
-    def control_points(self) -> np.ndarray:
+    def control_points(self) -> Float64Array:
         """``(m, 4, 3)`` control points (read-only)."""
         return self._cp
 
     @property
-    def knots(self) -> np.ndarray:
+    def knots(self) -> Float64Array:
         """``(m + 1,)`` joint parameters (read-only)."""
         return self._knots
 
     @property
     def segments(self) -> int:
         """The number ``m`` of PH cubics; the spline parameter ``s`` runs over ``[0, m]``."""
-        return self._cp.shape[0]
+        out: int = self._cp.shape[0]
+        return out
 
     def __len__(self) -> int:
         return self.segments
@@ -441,13 +362,13 @@ class PHSpline:
     def __repr__(self) -> str:
         return f"PHSpline(segments={self.segments})"
 
-    def _s(self, s) -> np.ndarray:
+    def _s(self, s: Param) -> np.ndarray:
         a = as_float_array(s, "s")
         if a.ndim > 1:
             raise ValueError(f"s: expected a scalar or a 1-D array, got shape {a.shape}")
         return np.ascontiguousarray(np.atleast_1d(a))  # values: the core (finite, in [0, m])
 
-    def samples(self, n_per_segment: int = 16) -> np.ndarray:
+    def samples(self, n_per_segment: int = 16) -> Float64Array:
         """``m·n + 1`` uniformly spaced spline parameters ``s`` (the joints included)."""
         most = max(1, (MAX_SAMPLES - 1) // self.segments)
         n = as_int(n_per_segment, "n_per_segment", 1, most, out_of_bounds=lambda x: (
@@ -455,25 +376,26 @@ class PHSpline:
             f"{MAX_SAMPLES:,} samples), got {x}"))
         return np.linspace(0.0, self.segments, self.segments * n + 1)
 
-    def parameter(self, u) -> np.ndarray:
+    def parameter(self, u: float | Array) -> Float64Array:
         """Spline parameters ``s`` of curve parameters ``u`` (linear between the knots)."""
         a = np.atleast_1d(_finite(as_float_array(u, "u"), "u"))
         k = self._knots
         if np.any((a < k[0]) | (a > k[-1])):
             raise ValueError(f"u: values must lie within [{k[0]}, {k[-1]}]")
-        return np.interp(a, k, np.arange(self.segments + 1, dtype=float))
+        out: Float64Array = np.interp(a, k, np.arange(self.segments + 1, dtype=float))
+        return out
 
-    def evaluate(self, s, derivative: int = 0) -> np.ndarray:
+    def evaluate(self, s: float | Array, derivative: int = 0) -> Float64Array:
         """Points (or derivatives with respect to the local ``v``) at ``s``, ``(n, 3)``."""
         d = as_int(derivative, "derivative", minimum=0)  # <= 3: the core
         return _core.ph_eval(self._cp, self._s(s), d)
 
-    def points(self, n_per_segment: int = 16) -> np.ndarray:
+    def points(self, n_per_segment: int = 16) -> Float64Array:
         """Points at :meth:`samples` ``(m·n + 1, 3)``."""
         return self.evaluate(self.samples(n_per_segment))
 
     # -- frames -------------------------------------------------------------------------
-    def _initial(self, initial):
+    def _initial(self, initial: Array | None) -> np.ndarray | None:
         if initial is None:
             return None
         r = as_float_array(initial, "initial")
@@ -481,21 +403,30 @@ class PHSpline:
             raise ValueError(f"initial: expected shape (3,), got {r.shape}")
         return np.ascontiguousarray(r)
 
-    def _frames(self, s, mode, initial, omega_start):
+    def _frames(self, s: Param, mode: str, initial: Array | None, omega_start: float
+                ) -> tuple[Float64Array, Float64Array]:
         om = as_finite(omega_start, "omega_start")
         return _core.ph_frames(self._cp, self._s(s), mode, self._initial(initial), om, None)
 
-    def frenet(self, s) -> np.ndarray:
+    def frenet(self, s: float | Array) -> Float64Array:
         """Rational Frenet frames ``(n, 3, 3)``, columns ``(n, b, t)``: ``t = x′/σ``,
         ``b ∥ x′ × x″``, ``n = b × t`` (MJ (19)). Evaluated as the Euler–Rodrigues frame of the
         quaternion preimage (columns of the rotation ``A(v)/|A(v)|``), which on a PH cubic is
         the Frenet frame turned by a constant angle — well conditioned where ``x′ × x″`` is
         tiny. On straight cubics (no Frenet frame) the reference vector of :meth:`rmf` is
         used."""
-        return self._frames(s, "frenet", None, 0.0)[0]
+        out: Float64Array = self._frames(s, "frenet", None, 0.0)[0]
+        return out
 
-    def rmf(self, s=None, *, initial=None, exact: bool = False, omega_start: float = 0.0,
-            n_per_segment: int = 16) -> np.ndarray:
+    def rmf(
+        self,
+        s: float | Array | None = None,
+        *,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+        n_per_segment: int = 16,
+    ) -> Float64Array:
         """Rotation-minimising frames ``(n, 3, 3)`` (columns ``r, s, t``) at ``s``.
 
         ``exact=True``: the RMF of the PH spline, ``r = sin Ω b + cos Ω n`` with the closed
@@ -511,24 +442,36 @@ class PHSpline:
         if s is None:
             s = self.samples(n_per_segment)
         mode = "exact" if as_bool(exact, "exact") else "rational"
-        return self._frames(s, mode, initial, omega_start)[0]
+        out: Float64Array = self._frames(s, mode, initial, omega_start)[0]
+        return out
 
-    def angle(self, s, *, initial=None, exact: bool = False, omega_start: float = 0.0
-              ) -> np.ndarray:
+    def angle(
+        self,
+        s: float | Array,
+        *,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+    ) -> Float64Array:
         """The angle of :meth:`rmf`'s ``r`` at ``s``, radians from ``n`` towards ``b`` of
         the local cubic: ``Ω̃`` (rational, default) or ``Ω`` (``exact=True``). Per cubic, not
         unwrapped across joints; 0 on straight cubics."""
         mode = "exact" if as_bool(exact, "exact") else "rational"
-        return self._frames(s, mode, initial, omega_start)[1]
+        out: Float64Array = self._frames(s, mode, initial, omega_start)[1]
+        return out
 
-    def angle_fit(self, *, initial=None, omega_start: float = 0.0) -> dict:
+    def angle_fit(
+        self, *, initial: Array | None = None, omega_start: float = 0.0
+    ) -> dict[str, Any]:
         """Per-cubic data of the rational angle function (see :func:`angle_fit`; the start
         as in :meth:`rmf`). Values are ``(m,)`` arrays, ``beta``/``gamma`` ``(m, 3)``."""
         om = as_finite(omega_start, "omega_start")
         rows = _core.ph_frame_setup(self._cp, self._initial(initial), om, None)
         return _fit_dict(rows, False)
 
-    def rational_frames(self, *, initial=None, omega_start: float = 0.0) -> dict:
+    def rational_frames(
+        self, *, initial: Array | None = None, omega_start: float = 0.0
+    ) -> dict[str, Float64Array]:
         """Bernstein coefficients of the rational RMF, per cubic (MJ (29), rotated pair).
 
         MJ write the frame with the Frenet numerators ``n̂ = σx″ − σ′x′``, ``b̂ = x′ × x″``
@@ -555,8 +498,14 @@ class PHSpline:
             _straighten(rf, st, self._cp[st], r)
         return rf
 
-    def surface(self, section_ctrl, section_weights=None, *, initial=None,
-                omega_start: float = 0.0) -> np.ndarray:
+    def surface(
+        self,
+        section_ctrl: Array,
+        section_weights: Array | None = None,
+        *,
+        initial: Array | None = None,
+        omega_start: float = 0.0,
+    ) -> Float64Array:
         """Rational Bézier sweep surface, one homogeneous patch per cubic (MJ (42), corrected).
 
         ``s(u, v) = x(v) + c₂(u) f₂(v) + c₃(u) f₃(v)`` with the rational frame of
@@ -574,8 +523,16 @@ class PHSpline:
         rf = self.rational_frames(initial=initial, omega_start=omega_start)
         return _sweep_patches(self._cp, rf, c, wj)
 
-    def sweep(self, profile, *, n_per_segment: int = 16, initial=None, exact: bool = False,
-              omega_start: float = 0.0, **kwargs):
+    def sweep(
+        self,
+        profile: Array,
+        *,
+        n_per_segment: int = 16,
+        initial: Array | None = None,
+        exact: bool = False,
+        omega_start: float = 0.0,
+        **kwargs: Any,
+    ) -> Mesh:
         """A triangle mesh of a profile swept along the spline: :func:`spinal.sweep` on the
         points :meth:`points` ``(n_per_segment)`` with the frames :meth:`rmf` (rational by
         default, the frame of :meth:`surface`). ``kwargs`` go to :func:`spinal.sweep`
@@ -590,187 +547,17 @@ class PHSpline:
 # ---------------------------------------------------------------------------------------
 # Curve -> G¹ PH spline (Mäurer & Jüttler end of §3.2; the adaptive splitting is ours)
 
-_REASONS = {
-    1: "no PH cubic: the end tangents are parallel but the chord is not along them",
-    2: "no PH cubic: the end tangents are antiparallel and the chord is along them",
-    3: "no PH cubic interpolates the data (an inflection or S-shape inside the interval)",
-    4: "no PH cubic interpolates the data (only reversed polygons: an inflection or "
-       "S-shape inside the interval)",
-}
 
-
-def _bez(cp: np.ndarray, v: np.ndarray, k: int = 0) -> np.ndarray:
-    """Points (k = 0) or derivatives of cubics ``cp (q, 4, 3)`` at ``v (q, r)`` -> (q, r, 3)."""
-    v = v[..., None]
-    u = 1 - v
-    b0, b1, b2, b3 = (cp[:, None, i] for i in range(4))
-    if k == 0:
-        return u**3 * b0 + 3 * u**2 * v * b1 + 3 * u * v**2 * b2 + v**3 * b3
-    if k == 1:
-        return 3 * (u**2 * (b1 - b0) + 2 * u * v * (b2 - b1) + v**2 * (b3 - b2))
-    return 6 * (u * (b2 - 2 * b1 + b0) + v * (b3 - 2 * b2 + b1))
-
-
-def _hermite_batch(p0, t0, p1, t1):
-    """Best candidate per row (q, 4, 3) and reason codes (0 = solved)."""
-    try:
-        cand, counts, codes = _core.ph_hermite(
-            np.ascontiguousarray(p0), np.ascontiguousarray(t0), np.ascontiguousarray(p1),
-            np.ascontiguousarray(t1), True, True)
-    except ValueError as exc:  # a zero or non-finite tangent, a repeated point
-        raise ValueError(f"curve: bad Hermite data at an interval end (rows are intervals): "
-                         f"{exc}") from None
-    return cand.reshape(-1, 2, 4, 3)[:, 0], counts, codes
-
-
-def _dev_curve(curve, cp, ta, tb, lo, hi) -> np.ndarray:
-    """Max distance from 41 points of each cubic to the curve arc over [ta, tb] (per row),
-    in blocks of 1024 rows (the scan needs 64 kB per row)."""
-    if cp.shape[0] > 1024:
-        return np.concatenate([_dev_curve(curve, cp[i:i + 1024], ta[i:i + 1024],
-                                          tb[i:i + 1024], lo, hi)
-                               for i in range(0, cp.shape[0], 1024)])
-    q = cp.shape[0]
-    v = np.broadcast_to(np.linspace(0, 1, 41), (q, 41))
-    X = _bez(cp, v)
-    h = tb - ta
-    a = np.maximum(ta - 0.1 * h, lo)
-    b = np.minimum(tb + 0.1 * h, hi)
-    # coarse scan of the enlarged interval, then Newton on (p(u) − X)·p′(u) = 0
-    scan = a[:, None] + (b - a)[:, None] * np.linspace(0, 1, 65)
-    P = curve.point(scan.ravel()).reshape(q, 65, 3)
-    d2 = ((X[:, :, None, :] - P[:, None, :, :]) ** 2).sum(-1)
-    u = np.take_along_axis(scan, d2.argmin(axis=2), axis=1)
-    for _ in range(12):
-        flat = u.ravel()
-        p, d1, dd = (f(flat).reshape(q, 41, 3) for f in (curve.point, curve.d1, curve.d2))
-        e = p - X
-        g = (e * d1).sum(-1)
-        gp = (d1 * d1).sum(-1) + (e * dd).sum(-1)
-        step = np.where(gp > 0, g / np.where(gp > 0, gp, 1.0), 0.0)
-        u = np.clip(u - step, a[:, None], b[:, None])
-    dist = np.linalg.norm(curve.point(u.ravel()).reshape(q, 41, 3) - X, axis=-1)
-    return dist.max(axis=1)
-
-
-def _dev_rows(cp: np.ndarray, pts: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
-    """Max distance from the rows ia..ib of ``pts`` to each cubic (Newton on v), in blocks
-    of 8192 rows (every row is projected on its own, so the blocks give the same bits; each
-    NumPy step stays short enough for Ctrl-C to be handled between them)."""
-    out = np.zeros(cp.shape[0])
-    vs = np.linspace(0, 1, 33)
-    for j in range(cp.shape[0]):
-        c = cp[j: j + 1]
-        S = _bez(c, vs[None])[0]
-        for k in range(ia[j], ib[j] + 1, 8192):
-            X = pts[k: min(k + 8192, ib[j] + 1)][None]
-            v = vs[((X[0, :, None, :] - S[None]) ** 2).sum(-1).argmin(axis=1)][None]
-            for _ in range(12):
-                e = _bez(c, v) - X
-                d1, dd = _bez(c, v, 1), _bez(c, v, 2)
-                g = (e * d1).sum(-1)
-                gp = (d1 * d1).sum(-1) + (e * dd).sum(-1)
-                v = np.clip(v - np.where(gp > 0, g / np.where(gp > 0, gp, 1.0), 0.0), 0, 1)
-            out[j] = np.maximum(out[j], np.linalg.norm(_bez(c, v) - X, axis=-1).max())
-    return out
-
-
-def _inflections(curve, lo: float, hi: float, n: int, diag: float) -> list[float]:
-    """Parameters where κ has a local minimum with κ·diag < 1e-6 (golden-section refined)."""
-    u = np.linspace(lo, hi, n)
-    k = curve.curvature(u)
-    out = []
-    g = (np.sqrt(5) - 1) / 2
-    for i in np.flatnonzero((k[1:-1] <= k[:-2]) & (k[1:-1] <= k[2:])) + 1:
-        a, b = u[i - 1], u[i + 1]
-        while b - a > 1e-12 * (hi - lo):
-            x1, x2 = b - g * (b - a), a + g * (b - a)
-            k1, k2 = curve.curvature(np.array([x1, x2]))
-            if k1 <= k2:
-                b = x2
-            else:
-                a = x1
-        m = (a + b) / 2
-        if curve.curvature(np.array([m]))[0] * diag < 1e-6:
-            if out and m - out[-1] <= 1e-6 * (hi - lo):  # two scan minima, one inflection
-                out[-1] = (out[-1] + m) / 2
-            else:
-                out.append(float(m))
-    return out
-
-
-def _initial_knots(curve, pts, data, analytic: bool, lo: float, hi: float,
-                   diag: float) -> np.ndarray:
-    """Starting knots of the adaptive fit: uniform (4 intervals of a curve, every ⌈n/8⌉-th
-    row of samples), the inflections (κ minima with κ·diag < 1e-6, or rows where the
-    discrete binormal flips), then intervals halved until the tangent turns by less than
-    π/2 on each (8-point scan)."""
-    if analytic:
-        h_min = 1e-6 * (hi - lo)
-        infl = [x for x in _inflections(curve, lo, hi, 256, diag)
-                if lo + h_min < x < hi - h_min]
-        # uniform knots give way to nearby inflections (no sliver intervals)
-        k = {x for x in np.linspace(lo, hi, 5).tolist()
-             if x in (lo, hi) or all(abs(x - y) > h_min for y in infl)}
-        k.update(infl)
-    else:
-        n = pts.shape[0]
-        k = set(np.arange(0, n - 1, max(1, -(-n // 8))).tolist()) | {float(n - 1)}
-        d = np.diff(pts, axis=0)
-        bn = np.cross(d[:-1], d[1:])
-        bl = np.linalg.norm(bn, axis=1)
-        ok = bl > 1e-12 * np.linalg.norm(d[:-1], axis=1) * np.linalg.norm(d[1:], axis=1)
-        bn = bn / np.where(ok, bl, 1.0)[:, None]
-        for j in range(len(bn) - 1):
-            if ok[j] and ok[j + 1] and bn[j] @ bn[j + 1] < 0:  # rows j+1 and j+2
-                k.add(float(j + 1 if bl[j] <= bl[j + 1] else j + 2))
-        h_min = 1.0
-    k = np.array(sorted(k))
-    for _ in range(64):
-        sub = k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.linspace(0, 1, 9)
-        if not analytic:
-            sub = np.round(sub)
-        t0 = data(k[:-1])[1]
-        ts = data(sub.ravel())[1].reshape(sub.shape[0], 9, 3)
-        turn = (ts * t0[:, None]).sum(-1).min(axis=1) <= 0
-        split = turn & (np.diff(k) > h_min)
-        if not split.any():
-            break
-        mid = (k[:-1] + k[1:])[split] / 2
-        k = np.union1d(k, np.floor(mid) if not analytic else mid)
-    return k
-
-
-#: The largest ``segments`` of :func:`fit` (the knots, the Hermite data and the cubics are
-#: held at once; 10**7 intervals exhausted the memory).
-_MAX_FIT_SEGMENTS = 100_000
-
-
-def _fixed_knots(segments, knots, analytic: bool, lo: float, hi: float):
-    """The knots of a fit with ``segments`` uniform intervals or explicit ``knots``, and the
-    name of the argument that set them."""
-    if segments is not None:
-        N = as_int(segments, "segments", minimum=1)
-        if N > _MAX_FIT_SEGMENTS:  # the deviation needs (N, 41, 65, 3) temporaries
-            raise ValueError(f"segments: must be <= {_MAX_FIT_SEGMENTS}, got {N}")
-        k = np.linspace(lo, hi, N + 1)
-        if not analytic:
-            k = np.unique(np.round(k))
-            if k.size != N + 1:
-                raise ValueError(f"segments: {N} intervals need at least {N + 1} samples")
-        return k, "segments"
-    k = _finite(as_float_array(knots, "knots"), "knots")
-    if k.ndim != 1 or k.size < 2 or not np.all(np.diff(k) > 0):
-        raise ValueError("knots: expected a strictly increasing 1-D array of >= 2 values")
-    if k[0] < lo or k[-1] > hi:
-        raise ValueError(f"knots: must lie within [{lo:g}, {hi:g}]")
-    if not analytic and not np.all(k == np.round(k)):
-        raise ValueError("knots: sample knots must be integer rows")
-    return k, "knots"
-
-
-def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=None,
-        max_segments: int = 4096) -> PHSpline:
+def fit(
+    curve: Curve | Array,
+    *,
+    tol: float | None = None,
+    segments: int | None = None,
+    knots: Array | None = None,
+    tangents: Array | None = None,
+    domain: tuple[float, float] | None = None,
+    max_segments: int = 4096,
+) -> PHSpline:
     """Convert a curve into a G¹ spline of PH cubics (Mäurer & Jüttler §3.2, Theorem 10).
 
     Each interval ``[kᵢ, kᵢ₊₁]`` of the knots gets the PH cubic of :func:`hermite` through
@@ -827,18 +614,19 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         raise TypeError("tol, segments, knots: pass at most one of them")
     max_segments = as_int(max_segments, "max_segments", 1, _MAX_FIT_SEGMENTS)
     analytic = isinstance(curve, Curve)
-    if analytic:
+    shape = curve if isinstance(curve, Curve) else None  # the analytic curve
+    pts: np.ndarray | None = None  # the samples
+    if isinstance(curve, Curve):
         if tangents is not None:
             raise TypeError("tangents: not accepted with an analytic curve (exact tangents)")
         lo, hi = curve.domain if domain is None else domain
         lo, hi = float(lo), float(hi)
         if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
             raise ValueError(f"domain: expected a finite interval (lo, hi), got {domain!r}")
-        pts = None
         probe = curve.point(np.linspace(lo, hi, 257))
         diag = float(np.linalg.norm(probe.max(0) - probe.min(0)))
 
-        def data(k):
+        def data(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             return curve.point(k), curve.tangent(k)
     else:
         if domain is not None:
@@ -865,11 +653,11 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         lo, hi = 0.0, float(n - 1)
         diag = float(np.linalg.norm(pts.max(0) - pts.min(0)))
 
-        def data(k):
+        def data(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             i = k.astype(np.intp)
             return pts[i], T[i]
 
-    def solve(k, what):
+    def solve(k: np.ndarray, what: str) -> np.ndarray:
         p, t = data(k)
         cp, counts, codes = _hermite_batch(p[:-1], t[:-1], p[1:], t[1:])
         bad = np.flatnonzero(counts == 0)
@@ -879,10 +667,17 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
                              f"{_REASONS[int(codes[i])]}; split it or move the knots")
         return cp
 
-    def deviation(cp, k):
-        if analytic:
-            return _dev_curve(curve, cp, k[:-1], k[1:], lo, hi)
+    def deviation(cp: np.ndarray, k: np.ndarray) -> np.ndarray:
+        if shape is not None:
+            return _dev_curve(shape, cp, k[:-1], k[1:], lo, hi)
+        assert pts is not None  # samples when not analytic
         return _dev_rows(cp, pts, k[:-1].astype(np.intp), k[1:].astype(np.intp))
+
+    def deviation_between(cp: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        if shape is not None:
+            return _dev_curve(shape, cp, a, b, lo, hi)
+        assert pts is not None  # samples when not analytic
+        return _dev_rows(cp, pts, a.astype(np.intp), b.astype(np.intp))
 
     if segments is not None or knots is not None:
         k, what = _fixed_knots(segments, knots, analytic, lo, hi)
@@ -892,7 +687,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         return sp
 
     tol = 1e-5 * diag if tol is None else as_positive(tol, "tol")
-    k = _initial_knots(curve, pts, data, analytic, lo, hi, diag)
+    k = _initial_knots(shape, pts, data, lo, hi, diag)
     h_min = 1e-6 * (hi - lo) if analytic else 1.0
     # work queue, processed in batches
     pending = [(k[i], k[i + 1]) for i in range(len(k) - 1)]
@@ -906,8 +701,7 @@ def fit(curve, *, tol=None, segments=None, knots=None, tangents=None, domain=Non
         dev = np.full(a.size, np.inf)
         okr = counts > 0
         if okr.any():
-            dev_ok = (_dev_curve(curve, cp[okr], a[okr], b[okr], lo, hi) if analytic else
-                      _dev_rows(cp[okr], pts, a[okr].astype(np.intp), b[okr].astype(np.intp)))
+            dev_ok = deviation_between(cp[okr], a[okr], b[okr])
             dev[okr] = dev_ok
         pending = []
         for j in range(a.size):

@@ -45,11 +45,14 @@ everywhere (turned by π more: ``K < 0``); for ``δ ≥ π`` no turn avoids para
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal, TypeAlias
 
 import numpy as np
+import numpy.typing as npt
 
 from ._frames import estimate_tangents
 from ._frames import frames as _frames
+from ._types import Array, Float64Array
 from ._validate import (
     MAX_SAMPLES,
     as_bool,
@@ -60,6 +63,10 @@ from ._validate import (
     as_points,
 )
 from .curves import Curve
+
+if TYPE_CHECKING:
+    from ._mesh import Mesh
+    from ._ph import PHSpline
 
 __all__ = ["ProfileSurface", "profile_surface"]
 
@@ -153,35 +160,35 @@ class ProfileSurface:
         join the profile's last sample to its first).
     """
 
-    u: np.ndarray
-    v: np.ndarray
-    points: np.ndarray
-    normals: np.ndarray
-    frames: np.ndarray
-    spine_curvature: np.ndarray
-    profile_tangents: np.ndarray
-    profile_curvature: np.ndarray
-    mu: np.ndarray
-    curvature_u: np.ndarray
-    curvature_v: np.ndarray
-    k1: np.ndarray
-    k2: np.ndarray
-    d1: np.ndarray
-    d2: np.ndarray
-    gaussian: np.ndarray
-    mean: np.ndarray
-    parabolic_sign: np.ndarray
-    singular_points: np.ndarray
+    u: Float64Array
+    v: Float64Array
+    points: Float64Array
+    normals: Float64Array
+    frames: Float64Array
+    spine_curvature: Float64Array
+    profile_tangents: Float64Array
+    profile_curvature: Float64Array
+    mu: Float64Array
+    curvature_u: Float64Array
+    curvature_v: Float64Array
+    k1: Float64Array
+    k2: Float64Array
+    d1: Float64Array
+    d2: Float64Array
+    gaussian: Float64Array
+    mean: Float64Array
+    parabolic_sign: npt.NDArray[np.int8]
+    singular_points: Float64Array
     singularity_free: bool
     convex: bool
     profile_turning: float
     frame_turning: float
     convexity_criterion: bool
-    convex_turns: np.ndarray | None
+    convex_turns: Float64Array | None
     closed: bool
     profile_closed: bool
 
-    def parabolic_lines(self, space: str = "parameters") -> list[np.ndarray]:
+    def parabolic_lines(self, space: Literal["parameters", "points"] = "parameters") -> list[Float64Array]:
         """The parabolic lines (``K = 0``, MJ (14) and §2.3) as polylines.
 
         Marching squares on the sample grid of ``K μ = −κ_c κ cos ϑ`` (the zeros of ``K``
@@ -217,14 +224,15 @@ class ProfileSurface:
         for fi, fj in lines:
             if space == "parameters":
                 pu = np.interp(fi, np.arange(nu), self.u)
-                vx = np.r_[self.v, self._v_end] if self.profile_closed else self.v
+                v_end: float | None = getattr(self, "_v_end")  # noqa: B009 (set by profile_surface)
+                vx = np.r_[self.v, v_end] if self.profile_closed else self.v
                 pv = np.interp(fj, np.arange(len(vx)), vx)
                 out.append(np.stack([pu, pv], axis=1))
             else:
                 out.append(_bilinear(self.points, fi, fj, self.profile_closed))
         return out
 
-    def mesh(self):
+    def mesh(self) -> Mesh:
         """The sample grid as a :class:`spinal.Mesh` with the surface's normals.
 
         Vertex ``i·nv + j`` is ``points[i, j]`` (so ``field.ravel()`` of any ``(nu, nv)``
@@ -245,7 +253,7 @@ class ProfileSurface:
         faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
                                 np.stack([b, d, c], -1).reshape(-1, 3)])
         uv = np.stack(np.meshgrid(self.u, self.v, indexing="ij"), -1).reshape(-1, 2)
-        data = {k: np.array(getattr(self, k)).reshape(-1)
+        data: dict[str, Array] = {k: np.array(getattr(self, k)).reshape(-1)
                 for k in ("gaussian", "mean", "k1", "k2", "mu", "parabolic_sign")}
         return Mesh(self.points.reshape(-1, 3), faces, self.normals.reshape(-1, 3), uv,
                     point_data=data)
@@ -255,8 +263,17 @@ class ProfileSurface:
 # the function
 
 
-def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None,
-                    closed: bool = False, profile_closed: bool = False) -> ProfileSurface:
+def profile_surface(
+    spine: Array | Curve | PHSpline,
+    profile: Array | Curve,
+    u: int | Array | None = None,
+    v: int | Array | None = None,
+    *,
+    frames: Array | None = None,
+    initial: Array | None = None,
+    closed: bool = False,
+    profile_closed: bool = False,
+) -> ProfileSurface:
     r"""Normals, principal curvatures, parabolic lines, singular points and convexity of the
     profile (moulding) surface ``X(u, v) = x(u) + a(v) r(u) + b(v) s(u)`` swept with the
     rotation-minimising frame (RMF) ``(r, s, t)`` (Mäurer & Jüttler 1999, "MJ", §2.2–2.3).
@@ -454,7 +471,7 @@ def profile_surface(spine, profile, u=None, v=None, *, frames=None, initial=None
     sing = _singular_points(mu, uu, vv, v_end)
     conv = _convexity(T, kc, k, prof_size, spine_size, profile_closed)
 
-    def ro(arr):
+    def ro(arr: np.ndarray) -> np.ndarray:
         arr = np.ascontiguousarray(arr)
         arr.setflags(write=False)
         return arr
@@ -489,7 +506,7 @@ def _repeat_floor(p: np.ndarray) -> float:
     return float(np.max(p.max(axis=0) - p.min(axis=0))) * 2.0**-40
 
 
-def _count_or_values(x, name: str, domain: tuple[float, float], default: int) -> np.ndarray:
+def _count_or_values(x: object, name: str, domain: tuple[float, float], default: int) -> np.ndarray:
     if x is None:
         x = default
     if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
@@ -507,21 +524,23 @@ def _count_or_values(x, name: str, domain: tuple[float, float], default: int) ->
     return np.array(arr, dtype=float)
 
 
-def _curve_params(curve: Curve, x, name: str) -> np.ndarray:
+def _curve_params(curve: Curve, x: object, name: str) -> np.ndarray:
     return _count_or_values(x, name, curve.domain, _DEFAULT_COUNT)
 
 
-def _spline_params(spline, x) -> np.ndarray:
+def _spline_params(spline: PHSpline, x: object) -> np.ndarray:
     m = spline.segments
     if x is None:
-        return spline.samples(16)
+        out: np.ndarray = spline.samples(16)
+        return out
     uu = _count_or_values(x, "u", (0.0, float(m)), _DEFAULT_COUNT)
     if uu[0] < 0 or uu[-1] > m:
         raise ValueError(f"u: spline parameters must lie within [0, {m}]")
     return uu
 
 
-def _profile(profile, v, profile_closed: bool):
+def _profile(profile: Array | Curve, v: object, profile_closed: bool
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float | None]:
     """``(c (nv, 2), T (nv, 2), κ_c (nv,), v (nv,), size, v_end)``; ``v_end`` is the
     parameter at which a closed profile returns to its first sample (None when open)."""
     if isinstance(profile, Curve):
@@ -569,7 +588,7 @@ def _profile(profile, v, profile_closed: bool):
     return c, T, kc, vv, _size(c), (float(vv[-1] + h[-1]) if profile_closed else None)
 
 
-def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray):
+def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangents and signed curvatures of a 2-D polyline from the circle through each
     sample and its neighbours: ``T ∝ α/|α|² + β/|β|²`` (α, β the chords in and out),
     ``κ = 2 (α × β)/(|α||β||α + β|)``."""
@@ -606,7 +625,8 @@ def _circle_2d(c: np.ndarray, closed: bool, vv: np.ndarray):
 def _reflect(t: np.ndarray, chord: np.ndarray) -> np.ndarray:
     """The tangent at the far end of a circular arc: ``t`` reflected in the chord."""
     e = chord / np.hypot(*chord)
-    return 2 * np.dot(t / np.hypot(*t), e) * e - t / np.hypot(*t)
+    out: np.ndarray = 2 * np.dot(t / np.hypot(*t), e) * e - t / np.hypot(*t)
+    return out
 
 
 def _curvature_vector(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
@@ -614,7 +634,8 @@ def _curvature_vector(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
     sp2 = np.einsum("ij,ij->i", d1, d1)
     if np.any(sp2 == 0):
         raise ValueError("spine: the curve is not regular (zero derivative) at a sample")
-    return np.cross(np.cross(d1, d2), d1) / sp2[:, None] ** 2
+    out: np.ndarray = np.cross(np.cross(d1, d2), d1) / sp2[:, None] ** 2
+    return out
 
 
 def _circle_curvature(x: np.ndarray, closed: bool) -> np.ndarray:
@@ -632,7 +653,8 @@ def _circle_curvature(x: np.ndarray, closed: bool) -> np.ndarray:
     kn[~(pp > 0)] = 0.0
     if not closed:
         kn[0], kn[-1] = kn[1], kn[-2]
-    return kn
+    out: np.ndarray = kn
+    return out
 
 
 def _extrapolate_ends(k: np.ndarray, uu: np.ndarray) -> np.ndarray:
@@ -645,7 +667,8 @@ def _extrapolate_ends(k: np.ndarray, uu: np.ndarray) -> np.ndarray:
     return k
 
 
-def _checked_frames(frames, x, uu, kn, size, tangents) -> np.ndarray:
+def _checked_frames(frames: Array, x: np.ndarray, uu: np.ndarray, kn: np.ndarray, size: float,
+                    tangents: np.ndarray | None) -> np.ndarray:
     """User frames: rotation matrices, one per sample, without a turn about the tangent
     beyond :data:`_TWIST_TOL`."""
     F, _ = as_frames(frames, "frames", len(x))
@@ -690,7 +713,8 @@ def _checked_frames(frames, x, uu, kn, size, tangents) -> np.ndarray:
 # singular points, convexity
 
 
-def _singular_points(mu, uu, vv, v_end) -> np.ndarray:
+def _singular_points(mu: np.ndarray, uu: np.ndarray, vv: np.ndarray, v_end: float | None
+                     ) -> np.ndarray:
     profile_closed = v_end is not None
     vx = np.r_[vv, v_end] if profile_closed else vv
     out = []
@@ -706,7 +730,9 @@ def _singular_points(mu, uu, vv, v_end) -> np.ndarray:
     return arr
 
 
-def _convexity(T, kc, k, prof_size, spine_size, profile_closed):
+def _convexity(T: np.ndarray, kc: np.ndarray, k: np.ndarray, prof_size: float,
+               spine_size: float, profile_closed: bool
+               ) -> tuple[float, float, bool, np.ndarray | None]:
     """``(δ, ΔΩ, Cor. 9 criterion, interval of turns or None)``."""
     gamma = np.unwrap(np.arctan2(T[:, 1], T[:, 0]))
     delta = float(gamma.max() - gamma.min())
@@ -739,6 +765,10 @@ def _convexity(T, kc, k, prof_size, spine_size, profile_closed):
 # marching squares
 
 
+#: An edge of the sample grid: ``("u", i, j)`` from (i, j) to (i+1, j), ``("v", i, j)`` to (i, j+1).
+_Edge: TypeAlias = tuple[str, int, int]
+
+
 def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]]:
     """Zero lines of ``f`` on its grid as ``(i, j)`` fractional index polylines: crossings
     on edges between ``f > 0`` and ``f ≤ 0`` samples, chained through shared edges."""
@@ -747,13 +777,13 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
     cols = nv if wrap_v else nv - 1
 
     # crossing points, keyed by edge: "u" edges (i, j)-(i+1, j), "v" edges (i, j)-(i, j+1)
-    def u_edge(i, j):
+    def u_edge(i: int, j: int) -> _Edge:
         return ("u", i, j % nv)
 
-    def v_edge(i, j):
+    def v_edge(i: int, j: int) -> _Edge:
         return ("v", i, j % nv)
 
-    def point(key):
+    def point(key: _Edge) -> tuple[float, float]:
         kind, i, j = key
         if kind == "u":
             a, b = f[i, j], f[i + 1, j]
@@ -762,9 +792,9 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
         a, b = f[i, j], f[i, jn]
         return float(i), j + a / (a - b)
 
-    graph: dict = {}
+    graph: dict[_Edge, list[_Edge]] = {}
 
-    def link(p, q):
+    def link(p: _Edge, q: _Edge) -> None:
         graph.setdefault(p, []).append(q)
         graph.setdefault(q, []).append(p)
 
@@ -796,7 +826,7 @@ def _contours(f: np.ndarray, wrap_v: bool) -> list[tuple[np.ndarray, np.ndarray]
                 link(bottom, left)
                 link(right, top)
     lines = []
-    seen: set = set()
+    seen: set[_Edge] = set()
     starts = [n for n, nb in graph.items() if len(nb) == 1] + list(graph)
     for start in starts:
         if start in seen:
@@ -827,5 +857,6 @@ def _bilinear(P: np.ndarray, fi: np.ndarray, fj: np.ndarray, wrap: bool) -> np.n
     a = (fi - i0)[:, None]
     b = (fj - np.floor(fj))[:, None] if wrap else (fj - j0)[:, None]
     j1 = (j0 + 1) % nv
-    return ((1 - a) * (1 - b) * P[i0, j0] + a * (1 - b) * P[i0 + 1, j0]
+    out: np.ndarray = ((1 - a) * (1 - b) * P[i0, j0] + a * (1 - b) * P[i0 + 1, j0]
             + (1 - a) * b * P[i0, j1] + a * b * P[i0 + 1, j1])
+    return out

@@ -15,15 +15,19 @@ propagates.
 from __future__ import annotations
 
 import sys
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:  # Python 3.11+ at run time
     from typing import Self
 
+#: ``progress=`` once checked: a bool or the user's callable.
+Report = bool | Callable[..., object]
 
-def checked(progress, name: str = "progress"):
+
+def checked(progress: object, name: str = "progress") -> Report:
     """``progress`` as a bool (NumPy's too) or the callable, else ``TypeError`` naming it."""
     if isinstance(progress, (bool, np.bool_)):
         return bool(progress)
@@ -46,11 +50,12 @@ class Progress:
     """The report of one call: ``update(done)`` after every block, ``close()`` at the end
     (also on errors). ``Progress(False, …)`` does nothing."""
 
-    def __init__(self, progress, total: int | None, desc: str, unit: str = "it"):
+    def __init__(self, progress: object, total: int | None, desc: str,
+                 unit: str = "it") -> None:
         # total None: not known in advance (a stream), a plain line after every update
         self.total, self.desc, self.unit = None if total is None else int(total), desc, unit
-        self.call = progress if callable(progress) else None
-        self.bar = None
+        self.call: Callable[..., object] | None = progress if callable(progress) else None
+        self.bar: Any = None  # a tqdm bar
         self.line = False
         self.shown = -1  # the tenth of the work that the plain line showed last
         self.done = 0
@@ -79,10 +84,10 @@ class Progress:
             sys.stderr.write(f"{self.desc}: {done:,} {self.unit}s\n")
             sys.stderr.flush()
         elif self.line:
-            tenth = 10 * done // max(self.total, 1)
+            tenth = 10 * done // max(self.total or 0, 1)
             if tenth > self.shown:
                 self.shown = tenth
-                sys.stderr.write(f"{self.desc}: {done:,}/{self.total:,} {self.unit}s\n")
+                sys.stderr.write(f"{self.desc}: {done:,}/{self.total or 0:,} {self.unit}s\n")
                 sys.stderr.flush()
         self.done = done
 
@@ -94,7 +99,7 @@ class Progress:
     def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 
@@ -104,12 +109,12 @@ class Reported:
     made then. ``callback`` is None without ``progress`` (the core then skips the counts).
     Use as a context manager; ``close()`` ends the bar."""
 
-    def __init__(self, progress, desc: str, unit: str = "it"):
+    def __init__(self, progress: object, desc: str, unit: str = "it") -> None:
         self.progress, self.desc, self.unit = progress, desc, unit
-        self.report = None
+        self.report: Progress | None = None
 
     @property
-    def callback(self):
+    def callback(self) -> Reported | None:
         return None if self.progress is False else self
 
     def __call__(self, done: int, total: int) -> None:
@@ -127,5 +132,5 @@ class Reported:
     def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()

@@ -2,8 +2,10 @@
 names from private modules that hold the code; :func:`publish` shows those names under the
 public module, where the documentation lists them and pickles find them."""
 
+from typing import Any
 
-def publish(namespace: dict) -> None:
+
+def publish(namespace: dict[str, Any]) -> None:
     """Set ``__module__`` of the classes and functions named in ``namespace["__all__"]``
     that come from the private twin ``spinal._<name>`` to the public module's name."""
     public = namespace["__name__"]

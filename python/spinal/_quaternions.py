@@ -3,12 +3,14 @@ re-exported there."""
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _merge
 from ._frames import frames
+from ._types import Array, Float64Array, Int64Array
 from ._validate import (
     as_bool,
     as_choice,
@@ -30,7 +32,7 @@ def _from_xyzw(q: np.ndarray, scalar_first: bool) -> np.ndarray:
     return np.ascontiguousarray(q[..., [3, 0, 1, 2]]) if scalar_first else q
 
 
-def _quats(x, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
+def _quats(x: Array, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
     """(n, 4) xyzw array and whether the input was a single quaternion."""
     q = as_float_array(x, name)
     single = q.ndim == 1
@@ -41,7 +43,9 @@ def _quats(x, name: str, scalar_first: bool) -> tuple[np.ndarray, bool]:
     return _to_xyzw(q, scalar_first), single
 
 
-def to_quaternions(frames, *, scalar_first: bool = False, continuous: bool = True) -> np.ndarray:
+def to_quaternions(
+    frames: Array, *, scalar_first: bool = False, continuous: bool = True
+) -> Float64Array:
     """Unit quaternions of frames: ``(n, 3, 3)`` → ``(n, 4)`` (a single ``(3, 3)`` → ``(4,)``).
 
     Shepperd's method: the largest of ``1 + tr R`` and ``1 + 2R_kk − tr R`` gives the
@@ -60,7 +64,7 @@ def to_quaternions(frames, *, scalar_first: bool = False, continuous: bool = Tru
     return q[0] if single else q
 
 
-def from_quaternions(quaternions, *, scalar_first: bool = False) -> np.ndarray:
+def from_quaternions(quaternions: Array, *, scalar_first: bool = False) -> Float64Array:
     """Frames (rotation matrices, columns ``r, s, t``) of quaternions: ``(n, 4)`` →
     ``(n, 3, 3)``. Quaternions are normalised first; a zero or non-finite row is refused."""
     q, single = _quats(quaternions, "quaternions", as_bool(scalar_first, "scalar_first"))
@@ -68,7 +72,7 @@ def from_quaternions(quaternions, *, scalar_first: bool = False) -> np.ndarray:
     return f[0] if single else f
 
 
-def make_continuous(quaternions, *, scalar_first: bool = False) -> np.ndarray:
+def make_continuous(quaternions: Array, *, scalar_first: bool = False) -> Float64Array:
     """A copy with signs flipped so that consecutive quaternions have a non-negative dot
     product (the first made canonical, ``w ≥ 0``). The frames are unchanged."""
     sf = as_bool(scalar_first, "scalar_first")
@@ -76,7 +80,7 @@ def make_continuous(quaternions, *, scalar_first: bool = False) -> np.ndarray:
     return _from_xyzw(_core.quat_continuous(q), sf)
 
 
-def slerp(q0, q1, u, *, scalar_first: bool = False) -> np.ndarray:
+def slerp(q0: Array, q1: Array, u: float | Array, *, scalar_first: bool = False) -> Float64Array:
     """Spherical linear interpolation ``q(u)`` from ``q0`` (``u = 0``) to ``q1`` (``u = 1``)
     on the short arc (``q1`` is negated when ``q0·q1 < 0``): constant angular speed, the
     rotation of the frames turning about a fixed axis. ``q0``, ``q1``: ``(4,)`` or ``(k, 4)``;
@@ -101,7 +105,7 @@ def slerp(q0, q1, u, *, scalar_first: bool = False) -> np.ndarray:
     return out[0] if single else out
 
 
-def slerp_frames(frames, new_u, key_u=None) -> np.ndarray:
+def slerp_frames(frames: Array, new_u: Array, key_u: Array | None = None) -> Float64Array:
     """Frames interpolated between key frames by slerp.
 
     ``frames`` ``(n, 3, 3)`` at the strictly increasing parameters ``key_u`` (default
@@ -119,7 +123,7 @@ def slerp_frames(frames, new_u, key_u=None) -> np.ndarray:
     return _core.quat_slerp_frames(f, np.ascontiguousarray(ku), np.ascontiguousarray(nu))
 
 
-def _initial_r(initial):
+def _initial_r(initial: Array | None) -> np.ndarray | None:
     """The reference vector at row 0 as given: a (3,) vector or a frame's first column."""
     if initial is None:
         return None
@@ -132,15 +136,15 @@ def _initial_r(initial):
 
 
 def quaternion_frames(
-    points,
-    tangents=None,
+    points: Array,
+    tangents: Array | None = None,
     *,
-    method: str = "transport",
-    initial=None,
+    method: Literal["transport", "frenet"] = "transport",
+    initial: Array | None = None,
     closed: bool = False,
     turns: float = 0,
     scalar_first: bool = False,
-) -> np.ndarray:
+) -> Float64Array:
     r"""Frames along a sampled curve as a sign-continuous quaternion curve ``(n, 4)``.
 
     * ``method="transport"`` (default): discrete parallel transport written with
@@ -182,7 +186,7 @@ def quaternion_frames(
             raise ValueError(f"tangents: expected shape {pts.shape} to match points, got {t.shape}")
     r0 = _initial_r(initial)
 
-    def transport(pts, offs, t):
+    def transport(pts: np.ndarray, offs: np.ndarray, t: np.ndarray) -> np.ndarray:
         n = len(pts)
         repeat = closed and n > 3 and np.array_equal(pts[0], pts[-1])
         core_pts = pts[:-1] if repeat else pts
@@ -196,7 +200,7 @@ def quaternion_frames(
     return _from_xyzw(_merge.on_rows(transport, pts, offs, closed, False, (t,)), sf)
 
 
-def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) -> float:
+def quaternion_length(q: Array, *, closed: bool = False, scalar_first: bool = False) -> float:
     r"""Length of the quaternion curve on the unit sphere S³: ``Σ 2·atan2(|q_{i+1} − q_i|,
     |q_{i+1} + q_i|)`` with each pair sign-aligned (= ``Σ arccos|q_i·q_{i+1}|``), plus the
     closing arc when ``closed``. Half the total rotation angle of the frames; in the limit
@@ -211,7 +215,7 @@ def quaternion_length(q, *, closed: bool = False, scalar_first: bool = False) ->
     return float(_core.quat_path_length(a, as_bool(closed, "closed"))) + 0.0
 
 
-def spin(a, b) -> np.ndarray | float:
+def spin(a: Array, b: Array) -> Float64Array | float:
     """Signed angle (radians, in (−π, π]) that turns frame ``a``'s reference vector ``r``
     into frame ``b``'s about ``a``'s tangent — the twist between two frames with the same
     tangent (e.g. an RMF against the Frenet frame). ``a``, ``b``: ``(3, 3)`` or ``(n, 3, 3)``
@@ -226,16 +230,16 @@ def spin(a, b) -> np.ndarray | float:
 
 
 def camera_frames(
-    points,
+    points: Array,
     *,
-    up=None,
-    mode: str = "transport",
+    up: Array | None = None,
+    mode: Literal["transport", "up"] = "transport",
     closed: bool = False,
     turns: int = 0,
-    bank=None,
-    tangents=None,
+    bank: float | Array | None = None,
+    tangents: Array | None = None,
     singular_angle: float = 1e-3,
-) -> np.ndarray:
+) -> Float64Array:
     r"""Camera orientations for flying along a path: ``(n, 3, 3)`` camera-to-world rotations
     with columns ``(right, up, back)``, ``back = −gaze`` (the OpenGL/VTK convention: the
     camera looks along its −z). With pyvista: ``position = points[i]``, ``focal_point =
@@ -281,13 +285,14 @@ def camera_frames(
     singular = as_finite(singular_angle, "singular_angle", 0.0, np.pi / 2)
     turns = as_int(turns, "turns")
 
-    def camera(pts, offs, t, b):
+    def camera(pts: np.ndarray, offs: np.ndarray, t: np.ndarray, b: np.ndarray) -> np.ndarray:
         t, uu, vertical, regular = _core.camera_inputs(pts, t, u, b, closed, mode == "up",
                                                        singular)
         if mode == "transport":
             init = None if vertical else uu
             f = frames(pts, t, initial=init, closed=closed, turns=turns)
         else:
+            assert regular is not None  # (given in the "up" mode)
             f = _level_frames(pts, t, uu, regular, closed)
         # spinal frame (r, s, t) = (up, right, gaze), rolled by the bank about the gaze
         # (up' = cos b up + sin b (t × up)), then reordered to camera (right, up, −gaze)
@@ -295,7 +300,8 @@ def camera_frames(
 
     # consecutive repeated samples (a pause in a GPS track) merged: their rows get the
     # camera of the row they repeat
-    return _merge.on_rows(camera, pts, np.array([0, n], dtype=np.int64), closed, False, (t, b))
+    out: Float64Array = _merge.on_rows(camera, pts, np.array([0, n], dtype=np.int64), closed, False, (t, b))
+    return out
 
 
 def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
@@ -306,11 +312,12 @@ def _rotate_about_t(f: np.ndarray, ang: float) -> np.ndarray:
     return g
 
 
-def _angle_about(a, b, t) -> float:
+def _angle_about(a: np.ndarray, b: np.ndarray, t: np.ndarray) -> float:
     return float(np.arctan2(np.cross(a, b) @ t, a @ b))
 
 
-def _level_frames(pts, t, u, regular, closed):
+def _level_frames(pts: np.ndarray, t: np.ndarray, u: np.ndarray, regular: np.ndarray,
+                  closed: bool) -> np.ndarray:
     """Level-horizon frames; ``regular``: the rows where ``u`` projects onto the normal plane
     (checked by the core: at least one)."""
     n = len(pts)
@@ -362,16 +369,16 @@ class WalkResult(NamedTuple):
         The move each path point belongs to (0 = the start).
     """
 
-    points: np.ndarray
-    faces: np.ndarray
-    frames: np.ndarray
-    stopped: np.ndarray
-    path: np.ndarray
-    path_faces: np.ndarray
-    path_moves: np.ndarray
+    points: Float64Array
+    faces: Int64Array
+    frames: Float64Array
+    stopped: npt.NDArray[np.bool_]
+    path: Float64Array
+    path_faces: Int64Array
+    path_moves: Int64Array
 
 
-def _faces(faces) -> np.ndarray:
+def _faces(faces: Array) -> np.ndarray:
     fa = np.asarray(faces)
     if fa.ndim != 2 or fa.shape[1] != 3 or not (fa.size == 0 or np.issubdtype(fa.dtype, np.integer)):
         raise ValueError(f"faces: expected an integer array of shape (F, 3), got {fa.shape} "
@@ -379,7 +386,15 @@ def _faces(faces) -> np.ndarray:
     return np.ascontiguousarray(fa, dtype=np.int64)
 
 
-def walk_mesh(vertices, faces, face, point, moves, *, direction=None) -> WalkResult:
+def walk_mesh(
+    vertices: Array,
+    faces: Array,
+    face: int,
+    point: Array,
+    moves: Array,
+    *,
+    direction: Array | None = None,
+) -> WalkResult:
     r"""Walk on a triangle mesh with a frame (Ma 1996 §4.2.1).
 
     The walker starts at ``point`` (projected onto face ``face``; must lie inside it) with
@@ -430,13 +445,21 @@ class WalksResult(NamedTuple):
         The move ended early at a boundary edge.
     """
 
-    points: np.ndarray
-    faces: np.ndarray
-    frames: np.ndarray
-    stopped: np.ndarray
+    points: Float64Array
+    faces: Int64Array
+    frames: Float64Array
+    stopped: npt.NDArray[np.bool_]
 
 
-def walk_mesh_many(vertices, faces, face, points, moves, *, directions=None) -> WalksResult:
+def walk_mesh_many(
+    vertices: Array,
+    faces: Array,
+    face: Array,
+    points: Array,
+    moves: Array,
+    *,
+    directions: Array | None = None,
+) -> WalksResult:
     r"""Many walkers on one triangle mesh at once, in parallel: :func:`walk_mesh` for every
     walker, with the edge adjacency built once.
 

@@ -20,8 +20,15 @@ the kind. This module builds ``c`` for the three kinds, and the arc-length table
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import TypeAlias
 
 import numpy as np
+
+#: ``speed(piece, s)``: ``|x′|`` on the pieces at the local parameters ``s``.
+Speed: TypeAlias = Callable[[np.ndarray, np.ndarray], np.ndarray]
+#: :func:`arc_length_table`: intervals ``(piece, a, b)`` and the arc length ``S`` at their starts.
+ArcTable: TypeAlias = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 #: Gauss–Legendre nodes and weights on [−1, 1]; 16 nodes integrate polynomials of degree 31
 #: exactly, and the speed |x′| (the square root of a quartic) to rounding on a piece where it
@@ -68,7 +75,8 @@ _CHORDS = (1e-100, 1e100)
 def row_norms(d: np.ndarray) -> np.ndarray:
     """Lengths of the rows of ``d`` (n, 3) without overflow or underflow in the squares
     (``hypot``), so splines of any size have finite, non-zero chords and speeds."""
-    return np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    out: np.ndarray = np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2])
+    return out
 
 
 def chords(p: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -94,7 +102,7 @@ def chords(p: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray, np.ndar
     return d, h, d / h[:, None]
 
 
-def hermite_pieces(p, m, h, d) -> np.ndarray:
+def hermite_pieces(p: np.ndarray, m: np.ndarray, h: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Power-basis coefficients of the cubic Hermite pieces with end values ``p_i, p_{i+1}``
     and end slopes ``m_i, m_{i+1}`` on ``[0, h_i]`` (de Boor Ch. IV): with ``δ = Δ/h``,
     ``c₀ = p_i, c₁ = m_i, c₂ = (3δ − 2m_i − m_{i+1})/h, c₃ = (m_i + m_{i+1} − 2δ)/h²``.
@@ -154,7 +162,7 @@ def natural_pieces(p: np.ndarray, h: np.ndarray, d: np.ndarray, closed: bool) ->
                      (M[1:] - M[:-1]) / (6 * hh)])
 
 
-def tridiagonal(a, b, c, r):
+def tridiagonal(a: np.ndarray, b: np.ndarray, c: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Solve ``a_i x_{i−1} + b_i x_i + c_i x_{i+1} = r_i`` (``a_0``, ``c_{n−1}`` unused) by
     Gaussian elimination without pivoting (the Thomas algorithm, Numerical Recipes §2.4;
     stable for the diagonally dominant systems here). ``r``: ``(n, k)``, k right-hand sides.
@@ -182,7 +190,8 @@ def tridiagonal(a, b, c, r):
     return out
 
 
-def cyclic_tridiagonal(a, b, c, r):
+def cyclic_tridiagonal(a: np.ndarray, b: np.ndarray, c: np.ndarray, r: np.ndarray
+                       ) -> np.ndarray:
     """Solve the cyclic system of :func:`tridiagonal` with corners ``A[0, n−1] = a_0`` and
     ``A[n−1, 0] = c_{n−1}`` (n ≥ 3) by Sherman–Morrison (Numerical Recipes §2.7.2):
     ``A = B + u vᵀ`` with ``u = (γ, 0, …, 0, c_{n−1})``, ``v = (1, 0, …, 0, a_0/γ)``,
@@ -219,10 +228,11 @@ def bspline_pieces(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray
     j = np.arange(3, len(q))  # one span per piece
     tj = t[j]
 
-    def times_linear(poly, const, slope):  # poly · (const + slope s), degree stays ≤ 3
+    def times_linear(poly: np.ndarray, const: np.ndarray, slope: float) -> np.ndarray:  # poly · (const + slope s), degree stays ≤ 3
         out = const[:, None] * poly
         out[:, 1:] += slope * poly[:, :-1]
-        return out
+        res: np.ndarray = out
+        return res
 
     basis = [np.zeros((len(j), 4)) for _ in range(4)]
     basis[0][:, 0] = 1.0
@@ -256,7 +266,7 @@ def periodic_bspline(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 # --------------------------------------------------------------------- arc length
 
 
-def _integrals(speed, piece, a, b):
+def _integrals(speed: Speed, piece: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``∫_a^b speed(piece, s) ds`` by 16-point Gauss–Legendre, for arrays of intervals (in
     blocks, to bound the temporary arrays of 16 nodes per interval)."""
     out = np.empty(len(a))
@@ -269,7 +279,7 @@ def _integrals(speed, piece, a, b):
     return out
 
 
-def arc_length_table(speed, h: np.ndarray):
+def arc_length_table(speed: Speed, h: np.ndarray) -> ArcTable:
     """Intervals ``(piece, a, b)`` of local parameters covering all pieces in order, and the
     arc length ``S`` at their starts (one more entry: the total length).
 
@@ -306,7 +316,8 @@ def arc_length_table(speed, h: np.ndarray):
     return piece, a, b, S
 
 
-def invert_arc_length(speed, table, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def invert_arc_length(speed: Speed, table: ArcTable, targets: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """The pieces and local parameters ``s`` where the arc length reaches ``targets``.
 
     In the table's interval ``[a, b]`` holding the target, solve

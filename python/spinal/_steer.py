@@ -15,7 +15,8 @@ from ._validate import as_choice, as_float_array, as_real, as_turns
 TWIST_RULES = ("arc_length", "min_angular_speed")
 
 
-def _orientation_rows(vals: np.ndarray, name: str):
+def _orientation_rows(vals: np.ndarray, name: str
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(k, 3) vectors or (k, 3, 3) frames -> (vectors, frames, is_frame)."""
     k = vals.shape[0]
     if vals.ndim == 2 and vals.shape[1] == 3:
@@ -25,7 +26,8 @@ def _orientation_rows(vals: np.ndarray, name: str):
     raise ValueError(f"{name}: expected vectors (k, 3) or frames (k, 3, 3), got shape {vals.shape}")
 
 
-def _one_curve(given: Any, rows: int, where: str):
+def _one_curve(given: Any, rows: int, where: str
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The constraints of one curve: (local rows, vectors, frames, is_frame)."""
     name = "constraints"
     if given is None:
@@ -79,7 +81,8 @@ def _one_curve(given: Any, rows: int, where: str):
     return idx, vec, frm, kind
 
 
-def _constraints(given: Any, offs: np.ndarray, bundle: bool):
+def _constraints(given: Any, offs: np.ndarray, bundle: bool
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Flattened constraints of all curves: (curves, rows, vectors, frames, is_frame)."""
     curves = offs.size - 1
     if given is None:
@@ -94,8 +97,10 @@ def _constraints(given: Any, offs: np.ndarray, bundle: bool):
     else:
         parts = [(0, _one_curve(given, int(offs[1]), ""))]
     cc = [np.full(p[0].size, c, np.int64) for c, p in parts]
-    cat = (lambda xs, shape: np.ascontiguousarray(np.concatenate(xs))
-           if xs else np.zeros(shape))
+
+    def cat(xs: list[np.ndarray], shape: int | tuple[int, ...]) -> np.ndarray:
+        return np.ascontiguousarray(np.concatenate(xs)) if xs else np.zeros(shape)
+
     return (
         cat(cc, 0).astype(np.int64),
         cat([p[0] for _, p in parts], 0).astype(np.int64),
@@ -123,7 +128,7 @@ def _fits_int64(a: np.ndarray, name: str, context: str) -> None:
         raise ValueError(f"{name}: {int(a.max())} is out of range{context}")
 
 
-def guide_rows(guide: Any, rows: int):
+def guide_rows(guide: Any, rows: int) -> np.ndarray | None:
     """``guide`` as a C-contiguous (1, 3) or (rows, 3) array, or None."""
     if guide is None:
         return None
@@ -142,7 +147,7 @@ def guide_rows(guide: Any, rows: int):
 
 
 def previous_frames(previous: Any, rows: int, what: str = "the frames of the same curve at "
-                    "the previous time step"):
+                    "the previous time step") -> np.ndarray | None:
     """``previous`` as a C-contiguous (rows, 3, 3) array, or None."""
     if previous is None:
         return None
@@ -158,9 +163,11 @@ STEERING = ("turns", "con_curves", "con_rows", "con_vectors", "con_frames", "con
             "guide_previous", "previous_weight")
 
 
-def steering(constraints, twist_rule, turns, guide, guide_weight, guide_tolerance, previous,
+def steering(constraints: object, twist_rule: object, turns: object, guide: object,
+             guide_weight: object, guide_tolerance: object, previous: object,
              offs: np.ndarray, bundle: bool, rows: int, guide_sign: str = "follow",
-             guide_previous=None, previous_weight: float = 1.0):
+             guide_previous: np.ndarray | None = None, previous_weight: float = 1.0
+             ) -> tuple[object, ...]:
     """The steering arguments of :func:`spinal.frames` as the core takes them: the turns,
     the five constraint arrays, the rule, the guide, its weight, tolerance and whether its
     rows are axes (``guide_sign="free"``), previous, the previous frames' ``r`` columns as a

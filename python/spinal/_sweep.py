@@ -5,13 +5,18 @@ from __future__ import annotations
 import functools
 import re
 import warnings
+from collections.abc import Callable
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _core, _merge
-from ._frames import DEFAULT_TANGENT_RULE, TANGENT_RULES, estimate_tangents
+from ._frames import estimate_tangents
+from ._frames_args import DEFAULT_TANGENT_RULE, TANGENT_RULES
 from ._mesh import FoldOverWarning, Mesh, PrecisionWarning, SkippedCurvesWarning
 from ._progress import Reported, checked
+from ._types import Array, CurveBundle, Ints, PointData, ProgressArg, TangentRule
 from ._validate import (
     as_bool,
     as_choice,
@@ -34,18 +39,20 @@ MAX_SIDES = 2**20
 
 
 
-def _dtype(dtype) -> bool:
+def _dtype(dtype: npt.DTypeLike) -> bool:
     """True for float32 output, False for float64; anything else is refused by name."""
+    dt: np.dtype[Any] | None
     try:
         dt = np.dtype(dtype)
     except TypeError:
         dt = None
     if dt is None or dt not in (np.dtype(np.float64), np.dtype(np.float32)):
         raise ValueError(f"dtype: expected numpy.float64 or numpy.float32, got {dtype!r}")
-    return dt == np.float32
+    out: bool = dt == np.float32
+    return out
 
 
-def _scale_rows(scale, name: str, n: int, lens) -> np.ndarray:
+def _scale_rows(scale: object, name: str, n: int, lens: np.ndarray | None) -> np.ndarray:
     """The scale as ``(n, 2)`` rows, or one ``(1, 2)`` row when it is the same everywhere
     (the core broadcasts it; no per-row copy). ``lens``: the curves' row counts of a bundle,
     for a value per curve; a tube's ``radius`` is one value per row (or curve)."""
@@ -76,32 +83,32 @@ def _ranges(rows: np.ndarray, most: int = 20) -> str:
 
 
 def sweep(
-    points,
-    profile,
+    points: Array | CurveBundle,
+    profile: Array,
     *,
-    frames=None,
-    scale=None,
-    twist=None,
+    frames: Array | None = None,
+    scale: float | Array | None = None,
+    twist: float | Array | None = None,
     closed: bool = False,
     caps: bool = True,
     profile_closed: bool = True,
     miter_limit: float = 4.0,
     split_seams: bool = False,
     strict: bool = False,
-    lengths=None,
-    offsets=None,
-    tangents=None,
-    tangent_rule: str = DEFAULT_TANGENT_RULE,
-    dtype="float64",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    tangents: Array | None = None,
+    tangent_rule: TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
-    point_data=None,
-    on_short: str = "raise",
-    on_invalid: str = "raise",
-    join: str = "round",
-    progress=False,
+    point_data: PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
+    progress: ProgressArg = False,
     turns: float = 0,
-    out=None,
+    out: Mesh | None = None,
 ) -> Mesh:
     """Sweep a profile polygon along a spine into a triangle mesh.
 
@@ -305,7 +312,8 @@ def sweep(
                        on_invalid, join, progress, turns, out)
 
 
-def _out_buffers(out, normals: bool, uv: bool, inputs) -> tuple:
+def _out_buffers(out: object, normals: bool, uv: bool, inputs: list[tuple[str, object]]
+                 ) -> tuple[np.ndarray | None, ...]:
     """The arrays of the Mesh ``out`` the sweep refills: ``(vertices, normals, uv)``, None
     for those the call does not make; the core checks their shapes, dtype, order and
     writeability (errors name ``out.vertices`` …)."""
@@ -316,7 +324,7 @@ def _out_buffers(out, normals: bool, uv: bool, inputs) -> tuple:
                         f"sizes), got {type(out).__name__}")
     arrays = [("vertices", out.vertices, True), ("normals", out.normals, normals),
               ("uv", out.uv, uv)]
-    found = []
+    found: list[np.ndarray | None] = []
     for name, a, wanted in arrays:
         if not wanted:
             found.append(None)
@@ -328,7 +336,8 @@ def _out_buffers(out, normals: bool, uv: bool, inputs) -> tuple:
     return tuple(found)
 
 
-def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
+def _sweep_frames(pts: np.ndarray, fr: np.ndarray | None, closed: bool, tg: np.ndarray | None, rule: TangentRule,
+                  offs: np.ndarray, bundle: bool) -> tuple[np.ndarray | None, np.ndarray | None]:
     """The sweep's frames as the core takes them: ``(frames, None)`` for checked frames
     ``fr``, or ``(None, tangents)``: the RMF of :func:`spinal.frames` with the given
     (checked) tangents ``tg``, with tangents estimated by ``rule``, or (``tangents`` None)
@@ -345,16 +354,20 @@ def _sweep_frames(pts, fr, closed, tg, rule, offs, bundle):
             raise TypeError("tangent_rule: not used with tangents= (they replace the estimate)")
         return None, tg
     if rule != DEFAULT_TANGENT_RULE:
-        kw = {"offsets": offs} if bundle else {}
-        return None, estimate_tangents(pts, closed=closed, method=rule, **kw)
+        return None, estimate_tangents(pts, closed=closed, method=rule,
+                                       offsets=offs if bundle else None)
     return None, None
 
 
-def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_closed,
-                miter_limit, split_seams, strict, lengths, offsets, scale_arg,
-                tangents=None, tangent_rule=DEFAULT_TANGENT_RULE, dtype="float64",
-                normals=True, uv=True, point_data=None, on_short="raise",
-                on_invalid="raise", join="round", progress=False, turns=0, out=None) -> Mesh:
+def _sweep_mesh(points: object, profile: object, frames: object, scale: object, twist: object,
+                closed: object, caps: object, profile_closed: object, miter_limit: object,
+                split_seams: object, strict: object, lengths: object, offsets: object,
+                scale_arg: str, tangents: object = None,
+                tangent_rule: object = DEFAULT_TANGENT_RULE, dtype: npt.DTypeLike = "float64",
+                normals: object = True, uv: object = True, point_data: object = None,
+                on_short: object = "raise", on_invalid: object = "raise",
+                join: object = "round", progress: object = False, turns: object = 0,
+                out: Mesh | None = None) -> Mesh:
     """:func:`sweep`, with the scale's errors naming ``scale_arg`` (called one level below
     the public function, which the warnings point at)."""
     progress = checked(progress)
@@ -402,7 +415,8 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
     curve_ids, skipped = np.arange(curves), np.zeros(0, dtype=np.int64)
     keep_rows = None  # the given rows swept, where some are left out
     need = 3 if closed else 2
-    counts = lens if lens is not None else (np.array([n]) if not bundle else None)
+    counts: np.ndarray | None = lens if lens is not None else (
+        np.array([n]) if not bundle else None)
     short = np.zeros(curves, dtype=bool)
     if on_short == "skip" and lens is not None:
         short = lens < need
@@ -427,6 +441,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
                 np.flatnonzero(nan | few)), stacklevel=3)
             short = short | nan | few
     if short.any():
+        assert counts is not None  # (curves are left out only when their rows are known)
         skipped = np.flatnonzero(short).astype(np.int64)
         keep_rows = np.repeat(~short, counts)
         pts, fr, tg, sc, tw = _cut(keep_rows, pts, fr, tg, sc, tw)
@@ -450,10 +465,11 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
 
     report = Reported(progress, "tube" if scale_arg == "radius" else "sweep", "row")
 
-    def core(pts, offs, fr, tg, sc, tw):
+    def core(pts: np.ndarray, offs: np.ndarray, fr: np.ndarray | None, tg: np.ndarray | None,
+             sc: np.ndarray, tw: np.ndarray | None) -> tuple[Any, ...]:
         fr, tg = _sweep_frames(pts, fr, closed, tg, rule, offs, bundle)
         with report:
-            options = {
+            options: dict[str, object] = {
                 "profile_closed": profile_closed, "closed": closed, "caps": caps,
                 "miter_limit": miter_limit, "split_seams": split_seams, "scale_arg": scale_arg,
                 "single": single, "index32": single, "normals": want_normals, "uv": want_uv,
@@ -463,7 +479,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
             return _core.sweep_mesh(pts, fr, sc, tw, offs, np.ascontiguousarray(prof), options,
                                     report.callback)
 
-    def merged(p):
+    def merged(p: _merge.Plan) -> None:
         # consecutive repeated samples: merged (a ring for the first row of each group)
         nonlocal pts, fr, tg, sc, tw, offs, keep_rows
         pts, fr, tg, sc, tw = _cut(p.keep, pts, fr, tg, sc, tw)
@@ -499,7 +515,7 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
             raise
         # the core numbered the curves that were kept: back to the curves as given
         raise ValueError(_as_given(str(exc), curve_ids, given)) from None
-    v, f, nrm, uv, folds, faces_per_curve, join_rows = result
+    v, f, nrm, tex, folds, faces_per_curve, join_rows = result
     row_of = None if keep_rows is None else np.flatnonzero(keep_rows)
     if folds.size and row_of is not None:  # back to the rows as given
         folds = row_of[folds]
@@ -523,12 +539,12 @@ def _sweep_mesh(points, profile, frames, scale, twist, closed, caps, profile_clo
         warnings.warn(FoldOverWarning(msg, folds, fold_curves, local), stacklevel=3)
     if single and len(v):
         _check_float32(pts, prof, sc)
-    mesh = Mesh._of_sweep(v, f, nrm, uv, folds, rings, n, curves)
+    mesh = Mesh._of_sweep(v, f, nrm, tex, folds, rings, n, curves)
     mesh.skipped_curves = skipped
     if pdata:
-        rings = mesh._ring_arrays()
+        ring_sample, ring_curve, cols = mesh._ring_arrays()
         for k, (a, per_curve) in pdata.items():
-            mesh.point_data[k] = np.repeat(a[rings[1] if per_curve else rings[0]], rings[2],
+            mesh.point_data[k] = np.repeat(a[ring_curve if per_curve else ring_sample], cols,
                                            axis=0)
     if bundle:  # each curve's faces follow those of the curve before it
         small = curves <= np.iinfo(np.int32).max
@@ -561,13 +577,13 @@ def _check_float32(pts: np.ndarray, profile: np.ndarray, scale: np.ndarray) -> N
 def _as_given(msg: str, curve_ids: np.ndarray, starts: np.ndarray) -> str:
     """``msg`` with its ``curve c (rows a to b)`` (curve ``c`` of the curves kept) naming the
     curve and rows as given (``curve_ids[c]``; ``starts``: the given curves' first rows)."""
-    def given(m):
+    def given(m: re.Match[str]) -> str:
         c = curve_ids[int(m.group(1))]
         return f"curve {c} (rows {starts[c]} to {max(starts[c + 1], 1) - 1})"
     return re.sub(r"curve (\d+) \(rows \d+ to \d+\)", given, msg, count=1)
 
 
-def _orig_offsets(lens, n: int) -> np.ndarray:
+def _orig_offsets(lens: np.ndarray | None, n: int) -> np.ndarray:
     return np.concatenate([[0], np.cumsum(lens)]) if lens is not None else np.array([0, n])
 
 
@@ -582,7 +598,8 @@ def _by_curve(curves: np.ndarray, rows: np.ndarray, most: int = 8) -> str:
     return "; ".join(parts) + more
 
 
-def _per_row_or_curve(x, name: str, n: int, lens, *, pair: bool) -> np.ndarray:
+def _per_row_or_curve(x: object, name: str, n: int, lens: np.ndarray | None, *, pair: bool
+                      ) -> np.ndarray:
     """:func:`as_per_row`, also accepting one value per curve of a bundle, ``(C,)`` (or
     ``(C, 2)`` with ``pair``), repeated over the curve's rows."""
     a = as_float_array(x, name)
@@ -592,7 +609,7 @@ def _per_row_or_curve(x, name: str, n: int, lens, *, pair: bool) -> np.ndarray:
     return as_per_row(a, name, n, pair=pair)
 
 
-def _per_curve_list(v, lens):
+def _per_curve_list(v: Any, lens: np.ndarray | None) -> Any:
     """A list (any sequence but an array) of one array per curve, as users hold values of
     streamlines (dipy's ``values_from_volume``): one row per point of each curve,
     concatenated, or one value (or ``(k,)`` row) per curve, stacked; anything else as
@@ -611,7 +628,8 @@ def _per_curve_list(v, lens):
     return v
 
 
-def _point_data(data, n: int, curves: int | None, lens=None) -> dict:
+def _point_data(data: object, n: int, curves: int | None, lens: np.ndarray | None = None
+                ) -> dict[str, tuple[np.ndarray, bool]]:
     """``{name: (array, per_curve)}``: ``(n,)``/``(n, k)`` arrays per spine row, or for a
     bundle ``(C,)``/``(C, k)`` per curve, or a list of one ``(n_c,)``/``(n_c, k)`` array per
     curve (``lens``: the curves' row counts)."""
@@ -619,7 +637,7 @@ def _point_data(data, n: int, curves: int | None, lens=None) -> dict:
         return {}
     if not isinstance(data, dict):
         raise TypeError(f"point_data: expected a dict of arrays, got {type(data).__name__}")
-    out = {}
+    out: dict[str, tuple[np.ndarray, bool]] = {}
     for k, v in data.items():
         if not isinstance(k, str):
             raise TypeError(f"point_data: keys must be strings, got {k!r}")
@@ -642,7 +660,7 @@ def _point_data(data, n: int, curves: int | None, lens=None) -> dict:
     return out
 
 
-def _joined(x, name: str, offs: np.ndarray, ndim: int):
+def _joined(x: Any, name: str, offs: np.ndarray, ndim: int) -> Any:
     """Per-row data given as a list (any sequence but an array) of one array per curve, as
     ``points`` may be (``ndim``: of each array, 2 for tangents, 3 for frames), back to back;
     anything else as given."""
@@ -663,14 +681,21 @@ def _joined(x, name: str, offs: np.ndarray, ndim: int):
     return np.concatenate(parts)
 
 
-def _cut(keep, pts, fr, tg, sc, tw):
+def _cut(keep: np.ndarray, pts: np.ndarray, fr: np.ndarray | None, tg: np.ndarray | None, sc: np.ndarray, tw: np.ndarray | None
+         ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray, np.ndarray | None]:
     """The per-row inputs of a sweep on the rows ``keep`` (a scale of one row stays)."""
-    def cut(a):
+    def cut(a: np.ndarray | None) -> np.ndarray | None:
         return None if a is None else np.ascontiguousarray(a[keep])
-    return cut(pts), cut(fr), cut(tg), (cut(sc) if sc.shape[0] > 1 else sc), cut(tw)
+
+    def rows(a: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(a[keep])
+    return rows(pts), cut(fr), cut(tg), (rows(sc) if sc.shape[0] > 1 else sc), cut(tw)
 
 
-def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv, join_rows=None):
+def _ring_layout(pts: np.ndarray, offs: np.ndarray, row_of: np.ndarray | None,
+                 curve_ids: np.ndarray, closed: bool, split_seams: bool, nv: int,
+                 join_rows: np.ndarray | None = None
+                 ) -> tuple[Callable[[], tuple[np.ndarray, np.ndarray, int]], np.ndarray]:
     """The stored rings of a sweep, as the core lays them out: per curve, one ring per
     distinct sample (a closed curve's repeated first point has none; split seams on a
     closed curve repeat its first ring at the end), then the extra rings of its corner
@@ -702,8 +727,10 @@ def _ring_layout(pts, offs, row_of, curve_ids, closed, split_seams, nv, join_row
     return per_ring, starts * cols
 
 
-def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols, extra=None,
-              join_rows=None):
+def _per_ring(row0: np.ndarray, stored: np.ndarray, rings: np.ndarray, starts: np.ndarray,
+              row_of: np.ndarray | None, curve_ids: np.ndarray, cols: int,
+              extra: np.ndarray | None = None, join_rows: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, int]:
     """``(ring_sample, ring_curve, cols)`` of :func:`_ring_layout` (a module-level function
     bound with :func:`functools.partial`, so meshes that hold it pickle)."""
     total = int(starts[-1])
@@ -718,30 +745,30 @@ def _per_ring(row0, stored, rings, starts, row_of, curve_ids, cols, extra=None,
 
 
 def tube(
-    points,
-    radius=1.0,
+    points: Array | CurveBundle,
+    radius: float | Array = 1.0,
     sides: int = 16,
     *,
-    frames=None,
+    frames: Array | None = None,
     closed: bool = False,
     caps: bool = True,
     miter_limit: float = 4.0,
     split_seams: bool = False,
     strict: bool = False,
-    lengths=None,
-    offsets=None,
-    tangents=None,
-    tangent_rule: str = DEFAULT_TANGENT_RULE,
-    dtype="float64",
+    lengths: Ints | None = None,
+    offsets: Ints | None = None,
+    tangents: Array | None = None,
+    tangent_rule: TangentRule = "five_point_bounded",
+    dtype: npt.DTypeLike = "float64",
     normals: bool = True,
     uv: bool = True,
-    point_data=None,
-    on_short: str = "raise",
-    on_invalid: str = "raise",
-    join: str = "round",
-    progress=False,
+    point_data: PointData | None = None,
+    on_short: Literal["raise", "skip"] = "raise",
+    on_invalid: Literal["raise", "skip"] = "raise",
+    join: Literal["round", "bevel", "miter"] = "round",
+    progress: ProgressArg = False,
     turns: float = 0,
-    out=None,
+    out: Mesh | None = None,
 ) -> Mesh:
     """A tube of the given radius around a spine: :func:`sweep` of a regular polygon with
     ``sides`` vertices on the unit circle (vertex ``j`` at angle ``2πj/sides`` from r

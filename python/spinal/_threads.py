@@ -28,9 +28,10 @@ def _as_count(n: object) -> int | None:
         return None
     if isinstance(n, bool) or not isinstance(n, numbers.Integral):
         raise TypeError(f"n: must be a positive int or None, got {type(n).__name__}")
-    if not 1 <= n <= MAX_THREADS:
-        raise ValueError(f"n: must be a positive int (at most {MAX_THREADS}), got {int(n)}")
-    return int(n)
+    count = int(n)
+    if not 1 <= count <= MAX_THREADS:
+        raise ValueError(f"n: must be a positive int (at most {MAX_THREADS}), got {count}")
+    return count
 
 
 def set_num_threads(n: int | None) -> None:

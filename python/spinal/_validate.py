@@ -14,9 +14,12 @@ wrong shape) with a message that starts with the argument's name.
 from __future__ import annotations
 
 import numbers
-from typing import Any
+from collections.abc import Callable, Iterable
+from typing import Any, TypeVar
 
 import numpy as np
+
+_S = TypeVar("_S", bound=str)
 
 
 def as_float_array(x: Any, name: str) -> np.ndarray:
@@ -209,22 +212,22 @@ def as_finite(x: Any, name: str, minimum: float | None = None,
               maximum: float | None = None) -> float:
     """A finite Python float (for values that no core check sees), within
     ``[minimum, maximum]`` when given."""
-    x = as_real(x, name)
-    if not np.isfinite(x):
-        raise ValueError(f"{name}: must be finite, got {x}")
-    if minimum is not None and x < minimum:
-        raise ValueError(f"{name}: must be >= {minimum}, got {x}")
-    if maximum is not None and x > maximum:
-        raise ValueError(f"{name}: must be <= {maximum}, got {x}")
-    return x
+    v = as_real(x, name)
+    if not np.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {v}")
+    if minimum is not None and v < minimum:
+        raise ValueError(f"{name}: must be >= {minimum}, got {v}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {v}")
+    return v
 
 
 def as_positive(x: Any, name: str) -> float:
     """A finite Python float > 0."""
-    x = as_finite(x, name)
-    if not x > 0:
-        raise ValueError(f"{name}: must be positive, got {x}")
-    return x
+    v = as_finite(x, name)
+    if not v > 0:
+        raise ValueError(f"{name}: must be positive, got {v}")
+    return v
 
 
 #: Integers reach the core as 64-bit values.
@@ -236,26 +239,26 @@ MAX_SAMPLES = 100_000_000
 
 
 def as_int(x: Any, name: str, minimum: int | None = None, maximum: int | None = None, *,
-           out_of_bounds=None) -> int:
+           out_of_bounds: Callable[[int], str] | None = None) -> int:
     """A Python int (not a bool) that fits a 64-bit integer, within ``[minimum, maximum]``
     when given. ``out_of_bounds(x)``, when given, words the error for a value outside the
     bounds (checked first, so a huge value gets the argument's own limits)."""
     if isinstance(x, bool) or not isinstance(x, numbers.Integral):
         raise TypeError(f"{name}: expected an integer, got {type(x).__name__}")
-    x = int(x)
+    v = int(x)
     if out_of_bounds is not None and (
-            (minimum is not None and x < minimum) or (maximum is not None and x > maximum)):
-        huge = "" if INT64_MIN <= x <= INT64_MAX else (
+            (minimum is not None and v < minimum) or (maximum is not None and v > maximum)):
+        huge = "" if INT64_MIN <= v <= INT64_MAX else (
             " (out of the representable range of a 64-bit integer, too)")
-        raise ValueError(f"{name}: {out_of_bounds(x)}{huge}")
-    if not INT64_MIN <= x <= INT64_MAX:
-        raise ValueError(f"{name}: {x} is out of the representable range of a 64-bit "
+        raise ValueError(f"{name}: {out_of_bounds(v)}{huge}")
+    if not INT64_MIN <= v <= INT64_MAX:
+        raise ValueError(f"{name}: {v} is out of the representable range of a 64-bit "
                          f"integer [-2**63, 2**63 - 1]")
-    if minimum is not None and x < minimum:
-        raise ValueError(f"{name}: must be >= {minimum}, got {x}")
-    if maximum is not None and x > maximum:
-        raise ValueError(f"{name}: must be <= {maximum}, got {x}")
-    return x
+    if minimum is not None and v < minimum:
+        raise ValueError(f"{name}: must be >= {minimum}, got {v}")
+    if maximum is not None and v > maximum:
+        raise ValueError(f"{name}: must be <= {maximum}, got {v}")
+    return v
 
 
 def as_turns(x: Any, name: str = "turns") -> int | float:
@@ -281,7 +284,7 @@ def as_bool(x: Any, name: str) -> bool:
     return bool(x)
 
 
-def as_choice(x: Any, name: str, choices: tuple[str, ...]) -> str:
+def as_choice(x: Any, name: str, choices: tuple[_S, ...]) -> _S:
     if not isinstance(x, str):
         raise TypeError(f"{name}: expected a string, one of {choices}, got {type(x).__name__}")
     if x not in choices:
@@ -289,7 +292,8 @@ def as_choice(x: Any, name: str, choices: tuple[str, ...]) -> str:
     return x
 
 
-def as_out(out, inputs=(), name: str = "out"):
+def as_out(out: object, inputs: Iterable[tuple[str, object]] = (),
+           name: str = "out") -> np.ndarray | None:
     """A caller's output buffer ``out`` (or None), refused when it is not a NumPy array
     (TypeError) or shares memory with one of ``inputs`` (``(argument name, value)`` pairs;
     values that are not arrays, or lists of arrays, are passed over): a ValueError naming
@@ -308,7 +312,7 @@ def as_out(out, inputs=(), name: str = "out"):
     return out
 
 
-def fill_out(out, result: np.ndarray, name: str = "out") -> np.ndarray:
+def fill_out(out: np.ndarray | None, result: np.ndarray, name: str = "out") -> np.ndarray:
     """``result`` written into the caller's ``out`` (as the core checks it: exactly
     ``result``'s shape and dtype, C-contiguous, writeable; else a ValueError naming
     ``name``), which is returned; ``result`` itself when ``out`` is None."""

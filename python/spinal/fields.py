@@ -52,8 +52,8 @@ of :func:`spinal.frames`; it translates (pushes or carries), and optionally rota
 frames, twists or bends the material around it.
 """
 
+from ._core import Field
 from ._fields import (  # noqa: F401
-    Field,
     _rebuild,
     along_path,
     bend,

@@ -26,9 +26,15 @@ Meshes are read by :meth:`spinal.Mesh.load` and written by :meth:`spinal.Mesh.sa
 import os as _os
 import pathlib as _pathlib
 import warnings as _warnings
+from collections.abc import Callable as _Callable
+from collections.abc import Iterable as _Iterable
+from collections.abc import Iterator as _Iterator
+from typing import Any as _Any
+from typing import Literal as _Literal
 from typing import NamedTuple as _NamedTuple
 
 import numpy as _np
+import numpy.typing as _npt
 
 __all__ = ["STREAMLINE_SUFFIXES", "Streamlines", "read_streamlines", "tube_file"]
 
@@ -52,9 +58,9 @@ class Streamlines(_NamedTuple):
         ``dps``, VTK cell data).
     """
 
-    points: list
-    point_data: dict
-    streamline_data: dict
+    points: list[_np.ndarray]
+    point_data: dict[str, list[_np.ndarray]]
+    streamline_data: dict[str, _np.ndarray]
 
     @property
     def lengths(self) -> _np.ndarray:
@@ -62,7 +68,7 @@ class Streamlines(_NamedTuple):
         return _np.array([len(p) for p in self.points], dtype=_np.int64)
 
 
-def _need(module: str, extra: str = "io"):
+def _need(module: str, extra: str = "io") -> _Any:
     """Import ``module`` or say which extra installs it."""
     import importlib
 
@@ -75,7 +81,8 @@ def _need(module: str, extra: str = "io"):
             f"'.[{extra}]')") from None
 
 
-def _split(data: _np.ndarray, lengths: _np.ndarray, squeeze: bool = True) -> list:
+def _split(data: _np.ndarray, lengths: _np.ndarray, squeeze: bool = True
+           ) -> list[_np.ndarray]:
     """``data`` (the rows of all streamlines back to back) cut into one array per streamline
     (views); ``(n, 1)`` columns become ``(n,)``."""
     data = _np.asarray(data)
@@ -85,7 +92,7 @@ def _split(data: _np.ndarray, lengths: _np.ndarray, squeeze: bool = True) -> lis
     return _np.split(data, ends[:-1]) if len(lengths) else []
 
 
-def _from_sequence(seq) -> tuple[_np.ndarray, _np.ndarray]:
+def _from_sequence(seq: _Any) -> tuple[_np.ndarray, _np.ndarray]:
     """The rows and lengths of a nibabel ``ArraySequence`` (copied into one block when its
     pieces are not back to back)."""
     lengths = _np.asarray(seq._lengths, dtype=_np.int64)
@@ -97,17 +104,18 @@ def _from_sequence(seq) -> tuple[_np.ndarray, _np.ndarray]:
     return data[:total], lengths
 
 
-def _sequences(points, per_point: dict, per_streamline: dict) -> Streamlines:
+def _sequences(points: _Any, per_point: dict[str, _Any], per_streamline: dict[str, _Any]
+               ) -> Streamlines:
     data, lengths = _from_sequence(points)
     pts = _split(_np.asarray(data, dtype=_np.float64), lengths, squeeze=False)
-    pd = {}
+    pd: dict[str, list[_np.ndarray]] = {}
     for k, v in per_point.items():
         d, _ = _from_sequence(v)
         pd[k] = _split(d, lengths)
-    sd = {}
+    sd: dict[str, _np.ndarray] = {}
     for k, v in per_streamline.items():
-        v = _np.asarray(v)
-        sd[k] = v[:, 0] if v.ndim == 2 and v.shape[1] == 1 else v
+        a = _np.asarray(v)
+        sd[k] = a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
     return Streamlines(pts, pd, sd)
 
 
@@ -154,7 +162,7 @@ def _read_vtk(path: _pathlib.Path) -> Streamlines:
     return Streamlines(_split(pts, lengths, squeeze=False), pd, sd)
 
 
-def read_streamlines(path: str | _os.PathLike) -> Streamlines:
+def read_streamlines(path: str | _os.PathLike[str]) -> Streamlines:
     """Read the streamlines (polylines) of a ``.trk``, ``.tck``, ``.trx``, ``.vtp`` or
     ``.vtk`` file.
 
@@ -186,7 +194,8 @@ def read_streamlines(path: str | _os.PathLike) -> Streamlines:
     return _read_vtk(path)
 
 
-def _lazy_items(path: _pathlib.Path):
+def _lazy_items(path: _pathlib.Path
+                ) -> _Iterator[tuple[_np.ndarray, dict[str, _np.ndarray]]]:
     """``(points (n, 3) float64, {name: per-point values})`` of every streamline of the file,
     read lazily where the format allows (nibabel's lazy loading of ``.trk``/``.tck``, the
     memory maps of ``.trx``)."""
@@ -223,7 +232,7 @@ def _lazy_items(path: _pathlib.Path):
             yield p, {k: v[i] for k, v in s.point_data.items()}
 
 
-def _is_pair(x) -> bool:
+def _is_pair(x: object) -> bool:
     """Whether an item of ``tube_file``'s ``src`` is a ``(points, data)`` pair."""
     return isinstance(x, tuple) and len(x) == 2 and isinstance(x[1], dict)
 
@@ -239,7 +248,8 @@ def _orientation(p: _np.ndarray) -> _np.ndarray:
         return _np.zeros((len(p), 3))
 
 
-def _summarise(folds: list, skipped: list, other: dict) -> None:
+def _summarise(folds: list[tuple[int, int, _Any]], skipped: list[_np.ndarray],
+               other: dict[str, _warnings.WarningMessage]) -> None:
     """One warning per kind for the whole file, naming streamlines by their index in
     ``src``."""
     from ._mesh import FoldOverWarning, SkippedCurvesWarning
@@ -265,9 +275,18 @@ def _summarise(folds: list, skipped: list, other: dict) -> None:
         _warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
-def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
-              chunk_points: int = 1 << 20, dtype="float32", colors=None, join: str = "round",
-              progress=False) -> _pathlib.Path:
+def tube_file(
+    src: str | _os.PathLike[str] | _Iterable[object],
+    dst: str | _os.PathLike[str],
+    radius: float | str = 0.25,
+    sides: int = 8,
+    *,
+    chunk_points: int = 1 << 20,
+    dtype: _npt.DTypeLike = "float32",
+    colors: str | None = None,
+    join: _Literal["round", "bevel", "miter"] = "round",
+    progress: bool | _Callable[[int], object] = False,
+) -> _pathlib.Path:
     """Sweep a tube around every streamline of ``src`` into the mesh file ``dst``, a chunk
     of streamlines at a time.
 
@@ -325,6 +344,7 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
     if not (isinstance(progress, bool) or callable(progress)):
         raise TypeError(f"progress: expected a bool or a callable, got "
                         f"{type(progress).__name__}")
+    items: _Iterable[tuple[_Any, dict[str, _Any]]]
     if isinstance(src, (str, _os.PathLike)):
         path = _pathlib.Path(src)
         if not path.exists():
@@ -334,14 +354,14 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
                              f"{', '.join(STREAMLINE_SUFFIXES)}")
         items = _lazy_items(path)
     else:
-        items = (x if _is_pair(x) else (x, {}) for x in src)
+        items = (x if isinstance(x, tuple) and _is_pair(x) else (x, {}) for x in src)
     named = [x for x in (radius, colors) if isinstance(x, str) and x != "orientation"]
     spool = Spool(_pathlib.Path(dst))
     bar = Progress(progress is True, None, "tube_file", "streamline")
 
-    def flush(chunk, data, first):
+    def flush(chunk: list[_np.ndarray], data: dict[str, list[_np.ndarray]], first: int) -> None:
         r = _np.concatenate(data[radius]) if isinstance(radius, str) else radius
-        point_data = None
+        point_data: dict[str, _npt.ArrayLike] | None = None
         if colors == "orientation":
             point_data = {"colors": _np.concatenate([_orientation(p) for p in chunk])}
         elif colors is not None:
@@ -365,10 +385,14 @@ def tube_file(src, dst: str | _os.PathLike, radius=0.25, sides: int = 8, *,
 
     done = 0
     # the chunks' warnings, given once at the end for the whole file
-    folds, skipped, other = [], [], {}
+    folds: list[tuple[int, int, _Any]] = []
+    skipped: list[_np.ndarray] = []
+    other: dict[str, _warnings.WarningMessage] = {}
     rows_before = [0]  # spine rows of the chunks written
     try:
-        chunk, data, size = [], {k: [] for k in named}, 0
+        chunk: list[_np.ndarray] = []
+        data: dict[str, list[_np.ndarray]] = {k: [] for k in named}
+        size = 0
         for i, (p, d) in enumerate(items):
             p = _np.asarray(p, dtype=_np.float64)
             for k in named:

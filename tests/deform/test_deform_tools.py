@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation, RotationSpline
 from test_deform import ball, blend, grad, icosphere, jacobian, volumes
 
 import spinal
-from spinal import _core, _fields, fields
+from spinal import _core, _fields_grid, fields
 
 RNG = np.random.default_rng(11)
 
@@ -425,7 +425,7 @@ def test_grid_and_mesh_tool_bad_input():
 def test_core_strip_and_grid_constructors_refuse_bad_input():
     """The compiled constructors check the axis and the grid themselves (called here without
     the Python wrappers), naming the argument, never panicking."""
-    from spinal._fields import _spline_prefilter
+    from spinal._fields_grid import _spline_prefilter
 
     x = np.ascontiguousarray(ARC)
     ok = (RHO, SPEED, RF, "c1")
@@ -491,7 +491,7 @@ def test_grid_coefficients_interpolate_and_match_the_numpy_formulation(shape):
     formulation, and the spline they define passes through the samples: at a node the
     uniform cubic B-spline is (c_{i-1} + 4c_i + c_{i+1})/6 along each axis."""
     d = np.random.default_rng(sum(shape)).normal(size=shape)
-    c = _fields._spline_prefilter(d)
+    c = _fields_grid._spline_prefilter(d)
     assert c.shape == tuple(k + 2 for k in shape)
     np.testing.assert_array_equal(c, _prefilter_numpy(d))
     for axis in range(3):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import spinal
-from spinal import _fields, fields
+from spinal import _fields_grid, fields
 
 
 def walks(count=1200, seed=3):
@@ -144,8 +144,8 @@ def test_mesh_tool_samples_in_slabs_with_the_same_field(monkeypatch):
     box = trimesh.creation.box((1.0, 0.6, 0.4))
     x = np.random.default_rng(4).uniform(-1, 1, (200, 3))
     one = fields.mesh_tool(box, [0, 0, 1], resolution=24)
-    monkeypatch.setattr(_fields, "SLAB_NODES", 1000)  # a few planes per slab
-    monkeypatch.setattr(_fields, "SLAB_PER_FACE", 0)
+    monkeypatch.setattr(_fields_grid, "SLAB_NODES", 1000)  # a few planes per slab
+    monkeypatch.setattr(_fields_grid, "SLAB_PER_FACE", 0)
     calls = Calls()
     slabs = fields.mesh_tool(box, [0, 0, 1], resolution=24, progress=calls)
     assert np.array_equal(one(x), slabs(x))
