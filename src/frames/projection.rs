@@ -19,7 +19,15 @@ use super::transport::Step;
 
 #[inline(always)]
 pub fn projection_step(d: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
-    let p = r - (r.dot(t1) / d.dot(t1)) * d;
+    let dt = d.dot(t1);
+    let mut p = r - (r.dot(t1) / dt) * d;
+    // where `r` nearly lies along `d` the difference cancels and keeps a rounding error of
+    // `ε|r|` along `t1` on a short `p`: once more along `d` (a no-op in exact arithmetic), so
+    // the frame stays orthonormal to rounding
+    let res = p.dot(t1);
+    if res.abs() > 1e-12 * p.length() {
+        p -= (res / dt) * d;
+    }
     // p = 0 would need r ∥ d ⟂ t1 as well as r ⟂ t0: excluded by the chord check; keep r
     // finite anyway.
     p.try_normalize().unwrap_or(r)
