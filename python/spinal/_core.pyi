@@ -254,14 +254,7 @@ def field_strip_curve(
 ) -> Field: ...
 def field_grid(
     coefficients: npt.NDArray[np.float64],
-    origin: _V3,
-    spacing: float,
-    velocity: _V3,
-    center: _V3,
-    reach: float,
-    blend: str,
-    moving: bool,
-    name: str,
+    options: Options,
 ) -> Field: ...
 def field_grid_coefficients(values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def field_path(
@@ -272,16 +265,7 @@ def field_path(
 def field_zero() -> Field: ...
 def field_grid_curl(
     coefficients: npt.NDArray[np.float64],
-    origin: _V3,
-    spacing: float,
-    center: _V3,
-    reach: float,
-    velocity: _V3 | None,
-    angular_velocity: _V3 | None,
-    pivot: _V3 | None,
-    falloff_power: int,
-    moving: bool,
-    name: str,
+    options: Options,
 ) -> Field: ...
 def field_rod(
     points: npt.NDArray[np.float64],
@@ -362,11 +346,7 @@ def flesh_deform(
     posed_frames: npt.NDArray[np.float64],
     edge: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    solution: str,
-    twist: npt.NDArray[np.float64] | None,
-    closed: bool = False,
-    blend: float | None = None,
-    planar: bool = False,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]

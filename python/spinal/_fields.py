@@ -254,7 +254,9 @@ def _grid_field(values, origin, h, velocity, center, reach, blend, moving, name)
     the support stays inside the grid)."""
     u = as_vector(velocity, "velocity")
     coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid(coef, origin, h, u, c, reach, blend, as_bool(moving, "moving"), name)
+    return _core.field_grid(coef, {"origin": origin, "spacing": h, "velocity": u, "center": c,
+                                   "reach": reach, "blend": blend,
+                                   "moving": as_bool(moving, "moving"), "name": name})
 
 
 def _grid_spline(values, origin, h, center, reach):
@@ -567,8 +569,10 @@ def _grid_curl(values, origin, h, center, reach, velocity, angular_velocity, piv
                falloff_power, moving, name):
     u, w, p = _motion(velocity, angular_velocity, pivot)
     coef, c, reach = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid_curl(coef, origin, h, c, reach, u, w, p, _power(falloff_power),
-                                 as_bool(moving, "moving"), name)
+    return _core.field_grid_curl(coef, {"origin": origin, "spacing": h, "center": c,
+                                        "reach": reach, "velocity": u, "angular_velocity": w,
+                                        "pivot": p, "falloff_power": _power(falloff_power),
+                                        "moving": as_bool(moving, "moving"), "name": name})
 
 
 @_recorded

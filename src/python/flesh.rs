@@ -8,6 +8,7 @@ use numpy::{
 use pyo3::prelude::*;
 
 use super::convert::{Stop, detach_stoppable, empty, slice_mut, slice_of, vec3_array, vec3s};
+use super::options::Options;
 use crate::flesh::{self, Solution, surface, trisurf};
 use crate::run::alloc;
 
@@ -49,24 +50,24 @@ pub fn flesh_bind<'py>(
 }
 
 /// Deform registered vertices onto a posed spine; see `spinal.SpineBinding.deform`.
-/// `blend` is the weight of `solution="blend"` (refused with the other solutions);
-/// `planar`: the shape lies in the spine's plane, where every corrected solution is the
-/// planar quadratic (the normal solution).
+/// `options`: `solution`, `twist` (per-vertex angles, `None` for none), `closed` (default
+/// false), `blend` (the weight of `solution="blend"`, refused with the other solutions) and
+/// `planar` (default false: the shape lies in the spine's plane, where every corrected
+/// solution is the planar quadratic, the normal solution).
 #[pyfunction]
-#[pyo3(signature = (posed_points, posed_frames, edge, coords, solution, twist, closed=false, blend=None, planar=false))]
-#[allow(clippy::too_many_arguments)]
 pub fn flesh_deform<'py>(
     py: Python<'py>,
     posed_points: PyReadonlyArray2<'py, f64>,
     posed_frames: PyReadonlyArray3<'py, f64>,
     edge: PyReadonlyArray1<'py, i64>,
     coords: PyReadonlyArray2<'py, f64>,
-    solution: Solution,
-    twist: Option<PyReadonlyArray1<'py, f64>>,
-    closed: bool,
-    blend: Option<f64>,
-    planar: bool,
+    options: Options<'py>,
 ) -> PyResult<FleshPose<'py>> {
+    let solution: Solution = options.get("solution")?;
+    let twist: Option<PyReadonlyArray1<'py, f64>> = options.opt("twist")?;
+    let closed: bool = options.get_or("closed", false)?;
+    let blend: Option<f64> = options.opt("blend")?;
+    let planar: bool = options.get_or("planar", false)?;
     let mut solution = solution.with_blend(blend)?;
     if planar && solution != Solution::None {
         solution = Solution::Normal;
