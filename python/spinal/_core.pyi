@@ -404,9 +404,7 @@ def flesh_trisurface_deform(
     faces: npt.NDArray[np.int64],
     face: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    rest_exp: int,
-    corrected: bool,
-    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_surface_deform(
     posed_points: npt.NDArray[np.float64],
@@ -414,9 +412,7 @@ def flesh_surface_deform(
     nv: int,
     cell: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    rest_exp: int,
-    corrected: bool,
-    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def stamp(
     vertices: npt.NDArray[np.float64],

@@ -12,7 +12,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use super::coerce;
-use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
+use super::convert::{
+    Stop, detach_stoppable, empty, option_string, real, slice_mut, slice_of, vec3s,
+};
 use super::options::Options;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -246,10 +248,11 @@ macro_rules! two_way {
         #[derive(Clone, Copy)]
         pub struct $ty(bool);
 
-        impl FromPyObject<'_, '_> for $ty {
-            type Error = PyErr;
-            fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-                choice(obj, $arg, $arg, &[($false_name, $ty(false)), ($true_name, $ty(true))])
+        option_string!($ty, $arg, $arg, [($false_name, $ty(false)), ($true_name, $ty(true))]);
+
+        impl Core<bool> for $ty {
+            fn core(self) -> bool {
+                self.0
             }
         }
     };
@@ -272,68 +275,96 @@ two_way!(
     Carry, "tool", "push", "carry"
 );
 
-impl FromPyObject<'_, '_> for path::PathKind {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        use path::PathKind as K;
-        choice(
-            obj,
-            "kind",
-            "kind",
-            &[
-                ("translate", K::Translate),
-                ("rotate", K::Rotate),
-                ("twist", K::Twist),
-                ("bend", K::Bend),
-            ],
-        )
+option_string!(
+    path::PathKind,
+    "kind",
+    "kind",
+    [
+        ("translate", path::PathKind::Translate),
+        ("rotate", path::PathKind::Rotate),
+        ("twist", path::PathKind::Twist),
+        ("bend", path::PathKind::Bend),
+    ]
+);
+
+/// An argument as the core's constructors take it (vectors as [`DVec3`], option strings as
+/// their `bool`).
+trait Core<T> {
+    fn core(self) -> T;
+}
+
+impl Core<DVec3> for [f64; 3] {
+    fn core(self) -> DVec3 {
+        self.into()
     }
 }
 
-/// `spinal.fields.translation`.
-#[pyfunction]
-pub fn field_translation(
-    center: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    falloff_power: i64,
-    moving: bool,
-) -> PyResult<PyField> {
-    let t = Translation::new(
-        center.into(),
-        radius,
-        velocity.into(),
-        reach,
-        falloff_power,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(t), "translation"))
+impl Core<Option<DVec3>> for Option<[f64; 3]> {
+    fn core(self) -> Option<DVec3> {
+        self.map(DVec3::from)
+    }
 }
 
-/// `spinal.fields.rotation`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_rotation(
-    center: [f64; 3],
-    radius: f64,
-    axis: [f64; 3],
-    angular_speed: f64,
-    pivot: Option<[f64; 3]>,
-    reach: Option<f64>,
-    falloff_power: i64,
-) -> PyResult<PyField> {
-    let r = Rotation::new(
-        center.into(),
-        radius,
-        axis.into(),
-        angular_speed,
-        pivot.map(DVec3::from),
-        reach,
-        falloff_power,
-    )?;
-    Ok(PyField::new(Field::single(r), "rotation"))
+/// Numbers and flags pass as they are.
+macro_rules! core_as_is {
+    ($($ty:ty),+) => {
+        $(impl Core<$ty> for $ty {
+            fn core(self) -> $ty {
+                self
+            }
+        })+
+    };
 }
+core_as_is!(f64, Option<f64>, i64, bool);
+
+/// A constructor of one tool with a fixed name: `tool_binding!(field_x, "x", X::new, (arg:
+/// Type, …))` converts each argument with [`Core`] and passes them to `X::new` in order.
+macro_rules! tool_binding {
+    ($(#[$doc:meta])* $fn:ident, $name:literal, $new:path, ($($arg:ident: $ty:ty),+ $(,)?)) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $fn($($arg: $ty),+) -> PyResult<PyField> {
+            let tool = $new($($arg.core()),+)?;
+            Ok(PyField::new(Field::single(tool), $name))
+        }
+    };
+}
+
+tool_binding!(
+    /// `spinal.fields.translation`.
+    field_translation, "translation", Translation::new,
+    (center: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>,
+     falloff_power: i64, moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.rotation`.
+    field_rotation, "rotation", Rotation::new,
+    (center: [f64; 3], radius: f64, axis: [f64; 3], angular_speed: f64,
+     pivot: Option<[f64; 3]>, reach: Option<f64>, falloff_power: i64)
+);
+
+tool_binding!(
+    /// `spinal.fields.sphere`.
+    field_sphere, "sphere", Sphere::new,
+    (center: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>, blend: Blend,
+     moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.capsule`.
+    field_capsule, "capsule", Capsule::new,
+    (start: [f64; 3], end: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>,
+     blend: Blend, moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.torus`.
+    field_torus, "torus", Torus::new,
+    (center: [f64; 3], axis: [f64; 3], major: f64, minor: f64, speed: f64,
+     reach: Option<f64>, blend: Blend, moving: bool)
+);
 
 /// `spinal.fields.twist` (`bend = false`) and `spinal.fields.bend`.
 #[pyfunction]
@@ -355,51 +386,6 @@ pub fn field_swirl(
         Field::single(s),
         if bend { "bend" } else { "twist" },
     ))
-}
-
-/// `spinal.fields.sphere`.
-#[pyfunction]
-pub fn field_sphere(
-    center: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let s = Sphere::new(
-        center.into(),
-        radius,
-        velocity.into(),
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(s), "sphere"))
-}
-
-/// `spinal.fields.capsule`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_capsule(
-    start: [f64; 3],
-    end: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let c = Capsule::new(
-        start.into(),
-        end.into(),
-        radius,
-        velocity.into(),
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(c), "capsule"))
 }
 
 /// `spinal.fields.strip`.
@@ -430,32 +416,6 @@ pub fn field_strip(
             "strip(along)"
         },
     ))
-}
-
-/// `spinal.fields.torus`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_torus(
-    center: [f64; 3],
-    axis: [f64; 3],
-    major: f64,
-    minor: f64,
-    speed: f64,
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let t = Torus::new(
-        center.into(),
-        axis.into(),
-        major,
-        minor,
-        speed,
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(t), "torus"))
 }
 
 /// `spinal.fields.strip_curve` from its axis samples `(n, 3)`.
@@ -687,10 +647,9 @@ impl MotionOptions {
     }
 }
 
-/// `spinal.fields.sdf_curl` / `mesh_curl` from the B-spline coefficients `(nx+2, ny+2,
-/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes. `options`: the grid's (see
-/// [`GridPlace`]), `velocity`, `angular_velocity`, `pivot` (the motion, each `None` when not
-/// given), `falloff_power` and `moving`.
+/// `spinal.fields.sdf_curl` / `mesh_curl`: a curl tool shaped by the sampled distance of
+/// [`field_grid`] (the same `coefficients`). `options`: the grid's (see [`GridPlace`]) and
+/// the motion's (see [`MotionOptions`]).
 #[pyfunction]
 pub fn field_grid_curl(
     py: Python<'_>,
