@@ -254,14 +254,7 @@ def field_strip_curve(
 ) -> Field: ...
 def field_grid(
     coefficients: npt.NDArray[np.float64],
-    origin: _V3,
-    spacing: float,
-    velocity: _V3,
-    center: _V3,
-    reach: float,
-    blend: str,
-    moving: bool,
-    name: str,
+    options: Options,
 ) -> Field: ...
 def field_grid_coefficients(values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 def field_path(
@@ -272,16 +265,7 @@ def field_path(
 def field_zero() -> Field: ...
 def field_grid_curl(
     coefficients: npt.NDArray[np.float64],
-    origin: _V3,
-    spacing: float,
-    center: _V3,
-    reach: float,
-    velocity: _V3 | None,
-    angular_velocity: _V3 | None,
-    pivot: _V3 | None,
-    falloff_power: int,
-    moving: bool,
-    name: str,
+    options: Options,
 ) -> Field: ...
 def field_rod(
     points: npt.NDArray[np.float64],
@@ -314,24 +298,42 @@ def advect_runs(
     every: int = 0,
     out: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
-class DeformStats(TypedDict):
-    """The counts and timings of :func:`deform_mesh` (a dict at run time)."""
+class DeformStats:
+    """What ``deform_mesh`` did besides moving the vertices (frozen; pickles)."""
 
-    passes: int
-    torn: int
-    over_threshold: int
-    bounded: bool
-    time_integrate: float
-    time_refine: float
-    slip_vertices: int
-    fallback: int
-    flips: int
-    flip_volume: float
-    collapses: int
-    moves: int
-    collapse_volume: float
-    bent: int
-    bend_splits: int
+    def __init__(self, fields: dict[str, int | float | bool]) -> None: ...
+    @property
+    def passes(self) -> int: ...
+    @property
+    def torn(self) -> int: ...
+    @property
+    def over_threshold(self) -> int: ...
+    @property
+    def bounded(self) -> bool: ...
+    @property
+    def time_integrate(self) -> float: ...
+    @property
+    def time_refine(self) -> float: ...
+    @property
+    def slip_vertices(self) -> int: ...
+    @property
+    def fallback(self) -> int: ...
+    @property
+    def flips(self) -> int: ...
+    @property
+    def flip_volume(self) -> float: ...
+    @property
+    def collapses(self) -> int: ...
+    @property
+    def moves(self) -> int: ...
+    @property
+    def collapse_volume(self) -> float: ...
+    @property
+    def bent(self) -> int: ...
+    @property
+    def bend_splits(self) -> int: ...
+    def _asdict(self) -> dict[str, int | float | bool]: ...
+    def __reduce__(self) -> tuple[type[DeformStats], tuple[dict[str, int | float | bool]]]: ...
 
 def deform_mesh(
     vertices: npt.NDArray[np.float64],
@@ -381,11 +383,7 @@ def flesh_deform(
     posed_frames: npt.NDArray[np.float64],
     edge: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    solution: str,
-    twist: npt.NDArray[np.float64] | None,
-    closed: bool = False,
-    blend: float | None = None,
-    planar: bool = False,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_resample(
     posed_points: npt.NDArray[np.float64], chords: npt.NDArray[np.float64]
@@ -406,9 +404,7 @@ def flesh_trisurface_deform(
     faces: npt.NDArray[np.int64],
     face: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    rest_exp: int,
-    corrected: bool,
-    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def flesh_surface_deform(
     posed_points: npt.NDArray[np.float64],
@@ -416,9 +412,7 @@ def flesh_surface_deform(
     nv: int,
     cell: npt.NDArray[np.int64],
     coords: npt.NDArray[np.float64],
-    rest_exp: int,
-    corrected: bool,
-    directions: tuple[str, npt.NDArray[np.float64]] | None = None,
+    options: Options,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
 def stamp(
     vertices: npt.NDArray[np.float64],

@@ -359,12 +359,12 @@ def deform(
     finally:
         if bar:
             bar[0].close()
-    torn, over, bounded = stats["torn"], stats["over_threshold"], stats["bounded"]
-    on_slip, chord, bent = stats["slip_vertices"], stats["fallback"], stats["bent"]
-    flips, flip_volume = stats["flips"], stats["flip_volume"]
-    collapses, moves, collapse_volume = stats["collapses"], stats["moves"], stats["collapse_volume"]
-    passes, bent_added = stats["passes"], stats["bend_splits"]
-    t_int, t_ref = stats["time_integrate"], stats["time_refine"]
+    torn, over, bounded = stats.torn, stats.over_threshold, stats.bounded
+    on_slip, chord, bent = stats.slip_vertices, stats.fallback, stats.bent
+    flips, flip_volume = stats.flips, stats.flip_volume
+    collapses, moves, collapse_volume = stats.collapses, stats.moves, stats.collapse_volume
+    passes, bent_added = stats.passes, stats.bend_splits
+    t_int, t_ref = stats.time_integrate, stats.time_refine
     clock = time.perf_counter()
     e, (rest, vol) = _volumes(Fr, Vr, W)
     change = vol / rest - 1 if rest != 0 else float("nan")

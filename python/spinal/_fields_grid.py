@@ -47,7 +47,9 @@ def _grid_field(values: np.ndarray, origin: np.ndarray, h: float, velocity: Arra
     the support stays inside the grid)."""
     u = as_vector(velocity, "velocity")
     coef, c, r = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid(coef, origin, h, u, c, r, blend, as_bool(moving, "moving"), name)
+    return _core.field_grid(coef, {"origin": origin, "spacing": h, "velocity": u, "center": c,
+                                   "reach": r, "blend": blend,
+                                   "moving": as_bool(moving, "moving"), "name": name})
 
 
 def _grid_spline(values: np.ndarray, origin: np.ndarray, h: float, center: Array | None,
@@ -176,5 +178,7 @@ def _grid_curl(values: np.ndarray, origin: np.ndarray, h: float, center: Array |
                pivot: Array | None, falloff_power: int, moving: bool, name: str) -> Field:
     u, w, p = _motion(velocity, angular_velocity, pivot)
     coef, c, r = _grid_spline(values, origin, h, center, reach)
-    return _core.field_grid_curl(coef, origin, h, c, r, u, w, p, _power(falloff_power),
-                                 as_bool(moving, "moving"), name)
+    return _core.field_grid_curl(coef, {"origin": origin, "spacing": h, "center": c,
+                                        "reach": r, "velocity": u, "angular_velocity": w,
+                                        "pivot": p, "falloff_power": _power(falloff_power),
+                                        "moving": as_bool(moving, "moving"), "name": name})

@@ -480,7 +480,9 @@ class SpineBinding:
         # in the plane every corrected solution is the planar quadratic (the core checks
         # `blend` first)
         out, flags = _core.flesh_deform(_loop(posed, c), _loop(frames1, c), self._edge,
-                                        self._coords, solution, tw, c, blend, self._dim == 2)
+                                        self._coords, {"solution": solution, "twist": tw,
+                                                       "closed": c, "blend": blend,
+                                                       "planar": self._dim == 2})
         self.clamped = _report_clamped(flags, strict, level)
         if self._dim == 2:
             out = np.ascontiguousarray(out[:, :2])

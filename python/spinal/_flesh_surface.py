@@ -335,9 +335,10 @@ class SurfaceBinding:
             pv = self._posed_vertices(posed_surface)
             dirs = _surface_directions(posed_frames, posed_up, (self._nverts,))
             out, flags = _core.flesh_trisurface_deform(
-                pv, self._faces, self._cell, self._coords, self._exp, solution == "offset",
-                dirs)
-            res: Float64Array | tuple[Float64Array, Int64Array] = self._report(out, flags, strict, return_clamped)
+                pv, self._faces, self._cell, self._coords,
+                {"rest_exp": self._exp, "corrected": solution == "offset", "directions": dirs})
+            res: Float64Array | tuple[Float64Array, Int64Array] = self._report(
+                out, flags, strict, return_clamped)
             return res
         g = _grid(posed_surface, "posed_surface")
         if g.shape[:2] != self._shape:
@@ -345,8 +346,10 @@ class SurfaceBinding:
                              f"{self._shape}, got {g.shape[:2]}")
         dirs = _surface_directions(posed_frames, posed_up, self._shape)
         out, flags = _core.flesh_surface_deform(g.reshape(-1, 3), g.shape[0], g.shape[1],
-                                                self._cell, self._coords, self._exp,
-                                                solution == "offset", dirs)
+                                                self._cell, self._coords,
+                                                {"rest_exp": self._exp,
+                                                 "corrected": solution == "offset",
+                                                 "directions": dirs})
         return self._report(out, flags, strict, return_clamped)
 
     def _posed_vertices(self, posed_surface: object) -> np.ndarray:

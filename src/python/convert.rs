@@ -355,15 +355,15 @@ pub fn offsets_of(offsets: &PyReadonlyArray1<'_, i64>) -> PyResult<Vec<usize>> {
 /// `(k, 3, 3)` (row-major with columns `r, s, t`); `arg` is `"initial"` or `"end"`.
 pub fn orientations(
     arg: &str,
-    vectors: Option<PyReadonlyArray2<'_, f64>>,
-    frames: Option<PyReadonlyArray3<'_, f64>>,
+    vectors: Option<&PyReadonlyArray2<'_, f64>>,
+    frames: Option<&PyReadonlyArray3<'_, f64>>,
 ) -> PyResult<Vec<Orientation>> {
     let mut out = Vec::new();
     if let Some(v) = vectors {
-        out.extend(vec3s(arg, &v)?.iter().map(|p| Orientation::Vector(*p)));
+        out.extend(vec3s(arg, v)?.iter().map(|p| Orientation::Vector(*p)));
     }
     if let Some(f) = frames {
-        let s = slice_of(arg, &f)?;
+        let s = slice_of(arg, f)?;
         // row-major (rows of the matrix) -> glam's column-major: transpose
         out.extend(s.chunks_exact(9).map(|a| {
             let mut cols = [0.0; 9];
@@ -520,27 +520,36 @@ pub fn choice<T: Copy>(
     )))
 }
 
-impl FromPyObject<'_, '_> for Method {
-    type Error = PyErr;
+/// `FromPyObject` for an option string read by [`choice`]: `option_string!(Type, "arg",
+/// "what", [("name", value), …])`.
+macro_rules! option_string {
+    ($ty:ty, $arg:literal, $what:literal, [$(($name:literal, $value:expr)),+ $(,)?]) => {
+        impl ::pyo3::FromPyObject<'_, '_> for $ty {
+            type Error = ::pyo3::PyErr;
 
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        choice(
-            obj,
-            "method",
-            "method",
-            &[
-                ("double_reflection", Method::DoubleReflection),
-                ("projection", Method::Projection),
-                ("rotation", Method::Rotation),
-                ("frenet", Method::Frenet),
-                ("rk4", Method::Rk4),
-                ("rk4_phi", Method::Rk4Phi),
-                ("torsion", Method::Torsion),
-                ("bisector", Method::Bisector),
-            ],
-        )
-    }
+            fn extract(obj: ::pyo3::Borrowed<'_, '_, ::pyo3::PyAny>) -> ::pyo3::PyResult<Self> {
+                $crate::python::convert::choice(obj, $arg, $what, &[$(($name, $value)),+])
+            }
+        }
+    };
 }
+pub(crate) use option_string;
+
+option_string!(
+    Method,
+    "method",
+    "method",
+    [
+        ("double_reflection", Method::DoubleReflection),
+        ("projection", Method::Projection),
+        ("rotation", Method::Rotation),
+        ("frenet", Method::Frenet),
+        ("rk4", Method::Rk4),
+        ("rk4_phi", Method::Rk4Phi),
+        ("torsion", Method::Torsion),
+        ("bisector", Method::Bisector),
+    ]
+);
 
 impl FromPyObject<'_, '_> for TangentRule {
     type Error = PyErr;
@@ -576,55 +585,38 @@ impl FromPyObject<'_, '_> for TangentRule {
     }
 }
 
-impl FromPyObject<'_, '_> for ph::frame::Mode {
-    type Error = PyErr;
+option_string!(
+    ph::frame::Mode,
+    "mode",
+    "frame",
+    [
+        ("frenet", ph::frame::Mode::Frenet),
+        ("exact", ph::frame::Mode::Exact),
+        ("rational", ph::frame::Mode::Rational),
+    ]
+);
 
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        use ph::frame::Mode;
-        choice(
-            obj,
-            "mode",
-            "frame",
-            &[
-                ("frenet", Mode::Frenet),
-                ("exact", Mode::Exact),
-                ("rational", Mode::Rational),
-            ],
-        )
-    }
-}
+option_string!(
+    deform::advect::Method,
+    "method",
+    "method",
+    [
+        ("rk4", deform::advect::Method::Rk4),
+        ("euler", deform::advect::Method::Euler),
+        ("split", deform::advect::Method::Split),
+    ]
+);
 
-impl FromPyObject<'_, '_> for deform::advect::Method {
-    type Error = PyErr;
-
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        use deform::advect::Method as M;
-        choice(
-            obj,
-            "method",
-            "method",
-            &[("rk4", M::Rk4), ("euler", M::Euler), ("split", M::Split)],
-        )
-    }
-}
-
-impl FromPyObject<'_, '_> for flesh::Solution {
-    type Error = PyErr;
-
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        use flesh::Solution as S;
-        choice(
-            obj,
-            "solution",
-            "value",
-            &[
-                ("none", S::None),
-                ("normal", S::Normal),
-                ("binormal", S::Binormal),
-                ("radial", S::Radial),
-                // the weight is set from the `blend` argument (Solution::with_blend)
-                ("blend", S::Blend(f64::NAN)),
-            ],
-        )
-    }
-}
+option_string!(
+    flesh::Solution,
+    "solution",
+    "value",
+    [
+        ("none", flesh::Solution::None),
+        ("normal", flesh::Solution::Normal),
+        ("binormal", flesh::Solution::Binormal),
+        ("radial", flesh::Solution::Radial),
+        // the weight is set from the `blend` option (Solution::with_blend)
+        ("blend", flesh::Solution::Blend(f64::NAN)),
+    ]
+);

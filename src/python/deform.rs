@@ -4,7 +4,7 @@
 use glam::DVec3;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
 
 use super::convert::{
     Stop, Ticker, detach_stoppable, slice_mut, triangles, value_error, vec3_array, vec3s,
@@ -108,21 +108,109 @@ fn advect_runs_impl<'py>(
     Ok(out)
 }
 
+/// Declares a frozen record class of the core from one list of its fields, each copied from
+/// the same field of a core struct: read-only attributes, `repr`, `==` and pickling (by
+/// rebuilding from the `dict` of its fields, `_asdict()`).
+macro_rules! record {
+    ($(#[$doc:meta])* $name:ident from $source:ty {
+        $($(#[$fdoc:meta])* $field:ident: $ty:ty,)+
+    }) => {
+        $(#[$doc])*
+        #[pyclass(frozen, eq, module = "spinal._core")]
+        #[derive(Clone, PartialEq)]
+        pub struct $name {
+            $($(#[$fdoc])* #[pyo3(get)] pub $field: $ty,)+
+        }
+
+        impl From<&$source> for $name {
+            fn from(s: &$source) -> $name {
+                $name { $($field: s.$field,)+ }
+            }
+        }
+
+        #[pymethods]
+        impl $name {
+            /// The record of the `dict` of its fields (as `_asdict()` gives them).
+            #[new]
+            fn new(fields: Options<'_>) -> PyResult<$name> {
+                Ok($name { $($field: fields.get(stringify!($field))?,)+ })
+            }
+
+            /// The fields as a `dict`, in order.
+            fn _asdict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+                let d = PyDict::new(py);
+                $(d.set_item(stringify!($field), self.$field)?;)+
+                Ok(d)
+            }
+
+            fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+                let fields = [$(format!(
+                    "{}={}",
+                    stringify!($field),
+                    self.$field.into_pyobject(py)?.repr()?
+                )),+];
+                Ok(format!("{}({})", stringify!($name), fields.join(", ")))
+            }
+
+            /// Pickle support: rebuilt from `_asdict()`.
+            fn __reduce__<'py>(
+                slf: &Bound<'py, Self>,
+            ) -> PyResult<(Bound<'py, PyType>, (Bound<'py, PyDict>,))> {
+                Ok((slf.get_type(), (slf.get()._asdict(slf.py())?,)))
+            }
+        }
+    };
+}
+
+record!(
+    /// What [`deform_mesh`] did besides moving the vertices (`spinal.DeformReport` is built
+    /// from it and the volumes).
+    DeformStats from refine::Deformed {
+        /// Refinement passes that split at least one edge.
+        passes: usize,
+        /// New vertices of edges that the slip at a curl tool's surface tore apart.
+        torn: usize,
+        /// Edges over the threshold at the end (0 when the refinement converged).
+        over_threshold: usize,
+        /// Whether `max_vertices` or `max_passes` stopped the refinement with edges still
+        /// too long or bent.
+        bounded: bool,
+        /// Wall time of the integration of the mesh's vertices, seconds.
+        time_integrate: f64,
+        /// Wall time of the refinement, seconds.
+        time_refine: f64,
+        /// Vertices on a slip surface at the end.
+        slip_vertices: usize,
+        /// New vertices placed at a torn edge's chord midpoint.
+        fallback: usize,
+        /// Edges flipped along slip surfaces.
+        flips: usize,
+        /// The change of the volume by the flips.
+        flip_volume: f64,
+        /// Edges collapsed along slip surfaces after the integration.
+        collapses: usize,
+        /// Vertices of slivers moved on a slip surface after the collapses.
+        moves: usize,
+        /// The change of the volume by the collapses and moves.
+        collapse_volume: f64,
+        /// Edges still bent by the flow at the end.
+        bent: usize,
+        /// Vertices added by the bending splits.
+        bend_splits: usize,
+    }
+);
+
 type DeformArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyDict>,
+    DeformStats,
 );
 
 /// Deform a closed mesh along a field, refining after every step (see `deform::refine`):
-/// `(vertices, rest_vertices, faces, vertices after each step, statistics)`. The statistics
-/// are a dict: `passes`, `torn` (vertices), `over_threshold` (edges over the threshold),
-/// `bounded`, `time_integrate` and `time_refine` (seconds), `slip_vertices` (vertices on a
-/// slip surface), `fallback` (vertices at a torn edge's chord midpoint), `flips`,
-/// `flip_volume` (their volume change), `collapses`, `moves`, `collapse_volume` (the volume
-/// change of the collapses and moves), `bent` and `bend_splits`. `options`: `t0`,
+/// `(vertices, rest_vertices, faces, vertices after each step, statistics)`, the statistics
+/// a [`DeformStats`]. `options`: `t0`,
 /// `duration`, `steps`, `refine` (`None` only advects), `max_vertices`, `max_passes` and
 /// `check` (default true). With `check`, a mesh that is open, not edge-manifold,
 /// inconsistently wound or wound inwards is refused first (errors name `mesh`). Ctrl-C stops
@@ -171,22 +259,7 @@ pub fn deform_mesh<'py>(
     let faces = alloc::flat("deform", d.faces.iter().map(|f| f.map(|i| i as i64)))?;
     let nf = d.faces.len();
     let counts = alloc::collect("deform", d.step_vertices.iter().map(|&c| c as i64))?;
-    let stats = PyDict::new(py);
-    stats.set_item("passes", d.passes)?;
-    stats.set_item("torn", d.torn)?;
-    stats.set_item("over_threshold", d.over_threshold)?;
-    stats.set_item("bounded", d.bounded)?;
-    stats.set_item("time_integrate", d.time_integrate)?;
-    stats.set_item("time_refine", d.time_refine)?;
-    stats.set_item("slip_vertices", d.slip_vertices)?;
-    stats.set_item("fallback", d.fallback)?;
-    stats.set_item("flips", d.flips)?;
-    stats.set_item("flip_volume", d.flip_volume)?;
-    stats.set_item("collapses", d.collapses)?;
-    stats.set_item("moves", d.moves)?;
-    stats.set_item("collapse_volume", d.collapse_volume)?;
-    stats.set_item("bent", d.bent)?;
-    stats.set_item("bend_splits", d.bend_splits)?;
+    let stats = DeformStats::from(&d);
     Ok((
         vec3_array(py, d.vertices)?,
         vec3_array(py, d.rest)?,

@@ -12,7 +12,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use super::coerce;
-use super::convert::{Stop, choice, detach_stoppable, empty, real, slice_mut, slice_of, vec3s};
+use super::convert::{
+    Stop, detach_stoppable, empty, option_string, real, slice_mut, slice_of, vec3s,
+};
 use super::options::Options;
 use crate::deform::{
     self, Capsule, Field, Rotation, Sphere, Swirl, SwirlKind, Torus, Translation, curl, grid,
@@ -246,10 +248,11 @@ macro_rules! two_way {
         #[derive(Clone, Copy)]
         pub struct $ty(bool);
 
-        impl FromPyObject<'_, '_> for $ty {
-            type Error = PyErr;
-            fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-                choice(obj, $arg, $arg, &[($false_name, $ty(false)), ($true_name, $ty(true))])
+        option_string!($ty, $arg, $arg, [($false_name, $ty(false)), ($true_name, $ty(true))]);
+
+        impl Core<bool> for $ty {
+            fn core(self) -> bool {
+                self.0
             }
         }
     };
@@ -272,68 +275,96 @@ two_way!(
     Carry, "tool", "push", "carry"
 );
 
-impl FromPyObject<'_, '_> for path::PathKind {
-    type Error = PyErr;
-    fn extract(obj: Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
-        use path::PathKind as K;
-        choice(
-            obj,
-            "kind",
-            "kind",
-            &[
-                ("translate", K::Translate),
-                ("rotate", K::Rotate),
-                ("twist", K::Twist),
-                ("bend", K::Bend),
-            ],
-        )
+option_string!(
+    path::PathKind,
+    "kind",
+    "kind",
+    [
+        ("translate", path::PathKind::Translate),
+        ("rotate", path::PathKind::Rotate),
+        ("twist", path::PathKind::Twist),
+        ("bend", path::PathKind::Bend),
+    ]
+);
+
+/// An argument as the core's constructors take it (vectors as [`DVec3`], option strings as
+/// their `bool`).
+trait Core<T> {
+    fn core(self) -> T;
+}
+
+impl Core<DVec3> for [f64; 3] {
+    fn core(self) -> DVec3 {
+        self.into()
     }
 }
 
-/// `spinal.fields.translation`.
-#[pyfunction]
-pub fn field_translation(
-    center: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    falloff_power: i64,
-    moving: bool,
-) -> PyResult<PyField> {
-    let t = Translation::new(
-        center.into(),
-        radius,
-        velocity.into(),
-        reach,
-        falloff_power,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(t), "translation"))
+impl Core<Option<DVec3>> for Option<[f64; 3]> {
+    fn core(self) -> Option<DVec3> {
+        self.map(DVec3::from)
+    }
 }
 
-/// `spinal.fields.rotation`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_rotation(
-    center: [f64; 3],
-    radius: f64,
-    axis: [f64; 3],
-    angular_speed: f64,
-    pivot: Option<[f64; 3]>,
-    reach: Option<f64>,
-    falloff_power: i64,
-) -> PyResult<PyField> {
-    let r = Rotation::new(
-        center.into(),
-        radius,
-        axis.into(),
-        angular_speed,
-        pivot.map(DVec3::from),
-        reach,
-        falloff_power,
-    )?;
-    Ok(PyField::new(Field::single(r), "rotation"))
+/// Numbers and flags pass as they are.
+macro_rules! core_as_is {
+    ($($ty:ty),+) => {
+        $(impl Core<$ty> for $ty {
+            fn core(self) -> $ty {
+                self
+            }
+        })+
+    };
 }
+core_as_is!(f64, Option<f64>, i64, bool);
+
+/// A constructor of one tool with a fixed name: `tool_binding!(field_x, "x", X::new, (arg:
+/// Type, …))` converts each argument with [`Core`] and passes them to `X::new` in order.
+macro_rules! tool_binding {
+    ($(#[$doc:meta])* $fn:ident, $name:literal, $new:path, ($($arg:ident: $ty:ty),+ $(,)?)) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $fn($($arg: $ty),+) -> PyResult<PyField> {
+            let tool = $new($($arg.core()),+)?;
+            Ok(PyField::new(Field::single(tool), $name))
+        }
+    };
+}
+
+tool_binding!(
+    /// `spinal.fields.translation`.
+    field_translation, "translation", Translation::new,
+    (center: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>,
+     falloff_power: i64, moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.rotation`.
+    field_rotation, "rotation", Rotation::new,
+    (center: [f64; 3], radius: f64, axis: [f64; 3], angular_speed: f64,
+     pivot: Option<[f64; 3]>, reach: Option<f64>, falloff_power: i64)
+);
+
+tool_binding!(
+    /// `spinal.fields.sphere`.
+    field_sphere, "sphere", Sphere::new,
+    (center: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>, blend: Blend,
+     moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.capsule`.
+    field_capsule, "capsule", Capsule::new,
+    (start: [f64; 3], end: [f64; 3], radius: f64, velocity: [f64; 3], reach: Option<f64>,
+     blend: Blend, moving: bool)
+);
+
+tool_binding!(
+    /// `spinal.fields.torus`.
+    field_torus, "torus", Torus::new,
+    (center: [f64; 3], axis: [f64; 3], major: f64, minor: f64, speed: f64,
+     reach: Option<f64>, blend: Blend, moving: bool)
+);
 
 /// `spinal.fields.twist` (`bend = false`) and `spinal.fields.bend`.
 #[pyfunction]
@@ -355,51 +386,6 @@ pub fn field_swirl(
         Field::single(s),
         if bend { "bend" } else { "twist" },
     ))
-}
-
-/// `spinal.fields.sphere`.
-#[pyfunction]
-pub fn field_sphere(
-    center: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let s = Sphere::new(
-        center.into(),
-        radius,
-        velocity.into(),
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(s), "sphere"))
-}
-
-/// `spinal.fields.capsule`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_capsule(
-    start: [f64; 3],
-    end: [f64; 3],
-    radius: f64,
-    velocity: [f64; 3],
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let c = Capsule::new(
-        start.into(),
-        end.into(),
-        radius,
-        velocity.into(),
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(c), "capsule"))
 }
 
 /// `spinal.fields.strip`.
@@ -432,32 +418,6 @@ pub fn field_strip(
     ))
 }
 
-/// `spinal.fields.torus`.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_torus(
-    center: [f64; 3],
-    axis: [f64; 3],
-    major: f64,
-    minor: f64,
-    speed: f64,
-    reach: Option<f64>,
-    blend: Blend,
-    moving: bool,
-) -> PyResult<PyField> {
-    let t = Torus::new(
-        center.into(),
-        axis.into(),
-        major,
-        minor,
-        speed,
-        reach,
-        blend.0,
-        moving,
-    )?;
-    Ok(PyField::new(Field::single(t), "torus"))
-}
-
 /// `spinal.fields.strip_curve` from its axis samples `(n, 3)`.
 #[pyfunction]
 pub fn field_strip_curve(
@@ -476,32 +436,76 @@ pub fn field_strip_curve(
     Ok(PyField::new(Field::single(tool), "strip_curve"))
 }
 
+/// The grid of a sampled distance and where its tool sits, read from a grid constructor's
+/// `options`: `origin`, `spacing`, `center`, `reach` and `name` (the constructor's, for
+/// `repr`).
+struct GridPlace {
+    origin: DVec3,
+    spacing: f64,
+    center: DVec3,
+    reach: f64,
+    name: String,
+}
+
+impl GridPlace {
+    fn read(o: &Options<'_>) -> PyResult<GridPlace> {
+        Ok(GridPlace {
+            origin: o.get::<[f64; 3]>("origin")?.into(),
+            spacing: o.get("spacing")?,
+            center: o.get::<[f64; 3]>("center")?.into(),
+            reach: o.get("reach")?,
+            name: o.get("name")?,
+        })
+    }
+
+    /// The region tool of the B-spline `coefficients` at this place ([`grid::grid_tool`]).
+    fn tool(
+        &self,
+        py: Python<'_>,
+        coefficients: &PyReadonlyArray3<'_, f64>,
+        velocity: DVec3,
+        blend: Blend,
+        moving: bool,
+    ) -> PyResult<grid::GridTool> {
+        let sh = coefficients.shape();
+        let shape = [sh[0], sh[1], sh[2]];
+        let coef = slice_of("grid", coefficients)?;
+        let stop = Stop::default();
+        let tool = detach_stoppable(py, &stop, || {
+            let (o, c) = (self.origin, self.center);
+            let cancel = || stop.requested();
+            grid::grid_tool(
+                o,
+                self.spacing,
+                shape,
+                coef,
+                velocity,
+                c,
+                self.reach,
+                blend.0,
+                moving,
+                &cancel,
+            )
+        })??;
+        Ok(tool)
+    }
+}
+
 /// `spinal.fields.sdf_tool` / `mesh_tool` from the B-spline coefficients `(nx+2, ny+2,
-/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes.
+/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes. `options`: the grid's (see
+/// [`GridPlace`]), `velocity`, `blend` and `moving`.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 pub fn field_grid(
     py: Python<'_>,
     coefficients: PyReadonlyArray3<'_, f64>,
-    origin: [f64; 3],
-    spacing: f64,
-    velocity: [f64; 3],
-    center: [f64; 3],
-    reach: f64,
-    blend: Blend,
-    moving: bool,
-    name: &str,
+    options: Options<'_>,
 ) -> PyResult<PyField> {
-    let (shape, coef) = coefficients_of(&coefficients)?;
-    let stop = Stop::default();
-    let tool = detach_stoppable(py, &stop, || {
-        let (o, u, c) = (origin.into(), velocity.into(), center.into());
-        let cancel = || stop.requested();
-        grid::grid_tool(
-            o, spacing, shape, coef, u, c, reach, blend.0, moving, &cancel,
-        )
-    })??;
-    Ok(PyField::new(Field::single(tool), name))
+    let place = GridPlace::read(&options)?;
+    let velocity: [f64; 3] = options.get("velocity")?;
+    let blend: Blend = options.get("blend")?;
+    let moving: bool = options.get("moving")?;
+    let tool = place.tool(py, &coefficients, velocity.into(), blend, moving)?;
+    Ok(PyField::new(Field::single(tool), &place.name))
 }
 
 /// `spinal.fields.along_path`: spine samples `(n, 3)` and their frames `(n, 3, 3)` (columns
@@ -595,12 +599,6 @@ pub fn field_grid_coefficients<'py>(
     Ok(out)
 }
 
-/// A grid's B-spline coefficients and their array shape (checked by the core).
-fn coefficients_of<'a>(c: &'a PyReadonlyArray3<'_, f64>) -> PyResult<([usize; 3], &'a [f64])> {
-    let sh = c.shape();
-    Ok(([sh[0], sh[1], sh[2]], slice_of("grid", c)?))
-}
-
 /// A field of one curl tool of `shape` (shared by the tool's copies).
 fn curl_field<D>(
     shape: D,
@@ -617,60 +615,52 @@ where
     Ok(PyField::new(Field::single(tool), name))
 }
 
-/// The motion of a curl tool from its optional arguments.
-fn motion(
-    velocity: Option<[f64; 3]>,
-    angular_velocity: Option<[f64; 3]>,
-    pivot: Option<[f64; 3]>,
-    center: DVec3,
-) -> PyResult<curl::Motion> {
-    Ok(curl::Motion::new(
-        velocity.map(DVec3::from),
-        angular_velocity.map(DVec3::from),
-        pivot.map(DVec3::from),
-        center,
-    )?)
-}
-
-/// `spinal.fields.sdf_curl` / `mesh_curl` from the B-spline coefficients `(nx+2, ny+2,
-/// nz+2)` of the distance sampled on `(nx, ny, nz)` nodes.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-pub fn field_grid_curl(
-    py: Python<'_>,
-    coefficients: PyReadonlyArray3<'_, f64>,
-    origin: [f64; 3],
-    spacing: f64,
-    center: [f64; 3],
-    reach: f64,
+/// The motion of a curl tool, read from its `options`: `velocity`, `angular_velocity`,
+/// `pivot` (each `None` when not given), `falloff_power` and `moving`.
+struct MotionOptions {
     velocity: Option<[f64; 3]>,
     angular_velocity: Option<[f64; 3]>,
     pivot: Option<[f64; 3]>,
     falloff_power: i64,
     moving: bool,
-    name: &str,
+}
+
+impl MotionOptions {
+    fn read(o: &Options<'_>) -> PyResult<MotionOptions> {
+        Ok(MotionOptions {
+            velocity: o.opt("velocity")?,
+            angular_velocity: o.opt("angular_velocity")?,
+            pivot: o.opt("pivot")?,
+            falloff_power: o.get("falloff_power")?,
+            moving: o.get("moving")?,
+        })
+    }
+
+    /// The motion about the tool's `center`.
+    fn motion(&self, center: DVec3) -> PyResult<curl::Motion> {
+        Ok(curl::Motion::new(
+            self.velocity.map(DVec3::from),
+            self.angular_velocity.map(DVec3::from),
+            self.pivot.map(DVec3::from),
+            center,
+        )?)
+    }
+}
+
+/// `spinal.fields.sdf_curl` / `mesh_curl`: a curl tool shaped by the sampled distance of
+/// [`field_grid`] (the same `coefficients`). `options`: the grid's (see [`GridPlace`]) and
+/// the motion's (see [`MotionOptions`]).
+#[pyfunction]
+pub fn field_grid_curl(
+    py: Python<'_>,
+    coefficients: PyReadonlyArray3<'_, f64>,
+    options: Options<'_>,
 ) -> PyResult<PyField> {
-    let (shape, coef) = coefficients_of(&coefficients)?;
-    let stop = Stop::default();
-    let shape = detach_stoppable(py, &stop, || {
-        let (o, c) = (origin.into(), center.into());
-        let cancel = || stop.requested();
-        grid::grid_tool(
-            o,
-            spacing,
-            shape,
-            coef,
-            DVec3::ZERO,
-            c,
-            reach,
-            false,
-            false,
-            &cancel,
-        )
-    })??;
-    let center = shape.center;
-    let m = motion(velocity, angular_velocity, pivot, center)?;
-    curl_field(shape, m, falloff_power, moving, name)
+    let place = GridPlace::read(&options)?;
+    let m = MotionOptions::read(&options)?;
+    let shape = place.tool(py, &coefficients, DVec3::ZERO, Blend(false), false)?;
+    let mo = m.motion(shape.center)?;
+    curl_field(shape, mo, m.falloff_power, m.moving, &place.name)
 }
 
 /// `spinal.fields.rod`: a curl tool shaped as the tube about the axis through `points`.
@@ -685,19 +675,15 @@ pub fn field_rod(
     let radius: f64 = options.get("radius")?;
     let center: Option<[f64; 3]> = options.opt("center")?;
     let reach: Option<f64> = options.opt("reach")?;
-    let velocity: Option<[f64; 3]> = options.opt("velocity")?;
-    let angular_velocity: Option<[f64; 3]> = options.opt("angular_velocity")?;
-    let pivot: Option<[f64; 3]> = options.opt("pivot")?;
-    let falloff_power: i64 = options.get("falloff_power")?;
-    let moving: bool = options.get("moving")?;
+    let m = MotionOptions::read(&options)?;
     let x = vec3s("points", &points)?;
     let stop = Stop::default();
     let rod = detach_stoppable(py, &stop, || {
         let c = center.map(DVec3::from);
         rod::Rod::from_points(x, radius, reach, c, &|| stop.requested())
     })??;
-    let mo = motion(velocity, angular_velocity, pivot, rod.center)?;
-    curl_field(rod, mo, falloff_power, moving, "rod")
+    let mo = m.motion(rod.center)?;
+    curl_field(rod, mo, m.falloff_power, m.moving, "rod")
 }
 
 /// `spinal.fields.keyframed`: `tool` (a field) following keys — its shape when it is one tool

@@ -1,6 +1,7 @@
 //! Frames of sampled and analytic curves and tangent estimates (`spinal.frames`,
 //! `spinal.estimate_tangents`); the algorithms are in [`crate::frames`].
 
+use glam::DVec3;
 use numpy::{
     PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
     PyReadonlyArray3,
@@ -49,6 +50,72 @@ impl<'py> Shape<'py> {
             end_frames: o.opt("end_frames")?,
         })
     }
+
+    /// The start orientations of the curves.
+    fn initial(&self) -> PyResult<Vec<Orientation>> {
+        orientations(
+            "initial",
+            self.initial_vectors.as_ref(),
+            self.initial_frames.as_ref(),
+        )
+    }
+
+    /// The end orientations of the curves.
+    fn end(&self) -> PyResult<Vec<Orientation>> {
+        orientations("end", self.end_vectors.as_ref(), self.end_frames.as_ref())
+    }
+
+    /// A request of these settings for sampled `points` and/or `tangents`, turning by
+    /// `turns` (no analytic curve, start or end yet).
+    fn request<'a>(&self, (points, tangents): Curves<'a>, turns: f64) -> Request<'a> {
+        Request {
+            points,
+            tangents,
+            analytic: None,
+            closed: self.closed,
+            method: self.method,
+            tangent_chords: self.tangent_chords,
+            tangent_rule: self.tangent_rule,
+            initial: None,
+            end: None,
+            turns,
+        }
+    }
+}
+
+/// Sampled points and/or tangents of curves, back to back.
+type Curves<'a> = (Option<&'a [DVec3]>, Option<&'a [DVec3]>);
+
+/// The rows of the `points` and `tangents` arrays (either may be absent) and their count.
+fn curves<'a>(
+    points: &'a Option<PyReadonlyArray2<'_, f64>>,
+    tangents: &'a Option<PyReadonlyArray2<'_, f64>>,
+) -> PyResult<(Curves<'a>, usize)> {
+    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
+    let tgs = tangents
+        .as_ref()
+        .map(|t| vec3s("tangents", t))
+        .transpose()?;
+    Ok(((pts, tgs), pts.or(tgs).map(<[_]>::len).unwrap_or(0)))
+}
+
+/// The exact derivatives of an analytic curve at parameters `u` (`d3` read by the torsion
+/// method only), named after the user's curve `points`.
+fn analytic<'a>(
+    u: &'a PyReadonlyArray1<'_, f64>,
+    d1: &'a PyReadonlyArray2<'_, f64>,
+    d2: &'a PyReadonlyArray2<'_, f64>,
+    d3: &'a Option<PyReadonlyArray2<'_, f64>>,
+) -> PyResult<Analytic<'a>> {
+    Ok(Analytic {
+        u: slice_of("u", u)?,
+        d1: vec3s("points.d1", d1)?,
+        d2: vec3s("points.d2", d2)?,
+        d3: match d3 {
+            Some(d) => vec3s("points.d3", d)?,
+            None => &[],
+        },
+    })
 }
 
 /// Frames of one or many sampled curves; see `spinal.frames` for the meaning. Errors about
@@ -66,39 +133,14 @@ pub fn frames_sampled<'py>(
     progress: Option<Py<PyAny>>,
     out: Option<Bound<'py, PyAny>>,
 ) -> PyResult<FramesAndAngles<'py>> {
-    let Shape {
-        method,
-        tangent_rule,
-        tangent_chords,
-        closed,
-        initial_vectors,
-        initial_frames,
-        end_vectors,
-        end_frames,
-    } = Shape::read(&options)?;
+    let shape = Shape::read(&options)?;
     let turns: f64 = options.get("turns")?;
     let points_arg: String = options.get_or("points_arg", "points".to_string())?;
-    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
-    let tgs = tangents
-        .as_ref()
-        .map(|t| vec3s("tangents", t))
-        .transpose()?;
-    let rows = pts.or(tgs).map(<[_]>::len).unwrap_or(0);
+    let (given, rows) = curves(&points, &tangents)?;
     let offsets = offsets_of(&offsets)?;
-    let initial = orientations("initial", initial_vectors, initial_frames)?;
-    let end = orientations("end", end_vectors, end_frames)?;
-    let template = Request {
-        points: pts,
-        tangents: tgs,
-        analytic: None,
-        closed,
-        method,
-        tangent_chords,
-        tangent_rule,
-        initial: None,
-        end: None,
-        turns,
-    };
+    let initial = shape.initial()?;
+    let end = shape.end()?;
+    let template = shape.request(given, turns);
     // the output and the working vectors of the frames
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = output::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3], out, "out")?;
@@ -131,40 +173,20 @@ pub fn frames_analytic<'py>(
     options: Options<'py>,
     d3: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, f64)> {
-    let Shape {
-        method,
-        closed,
-        initial_vectors,
-        initial_frames,
-        end_vectors,
-        end_frames,
-        ..
-    } = Shape::read(&options)?;
+    let shape = Shape::read(&options)?;
     let turns: f64 = options.get("turns")?;
     let pts = vec3s("points", &points)?;
-    let us = slice_of("u", &u)?;
-    let d1s = vec3s("points.d1", &d1)?;
-    let d2s = vec3s("points.d2", &d2)?;
-    let d3s = match &d3 {
-        Some(d) => vec3s("points.d3", d)?,
-        None => &[],
-    };
-    let initial = orientations("initial", initial_vectors, initial_frames)?;
-    let end = orientations("end", end_vectors, end_frames)?;
+    let exact = analytic(&u, &d1, &d2, &d3)?;
+    let initial = shape.initial()?;
+    let end = shape.end()?;
     let req = Request {
-        points: Some(pts),
-        analytic: Some(Analytic {
-            u: us,
-            d1: d1s,
-            d2: d2s,
-            d3: d3s,
-        }),
-        closed,
-        method,
+        analytic: Some(exact),
         initial: frames::pick(&initial, 0),
         end: frames::pick(&end, 0),
-        turns,
-        ..Request::default()
+        // the tangents are the exact derivatives: no estimate
+        tangent_chords: false,
+        tangent_rule: Request::default().tangent_rule,
+        ..shape.request((Some(pts), None), turns)
     };
     // the output and the working vectors of the frames' scan
     ensure_memory("frames", pts.len(), PROBE_BYTES_PER_ROW)?;
@@ -257,16 +279,7 @@ pub fn frames_steered<'py>(
     use crate::frames::steer::{self, Steering};
     use glam::DMat3;
 
-    let Shape {
-        method,
-        tangent_rule,
-        tangent_chords,
-        closed,
-        initial_vectors,
-        initial_frames,
-        end_vectors,
-        end_frames,
-    } = Shape::read(&options)?;
+    let shape = Shape::read(&options)?;
     let u: Option<PyReadonlyArray1<'py, f64>> = options.opt("u")?;
     let d1: Option<PyReadonlyArray2<'py, f64>> = options.opt("d1")?;
     let d2: Option<PyReadonlyArray2<'py, f64>> = options.opt("d2")?;
@@ -288,16 +301,11 @@ pub fn frames_steered<'py>(
     let guide_previous: Option<PyReadonlyArray2<'py, f64>> = s.opt("guide_previous")?;
     let previous_weight: f64 = s.get_or("previous_weight", 1.0)?;
 
-    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
-    let tgs = tangents
-        .as_ref()
-        .map(|t| vec3s("tangents", t))
-        .transpose()?;
-    let rows = pts.or(tgs).map(<[_]>::len).unwrap_or(0);
+    let (given, rows) = curves(&points, &tangents)?;
     let offsets = offsets_of(&offsets)?;
     let curves = offsets.len().saturating_sub(1);
-    let initial = orientations("initial", initial_vectors, initial_frames)?;
-    let end = orientations("end", end_vectors, end_frames)?;
+    let initial = shape.initial()?;
+    let end = shape.end()?;
     let turns = slice_of("turns", &turns)?;
     let rule = match twist_rule.as_str() {
         "arc_length" => TwistRule::ArcLength,
@@ -357,18 +365,7 @@ pub fn frames_steered<'py>(
             }
         })
         .collect();
-    let template = Request {
-        points: pts,
-        tangents: tgs,
-        analytic: None,
-        closed,
-        method,
-        tangent_chords,
-        tangent_rule,
-        initial: None,
-        end: None,
-        turns: 0.0,
-    };
+    let template = shape.request(given, 0.0);
     // the output, the rotation-minimising frames, the tangents and the twist solve
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3])?;
@@ -377,15 +374,7 @@ pub fn frames_steered<'py>(
         let buf = slice_mut(&mut rw)?;
         if let (Some(u), Some(d1), Some(d2)) = (u.as_ref(), d1.as_ref(), d2.as_ref()) {
             let req = Request {
-                analytic: Some(Analytic {
-                    u: slice_of("u", u)?,
-                    d1: vec3s("points.d1", d1)?,
-                    d2: vec3s("points.d2", d2)?,
-                    d3: match &d3 {
-                        Some(d) => vec3s("points.d3", d)?,
-                        None => &[],
-                    },
-                }),
+                analytic: Some(analytic(u, d1, d2, &d3)?),
                 initial: frames::pick(&initial, 0),
                 end: frames::pick(&end, 0),
                 ..template
@@ -423,43 +412,21 @@ pub fn frames_in_time<'py>(
     previous: Option<PyReadonlyArray3<'py, f64>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let Shape {
-        method,
-        tangent_rule,
-        tangent_chords,
-        closed,
-        initial_vectors,
-        initial_frames,
-        ..
-    } = Shape::read(&options)?;
+    let shape = Shape::read(&options)?;
     let turns: f64 = options.get("turns")?;
-    let pts = points.as_ref().map(|p| vec3s("points", p)).transpose()?;
-    let tgs = tangents
-        .as_ref()
-        .map(|t| vec3s("tangents", t))
-        .transpose()?;
-    let total = pts.or(tgs).map(<[_]>::len).unwrap_or(0);
+    let (given, total) = curves(&points, &tangents)?;
     if steps == 0 || total % steps != 0 {
         return Err(value_error(
             "points: expected shape (T, n, 3) with T ≥ 1 time steps",
         ));
     }
     let rows = total / steps;
-    let initial = orientations("initial", initial_vectors, initial_frames)?;
+    let initial = shape.initial()?;
     let prev = previous
         .as_ref()
         .map(|p| super::convert::frames_of("previous", p))
         .transpose()?;
-    let template = Request {
-        points: pts,
-        tangents: tgs,
-        closed,
-        method,
-        tangent_chords,
-        tangent_rule,
-        turns,
-        ..Request::default()
-    };
+    let template = shape.request(given, turns);
     // the output and every step's working vectors (the steps run in parallel, but each holds
     // its rows' share only)
     ensure_memory("frames", total, PROBE_BYTES_PER_ROW)?;

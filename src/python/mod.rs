@@ -71,6 +71,7 @@ fn core_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fields::field_keyframed, m)?)?;
     m.add_function(wrap_pyfunction!(deform::advect, m)?)?;
     m.add_function(wrap_pyfunction!(deform::advect_runs, m)?)?;
+    m.add_class::<deform::DeformStats>()?;
     m.add_function(wrap_pyfunction!(deform::deform_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(deform::stamp, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::mesh_volume, m)?)?;

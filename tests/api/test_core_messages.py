@@ -34,7 +34,7 @@ def test_option_strings_name_the_argument_and_list_the_choices():
     with pytest.raises(ValueError, match=r"^solution: unknown value \"x\"; expected 'none', "
                        r"'normal', 'binormal', 'radial' or 'blend'"):
         _core.flesh_deform(PTS, np.zeros((4, 3, 3)), np.zeros(0, dtype=np.int64),
-                           np.zeros((0, 3)), "x", None)
+                           np.zeros((0, 3)), {"solution": "x", "twist": None})
     with pytest.raises(TypeError):
         sampled(method=3)
 

@@ -442,18 +442,19 @@ def test_core_strip_and_grid_constructors_refuse_bad_input():
         _core.field_strip_curve(x, RHO, np.nan, RF, "c1")
     d, o = sphere_grid(0.05)
     coef = np.ascontiguousarray(_spline_prefilter(d))
-    grid = (o, 0.05, U, C, 0.4, "c1", True, "sdf_tool")
-    _core.field_grid(coef, *grid)
+    grid = {"origin": o, "spacing": 0.05, "velocity": U, "center": C, "reach": 0.4,
+            "blend": "c1", "moving": True, "name": "sdf_tool"}
+    _core.field_grid(coef, grid)
     with pytest.raises(ValueError, match="^grid: the field's support"):
-        _core.field_grid(coef, o, 0.05, U, C, 2.0, "c1", True, "sdf_tool")
+        _core.field_grid(coef, {**grid, "reach": 2.0})
     with pytest.raises(ValueError, match="^spacing: grid too coarse"):
-        _core.field_grid(coef, o, 0.05, U, C, 0.1, "c1", True, "sdf_tool")
+        _core.field_grid(coef, {**grid, "reach": 0.1})
     bad = coef.copy()
     bad[3, 3, 3] = np.nan
     with pytest.raises(ValueError, match="^grid"):
-        _core.field_grid(bad, *grid)
+        _core.field_grid(bad, grid)
     with pytest.raises(ValueError, match="^grid"):
-        _core.field_grid(coef[:4, :4, :4].copy(), *grid)
+        _core.field_grid(coef[:4, :4, :4].copy(), grid)
 
 
 def _prefilter_numpy(values):
