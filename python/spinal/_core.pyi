@@ -1,7 +1,7 @@
 """Type stubs for the compiled core (``spinal._core``). Use the wrappers in ``spinal``."""
 
 from collections.abc import Callable, Sequence
-from typing import TypeAlias, TypedDict
+from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
