@@ -69,23 +69,30 @@ pub fn corners(
     let interior = |k: usize| closed || (k > 0 && k + 1 < n);
     // the raw chord out of sample k (the closing chord on a closed spine)
     let raw = |k: usize| x[next(k)] - x[k];
-    let mut din = match closed {
-        true => raw(n - 1),
-        false => raw(0),
+    // a turn of 15° or more between chords `a` and `b` (squared lengths `la`, `lb`):
+    // cos φ < cos 15°, decided without a square root
+    let sharp = |a: DVec3, b: DVec3, la: f64, lb: f64| {
+        let c = a.dot(b);
+        c < 0.0 || c * c < MIN_TURN_COS2 * (la * lb)
     };
+    // most spines have no such turn: one pass over the chords, each computed once
+    let mut din = x[1] - x[0];
+    let mut lin = din.length_squared();
     let mut candidates = false;
-    for k in 0..n {
-        if !interior(k) {
-            continue;
-        }
-        let dout = raw(k);
-        let (c, l2) = (din.dot(dout), din.length_squared() * dout.length_squared());
-        // turn ≥ 15°: cos φ < cos 15°, decided without a square root
-        if c < 0.0 || c * c < MIN_TURN_COS2 * l2 {
+    for w in x[1..].windows(2) {
+        let dout = w[1] - w[0];
+        let lout = dout.length_squared();
+        if sharp(din, dout, lin, lout) {
             candidates = true;
             break;
         }
-        din = dout;
+        (din, lin) = (dout, lout);
+    }
+    if closed && !candidates {
+        // the two turns at the closing chord
+        let (a, b, c) = (raw(n - 2), raw(n - 1), raw(0));
+        let (la, lb, lc) = (a.length_squared(), b.length_squared(), c.length_squared());
+        candidates = sharp(a, b, la, lb) || sharp(b, c, lb, lc);
     }
     if !candidates {
         return;
