@@ -4,14 +4,17 @@
 //! ([`ErrorKind::OutOfMemory`], raised as `MemoryError`) and a call stopped by its hook
 //! ([`ErrorKind::Stopped`], raised as `KeyboardInterrupt`).
 
+use std::borrow::Cow;
 use std::fmt;
 
 /// An input that cannot be processed, with the name of the offending argument.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InputError {
     /// Name of the argument as the user sees it (`"points"`, `"tangents"`, `"initial"`, …),
-    /// of the call for [`ErrorKind::OutOfMemory`], `"cancel"` for [`ErrorKind::Stopped`].
-    pub arg: &'static str,
+    /// of the call for [`ErrorKind::OutOfMemory`], `"cancel"` for [`ErrorKind::Stopped`]. A
+    /// literal, or the name under which the user passed an argument that a request carries
+    /// (the points of a curve moving in time as `points_t`, a tube's scale as `radius`).
+    pub arg: Cow<'static, str>,
     /// What is wrong, in words, including the row index where one applies.
     pub msg: String,
     /// Bad input, input too large for the memory, or a call stopped by its hook.
@@ -36,9 +39,9 @@ pub enum ErrorKind {
 }
 
 impl InputError {
-    pub fn new(arg: &'static str, msg: impl Into<String>) -> Self {
+    pub fn new(arg: impl Into<Cow<'static, str>>, msg: impl Into<String>) -> Self {
         InputError {
-            arg,
+            arg: arg.into(),
             msg: msg.into(),
             kind: ErrorKind::Invalid,
         }
@@ -57,7 +60,7 @@ impl InputError {
             }
         };
         InputError {
-            arg: what,
+            arg: Cow::Borrowed(what),
             msg,
             kind: ErrorKind::OutOfMemory,
         }
@@ -66,7 +69,7 @@ impl InputError {
     /// The error of a call stopped by its hook ([`crate::run::cancel`]).
     pub fn stopped() -> Self {
         InputError {
-            arg: "cancel",
+            arg: Cow::Borrowed("cancel"),
             msg: "stopped on request".to_string(),
             kind: ErrorKind::Stopped,
         }
@@ -76,7 +79,7 @@ impl InputError {
     /// input's numbers rather than one buffer's element count).
     pub fn oom_message(what: &'static str, msg: String) -> Self {
         InputError {
-            arg: what,
+            arg: Cow::Borrowed(what),
             msg: format!("out of memory: {msg}"),
             kind: ErrorKind::OutOfMemory,
         }
@@ -90,9 +93,8 @@ impl InputError {
     /// The same error with a prefix locating it (used for curve bundles).
     pub fn context(self, prefix: &str) -> Self {
         InputError {
-            arg: self.arg,
             msg: format!("{prefix}: {}", self.msg),
-            kind: self.kind,
+            ..self
         }
     }
 }

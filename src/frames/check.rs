@@ -10,13 +10,13 @@ use super::request::{Analytic, Method, Request, STRAIGHT_TOL};
 use super::validate;
 use crate::error::{InputError, Result};
 
-/// `tangents` must have one row per point.
-pub(super) fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
+/// `tangents` (passed as `name`) must have one row per point.
+pub(super) fn rows_match(points: &[DVec3], tangents: &[DVec3], name: &str) -> Result<()> {
     if points.len() == tangents.len() {
         return Ok(());
     }
     Err(InputError::new(
-        "tangents",
+        name.to_owned(),
         format!(
             "shape ({}, 3) does not match points ({}, 3): one tangent per point",
             tangents.len(),
@@ -30,7 +30,7 @@ pub(super) fn rows_match(points: &[DVec3], tangents: &[DVec3]) -> Result<()> {
 pub(super) fn check_input(req: &Request, out: &[f64]) -> Result<usize> {
     let rows = check_shapes(req, out)?;
     if let Some(a) = req.analytic {
-        check_analytic(&a, rows)?;
+        check_analytic(&a, rows, req.names.points)?;
     }
     check_options(req)?;
     if req.method == Method::Torsion {
@@ -90,7 +90,7 @@ fn check_torsion(req: &Request) -> Result<()> {
              object with u=...)",
         ));
     }
-    validate::finite("points", a.d3, &cancel::never)?;
+    validate::finite(req.names.points, a.d3, &cancel::never)?;
     let diag = super::geometry::scale_and_diagonal(req.points.unwrap_or(&[])).1;
     let flat = |k: usize| {
         let (d1, d2) = (a.d1[k], a.d2[k]);
@@ -120,20 +120,26 @@ fn check_shapes(req: &Request, out: &[f64]) -> Result<usize> {
     let rows = match (req.points, req.tangents) {
         (Some(p), _) => p.len(),
         (None, Some(t)) => t.len(),
-        (None, None) => return Err(InputError::new("points", "points or tangents are required")),
+        (None, None) => {
+            return Err(InputError::new(
+                req.points_arg(),
+                "points or tangents are required",
+            ));
+        }
     };
     if let (Some(p), Some(t)) = (req.points, req.tangents) {
-        rows_match(p, t)?;
+        rows_match(p, t, req.names.tangents)?;
     }
     if rows < 2 {
         return Err(InputError::new(
             if req.analytic.is_some() {
                 "u"
             } else if req.points.is_some() {
-                "points"
+                req.names.points
             } else {
-                "tangents"
-            },
+                req.names.tangents
+            }
+            .to_owned(),
             format!("need at least 2 samples, got {rows}"),
         ));
     }
@@ -141,17 +147,17 @@ fn check_shapes(req: &Request, out: &[f64]) -> Result<usize> {
         return Err(InputError::new("out", "output buffer has the wrong size"));
     }
     if let Some(p) = req.points {
-        validate::finite("points", p, &cancel::never)?;
+        validate::finite(req.names.points, p, &cancel::never)?;
     }
     if let Some(t) = req.tangents {
-        validate::finite("tangents", t, &cancel::never)?;
+        validate::finite(req.names.tangents, t, &cancel::never)?;
     }
     Ok(rows)
 }
 
 /// The analytic samples: `rows` parameter values increasing strictly, `2·rows − 1` finite
-/// derivatives of each order.
-fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
+/// derivatives of each order (of the curve passed as `points`).
+fn check_analytic(a: &Analytic, rows: usize, points: &str) -> Result<()> {
     if a.u.len() != rows || a.d1.len() != 2 * rows - 1 || a.d2.len() != 2 * rows - 1 {
         return Err(InputError::new(
             "u",
@@ -159,8 +165,8 @@ fn check_analytic(a: &Analytic, rows: usize) -> Result<()> {
         ));
     }
     validate::finite_scalars("u", a.u)?;
-    validate::finite("points", a.d1, &cancel::never)?;
-    validate::finite("points", a.d2, &cancel::never)?;
+    validate::finite(points, a.d1, &cancel::never)?;
+    validate::finite(points, a.d2, &cancel::never)?;
     if let Some(i) = a.u.windows(2).position(|w| !(w[1] > w[0])) {
         return Err(InputError::new(
             "u",
@@ -202,7 +208,7 @@ fn check_options(req: &Request) -> Result<()> {
         }
         if req.tangents.is_some() {
             return Err(InputError::new(
-                "tangents",
+                req.tangents_arg(),
                 "not used by method='bisector': its tangents are the normals of the polygon's \
                  bisector planes (use method='projection' with given tangents)",
             ));
@@ -217,7 +223,7 @@ fn check_options(req: &Request) -> Result<()> {
     }
     if req.points.is_none() && !req.tangent_chords {
         return Err(InputError::new(
-            "points",
+            req.points_arg(),
             "points are required for this method",
         ));
     }
@@ -252,7 +258,7 @@ pub(super) fn distinct_samples(req: &Request, rows: usize) -> Result<usize> {
     }
     if n < 3 {
         return Err(InputError::new(
-            "points",
+            req.points_arg(),
             format!("a closed curve needs at least 3 distinct points, got {n}"),
         ));
     }
@@ -266,9 +272,9 @@ pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()>
     let n = t.len();
     if !matches!(req.method, Method::Rk4 | Method::Rk4Phi | Method::Torsion) {
         let what = if req.tangent_chords {
-            "tangents"
+            req.names.tangents
         } else {
-            "points"
+            req.names.points
         };
         validate::aligned(t, closed, |i| dr.chord(i), what)?;
     }
@@ -279,7 +285,7 @@ pub(super) fn check_segments(req: &Request, dr: &DoubleReflection) -> Result<()>
             !(d.dot(t[(i + 1) % n]) > 1e-9 * d.length())
         }) {
             return Err(InputError::new(
-                "points",
+                req.points_arg(),
                 format!(
                     "the projection method needs each chord to cross the next normal plane; \
                      the segment from row {i} lies in it; sample more densely"

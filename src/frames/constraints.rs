@@ -221,6 +221,6 @@ mod tests {
             TwistRule::ArcLength,
             &[1.0, 2.0, 3.0],
         );
-        assert_eq!(e.map_err(|e| e.arg), Err("turns"));
+        assert_eq!(e.map_err(|e| e.arg).unwrap_err(), "turns");
     }
 }

@@ -80,7 +80,7 @@ pub(crate) fn bundle_slices<'o>(
         .or(template.tangents.map(<[DVec3]>::len))
         .unwrap_or(0);
     if let (Some(p), Some(t)) = (template.points, template.tangents) {
-        rows_match(p, t)?;
+        rows_match(p, t, template.names.tangents)?;
     }
     validate::offsets(offsets, total)?;
     if out.len() != 9 * total {
@@ -203,7 +203,7 @@ pub fn compute_general(
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords(x, closed, cancel)?
+        validate::chords(x, closed, req.names.points, cancel)?
     };
     if cancel() {
         return Ok(0.0);
@@ -253,7 +253,7 @@ fn unit_tangents(
     let t: Vec<DVec3> = if let Some(a) = req.analytic {
         if let Some(j) = a.d1.par_iter().position_first(|d| !(d.length() > 0.0)) {
             return Err(InputError::new(
-                "points",
+                req.points_arg(),
                 format!(
                     "the curve's derivative vanishes at u = {} (a singular point); frames \
                      need a regular curve",
@@ -267,13 +267,16 @@ fn unit_tangents(
         }
         let mut t: Vec<DVec3> = (0..n).map(|i| a.d1[2 * i]).collect();
         tangents::normalize_all(&mut t).map_err(|i| {
-            InputError::new("points", format!("cannot normalise the tangent at row {i}"))
+            InputError::new(
+                req.points_arg(),
+                format!("cannot normalise the tangent at row {i}"),
+            )
         })?;
         t
     } else if req.method == Method::Bisector {
         projection::bisector_tangents(x, req.closed).map_err(|i| {
             InputError::new(
-                "points",
+                req.points_arg(),
                 format!(
                     "the polygon turns back on itself at row {i} (the segments there are \
                      opposite), so the bisector plane is undefined"
@@ -284,17 +287,24 @@ fn unit_tangents(
         let mut t = tg[..n].to_vec();
         tangents::normalize_all(&mut t).map_err(|i| {
             InputError::new(
-                "tangents",
+                req.tangents_arg(),
                 format!("zero-length (or too small to normalise) tangent at row {i}"),
             )
         })?;
         t
     } else {
-        tangents::estimate(x, chords, req.closed, req.tangent_rule, cancel)?
+        tangents::estimate(
+            x,
+            chords,
+            req.closed,
+            req.tangent_rule,
+            req.names.points,
+            cancel,
+        )?
     };
     if req.tangent_chords && n < 4 {
         return Err(InputError::new(
-            "tangents",
+            req.tangents_arg(),
             format!("tangents-only double reflection needs at least 4 samples, got {n}"),
         ));
     }
@@ -546,7 +556,7 @@ pub(crate) fn rmf_parts(
     let chords = if x.is_empty() {
         Vec::new()
     } else {
-        validate::chords(x, req.closed, &cancel::never)?
+        validate::chords(x, req.closed, req.names.points, &cancel::never)?
     };
     let seg = segment_lengths(req, x, n, chords);
     if req.closed && closing != 0.0 {

@@ -54,7 +54,7 @@ pub(crate) use dispatch::{bundle_slices, rmf_parts};
 pub use dispatch::{compute_general, compute_into, compute_many};
 pub(crate) use request::resolve;
 pub use request::{
-    Analytic, FRAME_TANGENT_TOL, Method, Orientation, Request, STRAIGHT_TOL, WORKING_BYTES_PER_ROW,
-    pick,
+    Analytic, FRAME_TANGENT_TOL, Method, Names, Orientation, Request, STRAIGHT_TOL,
+    WORKING_BYTES_PER_ROW, pick,
 };
 pub use tangents::TangentRule;

@@ -61,6 +61,38 @@ pub struct Request<'a> {
     /// number, or on a closed curve without `end` also a half-integer (see
     /// [`super::check::turns`]).
     pub turns: f64,
+    /// The names the user sees for the points and the tangents, which errors about them
+    /// start with (`"points"`, `"tangents"` unless the caller passed them under other names,
+    /// e.g. the steps of a curve moving in time as `points_t`).
+    pub names: Names<'a>,
+}
+
+/// The names of a [`Request`]'s points and tangents as the user passed them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Names<'a> {
+    pub points: &'a str,
+    pub tangents: &'a str,
+}
+
+impl Default for Names<'_> {
+    fn default() -> Self {
+        Names {
+            points: "points",
+            tangents: "tangents",
+        }
+    }
+}
+
+impl Request<'_> {
+    /// The points' name, for an error about them.
+    pub(crate) fn points_arg(&self) -> String {
+        self.names.points.to_owned()
+    }
+
+    /// The tangents' name, for an error about them.
+    pub(crate) fn tangents_arg(&self) -> String {
+        self.names.tangents.to_owned()
+    }
 }
 
 impl Default for Request<'_> {
@@ -76,6 +108,7 @@ impl Default for Request<'_> {
             initial: None,
             end: None,
             turns: 0.0,
+            names: Names::default(),
         }
     }
 }

@@ -128,7 +128,7 @@ mod tests {
     /// Every group's rows against the scalar function, bit for bit; returns (groups taken
     /// four at a time, groups left to the scalar function).
     fn compare(x: &[DVec3]) -> (usize, usize) {
-        let h = crate::frames::validate::chords(x, false, &cancel::never).unwrap();
+        let h = crate::frames::validate::chords(x, false, "points", &cancel::never).unwrap();
         let (mut fast, mut slow) = (0, 0);
         for g in (0..x.len()).step_by(L) {
             let Some(g) = group_of(g, x.len()) else {

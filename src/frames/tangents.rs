@@ -264,9 +264,9 @@ fn circle_raw(x: &[DVec3], i: usize, closed: bool) -> DVec3 {
     b.length_squared() * a + a.length_squared() * b
 }
 
-fn cusp_error(i: usize) -> InputError {
+fn cusp_error(i: usize, name: &str) -> InputError {
     InputError::new(
-        "points",
+        name.to_owned(),
         format!(
             "cannot estimate a tangent at row {i}: the neighbouring points cancel (the curve \
              reverses on itself there, a cusp); sample the curve more densely or pass `tangents`"
@@ -285,6 +285,8 @@ const CANCEL_SEGMENT: usize = 1 << 20;
 ///
 /// `chords[i] = |x_{i+1} − x_i|` (mod n when closed), as returned by `validate::chords`.
 ///
+/// Errors name the points `name` (the argument the user passed them as).
+///
 /// Polls `cancel` before every segment of [`CANCEL_SEGMENT`] rows and returns the rows done so far
 /// once it says stop (see [`crate::run::cancel`]).
 pub fn estimate(
@@ -292,13 +294,14 @@ pub fn estimate(
     chords: &[f64],
     closed: bool,
     rule: TangentRule,
+    name: &str,
     cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<DVec3>> {
     let n = x.len();
     let min = if closed { 3 } else { 2 };
     if n < min {
         return Err(InputError::new(
-            "points",
+            name.to_owned(),
             format!(
                 "need at least {min} points to estimate tangents{}, got {n}",
                 if closed { " of a closed curve" } else { "" }
@@ -383,7 +386,7 @@ pub fn estimate(
         }
     }
     match first_zero(&t) {
-        Some(i) => Err(cusp_error(i)),
+        Some(i) => Err(cusp_error(i, name)),
         None => Ok(t),
     }
 }
@@ -711,11 +714,11 @@ pub fn estimate_rows(
     if cancel() {
         return Ok(Vec::new());
     }
-    let chords = crate::frames::validate::chords(&x[..n], closed, cancel)?;
+    let chords = crate::frames::validate::chords(&x[..n], closed, "points", cancel)?;
     if cancel() {
         return Ok(Vec::new());
     }
-    let mut t = estimate(&x[..n], &chords, closed, rule, cancel)?;
+    let mut t = estimate(&x[..n], &chords, closed, rule, "points", cancel)?;
     if cancel() {
         return Ok(t);
     }

@@ -148,7 +148,7 @@ pub fn frames_in_time(
         .unwrap_or(0);
     if total != steps * rows || out.len() != 9 * total {
         return Err(InputError::new(
-            "points",
+            template.points_arg(),
             format!("expected {steps} time steps of {rows} samples, got {total} rows"),
         ));
     }

@@ -44,15 +44,11 @@ pub(crate) fn first_bad<T: Sync>(
 }
 
 /// Polls `cancel` before every block ([`first_bad`]).
-pub fn finite(
-    arg: &'static str,
-    v: &[DVec3],
-    cancel: crate::run::cancel::Cancel<'_>,
-) -> Result<()> {
+pub fn finite(arg: &str, v: &[DVec3], cancel: crate::run::cancel::Cancel<'_>) -> Result<()> {
     match first_bad(v, |p| p.is_finite(), cancel) {
         None => Ok(()),
         Some(i) => Err(InputError::new(
-            arg,
+            arg.to_owned(),
             format!("non-finite value ({}) at row {i}", describe(v[i])),
         )),
     }
@@ -103,7 +99,7 @@ pub fn repeated(a: DVec3, b: DVec3, floor: f64) -> bool {
 const CHORD_SEGMENT: usize = 1 << 20;
 
 /// Chord lengths `|x_{i+1} − x_i|` (and `|x_0 − x_{n−1}|` when `closed`), refusing repeated
-/// consecutive points ([`repeated`]).
+/// consecutive points ([`repeated`]) of the points passed as `name`.
 ///
 /// Polls `cancel` before every segment of [`CHORD_SEGMENT`] chords and every block of the check for
 /// repeated points, and returns the chords done so far once it says stop (see
@@ -112,6 +108,7 @@ const CHORD_SEGMENT: usize = 1 << 20;
 pub fn chords(
     x: &[DVec3],
     closed: bool,
+    name: &str,
     cancel: crate::run::cancel::Cancel<'_>,
 ) -> Result<Vec<f64>> {
     let n = x.len();
@@ -146,7 +143,7 @@ pub fn chords(
     match bad {
         None => Ok(seg),
         Some(i) => Err(InputError::new(
-            "points",
+            name.to_owned(),
             format!(
                 "rows {i} and {} coincide (a zero-length segment); remove repeated \
                  consecutive points",
@@ -259,7 +256,7 @@ pub fn aligned(
     t: &[DVec3],
     closed: bool,
     chord: impl Fn(usize) -> DVec3 + Sync,
-    what: &'static str,
+    what: &str,
 ) -> Result<()> {
     let n = t.len();
     let m = if closed { n } else { n - 1 };
@@ -274,7 +271,7 @@ pub fn aligned(
     match bad {
         None => Ok(()),
         Some(i) => Err(InputError::new(
-            what,
+            what.to_owned(),
             format!(
                 "the segment from row {i} to row {} runs against its tangents (the curve \
                  reverses there, a cusp, or the tangents point backwards; they turn by \
@@ -368,8 +365,13 @@ mod tests {
         );
         // the kept rows pass the chord check the frames and sweeps make
         let kept: Vec<DVec3> = (0..7).filter(|&j| into[j] == j).map(|j| x[j]).collect();
-        assert!(chords(&kept, false, &cancel::never).is_ok());
-        assert!(chords(&x[..7], false, &cancel::never).unwrap_err().kind == ErrorKind::Repeated);
+        assert!(chords(&kept, false, "points", &cancel::never).is_ok());
+        assert!(
+            chords(&x[..7], false, "points", &cancel::never)
+                .unwrap_err()
+                .kind
+                == ErrorKind::Repeated
+        );
         // closed: a last row that repeats the first joins it; a triangle with a repeat has
         // too few distinct points
         let tri = [
@@ -391,7 +393,7 @@ mod tests {
         let (into, _) =
             distinct_rows(&jit, &[0, 5], true, &crate::run::cancel::never).expect("valid offsets");
         assert_eq!(into, [0, 1, 2, 0, 0]);
-        assert!(chords(&jit[..3], true, &cancel::never).is_ok());
+        assert!(chords(&jit[..3], true, "points", &cancel::never).is_ok());
         let (_, status) = distinct_rows(&tri[..3], &[0, 3], true, &crate::run::cancel::never)
             .expect("valid offsets");
         assert_eq!(status, [CurveStatus::TooFew]);

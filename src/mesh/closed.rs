@@ -210,7 +210,7 @@ pub(crate) mod tests {
         mixed[0] = [f[0][0], f[0][2], f[0][1]];
         let e = closed_volume_centroid(&v, &mixed, &cancel::never).unwrap_err();
         assert_eq!(
-            (e.arg, e.msg.as_str()),
+            (&*e.arg, e.msg.as_str()),
             ("mesh", "faces are not consistently oriented")
         );
         let e = closed_volume_centroid(&v, &[[0, 1, 9]], &cancel::never).unwrap_err();

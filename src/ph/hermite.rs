@@ -425,7 +425,7 @@ mod tests {
             &cancel::never,
         )
         .unwrap_err();
-        assert_eq!((e.arg, e.msg.as_str()), ("t0", "zero tangent vector"));
+        assert_eq!((&*e.arg, e.msg.as_str()), ("t0", "zero tangent vector"));
         let e = hermite_rows(
             &[DVec3::X],
             &[],

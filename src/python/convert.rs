@@ -253,20 +253,6 @@ impl<'a> Ticker<'a> {
     }
 }
 
-/// The error as a `ValueError` naming `to` where the core named its argument `from` (a
-/// routine that serves several Python arguments, e.g. the frames of a rest and a posed spine).
-pub fn renamed(e: InputError, from: &str, to: &str) -> PyErr {
-    if e.arg == from && matches!(e.kind, ErrorKind::Invalid | ErrorKind::Repeated) {
-        let msg = format!("{to}: {}", e.msg);
-        match e.kind {
-            ErrorKind::Repeated => RepeatedPointsError::new_err(msg),
-            _ => PyValueError::new_err(msg),
-        }
-    } else {
-        e.into()
-    }
-}
-
 /// A `ValueError` with the given message.
 pub fn value_error(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())

@@ -10,11 +10,11 @@ use pyo3::prelude::*;
 
 use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, offsets_of,
-    orientations, renamed, slice_mut, slice_of, value_error, vec3_array, vec3s,
+    orientations, slice_mut, slice_of, value_error, vec3_array, vec3s,
 };
 use super::options::Options;
 use super::out::{output, writing};
-use crate::frames::{self, Analytic, Method, Orientation, Request, TangentRule};
+use crate::frames::{self, Analytic, Method, Names, Orientation, Request, TangentRule};
 
 /// Bytes a row checked free before a frames call: the output (72) and the working vectors
 /// ([`frames::WORKING_BYTES_PER_ROW`], measured).
@@ -66,8 +66,13 @@ impl<'py> Shape<'py> {
     }
 
     /// A request of these settings for sampled `points` and/or `tangents`, turning by
-    /// `turns` (no analytic curve, start or end yet).
-    fn request<'a>(&self, (points, tangents): Curves<'a>, turns: f64) -> Request<'a> {
+    /// `turns` (no analytic curve, start or end yet), with errors about them naming `names`.
+    fn request<'a>(
+        &self,
+        (points, tangents): Curves<'a>,
+        turns: f64,
+        names: Names<'a>,
+    ) -> Request<'a> {
         Request {
             points,
             tangents,
@@ -79,6 +84,7 @@ impl<'py> Shape<'py> {
             initial: None,
             end: None,
             turns,
+            names,
         }
     }
 }
@@ -140,7 +146,11 @@ pub fn frames_sampled<'py>(
     let offsets = offsets_of(&offsets)?;
     let initial = shape.initial()?;
     let end = shape.end()?;
-    let template = shape.request(given, turns);
+    let names = Names {
+        points: &points_arg,
+        ..Names::default()
+    };
+    let template = shape.request(given, turns, names);
     // the output and the working vectors of the frames
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = output::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3], out, "out")?;
@@ -153,8 +163,7 @@ pub fn frames_sampled<'py>(
         detach_reporting(py, &stop, report.as_ref(), || {
             let cancel = || stop.requested();
             frames::compute_many(&template, &offsets, &initial, &end, buf, &cancel, done)
-        })?
-        .map_err(|e| renamed(e, "points", &points_arg))?
+        })??
     };
     Ok((out, PyArray1::from_vec(py, angles)))
 }
@@ -186,7 +195,7 @@ pub fn frames_analytic<'py>(
         // the tangents are the exact derivatives: no estimate
         tangent_chords: false,
         tangent_rule: Request::default().tangent_rule,
-        ..shape.request((Some(pts), None), turns)
+        ..shape.request((Some(pts), None), turns, Names::default())
     };
     // the output and the working vectors of the frames' scan
     ensure_memory("frames", pts.len(), PROBE_BYTES_PER_ROW)?;
@@ -365,7 +374,11 @@ pub fn frames_steered<'py>(
             }
         })
         .collect();
-    let template = shape.request(given, 0.0);
+    let names = Names {
+        points: &points_arg,
+        ..Names::default()
+    };
+    let template = shape.request(given, 0.0, names);
     // the output, the rotation-minimising frames, the tangents and the twist solve
     ensure_memory("frames", rows, PROBE_BYTES_PER_ROW)?;
     let out = empty::<f64, numpy::Ix3>(py, "frames", &[rows, 3, 3])?;
@@ -391,8 +404,7 @@ pub fn frames_steered<'py>(
                 steer::compute_steered_many(
                     &template, &offsets, &initial, &end, &steering, buf, &cancel,
                 )
-            })?
-            .map_err(|e| renamed(e, "points", &points_arg))?;
+            })??;
         }
     }
     Ok(out)
@@ -426,7 +438,11 @@ pub fn frames_in_time<'py>(
         .as_ref()
         .map(|p| super::convert::frames_of("previous", p))
         .transpose()?;
-    let template = shape.request(given, turns);
+    let names = Names {
+        points: "points_t",
+        tangents: "tangents_t",
+    };
+    let template = shape.request(given, turns, names);
     // the output and every step's working vectors (the steps run in parallel, but each holds
     // its rows' share only)
     ensure_memory("frames", total, PROBE_BYTES_PER_ROW)?;
@@ -448,11 +464,7 @@ pub fn frames_in_time<'py>(
                 &|| stop.requested(),
                 done,
             )
-        })?
-        .map_err(|e| match e.arg {
-            "tangents" => renamed(e, "tangents", "tangents_t"),
-            _ => renamed(e, "points", "points_t"),
-        })?;
+        })??;
     }
     Ok(out)
 }

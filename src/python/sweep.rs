@@ -7,7 +7,7 @@ use pyo3::types::PySlice;
 
 use super::convert::{
     Report, Stop, detach_reporting, detach_stoppable, empty, ensure_memory, frames_of, offsets_of,
-    renamed, slice_mut, slice_of, vec2s, vec3s,
+    slice_mut, slice_of, vec2s, vec3s,
 };
 use super::options::Options as Request;
 use super::out::{output, writing};
@@ -116,22 +116,21 @@ pub fn sweep_mesh<'py>(
         split_seams,
         join,
         turns,
+        scale_name: &scale_arg,
     };
-    let rename = |e| renamed(e, "scale", &scale_arg);
     let stop = Stop::default();
     let prep = detach_stoppable(py, &stop, || {
         let cancel = || stop.requested();
         Prepared::new(spine, &offsets, prof, profile_closed, opts, source, &cancel)
     })?
     // stopped only when a signal handler raised, whose error detach_stoppable returned
-    .map_err(rename)?;
+    ?;
     // int32 faces only where every index fits
     let index32 = index32 && prep.layout.indices_fit_i32();
     let job = Job {
         prep: &prep,
         normals,
         uv,
-        scale_arg: &scale_arg,
         report: Report::new(progress, offsets.last().copied().unwrap_or(0)),
         out: [out_vertices, out_normals, out_uv],
     };
@@ -148,7 +147,6 @@ struct Job<'a, 'py> {
     prep: &'a Prepared<'a>,
     normals: bool,
     uv: bool,
-    scale_arg: &'a str,
     /// The spine rows swept, reported to the caller's `progress(done, total)`.
     report: Option<Report>,
     /// The caller's arrays for the vertices, normals and uv, where given.
@@ -205,8 +203,7 @@ impl<'py> Job<'_, 'py> {
             let done = Report::counter(&self.report);
             detach_reporting(py, &stop, self.report.as_ref(), || {
                 self.prep.write_into(out, &|| stop.requested(), done)
-            })?
-            .map_err(|e| renamed(e, "scale", self.scale_arg))?
+            })??
         };
         let written = folds;
         let as_i64 = |a: &[usize]| a.iter().map(|&i| i as i64).collect::<Vec<i64>>();

@@ -211,7 +211,7 @@ mod tests {
         (0..5).map(|i| DVec3::new(f64::from(i), 0.0, 0.0)).collect()
     }
 
-    fn arg(r: Result<Inputs>) -> &'static str {
+    fn arg(r: Result<Inputs>) -> std::borrow::Cow<'static, str> {
         r.expect_err("an input error").arg
     }
 

@@ -561,7 +561,10 @@ mod tests {
     fn a_mesh_without_faces_is_refused() {
         let (v, _) = cube();
         let e = Walker::new(&v, &[]).err().expect("no faces");
-        assert_eq!((e.arg, e.msg.as_str()), ("faces", "the mesh has no faces"));
+        assert_eq!(
+            (&*e.arg, e.msg.as_str()),
+            ("faces", "the mesh has no faces")
+        );
     }
 
     /// A regular tetrahedron around the origin, faces wound outwards.

@@ -188,6 +188,7 @@ fn sweep_stops_anywhere() {
         split_seams: true,
         join: crate::sweep::Join::Round,
         turns: 0.0,
+        scale_name: "scale",
     };
     let profile = [DVec2::X, DVec2::Y, -DVec2::X, -DVec2::Y];
     // near unit size, and far from it (the set-up scales the input first)
@@ -303,6 +304,7 @@ fn non_convex_profile_sweep_stops_anywhere() {
         split_seams: true,
         join: crate::sweep::Join::Round,
         turns: 0.0,
+        scale_name: "scale",
     };
     let spine = Spine {
         points: &x,

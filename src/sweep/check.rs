@@ -35,7 +35,7 @@ pub(super) fn check_spine(
     }
     if s.scale.len() != n && s.scale.len() != 1 {
         return Err(InputError::new(
-            "scale",
+            opts.scale_name.to_owned(),
             format!("has {} rows but points has {n}", s.scale.len()),
         ));
     }
@@ -61,7 +61,7 @@ pub(super) fn check_spine(
             ),
         ));
     }
-    let chords = validate::chords(&s.points[..rings], opts.closed, cancel)?;
+    let chords = validate::chords(&s.points[..rings], opts.closed, "points", cancel)?;
     if cancel() {
         return Ok(None);
     }
@@ -120,7 +120,7 @@ pub(super) fn check_spine(
     let positive = |v: &DVec2| v.x > 0.0 && v.y > 0.0 && v.is_finite();
     if let Some(i) = validate::first_bad(s.scale, positive, cancel) {
         return Err(InputError::new(
-            "scale",
+            opts.scale_name.to_owned(),
             format!(
                 "must be positive and finite, got {} at row {i} (for a pointed end use a \
                  small positive value)",

@@ -99,7 +99,7 @@ pub struct Spine<'a> {
 
 /// Options shared by all spines of a sweep.
 #[derive(Debug, Clone, Copy)]
-pub struct Options {
+pub struct Options<'a> {
     pub closed: bool,
     pub caps: bool,
     pub miter_limit: f64,
@@ -111,6 +111,9 @@ pub struct Options {
     /// twist); a half number joins the seam with a half turn ([`seam`]; with given frames,
     /// it says they close up to a half turn).
     pub turns: f64,
+    /// The scale's name as the user passed it (`"scale"`, `"radius"` for a tube), which
+    /// errors about it start with.
+    pub scale_name: &'a str,
 }
 
 /// A triangle mesh.

@@ -236,7 +236,7 @@ struct Sweep<'s> {
     points: &'s [DVec3],
     frames: FrameSource<'s>,
     offsets: &'s [usize],
-    opts: &'s Options,
+    opts: &'s Options<'s>,
     layout: &'s Layout,
     sh: Shared<'s>,
     /// See [`unscaled`].
@@ -338,7 +338,7 @@ impl Sweep<'_> {
             return Err(e);
         }
         if let Some(i) = bad {
-            return Err(out_of_range::<R>(i));
+            return Err(out_of_range::<R>(i, self.opts.scale_name));
         }
         let mut w = Written {
             folds: Vec::new(),
@@ -518,7 +518,7 @@ pub struct Prepared<'a> {
     offsets: &'a [usize],
     scaled: Option<Scaled>,
     profile: Profile,
-    opts: Options,
+    opts: Options<'a>,
     frames: FrameSource<'a>,
     pub layout: Layout,
 }
@@ -537,7 +537,7 @@ impl<'a> Prepared<'a> {
         offsets: &'a [usize],
         profile: &[DVec2],
         profile_closed: bool,
-        opts: Options,
+        opts: Options<'a>,
         frames: FrameSource<'a>,
         cancel: Cancel<'_>,
     ) -> Result<Prepared<'a>> {

@@ -111,10 +111,10 @@ pub(super) fn unscaled<R: Real>(x: f64, k: Option<i32>) -> R {
 }
 
 /// The error for swept vertex `i` beyond the range of the output type (float64, or float32
-/// with `dtype=float32`); named by the profile's `scale`.
-pub(super) fn out_of_range<R>(i: usize) -> InputError {
+/// with `dtype=float32`); named by the profile's scale, passed as `scale_name`.
+pub(super) fn out_of_range<R>(i: usize, scale_name: &str) -> InputError {
     InputError::new(
-        "scale",
+        scale_name.to_owned(),
         format!(
             "the swept vertex {i} (spine point + frame · scale · profile) is out of the \
              representable range of the output dtype (float{}); reduce the profile, its \

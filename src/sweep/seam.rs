@@ -157,16 +157,16 @@ mod tests {
         assert_eq!(shift(&p, true, 2.0).ok(), Some(0));
         assert_eq!(shift(&p, true, 0.5).ok(), Some(6));
         assert_eq!(shift(&p, true, -1.5).ok(), Some(6));
-        let arg = |r: Result<usize>| r.err().map(|e| e.arg);
-        assert_eq!(arg(shift(&p, true, 0.25)), Some("turns"));
-        assert_eq!(arg(shift(&p, false, 0.5)), Some("turns"));
+        let arg = |r: Result<usize>| r.err().map(|e| e.arg.into_owned());
+        assert_eq!(arg(shift(&p, true, 0.25)), Some("turns".to_string()));
+        assert_eq!(arg(shift(&p, false, 0.5)), Some("turns".to_string()));
         assert_eq!(
             arg(shift(&polygon(12, 1.0, 0.4, 0.1), true, 0.5)),
-            Some("profile")
+            Some("profile".to_string())
         );
         assert_eq!(
             arg(shift(&polygon(11, 1.0, 0.4, 0.0), true, 0.5)),
-            Some("profile")
+            Some("profile".to_string())
         );
     }
 
@@ -180,6 +180,6 @@ mod tests {
         assert!(check_given(&[frame(0.0), frame(3.0)], 2).is_ok());
         assert!(check_given(&[frame(0.0), frame(-2.0)], 2).is_ok());
         let e = check_given(&[frame(0.0), frame(0.3)], 2).err();
-        assert_eq!(e.map(|e| e.arg), Some("frames"));
+        assert_eq!(e.map(|e| e.arg.into_owned()), Some("frames".to_string()));
     }
 }

@@ -52,7 +52,7 @@ fn star() -> Vec<DVec2> {
         .collect()
 }
 
-fn options(closed: bool, caps: bool, split_seams: bool) -> Options {
+fn options(closed: bool, caps: bool, split_seams: bool) -> Options<'static> {
     Options {
         closed,
         caps,
@@ -60,6 +60,7 @@ fn options(closed: bool, caps: bool, split_seams: bool) -> Options {
         split_seams,
         join: crate::sweep::Join::Round,
         turns: 0.0,
+        scale_name: "scale",
     }
 }
 

@@ -4,7 +4,7 @@
 use super::*;
 
 fn ch(x: &[DVec3]) -> Vec<f64> {
-    crate::frames::validate::chords(x, false, &cancel::never).unwrap()
+    crate::frames::validate::chords(x, false, "points", &cancel::never).unwrap()
 }
 
 fn helix(u: f64) -> DVec3 {
@@ -19,7 +19,15 @@ fn five_point_is_fourth_order() {
     let err = |n: usize| {
         let h = 3.0 / n as f64;
         let x: Vec<DVec3> = (0..=n).map(|i| helix(i as f64 * h)).collect();
-        let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+        let t = estimate(
+            &x,
+            &ch(&x),
+            false,
+            TangentRule::FivePoint,
+            "points",
+            &cancel::never,
+        )
+        .unwrap();
         (0..=n)
             .map(|i| (t[i] - helix_t(i as f64 * h)).length())
             .fold(0.0, f64::max)
@@ -70,7 +78,15 @@ fn circle_rule_exact_on_circle() {
         .iter()
         .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
         .collect();
-    let t = estimate(&x, &ch(&x), false, TangentRule::Circle, &cancel::never).unwrap();
+    let t = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::Circle,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     for (i, &u) in u.iter().enumerate() {
         let e = DVec3::new(-u.sin(), u.cos(), 0.0);
         assert!((t[i] - e).length() < 1e-14, "{i}");
@@ -81,7 +97,15 @@ fn circle_rule_exact_on_circle() {
         .iter()
         .map(|&u| DVec3::new(u.cos(), u.sin(), 0.0))
         .collect();
-    let t = estimate(&x, &ch(&x), false, TangentRule::Circle, &cancel::never).unwrap();
+    let t = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::Circle,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     let b = ((x[1] - x[0]).normalize() + (x[2] - x[1]).normalize()).normalize();
     assert!(
         (t[1] - b).length() < 1e-15
@@ -97,7 +121,15 @@ fn chord_rule_exact_on_lines_and_uniform_rule_on_equal_chords() {
         .iter()
         .map(|&v| DVec3::new(1.0, 2.0, 3.0) + v * d)
         .collect();
-    let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+    let t = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::FivePoint,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     for ti in &t {
         assert!((*ti - d).length() < 1e-9, "{ti}");
     }
@@ -108,12 +140,21 @@ fn chord_rule_exact_on_lines_and_uniform_rule_on_equal_chords() {
             DVec3::new(a.cos(), a.sin(), 0.0)
         })
         .collect();
-    let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+    let a = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::FivePoint,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     let b = estimate(
         &x,
         &ch(&x),
         false,
         TangentRule::FivePointUniform,
+        "points",
         &cancel::never,
     )
     .unwrap();
@@ -242,12 +283,21 @@ fn bounded_ends_stay_in_the_cone_and_keep_the_order() {
     .iter()
     .map(|&p| DVec3::from_array(p))
     .collect();
-    let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+    let a = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::FivePoint,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     let b = estimate(
         &x,
         &ch(&x),
         false,
         TangentRule::FivePointBounded,
+        "points",
         &cancel::never,
     )
     .unwrap();
@@ -286,12 +336,21 @@ fn bounded_ends_stay_in_the_cone_and_keep_the_order() {
     }
     // fine samplings: the bound never acts
     let x: Vec<DVec3> = (0..=200).map(|i| helix(i as f64 * 0.015)).collect();
-    let a = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+    let a = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::FivePoint,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     let b = estimate(
         &x,
         &ch(&x),
         false,
         TangentRule::FivePointBounded,
+        "points",
         &cancel::never,
     )
     .unwrap();
@@ -411,7 +470,15 @@ fn jagged_polylines_get_tangents_along_their_chords() {
                     let d = DVec3::new(r() + r(), r() + r(), r() + r());
                     x.push(*x.last().unwrap() + d);
                 }
-                let t = estimate(&x, &ch_closed(&x, closed), closed, rule, &cancel::never).unwrap();
+                let t = estimate(
+                    &x,
+                    &ch_closed(&x, closed),
+                    closed,
+                    rule,
+                    "points",
+                    &cancel::never,
+                )
+                .unwrap();
                 let m = if closed { n } else { n - 1 };
                 // the unbounded rules leave their end tangents as the quartic gives them
                 let unbounded =
@@ -436,7 +503,7 @@ fn jagged_polylines_get_tangents_along_their_chords() {
 }
 
 fn ch_closed(x: &[DVec3], closed: bool) -> Vec<f64> {
-    crate::frames::validate::chords(x, closed, &cancel::never).unwrap()
+    crate::frames::validate::chords(x, closed, "points", &cancel::never).unwrap()
 }
 
 #[test]
@@ -448,6 +515,7 @@ fn exact_reversals_get_a_tangent_normal_to_the_chord() {
         &ch(&x),
         false,
         TangentRule::FivePointBounded,
+        "points",
         &cancel::never,
     )
     .unwrap();
@@ -470,6 +538,7 @@ fn exact_reversals_get_a_tangent_normal_to_the_chord() {
             &ch(&x),
             false,
             TangentRule::FivePointBounded,
+            "points",
             &cancel::never,
         )
         .unwrap()[2]
@@ -485,7 +554,15 @@ fn exact_reversals_get_a_tangent_normal_to_the_chord() {
     assert!(near.z == 0.0 && near.y > 0.0, "{near}");
     // two reversals in a row leave a segment with no forward tangent: refused
     let x = [DVec3::ZERO, DVec3::X, DVec3::ZERO, DVec3::X];
-    let t = estimate(&x, &ch(&x), false, TangentRule::FivePoint, &cancel::never).unwrap();
+    let t = estimate(
+        &x,
+        &ch(&x),
+        false,
+        TangentRule::FivePoint,
+        "points",
+        &cancel::never,
+    )
+    .unwrap();
     let c = x[2] - x[1];
     assert!(c.dot(t[1] + t[2]) <= 1e-6);
 }
