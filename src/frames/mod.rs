@@ -27,6 +27,7 @@
 
 pub mod constraints;
 pub mod double_reflection;
+pub mod end_cone;
 pub mod frenet;
 pub mod fused;
 pub mod geometry;

@@ -88,6 +88,10 @@ pub fn group_of(i: usize, n: usize) -> Option<usize> {
 /// relative to the bisector's (see [`guard_chords`](super::tangents::guard_chords)).
 pub const CHORD_MARGIN: f64 = 0.5;
 
+/// Cosine of the turn between two chords below which an estimate is left alone (30°), and
+/// of the turn from which the bisector replaces it (60°); see [`guard_chords`](super::tangents::guard_chords).
+pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
+
 /// `cos² 30° = 3/4`, for [`guard_chords`](super::tangents::guard_chords)' test without square roots.
 pub const CORNER_COS2: f64 = 0.75;
 

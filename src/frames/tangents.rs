@@ -58,9 +58,10 @@
 //!   its mirror (a choice of ours: the paper omits the two end vectors; these weights keep
 //!   the 4th order). Needs 4 tangents.
 
+pub use super::end_cone::{END_CONE_COS, END_HALF_COS, bound_end};
 use super::tangent_lanes;
 use super::tangent_lanes::centred_weights;
-pub use super::tangent_lanes::{CHORD_MARGIN, CORNER_COS2, OVERSHOOT_COS};
+pub use super::tangent_lanes::{CHORD_MARGIN, CORNER_COS, CORNER_COS2, OVERSHOOT_COS};
 use crate::run::cancel;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -407,77 +408,6 @@ pub fn five_point_unit_open(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64) -> 
     })
 }
 
-/// Cosine of the widest end cone of [`bound_end`], 45°.
-pub const END_CONE_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
-
-/// Cosines of the end turns `φ` between which [`bound_end`]'s cone narrows from the whole
-/// turn (fine samplings, up to 10°) to half the turn (coarse ones, from 20° on).
-pub const END_HALF_COS: [f64; 2] = [0.984_807_753_012_208, 0.939_692_620_785_908_4];
-
-/// The end tangent `u` at the open end `i` (0 or n − 1, `n ≥ 3`), turned towards the end
-/// chord `ĉ` onto the cone about it where it leans further; unchanged inside the cone. With
-/// `φ = ∠(ĉ, p̂)` the turn of the end chords (`p̂` the neighbouring chord), the cone's
-/// half-angle is `φ` up to `φ = 10°`, `φ/2` from 20° on, `φ·(1 − w/2)` between (`w` the
-/// smoothstep from 10° to 20°), and at most 45°. A smooth curve's end leans `κh/2 + O(h²)`,
-/// inside the whole-turn cone of fine samplings; coarse samplings end within half their
-/// last turn, so the end faces of their tubes stay close to square to the end chord. Where
-/// the end chords turn by more than 30° (a corner of the polyline, as [`guard_chords`] has
-/// it) the result is then blended towards `ĉ` with the same smoothstep weight, `ĉ` itself
-/// from 60° on: the end of a coarse polyline is cut square to its last chord.
-#[inline]
-pub fn bound_end(x: &[DVec3], i: usize, u: DVec3) -> DVec3 {
-    let n = x.len();
-    let (c, p) = if i == 0 {
-        (x[1] - x[0], x[2] - x[1])
-    } else {
-        (x[n - 1] - x[n - 2], x[n - 2] - x[n - 3])
-    };
-    let (Some(c), Some(p)) = (c.try_normalize(), p.try_normalize()) else {
-        return u;
-    };
-    let d = c.dot(p);
-    let (cos_a, sin_a) = end_cone(d, c.cross(p).length());
-    let u = if u.dot(c) >= cos_a {
-        u
-    } else {
-        // the direction of the lean in the normal plane of ĉ; for a tangent along −ĉ, the
-        // turn of the chords continued (away from p̂), or any normal on a straight end
-        let side = (u - u.dot(c) * c)
-            .try_normalize()
-            .or_else(|| (c * d - p).try_normalize())
-            .unwrap_or_else(|| super::geometry::any_perpendicular(c));
-        (cos_a * c + sin_a * side).normalize_or(c)
-    };
-    // a corner next to the end (a turn over 30°): towards the end chord, as the chord guard
-    // turns interior tangents towards the bisector, fully from 60° on
-    let s = ((CORNER_COS[0] - d) / (CORNER_COS[0] - CORNER_COS[1])).clamp(0.0, 1.0);
-    if s > 0.0 {
-        let w = s * s * (3.0 - 2.0 * s);
-        ((1.0 - w) * u + w * c).normalize_or(c)
-    } else {
-        u
-    }
-}
-
-/// Cosine and sine of [`bound_end`]'s cone half-angle for end chords turning by `φ`, given
-/// as `cos φ` and `sin φ`: `φ` itself (the same values, bit for bit) up to 10°, `φ/2` from
-/// 20° on with a smoothstep between, at most 45°.
-#[inline]
-fn end_cone(cos_phi: f64, sin_phi: f64) -> (f64, f64) {
-    if cos_phi >= END_HALF_COS[0] {
-        return (cos_phi, sin_phi);
-    }
-    let phi = sin_phi.atan2(cos_phi);
-    let (lo, hi) = (END_HALF_COS[0].acos(), END_HALF_COS[1].acos());
-    let s = ((phi - lo) / (hi - lo)).clamp(0.0, 1.0);
-    let half = phi * (1.0 - 0.5 * s * s * (3.0 - 2.0 * s));
-    if half >= std::f64::consts::FRAC_PI_4 {
-        (END_CONE_COS, END_CONE_COS)
-    } else {
-        (half.cos(), half.sin())
-    }
-}
-
 /// The guarded five-point chord-length tangent of [`TangentRule::FivePoint`] at `i` of an
 /// open curve (`n ≥ 5`), ends unbounded; see [`five_point_unit_open`].
 #[inline(always)]
@@ -513,10 +443,6 @@ pub fn five_point_unit_unbounded(x: &[DVec3], i: usize, h: impl Fn(usize) -> f64
 /// `|p̂ + q̂| = 2 cos(φ/2)` at or below which two unit chords reverse (a turn within 10⁻⁶ rad
 /// of 180°): their bisector would be rounding noise (see [`guard_chords`]).
 const REVERSAL: f64 = 1e-6;
-
-/// Cosine of the turn between two chords below which an estimate is left alone (30°), and
-/// of the turn from which the bisector replaces it (60°); see [`guard_chords`].
-pub const CORNER_COS: [f64; 2] = [0.866_025_403_784_438_6, 0.5];
 
 /// The unit tangent `u` estimated at a sample between the chords `c_in = x_i − x_{i−1}` and
 /// `c_out = x_{i+1} − x_i`, turned towards their bisector where the polyline turns sharply
