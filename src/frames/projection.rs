@@ -25,7 +25,7 @@ pub fn projection_step(d: DVec3, t1: DVec3, r: DVec3) -> DVec3 {
     // `ε|r|` along `t1` on a short `p`: once more along `d` (a no-op in exact arithmetic), so
     // the frame stays orthonormal to rounding
     let res = p.dot(t1);
-    if res.abs() > 1e-12 * p.length() {
+    if res * res > 1e-24 * p.length_squared() {
         p -= (res / dt) * d;
     }
     // p = 0 would need r ∥ d ⟂ t1 as well as r ⟂ t0: excluded by the chord check; keep r
